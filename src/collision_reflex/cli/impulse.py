@@ -1,0 +1,172 @@
+"""``crx impulse``: the 1D collision reflex for parameters given on the command line."""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from ..impulse import (
+    REACTION_MODES,
+    collision_times,
+    minimum_impulse,
+    optimal_velocity,
+    phase_impulses,
+    series_stiffness,
+)
+from ._args import non_negative_float, positive_float, value_range
+
+# Defaults: the paper's direct-drive U8 actuator in its soft setting (one-shot fit, tab:one_shot), against
+# the ATI Mini40 sensor's stiffness.
+_DEFAULTS = {"m_f": 0.1, "k_m": 2e7, "k_s": 440.0, "F_s": 3.0, "a": 4.7e-5, "v0": 0.1}
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "impulse",
+        help="phase impulses, total, v* and I* of a 1D collision",
+        description=(
+            "Collision reflex of a finger-spring-robot system hitting a rigid constraint: impulse of the "
+            "impact, sensing and reaction phases, their total, the optimal approach velocity v* and the "
+            "minimum impulse I*. Defaults are the paper's direct-drive U8 actuator (soft setting, tab:one_shot) "
+            "against a force sensor of stiffness 2e7 N/m."
+        ),
+    )
+    add = parser.add_argument
+    add(
+        "--finger-mass",
+        dest="m_f",
+        type=positive_float,
+        default=_DEFAULTS["m_f"],
+        metavar="KG",
+        help="finger (sprung) mass m_f [kg] (default %(default)s)",
+    )
+    add(
+        "--mech-stiffness",
+        dest="k_m",
+        type=positive_float,
+        default=_DEFAULTS["k_m"],
+        metavar="N/M",
+        help="mechanical stiffness k_m, the spring left during the reaction [N/m] (default %(default)g)",
+    )
+    add(
+        "--soft-stiffness",
+        dest="k_s",
+        type=positive_float,
+        default=_DEFAULTS["k_s"],
+        metavar="N/M",
+        help="software (controller) stiffness k_s, in series with k_m while sensing [N/m] (default %(default)s)",
+    )
+    add(
+        "--stiffness",
+        dest="k",
+        type=positive_float,
+        default=None,
+        metavar="N/M",
+        help="lumped sensing stiffness k [N/m]; overrides the series combination of k_m and k_s",
+    )
+    add(
+        "--threshold",
+        dest="F_s",
+        type=positive_float,
+        default=_DEFAULTS["F_s"],
+        metavar="N",
+        help="sensing threshold F_s, the contact force at detection [N] (default %(default)s)",
+    )
+    add(
+        "--accel",
+        dest="a",
+        type=positive_float,
+        default=_DEFAULTS["a"],
+        metavar="M/S2",
+        help="reaction acceleration a of the robot mass away from the contact [m/s^2] (default %(default)g)",
+    )
+    add(
+        "--velocity",
+        dest="v0",
+        type=positive_float,
+        default=_DEFAULTS["v0"],
+        metavar="M/S",
+        help="pre-impact (approach) velocity v0 [m/s] (default %(default)s)",
+    )
+    add(
+        "--reaction",
+        choices=REACTION_MODES,
+        default="at_rest",
+        help="reaction model: robot mass at rest at detection (the paper's) or still moving (default %(default)s)",
+    )
+    add(
+        "--robot-velocity",
+        dest="v_r",
+        type=non_negative_float,
+        default=None,
+        metavar="M/S",
+        help="robot-mass velocity toward the contact at detection [m/s], with --reaction moving (default v0)",
+    )
+    add(
+        "--velocities",
+        type=value_range,
+        default=None,
+        metavar="RANGE",
+        help="also tabulate I(v0) over START:STOP:N (N log-spaced values) or a list v1,v2,... [m/s]",
+    )
+    add(
+        "--plot",
+        default=None,
+        metavar="FILE",
+        help="draw the force-time profile with the phases shaded to FILE (.png, .svg or .pdf)",
+    )
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.plot is not None:
+        from ..plots import check_figure_path
+
+        check_figure_path(args.plot)  # refuse a bad name before doing any work
+    if args.v_r is not None and args.reaction != "moving":
+        args.reaction = "moving"  # giving a robot velocity only makes sense for the moving reaction
+    k = args.k if args.k is not None else series_stiffness(args.k_m, args.k_s)
+    common = (args.m_f, k, args.k_m, args.F_s, args.a)
+    phases = phase_impulses(*common, args.v0, args.reaction, args.v_r)
+    t1, t2 = collision_times(*common, args.v0, args.reaction, args.v_r)
+    v_star = optimal_velocity(args.m_f, k, args.F_s, args.reaction, args.k_m, args.a)
+    i_star = minimum_impulse(*common, args.reaction)
+
+    print(
+        f"m_f = {args.m_f:g} kg, k = {k:g} N/m (k_m = {args.k_m:g}, "
+        + (f"k_s = {args.k_s:g})" if args.k is None else "given directly)")
+        + f", F_s = {args.F_s:g} N, a = {args.a:g} m/s^2, v0 = {args.v0:g} m/s, reaction: {args.reaction}"
+    )
+    print()
+    print(f"{'phase':<22}{'impulse [N*s]':>16}{'share':>9}")
+    rows = (
+        ("I   impact", phases.initial),
+        ("II  sensing", phases.sensing),
+        ("III reaction", phases.reaction),
+    )
+    for name, value in rows:
+        print(f"{name:<22}{float(value):>16.6g}{float(value / phases.total):>9.1%}")
+    print(f"{'total I':<22}{float(phases.total):>16.6g}")
+    print()
+    print(f"detection t1 = {float(t1):.6g} s, contact ends t2 = {float(t2):.6g} s")
+    print(f"optimal velocity v* = {float(v_star):.6g} m/s, minimum impulse I* = {float(i_star):.6g} N*s")
+    regime = "sensing-dominated: going faster lowers I" if args.v0 < v_star else "impact-dominated"
+    print(f"v0 / v* = {args.v0 / float(v_star):.3g} ({regime})")
+
+    if args.velocities is not None:
+        sweep = phase_impulses(*common, args.velocities, args.reaction, args.v_r)
+        print()
+        print(f"{'v0 [m/s]':>12}{'I impact':>14}{'II sensing':>14}{'III reaction':>14}{'total I':>14}")
+        columns = np.broadcast_arrays(
+            args.velocities, sweep.initial, sweep.sensing, sweep.reaction, sweep.total
+        )
+        for row in zip(*columns, strict=True):
+            print("".join(f"{float(x):>{12 if i == 0 else 14}.6g}" for i, x in enumerate(row)))
+
+    if args.plot is not None:
+        from ..plots.profile import plot_force_profile
+
+        path = plot_force_profile(args.plot, *common, args.v0, args.reaction, args.v_r)
+        print(f"\nwrote {path}")
+    return 0

@@ -1,0 +1,243 @@
+"""The one-dimensional collision-reflex model.
+
+From Bhatia, Mason and Johnson, "Reacting to Contact: Transparency and Collision Reflex in Actuation"
+(equations ``eq:initial`` to ``eq:v_star``). A finger (sprung) mass ``m_f`` and a robot (unsprung) mass ``m_r``,
+joined by a spring, move at ``v0`` into a rigid constraint. The impulse transferred has three phases:
+
+1. plastic impact of the finger, ``I1 = m_f v0``;
+2. sensing: the velocity-controlled robot compresses the lumped spring ``k`` until the force reaches the
+   threshold ``F_s`` at ``t1 = F_s / (k v0)``, ``I2 = F_s**2 / (2 k v0)``;
+3. reaction: the software spring is zeroed and the robot accelerates away at ``a`` against the mechanical
+   spring ``k_m`` until the force returns to zero at ``t2``.
+
+Every function here accepts floats, NumPy arrays (broadcast against each other) and CasADi ``SX``/``MX``
+symbols alike, from one implementation. Units are SI throughout: masses [kg], stiffnesses [N/m], forces [N],
+accelerations [m/s^2], velocities [m/s], times [s], impulses [N*s].
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from . import _validate
+from ._backend import is_symbolic, sin, sqrt, where
+from .errors import InvalidParameter
+
+REACTION_MODES: tuple[str, ...] = ("at_rest", "moving")
+"""``"at_rest"``: the paper's reaction, robot mass at rest at detection (its default).
+``"moving"``: robot mass still moving toward the constraint at ``v_r`` at detection."""
+
+
+@dataclass(frozen=True)
+class PhaseImpulses:
+    """Impulse of each phase of a collision [N*s] (floats, arrays or CasADi expressions)."""
+
+    initial: Any
+    """Plastic impact of the finger mass, ``m_f v0`` (``eq:initial``)."""
+    sensing: Any
+    """Spring compression until detection, ``F_s**2 / (2 k v0)`` (``eq:sensing``)."""
+    reaction: Any
+    """Acceleration away against the mechanical spring (``eq:reaction`` or its moving-robot extension)."""
+
+    @property
+    def total(self) -> Any:
+        """Collision-reflex metric, the sum of the three phases (``eq:total_impulse``)."""
+        return self.initial + self.sensing + self.reaction
+
+
+def series_stiffness(k_m: Any, k_s: Any) -> Any:
+    """Lumped stiffness of the mechanical and software springs in series [N/m].
+
+    Parameters
+    ----------
+    k_m: mechanical stiffness [N/m], > 0 (``inf`` for a rigid structure).
+    k_s: software (controller) stiffness [N/m], > 0 (``inf`` for an ideal position controller).
+    """
+    _validate.positive("k_m", k_m, allow_inf=True)
+    _validate.positive("k_s", k_s, allow_inf=True)
+    # Compliances add; written this way an infinite stiffness simply drops out.
+    return 1 / (1 / k_m + 1 / k_s)
+
+
+def phase_impulses(
+    m_f: Any, k: Any, k_m: Any, F_s: Any, a: Any, v0: Any, reaction: str = "at_rest", v_r: Any = None
+) -> PhaseImpulses:
+    """Impulse of the three phases of a collision.
+
+    Parameters
+    ----------
+    m_f: finger (sprung) mass [kg].
+    k: lumped stiffness during sensing [N/m], see :func:`series_stiffness`.
+    k_m: mechanical stiffness, the only spring left during the reaction [N/m].
+    F_s: sensing threshold, contact force at detection [N].
+    a: acceleration of the robot mass away from the constraint during the reaction [m/s^2].
+    v0: pre-impact (approach) velocity [m/s].
+    reaction: ``"at_rest"`` (the paper's model) or ``"moving"`` (robot still moving at ``v_r`` at detection).
+    v_r: robot-mass velocity toward the constraint at detection [m/s], ``"moving"`` only; default ``v0``
+        (an ideally velocity-controlled robot mass).
+    """
+    m_f, k, k_m, F_s, a, v0, v_r = _checked(m_f, k, k_m, F_s, a, v0, reaction, v_r)
+    initial = m_f * v0
+    sensing = F_s**2 / (2 * k * v0)
+    _, reaction_impulse = _reaction_phase(F_s, k_m, a, v_r)
+    return PhaseImpulses(initial, sensing, reaction_impulse)
+
+
+def total_impulse(
+    m_f: Any, k: Any, k_m: Any, F_s: Any, a: Any, v0: Any, reaction: str = "at_rest", v_r: Any = None
+) -> Any:
+    """Collision-reflex metric ``I = I1 + I2 + I3`` [N*s]; arguments as :func:`phase_impulses`."""
+    return phase_impulses(m_f, k, k_m, F_s, a, v0, reaction, v_r).total
+
+
+def collision_times(
+    m_f: Any, k: Any, k_m: Any, F_s: Any, a: Any, v0: Any, reaction: str = "at_rest", v_r: Any = None
+) -> tuple[Any, Any]:
+    """Detection time ``t1`` and end of contact ``t2`` [s], impact at ``t = 0``; arguments as
+    :func:`phase_impulses`."""
+    m_f, k, k_m, F_s, a, v0, v_r = _checked(m_f, k, k_m, F_s, a, v0, reaction, v_r)
+    t1 = F_s / (k * v0)  # eq:t1def
+    duration, _ = _reaction_phase(F_s, k_m, a, v_r)
+    return t1, t1 + duration
+
+
+def velocity_coefficients(m_f: Any, k: Any, k_m: Any, F_s: Any, a: Any) -> tuple[Any, Any, Any]:
+    """Coefficients of ``I(v0) = A v0 + B / v0 + C`` for the paper's (at-rest) reaction.
+
+    Returns ``(A, B, C) = (m_f, F_s**2 / (2 k), I3)``: ``A`` [kg] = [N*s per m/s], ``B`` [N*m] = [N*s times
+    m/s], ``C`` [N*s]; they are the three phase impulses at ``v0 = 1 m/s`` (paper, "Effect of Actuator
+    Selection").
+    """
+    phases = phase_impulses(m_f, k, k_m, F_s, a, 1.0)
+    return phases.initial, phases.sensing, phases.reaction
+
+
+def optimal_velocity(
+    m_f: Any, k: Any, F_s: Any, reaction: str = "at_rest", k_m: Any = None, a: Any = None
+) -> Any:
+    """Approach velocity that minimises the impulse [m/s].
+
+    For the paper's reaction it is ``v* = F_s / sqrt(2 k m_f)`` (``eq:v_star``); ``d2I/dv0^2 = F_s^2/(k v0^3)
+    > 0`` so it is the unique minimum. With ``reaction="moving"`` and the robot moving at ``v_r = v0``, the
+    reaction impulse grows with ``v0`` and the optimum lies below the paper's ``v*``; it is found numerically
+    (bounded scalar minimisation per element, numeric inputs only) and needs ``k_m`` and ``a``.
+    """
+    _validate.choice("reaction", reaction, REACTION_MODES)
+    for name, value in (("m_f", m_f), ("k", k), ("F_s", F_s)):
+        _validate.positive(name, value)
+    v_star = F_s / sqrt(2 * k * m_f)
+    if reaction == "at_rest":
+        return v_star
+    if k_m is None or a is None:
+        raise InvalidParameter(
+            "k_m, a", (k_m, a), "both given", "the moving-robot optimum depends on the reaction phase"
+        )
+    if is_symbolic(m_f, k, F_s, k_m, a):
+        raise InvalidParameter(
+            "reaction",
+            reaction,
+            "'at_rest' for symbolic arguments",
+            "the moving-robot optimum has no closed form; use numeric values",
+        )
+    return _moving_optimum(m_f, k, k_m, F_s, a, v_star)
+
+
+def minimum_impulse(m_f: Any, k: Any, k_m: Any, F_s: Any, a: Any, reaction: str = "at_rest") -> Any:
+    """Impulse at the optimal approach velocity [N*s].
+
+    For the paper's reaction, ``I* = sqrt(2) F_s / w_s + I3`` with ``w_s = sqrt(k / m_f)`` the open-loop
+    sensing bandwidth and ``I3`` the reaction impulse (the paper writes the latter with ``w_a = sqrt(k/m_r)``;
+    its own derivation uses ``k_m`` in the reaction, which is what is used here). For ``"moving"``, the total
+    impulse at the numerically found optimum with ``v_r = v0``.
+    """
+    if reaction == "moving":
+        v_opt = optimal_velocity(m_f, k, F_s, "moving", k_m, a)
+        return total_impulse(m_f, k, k_m, F_s, a, v_opt, "moving")
+    m_f, k, k_m, F_s, a, _, _ = _checked(m_f, k, k_m, F_s, a, 1.0, reaction, None)
+    omega_s = sqrt(k / m_f)
+    _, reaction_impulse = _reaction_phase(F_s, k_m, a, 0.0)
+    return np.sqrt(2.0) * F_s / omega_s + reaction_impulse
+
+
+def force_profile(
+    t: Any, m_f: Any, k: Any, k_m: Any, F_s: Any, a: Any, v0: Any, reaction: str = "at_rest", v_r: Any = None
+) -> Any:
+    """Contact force ``F(t)`` [N] of the model, impact at ``t = 0`` [s].
+
+    The sum of three pieces whose integrals are the three phase impulses:
+
+    - the impact pulse, the compression quarter-period of ``m_f`` on ``k_m``:
+      ``m_f v0 w sin(w t)`` for ``0 <= t <= pi/(2 w)``, ``w = sqrt(k_m/m_f)`` (area ``m_f v0``);
+    - the sensing ramp ``k v0 t`` for ``0 <= t < t1``;
+    - the reaction from ``t1`` until the force returns to zero at ``t2``: ``F_s - k_m a tau^2/2`` at rest, or
+      ``k_m (x1 + v_r tau - a tau^2/2)`` with ``x1 = F_s/k_m`` when moving (``tau = t - t1``).
+    """
+    m_f, k, k_m, F_s, a, v0, v_r = _checked(m_f, k, k_m, F_s, a, v0, reaction, v_r)
+    omega = sqrt(k_m / m_f)
+    t1 = F_s / (k * v0)
+    duration, _ = _reaction_phase(F_s, k_m, a, v_r)
+    tau = t - t1
+    pulse = where(t >= 0, where(t <= np.pi / (2 * omega), m_f * v0 * omega * sin(omega * t), 0.0), 0.0)
+    ramp = where(t >= 0, where(t < t1, k * v0 * t, 0.0), 0.0)
+    reaction_force = k_m * (F_s / k_m + v_r * tau - a * tau**2 / 2)
+    reaction_part = where(tau >= 0, where(tau <= duration, reaction_force, 0.0), 0.0)
+    return pulse + ramp + reaction_part
+
+
+def _reaction_phase(F_s: Any, k_m: Any, a: Any, v_r: Any) -> tuple[Any, Any]:
+    """Duration ``t2 - t1`` [s] and impulse [N*s] of the reaction phase.
+
+    The spring starts compressed by ``x1 = F_s/k_m`` and the robot mass moves toward the constraint at ``v_r``
+    while accelerating away at ``a``: compression ``x1 + v_r tau - a tau^2/2``, zero at
+    ``tau_e = (v_r + sqrt(v_r^2 + 2 a x1)) / a``. With ``v_r = 0`` this is the paper's ``eq:reaction``:
+    ``tau_e = sqrt(2 F_s/(a k_m))`` and ``I3 = sqrt(8 F_s^3 / (9 a k_m))``.
+    """
+    x1 = F_s / k_m
+    duration = (v_r + sqrt(v_r**2 + 2 * a * x1)) / a
+    impulse = k_m * (x1 * duration + v_r * duration**2 / 2 - a * duration**3 / 6)
+    return duration, impulse
+
+
+def _checked(
+    m_f: Any, k: Any, k_m: Any, F_s: Any, a: Any, v0: Any, reaction: str, v_r: Any
+) -> tuple[Any, Any, Any, Any, Any, Any, Any]:
+    """Validate the model's inputs and resolve ``v_r`` from the reaction mode."""
+    _validate.choice("reaction", reaction, REACTION_MODES)
+    for name, value in (("m_f", m_f), ("k", k), ("k_m", k_m), ("F_s", F_s), ("a", a), ("v0", v0)):
+        _validate.positive(name, value)
+    if reaction == "at_rest":
+        if v_r is not None:
+            raise InvalidParameter(
+                "v_r", v_r, "None with reaction='at_rest'", "pass reaction='moving' to give a robot velocity"
+            )
+        v_r = 0.0
+    elif v_r is None:
+        v_r = v0
+    else:
+        _validate.non_negative("v_r", v_r)
+    return m_f, k, k_m, F_s, a, v0, v_r
+
+
+def _moving_optimum(m_f: Any, k: Any, k_m: Any, F_s: Any, a: Any, v_star: Any) -> Any:
+    """Minimise ``I(v0)`` with the moving-robot reaction (``v_r = v0``) per element on ``(0, v*]``."""
+    from scipy.optimize import minimize_scalar
+
+    args = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (m_f, k, k_m, F_s, a, v_star)))
+    out = np.empty(args[0].shape)
+    for index in np.ndindex(out.shape):
+        mf_i, k_i, km_i, fs_i, a_i, vs_i = (float(x[index]) for x in args)
+        impulse = functools.partial(_moving_impulse, mf_i, k_i, km_i, fs_i, a_i)
+        # The reaction impulse grows with v_r = v0, so the optimum is below the at-rest v*; I -> inf as v0 -> 0.
+        found = minimize_scalar(
+            impulse, bounds=(1e-6 * vs_i, vs_i), method="bounded", options={"xatol": 1e-12 * vs_i}
+        )
+        out[index] = found.x
+    return out if out.ndim else float(out)
+
+
+def _moving_impulse(m_f: float, k: float, k_m: float, F_s: float, a: float, v0: float) -> float:
+    return float(total_impulse(m_f, k, k_m, F_s, a, v0, "moving"))
