@@ -47,3 +47,23 @@ def _describe(value: Any) -> str:
     except Exception:  # describing must never itself fail
         pass
     return repr(value)
+
+
+class SolverFailed(CollisionReflexError):
+    """The optimiser did not converge, or found the problem infeasible.
+
+    Attributes
+    ----------
+    status: IPOPT's return status (e.g. ``"Infeasible_Problem_Detected"``).
+    stats: the solver statistics (iterations, timings, ...).
+    violated: ``(label, violation)`` pairs of the constraints that could not be met, worst first.
+    problem: the problem that was solved, for inspection.
+    """
+
+    def __init__(self, message: str, status: str, stats: dict, violated: list[tuple[str, float]],
+                 problem: object = None) -> None:
+        self.status = status
+        self.stats = stats
+        self.violated = violated
+        self.problem = problem
+        super().__init__(message)
