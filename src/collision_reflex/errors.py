@@ -7,6 +7,8 @@ to do, so that a command-line user sees one clear line instead of a traceback.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 
@@ -66,4 +68,52 @@ class SolverFailed(CollisionReflexError):
         self.stats = stats
         self.violated = violated
         self.problem = problem
+
+@dataclass(frozen=True)
+class StudyProblem:
+    """One problem found in a study file.
+
+    Attributes
+    ----------
+    file: the study file's path as given (``"<string>"`` for text not read from a file).
+    line, column: 1-based position of the offending node (its key, or the nearest enclosing node that exists).
+    path: the field's path in the study, e.g. ``"actuators.joints.joint2.software_stiffness"``.
+    found: a short description of what the file holds there.
+    expected: what would be accepted, and where useful what to do.
+    """
+
+    file: str
+    line: int
+    column: int
+    path: str
+    found: str
+    expected: str
+
+    def __str__(self) -> str:
+        where = f"{self.file}:{self.line}:{self.column}"
+        field = f" {self.path}:" if self.path else ""
+        return f"{where}:{field} found {self.found}; expected {self.expected}"
+
+
+class StudyFileError(CollisionReflexError, ValueError):
+    """A study file cannot be used: every problem found, each with its file, line, field path, what was found and
+    what was expected.
+
+    Attributes
+    ----------
+    file: the study file's path as given.
+    problems: the problems, in file order.
+    """
+
+    def __init__(self, file: str, problems: Sequence[StudyProblem]) -> None:
+        self.file = file
+        self.problems = tuple(sorted(problems, key=lambda p: (p.line, p.column, p.path)))
+        if not self.problems:
+            raise ValueError("StudyFileError needs at least one problem")
+        if len(self.problems) == 1:
+            message = str(self.problems[0])
+        else:
+            message = f"{len(self.problems)} problems in {file}:\n" + "\n".join(
+                f"  {problem}" for problem in self.problems
+            )
         super().__init__(message)

@@ -13,9 +13,11 @@ from collections.abc import Sequence
 from .. import __version__
 from ..errors import CollisionReflexError
 from . import impulse as _impulse
+from . import schema as _schema
+from . import validate as _validate
 
 # Subcommand modules, in the order `crx --help` lists them.
-_SUBCOMMANDS = [_impulse]
+_SUBCOMMANDS = [_impulse, _validate, _schema]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,34 @@
+"""``crx schema``: the JSON Schema of study files (for editors that complete and check YAML)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "schema",
+        help="print the JSON Schema of study files",
+        description=(
+            "Print the JSON Schema of design-study files. Save it and point your editor at it, e.g. with the "
+            "first line '# yaml-language-server: $schema=study.schema.json'."
+        ),
+    )
+    parser.add_argument("--out", metavar="FILE", default=None, help="write to FILE (atomically) instead of stdout")
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..study import study_json_schema
+
+    text = json.dumps(study_json_schema(), indent=2) + "\n"
+    if args.out is None:
+        print(text, end="")
+    else:
+        from .._io import atomic_open
+
+        with atomic_open(args.out, "w", encoding="utf-8") as handle:
+            handle.write(text)
+        print(f"wrote {args.out}")
+    return 0

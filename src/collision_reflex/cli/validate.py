@@ -1,0 +1,49 @@
+"""``crx validate``: check study files, reporting every problem with its file and line."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ..errors import StudyFileError
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "validate",
+        help="check study files (schema, units, robot, frames, joints); every problem with its line",
+        description=(
+            "Check design-study files without running them: the schema (unknown keys, units of the right "
+            "dimension, bounds), and for arm studies the robot, its contact frame, joint names and sizes. "
+            "Every problem is printed as FILE:LINE:COLUMN: FIELD: found ...; expected ... . Exit status 2 if "
+            "any file has a problem."
+        ),
+    )
+    parser.add_argument("studies", nargs="+", metavar="STUDY", help="study file(s) (YAML)")
+    parser.add_argument(
+        "--schema-only",
+        action="store_true",
+        help="skip the checks that load the robot model (faster; names of frames and joints are not checked)",
+    )
+    parser.add_argument("--resolved", action="store_true", help="print the resolved study (YAML, SI units)")
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..study import load_study, resolved_yaml
+    from ..study.prepare import describe_study
+
+    status = 0
+    for path in args.studies:
+        try:
+            loaded = load_study(path)
+            summary = describe_study(loaded, load_robot=not args.schema_only)
+        except StudyFileError as error:
+            for problem in error.problems:
+                print(problem, file=sys.stderr)
+            status = 2
+            continue
+        print(f"{path}: valid — {summary}")
+        if args.resolved:
+            print(resolved_yaml(loaded))
+    return status

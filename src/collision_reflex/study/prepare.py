@@ -1,0 +1,175 @@
+"""From a validated study to the objects a run needs: motors from the catalogue, the arm, the samples, and the
+actuator of every joint. Every failure is located in the study file."""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Any
+
+from ..errors import StudyFileError, StudyProblem
+from .load import LoadedStudy
+from .schema import PER_JOINT_DESIGN_VARIABLES, ActuatorStudy, ArmStudy, GearboxSpec, MotorSpec
+
+
+def _motor_specs(study: ArmStudy | ActuatorStudy) -> Iterator[tuple[tuple[Any, ...], MotorSpec]]:
+    if isinstance(study, ArmStudy):
+        yield ("actuators", "motor"), study.actuators.motor
+        for joint, override in study.actuators.joints.items():
+            if override.motor is not None:
+                yield ("actuators", "joints", joint, "motor"), override.motor
+    else:
+        for name, candidate in study.actuators.items():
+            yield ("actuators", name, "motor"), candidate.motor
+
+
+def check_motors(loaded: LoadedStudy, catalogue: dict[str, Any] | None = None) -> dict[str, Any]:
+    """The motor catalogue, after checking that every motor the study names is in it."""
+    from ..motors import load_catalogue
+
+    catalogue = catalogue if catalogue is not None else load_catalogue()
+    problems: list[StudyProblem] = []
+    names = sorted(catalogue)
+    for path, spec in _motor_specs(loaded.study):  # type: ignore[arg-type]
+        if spec.reference not in catalogue:
+            close = difflib.get_close_matches(spec.reference, names, n=1)
+            field = (*path, "reference") if _written_as_mapping(loaded, path) else path
+            problems.append(
+                loaded.problem(field, f"motor {spec.reference!r}, not in the catalogue",
+                               (f"{close[0]!r}? " if close else "") + "one of " + ", ".join(map(repr, names)))
+            )
+    if problems:
+        raise StudyFileError(loaded.source.file, problems)
+    return catalogue
+
+
+def _written_as_mapping(loaded: LoadedStudy, path: tuple[Any, ...]) -> bool:
+    node: Any = loaded.source.data
+    for key in path:
+        node = node.get(key) if isinstance(node, dict) else None
+    return isinstance(node, dict)
+
+
+def motor_for(spec: MotorSpec, catalogue: dict[str, Any]) -> Any:
+    """The :class:`collision_reflex.motors.Motor` a spec describes: the catalogue motor, scaled if asked."""
+    motor = catalogue[spec.reference]
+    if spec.stator_diameter is None and spec.stack_length is None:
+        return motor
+    return motor.scaled(stator_diameter=spec.stator_diameter, stack_length=spec.stack_length, law=spec.scaling_law)
+
+
+def gearbox_for(spec: GearboxSpec | None) -> Any:
+    """The :class:`collision_reflex.actuators.Gearbox` of a spec (``None`` for direct drive)."""
+    if spec is None:
+        return None
+    from ..actuators import Gearbox
+
+    return Gearbox(spec.kind, stages=spec.stages)
+
+
+@dataclass(frozen=True)
+class JointActuatorValues:
+    """The nominal actuator of one joint of an arm study (SI units): the study's defaults with the joint's
+    overrides applied."""
+
+    joint: str
+    motor: MotorSpec
+    gearbox: GearboxSpec | None
+    gear_ratio: float
+    mechanical_stiffness: float
+    software_stiffness: float
+
+
+def joint_actuators(study: ArmStudy, joint_names: list[str]) -> list[JointActuatorValues]:
+    """Per joint, the actuator defaults with the joint's overrides applied."""
+    base = study.actuators
+    out = []
+    for joint in joint_names:
+        override = base.joints.get(joint)
+
+        def pick(name: str, override: Any = override) -> Any:
+            value = getattr(override, name) if override is not None else None
+            return value if value is not None else getattr(base, name)
+
+        out.append(
+            JointActuatorValues(joint, pick("motor"), pick("gearbox"), float(pick("gear_ratio")),
+                                float(pick("mechanical_stiffness")), float(pick("software_stiffness")))
+        )
+    return out
+
+
+def free_variables(study: ArmStudy, n_joints: int, joint_names: list[str] | None = None) -> dict[str, int]:
+    """Number of free scalar design variables, by name (per joint unless ``joint_names`` are given)."""
+    counts: dict[str, int] = {}
+    design = study.design
+    for name in (*PER_JOINT_DESIGN_VARIABLES, "threshold", "position_error", "approach_velocity"):
+        spec = getattr(design, name)
+        if spec is None:
+            continue
+        if name in PER_JOINT_DESIGN_VARIABLES:
+            free = sum(_is_free(b) for b in _per_joint_bounds(spec, n_joints, joint_names))
+        else:
+            free = int(_is_free(spec))
+        if free:
+            counts[name] = free
+    return counts
+
+
+def _is_free(spec: Any) -> bool:
+    lower, upper = spec.bounds
+    return bool(lower < upper)
+
+
+def _per_joint_bounds(spec: Any, n_joints: int, joint_names: list[str] | None) -> list[Any]:
+    if joint_names is None:
+        return [spec] * n_joints
+    return [spec.joints.get(name, spec) for name in joint_names]
+
+
+def per_joint_bounds(spec: Any, joint_names: list[str]) -> list[tuple[float, float]]:
+    """``(lower, upper)`` per joint of a per-joint design variable (SI units)."""
+    return [b.bounds for b in _per_joint_bounds(spec, len(joint_names), joint_names)]
+
+
+def describe_study(loaded: LoadedStudy, load_robot: bool = True) -> str:
+    """A one-line summary of a study; with ``load_robot`` the motors and (arm studies) the robot are loaded and
+    checked, raising :class:`StudyFileError` at the offending line."""
+    study = loaded.study
+    if isinstance(study, ActuatorStudy):
+        if load_robot:
+            check_motors(loaded)
+        return (
+            f"actuator study {study.name!r}: {', '.join(study.actuators)} at a {study.load.lever * 1e3:g} mm lever, "
+            f"{study.velocities.count} velocities in [{study.velocities.min:g}, {study.velocities.max:g}] m/s"
+        )
+    assert isinstance(study, ArmStudy)
+    robot = study.robot.example_robot_data or study.robot.urdf
+    text = f"arm study {study.name!r} on {robot}"
+    n_joints = None
+    if load_robot:
+        from .robot import load_arm
+        from .samples import configuration_samples, direction_samples
+
+        check_motors(loaded)
+        arm = load_arm(loaded)
+        n_joints = len(arm.joint_names)
+        n_config = configuration_samples(loaded, arm).shape[0]
+        n_dir = direction_samples(study.samples.directions, int(arm.task_dim)).shape[0]
+        text += f" ({n_joints} joints: {', '.join(arm.joint_names)}), {n_config} configurations x {n_dir} directions"
+    free = free_variables(study, n_joints or 1, list(arm.joint_names) if load_robot else None)
+
+    def count(name: str, number: int) -> str:
+        per_joint = name in PER_JOINT_DESIGN_VARIABLES and n_joints is None
+        return f"{name} (per joint)" if per_joint else f"{name} ({number})"
+
+    text += "; free design variables: " + (
+        ", ".join(count(name, number) for name, number in free.items()) if free else "none"
+    )
+    text += "; objective: " + " + ".join(
+        (f"{w:g} x " if w != 1 else "") + name for name, w in study.objective.items()
+    )
+    if study.pareto is not None:
+        text += f"; Pareto front of {' vs '.join(study.pareto.objectives)} ({study.pareto.points} points)"
+    return text
+

@@ -1,0 +1,45 @@
+"""The resolved study: every default explicit, every quantity a number in SI units, paths absolute.
+
+It is what a run actually used; it is written to the output folder, and its fingerprint decides whether a
+restarted run may reuse finished results.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from typing import Any
+
+import yaml
+
+from .load import LoadedStudy
+from .schema import ArmStudy
+
+UNITS_NOTE = "All quantities in SI units: m, kg, s, N, N*m, N*m/rad, rad, m/s."
+
+
+def resolved_study(loaded: LoadedStudy) -> dict[str, Any]:
+    """The study as plain data (JSON types), defaults filled in, quantities in SI, relative paths resolved."""
+    data = loaded.study.model_dump(mode="json")
+    if isinstance(loaded.study, ArmStudy):
+        robot = data["robot"]
+        if robot["urdf"] is not None:
+            robot["urdf"] = str(loaded.path(robot["urdf"]))
+        robot["package_dirs"] = [str(loaded.path(p)) for p in robot["package_dirs"]]
+        trajectory = data["samples"]["configurations"]["trajectory"]
+        if trajectory is not None:
+            trajectory["file"] = str(loaded.path(trajectory["file"]))
+    return data
+
+
+def resolved_yaml(loaded: LoadedStudy) -> str:
+    """:func:`resolved_study` as YAML, in the schema's field order, with a comment on units."""
+    body = yaml.safe_dump(resolved_study(loaded), sort_keys=False, default_flow_style=None, width=110)
+    return f"# Resolved study: every default explicit. {UNITS_NOTE}\n{body}"
+
+
+def fingerprint(resolved: dict[str, Any], ignore: tuple[str, ...] = ("execution", "outputs", "description")) -> str:
+    """A hash of what determines a run's numbers (execution settings and outputs do not)."""
+    relevant = {key: value for key, value in resolved.items() if key not in ignore}
+    text = json.dumps(relevant, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:16]

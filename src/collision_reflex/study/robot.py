@@ -1,0 +1,129 @@
+"""The robot of an arm study: load it, and check every name and size in the study against it.
+
+Problems (an unknown robot, frame or joint, a configuration of the wrong size, ...) are reported at the line of
+the study file that names them.
+"""
+
+from __future__ import annotations
+
+import difflib
+from typing import Any
+
+from ..errors import CollisionReflexError, StudyFileError, StudyProblem
+from .load import LoadedStudy
+from .schema import PER_JOINT_DESIGN_VARIABLES, ArmStudy
+
+
+def example_robot_names() -> list[str]:
+    """Names of the models example-robot-data can load."""
+    from example_robot_data.robots_loader import ROBOTS
+
+    return sorted(ROBOTS)
+
+
+def load_arm(loaded: LoadedStudy) -> Any:
+    """The :class:`collision_reflex.arm.Arm` of an arm study, checked against the study.
+
+    Raises
+    ------
+    StudyFileError: the robot, its contact frame or a joint named in the study does not exist, or a size in the
+        study does not match the robot.
+    """
+    study = loaded.study
+    if not isinstance(study, ArmStudy):
+        raise TypeError("load_arm needs an arm study")
+    spec = study.robot
+    from ..arm import Arm
+
+    offset = list(spec.contact_offset)
+    try:
+        if spec.example_robot_data is not None:
+            names = example_robot_names()
+            if spec.example_robot_data not in names:
+                close = difflib.get_close_matches(spec.example_robot_data, names, n=3)
+                raise loaded.fail(
+                    ("robot", "example_robot_data"),
+                    f"{spec.example_robot_data!r}, not an example-robot-data model",
+                    ("one of " + ", ".join(map(repr, close)) + " or another of " if close else "one of ")
+                    + f"the {len(names)} models of example-robot-data (e.g. ur5, panda, double_pendulum)",
+                )
+            arm = Arm.from_example_robot_data(spec.example_robot_data, contact_frame=spec.contact_frame,
+                                              contact_offset=offset)
+        else:
+            assert spec.urdf is not None  # one source is guaranteed by the schema
+            arm = Arm.from_urdf(
+                str(loaded.path(spec.urdf)),
+                spec.contact_frame,
+                package_dirs=[str(loaded.path(p)) for p in spec.package_dirs] or None,
+                contact_offset=offset,
+            )
+    except StudyFileError:
+        raise
+    except CollisionReflexError as error:
+        field = "contact_frame" if "frame" in type(error).__name__.lower() or "frame" in str(error) else None
+        where = ("robot", field) if field and spec.contact_frame is not None else ("robot",)
+        raise loaded.fail(where, f"a robot that cannot be used ({error})", "a valid robot and contact frame") from None
+    problems = check_against_arm(loaded, arm)
+    if problems:
+        raise StudyFileError(loaded.source.file, problems)
+    return arm
+
+
+def check_against_arm(loaded: LoadedStudy, arm: Any) -> list[StudyProblem]:
+    """Every joint name and size in the study, checked against ``arm``."""
+    study = loaded.study
+    assert isinstance(study, ArmStudy)
+    joints = list(arm.joint_names)
+    problems: list[StudyProblem] = []
+
+    def check_joint(path: tuple[Any, ...], name: str) -> None:
+        if name not in joints:
+            close = difflib.get_close_matches(name, joints, n=1)
+            problems.append(
+                loaded.problem(path, f"joint {name!r}, not a joint of the robot",
+                               (f"{close[0]!r}? " if close else "") + "one of " + ", ".join(map(repr, joints)))
+            )
+
+    for name in study.actuators.joints:
+        check_joint(("actuators", "joints", name), name)
+    for variable in PER_JOINT_DESIGN_VARIABLES:
+        spec = getattr(study.design, variable)
+        for name in getattr(spec, "joints", {}) or {}:
+            check_joint(("design", variable, "joints", name), name)
+    for index, name in enumerate(study.robot.locked_joints):
+        check_joint(("robot", "locked_joints", index), name)
+
+    nq = int(arm.model.nq)
+    for index, q in enumerate(study.samples.configurations.list or []):
+        if len(q) != nq:
+            problems.append(
+                loaded.problem(("samples", "configurations", "list", index), f"{len(q)} joint positions",
+                               f"{nq} (the robot's nq) in rad")
+            )
+    task_dim = int(arm.task_dim)
+    directions = study.samples.directions
+    for index, vector in enumerate(directions.list or []):
+        if len(vector) != task_dim:
+            problems.append(
+                loaded.problem(("samples", "directions", "list", index), f"a vector of {len(vector)} components",
+                               f"{task_dim} components ({'a planar arm' if task_dim == 2 else 'a spatial arm'})")
+            )
+    if task_dim == 2:
+        if directions.sphere is not None:
+            problems.append(
+                loaded.problem(("samples", "directions", "sphere"), "sphere directions for a planar arm",
+                               "circle: N (directions in the arm's plane)")
+            )
+        for index, name in enumerate(directions.named or []):
+            if name.endswith("z"):
+                problems.append(
+                    loaded.problem(("samples", "directions", "named", index), f"{name!r} for a planar arm",
+                                   "one of +x, -x, +y, -y (the arm's plane)")
+                )
+    required = study.constraints.torque_required
+    if required is not None and len(required) != len(joints):
+        problems.append(
+            loaded.problem(("constraints", "torque_required"), f"{len(required)} torques",
+                           f"one per actuated joint ({len(joints)}: {', '.join(joints)}) in N*m")
+        )
+    return problems

@@ -1,0 +1,421 @@
+"""The study-file schema (pydantic v2): what a design study may say, with units, defaults and checks.
+
+Two kinds of study share most sections:
+
+- ``kind: arm`` (the default): actuators for every joint of a robot arm (example-robot-data or URDF), evaluated
+  over sampled configurations and contact directions, optimised by :mod:`collision_reflex.optimize`;
+- ``kind: actuator``: single-joint actuators (e.g. direct-drive against geared) compared in a 1D collision at a
+  lever, over a range of approach velocities.
+
+Every model forbids unknown keys. Quantities are floats in SI units once validated (see :mod:`.quantities`);
+``model_dump(mode="json")`` gives the *resolved* study with every default explicit.
+"""
+
+from __future__ import annotations
+
+import builtins
+import re
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, WithJsonSchema, field_validator, model_validator
+
+from .quantities import Angle, Force, Length, LinearStiffness, Mass, Ratio, RotaryStiffness, Torque, Velocity
+
+OBJECTIVE_NAMES = ("worst_case_impulse", "mean_impulse", "actuator_mass", "approach_velocity")
+ObjectiveName = Literal["worst_case_impulse", "mean_impulse", "actuator_mass", "approach_velocity"]
+SCALING_LAW_NAMES = ("haddadin", "isometric", "empirical", "quadruped")
+GEARBOX_KINDS = ("planetary", "parallel_shaft", "harmonic", "cycloidal", "ball_screw")
+NAMED_DIRECTIONS = ("+x", "-x", "+y", "-y", "+z", "-z")
+DEFAULT_REFERENCE_MOTOR = "Omni+ OPN-060-013-A"
+
+PositiveInt = Annotated[int, Field(ge=1, strict=True)]
+Name = Annotated[str, Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9._-]*$", max_length=80)]
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True, validate_default=True)
+
+
+def _exactly_one(model: BaseModel, names: tuple[str, ...], what: str) -> None:
+    given = [name for name in names if getattr(model, name) is not None]
+    if len(given) != 1:
+        found = "none of them" if not given else " and ".join(given)
+        raise ValueError(f"exactly one of {', '.join(names)} for {what} (found {found})")
+
+
+# --- robot -------------------------------------------------------------------------------------------------------
+
+
+class RobotSpec(_Model):
+    """The arm: an example-robot-data model or a URDF, and where it touches the world."""
+
+    example_robot_data: str | None = Field(None, description="name of an example-robot-data model, e.g. 'ur5'")
+    urdf: str | None = Field(None, description="URDF file, relative to the study file")
+    package_dirs: list[str] = Field(default_factory=list, description="directories to resolve package:// URIs")
+    contact_frame: str | None = Field(None, description="frame of the contact point (default: the robot's tip)")
+    contact_offset: tuple[Length, Length, Length] = Field(
+        (0.0, 0.0, 0.0), description="contact point in the contact frame [m]"
+    )
+    locked_joints: list[str] = Field(default_factory=list, description="joints held fixed (not actuated)")
+
+    @model_validator(mode="after")
+    def _one_source(self) -> RobotSpec:
+        _exactly_one(self, ("example_robot_data", "urdf"), "the robot")
+        return self
+
+
+# --- actuators ---------------------------------------------------------------------------------------------------
+
+
+class MotorSpec(_Model):
+    """A motor: a catalogue motor as it is, or scaled to another stator diameter (and stack length)."""
+
+    reference: str = Field(DEFAULT_REFERENCE_MOTOR, description="catalogue name of the (reference) motor")
+    scaling_law: Literal["haddadin", "isometric", "empirical", "quadruped"] = "haddadin"
+    stator_diameter: Length | None = Field(None, gt=0, description="scaled stator diameter [m]; null: reference's")
+    stack_length: Length | None = Field(None, gt=0, description="scaled stack length [m]; null: reference's")
+
+    @classmethod
+    def __get_pydantic_json_schema__(cls, core_schema: Any, handler: Any) -> Any:
+        # The shorthand: a catalogue name alone.
+        return {"anyOf": [{"type": "string", "description": "catalogue name"}, handler(core_schema)]}
+
+    @model_validator(mode="before")
+    @classmethod
+    def _catalogue_name(cls, value: Any) -> Any:
+        # ``motor: "T-motor U8"`` is shorthand for an unscaled catalogue motor.
+        return {"reference": value} if isinstance(value, str) else value
+
+
+class GearboxSpec(_Model):
+    kind: Literal["planetary", "parallel_shaft", "harmonic", "cycloidal", "ball_screw"]
+    stages: PositiveInt = 1
+
+
+class JointActuatorSpec(_Model):
+    """Per-joint overrides of the actuator defaults (every field optional)."""
+
+    motor: MotorSpec | None = None
+    gearbox: GearboxSpec | None = None
+    gear_ratio: Ratio | None = Field(None, ge=1)
+    mechanical_stiffness: RotaryStiffness | None = Field(None, gt=0)
+    software_stiffness: RotaryStiffness | None = Field(None, gt=0)
+
+
+class ActuatorsSpec(_Model):
+    """The actuator of every joint; ``joints`` overrides fields for named joints."""
+
+    motor: MotorSpec = Field(default_factory=MotorSpec)
+    gearbox: GearboxSpec | None = None
+    gearbox_inertia: bool = Field(False, description="add the gearbox's reflected inertia (the paper ignores it)")
+    gear_ratio: Ratio = Field(1.0, ge=1)
+    mechanical_stiffness: RotaryStiffness = Field(gt=0, description="joint mechanical stiffness [N m/rad]")
+    software_stiffness: RotaryStiffness = Field(gt=0, description="joint controller stiffness [N m/rad]")
+    joints: dict[str, JointActuatorSpec] = Field(default_factory=dict)
+
+
+# --- sensing -----------------------------------------------------------------------------------------------------
+
+
+class SensingSpec(_Model):
+    """How contact is detected (MODEL.md §2): a contact-force threshold, a position-error threshold (``F_s = k e``)
+    or a motor-current threshold (joint-side threshold torque ``N tau_s``)."""
+
+    scheme: Literal["force", "position", "current"]
+    threshold: Force | None = Field(None, gt=0, description="contact-force threshold [N] (scheme: force)")
+    error: Length | None = Field(None, gt=0, description="position-error threshold [m] (scheme: position)")
+    motor_torque: Torque | None = Field(
+        None, gt=0, description="motor-side torque threshold [N m] (scheme: current)"
+    )
+
+    @model_validator(mode="after")
+    def _matches_scheme(self) -> SensingSpec:
+        needed = {"force": "threshold", "position": "error", "current": "motor_torque"}[self.scheme]
+        given = [name for name in ("threshold", "error", "motor_torque") if getattr(self, name) is not None]
+        if given != [needed]:
+            raise ValueError(f"the {self.scheme} scheme takes exactly `{needed}` (found {', '.join(given) or 'none'})")
+        return self
+
+    @property
+    def value(self) -> float:
+        """The threshold in SI: [N], [m] or [N m] by scheme."""
+        return float({"force": self.threshold, "position": self.error, "current": self.motor_torque}[self.scheme])
+
+
+# --- samples -----------------------------------------------------------------------------------------------------
+
+
+class RandomConfigurations(_Model):
+    count: PositiveInt = Field(description="number of configurations drawn uniformly within joint limits")
+    seed: int = Field(0, strict=True, description="seed of the numpy Generator")
+
+
+class TrajectorySpec(_Model):
+    file: str = Field(description="CSV of joint positions [rad], one row per time step, one column per joint")
+    every: PositiveInt = Field(1, description="use every n-th row")
+
+
+class ConfigurationSamples(_Model):
+    """Exactly one of ``random``, ``list`` or ``trajectory``."""
+
+    random: RandomConfigurations | None = None
+    list: builtins.list[builtins.list[Angle]] | None = Field(None, min_length=1, description="configurations [rad]")
+    trajectory: TrajectorySpec | None = None
+
+    @model_validator(mode="after")
+    def _one(self) -> ConfigurationSamples:
+        _exactly_one(self, ("random", "list", "trajectory"), "configurations")
+        return self
+
+
+class DirectionSamples(_Model):
+    """Exactly one of ``circle`` (n directions in the plane: the arm's plane, or the world x-y plane), ``sphere``
+    (n directions spread evenly over the sphere), ``named`` or ``list`` (vectors, normalised)."""
+
+    circle: PositiveInt | None = None
+    sphere: PositiveInt | None = None
+    named: builtins.list[Literal["+x", "-x", "+y", "-y", "+z", "-z"]] | None = Field(None, min_length=1)
+    list: builtins.list[builtins.list[float]] | None = Field(None, min_length=1)
+
+    @model_validator(mode="after")
+    def _one(self) -> DirectionSamples:
+        _exactly_one(self, ("circle", "sphere", "named", "list"), "directions")
+        for index, vector in enumerate(self.list or []):
+            if not 2 <= len(vector) <= 3 or not any(vector) or not all(abs(x) < 1e300 for x in vector):
+                raise ValueError(f"directions.list[{index}]: a non-zero finite vector of 2 or 3 components")
+        return self
+
+
+class SamplesSpec(_Model):
+    configurations: ConfigurationSamples
+    directions: DirectionSamples
+
+
+# --- design variables --------------------------------------------------------------------------------------------
+
+
+def _variable_model(name: str, quantity: Any, floor: float | None, doc: str) -> type[_Model]:
+    """A model for a design variable: ``{min, max}`` (free), ``{value}`` (fixed) or a bare value (fixed)."""
+
+    class Bound(_Model):
+        min: quantity | None = Field(None, gt=0)
+        max: quantity | None = Field(None, gt=0)
+        value: quantity | None = Field(None, gt=0)
+
+        @model_validator(mode="before")
+        @classmethod
+        def _bare_value(cls, value: Any) -> Any:
+            return {"value": value} if not isinstance(value, dict) else value
+
+        @model_validator(mode="after")
+        def _bounds(self) -> Any:
+            if self.value is not None:
+                if self.min is not None or self.max is not None:
+                    raise ValueError("either {min, max} (a free variable) or {value} (fixed), not both")
+            elif self.min is None or self.max is None:
+                raise ValueError("both min and max (a free variable), or value (fixed)")
+            elif self.min > self.max:
+                raise ValueError(f"min <= max (min = {self.min:g}, max = {self.max:g} in SI units): swap them")
+            if floor is not None:
+                low = self.value if self.value is not None else self.min
+                if low is not None and low < floor:
+                    raise ValueError(f"values >= {floor:g} (found {low:g})")
+            return self
+
+        @property
+        def bounds(self) -> tuple[float, float]:
+            """``(lower, upper)`` in SI units (equal when fixed)."""
+            if self.value is not None:
+                return (self.value, self.value)
+            assert self.min is not None and self.max is not None  # guaranteed by _bounds
+            return (self.min, self.max)
+
+    Bound.__name__ = Bound.__qualname__ = f"{name}Bounds"
+    Bound.__doc__ = doc
+    return Bound
+
+
+def _per_joint(name: str, bound: type[_Model], doc: str) -> type[_Model]:
+    """A per-joint design variable: bounds for every joint, ``joints`` overriding them for named joints."""
+
+    class PerJoint(bound):  # type: ignore[misc,valid-type]
+        joints: dict[str, bound] = Field(default_factory=dict)  # type: ignore[valid-type]
+
+        @model_validator(mode="before")
+        @classmethod
+        def _bare_value(cls, value: Any) -> Any:
+            return {"value": value} if not isinstance(value, dict) else value
+
+    PerJoint.__name__ = PerJoint.__qualname__ = name
+    PerJoint.__doc__ = doc
+    return PerJoint
+
+
+_StatorBounds = _variable_model("StatorDiameter", Length, None, "motor stator diameter [m]")
+_StackBounds = _variable_model("StackLength", Length, None, "motor stack length [m]")
+_GearBounds = _variable_model("GearRatio", Ratio, 1.0, "gear ratio [-], >= 1")
+_SoftBounds = _variable_model("SoftwareStiffness", RotaryStiffness, None, "software stiffness [N m/rad]")
+StatorDiameterVariable = _per_joint("StatorDiameterVariable", _StatorBounds, "motor stator diameter [m]")
+StackLengthVariable = _per_joint("StackLengthVariable", _StackBounds, "motor stack length [m]")
+GearRatioVariable = _per_joint("GearRatioVariable", _GearBounds, "gear ratio [-], >= 1")
+SoftwareStiffnessVariable = _per_joint("SoftwareStiffnessVariable", _SoftBounds, "software stiffness [N m/rad]")
+ThresholdVariable = _variable_model("ThresholdVariable", Force, None, "contact-force threshold [N]")
+PositionErrorVariable = _variable_model("PositionErrorVariable", Length, None, "position-error threshold [m]")
+VelocityVariable = _variable_model("VelocityVariable", Velocity, None, "approach velocity [m/s]")
+
+PER_JOINT_DESIGN_VARIABLES = ("stator_diameter", "stack_length", "gear_ratio", "software_stiffness")
+
+
+class DesignSpec(_Model):
+    """Design variables the optimiser may change; any not listed keeps the value of its section
+    (``actuators``, ``sensing``, ``approach_velocity``). Per-joint variables take ``joints: {name: {...}}``."""
+
+    stator_diameter: StatorDiameterVariable | None = None  # type: ignore[valid-type]
+    stack_length: StackLengthVariable | None = None  # type: ignore[valid-type]
+    gear_ratio: GearRatioVariable | None = None  # type: ignore[valid-type]
+    software_stiffness: SoftwareStiffnessVariable | None = None  # type: ignore[valid-type]
+    threshold: ThresholdVariable | None = None  # type: ignore[valid-type]
+    position_error: PositionErrorVariable | None = None  # type: ignore[valid-type]
+    approach_velocity: VelocityVariable | None = None  # type: ignore[valid-type]
+
+
+# --- objectives, constraints, Pareto, outputs, execution ---------------------------------------------------------
+
+
+class ConstraintsSpec(_Model):
+    payload: Mass = Field(0.0, ge=0, description="mass carried at the contact point [kg]")
+    safety_factor: Ratio = Field(1.0, ge=1, description="peak torque >= safety_factor x required torque")
+    threshold_floor: Force = Field(0.0, ge=0, description="sensing noise floor [N]")
+    torque_required: list[Torque] | None = Field(
+        None, description="required torque per joint [N m]; null: gravity (+ payload) over the samples"
+    )
+
+
+class ParetoSpec(_Model):
+    objectives: list[ObjectiveName] = Field(min_length=2, max_length=3)
+    points: Annotated[int, Field(ge=2, le=400, strict=True)] = 20
+
+    @field_validator("objectives")
+    @classmethod
+    def _distinct(cls, value: list[str]) -> list[str]:
+        if len(set(value)) != len(value):
+            raise ValueError("different objectives")
+        return value
+
+
+class OutputsSpec(_Model):
+    figures: list[Literal["png", "svg"]] = Field(default_factory=lambda: ["png", "svg"])
+    pdf: bool = Field(False, description="also write report.pdf (needs Chromium)")
+
+
+class ExecutionSpec(_Model):
+    executor: Literal["serial", "processes", "dask"] = "serial"
+    workers: PositiveInt = 2
+    scheduler: str | None = Field(None, description="Dask scheduler address, e.g. tcp://host:8786")
+
+    @model_validator(mode="after")
+    def _scheduler(self) -> ExecutionSpec:
+        if self.scheduler is not None and not re.match(r"^(tcp|tls|inproc|ucx)://\S+$", self.scheduler):
+            raise ValueError(f"a scheduler address such as tcp://host:8786 (found {self.scheduler!r})")
+        return self
+
+
+Weight = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+
+
+class ArmStudy(_Model):
+    """A design study of the actuators of a robot arm."""
+
+    kind: Literal["arm"] = "arm"
+    name: Name = Field(description="the study's name; names the output folder")
+    description: str = ""
+    robot: RobotSpec
+    actuators: ActuatorsSpec
+    sensing: SensingSpec
+    approach_velocity: Velocity = Field(gt=0, description="approach velocity [m/s]")
+    reaction: Literal["at_rest", "moving"] = "at_rest"
+    samples: SamplesSpec
+    design: DesignSpec = Field(default_factory=DesignSpec)
+    objective: Annotated[
+        dict[ObjectiveName, Weight],
+        WithJsonSchema(
+            {
+                "anyOf": [
+                    {"enum": list(OBJECTIVE_NAMES)},
+                    {
+                        "type": "object",
+                        "propertyNames": {"enum": list(OBJECTIVE_NAMES)},
+                        "additionalProperties": {"type": "number", "exclusiveMinimum": 0},
+                        "minProperties": 1,
+                    },
+                ],
+                "description": "an objective name, or a weighted sum {name: weight}",
+            }
+        ),
+    ] = Field(
+        default_factory=lambda: {"worst_case_impulse": 1.0}, min_length=1
+    )
+    constraints: ConstraintsSpec = Field(default_factory=ConstraintsSpec)
+    pareto: ParetoSpec | None = None
+    outputs: OutputsSpec = Field(default_factory=OutputsSpec)
+    execution: ExecutionSpec = Field(default_factory=ExecutionSpec)
+
+    @field_validator("objective", mode="before")
+    @classmethod
+    def _single(cls, value: Any) -> Any:
+        # ``objective: worst_case_impulse`` is a weighted sum with one term.
+        return {value: 1.0} if isinstance(value, str) else value
+
+
+class ActuatorCandidate(_Model):
+    """One single-joint actuator of an actuator study."""
+
+    motor: MotorSpec
+    gearbox: GearboxSpec | None = None
+    gearbox_inertia: bool = False
+    gear_ratio: Ratio = Field(1.0, ge=1)
+    mechanical_stiffness: RotaryStiffness = Field(gt=0)
+    software_stiffness: RotaryStiffness = Field(gt=0)
+    sensing: SensingSpec | None = Field(None, description="overrides the study's sensing for this actuator")
+
+
+class LoadSpec(_Model):
+    """What the actuator drives: a link of given lever, whose structure mass is seen at the contact."""
+
+    lever: Length = Field(gt=0, description="distance from the joint axis to the contact [m]")
+    finger_mass: Mass = Field(gt=0, description="structure (sprung) mass seen at the contact [kg]")
+    contact_stiffness: LinearStiffness | None = Field(
+        None, gt=0, description="stiffness of the object hit [N/m], in series with the joint; null: rigid"
+    )
+
+
+class VelocityRange(_Model):
+    min: Velocity = Field(gt=0)
+    max: Velocity = Field(gt=0)
+    count: Annotated[int, Field(ge=2, le=10000, strict=True)] = 50
+
+    @model_validator(mode="after")
+    def _ordered(self) -> VelocityRange:
+        if self.min >= self.max:
+            raise ValueError(f"min < max (min = {self.min:g} m/s, max = {self.max:g} m/s)")
+        return self
+
+
+class ActuatorStudy(_Model):
+    """Single-joint actuators compared in a 1D collision at a lever (the paper's direct-drive U8 against the
+    geared A8, for example)."""
+
+    kind: Literal["actuator"]
+    name: Name
+    description: str = ""
+    load: LoadSpec
+    actuators: dict[Name, ActuatorCandidate] = Field(min_length=1)
+    sensing: SensingSpec
+    approach_velocity: Velocity = Field(gt=0, description="approach velocity of the tables [m/s]")
+    velocities: VelocityRange
+    reaction: Literal["at_rest", "moving"] = "at_rest"
+    outputs: OutputsSpec = Field(default_factory=OutputsSpec)
+
+
+Study = ArmStudy | ActuatorStudy
+STUDY_KINDS: dict[str, type[BaseModel]] = {"arm": ArmStudy, "actuator": ActuatorStudy}

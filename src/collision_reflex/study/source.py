@@ -1,0 +1,190 @@
+"""Reading a study file's YAML with the position of every node, so that any problem can name its line.
+
+PyYAML's composer gives the node tree with start marks; the same safe loader then constructs plain Python data
+from it. :class:`StudySource` keeps both and maps a field path (keys and list indices) to a line and column.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from ..errors import StudyFileError, StudyProblem
+
+PathKey = tuple[Any, ...]
+
+
+@dataclass(frozen=True)
+class StudySource:
+    """A study's YAML: the constructed data and the position of every node.
+
+    Attributes
+    ----------
+    file: the file name used in messages.
+    directory: the directory paths in the study are relative to [absolute].
+    data: the document as plain Python data (``None`` for an empty file).
+    positions: ``(line, column)`` (1-based) of each node by its path; a mapping entry's position is its key's.
+    duplicate_keys: paths of keys that appear more than once in the same mapping (YAML keeps the last).
+    """
+
+    file: str
+    directory: Path
+    data: Any
+    positions: dict[PathKey, tuple[int, int]] = field(repr=False)
+    duplicate_keys: tuple[PathKey, ...] = ()
+
+    def locate(self, path: Sequence[Any]) -> tuple[int, int]:
+        """Line and column of ``path``, or of its nearest ancestor that exists in the file."""
+        path = tuple(path)
+        while path and path not in self.positions:
+            path = path[:-1]
+        return self.positions.get(path, (1, 1))
+
+    def resolve_path(self, path: Sequence[Any]) -> PathKey:
+        """``path`` with the components that do not exist in the file dropped (validators insert the names of
+        union branches or wrapper functions into error locations)."""
+        kept: list[Any] = []
+        node = self.data
+        for key in path:
+            if isinstance(node, dict) and key in node:
+                node = node[key]
+                kept.append(key)
+            elif isinstance(node, list) and isinstance(key, int) and 0 <= key < len(node):
+                node = node[key]
+                kept.append(key)
+            elif isinstance(node, (dict, list)) and not _looks_internal(key):
+                kept.append(key)  # a missing field or key: still part of the path, with no further node
+                node = None
+            # else: an internal location component (union branch, validator name); skip it
+        return tuple(kept)
+
+    def problem(self, path: Sequence[Any], found: str, expected: str) -> StudyProblem:
+        """A :class:`StudyProblem` at ``path`` (a path in the file's data)."""
+        line, column = self.locate(path)
+        return StudyProblem(self.file, line, column, format_path(path), found, expected)
+
+
+def _looks_internal(key: Any) -> bool:
+    text = str(key)
+    return "[" in text or "-" in text and not text.startswith(("+", "-"))
+
+
+def format_path(path: Sequence[Any]) -> str:
+    """``("actuators", "joints", "j2", "gear_ratio")`` -> ``"actuators.joints.j2.gear_ratio"``; list indices as
+    ``[i]``."""
+    text = ""
+    for key in path:
+        if isinstance(key, int):
+            text += f"[{key}]"
+        else:
+            text += ("." if text else "") + str(key)
+    return text
+
+
+def read_study_source(path: str | os.PathLike[str]) -> StudySource:
+    """Read a study file. A missing or unreadable file, or YAML that does not parse, raises
+    :class:`~collision_reflex.errors.StudyFileError` with the line."""
+    name = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise StudyFileError(
+            name, [StudyProblem(name, 0, 0, "", "no such file", "the path of a study file (YAML)")]
+        ) from None
+    except (OSError, UnicodeDecodeError) as error:
+        raise StudyFileError(
+            name, [StudyProblem(name, 0, 0, "", f"a file that cannot be read ({error})", "a UTF-8 YAML file")]
+        ) from None
+    return parse_study_source(text, name, Path(path).resolve().parent)
+
+
+def parse_study_source(text: str, file: str = "<string>", directory: Path | None = None) -> StudySource:
+    """Parse YAML text into a :class:`StudySource`; errors as for :func:`read_study_source`."""
+    directory = directory if directory is not None else Path.cwd()
+    try:
+        loader = yaml.SafeLoader(text)
+    except yaml.reader.ReaderError as error:  # a character YAML does not allow, found before parsing starts
+        line = text.count("\n", 0, error.position) + 1
+        column = error.position - (text.rfind("\n", 0, error.position) + 1) + 1
+        raise StudyFileError(
+            file,
+            [StudyProblem(file, line, column, "", f"the character {chr(error.character)!r}", "printable text")],
+        ) from None
+    try:
+        node = loader.get_single_node()
+        data = loader.construct_document(node) if node is not None else None
+    except yaml.MarkedYAMLError as error:
+        mark = error.problem_mark or error.context_mark
+        line, column = (mark.line + 1, mark.column + 1) if mark is not None else (1, 1)
+        what = " ".join(part for part in (error.context, error.problem) if part)
+        raise StudyFileError(
+            file, [StudyProblem(file, line, column, "", f"invalid YAML ({what})", "well-formed YAML")]
+        ) from None
+    except (yaml.YAMLError, ValueError, OverflowError, RecursionError) as error:
+        # The safe constructor can still fail on odd scalars (e.g. an impossible date): report it at the start.
+        raise StudyFileError(
+            file, [StudyProblem(file, 1, 1, "", f"YAML that cannot be read ({error})", "well-formed YAML")]
+        ) from None
+    finally:
+        loader.dispose()
+    positions: dict[PathKey, tuple[int, int]] = {}
+    duplicates: list[PathKey] = []
+    if node is not None:
+        _index(node, (), positions, duplicates, set())
+    return StudySource(file, directory, data, positions, tuple(duplicates))
+
+
+def _index(
+    node: yaml.Node,
+    path: PathKey,
+    positions: dict[PathKey, tuple[int, int]],
+    duplicates: list[PathKey],
+    active: set[int],
+) -> None:
+    """Record the position of ``node`` and its children; ``active`` guards against recursive aliases."""
+    positions.setdefault(path, (node.start_mark.line + 1, node.start_mark.column + 1))
+    if id(node) in active:
+        return
+    active = active | {id(node)}
+    if isinstance(node, yaml.MappingNode):
+        seen: set[Any] = set()
+        for key_node, value_node in node.value:
+            key = key_node.value if isinstance(key_node, yaml.ScalarNode) else id(key_node)
+            key = _constructed_key(key_node, key)
+            if key in seen:
+                duplicates.append((*path, key))
+            seen.add(key)
+            # An entry is located at its key, where a reader looks for it.
+            positions[(*path, key)] = (key_node.start_mark.line + 1, key_node.start_mark.column + 1)
+            _index_children(value_node, (*path, key), positions, duplicates, active)
+    elif isinstance(node, yaml.SequenceNode):
+        for index, item in enumerate(node.value):
+            _index(item, (*path, index), positions, duplicates, active)
+
+
+def _index_children(
+    node: yaml.Node,
+    path: PathKey,
+    positions: dict[PathKey, tuple[int, int]],
+    duplicates: list[PathKey],
+    active: set[int],
+) -> None:
+    saved = positions[path]
+    _index(node, path, positions, duplicates, active)
+    positions[path] = saved
+
+
+def _constructed_key(key_node: yaml.Node, raw: Any) -> Any:
+    """The key as the safe loader constructs it (``1`` for ``1``, ``True`` for ``yes``...), so that paths from
+    the data and from the node tree agree."""
+    if not isinstance(key_node, yaml.ScalarNode):
+        return raw
+    try:
+        return yaml.safe_load(yaml.serialize(key_node))
+    except yaml.YAMLError:
+        return raw
