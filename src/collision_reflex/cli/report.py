@@ -1,0 +1,30 @@
+"""``crx report``: re-render a run's figures and report.html (and PDF) from its saved results."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "report",
+        help="re-render figures and report.html from a run's saved results",
+        description="Redraw the figures and rewrite report.html of an output folder from its designs.json.",
+    )
+    parser.add_argument("folder", metavar="DIR", help="output folder of `crx run`")
+    parser.add_argument("--pdf", action="store_true", help="also print report.pdf with headless Chromium")
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from ..report import render_report
+
+    path = render_report(args.folder)
+    print(path)
+    if args.pdf:
+        from ..report.pdf import html_to_pdf
+
+        print(html_to_pdf(path, Path(args.folder) / "report.pdf"))
+    return 0

@@ -1,0 +1,46 @@
+"""``crx run``: run a design study end to end and write its results and sizing report."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "run",
+        help="run a design study (YAML) end to end: designs, Pareto front, figures, report.html",
+        description=(
+            "Run a design study: check it (nothing is written if the study has a problem), solve the designs "
+            "through the study's executor, and write the resolved study, pareto.csv, designs.json, figures (PNG "
+            "and SVG) and report.html to the output folder. Run the same command again after an interruption to "
+            "resume from the finished Pareto points."
+        ),
+    )
+    parser.add_argument("study", metavar="STUDY", help="study file (YAML)")
+    parser.add_argument("--out", metavar="DIR", default=None, help="output folder (default: results/NAME)")
+    parser.add_argument("--quiet", action="store_true", help="no progress bars; print only the report's path")
+    parser.add_argument("--scheduler", metavar="ADDR", default=None,
+                        help="run on the Dask cluster at ADDR (e.g. tcp://host:8786); needs the 'dask' extra")
+    parser.add_argument("--executor", choices=("serial", "processes", "dask"), default=None,
+                        help="override the study's executor")
+    parser.add_argument("--workers", type=int, default=None, metavar="N", help="override the number of workers")
+    parser.add_argument("--smoke", action="store_true",
+                        help="shrink sample counts and Pareto points for a quick check (also: CRX_SMOKE=1)")
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..study.runner import run_study
+
+    if args.workers is not None and args.workers < 1:
+        print("crx run: error: --workers must be at least 1", file=sys.stderr)
+        return 2
+    result = run_study(args.study, args.out, quiet=args.quiet, scheduler=args.scheduler, executor=args.executor,
+                       workers=args.workers, smoke=True if args.smoke else None)
+    if not args.quiet:
+        how = f"{result.computed} computed" + (f", {result.reused} reused from the interrupted run"
+                                                if result.reused else "")
+        print(f"finished in {result.elapsed:.1f} s ({how})")
+    print(result.report)
+    return 0

@@ -1,0 +1,96 @@
+"""The report's figures, drawn from saved results into ``figures/`` (PNG and/or SVG files) and returned as SVG
+text for inlining in the HTML report."""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .outputs import OBJECTIVE_UNITS
+
+
+@contextlib.contextmanager
+def _unique_svg_ids(name: str) -> Iterator[None]:
+    """Matplotlib names SVG elements by hashes salted with ``svg.hashsalt``; a salt per figure keeps ids unique
+    when several figures are inlined in one HTML page (and identical between runs)."""
+    import matplotlib
+
+    with matplotlib.rc_context({"svg.hashsalt": name}):
+        yield
+
+
+def _draw(directory: Path, name: str, formats: list[str], draw: Callable[[Path], Any]) -> str:
+    directory.mkdir(parents=True, exist_ok=True)
+    with _unique_svg_ids(name):
+        svg_path = draw(directory / f"{name}.svg")
+        text = Path(svg_path).read_text(encoding="utf-8")
+        if "png" in formats:
+            draw(directory / f"{name}.png")
+    if "svg" not in formats:
+        Path(svg_path).unlink()
+    return text[text.index("<svg") :]
+
+
+def draw_figures(directory: Path, results: dict[str, Any], formats: list[str]) -> dict[str, str]:
+    """Draw every figure of a report; returns inline SVG text by figure name."""
+    if results["kind"] == "actuator":
+        return _actuator_figures(directory, results, formats)
+    return _arm_figures(directory, results, formats)
+
+
+def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -> dict[str, str]:
+    from ..plots.design_front import plot_design_front
+    from ..plots.impulse_directions import plot_impulse_directions
+    from ..plots.phase_breakdown import plot_phase_breakdown
+
+    svgs: dict[str, str] = {}
+    samples = results["samples"]
+    directions = np.asarray(samples["sample_directions"])
+    config_index = np.asarray(samples["config_index"])
+    pareto = results["pareto"]
+    chosen = results["chosen"]
+    names = pareto["objectives"]
+    if len(pareto["points"]) >= 2:
+        values = np.array([[p["objectives"][n] for n in names] for p in pareto["points"]])
+        svgs["front"] = _draw(directory, "pareto_front", formats, lambda path: plot_design_front(
+            path, names, [OBJECTIVE_UNITS[n] for n in names], values,
+            [chosen["objectives"][n] for n in names[:2]]))
+    featured = {"chosen design": chosen}
+    if pareto["points"]:
+        featured[f"Pareto design 0 (least {names[0].replace('_', ' ')})"] = pareto["points"][0]
+        featured[f"Pareto design {len(pareto['points']) - 1} (least {names[1].replace('_', ' ')})"] = pareto["points"][-1]
+    for index, (title, record) in enumerate(featured.items()):
+        svgs[f"surface-{index}"] = _draw(directory, f"impulse_directions_{index}", formats,
+                                         lambda path, r=record, t=title: plot_impulse_directions(
+                                             path, directions, config_index, np.asarray(r["impulses"]),
+                                             f"impulse by contact direction [N*s]: {t}"))
+    records = [("chosen", chosen)] + [(str(i), p) for i, p in enumerate(pareto["points"])]
+    worst = [int(np.argmax(r["impulses"])) for _, r in records]
+    svgs["phases"] = _draw(directory, "phase_breakdown", formats, lambda path: plot_phase_breakdown(
+        path, [label for label, _ in records],
+        [r["phases"]["initial"][w] for (_, r), w in zip(records, worst, strict=True)],
+        [r["phases"]["sensing"][w] for (_, r), w in zip(records, worst, strict=True)],
+        [r["phases"]["reaction"][w] for (_, r), w in zip(records, worst, strict=True)],
+        "impulse by phase at each design's worst sample"))
+    return svgs
+
+
+def _actuator_figures(directory: Path, results: dict[str, Any], formats: list[str]) -> dict[str, str]:
+    from ..plots.phase_breakdown import plot_phase_breakdown
+    from ..plots.velocity_sweep import plot_velocity_sweep
+
+    candidates = results["candidates"]
+    svgs = {
+        "sweep": _draw(directory, "velocity_sweep", formats, lambda path: plot_velocity_sweep(
+            path, results["velocities"], {c["name"]: c["sweep"]["total"] for c in candidates},
+            {c["name"]: (c["optimal_velocity"], c["minimum_impulse"]) for c in candidates})),
+        "phases": _draw(directory, "phase_breakdown", formats, lambda path: plot_phase_breakdown(
+            path, [c["name"] for c in candidates], [c["impulse"]["initial"] for c in candidates],
+            [c["impulse"]["sensing"] for c in candidates], [c["impulse"]["reaction"] for c in candidates],
+            f"impulse by phase at v0 = {results['approach_velocity']:g} m/s")),
+    }
+    return svgs

@@ -1,0 +1,100 @@
+"""The HTML sizing report: one self-contained page (inline CSS and SVG, no scripts, no network)."""
+
+from __future__ import annotations
+
+import math
+import statistics
+from typing import Any
+
+from .. import __version__
+
+UNITS = {
+    "stator_diameter": "m", "stack_length": "m", "mechanical_stiffness": "N*m/rad", "software_stiffness": "N*m/rad",
+    "threshold": "N", "error": "m", "motor_torque": "N*m", "approach_velocity": "m/s", "payload": "kg",
+    "threshold_floor": "N", "torque_required": "N*m", "contact_offset": "m", "lever": "m", "finger_mass": "kg",
+    "contact_stiffness": "N/m", "position_error": "m", "list": "rad",
+}
+
+
+def number(value: Any, digits: int = 4) -> str:
+    """A number with ``digits`` significant digits (the precision every table of the report uses)."""
+    if value is None:
+        return "–"
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return str(value)
+    if math.isinf(value):
+        return "∞" if value > 0 else "−∞"
+    return f"{value:.{digits}g}"
+
+
+def _assumptions(resolved: dict[str, Any]) -> list[tuple[str, str]]:
+    """The resolved study flattened to (field, value with unit) rows."""
+    rows: list[tuple[str, str]] = []
+
+    def walk(prefix: str, value: Any, unit: str) -> None:
+        if isinstance(value, dict):
+            if not value:
+                rows.append((prefix, "–"))
+            for key, item in value.items():
+                walk(f"{prefix}.{key}" if prefix else str(key), item, UNITS.get(str(key), unit))
+        elif isinstance(value, list) and value and all(isinstance(v, (int, float)) for v in value):
+            rows.append((prefix, "[" + ", ".join(number(v) for v in value) + "]" + (f" {unit}" if unit else "")))
+        elif isinstance(value, list) and len(value) > 6 and all(isinstance(v, list) for v in value):
+            rows.append((prefix, f"{len(value)} entries"))
+        elif isinstance(value, list):
+            for index, item in enumerate(value):
+                walk(f"{prefix}[{index}]", item, unit)
+            if not value:
+                rows.append((prefix, "[]"))
+        elif isinstance(value, (int, float)) and not isinstance(value, bool):
+            rows.append((prefix, number(value) + (f" {unit}" if unit else "")))
+        else:
+            rows.append((prefix, "–" if value is None else str(value)))
+
+    for key, value in resolved.items():
+        if key in ("name", "description"):
+            continue
+        walk(key, value, UNITS.get(key, ""))
+    return rows
+
+
+def _velocity_summary(record: dict[str, Any]) -> dict[str, float]:
+    v_star = [v for v in record["optimal_velocity"] if math.isfinite(v)]
+    v0 = record["approach_velocity"]
+    return {
+        "v0": v0,
+        "min": min(v_star) if v_star else math.inf,
+        "median": statistics.median(v_star) if v_star else math.inf,
+        "max": max(v_star) if v_star else math.inf,
+        "below": sum(v0 < v for v in v_star),
+        "count": len(record["optimal_velocity"]),
+    }
+
+
+def render_html(results: dict[str, Any], rows: list[dict[str, Any]], svgs: dict[str, str]) -> str:
+    """The report page for a run's results; ``rows`` are the rows of ``pareto.csv``."""
+    import jinja2
+
+    environment = jinja2.Environment(
+        loader=jinja2.PackageLoader("collision_reflex.report", "templates"),
+        autoescape=jinja2.select_autoescape(["html", "j2"]),
+        undefined=jinja2.StrictUndefined,
+        trim_blocks=True,
+        lstrip_blocks=True,
+    )
+    environment.filters["n"] = number
+    template = environment.get_template(f"{results['kind']}_report.html.j2")
+    context: dict[str, Any] = {
+        "results": results,
+        "rows": rows,
+        "columns": list(rows[0]) if rows else [],
+        "svgs": svgs,
+        "assumptions": _assumptions(results["resolved"]),
+        "version": __version__,
+    }
+    if results["kind"] == "arm":
+        context["velocity"] = {
+            "chosen": _velocity_summary(results["chosen"]),
+            **{str(i): _velocity_summary(p) for i, p in enumerate(results["pareto"]["points"])},
+        }
+    return template.render(**context)

@@ -1,0 +1,138 @@
+"""A run's result files from its results (plain data): ``designs.json``, ``pareto.csv``, figures (PNG and SVG),
+``report.html`` and optionally ``report.pdf``. :func:`render_report` redoes the figures and the report from a
+folder's saved ``designs.json`` alone."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+from ..errors import CollisionReflexError
+from ..study.store import DESIGNS, PARETO, REPORT, ResultsMissing, read_json, write_json, write_text
+
+OBJECTIVE_UNITS = {
+    "worst_case_impulse": "N*s",
+    "mean_impulse": "N*s",
+    "actuator_mass": "kg",
+    "approach_velocity": "m/s",
+}
+SENSE = {"worst_case_impulse": 1, "mean_impulse": 1, "actuator_mass": 1, "approach_velocity": -1}
+# Per-joint columns of pareto.csv: (record key, column name, unit).
+JOINT_COLUMNS = (
+    ("stator_diameter", "stator_diameter", "m"),
+    ("stack_length", "stack_length", "m"),
+    ("gear_ratio", "gear_ratio", "-"),
+    ("software_stiffness", "software_stiffness", "N*m/rad"),
+    ("reflected_inertia", "reflected_inertia", "kg*m^2"),
+    ("peak_torque", "peak_torque", "N*m"),
+    ("required_torque", "required_torque", "N*m"),
+    ("motor_mass", "motor_mass", "kg"),
+)
+
+
+def pareto_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
+    """The rows of ``pareto.csv``: one per Pareto design (arm studies; the chosen design if there is no front)
+    or per candidate actuator (actuator studies)."""
+    if results["kind"] == "actuator":
+        return _actuator_rows(results)
+    points = results["pareto"]["points"] or [results["chosen"]]
+    rows = []
+    for index, record in enumerate(points):
+        row: dict[str, Any] = {"point": index, "label": record["label"]}
+        for name, value in record["objectives"].items():
+            row[f"{name} [{OBJECTIVE_UNITS[name]}]"] = value
+        for key, column, unit in JOINT_COLUMNS:
+            for joint in record["joints"]:
+                row[f"{column}[{joint['joint']}] [{unit}]"] = joint[key]
+        unit = "N" if record["sensing"] == "force" else "m"
+        row[f"threshold [{unit}]"] = record["threshold"]
+        row["status"] = record["solver"]["status"]
+        row["iterations"] = record["solver"]["iterations"]
+        row["solve_time [s]"] = record["solver"]["solve_time"]
+        rows.append(row)
+    return rows
+
+
+def _actuator_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
+    candidates = results["candidates"]
+    best = _non_dominated_candidates(candidates)
+    rows = []
+    for candidate in candidates:
+        rows.append({
+            "actuator": candidate["name"],
+            "motor": candidate["motor"],
+            "gear_ratio [-]": candidate["gear_ratio"],
+            "mass [kg]": candidate["mass"],
+            "reflected_inertia [kg*m^2]": candidate["reflected_inertia"],
+            "peak_torque [N*m]": candidate["peak_torque"],
+            "threshold [N]": candidate["contact"]["F_s"],
+            "impulse_at_v0 [N*s]": candidate["impulse"]["total"],
+            "optimal_velocity [m/s]": candidate["optimal_velocity"],
+            "minimum_impulse [N*s]": candidate["minimum_impulse"],
+            "pareto_optimal": candidate["name"] in best,
+        })
+    return rows
+
+
+def _non_dominated_candidates(candidates: list[dict[str, Any]]) -> set[str]:
+    """Candidates no other beats in both minimum impulse and mass."""
+    out = set()
+    for c in candidates:
+        if not any(
+            o["minimum_impulse"] <= c["minimum_impulse"] and o["mass"] <= c["mass"]
+            and (o["minimum_impulse"] < c["minimum_impulse"] or o["mass"] < c["mass"])
+            for o in candidates
+        ):
+            out.add(c["name"])
+    return out
+
+
+def write_outputs(folder: str | os.PathLike[str], results: dict[str, Any], figures: bool = True,
+                  quiet: bool = True) -> Path:
+    """Write ``designs.json``, ``pareto.csv`` and the report (with its figures) into ``folder``."""
+    folder = Path(folder)
+    write_json(folder / DESIGNS, results)
+    _write_csv(folder / PARETO, pareto_rows(results))
+    return render_report(folder, results, figures=figures)
+
+
+def _write_csv(path: Path, rows: list[dict[str, Any]]) -> None:
+    import pandas as pd
+
+    from .._io import atomic_open
+
+    with atomic_open(path, "w", newline="", encoding="utf-8") as handle:
+        pd.DataFrame(rows).to_csv(handle, index=False, float_format="%.10g")
+
+
+def render_report(folder: str | os.PathLike[str], results: dict[str, Any] | None = None,
+                  figures: bool = True) -> Path:
+    """(Re)draw the figures and write ``report.html`` (and ``report.pdf`` if the study asks) from the results
+    saved in ``folder``."""
+    from .figures import draw_figures
+    from .html import render_html
+
+    folder = Path(folder)
+    if results is None:
+        path = folder / DESIGNS
+        if not path.exists():
+            raise ResultsMissing(f"{folder} has no {DESIGNS}: run the study first (crx run STUDY --out {folder})")
+        try:
+            results = read_json(path)
+        except ValueError as error:
+            raise ResultsMissing(f"{path} cannot be read ({error}); run the study again") from None
+    assert results is not None
+    svgs = draw_figures(folder / "figures", results, results["resolved"]["outputs"]["figures"]) if figures else {}
+    html = render_html(results, pareto_rows(results), svgs)
+    write_text(folder / REPORT, html)
+    if results["resolved"]["outputs"]["pdf"]:
+        from .pdf import html_to_pdf
+
+        try:
+            html_to_pdf(folder / REPORT, folder / "report.pdf")
+        except CollisionReflexError as error:
+            import warnings
+
+            warnings.warn(f"report.pdf not written: {error}", stacklevel=2)
+    return folder / REPORT

@@ -1,0 +1,355 @@
+"""The one place where arm studies call the optimiser (:mod:`collision_reflex.optimize`), the arm and the motors.
+
+It turns a validated arm study into the optimiser's inputs (design space, actuator technology, constraints,
+contact samples), solves single points of a Pareto sweep (anchors and epsilon-bounded points) and turns each
+result into a plain record (JSON types) with everything the report shows.
+
+Workers in other processes rebuild the problem from the resolved study text; :func:`problem_for` caches the
+built problems per process, so that a worker builds each objective's problem once.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import StudyFileError, StudyProblem
+from ..impulse import optimal_velocity, phase_impulses, series_stiffness
+from .load import LoadedStudy, parse_study
+from .prepare import check_motors, joint_actuators, per_joint_bounds
+from .robot import load_arm
+from .samples import configuration_samples, direction_samples
+from .schema import PER_JOINT_DESIGN_VARIABLES, ArmStudy
+
+IPOPT_OPTIONS = {"ipopt.max_iter": 400}
+"""Options over the optimiser's defaults for study runs (a cap keeps a hopeless Pareto point from stalling a run)."""
+
+
+@dataclass(frozen=True)
+class ArmSetup:
+    """Everything an arm study's solves need, built once per process.
+
+    arm: the :class:`collision_reflex.arm.Arm`; catalogue: the motor catalogue by name; configurations: (n, nq)
+    [rad]; directions: (m, task_dim) unit vectors; samples: the optimiser's contact samples (every configuration
+    with every direction); space, technology, constraints: the optimiser's inputs.
+    """
+
+    study: ArmStudy
+    arm: Any
+    catalogue: dict[str, Any]
+    configurations: np.ndarray
+    directions: np.ndarray
+    samples: Any
+    space: Any
+    technology: Any
+    constraints: Any
+
+
+def arm_setup(loaded: LoadedStudy) -> ArmSetup:
+    """Load the robot and motors and translate the study into the optimiser's inputs; every problem located."""
+    from ..optimize import ActuatorTechnology, Bounds, Constraints, ContactSamples, DesignSpace
+
+    study = loaded.study
+    assert isinstance(study, ArmStudy)
+    catalogue = check_motors(loaded)
+    arm = load_arm(loaded)
+    joints = list(arm.joint_names)
+    actuators = joint_actuators(study, joints)
+    _check_supported(loaded, study)
+    reference_spec = study.actuators.motor
+    reference = catalogue[reference_spec.reference]
+
+    def nominal(name: str, values: list[float]) -> list[Any]:
+        spec = getattr(study.design, name)
+        if spec is None:
+            return [Bounds.fixed(v, f"{name}[{j}]") for v, j in zip(values, joints, strict=True)]
+        return [Bounds(lo, hi, f"{name}[{j}]") for (lo, hi), j in zip(per_joint_bounds(spec, joints), joints, strict=True)]
+
+    diameters = [a.motor.stator_diameter or reference.stator_diameter for a in actuators]
+    stacks = [a.motor.stack_length or reference.stack_length for a in actuators]
+    scheme = study.sensing.scheme
+    threshold_spec = study.design.threshold if scheme == "force" else study.design.position_error
+    velocity_spec = study.design.approach_velocity
+    space = DesignSpace(
+        stator_diameter=nominal("stator_diameter", diameters),
+        stack_length=nominal("stack_length", stacks),
+        gear_ratio=nominal("gear_ratio", [a.gear_ratio for a in actuators]),
+        software_stiffness=nominal("software_stiffness", [a.software_stiffness for a in actuators]),
+        threshold=Bounds(*threshold_spec.bounds, "threshold") if threshold_spec else study.sensing.value,
+        approach_velocity=Bounds(*velocity_spec.bounds, "approach_velocity") if velocity_spec
+        else study.approach_velocity,
+    )
+    technology = ActuatorTechnology(
+        reference_motor=reference,
+        mechanical_stiffness=[a.mechanical_stiffness for a in actuators],
+        scaling_law=reference_spec.scaling_law,
+        sensing=scheme,
+        reaction=study.reaction,
+    )
+    constraints = Constraints(
+        payload=study.constraints.payload,
+        safety_factor=study.constraints.safety_factor,
+        torque_required=study.constraints.torque_required,
+        threshold_floor=study.constraints.threshold_floor,
+    )
+    configurations = configuration_samples(loaded, arm)
+    directions = direction_samples(study.samples.directions, int(arm.task_dim))
+    samples = ContactSamples.grid(arm.kinematics(configurations), directions)
+    return ArmSetup(study, arm, catalogue, configurations, directions, samples, space, technology, constraints)
+
+
+def _check_supported(loaded: LoadedStudy, study: ArmStudy) -> None:
+    """Refuse, at their lines, the study features the arm optimiser does not model."""
+    problems: list[StudyProblem] = []
+    base = study.actuators.motor
+    for joint, override in study.actuators.joints.items():
+        motor = override.motor
+        if motor is not None and (motor.reference != base.reference or motor.scaling_law != base.scaling_law):
+            problems.append(
+                loaded.problem(("actuators", "joints", joint, "motor"), "a different reference motor or law",
+                               "the same reference motor and scaling law for every joint (the optimiser scales one "
+                               "reference); override stator_diameter or stack_length only")
+            )
+        if override.gearbox is not None:
+            problems.append(_gearbox_problem(loaded, ("actuators", "joints", joint, "gearbox")))
+    if study.actuators.gearbox is not None:
+        problems.append(_gearbox_problem(loaded, ("actuators", "gearbox")))
+    if study.robot.locked_joints:
+        problems.append(
+            loaded.problem(("robot", "locked_joints"), "locked joints",
+                           "no locked joints: the arm model does not lock joints yet; use a URDF without them")
+        )
+    if problems:
+        raise StudyFileError(loaded.source.file, problems)
+
+
+def _gearbox_problem(loaded: LoadedStudy, path: tuple[Any, ...]) -> StudyProblem:
+    return loaded.problem(path, "a gearbox in an arm study",
+                          "null: the arm optimiser's actuator mass and inertia are the motor's (gear ratio only); "
+                          "compare gearboxes in an actuator study (kind: actuator)")
+
+
+@functools.lru_cache(maxsize=4)
+def _setup_from_text(resolved_text: str) -> ArmSetup:
+    return arm_setup(parse_study(resolved_text, "resolved study"))
+
+
+@functools.lru_cache(maxsize=16)
+def problem_for(resolved_text: str, objective: str, bounded: tuple[str, ...]) -> Any:
+    """The design problem minimising ``objective`` with ``bounded`` objectives, built once per process."""
+    from ..optimize import build_problem
+
+    setup = _setup_from_text(resolved_text)
+    return build_problem(setup.arm, setup.samples, setup.space, setup.technology, objective, setup.constraints,
+                         bounded)
+
+
+# --- tasks (run in workers: plain data in, plain data out) -------------------------------------------------------
+
+
+def solve_single(resolved_text: str) -> dict[str, Any]:
+    """Solve the study's own objective; returns a design record."""
+    from ..optimize import solve
+
+    setup = _setup_from_text(resolved_text)
+    problem = _weighted_problem(resolved_text, _objective_key(dict(setup.study.objective)))
+    return design_record(setup, problem, solve(problem, ipopt_options=IPOPT_OPTIONS), "optimum")
+
+
+@functools.lru_cache(maxsize=4)
+def _weighted_problem(resolved_text: str, key: Any) -> Any:
+    from ..optimize import build_problem
+
+    setup = _setup_from_text(resolved_text)
+    objective = key if isinstance(key, str) else dict(key)
+    return build_problem(setup.arm, setup.samples, setup.space, setup.technology, objective, setup.constraints)
+
+
+def solve_anchor(resolved_text: str, objective: str, objectives: tuple[str, ...]) -> dict[str, Any]:
+    """A Pareto anchor: ``objective`` minimised, then (lexicographically) each other objective with it held at
+    its optimum, so that the anchor is not dominated."""
+    from ..optimize import solve
+    from ..optimize.pareto import ANCHOR_SLACK
+
+    setup = _setup_from_text(resolved_text)
+    others = tuple(o for o in objectives if o != objective)
+    result = solve(problem_for(resolved_text, objective, others), ipopt_options=IPOPT_OPTIONS)
+    held = _held_bound(objective, result.objectives[objective], ANCHOR_SLACK)
+    for other in others:
+        bounded = tuple(o for o in objectives if o != other)
+        result = solve(problem_for(resolved_text, other, bounded), epsilon={objective: held}, x0=result.x,
+                       ipopt_options=IPOPT_OPTIONS)
+    record = design_record(setup, problem_for(resolved_text, objective, others), result, f"anchor: {objective}")
+    record["x"] = result.x.tolist()
+    return record
+
+
+def _held_bound(name: str, value: float, slack: float) -> float:
+    from ..optimize import OBJECTIVES
+
+    sense = OBJECTIVES[name][0]
+    return value * (1 + sense * slack) if value > 0 else value + sense * slack
+
+
+def epsilon_grid(anchors: dict[str, dict[str, Any]], objectives: tuple[str, ...], count: int) -> list[dict[str, float]]:
+    """Bounds on the other objectives spread evenly between their values at the anchors (interior points)."""
+    from ..optimize import OBJECTIVES
+
+    bounded = objectives[1:]
+    if count <= 0:
+        return []
+    ranges = {}
+    for name in bounded:
+        values = [anchor["objectives"][name] for anchor in anchors.values()]
+        ranges[name] = (max(values), min(values)) if OBJECTIVES[name][0] > 0 else (min(values), max(values))
+    if len(bounded) == 1:
+        (name,) = bounded
+        return [{name: float(v)} for v in np.linspace(*ranges[name], count + 2)[1:-1]]
+    per_axis = max(2, round(math.sqrt(count)))
+    axes = [np.linspace(*ranges[name], per_axis + 2)[1:-1] for name in bounded]
+    return [{bounded[0]: float(a), bounded[1]: float(b)} for a in axes[0] for b in axes[1]]
+
+
+def solve_point(resolved_text: str, objectives: tuple[str, ...], epsilon: dict[str, float],
+                start: list[float]) -> dict[str, Any]:
+    """One epsilon-constraint point: the first objective minimised with the others bounded by ``epsilon``,
+    started from ``start`` (the first objective's anchor, so the result does not depend on the order of work)."""
+    from ..errors import SolverFailed
+    from ..optimize import solve
+
+    setup = _setup_from_text(resolved_text)
+    problem = problem_for(resolved_text, objectives[0], objectives[1:])
+    try:
+        result = solve(problem, epsilon=epsilon, x0=np.asarray(start), ipopt_options=IPOPT_OPTIONS)
+    except SolverFailed as error:
+        return {"failed": True, "epsilon": epsilon, "status": error.status, "message": str(error.args[0])}
+    return design_record(setup, problem, result, "epsilon: " + ", ".join(f"{k} <= {v:.4g}" for k, v in epsilon.items()))
+
+
+# --- records -----------------------------------------------------------------------------------------------------
+
+
+def design_record(setup: ArmSetup, problem: Any, result: Any, label: str) -> dict[str, Any]:
+    """A design and everything the report shows about it, as JSON types (SI units)."""
+    from ..arm import effective_parameters
+
+    design = result.design
+    samples = problem.samples
+    params = effective_parameters(
+        samples.kinematics, samples.directions, config_index=samples.config_index,
+        reflected_inertia=design.reflected_inertia,
+        stiffness=series_stiffness(design.mechanical_stiffness, design.software_stiffness),
+        mechanical_stiffness=design.mechanical_stiffness, torque_limit=design.peak_torque,
+        motor_mass=design.motor_mass,
+    )
+    threshold = design.threshold if design.sensing == "force" else params.k * design.threshold
+    phases = phase_impulses(params.m_f, params.k, params.k_m, threshold, params.a, design.approach_velocity,
+                            setup.study.reaction)
+    v_star = optimal_velocity(params.m_f, params.k, threshold, setup.study.reaction, params.k_m, params.a)
+    joints = []
+    for i, name in enumerate(design.joint_names):
+        joints.append({
+            "joint": name,
+            "stator_diameter": float(design.stator_diameter[i]),
+            "stack_length": float(design.stack_length[i]),
+            "gear_ratio": float(design.gear_ratio[i]),
+            "rotor_inertia": float(design.rotor_inertia[i]),
+            "reflected_inertia": float(design.reflected_inertia[i]),
+            "motor_peak_torque": float(design.motor_peak_torque[i]),
+            "peak_torque": float(design.peak_torque[i]),
+            "required_torque": float(result.required_torque[i]),
+            "torque_margin": float(result.torque_margin[i]),
+            "mechanical_stiffness": float(design.mechanical_stiffness[i]),
+            "software_stiffness": float(design.software_stiffness[i]),
+            "stiffness": float(series_stiffness(design.mechanical_stiffness[i], design.software_stiffness[i])),
+            "motor_mass": float(design.motor_mass[i]),
+            "nearest_catalogue_motor": nearest_catalogue_motor(
+                setup.catalogue, float(design.motor_peak_torque[i]), float(design.rotor_inertia[i])),
+        })
+    return {
+        "label": label,
+        "objectives": {k: float(v) for k, v in result.numpy_objectives.items()},
+        "casadi_objectives": {k: float(v) for k, v in result.objectives.items()},
+        "threshold": float(design.threshold),
+        "sensing": design.sensing,
+        "approach_velocity": float(design.approach_velocity),
+        "joints": joints,
+        "impulses": np.asarray(result.impulses, dtype=float).tolist(),
+        "phases": {
+            "initial": np.broadcast_to(phases.initial, params.m_f.shape).tolist(),
+            "sensing": np.broadcast_to(phases.sensing, params.m_f.shape).tolist(),
+            "reaction": np.broadcast_to(phases.reaction, params.m_f.shape).tolist(),
+        },
+        "optimal_velocity": np.asarray(v_star, dtype=float).tolist(),
+        "solver": {
+            "status": result.status, "iterations": int(result.iterations), "solve_time": float(result.solve_time),
+            "build_time": float(result.build_time), "epsilon": {k: float(v) for k, v in result.epsilon.items()},
+        },
+    }
+
+
+def nearest_catalogue_motor(catalogue: dict[str, Any], peak_torque: float, rotor_inertia: float) -> str:
+    """The catalogue motor closest to a scaled motor in (log peak torque, log rotor inertia): the off-the-shelf
+    part a designer would start from."""
+    best, best_distance = "", math.inf
+    for name, motor in catalogue.items():
+        distance = math.hypot(math.log(motor.peak_torque / peak_torque), math.log(motor.rotor_inertia / rotor_inertia))
+        if distance < best_distance:
+            best, best_distance = name, distance
+    return best
+
+
+def sample_layout(setup: ArmSetup) -> dict[str, Any]:
+    """Where each sample comes from (for the report's surfaces): configuration index and direction per sample."""
+    return {
+        "configurations": setup.configurations.tolist(),
+        "directions": setup.directions.tolist(),
+        "config_index": setup.samples.config_index.tolist(),
+        "sample_directions": setup.samples.directions.tolist(),
+        "joint_names": list(setup.arm.joint_names),
+        "task_dim": int(setup.arm.task_dim),
+    }
+
+
+def checked_setup(loaded: LoadedStudy, resolved_text: str) -> ArmSetup:
+    """The setup of a study, with its problem built once: every input problem (robot, frames, samples on which
+    the arm cannot move, impossible bounds) is raised here, located in the study file, before a run writes
+    anything."""
+    from ..errors import InvalidParameter
+
+    setup = arm_setup(loaded)  # located errors for the robot, motors and names
+    try:
+        _setup_from_text(resolved_text)
+        objective = dict(setup.study.objective)
+        _weighted_problem(resolved_text, _objective_key(objective))
+    except InvalidParameter as error:
+        raise loaded.fail(_field_of(error.name), f"{error}", "inputs the design problem accepts") from None
+    return setup
+
+
+def _field_of(name: str) -> tuple[str, ...]:
+    """The study field an optimiser parameter comes from (for locating its errors)."""
+    root = name.split("[")[0].split(" ")[0]
+    if root in PER_JOINT_DESIGN_VARIABLES or root in ("threshold", "approach_velocity"):
+        return ("design", root)
+    if root in ("payload", "safety_factor", "torque_required", "threshold_floor"):
+        return ("constraints", root)
+    if root in ("sample", "directions", "config_index"):
+        return ("samples",)
+    return ()
+
+
+def _objective_key(objective: dict[str, float]) -> Any:
+    """A hashable key for the study's objective: its name alone when it is a single unweighted objective."""
+    if len(objective) == 1 and next(iter(objective.values())) == 1.0:
+        return next(iter(objective))
+    return tuple(sorted(objective.items()))
+
+
+def setup_from_text(resolved_text: str) -> ArmSetup:
+    """The (cached) setup of a resolved study."""
+    return _setup_from_text(resolved_text)

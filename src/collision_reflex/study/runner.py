@@ -1,0 +1,302 @@
+"""Running a study end to end: validate everything first, then do the independent work through an executor,
+keep each finished piece, and write the results and the report.
+
+A run restarted with the same command finds its finished pieces in ``OUT/points`` and does only the rest; the
+same study (and seed) gives the same numbers whatever the executor, because every piece of work is a pure
+function of the resolved study and its own inputs.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable
+from concurrent.futures import Executor, Future
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from .. import __version__
+from .executors import open_executor
+from .load import LoadedStudy, load_study, parse_study
+from .resolve import fingerprint, resolved_study, resolved_yaml
+from .schema import ActuatorStudy, ArmStudy
+from .store import DESIGNS, PARETO, RunFolder, write_json
+
+SMOKE_ENVIRONMENT = "CRX_SMOKE"
+"""Set to 1 to run every study with small sample counts (tests, quick checks): see :func:`smoke_study`."""
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """Where a run wrote its results, and what it did.
+
+    folder: the output folder; resumed: whether finished work was found and reused; computed: pieces of work
+    done in this run; reused: pieces found finished; elapsed: wall time [s].
+    """
+
+    folder: Path
+    resumed: bool
+    computed: int
+    reused: int
+    elapsed: float
+
+    @property
+    def report(self) -> Path:
+        return self.folder / "report.html"
+
+
+def smoke_study(data: dict[str, Any]) -> dict[str, Any]:
+    """A resolved study shrunk for a quick run: a few configurations, directions, Pareto points and
+    velocities. The shrunk study is what the run records as its resolved study."""
+    data = {**data}
+    if data.get("kind") == "actuator":
+        data["velocities"] = {**data["velocities"], "count": min(data["velocities"]["count"], 12)}
+        return data
+    samples = {**data["samples"]}
+    configurations = {**samples["configurations"]}
+    if configurations.get("random"):
+        configurations["random"] = {**configurations["random"], "count": min(configurations["random"]["count"], 3)}
+    if configurations.get("list"):
+        configurations["list"] = configurations["list"][:2]
+    if configurations.get("trajectory"):
+        configurations["trajectory"] = {**configurations["trajectory"],
+                                        "every": max(configurations["trajectory"]["every"], 50)}
+    directions = {**samples["directions"]}
+    for key in ("circle", "sphere"):
+        if directions.get(key):
+            directions[key] = min(directions[key], 6)
+    for key in ("named", "list"):
+        if directions.get(key):
+            directions[key] = directions[key][:4]
+    data["samples"] = {"configurations": configurations, "directions": directions}
+    if data.get("pareto"):
+        data["pareto"] = {**data["pareto"], "points": min(data["pareto"]["points"], 4)}
+    return data
+
+
+def default_output_folder(loaded: LoadedStudy) -> Path:
+    """``results/<study name>`` under the working directory."""
+    return Path.cwd() / "results" / loaded.study.name
+
+
+def run_study(
+    path: str | os.PathLike[str],
+    out: str | os.PathLike[str] | None = None,
+    *,
+    quiet: bool = False,
+    scheduler: str | None = None,
+    executor: str | None = None,
+    workers: int | None = None,
+    smoke: bool | None = None,
+    figures: bool = True,
+) -> RunResult:
+    """Run the study in file ``path`` and write its results to ``out`` (default ``results/<name>``).
+
+    Parameters
+    ----------
+    quiet: no progress bars (for scripts and logs).
+    scheduler: a Dask scheduler address (``tcp://host:8786``): run the work on that cluster.
+    executor, workers: override the study's execution settings (``serial``, ``processes``, ``dask``).
+    smoke: shrink sample counts for a quick run (default: the environment variable ``CRX_SMOKE``).
+
+    Every input is checked before the output folder is touched: a bad study raises
+    :class:`~collision_reflex.errors.StudyFileError` (with its lines) and writes nothing.
+    """
+    started = time.perf_counter()
+    loaded = load_study(path)
+    smoke = bool(os.environ.get(SMOKE_ENVIRONMENT, "")) if smoke is None else smoke
+    resolved = resolved_study(loaded)
+    if smoke:
+        resolved = smoke_study(resolved)
+        loaded = parse_study(_dump(resolved), str(path), loaded.directory)
+    text = resolved_yaml(loaded)
+    setup = _prepare(loaded, text)  # loads robot and motors: every problem raised here, before any output
+    folder = RunFolder(Path(out) if out is not None else default_output_folder(loaded))
+    execution = resolved.get("execution", {})
+    kind = executor or execution.get("executor", "serial")
+    if scheduler is None and kind == "dask":
+        scheduler = execution.get("scheduler")
+    resumed = folder.claim(fingerprint(resolved), text, {
+        "study": loaded.study.name, "study_file": str(path), "smoke": smoke, "version": __version__,
+        "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+    })
+    progress = _Progress(quiet)
+    try:
+        with open_executor(kind, workers or execution.get("workers", 2), scheduler) as pool:
+            if isinstance(loaded.study, ArmStudy):
+                results, counts = _run_arm(loaded.study, text, setup, folder, pool, progress)
+            else:
+                results, counts = _run_actuators(loaded, folder, progress)
+    except BaseException:
+        progress.stop()
+        folder.update_manifest(status="interrupted")
+        raise
+    progress.stop()
+    from ..report import write_outputs
+
+    write_outputs(folder.path, results, figures=figures, quiet=quiet)
+    elapsed = time.perf_counter() - started
+    folder.update_manifest(status="finished", elapsed=elapsed, computed=counts[0], reused=counts[1])
+    return RunResult(folder.path, resumed, counts[0], counts[1], elapsed)
+
+
+def _dump(data: dict[str, Any]) -> str:
+    import yaml
+
+    return yaml.safe_dump(data, sort_keys=False)
+
+
+def _prepare(loaded: LoadedStudy, text: str) -> Any:
+    if isinstance(loaded.study, ArmStudy):
+        from . import _optimizer
+
+        return _optimizer.checked_setup(loaded, text)
+    from .actuator_study import check_actuator_study
+
+    return check_actuator_study(loaded)
+
+
+class _Progress:
+    """Rich progress bars on stderr (none when quiet)."""
+
+    def __init__(self, quiet: bool) -> None:
+        self._bar: Any = None
+        if not quiet:
+            from rich.console import Console
+            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+            self._bar = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                                 TimeElapsedColumn(), console=Console(stderr=True))
+            self._bar.start()
+
+    def stage(self, description: str, total: int, done: int = 0) -> Callable[[], None]:
+        if self._bar is None:
+            return lambda: None
+        task = self._bar.add_task(description, total=total, completed=done)
+        return lambda: self._bar.advance(task)
+
+    def stop(self) -> None:
+        if self._bar is not None:
+            self._bar.stop()
+            self._bar = None
+
+
+def _gather(pool: Executor, folder: RunFolder, work: dict[str, tuple[Callable[..., Any], tuple[Any, ...]]],
+            progress: _Progress, description: str) -> tuple[dict[str, Any], int]:
+    """Run each named piece of work not finished yet; save each as it completes. Returns all records (finished
+    before and now) and how many were computed now."""
+    records: dict[str, Any] = {}
+    todo = {}
+    for name, job in work.items():
+        saved = folder.finished(name)
+        if saved is not None:
+            records[name] = saved
+        else:
+            todo[name] = job
+    advance = progress.stage(description, len(work), len(records))
+    futures: dict[Future, str] = {pool.submit(fn, *args): name for name, (fn, args) in todo.items()}
+    from concurrent.futures import as_completed
+
+    try:
+        for future in as_completed(futures):
+            name = futures[future]
+            record = future.result()
+            folder.save(name, record)
+            records[name] = record
+            advance()
+    except BaseException:
+        for future in futures:
+            future.cancel()
+        raise
+    return {name: records[name] for name in work}, len(todo)
+
+
+def _run_arm(study: ArmStudy, text: str, setup: Any, folder: RunFolder, pool: Executor,
+             progress: _Progress) -> tuple[dict[str, Any], tuple[int, int]]:
+    from . import _optimizer
+
+    computed = reused = 0
+    chosen, n = _gather(pool, folder, {"optimum": (_optimizer.solve_single, (text,))}, progress,
+                        "optimum of the study's objective")
+    computed += n
+    reused += 1 - n
+    pareto: dict[str, Any] = {"objectives": [], "points": [], "failed": [], "dominated": []}
+    if study.pareto is not None:
+        names = tuple(study.pareto.objectives)
+        anchors, n = _gather(
+            pool, folder, {f"anchor-{name}": (_optimizer.solve_anchor, (text, name, names)) for name in names},
+            progress, "Pareto anchors")
+        computed += n
+        reused += len(anchors) - n
+        by_objective = {name: anchors[f"anchor-{name}"] for name in names}
+        grid = _optimizer.epsilon_grid(by_objective, names, study.pareto.points - len(names))
+        start = by_objective[names[0]]["x"]
+        points, n = _gather(
+            pool, folder,
+            {f"point-{i:03d}": (_optimizer.solve_point, (text, names, epsilon, start)) for i, epsilon in enumerate(grid)},
+            progress, "Pareto points")
+        computed += n
+        reused += len(points) - n
+        solved = [*anchors.values(), *(p for p in points.values() if not p.get("failed"))]
+        front, dominated = non_dominated(solved, names)
+        pareto = {
+            "objectives": list(names),
+            "points": front,
+            "failed": [p for p in points.values() if p.get("failed")],
+            "dominated": dominated,
+        }
+    results = {
+        "kind": "arm",
+        "study": study.name,
+        "description": study.description,
+        "resolved": resolved_study(parse_study(text, "resolved study")),
+        "samples": _optimizer.sample_layout(setup),
+        "chosen": chosen["optimum"],
+        "pareto": pareto,
+    }
+    return results, (computed, reused)
+
+
+def non_dominated(records: list[dict[str, Any]], names: tuple[str, ...],
+                  tolerance: float = 1e-9) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """Split design records into the non-dominated ones (sorted by the first objective) and the rest.
+
+    ``a`` dominates ``b`` when it is no worse in every objective and better by more than ``tolerance``
+    (relative to the objective's range of magnitudes) in one; of near-duplicates the first is kept.
+    """
+    import numpy as np
+
+    from ..optimize import OBJECTIVES
+
+    if not records:
+        return [], []
+    sense = np.array([OBJECTIVES[name][0] for name in names], dtype=float)
+    values = np.array([[r["objectives"][n] for n in names] for r in records]) * sense
+    scale = np.maximum(np.abs(values).max(axis=0), 1e-300)
+    keep, drop = [], []
+    for i in range(len(records)):
+        diff = (values - values[i]) / scale
+        dominated = np.any(np.all(diff <= tolerance, axis=1) & np.any(diff < -tolerance, axis=1))
+        duplicate = np.any(np.all(np.abs(diff) <= tolerance, axis=1)[:i])
+        (drop if dominated or duplicate else keep).append(i)
+    keep.sort(key=lambda i: values[i, 0])
+    return [records[i] for i in keep], [records[i] for i in drop]
+
+
+def _run_actuators(loaded: LoadedStudy, folder: RunFolder,
+                   progress: _Progress) -> tuple[dict[str, Any], tuple[int, int]]:
+    from .actuator_study import evaluate_actuator_study
+
+    assert isinstance(loaded.study, ActuatorStudy)
+    saved = folder.finished("actuators")
+    if saved is None:
+        advance = progress.stage("actuators", 1)
+        saved = evaluate_actuator_study(loaded)
+        folder.save("actuators", saved)
+        advance()
+        return saved, (1, 0)
+    return saved, (0, 1)
+
+
+__all__ = ["DESIGNS", "PARETO", "RunResult", "non_dominated", "run_study", "smoke_study", "write_json"]

@@ -1,0 +1,114 @@
+"""A run's output folder: atomic files, a manifest that ties the folder to one study, and finished work kept
+for resuming.
+
+Layout::
+
+    OUT/study.resolved.yaml   the study as run (defaults explicit, SI units)
+    OUT/run.json              manifest: study fingerprint, status, timings
+    OUT/points/*.json         one file per finished piece of work (a Pareto point, an anchor, ...)
+    OUT/pareto.csv, OUT/designs.json, OUT/figures/*, OUT/report.html   the results
+
+Every file is written to a temporary name and renamed, so it is complete or absent.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from .._io import atomic_open
+from ..errors import CollisionReflexError
+
+MANIFEST = "run.json"
+RESOLVED = "study.resolved.yaml"
+DESIGNS = "designs.json"
+PARETO = "pareto.csv"
+REPORT = "report.html"
+
+
+class OutputFolderInUse(CollisionReflexError):
+    """The output folder holds results of a different study (or of the same study with other settings)."""
+
+
+class ResultsMissing(CollisionReflexError, FileNotFoundError):
+    """A folder has no saved results to report on."""
+
+
+def write_json(path: str | os.PathLike[str], data: Any) -> None:
+    """Write ``data`` as JSON, atomically (NaN refused: it is never a valid result)."""
+    with atomic_open(path, "w", encoding="utf-8") as handle:
+        json.dump(data, handle, indent=1, allow_nan=False)
+        handle.write("\n")
+
+
+def write_text(path: str | os.PathLike[str], text: str) -> None:
+    with atomic_open(path, "w", encoding="utf-8") as handle:
+        handle.write(text)
+
+
+def read_json(path: str | os.PathLike[str]) -> Any:
+    return json.loads(Path(path).read_text(encoding="utf-8"))
+
+
+@dataclass(frozen=True)
+class RunFolder:
+    """The output folder of one study run."""
+
+    path: Path
+
+    @property
+    def points(self) -> Path:
+        return self.path / "points"
+
+    @property
+    def figures(self) -> Path:
+        return self.path / "figures"
+
+    def claim(self, fingerprint: str, resolved_yaml: str, details: dict[str, Any]) -> bool:
+        """Make the folder this study's; returns True if it already was (a resumed run).
+
+        Raises :class:`OutputFolderInUse` if it holds another study's results.
+        """
+        manifest = self.path / MANIFEST
+        resumed = False
+        if manifest.exists():
+            try:
+                previous = read_json(manifest)
+            except (OSError, ValueError):
+                previous = {}
+            if previous.get("fingerprint") != fingerprint:
+                raise OutputFolderInUse(
+                    f"{self.path} holds results of {previous.get('study', 'another study')!r} run with other "
+                    "settings; give another folder with --out, or delete this one to start afresh"
+                )
+            resumed = True
+        elif self.path.exists() and any(self.path.iterdir()):
+            raise OutputFolderInUse(
+                f"{self.path} exists and is not a study's output folder; give another folder with --out"
+            )
+        self.path.mkdir(parents=True, exist_ok=True)
+        write_text(self.path / RESOLVED, resolved_yaml)
+        write_json(manifest, {"fingerprint": fingerprint, "status": "running", **details})
+        return resumed
+
+    def finished(self, name: str) -> dict[str, Any] | None:
+        """A finished piece of work saved under ``name``, or None."""
+        path = self.points / f"{name}.json"
+        if not path.exists():
+            return None
+        try:
+            return read_json(path)  # type: ignore[no-any-return]
+        except (OSError, ValueError):
+            return None  # unreadable: do the work again
+
+    def save(self, name: str, record: dict[str, Any]) -> None:
+        write_json(self.points / f"{name}.json", record)
+
+    def update_manifest(self, **fields: Any) -> None:
+        manifest = self.path / MANIFEST
+        data = read_json(manifest) if manifest.exists() else {}
+        data.update(fields)
+        write_json(manifest, data)
