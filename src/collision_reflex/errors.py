@@ -76,7 +76,8 @@ class StudyProblem:
     Attributes
     ----------
     file: the study file's path as given (``"<string>"`` for text not read from a file).
-    line, column: 1-based position of the offending node (its key, or the nearest enclosing node that exists).
+    line, column: 1-based position of the offending node (its key, or the nearest enclosing node that exists);
+        0 for problems with the file itself (missing, unreadable).
     path: the field's path in the study, e.g. ``"actuators.joints.joint2.software_stiffness"``.
     found: a short description of what the file holds there.
     expected: what would be accepted, and where useful what to do.
@@ -90,7 +91,7 @@ class StudyProblem:
     expected: str
 
     def __str__(self) -> str:
-        where = f"{self.file}:{self.line}:{self.column}"
+        where = f"{self.file}:{self.line}:{self.column}" if self.line > 0 else self.file  # 0: the file itself
         field = f" {self.path}:" if self.path else ""
         return f"{where}:{field} found {self.found}; expected {self.expected}"
 

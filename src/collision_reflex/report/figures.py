@@ -4,13 +4,14 @@ text for inlining in the HTML report."""
 from __future__ import annotations
 
 import contextlib
+import re
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from .outputs import OBJECTIVE_UNITS
+from .outputs import objective_unit
 
 
 @contextlib.contextmanager
@@ -32,7 +33,9 @@ def _draw(directory: Path, name: str, formats: list[str], draw: Callable[[Path],
             draw(directory / f"{name}.png")
     if "svg" not in formats:
         Path(svg_path).unlink()
-    return text[text.index("<svg") :]
+    # Inline: from the <svg> element on, without the metadata block (it only records the drawing time, which
+    # would make otherwise identical reports differ).
+    return re.sub(r"<metadata>.*?</metadata>\s*", "", text[text.index("<svg") :], count=1, flags=re.S)
 
 
 def draw_figures(directory: Path, results: dict[str, Any], formats: list[str]) -> dict[str, str]:
@@ -57,7 +60,7 @@ def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
     if len(pareto["points"]) >= 2:
         values = np.array([[p["objectives"][n] for n in names] for p in pareto["points"]])
         svgs["front"] = _draw(directory, "pareto_front", formats, lambda path: plot_design_front(
-            path, names, [OBJECTIVE_UNITS[n] for n in names], values,
+            path, names, [objective_unit(n) for n in names], values,
             [chosen["objectives"][n] for n in names[:2]]))
     featured = {"chosen design": chosen}
     if pareto["points"]:

@@ -11,13 +11,14 @@ from typing import Any
 from ..errors import CollisionReflexError
 from ..study.store import DESIGNS, PARETO, REPORT, ResultsMissing, read_json, write_json, write_text
 
-OBJECTIVE_UNITS = {
-    "worst_case_impulse": "N*s",
-    "mean_impulse": "N*s",
-    "actuator_mass": "kg",
-    "approach_velocity": "m/s",
-}
-SENSE = {"worst_case_impulse": 1, "mean_impulse": 1, "actuator_mass": 1, "approach_velocity": -1}
+
+
+def objective_unit(name: str) -> str:
+    """The unit of an optimiser objective (from :data:`collision_reflex.optimize.OBJECTIVES`)."""
+    from ..optimize import OBJECTIVES
+
+    return OBJECTIVES[name][1]
+
 # Per-joint columns of pareto.csv: (record key, column name, unit).
 JOINT_COLUMNS = (
     ("stator_diameter", "stator_diameter", "m"),
@@ -41,7 +42,7 @@ def pareto_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
     for index, record in enumerate(points):
         row: dict[str, Any] = {"point": index, "label": record["label"]}
         for name, value in record["objectives"].items():
-            row[f"{name} [{OBJECTIVE_UNITS[name]}]"] = value
+            row[f"{name} [{objective_unit(name)}]"] = value
         for key, column, unit in JOINT_COLUMNS:
             for joint in record["joints"]:
                 row[f"{column}[{joint['joint']}] [{unit}]"] = joint[key]

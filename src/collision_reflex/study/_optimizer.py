@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import functools
 import math
+import threading
 from dataclasses import dataclass
 from typing import Any
 
@@ -24,6 +25,10 @@ from .prepare import check_motors, joint_actuators, per_joint_bounds
 from .robot import load_arm
 from .samples import configuration_samples, direction_samples
 from .schema import PER_JOINT_DESIGN_VARIABLES, ArmStudy
+
+_SOLVER_LOCK = threading.RLock()
+"""CasADi functions, IPOPT and (sequential) MUMPS are not thread-safe: within one process the tasks below run one
+at a time (a Dask worker with several threads, for instance); parallelism comes from processes."""
 
 IPOPT_OPTIONS = {"ipopt.max_iter": 400}
 """Options over the optimiser's defaults for study runs (a cap keeps a hopeless Pareto point from stalling a run)."""
@@ -118,11 +123,6 @@ def _check_supported(loaded: LoadedStudy, study: ArmStudy) -> None:
             problems.append(_gearbox_problem(loaded, ("actuators", "joints", joint, "gearbox")))
     if study.actuators.gearbox is not None:
         problems.append(_gearbox_problem(loaded, ("actuators", "gearbox")))
-    if study.robot.locked_joints:
-        problems.append(
-            loaded.problem(("robot", "locked_joints"), "locked joints",
-                           "no locked joints: the arm model does not lock joints yet; use a URDF without them")
-        )
     if problems:
         raise StudyFileError(loaded.source.file, problems)
 
@@ -151,6 +151,17 @@ def problem_for(resolved_text: str, objective: str, bounded: tuple[str, ...]) ->
 # --- tasks (run in workers: plain data in, plain data out) -------------------------------------------------------
 
 
+def _one_at_a_time(function: Any) -> Any:
+    @functools.wraps(function)
+    def locked(*args: Any, **kwargs: Any) -> Any:
+        with _SOLVER_LOCK:
+            return function(*args, **kwargs)
+
+    return locked
+
+
+
+@_one_at_a_time
 def solve_single(resolved_text: str) -> dict[str, Any]:
     """Solve the study's own objective; returns a design record."""
     from ..optimize import solve
@@ -169,6 +180,7 @@ def _weighted_problem(resolved_text: str, key: Any) -> Any:
     return build_problem(setup.arm, setup.samples, setup.space, setup.technology, objective, setup.constraints)
 
 
+@_one_at_a_time
 def solve_anchor(resolved_text: str, objective: str, objectives: tuple[str, ...]) -> dict[str, Any]:
     """A Pareto anchor: ``objective`` minimised, then (lexicographically) each other objective with it held at
     its optimum, so that the anchor is not dominated."""
@@ -214,6 +226,7 @@ def epsilon_grid(anchors: dict[str, dict[str, Any]], objectives: tuple[str, ...]
     return [{bounded[0]: float(a), bounded[1]: float(b)} for a in axes[0] for b in axes[1]]
 
 
+@_one_at_a_time
 def solve_point(resolved_text: str, objectives: tuple[str, ...], epsilon: dict[str, float],
                 start: list[float]) -> dict[str, Any]:
     """One epsilon-constraint point: the first objective minimised with the others bounded by ``epsilon``,

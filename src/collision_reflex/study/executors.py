@@ -21,7 +21,7 @@ class SerialExecutor(Executor):
         future: Future = Future()
         try:
             future.set_result(fn(*args, **kwargs))
-        except BaseException as error:  # delivered through the future, as a pool would
+        except Exception as error:  # delivered through the future, as a pool would; Ctrl-C stops at once
             future.set_exception(error)
         return future
 

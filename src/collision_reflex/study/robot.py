@@ -7,6 +7,7 @@ the study file that names them.
 from __future__ import annotations
 
 import difflib
+import inspect
 from typing import Any
 
 from ..errors import CollisionReflexError, StudyFileError, StudyProblem
@@ -47,8 +48,9 @@ def load_arm(loaded: LoadedStudy) -> Any:
                     ("one of " + ", ".join(map(repr, close)) + " or another of " if close else "one of ")
                     + f"the {len(names)} models of example-robot-data (e.g. ur5, panda, double_pendulum)",
                 )
+            locking = _locking(loaded, Arm.from_example_robot_data)
             arm = Arm.from_example_robot_data(spec.example_robot_data, contact_frame=spec.contact_frame,
-                                              contact_offset=offset)
+                                              contact_offset=offset, **locking)
         else:
             assert spec.urdf is not None  # one source is guaranteed by the schema
             arm = Arm.from_urdf(
@@ -56,6 +58,7 @@ def load_arm(loaded: LoadedStudy) -> Any:
                 spec.contact_frame,
                 package_dirs=[str(loaded.path(p)) for p in spec.package_dirs] or None,
                 contact_offset=offset,
+                **_locking(loaded, Arm.from_urdf),
             )
     except StudyFileError:
         raise
@@ -67,6 +70,17 @@ def load_arm(loaded: LoadedStudy) -> Any:
     if problems:
         raise StudyFileError(loaded.source.file, problems)
     return arm
+
+
+def _locking(loaded: LoadedStudy, constructor: Any) -> dict[str, Any]:
+    """``locked_joints=...`` for the arm constructor, if the study locks joints."""
+    locked = list(loaded.study.robot.locked_joints)  # type: ignore[union-attr]
+    if not locked:
+        return {}
+    if "locked_joints" not in inspect.signature(constructor).parameters:
+        raise loaded.fail(("robot", "locked_joints"), "locked joints",
+                          "no locked joints: this version's arm model cannot lock joints")
+    return {"locked_joints": locked}
 
 
 def check_against_arm(loaded: LoadedStudy, arm: Any) -> list[StudyProblem]:
@@ -90,8 +104,6 @@ def check_against_arm(loaded: LoadedStudy, arm: Any) -> list[StudyProblem]:
         spec = getattr(study.design, variable)
         for name in getattr(spec, "joints", {}) or {}:
             check_joint(("design", variable, "joints", name), name)
-    for index, name in enumerate(study.robot.locked_joints):
-        check_joint(("robot", "locked_joints", index), name)
 
     nq = int(arm.model.nq)
     for index, q in enumerate(study.samples.configurations.list or []):

@@ -11,7 +11,7 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable
-from concurrent.futures import Executor, Future
+from concurrent.futures import FIRST_COMPLETED, Executor, Future, wait
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -123,9 +123,13 @@ def run_study(
     })
     progress = _Progress(quiet)
     try:
-        with open_executor(kind, workers or execution.get("workers", 2), scheduler) as pool:
+        n_workers = workers or execution.get("workers", 2)
+        # Work in flight: one at a time in-process; a few per worker for a pool (so that finished work is saved
+        # while the rest runs); everything at once for a Dask cluster, whose size is its own business.
+        window = 1 if kind == "serial" and scheduler is None else (10**6 if scheduler else 2 * n_workers)
+        with open_executor(kind, n_workers, scheduler) as pool:
             if isinstance(loaded.study, ArmStudy):
-                results, counts = _run_arm(loaded.study, text, setup, folder, pool, progress)
+                results, counts = _run_arm(loaded.study, text, setup, folder, pool, progress, window)
             else:
                 results, counts = _run_actuators(loaded, folder, progress)
     except BaseException:
@@ -183,42 +187,46 @@ class _Progress:
 
 
 def _gather(pool: Executor, folder: RunFolder, work: dict[str, tuple[Callable[..., Any], tuple[Any, ...]]],
-            progress: _Progress, description: str) -> tuple[dict[str, Any], int]:
-    """Run each named piece of work not finished yet; save each as it completes. Returns all records (finished
-    before and now) and how many were computed now."""
+            progress: _Progress, description: str, window: int) -> tuple[dict[str, Any], int]:
+    """Run each named piece of work not finished yet, at most ``window`` at a time, saving each as it
+    completes (so an interruption loses only the pieces in flight). Returns every record (finished before and
+    now) and how many were computed now."""
     records: dict[str, Any] = {}
-    todo = {}
+    queue: list[tuple[str, tuple[Callable[..., Any], tuple[Any, ...]]]] = []
     for name, job in work.items():
         saved = folder.finished(name)
         if saved is not None:
             records[name] = saved
         else:
-            todo[name] = job
+            queue.append((name, job))
+    computed = len(queue)
     advance = progress.stage(description, len(work), len(records))
-    futures: dict[Future, str] = {pool.submit(fn, *args): name for name, (fn, args) in todo.items()}
-    from concurrent.futures import as_completed
-
+    pending: dict[Future, str] = {}
     try:
-        for future in as_completed(futures):
-            name = futures[future]
-            record = future.result()
-            folder.save(name, record)
-            records[name] = record
-            advance()
+        while queue or pending:
+            while queue and len(pending) < window:
+                name, (fn, args) = queue.pop(0)
+                pending[pool.submit(fn, *args)] = name
+            done, _ = wait(pending, return_when=FIRST_COMPLETED)
+            for future in sorted(done, key=lambda f: pending[f]):
+                name = pending.pop(future)
+                records[name] = future.result()
+                folder.save(name, records[name])
+                advance()
     except BaseException:
-        for future in futures:
+        for future in pending:
             future.cancel()
         raise
-    return {name: records[name] for name in work}, len(todo)
+    return {name: records[name] for name in work}, computed
 
 
-def _run_arm(study: ArmStudy, text: str, setup: Any, folder: RunFolder, pool: Executor,
-             progress: _Progress) -> tuple[dict[str, Any], tuple[int, int]]:
+def _run_arm(study: ArmStudy, text: str, setup: Any, folder: RunFolder, pool: Executor, progress: _Progress,
+             window: int) -> tuple[dict[str, Any], tuple[int, int]]:
     from . import _optimizer
 
     computed = reused = 0
     chosen, n = _gather(pool, folder, {"optimum": (_optimizer.solve_single, (text,))}, progress,
-                        "optimum of the study's objective")
+                        "optimum of the study's objective", window)
     computed += n
     reused += 1 - n
     pareto: dict[str, Any] = {"objectives": [], "points": [], "failed": [], "dominated": []}
@@ -226,7 +234,7 @@ def _run_arm(study: ArmStudy, text: str, setup: Any, folder: RunFolder, pool: Ex
         names = tuple(study.pareto.objectives)
         anchors, n = _gather(
             pool, folder, {f"anchor-{name}": (_optimizer.solve_anchor, (text, name, names)) for name in names},
-            progress, "Pareto anchors")
+            progress, "Pareto anchors", window)
         computed += n
         reused += len(anchors) - n
         by_objective = {name: anchors[f"anchor-{name}"] for name in names}
@@ -235,7 +243,7 @@ def _run_arm(study: ArmStudy, text: str, setup: Any, folder: RunFolder, pool: Ex
         points, n = _gather(
             pool, folder,
             {f"point-{i:03d}": (_optimizer.solve_point, (text, names, epsilon, start)) for i, epsilon in enumerate(grid)},
-            progress, "Pareto points")
+            progress, "Pareto points", window)
         computed += n
         reused += len(points) - n
         solved = [*anchors.values(), *(p for p in points.values() if not p.get("failed"))]

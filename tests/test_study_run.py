@@ -1,0 +1,235 @@
+"""`crx run` and `crx report` end to end: every example study runs (small counts), the report is self-contained,
+opens in headless Chromium without console errors and shows the numbers of pareto.csv; runs resume, repeat and
+scale out to Dask with the same numbers; bad input writes nothing."""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import subprocess
+import textwrap
+from html.parser import HTMLParser
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from collision_reflex.cli import main
+from collision_reflex.report.pdf import find_browser, headless_flags
+from collision_reflex.study import _optimizer
+from collision_reflex.study.runner import run_study
+
+ROOT = Path(__file__).resolve().parents[1]
+STUDIES = sorted((ROOT / "studies").glob("*.yaml"))
+TWO_LINK = ROOT / "studies" / "two_link_paper.yaml"
+ACTUATORS = ROOT / "studies" / "direct_drive_vs_geared.yaml"
+SOLVER_COLUMNS = ("solve_time [s]",)  # wall times differ between runs; everything else must not
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    """Each example study run once (smoke size), shared by the tests that inspect the outputs."""
+    out = {}
+    for path in STUDIES:
+        folder = tmp_path_factory.mktemp(path.stem) / "out"
+        assert main(["run", str(path), "--out", str(folder), "--quiet", "--smoke", "--executor", "serial"]) == 0
+        out[path.stem] = folder
+    return out
+
+
+@pytest.mark.parametrize("name", [p.stem for p in STUDIES], ids=[p.stem for p in STUDIES])
+def test_every_example_study_runs(runs, name):
+    folder = runs[name]
+    for file in ("study.resolved.yaml", "run.json", "pareto.csv", "designs.json", "report.html"):
+        assert (folder / file).is_file(), file
+    assert json.loads((folder / "run.json").read_text())["status"] == "finished"
+    figures = sorted(p.name for p in (folder / "figures").iterdir())
+    assert any(f.endswith(".png") for f in figures) and any(f.endswith(".svg") for f in figures)
+    assert not [p for p in folder.rglob(".*") if p.is_file()]  # no temporary files left behind
+    table = pd.read_csv(folder / "pareto.csv")
+    assert len(table) >= 1
+    numbers = table.select_dtypes("number").to_numpy()
+    assert (numbers == numbers).all()  # no NaN anywhere in the results
+
+
+class _Tables(HTMLParser):
+    """The text of every cell of the table with a given id."""
+
+    def __init__(self, table_id: str) -> None:
+        super().__init__()
+        self.table_id, self.inside, self.rows, self.cell = table_id, False, [], None
+
+    def handle_starttag(self, tag, attrs):
+        if tag == "table" and dict(attrs).get("id") == self.table_id:
+            self.inside = True
+        elif self.inside and tag == "tr":
+            self.rows.append([])
+        elif self.inside and tag in ("td", "th"):
+            self.cell = ""
+
+    def handle_endtag(self, tag):
+        if tag == "table":
+            self.inside = False
+        elif self.inside and tag in ("td", "th") and self.cell is not None:
+            self.rows[-1].append(self.cell.strip())
+            self.cell = None
+
+    def handle_data(self, data):
+        if self.cell is not None:
+            self.cell += data
+
+
+@pytest.mark.parametrize("name", [p.stem for p in STUDIES], ids=[p.stem for p in STUDIES])
+def test_report_tables_hold_the_numbers_of_pareto_csv(runs, name):
+    folder = runs[name]
+    parser = _Tables("pareto-table")
+    parser.feed((folder / "report.html").read_text())
+    header, *body = parser.rows
+    table = pd.read_csv(folder / "pareto.csv")
+    assert header == list(table.columns)
+    assert len(body) == len(table)
+    for row, (_, expected) in zip(body, table.iterrows(), strict=True):
+        for text, (column, value) in zip(row, expected.items(), strict=True):
+            if isinstance(value, (bool,)) or column in ("label", "status", "actuator", "motor", "pareto_optimal"):
+                assert text == str(value), column
+            else:
+                # The report prints 4 significant digits: equal within half a unit of the 4th digit.
+                assert float(text) == pytest.approx(float(value), rel=5e-4), column
+
+
+def test_report_is_self_contained(runs):
+    for folder in runs.values():
+        html = (folder / "report.html").read_text()
+        assert "<svg" in html
+        # No resource is fetched: no scripts, stylesheets, images or frames from anywhere (SVG's xmlns are names,
+        # not loads).
+        assert not re.search(r"<(script|link|img|iframe)\b", html)
+        assert not re.search(r"""(src|href)\s*=\s*["'](https?:|//|file:)""", html)
+
+
+@pytest.fixture(scope="module")
+def browser():
+    path = find_browser()
+    if path is None:
+        pytest.skip("no Chromium installed (apt-get install chromium); .ci/run installs it where it can")
+    return path
+
+
+def test_report_opens_in_headless_chromium_without_console_errors(runs, browser, tmp_path):
+    for name, folder in runs.items():
+        completed = subprocess.run(
+            [browser, *headless_flags(str(tmp_path / f"profile-{name}")), "--enable-logging=stderr", "--v=0",
+             "--dump-dom", (folder / "report.html").as_uri()],
+            capture_output=True, text=True, timeout=120, check=False,
+        )
+        assert completed.returncode == 0, completed.stderr[-2000:]
+        assert 'id="pareto-table"' in completed.stdout  # the page loaded and rendered its tables
+        console = [line for line in completed.stderr.splitlines() if "CONSOLE" in line or "Failed to load" in line]
+        assert not console, console
+
+
+def _numbers(folder: Path) -> pd.DataFrame:
+    return pd.read_csv(folder / "pareto.csv").drop(columns=list(SOLVER_COLUMNS), errors="ignore")
+
+
+def test_same_study_gives_the_same_numbers(runs, tmp_path):
+    again = tmp_path / "again"
+    run_study(TWO_LINK, again, quiet=True, smoke=True, executor="serial")
+    pd.testing.assert_frame_equal(_numbers(again), _numbers(runs["two_link_paper"]))
+
+
+def test_interrupted_run_resumes_from_finished_points(runs, tmp_path, monkeypatch):
+    folder = tmp_path / "interrupted"
+    original = _optimizer.solve_point
+    calls = {"n": 0}
+
+    def interrupt_second_point(*args, **kwargs):
+        calls["n"] += 1
+        if calls["n"] == 2:
+            raise KeyboardInterrupt  # as Ctrl-C in the middle of the sweep
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(_optimizer, "solve_point", interrupt_second_point)
+    with pytest.raises(KeyboardInterrupt):
+        run_study(TWO_LINK, folder, quiet=True, smoke=True, executor="serial")
+    assert json.loads((folder / "run.json").read_text())["status"] == "interrupted"
+    assert not (folder / "pareto.csv").exists()  # no results until the run has finished
+    finished = sorted(p.name for p in (folder / "points").iterdir())
+    assert "point-000.json" in finished and "point-001.json" not in finished
+
+    monkeypatch.setattr(_optimizer, "solve_point", original)
+    result = run_study(TWO_LINK, folder, quiet=True, smoke=True, executor="serial")
+    assert result.resumed and result.reused == len(finished) and result.computed >= 1
+    pd.testing.assert_frame_equal(_numbers(folder), _numbers(runs["two_link_paper"]))
+
+
+def test_dask_cluster_gives_the_serial_result(runs, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                                  dashboard_address=None) as cluster:
+        assert main(["run", str(TWO_LINK), "--out", str(tmp_path / "dask"), "--quiet", "--smoke",
+                     "--scheduler", cluster.scheduler_address]) == 0
+    # The same solves from the same start points, so the same numbers (to rounding of the JSON round trip).
+    pd.testing.assert_frame_equal(_numbers(tmp_path / "dask"), _numbers(runs["two_link_paper"]), rtol=1e-9)
+
+
+def test_crx_report_re_renders_from_saved_results(runs, tmp_path, capsys):
+    folder = tmp_path / "copy"
+    shutil.copytree(runs["direct_drive_vs_geared"], folder)
+    before = (folder / "report.html").read_text()
+    (folder / "report.html").unlink()
+    shutil.rmtree(folder / "figures")
+    assert main(["report", str(folder)]) == 0
+    assert (folder / "report.html").read_text() == before
+    assert (folder / "figures" / "velocity_sweep.png").is_file()
+    assert main(["report", str(tmp_path / "nothing-here")]) == 2
+    assert "run the study first" in capsys.readouterr().err
+
+
+STUDY = textwrap.dedent(
+    """\
+    name: bad-input
+    robot:
+      example_robot_data: double_pendulum
+      contact_frame: link2
+      contact_offset: [0, 0, 0.2]
+    actuators:
+      mechanical_stiffness: 1000 N*m/rad
+      software_stiffness: 100 N*m/rad
+    sensing: {scheme: force, threshold: 3 N}
+    approach_velocity: 0.5 m/s
+    samples:
+      configurations: {list: [[0, 0.8]]}
+      directions: {circle: 4}
+    design:
+      gear_ratio: {min: 1, max: 50}
+    """
+)
+
+
+@pytest.mark.parametrize(
+    ("edit", "line", "words"),
+    [
+        (None, 0, ["no such file"]),
+        (("contact_frame: link2", "contact_frame: [link2"), 5, ["invalid YAML", "flow sequence"]),
+        (("double_pendulum", "double_pendulm"), 3, ["'double_pendulum'", "not an example-robot-data model"]),
+        (("contact_frame: link2", "contact_frame: link9"), 4, ["link9"]),
+        (("{min: 1, max: 50}", "{min: 50, max: 1}"), 15, ["min <= max"]),
+        (("1000 N*m/rad", "3 kg"), 7, ["[mass]", "N*m/rad"]),
+    ],
+    ids=["missing-file", "yaml-syntax", "unknown-robot", "unknown-frame", "impossible-bounds", "wrong-dimension"],
+)
+def test_bad_input_is_one_located_message_exit_2_and_nothing_written(tmp_path, capsys, edit, line, words):
+    study = tmp_path / "study.yaml"
+    if edit is not None:
+        study.write_text(STUDY.replace(*edit))
+    out = tmp_path / "out"
+    assert main(["run", str(study), "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    assert err[0].startswith(f"crx run: error: {study}:{line}:" if line else f"crx run: error: {study}: found")
+    for word in words:
+        assert word in err[0]
+    assert "Traceback" not in err[0]
+    assert not out.exists()

@@ -1,0 +1,162 @@
+"""Pieces of the study runner checked on their own: direction samplings, executors, dominance filter, smoke
+shrinking, the run folder, the actuator-study lever mapping and the report's number format."""
+
+from __future__ import annotations
+
+import itertools
+import math
+from concurrent.futures import Future
+
+import numpy as np
+import pytest
+
+from collision_reflex.impulse import phase_impulses, series_stiffness
+from collision_reflex.report.html import number
+from collision_reflex.study.actuator_study import contact_threshold
+from collision_reflex.study.executors import SerialExecutor, open_executor
+from collision_reflex.study.runner import non_dominated, smoke_study
+from collision_reflex.study.samples import circle_directions, named_directions, sphere_directions
+from collision_reflex.study.schema import SensingSpec
+from collision_reflex.study.store import OutputFolderInUse, RunFolder
+
+
+@pytest.mark.parametrize("count", [1, 4, 16, 33], ids=lambda n: f"n={n}")
+def test_circle_directions_are_unit_and_evenly_spread(count):
+    u = circle_directions(count)
+    assert u.shape == (count, 2)
+    np.testing.assert_allclose(np.linalg.norm(u, axis=1), 1.0, rtol=1e-12)  # unit vectors, rounding only
+    if count > 1:
+        # Evenly spread: consecutive angles differ by 2 pi / n, and the vectors sum to zero (roots of unity).
+        np.testing.assert_allclose(np.diff(np.unwrap(np.arctan2(u[:, 1], u[:, 0]))), 2 * np.pi / count, rtol=1e-12)
+        np.testing.assert_allclose(u.sum(axis=0), 0.0, atol=1e-12)
+    u3 = circle_directions(count, task_dim=3)
+    np.testing.assert_array_equal(u3[:, 2], 0.0)
+
+
+@pytest.mark.parametrize("count", [6, 14, 50, 400], ids=lambda n: f"n={n}")
+def test_sphere_directions_are_unit_and_equal_area(count):
+    u = sphere_directions(count)
+    np.testing.assert_allclose(np.linalg.norm(u, axis=1), 1.0, rtol=1e-12)
+    # Equal area (Archimedes): the share of points in any band of heights equals the band's share of the
+    # sphere's area, i.e. its height / 2, up to one point of rounding at each edge.
+    for low, high in [(-1.0, 0.0), (0.2, 0.7), (-0.9, -0.4)]:
+        inside = np.count_nonzero((u[:, 2] > low) & (u[:, 2] <= high))
+        assert abs(inside - count * (high - low) / 2) <= 1.0
+    # Balanced: the mean direction is near zero (the lattice's azimuths cancel to O(1/n)).
+    assert np.linalg.norm(u.mean(axis=0)) < 2.0 / count
+
+
+def test_named_directions():
+    np.testing.assert_array_equal(named_directions(["+x", "-z"], 3), [[1, 0, 0], [0, 0, -1]])
+    np.testing.assert_array_equal(named_directions(["-y"], 2), [[0, -1]])
+
+
+def _square(x: float) -> float:
+    return x * x
+
+
+@pytest.mark.parametrize("kind", ["serial", "processes"], ids=["serial", "processes"])
+def test_executors_run_tasks(kind):
+    with open_executor(kind, workers=2) as pool:
+        assert list(pool.map(_square, range(5))) == [0, 1, 4, 9, 16]
+
+
+def test_serial_executor_delivers_errors_through_the_future():
+    future: Future = SerialExecutor().submit(math.sqrt, -1.0)
+    with pytest.raises(ValueError):
+        future.result()
+
+
+def test_open_executor_refuses_unknown_kinds():
+    with pytest.raises(ValueError, match="executor"), open_executor("threads"):
+        pass
+
+
+def test_non_dominated_matches_brute_force():
+    rng = np.random.default_rng(3)
+    records = [{"objectives": {"worst_case_impulse": float(a), "actuator_mass": float(b)}}
+               for a, b in rng.uniform(0, 1, size=(60, 2))]
+    front, dropped = non_dominated(records, ("worst_case_impulse", "actuator_mass"))
+    values = [(r["objectives"]["worst_case_impulse"], r["objectives"]["actuator_mass"]) for r in records]
+    expected = {v for v in values if not any(o[0] <= v[0] and o[1] <= v[1] and o != v for o in values)}
+    assert {(r["objectives"]["worst_case_impulse"], r["objectives"]["actuator_mass"]) for r in front} == expected
+    assert len(front) + len(dropped) == len(records)
+    first = [r["objectives"]["worst_case_impulse"] for r in front]
+    assert first == sorted(first)
+    # A maximised objective (approach velocity) counts as better when larger.
+    fast = [{"objectives": {"worst_case_impulse": 1.0, "approach_velocity": v}} for v in (0.1, 0.5)]
+    front, _ = non_dominated(fast, ("worst_case_impulse", "approach_velocity"))
+    assert [r["objectives"]["approach_velocity"] for r in front] == [0.5]
+
+
+def test_smoke_study_shrinks_counts():
+    data = {
+        "kind": "arm",
+        "samples": {"configurations": {"random": {"count": 64, "seed": 1}, "list": None, "trajectory": None},
+                    "directions": {"circle": None, "sphere": 32, "named": None, "list": None}},
+        "pareto": {"objectives": ["worst_case_impulse", "actuator_mass"], "points": 20},
+    }
+    small = smoke_study(data)
+    assert small["samples"]["configurations"]["random"] == {"count": 3, "seed": 1}
+    assert small["samples"]["directions"]["sphere"] == 6
+    assert small["pareto"]["points"] == 4
+    assert data["pareto"]["points"] == 20  # the original is left alone
+
+
+def test_run_folder_refuses_another_studys_folder(tmp_path):
+    folder = RunFolder(tmp_path / "out")
+    assert folder.claim("abc", "name: x\n", {"study": "x"}) is False
+    folder.save("point-000", {"value": 1.5})
+    assert folder.claim("abc", "name: x\n", {"study": "x"}) is True  # same study: resume
+    assert folder.finished("point-000") == {"value": 1.5}
+    assert folder.finished("point-001") is None
+    with pytest.raises(OutputFolderInUse, match="--out"):
+        folder.claim("def", "name: y\n", {"study": "y"})
+    (tmp_path / "other").mkdir()
+    (tmp_path / "other" / "notes.txt").write_text("mine")
+    with pytest.raises(OutputFolderInUse, match="not a study's output folder"):
+        RunFolder(tmp_path / "other").claim("abc", "name: x\n", {})
+
+
+@pytest.mark.parametrize("reaction", ["at_rest", "moving"], ids=["at-rest", "moving"])
+def test_lever_mapping_equals_the_rotary_collision(reaction):
+    """A joint seen at lever L (m = J/L^2, k = k_rot/L^2, F = tau/L) transfers, at the contact, the angular
+    impulse of the same collision written in joint coordinates divided by L: the 1D model is the same in any
+    linear coordinate, so the two must agree to rounding."""
+    lever, finger_inertia, reflected, k_mech, k_soft, tau_s, tau_peak, omega = (
+        0.1143, 1.3e-3, 1.2e-2, 1e4, 5.75, 0.343, 27.0, 0.9)
+    k_rot = series_stiffness(k_mech, k_soft)
+    angular = phase_impulses(finger_inertia, k_rot, k_mech, tau_s, tau_peak / reflected, omega, reaction)
+    contact = phase_impulses(finger_inertia / lever**2, k_rot / lever**2, k_mech / lever**2, tau_s / lever,
+                             (tau_peak / lever) / (reflected / lever**2), omega * lever, reaction)
+    for phase in ("initial", "sensing", "reaction"):
+        assert getattr(contact, phase) == pytest.approx(getattr(angular, phase) / lever, rel=1e-12)
+
+
+def test_contact_threshold_by_scheme():
+    force = SensingSpec(scheme="force", threshold="3 N")
+    position = SensingSpec(scheme="position", error="2 mm")
+    current = SensingSpec(scheme="current", motor_torque="0.343 N*m")
+    assert contact_threshold(force, 9.0, 0.1143, 440.0) == 3.0
+    assert contact_threshold(position, 9.0, 0.1143, 440.0) == pytest.approx(0.88)  # F_s = k e
+    # Motor side of a 9:1 transmission: the joint sees 9 x the motor torque, the contact that / L.
+    assert contact_threshold(current, 9.0, 0.1143, 440.0) == pytest.approx(9 * 0.343 / 0.1143)
+
+
+@pytest.mark.parametrize(
+    ("value", "text"),
+    [(0.123456, "0.1235"), (12345.0, "1.234e+04"), (math.inf, "∞"), (None, "–"), ("Solve_Succeeded", "Solve_Succeeded"),
+     (3, "3")],
+    ids=["small", "large", "inf", "none", "text", "int"],
+)
+def test_report_number_format(value, text):
+    assert number(value) == text
+
+
+def test_every_pair_of_objectives_is_a_valid_pareto_spec():
+    from collision_reflex.study.schema import OBJECTIVE_NAMES, ParetoSpec
+
+    for pair in itertools.combinations(OBJECTIVE_NAMES, 2):
+        assert ParetoSpec(objectives=list(pair)).points == 20
+    with pytest.raises(ValueError, match="different"):
+        ParetoSpec(objectives=["mean_impulse", "mean_impulse"])
