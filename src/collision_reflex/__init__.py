@@ -6,7 +6,7 @@ Actuation"). This package evaluates it from structure, actuation, stiffness and 
 URDF arms, and optimises actuator designs against it.
 """
 
-from .errors import CollisionReflexError, InvalidParameter
+from .errors import CollisionReflexError, InvalidParameter, StudyFileError, StudyProblem
 from .impulse import (
     REACTION_MODES,
     PhaseImpulses,
@@ -19,6 +19,8 @@ from .impulse import (
     total_impulse,
     velocity_coefficients,
 )
+from .study import load_study, study_json_schema
+from .study.runner import run_study
 
 __version__ = "0.1.0"
 
@@ -27,13 +29,18 @@ __all__ = [
     "CollisionReflexError",
     "InvalidParameter",
     "PhaseImpulses",
+    "StudyFileError",
+    "StudyProblem",
     "__version__",
     "collision_times",
     "force_profile",
+    "load_study",
     "minimum_impulse",
     "optimal_velocity",
     "phase_impulses",
+    "run_study",
     "series_stiffness",
+    "study_json_schema",
     "total_impulse",
     "velocity_coefficients",
 ]

@@ -16,7 +16,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .. import __version__
 from .executors import open_executor
 from .load import LoadedStudy, load_study, parse_study
 from .resolve import fingerprint, resolved_study, resolved_yaml
@@ -103,6 +102,8 @@ def run_study(
     Every input is checked before the output folder is touched: a bad study raises
     :class:`~collision_reflex.errors.StudyFileError` (with its lines) and writes nothing.
     """
+    from .. import __version__
+
     started = time.perf_counter()
     loaded = load_study(path)
     smoke = bool(os.environ.get(SMOKE_ENVIRONMENT, "")) if smoke is None else smoke
