@@ -858,20 +858,19 @@ def collision_impulses(
 def _joint_array(
     name: str, value: Any, nv: int, *, allow_inf: bool = False, allow_zero: bool = False
 ) -> np.ndarray:
+    hint = "the URDF gives none for some joint; pass actuators= to the Arm or give the values explicitly"
     array = np.asarray(value, dtype=float)
     if array.ndim > 1 or array.size not in (1, nv):
         raise InvalidParameter(name, array, f"one value or {nv} values, one per joint")
     if np.any(np.isnan(array)):
-        raise InvalidParameter(
-            name,
-            value,
-            "known values for every joint",
-            "the URDF gives none for some joint; pass actuators= to the Arm or give the values",
-        )
-    if allow_zero:
-        _validate.non_negative(name, array)
-    else:
-        _validate.positive(name, array, allow_inf=allow_inf)
+        raise InvalidParameter(name, value, "known values for every joint", hint)
+    try:
+        if allow_zero:
+            _validate.non_negative(name, array)
+        else:
+            _validate.positive(name, array, allow_inf=allow_inf)
+    except InvalidParameter as error:
+        raise InvalidParameter(name, value, error.allowed, hint) from None
     return np.broadcast_to(array, (nv,)).astype(float)
 
 
