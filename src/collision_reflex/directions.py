@@ -85,7 +85,7 @@ def _vector(item: Any, task_dim: int, plane: np.ndarray | None) -> np.ndarray:
             raise InvalidParameter("direction", item, "2 plane coordinates (no plane basis to project onto)")
         world = vector
         vector = plane.T @ world
-        if np.linalg.norm(vector) < 1e-9 * max(np.linalg.norm(world), 1e-300):
+        if float(np.linalg.norm(vector)) < 1e-9 * float(np.linalg.norm(world)):
             raise InvalidParameter("direction", item, "a direction with a component in the arm's plane")
     if vector.size != task_dim or not np.all(np.isfinite(vector)) or np.linalg.norm(vector) == 0:
         raise InvalidParameter("direction", item, f"a non-zero finite vector of {task_dim} components")
