@@ -138,20 +138,25 @@ class ArmSamples:
     contact_gravity: (n, nv) gravity torque per kilogram of payload at the contact point [N m/kg].
     contact_position: (n, 3) world position of the contact point [m].
     joint_positions: (n, nv, 3) world positions of the joint origins [m].
+
+    The gravity and motor-mass terms are None when :meth:`Arm.kinematics` was asked to skip them.
     """
 
     q: np.ndarray
     mass_matrix: np.ndarray
     jacobian: np.ndarray
-    gravity: np.ndarray
-    motor_mass_influence: np.ndarray
-    motor_gravity: np.ndarray
-    contact_gravity: np.ndarray
-    contact_position: np.ndarray
-    joint_positions: np.ndarray
+    gravity: np.ndarray | None = None
+    motor_mass_influence: np.ndarray | None = None
+    motor_gravity: np.ndarray | None = None
+    contact_gravity: np.ndarray | None = None
+    contact_position: np.ndarray | None = None
+    joint_positions: np.ndarray | None = None
 
     def __post_init__(self) -> None:
-        n, nv = self.mass_matrix.shape[0], self.mass_matrix.shape[-1]
+        mass = np.asarray(self.mass_matrix)
+        if mass.ndim != 3 or mass.shape[1] != mass.shape[2]:
+            raise InvalidParameter("mass_matrix", mass.shape, "an array of shape (n, nv, nv)")
+        n, nv = mass.shape[0], mass.shape[-1]
         expected = {
             "q": (n, None),
             "mass_matrix": (n, nv, nv),
@@ -164,7 +169,10 @@ class ArmSamples:
             "joint_positions": (n, nv, 3),
         }
         for name, shape in expected.items():
-            array = np.asarray(getattr(self, name), dtype=float)
+            value = getattr(self, name)
+            if value is None:
+                continue
+            array = np.asarray(value, dtype=float)
             if array.ndim != len(shape) or any(
                 s is not None and s != a for s, a in zip(shape, array.shape, strict=False)
             ):
@@ -190,9 +198,12 @@ class ArmSamples:
 
     def take(self, index: Any) -> ArmSamples:
         """The samples at ``index`` (an integer array, slice or boolean mask over configurations)."""
-        picked = {name: np.asarray(getattr(self, name))[index] for name in self.__dataclass_fields__}
+        picked = {}
+        for name in self.__dataclass_fields__:
+            value = getattr(self, name)
+            picked[name] = None if value is None else np.asarray(value)[index]
         if picked["q"].ndim == 1:  # a single integer index: keep the leading axis
-            picked = {name: value[None] for name, value in picked.items()}
+            picked = {name: None if value is None else value[None] for name, value in picked.items()}
         return ArmSamples(**picked)
 
     def structure_mass_matrix(self, motor_mass: Any = None) -> np.ndarray:
@@ -200,6 +211,15 @@ class ArmSamples:
         if motor_mass is None:
             return self.mass_matrix
         masses = _joint_array("motor_mass", motor_mass, self.nv, allow_zero=True)
+        if not np.any(masses):
+            return self.mass_matrix
+        if self.motor_mass_influence is None:
+            raise InvalidParameter(
+                "motor_mass",
+                motor_mass,
+                "None for samples without motor terms",
+                "compute the samples with Arm.kinematics(q, motor_terms=True)",
+            )
         return self.mass_matrix + np.einsum("i,sijk->sjk", masses, self.motor_mass_influence)
 
 
@@ -214,6 +234,15 @@ class _JointKinematics:
     axis: np.ndarray  # unit axis in the joint frame
     rotation: np.ndarray  # placement of the joint frame in the parent joint frame
     translation: np.ndarray
+
+    @property
+    def rotation_skew(self) -> np.ndarray:
+        return self.rotation @ _skew(self.axis)
+
+    @property
+    def rotation_skew2(self) -> np.ndarray:
+        skew = _skew(self.axis)
+        return self.rotation @ skew @ skew
 
 
 class Arm:
@@ -289,16 +318,25 @@ class Arm:
             actuators if actuators is not None and not isinstance(actuators, JointParameters) else None
         )
 
+        self._source_model = model
         self.model = model.copy()
         self.model.armature = params.reflected_inertia.copy()
         # Kinematics use a structure-only model (no armature), so ArmSamples.mass_matrix is M_bb0.
         self._structure = model.copy()
         self._structure.armature = np.zeros(model.nv)
+        # A frame at the contact point itself, so that Pinocchio's frame Jacobian is the contact Jacobian.
+        self._contact_frame_id = self._structure.addFrame(
+            pin.Frame(
+                "collision_reflex_contact_point",
+                self._contact_joint,
+                pin.SE3(np.eye(3), self._contact_local),
+                pin.FrameType.OP_FRAME,
+            )
+        )
         self._data = self._structure.createData()
         self._gravity = np.asarray(self._structure.gravity.linear, dtype=float).copy()
         # Masks of the joints (velocity indices) that move the contact point and each motor's parent link.
         supports = [set(self._structure.supports[j]) for j in range(self._structure.njoints)]
-        self._contact_mask = _support_mask(self._structure, supports[self._contact_joint])
         self._motor_masks = np.array(
             [_support_mask(self._structure, supports[jk.parent]) for jk in self._joints]
         )
@@ -515,49 +553,55 @@ class Arm:
         return self.configuration(rng.uniform(lower, upper, size=(int(count), self.nv)))
 
     # ------------------------------------------------------------------ kinematics
-    def kinematics(self, q: Any) -> ArmSamples:
+    def kinematics(self, q: Any, *, full: bool = True) -> ArmSamples:
         """Mass matrix, contact Jacobian, gravity and motor-mass terms at configurations ``q`` (n, nq).
 
-        Pinocchio evaluates the mass matrix (CRBA), the joint Jacobians and the gravity torques once per
-        configuration; the contact-point and motor-point Jacobians are assembled from them for all
-        configurations at once.
+        Pinocchio evaluates the mass matrix (CRBA) and the contact Jacobian once per configuration, and with
+        ``full`` also the joint Jacobians and the gravity torques, from which the motor-point Jacobians, the
+        motor-mass terms and the positions are assembled for all configurations at once. ``full=False`` returns
+        only what the effective collision parameters need (``q``, ``mass_matrix``, ``jacobian``; the other
+        fields are None).
         """
         q = self._checked_q(q)
         pin, model, data = self._pin, self._structure, self._data
         n, nv = q.shape[0], self.nv
         mass = np.empty((n, nv, nv))
+        contact_jacobian = np.empty((n, 6, nv))
+        crba, frame_jacobian = pin.crba, pin.computeFrameJacobian
+        frame, aligned = self._contact_frame_id, pin.LOCAL_WORLD_ALIGNED
+        for s, qs in enumerate(q):
+            mass[s] = crba(model, data, qs)
+            contact_jacobian[s] = frame_jacobian(model, data, qs, frame, aligned)
+        jacobian3 = np.ascontiguousarray(contact_jacobian[:, :3])
+        jacobian = jacobian3 if self.plane is None else np.einsum("tp,stj->spj", self.plane, jacobian3)
+        if not full:
+            return ArmSamples(q=q, mass_matrix=mass, jacobian=jacobian)
+
         spatial = np.empty((n, 6, nv))
         gravity = np.empty((n, nv))
-        for s in range(n):
-            qs = q[s]
-            mass[s] = pin.crba(model, data, qs)
-            # crba leaves data.J in local frames; the world-frame joint Jacobians come after it.
-            spatial[s] = pin.computeJointJacobians(model, data, qs)
-            gravity[s] = pin.computeGeneralizedGravity(model, data, qs)
+        joint_jacobians, generalized_gravity = pin.computeJointJacobians, pin.computeGeneralizedGravity
+        for s, qs in enumerate(q):
+            spatial[s] = joint_jacobians(model, data, qs)  # world frame, every joint
+            gravity[s] = generalized_gravity(model, data, qs)
         rotations, origins, motor_points = self._forward_kinematics(q)
         linear, angular = spatial[:, :3], spatial[:, 3:]
-
         contact_joint = self._contact_joint - 1
-        contact = origins[:, contact_joint] + rotations[:, contact_joint] @ self._contact_local
-        jacobian3 = self._contact_mask * (linear + _cross_columns(angular, contact))
-        # Motor i sits at joint i's origin on the parent link: its velocity is that of the parent link's point.
+        contact = origins[contact_joint] + rotations[contact_joint] @ self._contact_local
+        # Motor i sits at joint i's origin on the parent link: it moves with the parent link's point there.
+        points = np.stack(motor_points, axis=1)  # (n, motor i, 3)
         motor_jac = self._motor_masks[None, :, None, :] * (
-            linear[:, None] + _cross_columns(angular[:, None], motor_points)
+            linear[:, None] - _skew(points) @ angular[:, None]
         )  # (n, motor i, 3, nv)
-        influence = np.einsum("sitj,sitk->sijk", motor_jac, motor_jac)
-        motor_gravity = -np.einsum("sitj,t->sij", motor_jac, self._gravity)
-        contact_gravity = -np.einsum("stj,t->sj", jacobian3, self._gravity)
-        jacobian = jacobian3 if self.plane is None else np.einsum("tp,stj->spj", self.plane, jacobian3)
         return ArmSamples(
             q=q,
             mass_matrix=mass,
             jacobian=jacobian,
             gravity=gravity,
-            motor_mass_influence=influence,
-            motor_gravity=motor_gravity,
-            contact_gravity=contact_gravity,
+            motor_mass_influence=np.swapaxes(motor_jac, -1, -2) @ motor_jac,
+            motor_gravity=-np.einsum("sitj,t->sij", motor_jac, self._gravity),
+            contact_gravity=-np.einsum("stj,t->sj", jacobian3, self._gravity),
             contact_position=contact,
-            joint_positions=origins,
+            joint_positions=np.stack(origins, axis=1),
         )
 
     def effective_parameters(
@@ -584,33 +628,42 @@ class Arm:
             raise InvalidParameter("q", q, "finite joint coordinates")
         return q
 
-    def _forward_kinematics(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Joint frames for all configurations at once: rotations (n, nv, 3, 3) and origins (n, nv, 3) of the
-        joint frames, and the parent-side points of the joint origins (n, nv, 3) where the motors sit [m]."""
+    def _forward_kinematics(
+        self, q: np.ndarray
+    ) -> tuple[list[np.ndarray], list[np.ndarray], list[np.ndarray]]:
+        """Joint frames for all configurations at once, one array per joint: rotations (n, 3, 3) and origins
+        (n, 3) of the joint frames, and the parent-side points of the joint origins (n, 3), where the motors
+        sit [m]."""
         n = q.shape[0]
-        rotations = np.empty((n, self.nv, 3, 3))
-        origins = np.empty((n, self.nv, 3))
-        motor_points = np.empty((n, self.nv, 3))
-        for v, joint in enumerate(self._joints):
+        rotations: list[np.ndarray] = []
+        origins: list[np.ndarray] = []
+        motor_points: list[np.ndarray] = []
+        for joint in self._joints:
             if joint.parent == 0:
                 parent_rotation = np.broadcast_to(np.eye(3), (n, 3, 3))
                 parent_origin = np.zeros((n, 3))
             else:
-                parent_rotation = rotations[:, joint.parent - 1]
-                parent_origin = origins[:, joint.parent - 1]
-            placed = parent_rotation @ joint.rotation  # joint frame before its own motion
+                parent_rotation = rotations[joint.parent - 1]
+                parent_origin = origins[joint.parent - 1]
             point = parent_origin + parent_rotation @ joint.translation
-            motor_points[:, v] = point
+            motor_points.append(point)
             if joint.nq == 1:
                 coordinate = q[:, joint.idx_q]
             else:
                 coordinate = np.arctan2(q[:, joint.idx_q + 1], q[:, joint.idx_q])
             if joint.revolute:
-                rotations[:, v] = placed @ _axis_rotations(joint.axis, coordinate)
-                origins[:, v] = point
+                # placement rotation times Rodrigues' rotation about the axis, as R_p + sin R_p K + (1-cos) R_p K^2
+                local = (
+                    joint.rotation
+                    + np.sin(coordinate)[:, None, None] * joint.rotation_skew
+                    + (1 - np.cos(coordinate))[:, None, None] * joint.rotation_skew2
+                )
+                rotations.append(parent_rotation @ local)
+                origins.append(point)
             else:
-                rotations[:, v] = placed
-                origins[:, v] = point + coordinate[:, None] * (placed @ joint.axis)
+                placed = parent_rotation @ joint.rotation
+                rotations.append(placed)
+                origins.append(point + coordinate[:, None] * (placed @ joint.axis))
         return rotations, origins, motor_points
 
 
@@ -719,53 +772,52 @@ def effective_parameters(
 
     jac = samples.jacobian
     structure = samples.structure_mass_matrix(motor_mass)
-    # Task-space inverse inertias and compliances, once per configuration: G = J X^-1 J^T.
-    g_f = jac @ _solve_spd(structure, np.swapaxes(jac, 1, 2))
-    g_r = (jac / inertia) @ np.swapaxes(jac, 1, 2)
-    g_k = (jac / joint_k) @ np.swapaxes(jac, 1, 2)
-    g_km = (jac / joint_km) @ np.swapaxes(jac, 1, 2)
-    scale = np.trace(g_f, axis1=1, axis2=2)
-
+    jac_t = np.swapaxes(jac, 1, 2)
+    # Task-space inverse inertias and compliances, once per configuration: G = J X^-1 J^T, stacked as
+    # (structure, actuators, stiffness, mechanical stiffness).
+    task = np.stack(
+        [
+            jac @ _solve_spd(structure, jac_t),
+            (jac / inertia) @ jac_t,
+            (jac / joint_k) @ jac_t,
+            (jac / joint_km) @ jac_t,
+        ]
+    )  # (4, n, task_dim, task_dim)
+    scale = np.trace(task[0], axis1=1, axis2=2)
+    pair_index = index if paired else None
     if paired:
-        u = units
-        j_s = jac[index]
-
-        def quadratic(g: np.ndarray) -> np.ndarray:
-            return np.einsum("sa,sab,sb->s", u, g[index], u)
-
-        moment = np.abs(np.einsum("sta,st->sa", j_s, u))  # |J^T u|, (n_samples, nv)
+        forms = np.einsum("sa,qsab,sb->qs", units, task[:, index], units)
         scale_s = scale[index]
     else:
+        # u^T G u for every G and u in one product: (4 n, task_dim^2) x (task_dim^2, d).
         outer = np.einsum("da,db->dab", units, units).reshape(units.shape[0], -1)
-
-        def quadratic(g: np.ndarray) -> np.ndarray:
-            return g.reshape(g.shape[0], -1) @ outer.T
-
-        moment = np.abs(np.swapaxes(jac, 1, 2) @ units.T)  # (n, nv, d)
-        moment = np.moveaxis(moment, 1, -1)  # (n, d, nv)
+        forms = (task.reshape(-1, task_dim * task_dim) @ outer.T).reshape(4, samples.count, -1)
         scale_s = scale[:, None]
 
-    w_f = quadratic(g_f)
-    singular = w_f <= singular_tolerance * scale_s
-    regular = ~singular
-    w_r = quadratic(g_r)
-    load = np.max(moment / tau_max, axis=-1)  # 1 / F_a
-
-    m_f = _reciprocal(w_f, regular)
-    m_r = _reciprocal(w_r, regular)
-    if stiffness_form == "paper":
-        k = _paper_stiffness(jac, joint_k, units, index if paired else None)
-        k = np.where(regular, k, np.inf)
-    else:
-        k = _reciprocal(quadratic(g_k), regular)
-    k_m = _reciprocal(quadratic(g_km), regular)
-    F_a = _reciprocal(load, regular)
-    a = np.zeros_like(w_r)
-    np.divide(w_r, load, out=a, where=regular & (load > 0))
-    a[regular & (load == 0)] = np.inf  # no torque limit at all: unbounded reaction
-    joint_force = None
-    if tau_s is not None:
-        joint_force = _reciprocal(np.max(moment / tau_s, axis=-1), regular)
+    # Reciprocals in place: a zero compliance (an infinite joint stiffness or torque) gives inf; the 0/0 and
+    # negative rounding of singular directions are overwritten with their limits below.
+    with np.errstate(divide="ignore", invalid="ignore"):
+        w_f, w_r, k, k_m = forms
+        singular = w_f <= singular_tolerance * scale_s
+        m_f = np.reciprocal(w_f, out=w_f)
+        load = _largest_moment(jac, 1 / tau_max, units, pair_index)  # 1 / F_a
+        a = w_r / load  # F_a / m_r
+        m_r = np.reciprocal(w_r, out=w_r)
+        F_a = np.reciprocal(load, out=load)
+        if stiffness_form == "paper":
+            k = _paper_stiffness(jac, joint_k, units, pair_index)
+        else:
+            np.reciprocal(k, out=k)
+        np.reciprocal(k_m, out=k_m)
+        joint_force = None
+        if tau_s is not None:
+            joint_force = _largest_moment(jac, 1 / tau_s, units, pair_index)
+            np.reciprocal(joint_force, out=joint_force)
+    if np.any(singular):
+        for value in (m_f, m_r, k, k_m, F_a, joint_force):
+            if value is not None:
+                value[singular] = np.inf
+        a[singular] = 0.0
     return EffectiveParameters(m_f, m_r, k, k_m, F_a, a, singular, joint_force)
 
 
@@ -831,26 +883,36 @@ def collision_impulses(
         if threshold is None:
             raise InvalidParameter("threshold", None, "a force [N] or a position error [m]")
         _validate.positive("threshold", threshold)
-        force = np.broadcast_to(np.asarray(threshold, dtype=float), shape)
+        force = np.asarray(threshold, dtype=float)
         if sensing == "position":
             force = params.k * force
-    velocity = np.broadcast_to(np.asarray(v0, dtype=float), shape)
-    _validate.positive("v0", velocity)
-    regular = ~params.singular
-    out = {name: np.full(shape, np.inf) for name in ("initial", "sensing", "reaction")}
-    v_star = np.zeros(shape)
-    if np.any(regular):
-        m_f, k, k_m = params.m_f[regular], params.k[regular], params.k_m[regular]
-        f_s, a = np.asarray(force)[regular], params.a[regular]
-        phases = phase_impulses(m_f, k, k_m, f_s, a, velocity[regular], reaction)
-        out["initial"][regular] = phases.initial
-        out["sensing"][regular] = phases.sensing
-        out["reaction"][regular] = phases.reaction
-        v_star[regular] = optimal_velocity(m_f, k, f_s, reaction, k_m, a)
-    total = out["initial"] + out["sensing"] + out["reaction"]
-    threshold_force = np.array(force, dtype=float)
+    _validate.positive("v0", v0)
+    singular = params.singular
+    any_singular = bool(np.any(singular))
+
+    def stand_in(value: Any) -> Any:
+        """Finite stand-ins along singular directions (their results are replaced below), so that the 1D
+        model sees only valid numbers; scalars pass as they are."""
+        value = np.asarray(value, dtype=float)
+        return np.where(singular, 1.0, value) if any_singular and value.ndim else value
+
+    m_f, k, k_m, a = (stand_in(x) for x in (params.m_f, params.k, params.k_m, params.a))
+    f_s, velocity = stand_in(force), stand_in(v0)
+    phases = phase_impulses(m_f, k, k_m, f_s, a, velocity, reaction)
+    v_star = optimal_velocity(m_f, k, f_s, reaction, k_m, a)
+    parts = [np.broadcast_to(x, shape) for x in (phases.initial, phases.sensing, phases.reaction)]
+    if any_singular:
+        parts = [np.where(singular, np.inf, x) for x in parts]
+        v_star = np.where(singular, 0.0, v_star)
+    initial, sensing_part, reaction_part = parts
     return CollisionImpulses(
-        threshold_force, out["initial"], out["sensing"], out["reaction"], total, v_star, params.singular
+        threshold=np.broadcast_to(force, shape),
+        initial=initial,
+        sensing=sensing_part,
+        reaction=reaction_part,
+        total=initial + sensing_part + reaction_part,
+        v_star=np.broadcast_to(v_star, shape),
+        singular=singular,
     )
 
 
@@ -897,10 +959,22 @@ def _solve_spd(matrix: np.ndarray, rhs: np.ndarray) -> np.ndarray:
         ) from None
 
 
-def _reciprocal(w: np.ndarray, regular: np.ndarray) -> np.ndarray:
-    """``1 / w`` where regular and ``w > 0``, ``inf`` elsewhere (the limit of a vanishing compliance)."""
-    out = np.full(w.shape, np.inf)
-    np.divide(1.0, w, out=out, where=regular & (w > 0))
+def _largest_moment(
+    jac: np.ndarray, weight: np.ndarray, units: np.ndarray, index: np.ndarray | None
+) -> np.ndarray:
+    """``max_i weight_i |(J^T u)_i|`` for the grid (n, d) or for paired samples (n_samples,)."""
+    scaled = jac * weight
+    if index is not None:
+        return np.max(np.abs(np.einsum("sta,st->sa", scaled[index], units)), axis=-1)
+    n, nv, d = jac.shape[0], jac.shape[2], units.shape[0]
+    out = np.empty((n, d))
+    # Blocks of configurations small enough to stay in cache (about 1 MB of moments each).
+    step = max(1, 2**17 // (nv * d))
+    directions_t = np.ascontiguousarray(units.T)
+    for start in range(0, n, step):
+        block = np.swapaxes(scaled[start : start + step], 1, 2) @ directions_t  # (block, nv, d)
+        np.abs(block, out=block)
+        np.max(block, axis=1, out=out[start : start + step])
     return out
 
 
@@ -928,25 +1002,11 @@ def _paper_stiffness(
     return np.where(along_null, np.inf, k)
 
 
-def _cross_columns(omega: np.ndarray, point: np.ndarray) -> np.ndarray:
-    """``omega_j x point`` for every column ``j``: omega (..., 3, nv), point (..., 3) -> (..., 3, nv)."""
-    p = point[..., :, None]
-    return np.stack(
-        [
-            omega[..., 1, :] * p[..., 2, :] - omega[..., 2, :] * p[..., 1, :],
-            omega[..., 2, :] * p[..., 0, :] - omega[..., 0, :] * p[..., 2, :],
-            omega[..., 0, :] * p[..., 1, :] - omega[..., 1, :] * p[..., 0, :],
-        ],
-        axis=-2,
-    )
-
-
-def _axis_rotations(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    """Rotations by ``angle`` (n,) [rad] about the unit ``axis`` (Rodrigues), (n, 3, 3)."""
-    x, y, z = axis
-    skew = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
-    c, s = np.cos(angle)[:, None, None], np.sin(angle)[:, None, None]
-    return np.eye(3) + s * skew + (1 - c) * (skew @ skew)
+def _skew(vector: np.ndarray) -> np.ndarray:
+    """Cross-product matrices ``[v]x`` of vectors (..., 3) -> (..., 3, 3), so that ``[v]x w = v x w``."""
+    x, y, z = vector[..., 0], vector[..., 1], vector[..., 2]
+    zero = np.zeros_like(x)
+    return np.stack([zero, -z, y, z, zero, -x, -y, x, zero], axis=-1).reshape(*vector.shape[:-1], 3, 3)
 
 
 def _support_mask(model: Any, joints: set[int]) -> np.ndarray:
