@@ -198,12 +198,15 @@ class ArmSamples:
 
     def take(self, index: Any) -> ArmSamples:
         """The samples at ``index`` (an integer array, slice or boolean mask over configurations)."""
-        picked = {}
+        single = np.ndim(np.arange(self.count)[index]) == 0  # an integer: keep the leading axis
+        picked: dict[str, Any] = {}
         for name in self.__dataclass_fields__:
             value = getattr(self, name)
-            picked[name] = None if value is None else np.asarray(value)[index]
-        if picked["q"].ndim == 1:  # a single integer index: keep the leading axis
-            picked = {name: None if value is None else value[None] for name, value in picked.items()}
+            if value is not None:
+                value = np.asarray(value)[index]
+                picked[name] = value[None] if single else value
+            else:
+                picked[name] = None
         return ArmSamples(**picked)
 
     def structure_mass_matrix(self, motor_mass: Any = None) -> np.ndarray:
