@@ -10,12 +10,15 @@ Structure (see the README's "Design optimisation" section):
   actuator quantities, and the 1D impulse of :mod:`collision_reflex.impulse` is applied. One SX function per
   sample is mapped over all samples inside an MX NLP.
 - The reaction capacity ``F_a = min_i tau_i / |w_i|`` is a minimum over joints (non-smooth). Each sample gets a
-  variable ``c_s >= |w_si| / tau_i`` for every joint its direction loads, and the impulse is evaluated with
-  ``F_a = 1 / c_s``. The impulse grows with ``c_s``, so at an optimum ``c_s`` sits on the largest ratio, i.e.
-  ``F_a`` on the minimum: exact, smooth, and the 1D impulse is evaluated once per sample.
-- The finger mass needs ``M_bb(q; m)^-1 w`` with motor masses ``m`` in ``M_bb``; a symbolic solve per sample
-  would dominate the exact Hessian, so ``y_s = M_bb^-1 w_s`` is a variable with the bilinear constraint
-  ``M_bb(m) y_s = w_s``.
+  variable ``g_s = log(1/F_a)`` with ``g_s >= log|w_si| - log tau_i`` for every joint its direction loads --
+  linear in the log design variables -- and the impulse is evaluated with ``F_a = exp(-g_s)``. The impulse grows
+  with ``g_s``, so at an optimum ``g_s`` sits on the largest ratio, i.e. ``F_a`` on the minimum: exact, smooth,
+  and the 1D impulse is evaluated once per sample.
+- The finger mass ``m_f = 1 / (w^T M_f^-1 w)`` has motor masses (and optionally reflected inertias) inside
+  ``M_f``. It is also ``min x^T M_f x`` over ``x`` with ``w^T x = 1`` (attained at ``x = M_f^-1 w / w^T M_f^-1
+  w``). The impulse grows with ``m_f``, so each sample gets a variable ``x_s`` with the linear constraint
+  ``w_s^T x_s = 1`` and uses ``x_s^T M_f x_s``: minimising over the design and ``x`` together is exact, and
+  avoids both a symbolic inverse and a badly conditioned bilinear equality.
 - The worst case is an epigraph ``t >= I_s``.
 - Objectives can be bounded (``f_k <= eps_k``) through NLP parameters, so one solver serves a whole
   epsilon-constraint Pareto sweep.
@@ -38,6 +41,12 @@ from ..impulse import REACTION_MODES, phase_impulses, series_stiffness
 from ..motors import Motor, scaled_motor_quantities
 from .space import GLOBAL_VARIABLES, PER_JOINT_VARIABLES, SENSING_SCHEMES, Bounds, Constraints, ContactSamples, DesignSpace
 
+TIE_BREAK_WEIGHT = 1e-3
+"""Weight of the (start-normalised) mean impulse added to every objective. A worst case leaves the samples that
+do not bind it, and the joints that do not affect it, undetermined; this small pull toward a lower mean picks a
+definite design among the equals and pins the per-sample auxiliary variables, at a cost of about this relative
+amount in the main objective."""
+
 OBJECTIVES: dict[str, tuple[int, str, str]] = {
     # name: (sense: +1 minimise / -1 maximise, unit, description)
     "worst_case_impulse": (1, "N*s", "largest collision impulse over the samples"),
@@ -45,6 +54,9 @@ OBJECTIVES: dict[str, tuple[int, str, str]] = {
     "actuator_mass": (1, "kg", "total mass of the motors"),
     "approach_velocity": (-1, "m/s", "approach velocity (maximised: shorter cycle time)"),
 }
+
+
+REFLECTED_INERTIA_PLACES = ("robot", "finger")
 
 
 @dataclass(frozen=True)
@@ -57,6 +69,11 @@ class ActuatorTechnology:
         the only spring left in the reaction phase.
     sensing: ``"force"`` (contact-force threshold) or ``"position"`` (contact position-error threshold).
     reaction: reaction-phase model, ``"at_rest"`` (the paper's) or ``"moving"``.
+    reflected_inertia_in: where the reflected rotor inertia ``N^2 J_m`` acts. ``"robot"`` (default, the paper's
+        arm model): behind the joint springs, in the robot mass ``m_r`` of the reaction phase only.
+        ``"finger"``: also rigidly on the link side, in the finger mass ``m_f`` of the impact phase -- a stiff
+        transmission with the compliance at the contact, as the paper measured for its geared A8 actuator
+        (fitted finger mass 20 kg against 0.12 kg direct-drive).
     """
 
     reference_motor: Motor
@@ -64,11 +81,13 @@ class ActuatorTechnology:
     scaling_law: str = "haddadin"
     sensing: str = "force"
     reaction: str = "at_rest"
+    reflected_inertia_in: str = "robot"
 
     def __post_init__(self) -> None:
         _validate.positive("mechanical_stiffness", np.asarray(self.mechanical_stiffness, dtype=float))
         _validate.choice("sensing", self.sensing, SENSING_SCHEMES)
         _validate.choice("reaction", self.reaction, REACTION_MODES)
+        _validate.choice("reflected_inertia_in", self.reflected_inertia_in, REFLECTED_INERTIA_PLACES)
 
     def joint_mechanical_stiffness(self, n_joints: int) -> np.ndarray:
         stiffness = np.broadcast_to(np.asarray(self.mechanical_stiffness, dtype=float), (n_joints,)).copy()
@@ -149,8 +168,8 @@ class DesignProblem:
     required_torque_function: Any
     epigraph_index: int | None
     capacity_index: slice
-    capacity_scale: float
     lifted_index: slice
+    lifted_scale: np.ndarray
     build_time: float
     _joint_numbers: Any = field(repr=False, default=None)
     _solvers: dict[str, Any] = field(default_factory=dict, repr=False)
@@ -163,9 +182,9 @@ class DesignProblem:
         """``x`` with the auxiliary variables (``y``, ``c`` and the epigraph ``t``) set to their exact values for
         the design in ``x``, so that evaluating there gives the model's values to machine precision."""
         x = np.array(x, dtype=float)
-        masses, torques = (np.asarray(v).ravel() for v in self._joint_numbers(x))
-        x[self.lifted_index] = lifted_solution(self.samples, masses).ravel()
-        x[self.capacity_index] = reaction_compliance(self.samples, torques) / self.capacity_scale
+        masses, torques, finger = (np.asarray(v).ravel() for v in self._joint_numbers(x))
+        x[self.lifted_index] = (lifted_solution(self.samples, masses, finger) / self.lifted_scale[:, None]).ravel()
+        x[self.capacity_index] = np.log(reaction_compliance(self.samples, torques))
         if self.epigraph_index is not None:
             impulses = np.asarray(self.evaluate(x)[0]).ravel()
             x[self.epigraph_index] = impulses.max() / self.objective_scale["worst_case_impulse"]
@@ -232,7 +251,8 @@ def build_problem(
             bounds = _with_noise_floor(bounds, constraints.threshold_floor)
         layout.add(name, [bounds])
 
-    # Variables: design (log values) | epigraph t (if needed) | c (n_samples) | y (n_joints * n_samples).
+    # Variables: design (log values) | epigraph t (if needed) | g = log(1/F_a) (n_samples) |
+    # finger-mass directions x (n_joints * n_samples).
     n_samples, n_design = samples.size, layout.size
     epigraph_index = n_design if "worst_case_impulse" in set(weights) | set(bounded) else None
     capacity_start = n_design + (epigraph_index is not None)
@@ -255,20 +275,28 @@ def build_problem(
         values["threshold"],
         values["approach_velocity"],
     )
-    joint_numbers = ca.Function("joint_numbers", [x], [motor_mass, peak_torque])
+    finger_inertia = gear**2 * motor.rotor_inertia if technology.reflected_inertia_in == "finger" else 0 * gear
+    joint_numbers = ca.Function("joint_numbers", [x], [motor_mass, peak_torque, finger_inertia])
 
     # Start point: log-midpoints of the bounds; auxiliaries at their exact values there.
     lbx, ubx, x0 = (np.full(x.shape[0], value) for value in (-np.inf, np.inf, 0.0))
     lbx[:n_design], ubx[:n_design], x0[:n_design] = layout.log_bounds()
-    start_mass, start_torque = (np.asarray(v).ravel() for v in joint_numbers(x0))
-    capacity_scale = float(np.max(reaction_compliance(samples, start_torque)))
-    lbx[capacity_index] = 0.0
+    _feasible_gear_start(x0, layout, joint_numbers, samples, constraints, joint_names)
+    start_mass, start_torque, start_finger = (np.asarray(v).ravel() for v in joint_numbers(x0))
+    # log(1/F_a) lies between its values at the weakest and the strongest actuators the bounds allow.
+    weakest, strongest = (np.asarray(joint_numbers(bound)[1]).ravel() for bound in (lbx, ubx))
+    lbx[capacity_index] = np.log(reaction_compliance(samples, strongest))
+    ubx[capacity_index] = np.log(reaction_compliance(samples, weakest))
 
     data = _sample_data(samples, k_mech)
-    per_sample = _sample_function(n_joints, technology.sensing, technology.reaction).map(n_samples)
-    lifted = ca.reshape(x[lifted_index], n_joints, n_samples)
-    compliance = ca.transpose(x[capacity_index]) * capacity_scale
-    impulses, thresholds, residuals = per_sample(design_column, lifted, compliance, ca.DM(data))
+    per_sample = _sample_function(n_joints, technology.sensing, technology.reaction,
+                                  technology.reflected_inertia_in).map(n_samples)
+    # x_s is scaled per sample by its size at the start: across samples it spans orders of magnitude.
+    start_lifted = lifted_solution(samples, start_mass, start_finger)
+    lifted_scale = np.maximum(np.abs(start_lifted).max(axis=1), 1e-300)
+    lifted = ca.reshape(x[lifted_index], n_joints, n_samples) * ca.DM(np.tile(lifted_scale, (n_joints, 1)))
+    compliance = ca.exp(ca.transpose(x[capacity_index]))
+    impulses, thresholds, normalisation = per_sample(design_column, lifted, compliance, ca.DM(data))
     actuator_mass = ca.sum1(motor_mass)
     required_torque = _required_torque_function(samples, constraints, n_joints)
     evaluate = ca.Function(
@@ -276,8 +304,8 @@ def build_problem(
         [impulses, actuator_mass, values["approach_velocity"], thresholds, required_torque(motor_mass), peak_torque],
         ["x"], ["impulses", "actuator_mass", "approach_velocity", "thresholds", "required_torque", "peak_torque"],
     )
-    x0[lifted_index] = lifted_solution(samples, start_mass).ravel()
-    x0[capacity_index] = reaction_compliance(samples, start_torque) / capacity_scale
+    x0[lifted_index] = (start_lifted / lifted_scale[:, None]).ravel()
+    x0[capacity_index] = np.log(reaction_compliance(samples, start_torque))
     start_impulses = np.asarray(evaluate(x0)[0]).ravel()
     _check_finite(start_impulses, "impulse at the start point", samples)
     scale = {
@@ -313,17 +341,16 @@ def build_problem(
             [f"worst-case bound >= impulse of sample {s}" for s in range(n_samples)])
         expressions["worst_case_impulse"] = t
 
-    # c_s |w_si|^-1 tau_i >= 1 for every loaded (sample, joint): c_s >= |w_si| / tau_i.
+    # g_s + log tau_i >= log|w_si| for every loaded (sample, joint), i.e. 1/F_a >= |w_si| / tau_i.
     loaded = loaded_joints(samples)
     pair_sample, pair_joint = np.nonzero(loaded)
-    inverse_arm = 1 / np.abs(samples.joint_moment_arms[pair_sample, pair_joint])
-    add(x[capacity_index][pair_sample.tolist()] * capacity_scale * peak_torque[pair_joint.tolist()] * inverse_arm,
-        1.0, np.inf,
+    log_arm = np.log(np.abs(samples.joint_moment_arms[pair_sample, pair_joint]))
+    add(x[capacity_index][pair_sample.tolist()] + ca.log(peak_torque)[pair_joint.tolist()] - log_arm,
+        0.0, np.inf,
         [f"reaction capacity of sample {s} within the torque of {joint_names[j]}"
          for s, j in zip(pair_sample, pair_joint, strict=True)])
 
-    add(ca.vec(residuals), 0.0, 0.0,
-        [f"M_bb y = J^T u at sample {s} (row {i})" for s in range(n_samples) for i in range(n_joints)])
+    add(ca.transpose(normalisation), 1.0, 1.0, [f"w^T x = 1 at sample {s}" for s in range(n_samples)])
 
     # Torque: peak output torque covers the requirement in every sampled configuration (linear constraints,
     # one per configuration, sign and joint), each scaled by the requirement at the start.
@@ -343,14 +370,16 @@ def build_problem(
             [f"{name} within its bound"])
 
     f = sum(weight * OBJECTIVES[name][0] * expressions[name] / scale[name] for name, weight in weights.items())
+    f += TIE_BREAK_WEIGHT * expressions["mean_impulse"] / scale["mean_impulse"]
     nlp = {"x": x, "f": f, "g": ca.vertcat(*g_parts), "p": p}
     return DesignProblem(
         nlp=nlp, x0=x0, lbx=lbx, ubx=ubx, lbg=np.concatenate(lbg_parts), ubg=np.concatenate(ubg_parts),
         constraint_labels=labels, objective=weights, bounded_objectives=bounded, objective_scale=scale,
         evaluate=evaluate, layout=layout, samples=samples, space=space, technology=technology,
         constraints=constraints, joint_names=joint_names, required_torque_function=required_torque,
-        epigraph_index=epigraph_index, capacity_index=capacity_index, capacity_scale=capacity_scale,
-        lifted_index=lifted_index, build_time=time.perf_counter() - started, _joint_numbers=joint_numbers,
+        epigraph_index=epigraph_index, capacity_index=capacity_index,
+        lifted_index=lifted_index, lifted_scale=lifted_scale, build_time=time.perf_counter() - started,
+        _joint_numbers=joint_numbers,
     )
 
 
@@ -364,6 +393,19 @@ def _objective_weights(objective: str | Mapping[str, float]) -> dict[str, float]
     return weights
 
 
+def _feasible_gear_start(x0: np.ndarray, layout: _Layout, joint_numbers: Any, samples: ContactSamples,
+                         constraints: Constraints, joint_names: tuple[str, ...]) -> None:
+    """Move the start's free gear ratios up to where the peak torque covers the requirement (with 10 % to
+    spare), within their bounds: IPOPT converges much faster from a torque-feasible start."""
+    masses, torques, _ = (np.asarray(v).ravel() for v in joint_numbers(x0))
+    rows, _ = _torque_requirement_rows(samples, constraints, joint_names)
+    required = np.max([base + per_motor @ masses for base, per_motor in rows], axis=0)
+    for joint, index in enumerate(layout.slices["gear_ratio"]):
+        if index is not None and required[joint] > torques[joint]:
+            x0[index] = min(x0[index] + math.log(1.1 * required[joint] / torques[joint]),
+                            math.log(layout.bounds["gear_ratio"][joint].upper))
+
+
 def _with_noise_floor(bounds: Bounds, floor: float) -> Bounds:
     """With force sensing the noise floor [N] is a lower bound on the threshold variable itself."""
     if floor <= 0:
@@ -375,38 +417,41 @@ def _with_noise_floor(bounds: Bounds, floor: float) -> Bounds:
     return Bounds(max(bounds.lower, floor), bounds.upper, "threshold")
 
 
-def _sample_function(n_joints: int, sensing: str, reaction: str) -> Any:
+def _sample_function(n_joints: int, sensing: str, reaction: str, reflected_inertia_in: str) -> Any:
     """SX function of one contact sample.
 
     Inputs: the design column (motor masses, reflected inertias, joint stiffnesses (n each), threshold,
-    approach velocity), the lifted ``y`` (n, standing for ``M_bb(m)^-1 w``), the reaction compliance ``c``
+    approach velocity), the finger-mass direction ``x`` (n, with ``w^T x = 1``), the reaction compliance ``c``
     (``1/F_a`` [1/N]) and the sample's data (``w = J^T u`` (n), ``M_bb0`` (n*n), motor-mass influence matrices
-    (n*n*n), effective mechanical stiffness). Outputs: the impulse [N*s], the contact-force threshold [N] and the
-    residual of ``M_bb(m) y = w``.
+    (n*n*n), effective mechanical stiffness). Outputs: the impulse [N*s], the contact-force threshold [N] and
+    ``w^T x``.
     """
     n = n_joints
     design = ca.SX.sym("design", 3 * n + 2)
-    y = ca.SX.sym("y", n)
+    direction = ca.SX.sym("x", n)
     compliance = ca.SX.sym("c")
     data = ca.SX.sym("data", n + n * n + n**3 + 1)
     mass, inertia, stiffness = (design[i * n:(i + 1) * n] for i in range(3))
     threshold_variable, velocity = design[3 * n], design[3 * n + 1]
     w = data[:n]
-    structure = ca.reshape(data[n:n + n * n], n, n)
     offset = n + n * n
+    # x^T M_f x with M_f = M_bb0 + sum_i m_i A_i (+ diag(N^2 J_m)), each term a quadratic form in x.
+    finger_mass = ca.bilin(ca.reshape(data[n:offset], n, n), direction, direction)
     for i in range(n):
-        structure += mass[i] * ca.reshape(data[offset + i * n * n:offset + (i + 1) * n * n], n, n)
+        influence = ca.reshape(data[offset + i * n * n:offset + (i + 1) * n * n], n, n)
+        finger_mass += mass[i] * ca.bilin(influence, direction, direction)
+    if reflected_inertia_in == "finger":
+        finger_mass += ca.dot(inertia, direction**2)
     k_mech = data[-1]
 
     # Effective parameters along u (MODEL.md §3), compliance forms.
-    finger_mass = 1 / ca.dot(w, y)
     robot_mass = 1 / ca.sum1(w**2 / inertia)
     k = 1 / ca.sum1(w**2 / stiffness)
     force_threshold = threshold_variable if sensing == "force" else k * threshold_variable
     acceleration = 1 / (compliance * robot_mass)  # a = F_a / m_r
     impulse = phase_impulses(finger_mass, k, k_mech, force_threshold, acceleration, velocity, reaction).total
-    residual = ca.mtimes(structure, y) - w
-    return ca.Function("sample_impulse", [design, y, compliance, data], [impulse, force_threshold, residual])
+    return ca.Function("sample_impulse", [design, direction, compliance, data],
+                       [impulse, force_threshold, ca.dot(w, direction)])
 
 
 def _sample_data(samples: ContactSamples, k_mech: np.ndarray) -> np.ndarray:
@@ -433,12 +478,19 @@ def reaction_compliance(samples: ContactSamples, peak_torque: np.ndarray) -> np.
     return np.max(np.abs(samples.joint_moment_arms) / np.asarray(peak_torque, dtype=float), axis=1)
 
 
-def lifted_solution(samples: ContactSamples, motor_mass: np.ndarray) -> np.ndarray:
-    """``y_s = M_bb(q_s; m)^-1 w_s`` for every sample, (n_samples, n_joints), with motor masses ``m`` [kg]."""
+def lifted_solution(samples: ContactSamples, motor_mass: np.ndarray,
+                    finger_joint_inertia: np.ndarray | None = None) -> np.ndarray:
+    """The minimiser ``x_s = M_f^-1 w_s / (w_s^T M_f^-1 w_s)`` of ``x^T M_f x`` with ``w_s^T x = 1`` for every
+    sample, (n_samples, n_joints): ``M_f`` the structure mass matrix with motor masses ``m`` [kg] and, when the
+    reflected inertia acts on the finger, ``diag(N^2 J_m)`` [kg m^2]."""
     kin = samples.kinematics
     index = samples.config_index
     structure = kin.mass_matrix[index] + np.einsum("i,sijk->sjk", motor_mass, kin.motor_mass_influence[index])
-    return np.linalg.solve(structure, samples.joint_moment_arms[..., None])[..., 0]
+    if finger_joint_inertia is not None:
+        structure = structure + np.diag(finger_joint_inertia)
+    w = samples.joint_moment_arms
+    y = np.linalg.solve(structure, w[..., None])[..., 0]
+    return y / np.einsum("sj,sj->s", w, y)[:, None]
 
 
 def loaded_joints(samples: ContactSamples) -> np.ndarray:

@@ -27,6 +27,13 @@ DEFAULT_IPOPT_OPTIONS: dict[str, Any] = {
     "ipopt.mu_strategy": "adaptive",
     "ipopt.linear_solver": "mumps",
 }
+WARM_START_OPTIONS: dict[str, Any] = {
+    # Start from a neighbouring solution's primal and dual point, close to the central path.
+    "ipopt.warm_start_init_point": "yes",
+    "ipopt.warm_start_bound_push": 1e-6,
+    "ipopt.warm_start_mult_bound_push": 1e-6,
+    "ipopt.mu_init": 1e-4,
+}
 AGREEMENT_TOLERANCE = 1e-6
 """Largest relative difference allowed between the CasADi and NumPy evaluations of a design's objectives:
 both evaluate the same closed forms in double precision, so any larger difference is a modelling bug."""
@@ -93,6 +100,7 @@ class DesignResult:
     build_time: float
     epsilon: dict[str, float] = field(default_factory=dict)
     x: np.ndarray = field(default_factory=lambda: np.empty(0), repr=False)
+    multipliers: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)
 
     @property
     def worst_sample(self) -> int:
@@ -103,7 +111,7 @@ class DesignResult:
 def solve(
     problem: DesignProblem,
     epsilon: Mapping[str, float] | None = None,
-    x0: np.ndarray | None = None,
+    x0: np.ndarray | DesignResult | None = None,
     ipopt_options: Mapping[str, Any] | None = None,
 ) -> DesignResult:
     """Solve ``problem`` with IPOPT (exact Hessian, MUMPS).
@@ -111,8 +119,8 @@ def solve(
     Parameters
     ----------
     epsilon: upper bounds on objectives built as bounded (lower bound for ``approach_velocity``) [their units].
-    x0: start point in the NLP's variables (e.g. a neighbouring Pareto point's ``result.x``); default the
-        problem's start point.
+    x0: start point in the NLP's variables, or a neighbouring :class:`DesignResult` of the same problem, whose
+        point and multipliers then warm-start IPOPT; default the problem's start point.
     ipopt_options: options merged over :data:`DEFAULT_IPOPT_OPTIONS` (e.g. ``{"ipopt.max_iter": 100}``).
 
     Raises
@@ -120,17 +128,21 @@ def solve(
     SolverFailed: IPOPT did not reach a (locally) optimal point; it carries the status, the statistics and the
         constraints that could not be met.
     """
-    options = {**DEFAULT_IPOPT_OPTIONS, **(ipopt_options or {})}
+    warm = x0 if isinstance(x0, DesignResult) and x0.multipliers is not None else None
+    options = {**DEFAULT_IPOPT_OPTIONS, **(WARM_START_OPTIONS if warm else {}), **(ipopt_options or {})}
     key = repr(sorted(options.items()))
     solver = problem._solvers.get(key)
     if solver is None:
         solver = ca.nlpsol("actuator_design", "ipopt", problem.nlp, options)
         problem._solvers[key] = solver
     parameters = problem.parameters(epsilon)
+    if isinstance(x0, DesignResult):
+        x0 = x0.x
     start = np.clip(problem.x0 if x0 is None else np.asarray(x0, dtype=float), problem.lbx, problem.ubx)
+    multipliers = {"lam_x0": warm.multipliers[0], "lam_g0": warm.multipliers[1]} if warm else {}
     started = time.perf_counter()
     solution = solver(x0=start, lbx=problem.lbx, ubx=problem.ubx, lbg=problem.lbg, ubg=problem.ubg,
-                      p=parameters)
+                      p=parameters, **multipliers)
     elapsed = time.perf_counter() - started
     stats = solver.stats()
     status = str(stats.get("return_status", "unknown"))
@@ -145,11 +157,12 @@ def solve(
             "objective bounds.",
             status, dict(stats), violated, problem,
         )
-    return _result(problem, x, status, stats, elapsed, dict(epsilon or {}))
+    multipliers_out = (np.asarray(solution["lam_x"]).ravel(), np.asarray(solution["lam_g"]).ravel())
+    return _result(problem, x, status, stats, elapsed, dict(epsilon or {}), multipliers_out)
 
 
 def _result(problem: DesignProblem, x: np.ndarray, status: str, stats: dict, elapsed: float,
-            epsilon: dict[str, float]) -> DesignResult:
+            epsilon: dict[str, float], multipliers: tuple[np.ndarray, np.ndarray]) -> DesignResult:
     design = design_at(problem, x)
     evaluated = problem.evaluate(problem.exact_point(x))
     impulses = np.asarray(evaluated[0]).ravel()
@@ -176,7 +189,7 @@ def _result(problem: DesignProblem, x: np.ndarray, status: str, stats: dict, ela
         design=design, objectives=objectives, numpy_objectives=numpy_objectives, impulses=numpy_impulses,
         required_torque=required, torque_margin=design.peak_torque / np.maximum(required, 1e-300) - 1,
         status=status, success=True, iterations=int(stats.get("iter_count", -1)), solve_time=elapsed,
-        build_time=problem.build_time, epsilon=epsilon, x=x,
+        build_time=problem.build_time, epsilon=epsilon, x=x, multipliers=multipliers,
     )
 
 
