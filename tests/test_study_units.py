@@ -15,40 +15,8 @@ from collision_reflex.report.html import number
 from collision_reflex.study.actuator_study import contact_threshold
 from collision_reflex.study.executors import SerialExecutor, open_executor
 from collision_reflex.study.runner import non_dominated, smoke_study
-from collision_reflex.study.samples import circle_directions, named_directions, sphere_directions
 from collision_reflex.study.schema import SensingSpec
 from collision_reflex.study.store import OutputFolderInUse, RunFolder
-
-
-@pytest.mark.parametrize("count", [1, 4, 16, 33], ids=lambda n: f"n={n}")
-def test_circle_directions_are_unit_and_evenly_spread(count):
-    u = circle_directions(count)
-    assert u.shape == (count, 2)
-    np.testing.assert_allclose(np.linalg.norm(u, axis=1), 1.0, rtol=1e-12)  # unit vectors, rounding only
-    if count > 1:
-        # Evenly spread: consecutive angles differ by 2 pi / n, and the vectors sum to zero (roots of unity).
-        np.testing.assert_allclose(np.diff(np.unwrap(np.arctan2(u[:, 1], u[:, 0]))), 2 * np.pi / count, rtol=1e-12)
-        np.testing.assert_allclose(u.sum(axis=0), 0.0, atol=1e-12)
-    u3 = circle_directions(count, task_dim=3)
-    np.testing.assert_array_equal(u3[:, 2], 0.0)
-
-
-@pytest.mark.parametrize("count", [6, 14, 50, 400], ids=lambda n: f"n={n}")
-def test_sphere_directions_are_unit_and_equal_area(count):
-    u = sphere_directions(count)
-    np.testing.assert_allclose(np.linalg.norm(u, axis=1), 1.0, rtol=1e-12)
-    # Equal area (Archimedes): the share of points in any band of heights equals the band's share of the
-    # sphere's area, i.e. its height / 2, up to one point of rounding at each edge.
-    for low, high in [(-1.0, 0.0), (0.2, 0.7), (-0.9, -0.4)]:
-        inside = np.count_nonzero((u[:, 2] > low) & (u[:, 2] <= high))
-        assert abs(inside - count * (high - low) / 2) <= 1.0
-    # Balanced: the mean direction is near zero (the lattice's azimuths cancel to O(1/n)).
-    assert np.linalg.norm(u.mean(axis=0)) < 2.0 / count
-
-
-def test_named_directions():
-    np.testing.assert_array_equal(named_directions(["+x", "-z"], 3), [[1, 0, 0], [0, 0, -1]])
-    np.testing.assert_array_equal(named_directions(["-y"], 2), [[0, -1]])
 
 
 def _square(x: float) -> float:

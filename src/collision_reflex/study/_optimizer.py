@@ -94,6 +94,7 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
         scaling_law=reference_spec.scaling_law,
         sensing=scheme,
         reaction=study.reaction,
+        reflected_inertia_in=study.reflected_inertia_in,
     )
     constraints = Constraints(
         payload=study.constraints.payload,
@@ -102,7 +103,7 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
         threshold_floor=study.constraints.threshold_floor,
     )
     configurations = configuration_samples(loaded, arm)
-    directions = direction_samples(study.samples.directions, int(arm.task_dim))
+    directions = direction_samples(loaded, arm)
     samples = ContactSamples.grid(arm.kinematics(configurations), directions)
     return ArmSetup(study, arm, catalogue, configurations, directions, samples, space, technology, constraints)
 
@@ -252,12 +253,14 @@ def design_record(setup: ArmSetup, problem: Any, result: Any, label: str) -> dic
 
     design = result.design
     samples = problem.samples
+    # The same effective parameters as the optimiser's NumPy check (optimize.evaluate), kept for the phases.
+    finger = {"finger_joint_inertia": design.reflected_inertia} if setup.study.reflected_inertia_in == "finger" else {}
     params = effective_parameters(
         samples.kinematics, samples.directions, config_index=samples.config_index,
         reflected_inertia=design.reflected_inertia,
         stiffness=series_stiffness(design.mechanical_stiffness, design.software_stiffness),
         mechanical_stiffness=design.mechanical_stiffness, torque_limit=design.peak_torque,
-        motor_mass=design.motor_mass,
+        motor_mass=design.motor_mass, **finger,
     )
     threshold = design.threshold if design.sensing == "force" else params.k * design.threshold
     phases = phase_impulses(params.m_f, params.k, params.k_m, threshold, params.a, design.approach_velocity,

@@ -155,7 +155,7 @@ def describe_study(loaded: LoadedStudy, load_robot: bool = True) -> str:
         arm = load_arm(loaded)
         n_joints = len(arm.joint_names)
         n_config = configuration_samples(loaded, arm).shape[0]
-        n_dir = direction_samples(study.samples.directions, int(arm.task_dim)).shape[0]
+        n_dir = direction_samples(loaded, arm).shape[0]
         text += f" ({n_joints} joints: {', '.join(arm.joint_names)}), {n_config} configurations x {n_dir} directions"
     free = free_variables(study, n_joints or 1, list(arm.joint_names) if load_robot else None)
 

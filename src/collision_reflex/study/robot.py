@@ -7,10 +7,9 @@ the study file that names them.
 from __future__ import annotations
 
 import difflib
-import inspect
 from typing import Any
 
-from ..errors import CollisionReflexError, StudyFileError, StudyProblem
+from ..errors import FrameNotFound, InvalidParameter, StudyFileError, StudyProblem, UrdfError
 from .load import LoadedStudy
 from .schema import PER_JOINT_DESIGN_VARIABLES, ArmStudy
 
@@ -37,6 +36,7 @@ def load_arm(loaded: LoadedStudy) -> Any:
     from ..arm import Arm
 
     offset = list(spec.contact_offset)
+    locked = list(spec.locked_joints)
     try:
         if spec.example_robot_data is not None:
             names = example_robot_names()
@@ -48,39 +48,40 @@ def load_arm(loaded: LoadedStudy) -> Any:
                     ("one of " + ", ".join(map(repr, close)) + " or another of " if close else "one of ")
                     + f"the {len(names)} models of example-robot-data (e.g. ur5, panda, double_pendulum)",
                 )
-            locking = _locking(loaded, Arm.from_example_robot_data)
             arm = Arm.from_example_robot_data(spec.example_robot_data, contact_frame=spec.contact_frame,
-                                              contact_offset=offset, **locking)
+                                              contact_offset=offset, locked_joints=locked)
         else:
             assert spec.urdf is not None  # one source is guaranteed by the schema
+            if spec.contact_frame is None:
+                raise loaded.fail(("robot",), "a URDF without contact_frame",
+                                  "robot.contact_frame: the frame (link or fixed joint) that makes contact")
             arm = Arm.from_urdf(
                 str(loaded.path(spec.urdf)),
                 spec.contact_frame,
                 package_dirs=[str(loaded.path(p)) for p in spec.package_dirs] or None,
                 contact_offset=offset,
-                **_locking(loaded, Arm.from_urdf),
+                locked_joints=locked,
             )
-    except StudyFileError:
-        raise
-    except CollisionReflexError as error:
-        field = "contact_frame" if "frame" in type(error).__name__.lower() or "frame" in str(error) else None
-        where = ("robot", field) if field and spec.contact_frame is not None else ("robot",)
-        raise loaded.fail(where, f"a robot that cannot be used ({error})", "a valid robot and contact frame") from None
+    except FrameNotFound as error:
+        if error.kind == "joint" and error.name in locked:
+            where: tuple[Any, ...] = ("robot", "locked_joints", locked.index(error.name))
+        else:
+            where = ("robot", "contact_frame")
+        close = difflib.get_close_matches(error.name, error.available, n=1)
+        raise loaded.fail(where, f"{error.kind} {error.name!r}, not in the robot",
+                          (f"{close[0]!r}? " if close else "") + f"one of the {len(error.available)} "
+                          f"{error.kind}s: " + ", ".join(error.available)) from None
+    except UrdfError as error:
+        raise loaded.fail(("robot", "urdf"), f"a URDF that cannot be loaded ({error.reason})",
+                          "a URDF file Pinocchio can parse") from None
+    except InvalidParameter as error:
+        field = error.name if error.name in type(spec).model_fields else None
+        raise loaded.fail(("robot", field) if field else ("robot",), str(error),
+                          "a robot and contact point the arm model accepts") from None
     problems = check_against_arm(loaded, arm)
     if problems:
         raise StudyFileError(loaded.source.file, problems)
     return arm
-
-
-def _locking(loaded: LoadedStudy, constructor: Any) -> dict[str, Any]:
-    """``locked_joints=...`` for the arm constructor, if the study locks joints."""
-    locked = list(loaded.study.robot.locked_joints)  # type: ignore[union-attr]
-    if not locked:
-        return {}
-    if "locked_joints" not in inspect.signature(constructor).parameters:
-        raise loaded.fail(("robot", "locked_joints"), "locked joints",
-                          "no locked joints: this version's arm model cannot lock joints")
-    return {"locked_joints": locked}
 
 
 def check_against_arm(loaded: LoadedStudy, arm: Any) -> list[StudyProblem]:
@@ -105,12 +106,12 @@ def check_against_arm(loaded: LoadedStudy, arm: Any) -> list[StudyProblem]:
         for name in getattr(spec, "joints", {}) or {}:
             check_joint(("design", variable, "joints", name), name)
 
-    nq = int(arm.model.nq)
+    nv = int(arm.nv)
     for index, q in enumerate(study.samples.configurations.list or []):
-        if len(q) != nq:
+        if len(q) != nv:
             problems.append(
-                loaded.problem(("samples", "configurations", "list", index), f"{len(q)} joint positions",
-                               f"{nq} (the robot's nq) in rad")
+                loaded.problem(("samples", "configurations", "list", index), f"{len(q)} joint angles",
+                               f"{nv}, one per joint ({', '.join(joints)}) in rad")
             )
     task_dim = int(arm.task_dim)
     directions = study.samples.directions
@@ -120,18 +121,11 @@ def check_against_arm(loaded: LoadedStudy, arm: Any) -> list[StudyProblem]:
                 loaded.problem(("samples", "directions", "list", index), f"a vector of {len(vector)} components",
                                f"{task_dim} components ({'a planar arm' if task_dim == 2 else 'a spatial arm'})")
             )
-    if task_dim == 2:
-        if directions.sphere is not None:
-            problems.append(
-                loaded.problem(("samples", "directions", "sphere"), "sphere directions for a planar arm",
-                               "circle: N (directions in the arm's plane)")
-            )
-        for index, name in enumerate(directions.named or []):
-            if name.endswith("z"):
-                problems.append(
-                    loaded.problem(("samples", "directions", "named", index), f"{name!r} for a planar arm",
-                                   "one of +x, -x, +y, -y (the arm's plane)")
-                )
+    if task_dim == 2 and directions.sphere is not None:
+        problems.append(
+            loaded.problem(("samples", "directions", "sphere"), "sphere directions for a planar arm",
+                           "circle: N (directions in the arm's plane)")
+        )
     required = study.constraints.torque_required
     if required is not None and len(required) != len(joints):
         problems.append(

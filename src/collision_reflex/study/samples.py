@@ -1,65 +1,47 @@
 """Configurations and contact directions of a study's samples.
 
 Directions are unit vectors in the arm's task coordinates (2 components for a planar arm, 3 otherwise). The
-circle and sphere samplings are deterministic (evenly spread), so a study's numbers depend only on its file.
+circle and sphere samplings are deterministic (evenly spread), and random configurations come from the study's
+seed, so a study's numbers depend only on its file.
 """
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
 
+from ..directions import circle_directions, sphere_directions, unit_directions
+from ..errors import InvalidParameter
 from .load import LoadedStudy
 from .schema import ArmStudy, ConfigurationSamples, DirectionSamples
 
-_AXES = {"x": 0, "y": 1, "z": 2}
 
+def direction_samples(loaded: LoadedStudy, arm: Any) -> np.ndarray:
+    """The contact directions of an arm study, unit vectors (n, task_dim) in the arm's task coordinates.
 
-def circle_directions(count: int, task_dim: int = 2) -> np.ndarray:
-    """``count`` unit vectors evenly spread over the circle, starting at +x; in the x-y plane for ``task_dim`` 3.
-
-    Returns an array of shape (count, task_dim).
+    ``circle: n`` spreads n directions evenly over the arm's plane (planar arms) or the world x-y plane;
+    ``sphere: n`` over the sphere (:func:`collision_reflex.directions.sphere_directions`); named directions and
+    listed vectors go through :func:`collision_reflex.directions.unit_directions` (world vectors are projected
+    into a planar arm's plane). A direction the arm cannot use is reported at its line.
     """
-    angles = 2 * np.pi * np.arange(count) / count
-    out = np.zeros((count, task_dim))
-    out[:, 0], out[:, 1] = np.cos(angles), np.sin(angles)
-    return out
-
-
-def sphere_directions(count: int) -> np.ndarray:
-    """``count`` unit vectors spread evenly over the sphere (a Fibonacci lattice), shape (count, 3).
-
-    Each vector stands for an equal area of the sphere (the lattice places point ``i`` at height
-    ``1 - (2 i + 1) / count``, equally spaced in ``z``, which by Archimedes' hat-box theorem is equal area).
-    """
-    index = np.arange(count)
-    z = 1 - (2 * index + 1) / count
-    radius = np.sqrt(np.clip(1 - z**2, 0.0, None))
-    golden_angle = math.pi * (3 - math.sqrt(5))
-    azimuth = golden_angle * index
-    return np.column_stack([radius * np.cos(azimuth), radius * np.sin(azimuth), z])
-
-
-def named_directions(names: list[str], task_dim: int) -> np.ndarray:
-    """Unit vectors for names such as ``"+x"`` or ``"-z"``, shape (len(names), task_dim)."""
-    out = np.zeros((len(names), task_dim))
-    for row, name in enumerate(names):
-        out[row, _AXES[name[1]]] = 1.0 if name[0] == "+" else -1.0
-    return out
-
-
-def direction_samples(spec: DirectionSamples, task_dim: int) -> np.ndarray:
-    """The contact directions of a study, unit vectors of shape (n, task_dim)."""
+    study = loaded.study
+    assert isinstance(study, ArmStudy)
+    spec: DirectionSamples = study.samples.directions
+    task_dim = int(arm.task_dim)
     if spec.circle is not None:
-        return circle_directions(spec.circle, task_dim)
+        planar = circle_directions(spec.circle)
+        return planar if task_dim == 2 else np.column_stack([planar, np.zeros(spec.circle)])
     if spec.sphere is not None:
         return sphere_directions(spec.sphere)
-    if spec.named is not None:
-        return named_directions(list(spec.named), task_dim)
-    vectors = np.asarray(spec.list, dtype=float)
-    return vectors / np.linalg.norm(vectors, axis=1, keepdims=True)
+    field, items = ("named", list(spec.named)) if spec.named is not None else ("list", list(spec.list or []))
+    out = []
+    for index, item in enumerate(items):
+        try:
+            out.append(unit_directions([item], task_dim, arm.plane)[0])
+        except InvalidParameter as error:
+            raise loaded.fail(("samples", "directions", field, index), repr(item), error.allowed) from None
+    return np.array(out)
 
 
 def configuration_samples(loaded: LoadedStudy, arm: Any) -> np.ndarray:
@@ -76,7 +58,7 @@ def configuration_samples(loaded: LoadedStudy, arm: Any) -> np.ndarray:
         rng = np.random.default_rng(spec.random.seed)
         return np.asarray(arm.sample_configurations(spec.random.count, rng), dtype=float)
     if spec.list is not None:
-        return np.asarray(spec.list, dtype=float)
+        return np.asarray(arm.configuration(np.asarray(spec.list, dtype=float)), dtype=float)
     assert spec.trajectory is not None  # exactly one source is guaranteed by the schema
     return _trajectory(loaded, arm, spec.trajectory.file, spec.trajectory.every)
 
@@ -94,10 +76,7 @@ def _trajectory(loaded: LoadedStudy, arm: Any, file: str, every: int) -> np.ndar
     if missing:
         raise loaded.fail(where, f"{file!r} without columns {', '.join(missing)}",
                           "a header row naming every joint: " + ", ".join(joints))
-    if arm.model.nq != len(joints):
-        raise loaded.fail(where, "a trajectory for a robot whose nq differs from its joint count",
-                          "random or listed configurations for this robot")
     values = table[joints].to_numpy(dtype=float)[::every]
     if values.size == 0 or not np.all(np.isfinite(values)):
         raise loaded.fail(where, f"{file!r} with no rows or with non-numeric values", "finite joint positions [rad]")
-    return values
+    return np.asarray(arm.configuration(values), dtype=float)

@@ -334,6 +334,11 @@ class ArmStudy(_Model):
     sensing: SensingSpec
     approach_velocity: Velocity = Field(gt=0, description="approach velocity [m/s]")
     reaction: Literal["at_rest", "moving"] = "at_rest"
+    reflected_inertia_in: Literal["robot", "finger"] = Field(
+        "robot",
+        description="where N^2 J_m acts: 'robot' (behind the joint springs, the paper's arm model) or 'finger' "
+        "(also rigidly in the finger mass: a stiff transmission with the compliance at the contact)",
+    )
     samples: SamplesSpec
     design: DesignSpec = Field(default_factory=DesignSpec)
     objective: Annotated[
