@@ -6,7 +6,17 @@ Actuation"). This package evaluates it from structure, actuation, stiffness and 
 URDF arms, and optimises actuator designs against it.
 """
 
-from .errors import CollisionReflexError, InvalidParameter, StudyFileError, StudyProblem
+from .actuators import (
+    REFLECTED_INERTIA_PLACEMENTS,
+    Actuator,
+    CollisionParameters,
+    CurrentThreshold,
+    ForceThreshold,
+    PositionThreshold,
+    gear_ratio_for,
+)
+from .errors import CatalogueError, CollisionReflexError, InvalidParameter, StudyFileError, StudyProblem, UnknownMotor
+from .gearboxes import GEARBOX_KINDS, Gearbox
 from .impulse import (
     REACTION_MODES,
     PhaseImpulses,
@@ -19,26 +29,56 @@ from .impulse import (
     total_impulse,
     velocity_coefficients,
 )
+from .motors import (
+    SCALING_LAWS,
+    Motor,
+    MotorQuantities,
+    ScalingLaw,
+    load_catalogue,
+    reference_motor,
+    scaled_motor_quantities,
+    scaling_law,
+)
+
 from .study import load_study, study_json_schema
 from .study.runner import run_study
 
 __version__ = "0.1.0"
 
 __all__ = [
+    "GEARBOX_KINDS",
     "REACTION_MODES",
+    "REFLECTED_INERTIA_PLACEMENTS",
+    "SCALING_LAWS",
+    "Actuator",
+    "CatalogueError",
+    "CollisionParameters",
     "CollisionReflexError",
+    "CurrentThreshold",
+    "ForceThreshold",
+    "Gearbox",
     "InvalidParameter",
+    "Motor",
+    "MotorQuantities",
     "PhaseImpulses",
+    "PositionThreshold",
+    "ScalingLaw",
     "StudyFileError",
     "StudyProblem",
+    "UnknownMotor",
     "__version__",
     "collision_times",
     "force_profile",
+    "gear_ratio_for",
+    "load_catalogue",
     "load_study",
     "minimum_impulse",
     "optimal_velocity",
     "phase_impulses",
+    "reference_motor",
     "run_study",
+    "scaled_motor_quantities",
+    "scaling_law",
     "series_stiffness",
     "study_json_schema",
     "total_impulse",
