@@ -64,7 +64,7 @@ def test_defaults_are_explicit_in_the_resolved_study():
     resolved = resolved_study(parse_study(MINIMAL))
     assert resolved["objective"] == {"worst_case_impulse": 1.0}
     assert resolved["actuators"]["motor"] == {
-        "reference": "Omni+ OPN-060-013-A",
+        "reference": "OPN-060-013-A",
         "scaling_law": "haddadin",
         "stator_diameter": None,
         "stack_length": None,

@@ -12,7 +12,7 @@ import pytest
 
 from collision_reflex.impulse import phase_impulses, series_stiffness
 from collision_reflex.report.html import number
-from collision_reflex.study.actuator_study import contact_threshold
+from collision_reflex.study.actuator_study import sensing_scheme
 from collision_reflex.study.executors import SerialExecutor, open_executor
 from collision_reflex.study.runner import non_dominated, smoke_study
 from collision_reflex.study.schema import SensingSpec
@@ -101,14 +101,23 @@ def test_lever_mapping_equals_the_rotary_collision(reaction):
         assert getattr(contact, phase) == pytest.approx(getattr(angular, phase) / lever, rel=1e-12)
 
 
-def test_contact_threshold_by_scheme():
-    force = SensingSpec(scheme="force", threshold="3 N")
-    position = SensingSpec(scheme="position", error="2 mm")
-    current = SensingSpec(scheme="current", motor_torque="0.343 N*m")
-    assert contact_threshold(force, 9.0, 0.1143, 440.0) == 3.0
-    assert contact_threshold(position, 9.0, 0.1143, 440.0) == pytest.approx(0.88)  # F_s = k e
-    # Motor side of a 9:1 transmission: the joint sees 9 x the motor torque, the contact that / L.
-    assert contact_threshold(current, 9.0, 0.1143, 440.0) == pytest.approx(9 * 0.343 / 0.1143)
+def test_sensing_schemes_map_to_the_contact():
+    from collision_reflex.actuators import Actuator
+    from collision_reflex.motors import reference_motor
+
+    lever = 0.1143
+    motor = reference_motor()
+    for spec, expected in [
+        (SensingSpec(scheme="force", threshold="3 N"), lambda act: 3.0),
+        # A contact position error e is a joint error e / L: detection at (k / L^2) e at the contact.
+        (SensingSpec(scheme="position", error="2 mm"), lambda act: act.stiffness / lever**2 * 0.002),
+        # Motor side of a 9:1 transmission: the joint sees 9 x the motor torque, the contact that / L.
+        (SensingSpec(scheme="current", motor_torque="0.343 N*m"), lambda act: 9 * 0.343 / lever),
+    ]:
+        actuator = Actuator(motor, gear_ratio=9.0, mechanical_stiffness=1e4, software_stiffness=5.75,
+                            sensing=sensing_scheme(spec, lever))
+        params = actuator.contact_parameters(lever, 0.1)
+        assert params.F_s == pytest.approx(expected(actuator), rel=1e-12), spec.scheme
 
 
 @pytest.mark.parametrize(

@@ -1,15 +1,15 @@
 """Actuator studies: single-joint actuators compared in a 1D collision at a lever (no arm, no optimiser).
 
-A rotary joint seen at a contact point at lever ``L`` (MODEL.md §2): robot mass ``J / L²`` with ``J`` the
-actuator's reflected inertia, stiffness ``k_rot / L²``, force ``τ / L``. The mechanical spring is in series with
-the object hit (``load.contact_stiffness``, e.g. a force sensor). The contact-force threshold follows the
-sensing scheme: a force threshold is used as is; a position-error threshold ``e`` gives ``F_s = k e``; a
-motor-current threshold ``τ_s`` on the motor side gives ``F_s = N τ_s / L``.
+Each candidate is a :class:`collision_reflex.actuators.Actuator`; its ``contact_parameters`` map it to the contact
+at the study's lever (MODEL.md §2: inertia ``J / L²``, stiffness ``k / L²``, torque ``τ / L``, the threshold by
+its sensing scheme). The object hit (``load.contact_stiffness``, e.g. a force sensor) is a spring in series with
+the joint's, during sensing and reaction alike.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -29,14 +29,15 @@ def check_actuator_study(loaded: LoadedStudy) -> dict[str, Any]:
     actuators = {}
     for name, candidate in study.actuators.items():
         try:
-            actuators[name] = _actuator(candidate, catalogue)
+            actuators[name] = _actuator(candidate, candidate.sensing or study.sensing, study.load.lever, catalogue)
+            _contact(actuators[name], candidate, study)
         except CollisionReflexError as error:
             raise loaded.fail(("actuators", name), f"an actuator that cannot be built ({error})",
                               "a motor, gear ratio and stiffnesses the actuator model accepts") from None
     return actuators
 
 
-def _actuator(candidate: ActuatorCandidate, catalogue: dict[str, Any]) -> Any:
+def _actuator(candidate: ActuatorCandidate, sensing: SensingSpec, lever: float, catalogue: dict[str, Any]) -> Any:
     from ..actuators import Actuator
 
     return Actuator(
@@ -44,21 +45,32 @@ def _actuator(candidate: ActuatorCandidate, catalogue: dict[str, Any]) -> Any:
         gear_ratio=candidate.gear_ratio,
         mechanical_stiffness=candidate.mechanical_stiffness,
         software_stiffness=candidate.software_stiffness,
+        sensing=sensing_scheme(sensing, lever),
         gearbox=gearbox_for(candidate.gearbox),
         gearbox_inertia=candidate.gearbox_inertia,
     )
 
 
-def contact_threshold(sensing: SensingSpec, gear_ratio: float, lever: float, stiffness: float) -> float:
-    """Contact force at detection [N] for a sensing scheme (see the module docstring).
+def sensing_scheme(sensing: SensingSpec, lever: float) -> Any:
+    """The actuator model's sensing scheme for a study's sensing; a contact position error ``e`` [m] is the
+    joint error ``e / L`` [rad]."""
+    from ..actuators import CurrentThreshold, ForceThreshold, PositionThreshold
 
-    gear_ratio [-], lever [m], stiffness: the lumped sensing stiffness at the contact [N/m].
-    """
     if sensing.scheme == "force":
-        return float(sensing.value)
+        return ForceThreshold(sensing.value)
     if sensing.scheme == "position":
-        return stiffness * sensing.value
-    return gear_ratio * sensing.value / lever
+        return PositionThreshold(sensing.value / lever)
+    return CurrentThreshold(sensing.value)
+
+
+def _contact(actuator: Any, candidate: ActuatorCandidate, study: ActuatorStudy) -> Any:
+    """The candidate's collision parameters at the contact, with the object hit in series."""
+    params = actuator.contact_parameters(study.load.lever, study.load.finger_mass,
+                                         reflected_inertia_in=candidate.reflected_inertia_in)
+    if study.load.contact_stiffness is None:
+        return params
+    return replace(params, k=float(series_stiffness(params.k, study.load.contact_stiffness)),
+                   k_m=float(series_stiffness(params.k_m, study.load.contact_stiffness)))
 
 
 def evaluate_actuator_study(loaded: LoadedStudy) -> dict[str, Any]:
@@ -67,22 +79,13 @@ def evaluate_actuator_study(loaded: LoadedStudy) -> dict[str, Any]:
     study = loaded.study
     assert isinstance(study, ActuatorStudy)
     actuators = check_actuator_study(loaded)
-    lever = study.load.lever
     velocities = np.geomspace(study.velocities.min, study.velocities.max, study.velocities.count)
     candidates = []
     for name, candidate in study.actuators.items():
         actuator = actuators[name]
-        m_f = study.load.finger_mass
-        m_r = float(actuator.reflected_inertia) / lever**2
-        k_m = candidate.mechanical_stiffness / lever**2
-        if study.load.contact_stiffness is not None:
-            k_m = float(series_stiffness(k_m, study.load.contact_stiffness))
-        k_s = candidate.software_stiffness / lever**2
-        k = float(series_stiffness(k_m, k_s))
-        force_capacity = float(actuator.peak_torque) / lever
-        a = force_capacity / m_r
+        params = _contact(actuator, candidate, study)
+        m_f, k, k_m, F_s, a = params.m_f, params.k, params.k_m, params.F_s, params.a
         sensing = candidate.sensing or study.sensing
-        F_s = contact_threshold(sensing, candidate.gear_ratio, lever, k)
         common = (m_f, k, k_m, F_s, a)
         at_v0 = phase_impulses(*common, study.approach_velocity, study.reaction)
         sweep = phase_impulses(*common, velocities, study.reaction)
@@ -99,7 +102,8 @@ def evaluate_actuator_study(loaded: LoadedStudy) -> dict[str, Any]:
             "mechanical_stiffness": candidate.mechanical_stiffness,
             "software_stiffness": candidate.software_stiffness,
             "sensing": sensing.scheme,
-            "contact": {"m_f": m_f, "m_r": m_r, "k": k, "k_m": k_m, "F_s": F_s, "F_a": force_capacity, "a": a},
+            "reflected_inertia_in": candidate.reflected_inertia_in,
+            "contact": {"m_f": m_f, "m_r": params.m_r, "k": k, "k_m": k_m, "F_s": F_s, "F_a": params.F_a, "a": a},
             "impulse": {"initial": float(at_v0.initial), "sensing": float(at_v0.sensing),
                         "reaction": float(at_v0.reaction), "total": float(at_v0.total)},
             "optimal_velocity": v_star,
@@ -122,7 +126,7 @@ def evaluate_actuator_study(loaded: LoadedStudy) -> dict[str, Any]:
         "study": study.name,
         "description": study.description,
         "resolved": resolved_study(loaded),
-        "lever": lever,
+        "lever": study.load.lever,
         "approach_velocity": study.approach_velocity,
         "velocities": velocities.tolist(),
         "candidates": candidates,

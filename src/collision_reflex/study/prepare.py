@@ -63,9 +63,10 @@ def gearbox_for(spec: GearboxSpec | None) -> Any:
     """The :class:`collision_reflex.actuators.Gearbox` of a spec (``None`` for direct drive)."""
     if spec is None:
         return None
-    from ..actuators import Gearbox
+    from ..gearboxes import Gearbox
 
-    return Gearbox(spec.kind, stages=spec.stages)
+    return Gearbox(spec.kind, stages=spec.stages, diameter=spec.diameter, length=spec.length, mass=spec.mass,
+                   inertia=spec.inertia, rated_torque=spec.rated_torque, source=spec.source)
 
 
 @dataclass(frozen=True)

@@ -19,14 +19,14 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, WithJsonSchema, field_validator, model_validator
 
-from .quantities import Angle, Force, Length, LinearStiffness, Mass, Ratio, RotaryStiffness, Torque, Velocity
+from .quantities import Angle, Force, Inertia, Length, LinearStiffness, Mass, Ratio, RotaryStiffness, Torque, Velocity
 
 OBJECTIVE_NAMES = ("worst_case_impulse", "mean_impulse", "actuator_mass", "approach_velocity")
 ObjectiveName = Literal["worst_case_impulse", "mean_impulse", "actuator_mass", "approach_velocity"]
 SCALING_LAW_NAMES = ("haddadin", "isometric", "empirical", "quadruped")
 GEARBOX_KINDS = ("planetary", "parallel_shaft", "harmonic", "cycloidal", "ball_screw")
 NAMED_DIRECTIONS = ("+x", "-x", "+y", "-y", "+z", "-z")
-DEFAULT_REFERENCE_MOTOR = "Omni+ OPN-060-013-A"
+DEFAULT_REFERENCE_MOTOR = "OPN-060-013-A"
 
 PositiveInt = Annotated[int, Field(ge=1, strict=True)]
 Name = Annotated[str, Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9._-]*$", max_length=80)]
@@ -88,8 +88,16 @@ class MotorSpec(_Model):
 
 
 class GearboxSpec(_Model):
+    """A gearbox with the figures of a real unit (its datasheet): mass and inertia enter the actuator."""
+
     kind: Literal["planetary", "parallel_shaft", "harmonic", "cycloidal", "ball_screw"]
     stages: PositiveInt = 1
+    diameter: Length = Field(gt=0, description="outer diameter [m]")
+    length: Length = Field(gt=0, description="length [m]")
+    mass: Mass = Field(gt=0, description="mass [kg]")
+    inertia: Inertia = Field(gt=0, description="inertia at the input shaft [kg m^2]")
+    rated_torque: Torque = Field(gt=0, description="rated output torque [N m]")
+    source: str = Field("", description="where the figures come from")
 
 
 class JointActuatorSpec(_Model):
@@ -381,6 +389,9 @@ class ActuatorCandidate(_Model):
     gear_ratio: Ratio = Field(1.0, ge=1)
     mechanical_stiffness: RotaryStiffness = Field(gt=0)
     software_stiffness: RotaryStiffness = Field(gt=0)
+    reflected_inertia_in: Literal["robot", "finger"] = Field(
+        "robot", description="'finger': N^2 J_m also in the impact (a stiff transmission, like the paper's A8)"
+    )
     sensing: SensingSpec | None = Field(None, description="overrides the study's sensing for this actuator")
 
 
