@@ -18,11 +18,70 @@ TEXTS = [path.read_text() for path in STUDIES]
 # Pieces that matter to YAML, to units and to the schema: structure characters, anchors and tags, odd numbers,
 # units of every dimension, and names of real keys put in the wrong place.
 TOKENS = [
-    ":", "-", "- ", "[", "]", "{", "}", ",", "'", '"', "\n", "  ", "\t", "#", "&a ", "*a", "!!str ", "!!binary ",
-    "!!python/name:os.system ", "? ", "|", ">", "%", "@", "`", "~", "null", "yes", "1e999", "-1", "0", ".nan",
-    "-.inf", "2001-02-30", "0x1F", "1_000", "3 kg", "60 mm", "1.3 N*m", "0.5 m/s", "1000 N*m/rad", "45 deg",
-    "20 degC", "1/0 m", "kg**kg", "m^(1/0)", "\u00b5m", "name", "robot", "min", "max", "value", "joints",
-    "circle", "sphere", "list", "random", "count", "seed", "kind", "actuator", "arm", "scheme", "current",
+    ":",
+    "-",
+    "- ",
+    "[",
+    "]",
+    "{",
+    "}",
+    ",",
+    "'",
+    '"',
+    "\n",
+    "  ",
+    "\t",
+    "#",
+    "&a ",
+    "*a",
+    "!!str ",
+    "!!binary ",
+    "!!python/name:os.system ",
+    "? ",
+    "|",
+    ">",
+    "%",
+    "@",
+    "`",
+    "~",
+    "null",
+    "yes",
+    "1e999",
+    "-1",
+    "0",
+    ".nan",
+    "-.inf",
+    "2001-02-30",
+    "0x1F",
+    "1_000",
+    "3 kg",
+    "60 mm",
+    "1.3 N*m",
+    "0.5 m/s",
+    "1000 N*m/rad",
+    "45 deg",
+    "20 degC",
+    "1/0 m",
+    "kg**kg",
+    "m^(1/0)",
+    "\u00b5m",
+    "name",
+    "robot",
+    "min",
+    "max",
+    "value",
+    "joints",
+    "circle",
+    "sphere",
+    "list",
+    "random",
+    "count",
+    "seed",
+    "kind",
+    "actuator",
+    "arm",
+    "scheme",
+    "current",
 ]
 
 
@@ -32,7 +91,9 @@ def mutated(draw: st.DrawFn) -> str:
     for _ in range(draw(st.integers(1, 4))):
         if not text:
             break
-        operation = draw(st.sampled_from(["delete", "insert", "replace_value", "swap_lines", "duplicate_line"]))
+        operation = draw(
+            st.sampled_from(["delete", "insert", "replace_value", "swap_lines", "duplicate_line"])
+        )
         lines = text.splitlines(keepends=True)
         if operation == "delete":
             start = draw(st.integers(0, len(text) - 1))

@@ -33,7 +33,9 @@ def runs(tmp_path_factory):
     out = {}
     for path in STUDIES:
         folder = tmp_path_factory.mktemp(path.stem) / "out"
-        assert main(["run", str(path), "--out", str(folder), "--quiet", "--smoke", "--executor", "serial"]) == 0
+        assert (
+            main(["run", str(path), "--out", str(folder), "--quiet", "--smoke", "--executor", "serial"]) == 0
+        )
         out[path.stem] = folder
     return out
 
@@ -91,7 +93,13 @@ def test_report_tables_hold_the_numbers_of_pareto_csv(runs, name):
     assert len(body) == len(table)
     for row, (_, expected) in zip(body, table.iterrows(), strict=True):
         for text, (column, value) in zip(row, expected.items(), strict=True):
-            if isinstance(value, (bool,)) or column in ("label", "status", "actuator", "motor", "pareto_optimal"):
+            if isinstance(value, (bool,)) or column in (
+                "label",
+                "status",
+                "actuator",
+                "motor",
+                "pareto_optimal",
+            ):
                 assert text == str(value), column
             else:
                 # The report prints 4 significant digits: equal within half a unit of the 4th digit.
@@ -119,13 +127,24 @@ def browser():
 def test_report_opens_in_headless_chromium_without_console_errors(runs, browser, tmp_path):
     for name, folder in runs.items():
         completed = subprocess.run(
-            [browser, *headless_flags(str(tmp_path / f"profile-{name}")), "--enable-logging=stderr", "--v=0",
-             "--dump-dom", (folder / "report.html").as_uri()],
-            capture_output=True, text=True, timeout=120, check=False,
+            [
+                browser,
+                *headless_flags(str(tmp_path / f"profile-{name}")),
+                "--enable-logging=stderr",
+                "--v=0",
+                "--dump-dom",
+                (folder / "report.html").as_uri(),
+            ],
+            capture_output=True,
+            text=True,
+            timeout=120,
+            check=False,
         )
         assert completed.returncode == 0, completed.stderr[-2000:]
         assert 'id="pareto-table"' in completed.stdout  # the page loaded and rendered its tables
-        console = [line for line in completed.stderr.splitlines() if "CONSOLE" in line or "Failed to load" in line]
+        console = [
+            line for line in completed.stderr.splitlines() if "CONSOLE" in line or "Failed to load" in line
+        ]
         assert not console, console
 
 
@@ -166,10 +185,24 @@ def test_interrupted_run_resumes_from_finished_points(runs, tmp_path, monkeypatc
 
 def test_dask_cluster_gives_the_serial_result(runs, tmp_path):
     distributed = pytest.importorskip("distributed")
-    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
-                                  dashboard_address=None) as cluster:
-        assert main(["run", str(TWO_LINK), "--out", str(tmp_path / "dask"), "--quiet", "--smoke",
-                     "--scheduler", cluster.scheduler_address]) == 0
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None
+    ) as cluster:
+        assert (
+            main(
+                [
+                    "run",
+                    str(TWO_LINK),
+                    "--out",
+                    str(tmp_path / "dask"),
+                    "--quiet",
+                    "--smoke",
+                    "--scheduler",
+                    cluster.scheduler_address,
+                ]
+            )
+            == 0
+        )
     # The same solves from the same start points, so the same numbers (to rounding of the JSON round trip).
     pd.testing.assert_frame_equal(_numbers(tmp_path / "dask"), _numbers(runs["two_link_paper"]), rtol=1e-9)
 
@@ -218,7 +251,14 @@ STUDY = textwrap.dedent(
         (("{min: 1, max: 50}", "{min: 50, max: 1}"), 15, ["min <= max"]),
         (("1000 N*m/rad", "3 kg"), 7, ["[mass]", "N*m/rad"]),
     ],
-    ids=["missing-file", "yaml-syntax", "unknown-robot", "unknown-frame", "impossible-bounds", "wrong-dimension"],
+    ids=[
+        "missing-file",
+        "yaml-syntax",
+        "unknown-robot",
+        "unknown-frame",
+        "impossible-bounds",
+        "wrong-dimension",
+    ],
 )
 def test_bad_input_is_one_located_message_exit_2_and_nothing_written(tmp_path, capsys, edit, line, words):
     study = tmp_path / "study.yaml"
@@ -228,7 +268,9 @@ def test_bad_input_is_one_located_message_exit_2_and_nothing_written(tmp_path, c
     assert main(["run", str(study), "--out", str(out), "--quiet"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1, err
-    assert err[0].startswith(f"crx run: error: {study}:{line}:" if line else f"crx run: error: {study}: found")
+    assert err[0].startswith(
+        f"crx run: error: {study}:{line}:" if line else f"crx run: error: {study}: found"
+    )
     for word in words:
         assert word in err[0]
     assert "Traceback" not in err[0]

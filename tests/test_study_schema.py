@@ -11,7 +11,14 @@ import yaml
 
 from collision_reflex.cli import main
 from collision_reflex.errors import CollisionReflexError, StudyFileError
-from collision_reflex.study import ArmStudy, load_study, parse_study, resolved_study, resolved_yaml, study_json_schema
+from collision_reflex.study import (
+    ArmStudy,
+    load_study,
+    parse_study,
+    resolved_study,
+    resolved_yaml,
+    study_json_schema,
+)
 
 STUDIES = sorted((Path(__file__).resolve().parents[1] / "studies").glob("*.yaml"))
 
@@ -54,7 +61,10 @@ def test_quantities_with_units_become_si():
     assert study.approach_velocity == pytest.approx(0.5)  # 50 cm/s, exact conversion
     assert study.actuators.software_stiffness == 100.0  # a plain number is already SI
     assert study.sensing.threshold == 3.0
-    text = MINIMAL.replace("1000 N*m/rad", "1 kN*m/rad") + "design:\n  stator_diameter: {min: 2 cm, max: 0.1 m}\n"
+    text = (
+        MINIMAL.replace("1000 N*m/rad", "1 kN*m/rad")
+        + "design:\n  stator_diameter: {min: 2 cm, max: 0.1 m}\n"
+    )
     study = parse_study(text).study
     assert study.actuators.mechanical_stiffness == pytest.approx(1000.0)
     assert study.design.stator_diameter.bounds == pytest.approx((0.02, 0.1))
@@ -69,8 +79,12 @@ def test_defaults_are_explicit_in_the_resolved_study():
         "stator_diameter": None,
         "stack_length": None,
     }
-    assert resolved["constraints"] == {"payload": 0.0, "safety_factor": 1.0, "threshold_floor": 0.0,
-                                       "torque_required": None}
+    assert resolved["constraints"] == {
+        "payload": 0.0,
+        "safety_factor": 1.0,
+        "threshold_floor": 0.0,
+        "torque_required": None,
+    }
     assert resolved["execution"] == {"executor": "serial", "workers": 2, "scheduler": None}
     assert resolved["robot"]["contact_offset"] == [0.0, 0.0, 0.0]
 
@@ -78,18 +92,43 @@ def test_defaults_are_explicit_in_the_resolved_study():
 @pytest.mark.parametrize(
     ("line", "replacement", "path", "words"),
     [
-        ("  mechanical_stiffness: 1000 N*m/rad", "  mechanical_stiffness: 3 kg", "actuators.mechanical_stiffness",
-         ["'3 kg'", "[mass]", "N*m/rad"]),
+        (
+            "  mechanical_stiffness: 1000 N*m/rad",
+            "  mechanical_stiffness: 3 kg",
+            "actuators.mechanical_stiffness",
+            ["'3 kg'", "[mass]", "N*m/rad"],
+        ),
         ("approach_velocity: 50 cm/s", "approach_velocity: 2 s", "approach_velocity", ["m/s", "[time]"]),
         ("approach_velocity: 50 cm/s", "approach_velocity: fast", "approach_velocity", ["'fast'", "m/s"]),
-        ("approach_velocity: 50 cm/s", "approach_velocity: -1", "approach_velocity", ["-1", "greater than 0"]),
+        (
+            "approach_velocity: 50 cm/s",
+            "approach_velocity: -1",
+            "approach_velocity",
+            ["-1", "greater than 0"],
+        ),
         ("approach_velocity: 50 cm/s", "approach_velocity: .nan", "approach_velocity", ["finite"]),
-        ("  directions: {circle: 8}", "  directions: {circle: 8, sphere: 4}", "samples.directions",
-         ["exactly one"]),
-        ("  directions: {circle: 8}", "  directions: {circle: 8}\noutputs: {figure: [png]}", "outputs.figure",
-         ["'figures'?", "pdf"]),
+        (
+            "  directions: {circle: 8}",
+            "  directions: {circle: 8, sphere: 4}",
+            "samples.directions",
+            ["exactly one"],
+        ),
+        (
+            "  directions: {circle: 8}",
+            "  directions: {circle: 8}\noutputs: {figure: [png]}",
+            "outputs.figure",
+            ["'figures'?", "pdf"],
+        ),
     ],
-    ids=["mass-for-stiffness", "time-for-velocity", "not-a-quantity", "negative", "nan", "two-sources", "typo"],
+    ids=[
+        "mass-for-stiffness",
+        "time-for-velocity",
+        "not-a-quantity",
+        "negative",
+        "nan",
+        "two-sources",
+        "typo",
+    ],
 )
 def test_each_problem_names_line_field_found_and_expected(line, replacement, path, words):
     assert line in MINIMAL
@@ -148,7 +187,15 @@ def test_all_problems_are_reported_at_once():
         ("name: a\nname: b\n", 2, ["more than once"]),
         ("name: !!python/object:os.system x\n", 1, ["invalid YAML"]),
     ],
-    ids=["unclosed-flow", "bad-indent", "empty", "not-a-mapping", "unknown-kind", "duplicate-key", "unsafe-tag"],
+    ids=[
+        "unclosed-flow",
+        "bad-indent",
+        "empty",
+        "not-a-mapping",
+        "unknown-kind",
+        "duplicate-key",
+        "unsafe-tag",
+    ],
 )
 def test_unreadable_documents_are_located(text, line, words):
     problems = _problems(text)

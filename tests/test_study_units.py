@@ -42,12 +42,16 @@ def test_open_executor_refuses_unknown_kinds():
 
 def test_non_dominated_matches_brute_force():
     rng = np.random.default_rng(3)
-    records = [{"objectives": {"worst_case_impulse": float(a), "actuator_mass": float(b)}}
-               for a, b in rng.uniform(0, 1, size=(60, 2))]
+    records = [
+        {"objectives": {"worst_case_impulse": float(a), "actuator_mass": float(b)}}
+        for a, b in rng.uniform(0, 1, size=(60, 2))
+    ]
     front, dropped = non_dominated(records, ("worst_case_impulse", "actuator_mass"))
     values = [(r["objectives"]["worst_case_impulse"], r["objectives"]["actuator_mass"]) for r in records]
     expected = {v for v in values if not any(o[0] <= v[0] and o[1] <= v[1] and o != v for o in values)}
-    assert {(r["objectives"]["worst_case_impulse"], r["objectives"]["actuator_mass"]) for r in front} == expected
+    assert {
+        (r["objectives"]["worst_case_impulse"], r["objectives"]["actuator_mass"]) for r in front
+    } == expected
     assert len(front) + len(dropped) == len(records)
     first = [r["objectives"]["worst_case_impulse"] for r in front]
     assert first == sorted(first)
@@ -60,8 +64,10 @@ def test_non_dominated_matches_brute_force():
 def test_smoke_study_shrinks_counts():
     data = {
         "kind": "arm",
-        "samples": {"configurations": {"random": {"count": 64, "seed": 1}, "list": None, "trajectory": None},
-                    "directions": {"circle": None, "sphere": 32, "named": None, "list": None}},
+        "samples": {
+            "configurations": {"random": {"count": 64, "seed": 1}, "list": None, "trajectory": None},
+            "directions": {"circle": None, "sphere": 32, "named": None, "list": None},
+        },
         "pareto": {"objectives": ["worst_case_impulse", "actuator_mass"], "points": 20},
     }
     small = smoke_study(data)
@@ -92,11 +98,26 @@ def test_lever_mapping_equals_the_rotary_collision(reaction):
     impulse of the same collision written in joint coordinates divided by L: the 1D model is the same in any
     linear coordinate, so the two must agree to rounding."""
     lever, finger_inertia, reflected, k_mech, k_soft, tau_s, tau_peak, omega = (
-        0.1143, 1.3e-3, 1.2e-2, 1e4, 5.75, 0.343, 27.0, 0.9)
+        0.1143,
+        1.3e-3,
+        1.2e-2,
+        1e4,
+        5.75,
+        0.343,
+        27.0,
+        0.9,
+    )
     k_rot = series_stiffness(k_mech, k_soft)
     angular = phase_impulses(finger_inertia, k_rot, k_mech, tau_s, tau_peak / reflected, omega, reaction)
-    contact = phase_impulses(finger_inertia / lever**2, k_rot / lever**2, k_mech / lever**2, tau_s / lever,
-                             (tau_peak / lever) / (reflected / lever**2), omega * lever, reaction)
+    contact = phase_impulses(
+        finger_inertia / lever**2,
+        k_rot / lever**2,
+        k_mech / lever**2,
+        tau_s / lever,
+        (tau_peak / lever) / (reflected / lever**2),
+        omega * lever,
+        reaction,
+    )
     for phase in ("initial", "sensing", "reaction"):
         assert getattr(contact, phase) == pytest.approx(getattr(angular, phase) / lever, rel=1e-12)
 
@@ -114,16 +135,27 @@ def test_sensing_schemes_map_to_the_contact():
         # Motor side of a 9:1 transmission: the joint sees 9 x the motor torque, the contact that / L.
         (SensingSpec(scheme="current", motor_torque="0.343 N*m"), lambda act: 9 * 0.343 / lever),
     ]:
-        actuator = Actuator(motor, gear_ratio=9.0, mechanical_stiffness=1e4, software_stiffness=5.75,
-                            sensing=sensing_scheme(spec, lever))
+        actuator = Actuator(
+            motor,
+            gear_ratio=9.0,
+            mechanical_stiffness=1e4,
+            software_stiffness=5.75,
+            sensing=sensing_scheme(spec, lever),
+        )
         params = actuator.contact_parameters(lever, 0.1)
         assert params.F_s == pytest.approx(expected(actuator), rel=1e-12), spec.scheme
 
 
 @pytest.mark.parametrize(
     ("value", "text"),
-    [(0.123456, "0.1235"), (12345.0, "1.234e+04"), (math.inf, "∞"), (None, "–"), ("Solve_Succeeded", "Solve_Succeeded"),
-     (3, "3")],
+    [
+        (0.123456, "0.1235"),
+        (12345.0, "1.234e+04"),
+        (math.inf, "∞"),
+        (None, "–"),
+        ("Solve_Succeeded", "Solve_Succeeded"),
+        (3, "3"),
+    ],
     ids=["small", "large", "inf", "none", "text", "int"],
 )
 def test_report_number_format(value, text):

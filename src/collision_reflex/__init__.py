@@ -15,7 +15,14 @@ from .actuators import (
     PositionThreshold,
     gear_ratio_for,
 )
-from .errors import CatalogueError, CollisionReflexError, InvalidParameter, StudyFileError, StudyProblem, UnknownMotor
+from .errors import (
+    CatalogueError,
+    CollisionReflexError,
+    InvalidParameter,
+    StudyFileError,
+    StudyProblem,
+    UnknownMotor,
+)
 from .gearboxes import GEARBOX_KINDS, Gearbox
 from .impulse import (
     REACTION_MODES,
@@ -39,7 +46,6 @@ from .motors import (
     scaled_motor_quantities,
     scaling_law,
 )
-
 from .study import load_study, study_json_schema
 from .study.runner import run_study
 

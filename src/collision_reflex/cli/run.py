@@ -20,13 +20,26 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("study", metavar="STUDY", help="study file (YAML)")
     parser.add_argument("--out", metavar="DIR", default=None, help="output folder (default: results/NAME)")
     parser.add_argument("--quiet", action="store_true", help="no progress bars; print only the report's path")
-    parser.add_argument("--scheduler", metavar="ADDR", default=None,
-                        help="run on the Dask cluster at ADDR (e.g. tcp://host:8786); needs the 'dask' extra")
-    parser.add_argument("--executor", choices=("serial", "processes", "dask"), default=None,
-                        help="override the study's executor")
-    parser.add_argument("--workers", type=int, default=None, metavar="N", help="override the number of workers")
-    parser.add_argument("--smoke", action="store_true",
-                        help="shrink sample counts and Pareto points for a quick check (also: CRX_SMOKE=1)")
+    parser.add_argument(
+        "--scheduler",
+        metavar="ADDR",
+        default=None,
+        help="run on the Dask cluster at ADDR (e.g. tcp://host:8786); needs the 'dask' extra",
+    )
+    parser.add_argument(
+        "--executor",
+        choices=("serial", "processes", "dask"),
+        default=None,
+        help="override the study's executor",
+    )
+    parser.add_argument(
+        "--workers", type=int, default=None, metavar="N", help="override the number of workers"
+    )
+    parser.add_argument(
+        "--smoke",
+        action="store_true",
+        help="shrink sample counts and Pareto points for a quick check (also: CRX_SMOKE=1)",
+    )
     parser.set_defaults(run=run)
 
 
@@ -36,11 +49,19 @@ def run(args: argparse.Namespace) -> int:
     if args.workers is not None and args.workers < 1:
         print("crx run: error: --workers must be at least 1", file=sys.stderr)
         return 2
-    result = run_study(args.study, args.out, quiet=args.quiet, scheduler=args.scheduler, executor=args.executor,
-                       workers=args.workers, smoke=True if args.smoke else None)
+    result = run_study(
+        args.study,
+        args.out,
+        quiet=args.quiet,
+        scheduler=args.scheduler,
+        executor=args.executor,
+        workers=args.workers,
+        smoke=True if args.smoke else None,
+    )
     if not args.quiet:
-        how = f"{result.computed} computed" + (f", {result.reused} reused from the interrupted run"
-                                                if result.reused else "")
+        how = f"{result.computed} computed" + (
+            f", {result.reused} reused from the interrupted run" if result.reused else ""
+        )
         print(f"finished in {result.elapsed:.1f} s ({how})")
     print(result.report)
     return 0

@@ -15,7 +15,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
             "first line '# yaml-language-server: $schema=study.schema.json'."
         ),
     )
-    parser.add_argument("--out", metavar="FILE", default=None, help="write to FILE (atomically) instead of stdout")
+    parser.add_argument(
+        "--out", metavar="FILE", default=None, help="write to FILE (atomically) instead of stdout"
+    )
     parser.set_defaults(run=run)
 
 

@@ -23,15 +23,24 @@ def plot_phase_breakdown(
     title: str = "",
 ) -> Path:
     """Stacked bars of the three phase impulses [N*s] for each label."""
-    values = {"initial": np.asarray(initial, float), "sensing": np.asarray(sensing, float),
-              "reaction": np.asarray(reaction, float)}
+    values = {
+        "initial": np.asarray(initial, float),
+        "sensing": np.asarray(sensing, float),
+        "reaction": np.asarray(reaction, float),
+    }
     fig, ax = new_figure(figsize=(max(4.5, 0.55 * len(labels) + 2.5), 3.8))
     position = np.arange(len(labels))
     bottom = np.zeros(len(labels))
     for key, name in PHASES:
         ax.bar(position, values[key], bottom=bottom, label=name, width=0.7)
         bottom += values[key]
-    ax.set_xticks(position, list(labels), rotation=45 if len(labels) > 4 else 0, ha="right" if len(labels) > 4 else "center", fontsize=8)
+    ax.set_xticks(
+        position,
+        list(labels),
+        rotation=45 if len(labels) > 4 else 0,
+        ha="right" if len(labels) > 4 else "center",
+        fontsize=8,
+    )
     ax.set_ylabel("impulse [N*s]")
     ax.set_title(title or "impulse by phase", fontsize=10)
     ax.legend(fontsize=8)

@@ -4,6 +4,7 @@ text for inlining in the HTML report."""
 from __future__ import annotations
 
 import contextlib
+import functools
 import re
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -47,7 +48,6 @@ def draw_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
 
 def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -> dict[str, str]:
     from ..plots.design_front import plot_design_front
-    from ..plots.impulse_directions import plot_impulse_directions
     from ..plots.phase_breakdown import plot_phase_breakdown
 
     svgs: dict[str, str] = {}
@@ -59,27 +59,60 @@ def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
     names = pareto["objectives"]
     if len(pareto["points"]) >= 2:
         values = np.array([[p["objectives"][n] for n in names] for p in pareto["points"]])
-        svgs["front"] = _draw(directory, "pareto_front", formats, lambda path: plot_design_front(
-            path, names, [objective_unit(n) for n in names], values,
-            [chosen["objectives"][n] for n in names[:2]]))
+        svgs["front"] = _draw(
+            directory,
+            "pareto_front",
+            formats,
+            lambda path: plot_design_front(
+                path,
+                names,
+                [objective_unit(n) for n in names],
+                values,
+                [chosen["objectives"][n] for n in names[:2]],
+            ),
+        )
     featured = {"chosen design": chosen}
     if pareto["points"]:
-        featured[f"Pareto design 0 (least {names[0].replace('_', ' ')})"] = pareto["points"][0]
-        featured[f"Pareto design {len(pareto['points']) - 1} (least {names[1].replace('_', ' ')})"] = pareto["points"][-1]
+        last = len(pareto["points"]) - 1
+        featured[f"Pareto design 0 (best {_words(names[0])})"] = pareto["points"][0]
+        featured[f"Pareto design {last} (best {_words(names[1])})"] = pareto["points"][-1]
     for index, (title, record) in enumerate(featured.items()):
-        svgs[f"surface-{index}"] = _draw(directory, f"impulse_directions_{index}", formats,
-                                         lambda path, r=record, t=title: plot_impulse_directions(
-                                             path, directions, config_index, np.asarray(r["impulses"]),
-                                             f"impulse by contact direction [N*s]: {t}"))
+        draw = functools.partial(
+            _surface,
+            directions=directions,
+            config_index=config_index,
+            impulses=np.asarray(record["impulses"]),
+            title=f"impulse by contact direction [N*s]: {title}",
+        )
+        svgs[f"surface-{index}"] = _draw(directory, f"impulse_directions_{index}", formats, draw)
     records = [("chosen", chosen)] + [(str(i), p) for i, p in enumerate(pareto["points"])]
     worst = [int(np.argmax(r["impulses"])) for _, r in records]
-    svgs["phases"] = _draw(directory, "phase_breakdown", formats, lambda path: plot_phase_breakdown(
-        path, [label for label, _ in records],
-        [r["phases"]["initial"][w] for (_, r), w in zip(records, worst, strict=True)],
-        [r["phases"]["sensing"][w] for (_, r), w in zip(records, worst, strict=True)],
-        [r["phases"]["reaction"][w] for (_, r), w in zip(records, worst, strict=True)],
-        "impulse by phase at each design's worst sample"))
+    svgs["phases"] = _draw(
+        directory,
+        "phase_breakdown",
+        formats,
+        lambda path: plot_phase_breakdown(
+            path,
+            [label for label, _ in records],
+            [r["phases"]["initial"][w] for (_, r), w in zip(records, worst, strict=True)],
+            [r["phases"]["sensing"][w] for (_, r), w in zip(records, worst, strict=True)],
+            [r["phases"]["reaction"][w] for (_, r), w in zip(records, worst, strict=True)],
+            "impulse by phase at each design's worst sample",
+        ),
+    )
     return svgs
+
+
+def _words(name: str) -> str:
+    return name.replace("_", " ")
+
+
+def _surface(
+    path: Path, directions: np.ndarray, config_index: np.ndarray, impulses: np.ndarray, title: str
+) -> Path:
+    from ..plots.impulse_directions import plot_impulse_directions
+
+    return plot_impulse_directions(path, directions, config_index, impulses, title)
 
 
 def _actuator_figures(directory: Path, results: dict[str, Any], formats: list[str]) -> dict[str, str]:
@@ -88,12 +121,29 @@ def _actuator_figures(directory: Path, results: dict[str, Any], formats: list[st
 
     candidates = results["candidates"]
     svgs = {
-        "sweep": _draw(directory, "velocity_sweep", formats, lambda path: plot_velocity_sweep(
-            path, results["velocities"], {c["name"]: c["sweep"]["total"] for c in candidates},
-            {c["name"]: (c["optimal_velocity"], c["minimum_impulse"]) for c in candidates})),
-        "phases": _draw(directory, "phase_breakdown", formats, lambda path: plot_phase_breakdown(
-            path, [c["name"] for c in candidates], [c["impulse"]["initial"] for c in candidates],
-            [c["impulse"]["sensing"] for c in candidates], [c["impulse"]["reaction"] for c in candidates],
-            f"impulse by phase at v0 = {results['approach_velocity']:g} m/s")),
+        "sweep": _draw(
+            directory,
+            "velocity_sweep",
+            formats,
+            lambda path: plot_velocity_sweep(
+                path,
+                results["velocities"],
+                {c["name"]: c["sweep"]["total"] for c in candidates},
+                {c["name"]: (c["optimal_velocity"], c["minimum_impulse"]) for c in candidates},
+            ),
+        ),
+        "phases": _draw(
+            directory,
+            "phase_breakdown",
+            formats,
+            lambda path: plot_phase_breakdown(
+                path,
+                [c["name"] for c in candidates],
+                [c["impulse"]["initial"] for c in candidates],
+                [c["impulse"]["sensing"] for c in candidates],
+                [c["impulse"]["reaction"] for c in candidates],
+                f"impulse by phase at v0 = {results['approach_velocity']:g} m/s",
+            ),
+        ),
     }
     return svgs

@@ -9,10 +9,23 @@ from typing import Any
 from .. import __version__
 
 UNITS = {
-    "stator_diameter": "m", "stack_length": "m", "mechanical_stiffness": "N*m/rad", "software_stiffness": "N*m/rad",
-    "threshold": "N", "error": "m", "motor_torque": "N*m", "approach_velocity": "m/s", "payload": "kg",
-    "threshold_floor": "N", "torque_required": "N*m", "contact_offset": "m", "lever": "m", "finger_mass": "kg",
-    "contact_stiffness": "N/m", "position_error": "m", "list": "rad",
+    "stator_diameter": "m",
+    "stack_length": "m",
+    "mechanical_stiffness": "N*m/rad",
+    "software_stiffness": "N*m/rad",
+    "threshold": "N",
+    "error": "m",
+    "motor_torque": "N*m",
+    "approach_velocity": "m/s",
+    "payload": "kg",
+    "threshold_floor": "N",
+    "torque_required": "N*m",
+    "contact_offset": "m",
+    "lever": "m",
+    "finger_mass": "kg",
+    "contact_stiffness": "N/m",
+    "position_error": "m",
+    "list": "rad",
 }
 
 
@@ -38,7 +51,9 @@ def _assumptions(resolved: dict[str, Any]) -> list[tuple[str, str]]:
             for key, item in value.items():
                 walk(f"{prefix}.{key}" if prefix else str(key), item, UNITS.get(str(key), unit))
         elif isinstance(value, list) and value and all(isinstance(v, (int, float)) for v in value):
-            rows.append((prefix, "[" + ", ".join(number(v) for v in value) + "]" + (f" {unit}" if unit else "")))
+            rows.append(
+                (prefix, "[" + ", ".join(number(v) for v in value) + "]" + (f" {unit}" if unit else ""))
+            )
         elif isinstance(value, list) and len(value) > 6 and all(isinstance(v, list) for v in value):
             rows.append((prefix, f"{len(value)} entries"))
         elif isinstance(value, list):

@@ -12,12 +12,12 @@ from ..errors import CollisionReflexError
 from ..study.store import DESIGNS, PARETO, REPORT, ResultsMissing, read_json, write_json, write_text
 
 
-
 def objective_unit(name: str) -> str:
     """The unit of an optimiser objective (from :data:`collision_reflex.optimize.OBJECTIVES`)."""
     from ..optimize import OBJECTIVES
 
     return OBJECTIVES[name][1]
+
 
 # Per-joint columns of pareto.csv: (record key, column name, unit).
 JOINT_COLUMNS = (
@@ -60,19 +60,21 @@ def _actuator_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
     best = _non_dominated_candidates(candidates)
     rows = []
     for candidate in candidates:
-        rows.append({
-            "actuator": candidate["name"],
-            "motor": candidate["motor"],
-            "gear_ratio [-]": candidate["gear_ratio"],
-            "mass [kg]": candidate["mass"],
-            "reflected_inertia [kg*m^2]": candidate["reflected_inertia"],
-            "peak_torque [N*m]": candidate["peak_torque"],
-            "threshold [N]": candidate["contact"]["F_s"],
-            "impulse_at_v0 [N*s]": candidate["impulse"]["total"],
-            "optimal_velocity [m/s]": candidate["optimal_velocity"],
-            "minimum_impulse [N*s]": candidate["minimum_impulse"],
-            "pareto_optimal": candidate["name"] in best,
-        })
+        rows.append(
+            {
+                "actuator": candidate["name"],
+                "motor": candidate["motor"],
+                "gear_ratio [-]": candidate["gear_ratio"],
+                "mass [kg]": candidate["mass"],
+                "reflected_inertia [kg*m^2]": candidate["reflected_inertia"],
+                "peak_torque [N*m]": candidate["peak_torque"],
+                "threshold [N]": candidate["contact"]["F_s"],
+                "impulse_at_v0 [N*s]": candidate["impulse"]["total"],
+                "optimal_velocity [m/s]": candidate["optimal_velocity"],
+                "minimum_impulse [N*s]": candidate["minimum_impulse"],
+                "pareto_optimal": candidate["name"] in best,
+            }
+        )
     return rows
 
 
@@ -81,7 +83,8 @@ def _non_dominated_candidates(candidates: list[dict[str, Any]]) -> set[str]:
     out = set()
     for c in candidates:
         if not any(
-            o["minimum_impulse"] <= c["minimum_impulse"] and o["mass"] <= c["mass"]
+            o["minimum_impulse"] <= c["minimum_impulse"]
+            and o["mass"] <= c["mass"]
             and (o["minimum_impulse"] < c["minimum_impulse"] or o["mass"] < c["mass"])
             for o in candidates
         ):
@@ -89,8 +92,9 @@ def _non_dominated_candidates(candidates: list[dict[str, Any]]) -> set[str]:
     return out
 
 
-def write_outputs(folder: str | os.PathLike[str], results: dict[str, Any], figures: bool = True,
-                  quiet: bool = True) -> Path:
+def write_outputs(
+    folder: str | os.PathLike[str], results: dict[str, Any], figures: bool = True, quiet: bool = True
+) -> Path:
     """Write ``designs.json``, ``pareto.csv`` and the report (with its figures) into ``folder``."""
     folder = Path(folder)
     write_json(folder / DESIGNS, results)
@@ -107,8 +111,9 @@ def _write_csv(path: Path, rows: list[dict[str, Any]]) -> None:
         pd.DataFrame(rows).to_csv(handle, index=False, float_format="%.10g")
 
 
-def render_report(folder: str | os.PathLike[str], results: dict[str, Any] | None = None,
-                  figures: bool = True) -> Path:
+def render_report(
+    folder: str | os.PathLike[str], results: dict[str, Any] | None = None, figures: bool = True
+) -> Path:
     """(Re)draw the figures and write ``report.html`` (and ``report.pdf`` if the study asks) from the results
     saved in ``folder``."""
     from .figures import draw_figures
@@ -118,13 +123,19 @@ def render_report(folder: str | os.PathLike[str], results: dict[str, Any] | None
     if results is None:
         path = folder / DESIGNS
         if not path.exists():
-            raise ResultsMissing(f"{folder} has no {DESIGNS}: run the study first (crx run STUDY --out {folder})")
+            raise ResultsMissing(
+                f"{folder} has no {DESIGNS}: run the study first (crx run STUDY --out {folder})"
+            )
         try:
             results = read_json(path)
         except ValueError as error:
             raise ResultsMissing(f"{path} cannot be read ({error}); run the study again") from None
     assert results is not None
-    svgs = draw_figures(folder / "figures", results, results["resolved"]["outputs"]["figures"]) if figures else {}
+    svgs = (
+        draw_figures(folder / "figures", results, results["resolved"]["outputs"]["figures"])
+        if figures
+        else {}
+    )
     html = render_html(results, pareto_rows(results), svgs)
     write_text(folder / REPORT, html)
     if results["resolved"]["outputs"]["pdf"]:

@@ -28,21 +28,40 @@ def find_browser() -> str | None:
 
 def headless_flags(profile: str) -> list[str]:
     """Flags for a headless, offline, throw-away browser session."""
-    return ["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-background-networking",
-            "--disable-component-update", "--disable-sync", f"--user-data-dir={profile}"]
+    return [
+        "--headless",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--no-first-run",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+        f"--user-data-dir={profile}",
+    ]
 
 
 def html_to_pdf(html: Path, pdf: Path, timeout: float = 120.0) -> Path:
     """Print ``html`` to ``pdf`` (atomically) with headless Chromium."""
     browser = find_browser()
     if browser is None:
-        raise BrowserUnavailable("printing report.pdf needs Chromium or Chrome (e.g. apt-get install chromium)")
+        raise BrowserUnavailable(
+            "printing report.pdf needs Chromium or Chrome (e.g. apt-get install chromium)"
+        )
     with tempfile.TemporaryDirectory() as profile, atomic_path(pdf) as tmp:
         completed = subprocess.run(
-            [browser, *headless_flags(profile), "--no-pdf-header-footer", f"--print-to-pdf={tmp}",
-             Path(html).resolve().as_uri()],
-            capture_output=True, timeout=timeout, check=False,
+            [
+                browser,
+                *headless_flags(profile),
+                "--no-pdf-header-footer",
+                f"--print-to-pdf={tmp}",
+                Path(html).resolve().as_uri(),
+            ],
+            capture_output=True,
+            timeout=timeout,
+            check=False,
         )
         if completed.returncode != 0 or not tmp.exists() or tmp.stat().st_size == 0:
-            raise BrowserUnavailable(f"Chromium could not print the report (exit status {completed.returncode})")
+            raise BrowserUnavailable(
+                f"Chromium could not print the report (exit status {completed.returncode})"
+            )
     return pdf

@@ -72,7 +72,10 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
         spec = getattr(study.design, name)
         if spec is None:
             return [Bounds.fixed(v, f"{name}[{j}]") for v, j in zip(values, joints, strict=True)]
-        return [Bounds(lo, hi, f"{name}[{j}]") for (lo, hi), j in zip(per_joint_bounds(spec, joints), joints, strict=True)]
+        return [
+            Bounds(lo, hi, f"{name}[{j}]")
+            for (lo, hi), j in zip(per_joint_bounds(spec, joints), joints, strict=True)
+        ]
 
     diameters = [a.motor.stator_diameter or reference.stator_diameter for a in actuators]
     stacks = [a.motor.stack_length or reference.stack_length for a in actuators]
@@ -85,7 +88,8 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
         gear_ratio=nominal("gear_ratio", [a.gear_ratio for a in actuators]),
         software_stiffness=nominal("software_stiffness", [a.software_stiffness for a in actuators]),
         threshold=Bounds(*threshold_spec.bounds, "threshold") if threshold_spec else study.sensing.value,
-        approach_velocity=Bounds(*velocity_spec.bounds, "approach_velocity") if velocity_spec
+        approach_velocity=Bounds(*velocity_spec.bounds, "approach_velocity")
+        if velocity_spec
         else study.approach_velocity,
     )
     technology = ActuatorTechnology(
@@ -105,7 +109,9 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
     configurations = configuration_samples(loaded, arm)
     directions = direction_samples(loaded, arm)
     samples = ContactSamples.grid(arm.kinematics(configurations), directions)
-    return ArmSetup(study, arm, catalogue, configurations, directions, samples, space, technology, constraints)
+    return ArmSetup(
+        study, arm, catalogue, configurations, directions, samples, space, technology, constraints
+    )
 
 
 def _check_supported(loaded: LoadedStudy, study: ArmStudy) -> None:
@@ -116,9 +122,12 @@ def _check_supported(loaded: LoadedStudy, study: ArmStudy) -> None:
         motor = override.motor
         if motor is not None and (motor.reference != base.reference or motor.scaling_law != base.scaling_law):
             problems.append(
-                loaded.problem(("actuators", "joints", joint, "motor"), "a different reference motor or law",
-                               "the same reference motor and scaling law for every joint (the optimiser scales one "
-                               "reference); override stator_diameter or stack_length only")
+                loaded.problem(
+                    ("actuators", "joints", joint, "motor"),
+                    "a different reference motor or law",
+                    "the same reference motor and scaling law for every joint (the optimiser scales one "
+                    "reference); override stator_diameter or stack_length only",
+                )
             )
         if override.gearbox is not None:
             problems.append(_gearbox_problem(loaded, ("actuators", "joints", joint, "gearbox")))
@@ -129,9 +138,12 @@ def _check_supported(loaded: LoadedStudy, study: ArmStudy) -> None:
 
 
 def _gearbox_problem(loaded: LoadedStudy, path: tuple[Any, ...]) -> StudyProblem:
-    return loaded.problem(path, "a gearbox in an arm study",
-                          "null: the arm optimiser's actuator mass and inertia are the motor's (gear ratio only); "
-                          "compare gearboxes in an actuator study (kind: actuator)")
+    return loaded.problem(
+        path,
+        "a gearbox in an arm study",
+        "null: the arm optimiser's actuator mass and inertia are the motor's (gear ratio only); "
+        "compare gearboxes in an actuator study (kind: actuator)",
+    )
 
 
 @functools.lru_cache(maxsize=4)
@@ -145,8 +157,9 @@ def problem_for(resolved_text: str, objective: str, bounded: tuple[str, ...]) ->
     from ..optimize import build_problem
 
     setup = _setup_from_text(resolved_text)
-    return build_problem(setup.arm, setup.samples, setup.space, setup.technology, objective, setup.constraints,
-                         bounded)
+    return build_problem(
+        setup.arm, setup.samples, setup.space, setup.technology, objective, setup.constraints, bounded
+    )
 
 
 # --- tasks (run in workers: plain data in, plain data out) -------------------------------------------------------
@@ -161,14 +174,15 @@ def _one_at_a_time(function: Any) -> Any:
     return locked
 
 
-
 @_one_at_a_time
 def solve_single(resolved_text: str) -> dict[str, Any]:
     """Solve the study's own objective; returns a design record."""
     from ..optimize import solve
 
     setup = _setup_from_text(resolved_text)
-    problem = _weighted_problem(resolved_text, _objective_key(dict(setup.study.objective)))
+    problem = _weighted_problem(
+        resolved_text, _objective_key({str(k): float(v) for k, v in setup.study.objective.items()})
+    )
     return design_record(setup, problem, solve(problem, ipopt_options=IPOPT_OPTIONS), "optimum")
 
 
@@ -178,7 +192,9 @@ def _weighted_problem(resolved_text: str, key: Any) -> Any:
 
     setup = _setup_from_text(resolved_text)
     objective = key if isinstance(key, str) else dict(key)
-    return build_problem(setup.arm, setup.samples, setup.space, setup.technology, objective, setup.constraints)
+    return build_problem(
+        setup.arm, setup.samples, setup.space, setup.technology, objective, setup.constraints
+    )
 
 
 @_one_at_a_time
@@ -194,9 +210,15 @@ def solve_anchor(resolved_text: str, objective: str, objectives: tuple[str, ...]
     held = _held_bound(objective, result.objectives[objective], ANCHOR_SLACK)
     for other in others:
         bounded = tuple(o for o in objectives if o != other)
-        result = solve(problem_for(resolved_text, other, bounded), epsilon={objective: held}, x0=result.x,
-                       ipopt_options=IPOPT_OPTIONS)
-    record = design_record(setup, problem_for(resolved_text, objective, others), result, f"anchor: {objective}")
+        result = solve(
+            problem_for(resolved_text, other, bounded),
+            epsilon={objective: held},
+            x0=result.x,
+            ipopt_options=IPOPT_OPTIONS,
+        )
+    record = design_record(
+        setup, problem_for(resolved_text, objective, others), result, f"anchor: {objective}"
+    )
     record["x"] = result.x.tolist()
     return record
 
@@ -208,7 +230,9 @@ def _held_bound(name: str, value: float, slack: float) -> float:
     return value * (1 + sense * slack) if value > 0 else value + sense * slack
 
 
-def epsilon_grid(anchors: dict[str, dict[str, Any]], objectives: tuple[str, ...], count: int) -> list[dict[str, float]]:
+def epsilon_grid(
+    anchors: dict[str, dict[str, Any]], objectives: tuple[str, ...], count: int
+) -> list[dict[str, float]]:
     """Bounds on the other objectives spread evenly between their values at the anchors (interior points)."""
     from ..optimize import OBJECTIVES
 
@@ -228,8 +252,9 @@ def epsilon_grid(anchors: dict[str, dict[str, Any]], objectives: tuple[str, ...]
 
 
 @_one_at_a_time
-def solve_point(resolved_text: str, objectives: tuple[str, ...], epsilon: dict[str, float],
-                start: list[float]) -> dict[str, Any]:
+def solve_point(
+    resolved_text: str, objectives: tuple[str, ...], epsilon: dict[str, float], start: list[float]
+) -> dict[str, Any]:
     """One epsilon-constraint point: the first objective minimised with the others bounded by ``epsilon``,
     started from ``start`` (the first objective's anchor, so the result does not depend on the order of work)."""
     from ..errors import SolverFailed
@@ -241,7 +266,9 @@ def solve_point(resolved_text: str, objectives: tuple[str, ...], epsilon: dict[s
         result = solve(problem, epsilon=epsilon, x0=np.asarray(start), ipopt_options=IPOPT_OPTIONS)
     except SolverFailed as error:
         return {"failed": True, "epsilon": epsilon, "status": error.status, "message": str(error.args[0])}
-    return design_record(setup, problem, result, "epsilon: " + ", ".join(f"{k} <= {v:.4g}" for k, v in epsilon.items()))
+    return design_record(
+        setup, problem, result, "epsilon: " + ", ".join(f"{k} <= {v:.4g}" for k, v in epsilon.items())
+    )
 
 
 # --- records -----------------------------------------------------------------------------------------------------
@@ -254,38 +281,57 @@ def design_record(setup: ArmSetup, problem: Any, result: Any, label: str) -> dic
     design = result.design
     samples = problem.samples
     # The same effective parameters as the optimiser's NumPy check (optimize.evaluate), kept for the phases.
-    finger = {"finger_joint_inertia": design.reflected_inertia} if setup.study.reflected_inertia_in == "finger" else {}
+    finger = (
+        {"finger_joint_inertia": design.reflected_inertia}
+        if setup.study.reflected_inertia_in == "finger"
+        else {}
+    )
     params = effective_parameters(
-        samples.kinematics, samples.directions, config_index=samples.config_index,
+        samples.kinematics,
+        samples.directions,
+        config_index=samples.config_index,
         reflected_inertia=design.reflected_inertia,
         stiffness=series_stiffness(design.mechanical_stiffness, design.software_stiffness),
-        mechanical_stiffness=design.mechanical_stiffness, torque_limit=design.peak_torque,
-        motor_mass=design.motor_mass, **finger,
+        mechanical_stiffness=design.mechanical_stiffness,
+        torque_limit=design.peak_torque,
+        motor_mass=design.motor_mass,
+        **finger,
     )
     threshold = design.threshold if design.sensing == "force" else params.k * design.threshold
-    phases = phase_impulses(params.m_f, params.k, params.k_m, threshold, params.a, design.approach_velocity,
-                            setup.study.reaction)
+    phases = phase_impulses(
+        params.m_f, params.k, params.k_m, threshold, params.a, design.approach_velocity, setup.study.reaction
+    )
     v_star = optimal_velocity(params.m_f, params.k, threshold, setup.study.reaction, params.k_m, params.a)
     joints = []
     for i, name in enumerate(design.joint_names):
-        joints.append({
-            "joint": name,
-            "stator_diameter": float(design.stator_diameter[i]),
-            "stack_length": float(design.stack_length[i]),
-            "gear_ratio": float(design.gear_ratio[i]),
-            "rotor_inertia": float(design.rotor_inertia[i]),
-            "reflected_inertia": float(design.reflected_inertia[i]),
-            "motor_peak_torque": float(design.motor_peak_torque[i]),
-            "peak_torque": float(design.peak_torque[i]),
-            "required_torque": float(result.required_torque[i]),
-            "torque_margin": float(result.torque_margin[i]),
-            "mechanical_stiffness": float(design.mechanical_stiffness[i]),
-            "software_stiffness": float(design.software_stiffness[i]),
-            "stiffness": float(series_stiffness(design.mechanical_stiffness[i], design.software_stiffness[i])),
-            "motor_mass": float(design.motor_mass[i]),
-            "nearest_catalogue_motor": nearest_catalogue_motor(
-                setup.catalogue, float(design.motor_peak_torque[i]), float(design.rotor_inertia[i])),
-        })
+        joints.append(
+            {
+                "joint": name,
+                "stator_diameter": float(design.stator_diameter[i]),
+                "stack_length": float(design.stack_length[i]),
+                "gear_ratio": float(design.gear_ratio[i]),
+                "rotor_inertia": float(design.rotor_inertia[i]),
+                "reflected_inertia": float(design.reflected_inertia[i]),
+                "motor_peak_torque": float(design.motor_peak_torque[i]),
+                "peak_torque": float(design.peak_torque[i]),
+                "required_torque": float(result.required_torque[i]),
+                # No requirement (a joint gravity does not load): a margin is meaningless, not a huge number.
+                "torque_margin": (
+                    float(result.torque_margin[i])
+                    if result.required_torque[i] > 1e-9 * design.peak_torque[i]
+                    else None
+                ),
+                "mechanical_stiffness": float(design.mechanical_stiffness[i]),
+                "software_stiffness": float(design.software_stiffness[i]),
+                "stiffness": float(
+                    series_stiffness(design.mechanical_stiffness[i], design.software_stiffness[i])
+                ),
+                "motor_mass": float(design.motor_mass[i]),
+                "nearest_catalogue_motor": nearest_catalogue_motor(
+                    setup.catalogue, float(design.motor_peak_torque[i]), float(design.rotor_inertia[i])
+                ),
+            }
+        )
     return {
         "label": label,
         "objectives": {k: float(v) for k, v in result.numpy_objectives.items()},
@@ -302,8 +348,11 @@ def design_record(setup: ArmSetup, problem: Any, result: Any, label: str) -> dic
         },
         "optimal_velocity": np.asarray(v_star, dtype=float).tolist(),
         "solver": {
-            "status": result.status, "iterations": int(result.iterations), "solve_time": float(result.solve_time),
-            "build_time": float(result.build_time), "epsilon": {k: float(v) for k, v in result.epsilon.items()},
+            "status": result.status,
+            "iterations": int(result.iterations),
+            "solve_time": float(result.solve_time),
+            "build_time": float(result.build_time),
+            "epsilon": {k: float(v) for k, v in result.epsilon.items()},
         },
     }
 
@@ -313,7 +362,9 @@ def nearest_catalogue_motor(catalogue: dict[str, Any], peak_torque: float, rotor
     part a designer would start from."""
     best, best_distance = "", math.inf
     for name, motor in catalogue.items():
-        distance = math.hypot(math.log(motor.peak_torque / peak_torque), math.log(motor.rotor_inertia / rotor_inertia))
+        distance = math.hypot(
+            math.log(motor.peak_torque / peak_torque), math.log(motor.rotor_inertia / rotor_inertia)
+        )
         if distance < best_distance:
             best, best_distance = name, distance
     return best
@@ -340,7 +391,7 @@ def checked_setup(loaded: LoadedStudy, resolved_text: str) -> ArmSetup:
     setup = arm_setup(loaded)  # located errors for the robot, motors and names
     try:
         _setup_from_text(resolved_text)
-        objective = dict(setup.study.objective)
+        objective = {str(k): float(v) for k, v in setup.study.objective.items()}
         _weighted_problem(resolved_text, _objective_key(objective))
     except InvalidParameter as error:
         raise loaded.fail(_field_of(error.name), f"{error}", "inputs the design problem accepts") from None

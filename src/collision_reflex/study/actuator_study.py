@@ -29,15 +29,22 @@ def check_actuator_study(loaded: LoadedStudy) -> dict[str, Any]:
     actuators = {}
     for name, candidate in study.actuators.items():
         try:
-            actuators[name] = _actuator(candidate, candidate.sensing or study.sensing, study.load.lever, catalogue)
+            actuators[name] = _actuator(
+                candidate, candidate.sensing or study.sensing, study.load.lever, catalogue
+            )
             _contact(actuators[name], candidate, study)
         except CollisionReflexError as error:
-            raise loaded.fail(("actuators", name), f"an actuator that cannot be built ({error})",
-                              "a motor, gear ratio and stiffnesses the actuator model accepts") from None
+            raise loaded.fail(
+                ("actuators", name),
+                f"an actuator that cannot be built ({error})",
+                "a motor, gear ratio and stiffnesses the actuator model accepts",
+            ) from None
     return actuators
 
 
-def _actuator(candidate: ActuatorCandidate, sensing: SensingSpec, lever: float, catalogue: dict[str, Any]) -> Any:
+def _actuator(
+    candidate: ActuatorCandidate, sensing: SensingSpec, lever: float, catalogue: dict[str, Any]
+) -> Any:
     from ..actuators import Actuator
 
     return Actuator(
@@ -65,12 +72,16 @@ def sensing_scheme(sensing: SensingSpec, lever: float) -> Any:
 
 def _contact(actuator: Any, candidate: ActuatorCandidate, study: ActuatorStudy) -> Any:
     """The candidate's collision parameters at the contact, with the object hit in series."""
-    params = actuator.contact_parameters(study.load.lever, study.load.finger_mass,
-                                         reflected_inertia_in=candidate.reflected_inertia_in)
+    params = actuator.contact_parameters(
+        study.load.lever, study.load.finger_mass, reflected_inertia_in=candidate.reflected_inertia_in
+    )
     if study.load.contact_stiffness is None:
         return params
-    return replace(params, k=float(series_stiffness(params.k, study.load.contact_stiffness)),
-                   k_m=float(series_stiffness(params.k_m, study.load.contact_stiffness)))
+    return replace(
+        params,
+        k=float(series_stiffness(params.k, study.load.contact_stiffness)),
+        k_m=float(series_stiffness(params.k_m, study.load.contact_stiffness)),
+    )
 
 
 def evaluate_actuator_study(loaded: LoadedStudy) -> dict[str, Any]:
@@ -90,35 +101,52 @@ def evaluate_actuator_study(loaded: LoadedStudy) -> dict[str, Any]:
         at_v0 = phase_impulses(*common, study.approach_velocity, study.reaction)
         sweep = phase_impulses(*common, velocities, study.reaction)
         v_star = float(optimal_velocity(m_f, k, F_s, study.reaction, k_m, a))
-        candidates.append({
-            "name": name,
-            "motor": candidate.motor.reference,
-            "stator_diameter": float(actuator.motor.stator_diameter),
-            "gear_ratio": candidate.gear_ratio,
-            "gearbox": candidate.gearbox.kind if candidate.gearbox else "direct drive",
-            "reflected_inertia": float(actuator.reflected_inertia),
-            "peak_torque": float(actuator.peak_torque),
-            "mass": float(actuator.mass),
-            "mechanical_stiffness": candidate.mechanical_stiffness,
-            "software_stiffness": candidate.software_stiffness,
-            "sensing": sensing.scheme,
-            "reflected_inertia_in": candidate.reflected_inertia_in,
-            "contact": {"m_f": m_f, "m_r": params.m_r, "k": k, "k_m": k_m, "F_s": F_s, "F_a": params.F_a, "a": a},
-            "impulse": {"initial": float(at_v0.initial), "sensing": float(at_v0.sensing),
-                        "reaction": float(at_v0.reaction), "total": float(at_v0.total)},
-            "optimal_velocity": v_star,
-            "minimum_impulse": float(minimum_impulse(*common, study.reaction)),
-            "sweep": {
-                "initial": np.broadcast_to(sweep.initial, velocities.shape).tolist(),
-                "sensing": np.broadcast_to(sweep.sensing, velocities.shape).tolist(),
-                "reaction": np.broadcast_to(sweep.reaction, velocities.shape).tolist(),
-                "total": np.broadcast_to(sweep.total, velocities.shape).tolist(),
-            },
-        })
+        candidates.append(
+            {
+                "name": name,
+                "motor": candidate.motor.reference,
+                "stator_diameter": float(actuator.motor.stator_diameter),
+                "gear_ratio": candidate.gear_ratio,
+                "gearbox": candidate.gearbox.kind if candidate.gearbox else "direct drive",
+                "reflected_inertia": float(actuator.reflected_inertia),
+                "peak_torque": float(actuator.peak_torque),
+                "mass": float(actuator.mass),
+                "mechanical_stiffness": candidate.mechanical_stiffness,
+                "software_stiffness": candidate.software_stiffness,
+                "sensing": sensing.scheme,
+                "reflected_inertia_in": candidate.reflected_inertia_in,
+                "contact": {
+                    "m_f": m_f,
+                    "m_r": params.m_r,
+                    "k": k,
+                    "k_m": k_m,
+                    "F_s": F_s,
+                    "F_a": params.F_a,
+                    "a": a,
+                },
+                "impulse": {
+                    "initial": float(at_v0.initial),
+                    "sensing": float(at_v0.sensing),
+                    "reaction": float(at_v0.reaction),
+                    "total": float(at_v0.total),
+                },
+                "optimal_velocity": v_star,
+                "minimum_impulse": float(minimum_impulse(*common, study.reaction)),
+                "sweep": {
+                    "initial": np.broadcast_to(sweep.initial, velocities.shape).tolist(),
+                    "sensing": np.broadcast_to(sweep.sensing, velocities.shape).tolist(),
+                    "reaction": np.broadcast_to(sweep.reaction, velocities.shape).tolist(),
+                    "total": np.broadcast_to(sweep.total, velocities.shape).tolist(),
+                },
+            }
+        )
     for record in candidates:
         if not all(math.isfinite(v) for v in record["contact"].values()):
-            raise loaded.fail(("actuators", record["name"]), "an actuator with non-finite contact parameters",
-                              "finite stiffness, inertia and torque")
+            raise loaded.fail(
+                ("actuators", record["name"]),
+                "an actuator with non-finite contact parameters",
+                "finite stiffness, inertia and torque",
+            )
     from .resolve import resolved_study
 
     return {

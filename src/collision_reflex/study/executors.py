@@ -51,7 +51,9 @@ def open_executor(kind: str = "serial", workers: int = 2, scheduler: str | None 
         yield SerialExecutor()
     elif kind == "processes":
         # "spawn": workers start clean (no copied locks or solver state from this process), the same on every OS.
-        with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+        with ProcessPoolExecutor(
+            max_workers=workers, mp_context=multiprocessing.get_context("spawn")
+        ) as pool:
             yield pool
     else:
         with _dask_executor(workers, scheduler) as executor:
@@ -68,7 +70,9 @@ def _dask_executor(workers: int, scheduler: str | None) -> Iterator[Executor]:
         ) from None
     if scheduler is None:
         with (
-            LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None) as cluster,
+            LocalCluster(
+                n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None
+            ) as cluster,
             Client(cluster) as client,
         ):
             yield client.get_executor()
@@ -76,6 +80,8 @@ def _dask_executor(workers: int, scheduler: str | None) -> Iterator[Executor]:
     try:
         client = Client(scheduler, timeout="10s")
     except (OSError, TimeoutError) as error:
-        raise DaskUnavailable(f"cannot reach the Dask scheduler at {scheduler} ({error}); is it running?") from None
+        raise DaskUnavailable(
+            f"cannot reach the Dask scheduler at {scheduler} ({error}); is it running?"
+        ) from None
     with client:
         yield client.get_executor()

@@ -64,7 +64,9 @@ def load_study(path: str | os.PathLike[str]) -> LoadedStudy:
     return _validated(read_study_source(path))
 
 
-def parse_study(text: str, file: str = "<string>", directory: str | os.PathLike[str] | None = None) -> LoadedStudy:
+def parse_study(
+    text: str, file: str = "<string>", directory: str | os.PathLike[str] | None = None
+) -> LoadedStudy:
     """Validate study text (as :func:`load_study`); relative paths resolve against ``directory`` (default: the
     working directory)."""
     return _validated(parse_study_source(text, file, Path(directory) if directory is not None else None))
@@ -83,7 +85,9 @@ def _validated(source: StudySource) -> LoadedStudy:
     kind = data.get("kind", "arm")
     model = STUDY_KINDS.get(kind) if isinstance(kind, str) else None
     if model is None:
-        problems.append(source.problem(("kind",), _found(kind), "one of " + ", ".join(map(repr, STUDY_KINDS))))
+        problems.append(
+            source.problem(("kind",), _found(kind), "one of " + ", ".join(map(repr, STUDY_KINDS)))
+        )
         raise StudyFileError(source.file, problems)
     try:
         study: Study = model.model_validate(data)  # type: ignore[assignment]
@@ -103,14 +107,14 @@ def _problem_from_pydantic(source: StudySource, model: type[BaseModel], item: An
     context = item.get("ctx") or {}
     if kind == "extra_forbidden":
         allowed = _allowed_keys(model, path[:-1])
-        expected = "a known key"
+        known = "a known key"
         if allowed:
             close = difflib.get_close_matches(str(path[-1]), allowed, n=1)
-            expected = (f"{close[0]!r}? " if close else "") + "one of " + ", ".join(allowed)
-        return source.problem(path, f"unknown key {path[-1]!r}", expected)
+            known = (f"{close[0]!r}? " if close else "") + "one of " + ", ".join(allowed)
+        return source.problem(path, f"unknown key {path[-1]!r}", known)
     if kind == "missing":
         return source.problem(path, "nothing", f"the required field {path[-1]!r}" if path else "a value")
-    expected = context.get("expected") if kind.startswith("quantity") else None
+    expected: str | None = context.get("expected") if kind.startswith("quantity") else None
     if expected is None:
         expected = _lower_first(item["msg"].removeprefix("Value error, "))
     if kind == "quantity_dimension":
@@ -218,7 +222,9 @@ def _arm_checks(loaded: LoadedStudy, study: ArmStudy) -> list[StudyProblem]:
         )
     if study.pareto is not None:
         for index, name in enumerate(study.pareto.objectives):
-            if name == "approach_velocity" and (design.approach_velocity is None or _fixed(design.approach_velocity)):
+            if name == "approach_velocity" and (
+                design.approach_velocity is None or _fixed(design.approach_velocity)
+            ):
                 problems.append(
                     loaded.problem(
                         ("pareto", "objectives", index),
@@ -228,12 +234,17 @@ def _arm_checks(loaded: LoadedStudy, study: ArmStudy) -> list[StudyProblem]:
                 )
     robot = study.robot
     if robot.urdf is not None and not loaded.path(robot.urdf).is_file():
-        problems.append(loaded.problem(("robot", "urdf"), f"{robot.urdf!r} (no such file)", _relative_hint(loaded)))
+        problems.append(
+            loaded.problem(("robot", "urdf"), f"{robot.urdf!r} (no such file)", _relative_hint(loaded))
+        )
     for index, directory in enumerate(robot.package_dirs):
         if not loaded.path(directory).is_dir():
             problems.append(
-                loaded.problem(("robot", "package_dirs", index), f"{directory!r} (no such directory)",
-                               _relative_hint(loaded))
+                loaded.problem(
+                    ("robot", "package_dirs", index),
+                    f"{directory!r} (no such directory)",
+                    _relative_hint(loaded),
+                )
             )
     trajectory = study.samples.configurations.trajectory
     if trajectory is not None and not loaded.path(trajectory.file).is_file():
@@ -247,14 +258,20 @@ def _arm_checks(loaded: LoadedStudy, study: ArmStudy) -> list[StudyProblem]:
     lengths = {len(q) for q in study.samples.configurations.list or []}
     if len(lengths) > 1:
         problems.append(
-            loaded.problem(("samples", "configurations", "list"), f"configurations of sizes {sorted(lengths)}",
-                           "every configuration with the same number of joint positions")
+            loaded.problem(
+                ("samples", "configurations", "list"),
+                f"configurations of sizes {sorted(lengths)}",
+                "every configuration with the same number of joint positions",
+            )
         )
     directions = study.samples.directions.list or []
     if len({len(u) for u in directions}) > 1:
         problems.append(
-            loaded.problem(("samples", "directions", "list"), "vectors of different sizes",
-                           "every direction with the same number of components (2 for a planar arm, else 3)")
+            loaded.problem(
+                ("samples", "directions", "list"),
+                "vectors of different sizes",
+                "every direction with the same number of components (2 for a planar arm, else 3)",
+            )
         )
     return problems
 
@@ -279,4 +296,3 @@ def _actuator_checks(loaded: LoadedStudy, study: ActuatorStudy) -> list[StudyPro
             )
         )
     return problems
-

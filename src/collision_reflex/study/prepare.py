@@ -31,13 +31,16 @@ def check_motors(loaded: LoadedStudy, catalogue: dict[str, Any] | None = None) -
     catalogue = catalogue if catalogue is not None else load_catalogue()
     problems: list[StudyProblem] = []
     names = sorted(catalogue)
-    for path, spec in _motor_specs(loaded.study):  # type: ignore[arg-type]
+    for path, spec in _motor_specs(loaded.study):
         if spec.reference not in catalogue:
             close = difflib.get_close_matches(spec.reference, names, n=1)
             field = (*path, "reference") if _written_as_mapping(loaded, path) else path
             problems.append(
-                loaded.problem(field, f"motor {spec.reference!r}, not in the catalogue",
-                               (f"{close[0]!r}? " if close else "") + "one of " + ", ".join(map(repr, names)))
+                loaded.problem(
+                    field,
+                    f"motor {spec.reference!r}, not in the catalogue",
+                    (f"{close[0]!r}? " if close else "") + "one of " + ", ".join(map(repr, names)),
+                )
             )
     if problems:
         raise StudyFileError(loaded.source.file, problems)
@@ -56,7 +59,9 @@ def motor_for(spec: MotorSpec, catalogue: dict[str, Any]) -> Any:
     motor = catalogue[spec.reference]
     if spec.stator_diameter is None and spec.stack_length is None:
         return motor
-    return motor.scaled(stator_diameter=spec.stator_diameter, stack_length=spec.stack_length, law=spec.scaling_law)
+    return motor.scaled(
+        stator_diameter=spec.stator_diameter, stack_length=spec.stack_length, law=spec.scaling_law
+    )
 
 
 def gearbox_for(spec: GearboxSpec | None) -> Any:
@@ -65,8 +70,16 @@ def gearbox_for(spec: GearboxSpec | None) -> Any:
         return None
     from ..gearboxes import Gearbox
 
-    return Gearbox(spec.kind, stages=spec.stages, diameter=spec.diameter, length=spec.length, mass=spec.mass,
-                   inertia=spec.inertia, rated_torque=spec.rated_torque, source=spec.source)
+    return Gearbox(
+        spec.kind,
+        stages=spec.stages,
+        diameter=spec.diameter,
+        length=spec.length,
+        mass=spec.mass,
+        inertia=spec.inertia,
+        rated_torque=spec.rated_torque,
+        source=spec.source,
+    )
 
 
 @dataclass(frozen=True)
@@ -94,8 +107,14 @@ def joint_actuators(study: ArmStudy, joint_names: list[str]) -> list[JointActuat
             return value if value is not None else getattr(base, name)
 
         out.append(
-            JointActuatorValues(joint, pick("motor"), pick("gearbox"), float(pick("gear_ratio")),
-                                float(pick("mechanical_stiffness")), float(pick("software_stiffness")))
+            JointActuatorValues(
+                joint,
+                pick("motor"),
+                pick("gearbox"),
+                float(pick("gear_ratio")),
+                float(pick("mechanical_stiffness")),
+                float(pick("software_stiffness")),
+            )
         )
     return out
 
@@ -173,4 +192,3 @@ def describe_study(loaded: LoadedStudy, load_robot: bool = True) -> str:
     if study.pareto is not None:
         text += f"; Pareto front of {' vs '.join(study.pareto.objectives)} ({study.pareto.points} points)"
     return text
-

@@ -38,7 +38,9 @@ def resolved_yaml(loaded: LoadedStudy) -> str:
     return f"# Resolved study: every default explicit. {UNITS_NOTE}\n{body}"
 
 
-def fingerprint(resolved: dict[str, Any], ignore: tuple[str, ...] = ("execution", "outputs", "description")) -> str:
+def fingerprint(
+    resolved: dict[str, Any], ignore: tuple[str, ...] = ("execution", "outputs", "description")
+) -> str:
     """A hash of what determines a run's numbers (execution settings and outputs do not)."""
     relevant = {key: value for key, value in resolved.items() if key not in ignore}
     text = json.dumps(relevant, sort_keys=True, separators=(",", ":"))

@@ -48,13 +48,20 @@ def load_arm(loaded: LoadedStudy) -> Any:
                     ("one of " + ", ".join(map(repr, close)) + " or another of " if close else "one of ")
                     + f"the {len(names)} models of example-robot-data (e.g. ur5, panda, double_pendulum)",
                 )
-            arm = Arm.from_example_robot_data(spec.example_robot_data, contact_frame=spec.contact_frame,
-                                              contact_offset=offset, locked_joints=locked)
+            arm = Arm.from_example_robot_data(
+                spec.example_robot_data,
+                contact_frame=spec.contact_frame,
+                contact_offset=offset,
+                locked_joints=locked,
+            )
         else:
             assert spec.urdf is not None  # one source is guaranteed by the schema
             if spec.contact_frame is None:
-                raise loaded.fail(("robot",), "a URDF without contact_frame",
-                                  "robot.contact_frame: the frame (link or fixed joint) that makes contact")
+                raise loaded.fail(
+                    ("robot",),
+                    "a URDF without contact_frame",
+                    "robot.contact_frame: the frame (link or fixed joint) that makes contact",
+                )
             arm = Arm.from_urdf(
                 str(loaded.path(spec.urdf)),
                 spec.contact_frame,
@@ -68,16 +75,25 @@ def load_arm(loaded: LoadedStudy) -> Any:
         else:
             where = ("robot", "contact_frame")
         close = difflib.get_close_matches(error.name, error.available, n=1)
-        raise loaded.fail(where, f"{error.kind} {error.name!r}, not in the robot",
-                          (f"{close[0]!r}? " if close else "") + f"one of the {len(error.available)} "
-                          f"{error.kind}s: " + ", ".join(error.available)) from None
+        raise loaded.fail(
+            where,
+            f"{error.kind} {error.name!r}, not in the robot",
+            (f"{close[0]!r}? " if close else "") + f"one of the {len(error.available)} "
+            f"{error.kind}s: " + ", ".join(error.available),
+        ) from None
     except UrdfError as error:
-        raise loaded.fail(("robot", "urdf"), f"a URDF that cannot be loaded ({error.reason})",
-                          "a URDF file Pinocchio can parse") from None
+        raise loaded.fail(
+            ("robot", "urdf"),
+            f"a URDF that cannot be loaded ({error.reason})",
+            "a URDF file Pinocchio can parse",
+        ) from None
     except InvalidParameter as error:
         field = error.name if error.name in type(spec).model_fields else None
-        raise loaded.fail(("robot", field) if field else ("robot",), str(error),
-                          "a robot and contact point the arm model accepts") from None
+        raise loaded.fail(
+            ("robot", field) if field else ("robot",),
+            str(error),
+            "a robot and contact point the arm model accepts",
+        ) from None
     problems = check_against_arm(loaded, arm)
     if problems:
         raise StudyFileError(loaded.source.file, problems)
@@ -95,8 +111,11 @@ def check_against_arm(loaded: LoadedStudy, arm: Any) -> list[StudyProblem]:
         if name not in joints:
             close = difflib.get_close_matches(name, joints, n=1)
             problems.append(
-                loaded.problem(path, f"joint {name!r}, not a joint of the robot",
-                               (f"{close[0]!r}? " if close else "") + "one of " + ", ".join(map(repr, joints)))
+                loaded.problem(
+                    path,
+                    f"joint {name!r}, not a joint of the robot",
+                    (f"{close[0]!r}? " if close else "") + "one of " + ", ".join(map(repr, joints)),
+                )
             )
 
     for name in study.actuators.joints:
@@ -110,26 +129,38 @@ def check_against_arm(loaded: LoadedStudy, arm: Any) -> list[StudyProblem]:
     for index, q in enumerate(study.samples.configurations.list or []):
         if len(q) != nv:
             problems.append(
-                loaded.problem(("samples", "configurations", "list", index), f"{len(q)} joint angles",
-                               f"{nv}, one per joint ({', '.join(joints)}) in rad")
+                loaded.problem(
+                    ("samples", "configurations", "list", index),
+                    f"{len(q)} joint angles",
+                    f"{nv}, one per joint ({', '.join(joints)}) in rad",
+                )
             )
     task_dim = int(arm.task_dim)
     directions = study.samples.directions
     for index, vector in enumerate(directions.list or []):
         if len(vector) != task_dim:
             problems.append(
-                loaded.problem(("samples", "directions", "list", index), f"a vector of {len(vector)} components",
-                               f"{task_dim} components ({'a planar arm' if task_dim == 2 else 'a spatial arm'})")
+                loaded.problem(
+                    ("samples", "directions", "list", index),
+                    f"a vector of {len(vector)} components",
+                    f"{task_dim} components ({'a planar arm' if task_dim == 2 else 'a spatial arm'})",
+                )
             )
     if task_dim == 2 and directions.sphere is not None:
         problems.append(
-            loaded.problem(("samples", "directions", "sphere"), "sphere directions for a planar arm",
-                           "circle: N (directions in the arm's plane)")
+            loaded.problem(
+                ("samples", "directions", "sphere"),
+                "sphere directions for a planar arm",
+                "circle: N (directions in the arm's plane)",
+            )
         )
     required = study.constraints.torque_required
     if required is not None and len(required) != len(joints):
         problems.append(
-            loaded.problem(("constraints", "torque_required"), f"{len(required)} torques",
-                           f"one per actuated joint ({len(joints)}: {', '.join(joints)}) in N*m")
+            loaded.problem(
+                ("constraints", "torque_required"),
+                f"{len(required)} torques",
+                f"one per actuated joint ({len(joints)}: {', '.join(joints)}) in N*m",
+            )
         )
     return problems

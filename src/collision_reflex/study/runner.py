@@ -55,12 +55,17 @@ def smoke_study(data: dict[str, Any]) -> dict[str, Any]:
     samples = {**data["samples"]}
     configurations = {**samples["configurations"]}
     if configurations.get("random"):
-        configurations["random"] = {**configurations["random"], "count": min(configurations["random"]["count"], 3)}
+        configurations["random"] = {
+            **configurations["random"],
+            "count": min(configurations["random"]["count"], 3),
+        }
     if configurations.get("list"):
         configurations["list"] = configurations["list"][:2]
     if configurations.get("trajectory"):
-        configurations["trajectory"] = {**configurations["trajectory"],
-                                        "every": max(configurations["trajectory"]["every"], 50)}
+        configurations["trajectory"] = {
+            **configurations["trajectory"],
+            "every": max(configurations["trajectory"]["every"], 50),
+        }
     directions = {**samples["directions"]}
     for key in ("circle", "sphere"):
         if directions.get(key):
@@ -118,10 +123,17 @@ def run_study(
     kind = executor or execution.get("executor", "serial")
     if scheduler is None and kind == "dask":
         scheduler = execution.get("scheduler")
-    resumed = folder.claim(fingerprint(resolved), text, {
-        "study": loaded.study.name, "study_file": str(path), "smoke": smoke, "version": __version__,
-        "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
-    })
+    resumed = folder.claim(
+        fingerprint(resolved),
+        text,
+        {
+            "study": loaded.study.name,
+            "study_file": str(path),
+            "smoke": smoke,
+            "version": __version__,
+            "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+        },
+    )
     progress = _Progress(quiet)
     try:
         n_workers = workers or execution.get("workers", 2)
@@ -171,8 +183,13 @@ class _Progress:
             from rich.console import Console
             from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-            self._bar = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                                 TimeElapsedColumn(), console=Console(stderr=True))
+            self._bar = Progress(
+                TextColumn("{task.description}"),
+                BarColumn(),
+                MofNCompleteColumn(),
+                TimeElapsedColumn(),
+                console=Console(stderr=True),
+            )
             self._bar.start()
 
     def stage(self, description: str, total: int, done: int = 0) -> Callable[[], None]:
@@ -187,8 +204,14 @@ class _Progress:
             self._bar = None
 
 
-def _gather(pool: Executor, folder: RunFolder, work: dict[str, tuple[Callable[..., Any], tuple[Any, ...]]],
-            progress: _Progress, description: str, window: int) -> tuple[dict[str, Any], int]:
+def _gather(
+    pool: Executor,
+    folder: RunFolder,
+    work: dict[str, tuple[Callable[..., Any], tuple[Any, ...]]],
+    progress: _Progress,
+    description: str,
+    window: int,
+) -> tuple[dict[str, Any], int]:
     """Run each named piece of work not finished yet, at most ``window`` at a time, saving each as it
     completes (so an interruption loses only the pieces in flight). Returns every record (finished before and
     now) and how many were computed now."""
@@ -221,30 +244,55 @@ def _gather(pool: Executor, folder: RunFolder, work: dict[str, tuple[Callable[..
     return {name: records[name] for name in work}, computed
 
 
-def _run_arm(study: ArmStudy, text: str, setup: Any, folder: RunFolder, pool: Executor, progress: _Progress,
-             window: int) -> tuple[dict[str, Any], tuple[int, int]]:
+def _run_arm(
+    study: ArmStudy,
+    text: str,
+    setup: Any,
+    folder: RunFolder,
+    pool: Executor,
+    progress: _Progress,
+    window: int,
+) -> tuple[dict[str, Any], tuple[int, int]]:
     from . import _optimizer
 
     computed = reused = 0
-    chosen, n = _gather(pool, folder, {"optimum": (_optimizer.solve_single, (text,))}, progress,
-                        "optimum of the study's objective", window)
+    chosen, n = _gather(
+        pool,
+        folder,
+        {"optimum": (_optimizer.solve_single, (text,))},
+        progress,
+        "optimum of the study's objective",
+        window,
+    )
     computed += n
     reused += 1 - n
     pareto: dict[str, Any] = {"objectives": [], "points": [], "failed": [], "dominated": []}
     if study.pareto is not None:
         names = tuple(study.pareto.objectives)
         anchors, n = _gather(
-            pool, folder, {f"anchor-{name}": (_optimizer.solve_anchor, (text, name, names)) for name in names},
-            progress, "Pareto anchors", window)
+            pool,
+            folder,
+            {f"anchor-{name}": (_optimizer.solve_anchor, (text, name, names)) for name in names},
+            progress,
+            "Pareto anchors",
+            window,
+        )
         computed += n
         reused += len(anchors) - n
-        by_objective = {name: anchors[f"anchor-{name}"] for name in names}
+        by_objective: dict[str, dict[str, Any]] = {name: anchors[f"anchor-{name}"] for name in names}
         grid = _optimizer.epsilon_grid(by_objective, names, study.pareto.points - len(names))
         start = by_objective[names[0]]["x"]
         points, n = _gather(
-            pool, folder,
-            {f"point-{i:03d}": (_optimizer.solve_point, (text, names, epsilon, start)) for i, epsilon in enumerate(grid)},
-            progress, "Pareto points", window)
+            pool,
+            folder,
+            {
+                f"point-{i:03d}": (_optimizer.solve_point, (text, names, epsilon, start))
+                for i, epsilon in enumerate(grid)
+            },
+            progress,
+            "Pareto points",
+            window,
+        )
         computed += n
         reused += len(points) - n
         solved = [*anchors.values(), *(p for p in points.values() if not p.get("failed"))]
@@ -267,8 +315,9 @@ def _run_arm(study: ArmStudy, text: str, setup: Any, folder: RunFolder, pool: Ex
     return results, (computed, reused)
 
 
-def non_dominated(records: list[dict[str, Any]], names: tuple[str, ...],
-                  tolerance: float = 1e-9) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+def non_dominated(
+    records: list[dict[str, Any]], names: tuple[str, ...], tolerance: float = 1e-9
+) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     """Split design records into the non-dominated ones (sorted by the first objective) and the rest.
 
     ``a`` dominates ``b`` when it is no worse in every objective and better by more than ``tolerance``
@@ -283,7 +332,8 @@ def non_dominated(records: list[dict[str, Any]], names: tuple[str, ...],
     sense = np.array([OBJECTIVES[name][0] for name in names], dtype=float)
     values = np.array([[r["objectives"][n] for n in names] for r in records]) * sense
     scale = np.maximum(np.abs(values).max(axis=0), 1e-300)
-    keep, drop = [], []
+    keep: list[int] = []
+    drop: list[int] = []
     for i in range(len(records)):
         diff = (values - values[i]) / scale
         dominated = np.any(np.all(diff <= tolerance, axis=1) & np.any(diff < -tolerance, axis=1))
@@ -293,8 +343,9 @@ def non_dominated(records: list[dict[str, Any]], names: tuple[str, ...],
     return [records[i] for i in keep], [records[i] for i in drop]
 
 
-def _run_actuators(loaded: LoadedStudy, folder: RunFolder,
-                   progress: _Progress) -> tuple[dict[str, Any], tuple[int, int]]:
+def _run_actuators(
+    loaded: LoadedStudy, folder: RunFolder, progress: _Progress
+) -> tuple[dict[str, Any], tuple[int, int]]:
     from .actuator_study import evaluate_actuator_study
 
     assert isinstance(loaded.study, ActuatorStudy)

@@ -74,9 +74,14 @@ def _trajectory(loaded: LoadedStudy, arm: Any, file: str, every: int) -> np.ndar
     joints = list(arm.joint_names)
     missing = [name for name in joints if name not in table.columns]
     if missing:
-        raise loaded.fail(where, f"{file!r} without columns {', '.join(missing)}",
-                          "a header row naming every joint: " + ", ".join(joints))
+        raise loaded.fail(
+            where,
+            f"{file!r} without columns {', '.join(missing)}",
+            "a header row naming every joint: " + ", ".join(joints),
+        )
     values = table[joints].to_numpy(dtype=float)[::every]
     if values.size == 0 or not np.all(np.isfinite(values)):
-        raise loaded.fail(where, f"{file!r} with no rows or with non-numeric values", "finite joint positions [rad]")
+        raise loaded.fail(
+            where, f"{file!r} with no rows or with non-numeric values", "finite joint positions [rad]"
+        )
     return np.asarray(arm.configuration(values), dtype=float)

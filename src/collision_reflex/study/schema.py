@@ -19,7 +19,18 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, WithJsonSchema, field_validator, model_validator
 
-from .quantities import Angle, Force, Inertia, Length, LinearStiffness, Mass, Ratio, RotaryStiffness, Torque, Velocity
+from .quantities import (
+    Angle,
+    Force,
+    Inertia,
+    Length,
+    LinearStiffness,
+    Mass,
+    Ratio,
+    RotaryStiffness,
+    Torque,
+    Velocity,
+)
 
 OBJECTIVE_NAMES = ("worst_case_impulse", "mean_impulse", "actuator_mass", "approach_velocity")
 ObjectiveName = Literal["worst_case_impulse", "mean_impulse", "actuator_mass", "approach_velocity"]
@@ -49,10 +60,16 @@ def _exactly_one(model: BaseModel, names: tuple[str, ...], what: str) -> None:
 class RobotSpec(_Model):
     """The arm: an example-robot-data model or a URDF, and where it touches the world."""
 
-    example_robot_data: str | None = Field(None, description="name of an example-robot-data model, e.g. 'ur5'")
+    example_robot_data: str | None = Field(
+        None, description="name of an example-robot-data model, e.g. 'ur5'"
+    )
     urdf: str | None = Field(None, description="URDF file, relative to the study file")
-    package_dirs: list[str] = Field(default_factory=list, description="directories to resolve package:// URIs")
-    contact_frame: str | None = Field(None, description="frame of the contact point (default: the robot's tip)")
+    package_dirs: list[str] = Field(
+        default_factory=list, description="directories to resolve package:// URIs"
+    )
+    contact_frame: str | None = Field(
+        None, description="frame of the contact point (default: the robot's tip)"
+    )
     contact_offset: tuple[Length, Length, Length] = Field(
         (0.0, 0.0, 0.0), description="contact point in the contact frame [m]"
     )
@@ -72,7 +89,9 @@ class MotorSpec(_Model):
 
     reference: str = Field(DEFAULT_REFERENCE_MOTOR, description="catalogue name of the (reference) motor")
     scaling_law: Literal["haddadin", "isometric", "empirical", "quadruped"] = "haddadin"
-    stator_diameter: Length | None = Field(None, gt=0, description="scaled stator diameter [m]; null: reference's")
+    stator_diameter: Length | None = Field(
+        None, gt=0, description="scaled stator diameter [m]; null: reference's"
+    )
     stack_length: Length | None = Field(None, gt=0, description="scaled stack length [m]; null: reference's")
 
     @classmethod
@@ -113,9 +132,11 @@ class JointActuatorSpec(_Model):
 class ActuatorsSpec(_Model):
     """The actuator of every joint; ``joints`` overrides fields for named joints."""
 
-    motor: MotorSpec = Field(default_factory=MotorSpec)
+    motor: MotorSpec = Field(default_factory=MotorSpec)  # type: ignore[arg-type]
     gearbox: GearboxSpec | None = None
-    gearbox_inertia: bool = Field(False, description="add the gearbox's reflected inertia (the paper ignores it)")
+    gearbox_inertia: bool = Field(
+        False, description="add the gearbox's reflected inertia (the paper ignores it)"
+    )
     gear_ratio: Ratio = Field(1.0, ge=1)
     mechanical_stiffness: RotaryStiffness = Field(gt=0, description="joint mechanical stiffness [N m/rad]")
     software_stiffness: RotaryStiffness = Field(gt=0, description="joint controller stiffness [N m/rad]")
@@ -141,13 +162,18 @@ class SensingSpec(_Model):
         needed = {"force": "threshold", "position": "error", "current": "motor_torque"}[self.scheme]
         given = [name for name in ("threshold", "error", "motor_torque") if getattr(self, name) is not None]
         if given != [needed]:
-            raise ValueError(f"the {self.scheme} scheme takes exactly `{needed}` (found {', '.join(given) or 'none'})")
+            raise ValueError(
+                f"the {self.scheme} scheme takes exactly `{needed}` (found {', '.join(given) or 'none'})"
+            )
         return self
 
     @property
     def value(self) -> float:
         """The threshold in SI: [N], [m] or [N m] by scheme."""
-        return float({"force": self.threshold, "position": self.error, "current": self.motor_torque}[self.scheme])
+        value = {"force": self.threshold, "position": self.error, "current": self.motor_torque}[self.scheme]
+        if value is None:  # pragma: no cover - excluded by _matches_scheme
+            raise ValueError(f"no threshold for the {self.scheme} scheme")
+        return float(value)
 
 
 # --- samples -----------------------------------------------------------------------------------------------------
@@ -167,7 +193,9 @@ class ConfigurationSamples(_Model):
     """Exactly one of ``random``, ``list`` or ``trajectory``."""
 
     random: RandomConfigurations | None = None
-    list: builtins.list[builtins.list[Angle]] | None = Field(None, min_length=1, description="configurations [rad]")
+    list: builtins.list[builtins.list[Angle]] | None = Field(
+        None, min_length=1, description="configurations [rad]"
+    )
     trajectory: TrajectorySpec | None = None
 
     @model_validator(mode="after")
@@ -223,7 +251,9 @@ def _variable_model(name: str, quantity: Any, floor: float | None, doc: str) -> 
             elif self.min is None or self.max is None:
                 raise ValueError("both min and max (a free variable), or value (fixed)")
             elif self.min > self.max:
-                raise ValueError(f"min <= max (min = {self.min:g}, max = {self.max:g} in SI units): swap them")
+                raise ValueError(
+                    f"min <= max (min = {self.min:g}, max = {self.max:g} in SI units): swap them"
+                )
             if floor is not None:
                 low = self.value if self.value is not None else self.min
                 if low is not None and low < floor:
@@ -266,7 +296,9 @@ _SoftBounds = _variable_model("SoftwareStiffness", RotaryStiffness, None, "softw
 StatorDiameterVariable = _per_joint("StatorDiameterVariable", _StatorBounds, "motor stator diameter [m]")
 StackLengthVariable = _per_joint("StackLengthVariable", _StackBounds, "motor stack length [m]")
 GearRatioVariable = _per_joint("GearRatioVariable", _GearBounds, "gear ratio [-], >= 1")
-SoftwareStiffnessVariable = _per_joint("SoftwareStiffnessVariable", _SoftBounds, "software stiffness [N m/rad]")
+SoftwareStiffnessVariable = _per_joint(
+    "SoftwareStiffnessVariable", _SoftBounds, "software stiffness [N m/rad]"
+)
 ThresholdVariable = _variable_model("ThresholdVariable", Force, None, "contact-force threshold [N]")
 PositionErrorVariable = _variable_model("PositionErrorVariable", Length, None, "position-error threshold [m]")
 VelocityVariable = _variable_model("VelocityVariable", Velocity, None, "approach velocity [m/s]")
@@ -312,7 +344,7 @@ class ParetoSpec(_Model):
 
 
 class OutputsSpec(_Model):
-    figures: list[Literal["png", "svg"]] = Field(default_factory=lambda: ["png", "svg"])
+    figures: list[Literal["png", "svg"]] = Field(default_factory=lambda: ["png", "svg"])  # type: ignore[arg-type]
     pdf: bool = Field(False, description="also write report.pdf (needs Chromium)")
 
 
@@ -365,13 +397,11 @@ class ArmStudy(_Model):
                 "description": "an objective name, or a weighted sum {name: weight}",
             }
         ),
-    ] = Field(
-        default_factory=lambda: {"worst_case_impulse": 1.0}, min_length=1
-    )
-    constraints: ConstraintsSpec = Field(default_factory=ConstraintsSpec)
+    ] = Field(default_factory=lambda: {"worst_case_impulse": 1.0}, min_length=1)  # type: ignore[arg-type]
+    constraints: ConstraintsSpec = Field(default_factory=ConstraintsSpec)  # type: ignore[arg-type]
     pareto: ParetoSpec | None = None
-    outputs: OutputsSpec = Field(default_factory=OutputsSpec)
-    execution: ExecutionSpec = Field(default_factory=ExecutionSpec)
+    outputs: OutputsSpec = Field(default_factory=OutputsSpec)  # type: ignore[arg-type]
+    execution: ExecutionSpec = Field(default_factory=ExecutionSpec)  # type: ignore[arg-type]
 
     @field_validator("objective", mode="before")
     @classmethod
@@ -390,7 +420,8 @@ class ActuatorCandidate(_Model):
     mechanical_stiffness: RotaryStiffness = Field(gt=0)
     software_stiffness: RotaryStiffness = Field(gt=0)
     reflected_inertia_in: Literal["robot", "finger"] = Field(
-        "robot", description="'finger': N^2 J_m also in the impact (a stiff transmission, like the paper's A8)"
+        "robot",
+        description="'finger': N^2 J_m also in the impact (a stiff transmission, like the paper's A8)",
     )
     sensing: SensingSpec | None = Field(None, description="overrides the study's sensing for this actuator")
 
@@ -430,7 +461,7 @@ class ActuatorStudy(_Model):
     approach_velocity: Velocity = Field(gt=0, description="approach velocity of the tables [m/s]")
     velocities: VelocityRange
     reaction: Literal["at_rest", "moving"] = "at_rest"
-    outputs: OutputsSpec = Field(default_factory=OutputsSpec)
+    outputs: OutputsSpec = Field(default_factory=OutputsSpec)  # type: ignore[arg-type]
 
 
 Study = ArmStudy | ActuatorStudy

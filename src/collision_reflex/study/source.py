@@ -71,7 +71,7 @@ class StudySource:
 
 def _looks_internal(key: Any) -> bool:
     text = str(key)
-    return "[" in text or "-" in text and not text.startswith(("+", "-"))
+    return "[" in text or ("-" in text and not text.startswith(("+", "-")))
 
 
 def format_path(path: Sequence[Any]) -> str:
@@ -113,7 +113,11 @@ def parse_study_source(text: str, file: str = "<string>", directory: Path | None
         column = error.position - (text.rfind("\n", 0, error.position) + 1) + 1
         raise StudyFileError(
             file,
-            [StudyProblem(file, line, column, "", f"the character {chr(error.character)!r}", "printable text")],
+            [
+                StudyProblem(
+                    file, line, column, "", f"the character {chr(error.character)!r}", "printable text"
+                )
+            ],
         ) from None
     try:
         node = loader.get_single_node()

@@ -100,7 +100,8 @@ class RunFolder:
         if not path.exists():
             return None
         try:
-            return read_json(path)  # type: ignore[no-any-return]
+            record: dict[str, Any] = read_json(path)
+            return record
         except (OSError, ValueError):
             return None  # unreadable: do the work again
 
