@@ -12,9 +12,10 @@ import pytest
 
 from collision_reflex.impulse import phase_impulses, series_stiffness
 from collision_reflex.report.html import number
+from collision_reflex.study._optimizer import epsilon_grid, non_dominated
 from collision_reflex.study.actuator_study import sensing_scheme
 from collision_reflex.study.executors import SerialExecutor, open_executor
-from collision_reflex.study.runner import non_dominated, smoke_study
+from collision_reflex.study.runner import smoke_study
 from collision_reflex.study.schema import SensingSpec
 from collision_reflex.study.store import OutputFolderInUse, RunFolder
 
@@ -59,6 +60,16 @@ def test_non_dominated_matches_brute_force():
     fast = [{"objectives": {"worst_case_impulse": 1.0, "approach_velocity": v}} for v in (0.1, 0.5)]
     front, _ = non_dominated(fast, ("worst_case_impulse", "approach_velocity"))
     assert [r["objectives"]["approach_velocity"] for r in front] == [0.5]
+
+
+def test_epsilon_grid_spreads_bounds_between_saved_anchors():
+    anchors = {
+        "worst_case_impulse": {"objectives": {"worst_case_impulse": 0.2, "actuator_mass": 1.0}},
+        "actuator_mass": {"objectives": {"worst_case_impulse": 0.5, "actuator_mass": 0.1}},
+    }
+    grid = epsilon_grid(anchors, ("worst_case_impulse", "actuator_mass"), 3)
+    # Interior points only, evenly spaced from the loosest mass bound (1.0) to the tightest (0.1).
+    assert [g["actuator_mass"] for g in grid] == pytest.approx([0.775, 0.55, 0.325], rel=1e-12)
 
 
 def test_smoke_study_shrinks_counts():

@@ -202,12 +202,12 @@ def solve_anchor(resolved_text: str, objective: str, objectives: tuple[str, ...]
     """A Pareto anchor: ``objective`` minimised, then (lexicographically) each other objective with it held at
     its optimum, so that the anchor is not dominated."""
     from ..optimize import solve
-    from ..optimize.pareto import ANCHOR_SLACK
+    from ..optimize.pareto import _loosened
 
     setup = _setup_from_text(resolved_text)
     others = tuple(o for o in objectives if o != objective)
     result = solve(problem_for(resolved_text, objective, others), ipopt_options=IPOPT_OPTIONS)
-    held = _held_bound(objective, result.objectives[objective], ANCHOR_SLACK)
+    held = _loosened(objective, result.objectives[objective])
     for other in others:
         bounded = tuple(o for o in objectives if o != other)
         result = solve(
@@ -223,32 +223,40 @@ def solve_anchor(resolved_text: str, objective: str, objectives: tuple[str, ...]
     return record
 
 
-def _held_bound(name: str, value: float, slack: float) -> float:
-    from ..optimize import OBJECTIVES
+@dataclass(frozen=True)
+class _Saved:
+    """A saved design record seen as the optimiser's sweep helpers see a result (its NumPy objectives)."""
 
-    sense = OBJECTIVES[name][0]
-    return value * (1 + sense * slack) if value > 0 else value + sense * slack
+    record: dict[str, Any]
+
+    @property
+    def numpy_objectives(self) -> dict[str, float]:
+        objectives: dict[str, float] = self.record["objectives"]
+        return objectives
 
 
 def epsilon_grid(
     anchors: dict[str, dict[str, Any]], objectives: tuple[str, ...], count: int
 ) -> list[dict[str, float]]:
-    """Bounds on the other objectives spread evenly between their values at the anchors (interior points)."""
-    from ..optimize import OBJECTIVES
+    """The sweep's objective bounds between the saved anchors: the optimiser's own epsilon grid."""
+    from ..optimize.pareto import _epsilon_grid
 
-    bounded = objectives[1:]
-    if count <= 0:
-        return []
-    ranges = {}
-    for name in bounded:
-        values = [anchor["objectives"][name] for anchor in anchors.values()]
-        ranges[name] = (max(values), min(values)) if OBJECTIVES[name][0] > 0 else (min(values), max(values))
-    if len(bounded) == 1:
-        (name,) = bounded
-        return [{name: float(v)} for v in np.linspace(*ranges[name], count + 2)[1:-1]]
-    per_axis = max(2, round(math.sqrt(count)))
-    axes = [np.linspace(*ranges[name], per_axis + 2)[1:-1] for name in bounded]
-    return [{bounded[0]: float(a), bounded[1]: float(b)} for a in axes[0] for b in axes[1]]
+    saved: dict[str, Any] = {name: _Saved(a) for name, a in anchors.items()}
+    return _epsilon_grid(saved, objectives[1:], count)
+
+
+def non_dominated(
+    records: list[dict[str, Any]], names: tuple[str, ...]
+) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """Saved records split by the optimiser's dominance filter into the front (sorted by the first objective)
+    and the dominated rest."""
+    from ..optimize.pareto import _non_dominated
+
+    if not records:
+        return [], []
+    saved: list[Any] = [_Saved(r) for r in records]  # duck-typed as DesignResult: only numpy_objectives is read
+    front, dropped = _non_dominated(saved, names)
+    return [s.record for s in front], [s.record for s in dropped]
 
 
 @_one_at_a_time

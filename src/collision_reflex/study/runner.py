@@ -20,7 +20,7 @@ from .executors import open_executor
 from .load import LoadedStudy, load_study, parse_study
 from .resolve import fingerprint, resolved_study, resolved_yaml
 from .schema import ActuatorStudy, ArmStudy
-from .store import DESIGNS, PARETO, RunFolder, write_json
+from .store import RunFolder
 
 SMOKE_ENVIRONMENT = "CRX_SMOKE"
 """Set to 1 to run every study with small sample counts (tests, quick checks): see :func:`smoke_study`."""
@@ -296,7 +296,7 @@ def _run_arm(
         computed += n
         reused += len(points) - n
         solved = [*anchors.values(), *(p for p in points.values() if not p.get("failed"))]
-        front, dominated = non_dominated(solved, names)
+        front, dominated = _optimizer.non_dominated(solved, names)
         pareto = {
             "objectives": list(names),
             "points": front,
@@ -315,34 +315,6 @@ def _run_arm(
     return results, (computed, reused)
 
 
-def non_dominated(
-    records: list[dict[str, Any]], names: tuple[str, ...], tolerance: float = 1e-9
-) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
-    """Split design records into the non-dominated ones (sorted by the first objective) and the rest.
-
-    ``a`` dominates ``b`` when it is no worse in every objective and better by more than ``tolerance``
-    (relative to the objective's range of magnitudes) in one; of near-duplicates the first is kept.
-    """
-    import numpy as np
-
-    from ..optimize import OBJECTIVES
-
-    if not records:
-        return [], []
-    sense = np.array([OBJECTIVES[name][0] for name in names], dtype=float)
-    values = np.array([[r["objectives"][n] for n in names] for r in records]) * sense
-    scale = np.maximum(np.abs(values).max(axis=0), 1e-300)
-    keep: list[int] = []
-    drop: list[int] = []
-    for i in range(len(records)):
-        diff = (values - values[i]) / scale
-        dominated = np.any(np.all(diff <= tolerance, axis=1) & np.any(diff < -tolerance, axis=1))
-        duplicate = np.any(np.all(np.abs(diff) <= tolerance, axis=1)[:i])
-        (drop if dominated or duplicate else keep).append(i)
-    keep.sort(key=lambda i: values[i, 0])
-    return [records[i] for i in keep], [records[i] for i in drop]
-
-
 def _run_actuators(
     loaded: LoadedStudy, folder: RunFolder, progress: _Progress
 ) -> tuple[dict[str, Any], tuple[int, int]]:
@@ -359,4 +331,4 @@ def _run_actuators(
     return saved, (0, 1)
 
 
-__all__ = ["DESIGNS", "PARETO", "RunResult", "non_dominated", "run_study", "smoke_study", "write_json"]
+__all__ = ["RunResult", "run_study", "smoke_study"]
