@@ -256,7 +256,7 @@ def non_dominated(
         return [], []
     saved: list[Any] = [_Saved(r) for r in records]  # duck-typed as DesignResult: only numpy_objectives is read
     front, dropped = _non_dominated(saved, names)
-    return [s.record for s in front], [s.record for s in dropped]
+    return [s.record for s in front], [s.record for s in dropped]  # type: ignore[attr-defined]
 
 
 @_one_at_a_time
