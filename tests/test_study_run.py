@@ -275,3 +275,33 @@ def test_bad_input_is_one_located_message_exit_2_and_nothing_written(tmp_path, c
         assert word in err[0]
     assert "Traceback" not in err[0]
     assert not out.exists()
+
+
+def test_report_pdf_is_printed_by_chromium(runs, browser, tmp_path):
+    folder = tmp_path / "pdf"
+    shutil.copytree(runs["direct_drive_vs_geared"], folder)
+    assert main(["report", str(folder), "--pdf"]) == 0
+    assert (folder / "report.pdf").read_bytes().startswith(b"%PDF")
+
+
+def test_validate_checks_the_robot_with_lines(tmp_path, capsys):
+    assert main(["validate", *map(str, STUDIES)]) == 0
+    assert capsys.readouterr().out.count(": valid") == len(STUDIES)
+    study = tmp_path / "study.yaml"
+    study.write_text(
+        STUDY.replace("contact_frame: link2", "contact_frame: lnk2").replace(
+            "configurations: {list: [[0, 0.8]]}", "configurations: {list: [[0, 0.8, 0.1]]}"
+        )
+    )
+    assert main(["validate", str(study)]) == 2
+    err = capsys.readouterr().err
+    assert f"{study}:4:3: robot.contact_frame: found frame 'lnk2', not in the robot; expected 'link2'?" in err
+
+
+def test_readme_main_command_runs_an_example_study(runs):
+    """The README's main command is `crx run` on one of the example studies (each of which runs above)."""
+    readme = (ROOT / "README.md").read_text()
+    commands = re.findall(r"pip install -e \. && crx run (\S+)", readme)
+    assert commands, "the README's main command does not run a study"
+    assert (ROOT / commands[0]).resolve() in {p.resolve() for p in STUDIES}
+    assert Path(commands[0]).stem in runs
