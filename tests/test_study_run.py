@@ -305,3 +305,20 @@ def test_readme_main_command_runs_an_example_study(runs):
     assert commands, "the README's main command does not run a study"
     assert (ROOT / commands[0]).resolve() in {p.resolve() for p in STUDIES}
     assert Path(commands[0]).stem in runs
+
+
+def test_unreachable_torque_requirement_is_located_before_anything_is_written(tmp_path, capsys):
+    # 1.3 N*m reference motor at 60 mm; at most 80 mm and a 2:1 gear reaches 2 x 1.3 x (80/60)^2.5 = 5.34 N*m.
+    study = tmp_path / "study.yaml"
+    study.write_text(
+        STUDY.replace(
+            "gear_ratio: {min: 1, max: 50}",
+            "gear_ratio: {min: 1, max: 2}\n  stator_diameter: {min: 20 mm, max: 80 mm}",
+        )
+        + "constraints: {torque_required: [1 N*m, 6 N*m]}\n"
+    )
+    assert main(["run", str(study), "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"crx run: error: {study}:17:")
+    assert "constraints.torque_required[1]" in err and "at most 5.338 N*m" in err
+    assert not (tmp_path / "out").exists()

@@ -196,3 +196,22 @@ class CatalogueError(CollisionReflexError, ValueError):
         where = f"{path}:{line}" if line is not None else path
         subject = f"{field}: " if field else ""
         super().__init__(f"{where}: {subject}{reason}")
+
+
+class StudyRunFailed(CollisionReflexError):
+    """A study's design could not be found: the optimiser failed on a solve the study cannot do without (its
+    optimum or a Pareto anchor). Plain data only, so that it crosses process boundaries.
+
+    Attributes
+    ----------
+    what: which solve failed (``"optimum"``, ``"anchor: actuator_mass"``, ...).
+    status: the solver's return status.
+    """
+
+    def __init__(self, message: str, what: str = "", status: str = "") -> None:
+        self.what = what
+        self.status = status
+        super().__init__(message)
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (type(self), (str(self), self.what, self.status))

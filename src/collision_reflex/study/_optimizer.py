@@ -166,10 +166,20 @@ def problem_for(resolved_text: str, objective: str, bounded: tuple[str, ...]) ->
 
 
 def _one_at_a_time(function: Any) -> Any:
+    """Run a task under the solver lock; a solver failure leaves it as a plain, picklable error."""
+
     @functools.wraps(function)
     def locked(*args: Any, **kwargs: Any) -> Any:
+        from ..errors import SolverFailed, StudyRunFailed
+
         with _SOLVER_LOCK:
-            return function(*args, **kwargs)
+            try:
+                return function(*args, **kwargs)
+            except SolverFailed as error:
+                what = function.__name__.removeprefix("solve_")
+                raise StudyRunFailed(
+                    f"the {what} solve failed: {error.args[0] if error.args else error}", what, error.status
+                ) from None
 
     return locked
 
@@ -254,7 +264,9 @@ def non_dominated(
 
     if not records:
         return [], []
-    saved: list[Any] = [_Saved(r) for r in records]  # duck-typed as DesignResult: only numpy_objectives is read
+    saved: list[Any] = [
+        _Saved(r) for r in records
+    ]  # duck-typed as DesignResult: only numpy_objectives is read
     front, dropped = _non_dominated(saved, names)
     return [s.record for s in front], [s.record for s in dropped]  # type: ignore[attr-defined]
 
@@ -397,6 +409,9 @@ def checked_setup(loaded: LoadedStudy, resolved_text: str) -> ArmSetup:
     from ..errors import InvalidParameter
 
     setup = arm_setup(loaded)  # located errors for the robot, motors and names
+    problems = _torque_out_of_reach(loaded, setup)
+    if problems:
+        raise StudyFileError(loaded.source.file, problems)
     try:
         _setup_from_text(resolved_text)
         objective = {str(k): float(v) for k, v in setup.study.objective.items()}
@@ -404,6 +419,39 @@ def checked_setup(loaded: LoadedStudy, resolved_text: str) -> ArmSetup:
     except InvalidParameter as error:
         raise loaded.fail(_field_of(error.name), f"{error}", "inputs the design problem accepts") from None
     return setup
+
+
+def _torque_out_of_reach(loaded: LoadedStudy, setup: ArmSetup) -> list[StudyProblem]:
+    """Given torque requirements no design within the bounds can meet: the largest motor at the largest gear
+    ratio (torque grows with motor size under every scaling law) short of the safety factor times the need."""
+    from ..motors import scaled_motor_quantities
+
+    required = setup.study.constraints.torque_required
+    if required is None:
+        return []
+    joints = list(setup.arm.joint_names)
+    n = len(joints)
+    reference = setup.technology.reference_motor
+    diameters = setup.space.per_joint("stator_diameter", n)
+    stacks = setup.space.per_joint("stack_length", n, reference.stack_length)
+    gears = setup.space.per_joint("gear_ratio", n)
+    factor = setup.study.constraints.safety_factor
+    problems = []
+    for i, joint in enumerate(joints):
+        motor = scaled_motor_quantities(
+            reference, diameters[i].upper, stacks[i].upper, setup.technology.scaling_law
+        )
+        reachable = gears[i].upper * float(motor.peak_torque)
+        if factor * required[i] > reachable * (1 + 1e-9):
+            problems.append(
+                loaded.problem(
+                    ("constraints", "torque_required", i),
+                    f"{required[i]:g} N*m for {joint} (x {factor:g} safety)",
+                    f"at most {reachable:.4g} N*m, the peak torque of the largest motor at the largest gear "
+                    "ratio; widen design.stator_diameter or design.gear_ratio, or lower the requirement",
+                )
+            )
+    return problems
 
 
 def _field_of(name: str) -> tuple[str, ...]:

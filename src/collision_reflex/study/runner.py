@@ -145,9 +145,9 @@ def run_study(
                 results, counts = _run_arm(loaded.study, text, setup, folder, pool, progress, window)
             else:
                 results, counts = _run_actuators(loaded, folder, progress)
-    except BaseException:
+    except BaseException as error:
         progress.stop()
-        folder.update_manifest(status="interrupted")
+        folder.update_manifest(status="failed" if isinstance(error, Exception) else "interrupted")
         raise
     progress.stop()
     from ..report import write_outputs
