@@ -308,7 +308,8 @@ def test_readme_main_command_runs_an_example_study(runs):
 
 
 def test_unreachable_torque_requirement_is_located_before_anything_is_written(tmp_path, capsys):
-    # 1.3 N*m reference motor at 60 mm; at most 80 mm and a 2:1 gear reaches 2 x 1.3 x (80/60)^2.5 = 5.34 N*m.
+    # 1.3 N*m reference motor at 60 mm; at most 80 mm and a 2:1 gear reach 2 x 1.3 x (80/60)^2.5 = 5.337 N*m
+    # (Haddadin law, torque exponent 2.5).
     study = tmp_path / "study.yaml"
     study.write_text(
         STUDY.replace(
@@ -320,5 +321,5 @@ def test_unreachable_torque_requirement_is_located_before_anything_is_written(tm
     assert main(["run", str(study), "--out", str(tmp_path / "out"), "--quiet"]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith(f"crx run: error: {study}:17:")
-    assert "constraints.torque_required[1]" in err and "at most 5.338 N*m" in err
+    assert "constraints.torque_required[1]" in err and "at most 5.337 N*m" in err
     assert not (tmp_path / "out").exists()
