@@ -197,14 +197,14 @@ def radius_velocity_sweep(
         return contact, gear, actuator.reflected_inertia
 
     per_diameter = [parameters_at(float(d)) for d in diameters]
-    args = {
+    args: dict[str, Any] = {
         key: np.array([p[0].impulse_arguments()[key] for p in per_diameter])
         for key in ("m_f", "k", "k_m", "F_s", "a")
     }
     robot_masses = np.array([p[0].m_r for p in per_diameter])
     gears = np.array([p[1] for p in per_diameter])
     reflected = np.array([p[2] for p in per_diameter])
-    column = {key: value[:, None] for key, value in args.items()}
+    column: dict[str, Any] = {key: value[:, None] for key, value in args.items()}
     impulse = phase_impulses(**column, v0=velocities[None, :]).total
     v_star = optimal_velocity(args["m_f"], args["k"], args["F_s"])
     i_star = minimum_impulse(**args)
@@ -247,7 +247,7 @@ def radius_velocity_sweep(
     )
 
 
-def _min_impulse(args: dict[str, float]) -> float:
+def _min_impulse(args: dict[str, Any]) -> float:
     return float(minimum_impulse(**args))
 
 
