@@ -35,6 +35,12 @@ def test_units_converted_to_si(tmp_path):
     assert motor.stack_length == 0.01 and motor.continuous_torque == 0.2
 
 
+def test_plain_exponent_numbers_are_si(tmp_path):
+    # YAML 1.1 reads 1e-6 (no dot) as text; it must still be the SI number, not a unit error.
+    motor = cr.load_catalogue(_write(tmp_path, GOOD.replace("12 g*cm^2", "1e-6")))["small"]
+    assert motor.rotor_inertia == 1e-6
+
+
 def test_packaged_catalogue_cites_sources():
     catalogue = cr.load_catalogue()
     assert "OPN-060-013-A" in catalogue
