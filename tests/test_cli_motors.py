@@ -59,6 +59,7 @@ BAD = {
     "bad-figure-name": (["sweep", "radius-velocity", "--plot", "x.txt"], "figure file"),
     "bad-csv-name": (["sweep", "radius-velocity", "--csv", "x.txt"], "--csv"),
     "missing-catalogue": (["motors", "--catalogue", "nope.yaml"], "nope.yaml"),
+    "one-velocity-heat-map": (["sweep", "radius-velocity", "--velocities", "0.1"], "velocities"),
 }
 
 

@@ -13,7 +13,7 @@ LEVER, FINGER = 0.1143, 0.1  # the documented defaults
 
 
 def _hand_impulse(diameter, velocity, placement="finger"):
-    """fig:motor_scale_modeling written out from MODEL.md: Haddadin law from the Omni+ (60 mm, 2.21e-5 kg m^2,
+    """fig:motor_scale_modeling written out by hand: Haddadin law from the Omni+ (60 mm, 2.21e-5 kg m^2,
     1.3 N m), N = max(1, 1.3/tau_p), reflected N^2 J_m / L^2, k_m = 1000, k_s = 100 N/m, F_s = 3 N."""
     ratio = diameter / 0.060
     inertia, torque = 2.21e-5 * ratio**4, 1.3 * ratio**2.5

@@ -289,7 +289,7 @@ class Actuator:
         torque as ``tau/L``. The reflected inertia always counts in the robot mass that the reaction
         accelerates away; ``reflected_inertia_in`` says whether it also reaches the contact in the impact:
 
-        - ``"robot"`` (MODEL.md's arm model): the compliance sits between the rotor and the finger, so the
+        - ``"robot"`` (the arm model's placement): the compliance sits between the rotor and the finger, so the
           finger mass is only ``finger_mass``;
         - ``"finger"``: a rigid transmission with the compliance at the contact (like the paper's geared A8,
           whose fitted finger mass was 20 kg), so ``N**2 J_m / L**2`` is added to the finger mass too.

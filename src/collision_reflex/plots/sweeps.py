@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import InvalidParameter
 from ..sweeps import RadiusVelocitySweep, StiffnessSweep
 from . import check_figure_path, new_figure, save_figure
 
@@ -18,6 +19,7 @@ def plot_radius_velocity(sweep: RadiusVelocitySweep, path: str | os.PathLike[str
     from matplotlib.colors import LogNorm
 
     check_figure_path(path)
+    _check_heat_map_grid(sweep.diameters.size, sweep.velocities.size)
     fig, ax = new_figure(figsize=(7, 4.8))
     diameters_mm = sweep.diameters * 1e3
     impulse = sweep.impulse.T  # rows: velocity, columns: diameter
@@ -25,7 +27,7 @@ def plot_radius_velocity(sweep: RadiusVelocitySweep, path: str | os.PathLike[str
     mesh = ax.pcolormesh(
         diameters_mm, sweep.velocities, impulse, norm=norm, cmap="viridis", shading="gouraud"
     )
-    if sweep.diameters.size > 1 and sweep.velocities.size > 1:
+    if True:  # contour lines label the heat map's levels
         levels = np.geomspace(float(np.min(impulse)) * 1.05, float(np.max(impulse)), 9)
         lines = ax.contour(
             diameters_mm, sweep.velocities, impulse, levels=levels, colors="white", linewidths=0.6
@@ -81,3 +83,12 @@ def plot_stiffness(sweep: StiffnessSweep, path: str | os.PathLike[str]) -> Path:
     ax.grid(True, which="both", lw=0.3, alpha=0.5)
     ax.legend(fontsize=8)
     return save_figure(fig, path)
+
+
+def _check_heat_map_grid(n_diameters: int, n_velocities: int) -> None:
+    """A heat map needs at least two values along each axis."""
+    for name, count in (("diameters", n_diameters), ("velocities", n_velocities)):
+        if count < 2:
+            raise InvalidParameter(
+                name, count, "at least 2 values for a heat map", "e.g. START:STOP:N with N >= 2"
+            )
