@@ -33,7 +33,12 @@ def test_stiffness_is_series_and_mass_adds_gearbox():
     assert actuator.stiffness == pytest.approx(200.0, rel=1e-15)  # 1/(1/300 + 1/600)
     assert cr.Actuator(MOTOR).stiffness == math.inf
     gearbox = cr.Gearbox("harmonic", diameter=0.05, length=0.03, mass=0.25, inertia=1e-6, rated_torque=20.0)
-    assert cr.Actuator(MOTOR, 30.0, gearbox=gearbox).mass == pytest.approx(0.65, rel=1e-15)
+    geared = cr.Actuator(MOTOR, 30.0, gearbox=gearbox)
+    assert geared.mass == pytest.approx(0.65, rel=1e-15)
+    assert (
+        geared.peak_torque == pytest.approx(45.0) and geared.torque_limit == 20.0
+    )  # the gearbox's rating caps
+    assert cr.Actuator(MOTOR, 10.0, gearbox=gearbox).torque_limit == pytest.approx(15.0)
 
 
 def test_gearbox_inertia_is_optional():

@@ -256,8 +256,15 @@ class Actuator:
 
     @property
     def peak_torque(self) -> float:
-        """Peak output torque ``N tau_p`` [N m]."""
+        """Peak output torque ``N tau_p`` [N m] of the motor (see :attr:`torque_limit` for the gearbox's cap)."""
         return self.gear_ratio * self.motor.peak_torque
+
+    @property
+    def torque_limit(self) -> float:
+        """Largest output torque [N m]: ``N tau_p``, capped by the gearbox's rated torque if there is one."""
+        if self.gearbox is None:
+            return self.peak_torque
+        return min(self.peak_torque, self.gearbox.rated_torque)
 
     @property
     def continuous_torque(self) -> float:

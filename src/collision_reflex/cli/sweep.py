@@ -208,11 +208,11 @@ def _print_assumptions(assumptions: dict) -> None:
 
 
 def run_radius_velocity(args: argparse.Namespace) -> int:
-    from ..plots.sweeps import _check_heat_map_grid, plot_radius_velocity
+    from ..plots.sweeps import check_heat_map_grid, plot_radius_velocity
     from ..sweeps import radius_velocity_sweep
 
     _check_outputs(args)
-    _check_heat_map_grid(args.diameters.size, args.velocities.size)
+    check_heat_map_grid(args.diameters.size, args.velocities.size)
     sweep = radius_velocity_sweep(
         args.diameters,
         args.velocities,

@@ -19,7 +19,7 @@ def plot_radius_velocity(sweep: RadiusVelocitySweep, path: str | os.PathLike[str
     from matplotlib.colors import LogNorm
 
     check_figure_path(path)
-    _check_heat_map_grid(sweep.diameters.size, sweep.velocities.size)
+    check_heat_map_grid(sweep.diameters.size, sweep.velocities.size)
     fig, ax = new_figure(figsize=(7, 4.8))
     diameters_mm = sweep.diameters * 1e3
     impulse = sweep.impulse.T  # rows: velocity, columns: diameter
@@ -85,7 +85,7 @@ def plot_stiffness(sweep: StiffnessSweep, path: str | os.PathLike[str]) -> Path:
     return save_figure(fig, path)
 
 
-def _check_heat_map_grid(n_diameters: int, n_velocities: int) -> None:
+def check_heat_map_grid(n_diameters: int, n_velocities: int) -> None:
     """A heat map needs at least two values along each axis."""
     for name, count in (("diameters", n_diameters), ("velocities", n_velocities)):
         if count < 2:
