@@ -106,3 +106,17 @@ def test_bad_sweep_input(kwargs, name):
     args = {"diameters": [0.01, 0.06], "velocities": [0.1], **kwargs}
     with pytest.raises(cr.InvalidParameter, match=name):
         radius_velocity_sweep(args.pop("diameters"), args.pop("velocities"), **args)
+
+
+def test_optional_gearbox_inertia_against_hand_computation():
+    # A harmonic drive (figures of a test unit: 50 mm, J_g = 1e-6 kg m^2 at the input) scaled to each geared
+    # motor's diameter: J_g(r) = 1e-6 (r/0.05)^4 at its own length, reflected N^2 (J_m + J_g) in the finger.
+    gearbox = cr.Gearbox("harmonic", diameter=0.05, length=0.03, mass=0.2, inertia=1e-6, rated_torque=30.0)
+    d, v = np.array([0.01, 0.03, 0.08]), np.array([0.5])
+    with_box = radius_velocity_sweep(d, v, gearbox=gearbox)
+    ratio = d / 0.060
+    gear = np.maximum(1.0, 1.3 / (1.3 * ratio**2.5))
+    box = np.where(gear > 1, 1e-6 * (d / 0.05) ** 4, 0.0)  # direct drive (80 mm) has no gearbox
+    np.testing.assert_allclose(with_box.reflected_inertia, gear**2 * (2.21e-5 * ratio**4 + box), rtol=1e-12)
+    without = radius_velocity_sweep(d, v)
+    assert np.all(with_box.impulse[:2] > without.impulse[:2]) and with_box.impulse[2] == without.impulse[2]

@@ -41,6 +41,7 @@ from .actuators import (
     gear_ratio_for,
 )
 from .errors import InvalidParameter
+from .gearboxes import Gearbox
 from .impulse import REACTION_MODES, minimum_impulse, optimal_velocity, phase_impulses
 from .motors import DEFAULT_SCALING_LAW, Motor, reference_motor, scaling_law
 
@@ -124,7 +125,13 @@ class RadiusVelocitySweep:
 
 
 def _contact_actuator(
-    motor: Motor, gear: float, k_m: float, k_s: float, lever: float, sensing: Any
+    motor: Motor,
+    gear: float,
+    k_m: float,
+    k_s: float,
+    lever: float,
+    sensing: Any,
+    gearbox: Gearbox | None = None,
 ) -> Actuator:
     """An actuator whose joint stiffnesses are the contact stiffnesses [N/m] moved to the joint (``k L**2``)."""
     return Actuator(
@@ -133,6 +140,8 @@ def _contact_actuator(
         mechanical_stiffness=k_m * lever**2,
         software_stiffness=k_s * lever**2,
         sensing=sensing,
+        gearbox=gearbox,
+        gearbox_inertia=gearbox is not None,
     )
 
 
@@ -151,6 +160,7 @@ def radius_velocity_sweep(
     robot_mass: float = SWEEP_DEFAULTS["robot_mass"],
     reflected_inertia_in: str = SWEEP_DEFAULTS["reflected_inertia_in"],
     stack_length: float | None = None,
+    gearbox: Gearbox | None = None,
 ) -> RadiusVelocitySweep:
     """Impulse of a 1D collision over motor stator diameter x approach velocity (``fig:motor_scale_modeling``).
 
@@ -172,6 +182,9 @@ def radius_velocity_sweep(
     robot_mass: unsprung mass at the contact besides the reflected inertia [kg].
     reflected_inertia_in: ``"finger"`` or ``"robot"``, see :meth:`Actuator.contact_parameters`.
     stack_length: motor stack length [m], default the reference's.
+    gearbox: a real gearbox to add to every geared motor (``N > 1``), scaled to the motor's stator diameter at
+        its own length and stages; its reflected inertia then counts (the paper ignores it, the default).
+        Direct-drive motors get none.
     """
     reference = reference if reference is not None else reference_motor()
     diameters = _grid("diameters", diameters)
@@ -190,8 +203,15 @@ def radius_velocity_sweep(
     def parameters_at(diameter: float) -> tuple[CollisionParameters, float, float]:
         motor = reference.scaled(diameter, stack_length, law_name)
         gear = float(gear_ratio_for(torque_required, motor.peak_torque))
+        geared_box = gearbox.scaled(diameter=diameter) if gearbox is not None and gear > 1 else None
         actuator = _contact_actuator(
-            motor, gear, mechanical_stiffness, software_stiffness, lever, ForceThreshold(threshold)
+            motor,
+            gear,
+            mechanical_stiffness,
+            software_stiffness,
+            lever,
+            ForceThreshold(threshold),
+            geared_box,
         )
         contact = actuator.contact_parameters(lever, finger_mass, robot_mass, reflected_inertia_in)
         return contact, gear, actuator.reflected_inertia
@@ -226,7 +246,11 @@ def radius_velocity_sweep(
         "finger mass [kg] (assumed: the paper's U8 fit, tab:one_shot)": finger_mass,
         "extra robot mass [kg] (assumed)": robot_mass,
         "reflected inertia in (assumed, see docs)": reflected_inertia_in,
-        "gearbox inertia": "ignored, as in the paper",
+        "gearbox inertia": (
+            "ignored, as in the paper"
+            if gearbox is None
+            else f"{gearbox.kind} gearbox scaled to each geared motor's diameter, from: {gearbox.source}"
+        ),
         "reaction": "at_rest (the paper's)",
     }
     return RadiusVelocitySweep(
