@@ -13,9 +13,11 @@ from collections.abc import Sequence
 from .. import __version__
 from ..errors import CollisionReflexError
 from . import impulse as _impulse
+from . import motors as _motors
+from . import sweep as _sweep
 
 # Subcommand modules, in the order `crx --help` lists them.
-_SUBCOMMANDS = [_impulse]
+_SUBCOMMANDS = [_impulse, _motors, _sweep]
 
 
 def build_parser() -> argparse.ArgumentParser:
