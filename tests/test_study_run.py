@@ -12,10 +12,12 @@ import textwrap
 from html.parser import HTMLParser
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 
 from collision_reflex.cli import main
+from collision_reflex.errors import StudyFileError
 from collision_reflex.report.pdf import find_browser, headless_flags
 from collision_reflex.study import _optimizer
 from collision_reflex.study.runner import run_study
@@ -323,3 +325,27 @@ def test_unreachable_torque_requirement_is_located_before_anything_is_written(tm
     assert err.startswith(f"crx run: error: {study}:17:")
     assert "constraints.torque_required[1]" in err and "at most 5.337 N*m" in err
     assert not (tmp_path / "out").exists()
+
+
+def test_trajectory_configurations_come_from_the_csv_by_joint_name(tmp_path):
+    from collision_reflex.study import load_study
+    from collision_reflex.study.robot import load_arm
+    from collision_reflex.study.samples import configuration_samples
+
+    # Columns in another order than the joints, plus a time column that is ignored.
+    (tmp_path / "traj.csv").write_text("t,joint2,joint1\n0,0.1,1.0\n0.1,0.2,1.1\n0.2,0.3,1.2\n0.3,0.4,1.3\n")
+    study = tmp_path / "study.yaml"
+    study.write_text(
+        STUDY.replace(
+            "configurations: {list: [[0, 0.8]]}", "configurations: {trajectory: {file: traj.csv, every: 2}}"
+        )
+    )
+    loaded = load_study(study)
+    arm = load_arm(loaded)
+    q = configuration_samples(loaded, arm)
+    # Rows 0 and 2, joints in the arm's order (the double pendulum's joints are bounded: q holds the angles).
+    np.testing.assert_allclose(arm.joint_coordinates(q), [[1.0, 0.1], [1.2, 0.3]], atol=1e-12)  # exact copies
+    (tmp_path / "traj.csv").write_text("t,joint1\n0,0.1\n")
+    with pytest.raises(StudyFileError, match="without columns joint2") as caught:
+        configuration_samples(loaded, arm)
+    assert caught.value.problems[0].line == 12
