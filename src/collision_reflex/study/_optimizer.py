@@ -31,6 +31,40 @@ _SOLVER_LOCK = threading.RLock()
 at a time (a Dask worker with several threads, for instance); parallelism comes from processes."""
 
 IPOPT_OPTIONS = {"ipopt.max_iter": 400}
+
+
+def single_threaded_blas() -> Any:
+    """A context with every BLAS (NumPy's, and the OpenBLAS that CasADi bundles for IPOPT and MUMPS) on one
+    thread.
+
+    A threaded BLAS sums in an order that depends on its thread count, and Dask workers pin it to one thread
+    where a plain process does not; the difference moves IPOPT's iterates and so the results, within the solver
+    tolerance. With one thread everywhere, every executor gives the same numbers (parallelism comes from the
+    executor's processes).
+    """
+    import threadpoolctl
+
+    if not _CASADI_BLAS_REGISTERED:
+        threadpoolctl.register(_casadi_openblas_controller())
+        _CASADI_BLAS_REGISTERED.append(True)
+    return threadpoolctl.threadpool_limits(limits=1)
+
+
+_CASADI_BLAS_REGISTERED: list[bool] = []
+
+
+def _casadi_openblas_controller() -> Any:
+    from threadpoolctl import OpenBLASController
+
+    class CasadiOpenBLAS(OpenBLASController):
+        """CasADi's bundled OpenBLAS, which threadpoolctl does not know by its file name."""
+
+        internal_api = "casadi_openblas"
+        filename_prefixes = ("libcasadi-tp-openblas",)
+
+    return CasadiOpenBLAS
+
+
 """Options over the optimiser's defaults for study runs (a cap keeps a hopeless Pareto point from stalling a run)."""
 
 
@@ -148,12 +182,13 @@ def _gearbox_problem(loaded: LoadedStudy, path: tuple[Any, ...]) -> StudyProblem
 
 @functools.lru_cache(maxsize=4)
 def _setup_from_text(resolved_text: str) -> ArmSetup:
-    return arm_setup(parse_study(resolved_text, "resolved study"))
+    with single_threaded_blas():  # the same arithmetic in every process (see single_threaded_blas)
+        return arm_setup(parse_study(resolved_text, "resolved study"))
 
 
 @functools.lru_cache(maxsize=16)
 def problem_for(resolved_text: str, objective: str, bounded: tuple[str, ...]) -> Any:
-    """The design problem minimising ``objective`` with ``bounded`` objectives, built once per process."""
+    """The design problem minimising ``objective`` with ``bounded`` objectives, built once per task."""
     from ..optimize import build_problem
 
     setup = _setup_from_text(resolved_text)
@@ -172,7 +207,15 @@ def _one_at_a_time(function: Any) -> Any:
     def locked(*args: Any, **kwargs: Any) -> Any:
         from ..errors import SolverFailed, StudyRunFailed
 
-        with _SOLVER_LOCK:
+        # One BLAS thread: a threaded BLAS sums in an order that depends on its thread count (Dask workers pin it
+        # to 1, a local process does not), which moves IPOPT's iterates and so the results within the solver
+        # tolerance. Pinned, every executor gives the same numbers; parallelism comes from the executor.
+        with _SOLVER_LOCK, single_threaded_blas():
+            # Fresh problems (and so fresh IPOPT instances) per task: a solver object carries state from one
+            # solve to the next that moves results within the solver tolerance, so reusing it across tasks
+            # would make the numbers depend on which worker did what before. Within a task the order is fixed.
+            problem_for.cache_clear()
+            _weighted_problem.cache_clear()
             try:
                 return function(*args, **kwargs)
             except SolverFailed as error:
