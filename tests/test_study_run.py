@@ -374,3 +374,10 @@ def test_trajectory_configurations_come_from_the_csv_by_joint_name(tmp_path):
     with pytest.raises(StudyFileError, match="without columns joint2") as caught:
         configuration_samples(loaded, arm)
     assert caught.value.problems[0].line == 12
+
+
+def test_smoke_runs_locate_problems_in_the_file_as_written(tmp_path, capsys):
+    study = tmp_path / "study.yaml"
+    study.write_text("# a comment that the resolved study does not have\n" + STUDY.replace("link2", "link9"))
+    assert main(["run", str(study), "--out", str(tmp_path / "out"), "--quiet", "--smoke"]) == 2
+    assert capsys.readouterr().err.startswith(f"crx run: error: {study}:5:3: robot.contact_frame")

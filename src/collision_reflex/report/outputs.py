@@ -92,9 +92,7 @@ def _non_dominated_candidates(candidates: list[dict[str, Any]]) -> set[str]:
     return out
 
 
-def write_outputs(
-    folder: str | os.PathLike[str], results: dict[str, Any], figures: bool = True, quiet: bool = True
-) -> Path:
+def write_outputs(folder: str | os.PathLike[str], results: dict[str, Any], figures: bool = True) -> Path:
     """Write ``designs.json``, ``pareto.csv`` and the report (with its figures) into ``folder``."""
     folder = Path(folder)
     write_json(folder / DESIGNS, results)

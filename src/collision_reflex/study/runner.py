@@ -113,11 +113,14 @@ def run_study(
     loaded = load_study(path)
     smoke = bool(os.environ.get(SMOKE_ENVIRONMENT, "")) if smoke is None else smoke
     resolved = resolved_study(loaded)
+    as_written = loaded
     if smoke:
         resolved = smoke_study(resolved)
         loaded = parse_study(_dump(resolved), str(path), loaded.directory)
     text = resolved_yaml(loaded)
-    setup = _prepare(loaded, text)  # loads robot and motors: every problem raised here, before any output
+    # Robot, motors, samples and the problem build: every problem is raised here, located in the file as
+    # written, before any output.
+    _prepare(as_written, text)
     folder = RunFolder(Path(out) if out is not None else default_output_folder(loaded))
     execution = resolved.get("execution", {})
     kind = executor or execution.get("executor", "serial")
@@ -142,7 +145,7 @@ def run_study(
         window = 1 if kind == "serial" and scheduler is None else (10**6 if scheduler else 2 * n_workers)
         with open_executor(kind, n_workers, scheduler) as pool:
             if isinstance(loaded.study, ArmStudy):
-                results, counts = _run_arm(loaded.study, text, setup, folder, pool, progress, window)
+                results, counts = _run_arm(loaded.study, text, folder, pool, progress, window)
             else:
                 results, counts = _run_actuators(loaded, folder, progress)
     except BaseException as error:
@@ -152,7 +155,7 @@ def run_study(
     progress.stop()
     from ..report import write_outputs
 
-    write_outputs(folder.path, results, figures=figures, quiet=quiet)
+    write_outputs(folder.path, results, figures=figures)
     elapsed = time.perf_counter() - started
     folder.update_manifest(status="finished", elapsed=elapsed, computed=counts[0], reused=counts[1])
     return RunResult(folder.path, resumed, counts[0], counts[1], elapsed)
@@ -164,14 +167,17 @@ def _dump(data: dict[str, Any]) -> str:
     return yaml.safe_dump(data, sort_keys=False)
 
 
-def _prepare(loaded: LoadedStudy, text: str) -> Any:
+def _prepare(loaded: LoadedStudy, text: str) -> None:
+    """Check everything a run needs; problems are located in ``loaded`` (the file as written), while the
+    problem is built from ``text`` (the resolved study that runs)."""
     if isinstance(loaded.study, ArmStudy):
         from . import _optimizer
 
-        return _optimizer.checked_setup(loaded, text)
-    from .actuator_study import check_actuator_study
+        _optimizer.checked_setup(loaded, text)
+    else:
+        from .actuator_study import check_actuator_study
 
-    return check_actuator_study(loaded)
+        check_actuator_study(loaded)
 
 
 class _Progress:
@@ -247,7 +253,6 @@ def _gather(
 def _run_arm(
     study: ArmStudy,
     text: str,
-    setup: Any,
     folder: RunFolder,
     pool: Executor,
     progress: _Progress,
@@ -308,7 +313,7 @@ def _run_arm(
         "study": study.name,
         "description": study.description,
         "resolved": resolved_study(parse_study(text, "resolved study")),
-        "samples": _optimizer.sample_layout(setup),
+        "samples": _optimizer.sample_layout(_optimizer.setup_from_text(text)),
         "chosen": chosen["optimum"],
         "pareto": pareto,
     }
