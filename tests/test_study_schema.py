@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import textwrap
 from pathlib import Path
 
@@ -266,3 +267,12 @@ def test_cli_validate_reports_each_problem_and_exits_2(tmp_path, capsys):
     assert len(err) == 2
     assert err[0].startswith(f"{bad}:5:3: actuators.mechanical_stiffness: found '3 kg'")
     assert err[1].startswith(f"{bad}:11:")
+
+
+def test_readme_annotated_study_is_valid():
+    readme = Path(__file__).resolve().parents[1] / "README.md"
+    blocks = [b for b in re.findall(r"```yaml\n(.*?)```", readme.read_text(), flags=re.S) if "name:" in b]
+    assert blocks, "the README has no annotated study"
+    # It lives in studies/ as far as its relative paths are concerned.
+    study = parse_study(blocks[0], "README.md", STUDIES[0].parent).study
+    assert isinstance(study, ArmStudy) and study.pareto is not None
