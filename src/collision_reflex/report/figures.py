@@ -74,8 +74,12 @@ def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
     featured = {"chosen design": chosen}
     if pareto["points"]:
         last = len(pareto["points"]) - 1
+        # Sorted by the first objective: the ends of a two-objective front are its best in each.
+        two = len(names) == 2
         featured[f"Pareto design 0 (best {_words(names[0])})"] = pareto["points"][0]
-        featured[f"Pareto design {last} (best {_words(names[1])})"] = pareto["points"][-1]
+        featured[f"Pareto design {last}" + (f" (best {_words(names[1])})" if two else "")] = pareto["points"][
+            -1
+        ]
     for index, (title, record) in enumerate(featured.items()):
         draw = functools.partial(
             _surface,
