@@ -330,8 +330,15 @@ def solve_point(
     except SolverFailed as error:
         return {"failed": True, "epsilon": epsilon, "status": error.status, "message": str(error.args[0])}
     return design_record(
-        setup, problem, result, "epsilon: " + ", ".join(f"{k} <= {v:.4g}" for k, v in epsilon.items())
+        setup, problem, result, "epsilon: " + ", ".join(_bound_text(k, v) for k, v in epsilon.items())
     )
+
+
+def _bound_text(name: str, value: float) -> str:
+    """``mass <= 0.1`` for a minimised objective, ``approach_velocity >= 0.4`` for a maximised one."""
+    from ..optimize import OBJECTIVES
+
+    return f"{name} {'<=' if OBJECTIVES[name][0] > 0 else '>='} {value:.4g}"
 
 
 # --- records -----------------------------------------------------------------------------------------------------
