@@ -39,8 +39,8 @@ def single_threaded_blas() -> Any:
 
     A threaded BLAS sums in an order that depends on its thread count, and Dask workers pin it to one thread
     where a plain process does not; the difference moves IPOPT's iterates and so the results, within the solver
-    tolerance. With one thread everywhere, every executor gives the same numbers (parallelism comes from the
-    executor's processes).
+    tolerance. With one thread everywhere, every executor gives the same numbers, bitwise in practice
+    (parallelism comes from the executor's processes).
     """
     import threadpoolctl
 
