@@ -188,7 +188,8 @@ def _setup_from_text(resolved_text: str) -> ArmSetup:
 
 @functools.lru_cache(maxsize=16)
 def problem_for(resolved_text: str, objective: str, bounded: tuple[str, ...]) -> Any:
-    """The design problem minimising ``objective`` with ``bounded`` objectives, built once per task."""
+    """The design problem minimising ``objective`` with ``bounded`` objectives, built once per process (its
+    solvers are reused by later tasks; the results do not depend on which task came first)."""
     from ..optimize import build_problem
 
     setup = _setup_from_text(resolved_text)
@@ -207,15 +208,7 @@ def _one_at_a_time(function: Any) -> Any:
     def locked(*args: Any, **kwargs: Any) -> Any:
         from ..errors import SolverFailed, StudyRunFailed
 
-        # One BLAS thread: a threaded BLAS sums in an order that depends on its thread count (Dask workers pin it
-        # to 1, a local process does not), which moves IPOPT's iterates and so the results within the solver
-        # tolerance. Pinned, every executor gives the same numbers; parallelism comes from the executor.
         with _SOLVER_LOCK, single_threaded_blas():
-            # Fresh problems (and so fresh IPOPT instances) per task: a solver object carries state from one
-            # solve to the next that moves results within the solver tolerance, so reusing it across tasks
-            # would make the numbers depend on which worker did what before. Within a task the order is fixed.
-            problem_for.cache_clear()
-            _weighted_problem.cache_clear()
             try:
                 return function(*args, **kwargs)
             except SolverFailed as error:
