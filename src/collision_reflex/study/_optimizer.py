@@ -245,27 +245,41 @@ def _weighted_problem(resolved_text: str, key: Any) -> Any:
 
 @_one_at_a_time
 def solve_anchor(resolved_text: str, objective: str, objectives: tuple[str, ...]) -> dict[str, Any]:
-    """A Pareto anchor: ``objective`` minimised, then (lexicographically) each other objective with it held at
-    its optimum, so that the anchor is not dominated."""
+    """A Pareto anchor: ``objective`` optimised, then (lexicographically) each other objective with it held at
+    its optimum, so that the anchor is not dominated. A lexicographic step the solver cannot do keeps the
+    anchor found so far (the dominance filter then judges it) and is recorded in ``lexicographic_failed``."""
+    from ..errors import SolverFailed, StudyRunFailed
     from ..optimize import solve
     from ..optimize.pareto import _loosened
 
     setup = _setup_from_text(resolved_text)
     others = tuple(o for o in objectives if o != objective)
-    result = solve(problem_for(resolved_text, objective, others), ipopt_options=IPOPT_OPTIONS)
+    try:
+        result = solve(problem_for(resolved_text, objective, others), ipopt_options=IPOPT_OPTIONS)
+    except SolverFailed as error:
+        raise StudyRunFailed(
+            f"the Pareto anchor of {objective} could not be solved: {error.args[0] if error.args else error}",
+            f"anchor: {objective}",
+            error.status,
+        ) from None
     held = _loosened(objective, result.objectives[objective])
+    failed = []
     for other in others:
         bounded = tuple(o for o in objectives if o != other)
-        result = solve(
-            problem_for(resolved_text, other, bounded),
-            epsilon={objective: held},
-            x0=result.x,
-            ipopt_options=IPOPT_OPTIONS,
-        )
+        try:
+            result = solve(
+                problem_for(resolved_text, other, bounded),
+                epsilon={objective: held},
+                x0=result.x,
+                ipopt_options=IPOPT_OPTIONS,
+            )
+        except SolverFailed as error:
+            failed.append({"objective": other, "status": error.status})
     record = design_record(
         setup, problem_for(resolved_text, objective, others), result, f"anchor: {objective}"
     )
     record["x"] = result.x.tolist()
+    record["lexicographic_failed"] = failed
     return record
 
 
