@@ -78,7 +78,7 @@ def nsga2_front(
         # pymoo's convention: constraint values <= 0 are satisfied.
         return np.array([values[n] for n in names]) * senses, required - design.peak_torque
 
-    class _Design(ElementwiseProblem):  # type: ignore[misc]
+    class _Design(ElementwiseProblem):
         def __init__(self) -> None:
             super().__init__(n_var=lower.size, n_obj=len(names), n_ieq_constr=problem.n_joints, xl=lower,
                              xu=upper)

@@ -342,7 +342,9 @@ def build_problem(
     compliance = ca.exp(ca.transpose(x[capacity_index]))
     impulses, thresholds, normalisation = per_sample(design_column, lifted, compliance, ca.DM(data))
     actuator_mass = ca.sum1(motor_mass)
-    required_torque = _required_torque_function(samples, constraints, n_joints)
+    mass_bounds = [np.asarray(joint_numbers(bound)[0]).ravel() for bound in (lbx, ubx)]
+    torque_demands = _binding_torque_demands(samples, constraints, joint_names, *mass_bounds)
+    required_torque = _required_torque_function(torque_demands, n_joints)
     evaluate = ca.Function(
         "evaluate",
         [x],
@@ -416,18 +418,14 @@ def build_problem(
 
     add(ca.transpose(normalisation), 1.0, 1.0, [f"w^T x = 1 at sample {s}" for s in range(n_samples)])
 
-    # Torque: peak output torque covers the requirement in every sampled configuration (linear constraints,
-    # one per configuration, sign and joint), each scaled by the requirement at the start.
+    # Torque: peak output torque covers the requirement in every sampled configuration, as linear constraints
+    # scaled by the requirement at the start; only demands that can be the largest somewhere in the box of
+    # motor masses allowed by the bounds can bind, the others are dropped (exactly).
     torque_scale = np.maximum(np.asarray(required_torque(start_mass)).ravel(), 1e-3)
-    rows, demand_labels = _torque_requirement_rows(samples, constraints, joint_names)
-    for (base, per_motor), label in zip(rows, demand_labels, strict=True):
-        demand = ca.DM(base) + ca.mtimes(ca.DM(per_motor), motor_mass)
-        add(
-            (peak_torque - demand) / torque_scale,
-            0.0,
-            np.inf,
-            [f"peak torque of {name} >= {label}" for name in joint_names],
-        )
+    for j, (bases, slopes, demand_labels) in enumerate(torque_demands):
+        demand = ca.DM(bases) + ca.mtimes(ca.DM(slopes), motor_mass)
+        add((peak_torque[j] - demand) / torque_scale[j], 0.0, np.inf,
+            [f"peak torque of {joint_names[j]} >= {label}" for label in demand_labels])
 
     if technology.sensing == "position" and constraints.threshold_floor > 0:
         add(
@@ -666,17 +664,34 @@ def _torque_requirement_rows(
     return rows, labels
 
 
-def _required_torque_function(samples: ContactSamples, constraints: Constraints, n_joints: int) -> Any:
-    """CasADi function: motor masses [kg] -> required peak torque per joint [N m], for reporting: the largest
-    of the demands of :func:`_torque_requirement_rows`."""
+def _binding_torque_demands(
+    samples: ContactSamples, constraints: Constraints, joint_names: tuple[str, ...], mass_low: np.ndarray,
+    mass_high: np.ndarray,
+) -> list[tuple[np.ndarray, np.ndarray, list[str]]]:
+    """Per joint, the torque demands ``b + S m`` [N m] that can bind: ``(b (R,), S (R, n), labels)``.
+
+    A demand whose largest value over the box of motor masses ``[mass_low, mass_high]`` [kg] is below another
+    demand's smallest value there never sets the requirement, so it is left out: an exact reduction (on arms,
+    from two rows per sampled configuration to a handful).
+    """
+    rows, labels = _torque_requirement_rows(samples, constraints, joint_names)
+    demands = []
+    for j in range(len(joint_names)):
+        bases = np.array([base[j] for base, _ in rows])
+        slopes = np.array([per_motor[j] for _, per_motor in rows])
+        low = bases + np.minimum(slopes * mass_low, slopes * mass_high).sum(axis=1)
+        high = bases + np.maximum(slopes * mass_low, slopes * mass_high).sum(axis=1)
+        keep = high >= low.max() - 1e-12 * abs(low.max())
+        demands.append((bases[keep], slopes[keep], [label for label, k in zip(labels, keep, strict=True) if k]))
+    return demands
+
+
+def _required_torque_function(demands: list[tuple[np.ndarray, np.ndarray, list[str]]], n_joints: int) -> Any:
+    """CasADi function: motor masses [kg] -> required peak torque per joint [N m], the largest binding demand
+    (safety factor included), for reporting."""
     masses = ca.MX.sym("motor_mass", n_joints)
-    names = tuple(f"joint{i}" for i in range(n_joints))
-    rows, _ = _torque_requirement_rows(samples, constraints, names)
-    demands = [ca.DM(base) + ca.mtimes(ca.DM(per_motor), masses) for base, per_motor in rows]
-    worst = demands[0]
-    for demand in demands[1:]:
-        worst = ca.fmax(worst, demand)
-    return ca.Function("required_torque", [masses], [worst])
+    required = [ca.mmax(ca.DM(bases) + ca.mtimes(ca.DM(slopes), masses)) for bases, slopes, _ in demands]
+    return ca.Function("required_torque", [masses], [ca.vertcat(*required)])
 
 
 def _check_finite(values: np.ndarray, what: str, samples: ContactSamples) -> None:
