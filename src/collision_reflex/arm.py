@@ -17,6 +17,7 @@ separately and linearly (``M_bb(q; m) = M_bb0(q) + sum_i m_i A_i(q)``).
 from __future__ import annotations
 
 import contextlib
+import functools
 import os
 import sys
 import tempfile
@@ -393,21 +394,7 @@ class Arm:
         ``a1``) at the front-left foot with the base fixed to the world. Other robots need ``contact_frame``.
         ``locked_joints`` replaces the default list of locked joints (``()`` locks none).
         """
-        try:
-            import example_robot_data
-        except ImportError as error:  # pragma: no cover - a declared dependency
-            raise InvalidParameter(
-                "name", name, "an installed example-robot-data", "pip install example-robot-data"
-            ) from error
-        try:
-            robot = example_robot_data.load(name)
-        except Exception as error:  # the loader raises plain ValueErrors for unknown names
-            raise InvalidParameter(
-                "name",
-                name,
-                "a robot of example-robot-data, e.g. 'ur5', 'panda', 'double_pendulum'",
-                str(error),
-            ) from None
+        model, urdf = _example_robot(name)
         defaults = _ROBOT_DEFAULTS.get(name, {})
         if contact_frame is None:
             if "contact_frame" not in defaults:
@@ -415,22 +402,21 @@ class Arm:
                     "contact_frame",
                     None,
                     f"a frame name for {name!r} (no default is known)",
-                    "frames: " + ", ".join(f.name for f in robot.model.frames),
+                    "frames: " + ", ".join(f.name for f in model.frames),
                 )
             contact_frame = defaults["contact_frame"]
             if contact_offset is None:
                 contact_offset = defaults.get("contact_offset")
-        model = robot.model
         if model.njoints > 1 and model.joints[1].nq == 7:  # free-flyer root: fix the base to the world
-            model = _load_urdf(robot.urdf)
+            model = _load_urdf(urdf)
         locked = defaults.get("locked_joints", ()) if locked_joints is None else tuple(locked_joints)
         model = _locked(model, locked, name)
-        return cls(model, contact_frame, contact_offset, actuators, name, robot.urdf)
+        return cls(model, contact_frame, contact_offset, actuators, name, urdf)
 
     def with_actuators(self, actuators: Any) -> Arm:
         """The same arm and contact point with other actuators (see :class:`Arm`)."""
         return Arm(
-            self._structure,
+            self._source_model,
             self.contact_frame,
             self.contact_offset,
             actuators,
@@ -719,6 +705,7 @@ def effective_parameters(
     motor_mass: Any = None,
     stiffness_form: str = "compliance",
     joint_threshold: Any = None,
+    task_stiffness: Any = None,
     singular_tolerance: float = 1e-12,
 ) -> EffectiveParameters:
     """Effective 1D collision parameters for many configurations and directions at once (MODEL.md §3).
@@ -739,6 +726,9 @@ def effective_parameters(
         :data:`STIFFNESS_FORMS`.
     joint_threshold: joint torque at which a joint detects the contact [N m] (a motor-current threshold
         reflected through the transmission); fills ``joint_threshold_force``.
+    task_stiffness: stiffness of a Cartesian (task-space) controller [N/m], the same in every direction, in
+        series with the joint springs while sensing (``1/k = u^T J K^-1 J^T u + 1/k_task``); None for none.
+        With stiff joints it makes the sensing phase isotropic, as the paper's two-link example assumes.
     singular_tolerance: a direction is singular where ``u^T J M_bb^-1 J^T u`` is below this fraction of
         ``trace(J M_bb^-1 J^T)`` (an effective-mass ratio above ``1 / singular_tolerance``).
 
@@ -780,7 +770,7 @@ def effective_parameters(
     # (structure, actuators, stiffness, mechanical stiffness).
     task = np.stack(
         [
-            jac @ _solve_spd(structure, jac_t),
+            task_inverse_inertia(structure, jac),
             (jac / inertia) @ jac_t,
             (jac / joint_k) @ jac_t,
             (jac / joint_km) @ jac_t,
@@ -821,6 +811,11 @@ def effective_parameters(
             if value is not None:
                 value[singular] = np.inf
         a[singular] = 0.0
+    if task_stiffness is not None:
+        from .impulse import series_stiffness
+
+        _validate.positive("task_stiffness", task_stiffness)
+        k = np.where(singular, np.inf, series_stiffness(k, task_stiffness))
     return EffectiveParameters(m_f, m_r, k, k_m, F_a, a, singular, joint_force)
 
 
@@ -947,6 +942,12 @@ def _unit_directions(directions: Any, task_dim: int) -> np.ndarray:
     if not np.all(np.isfinite(norms) & (norms > 0)):
         raise InvalidParameter("directions", directions, "non-zero finite vectors")
     return units / norms[:, None]
+
+
+def task_inverse_inertia(mass_matrix: np.ndarray, jacobian: np.ndarray) -> np.ndarray:
+    """``J M^-1 J^T`` for stacked mass matrices (n, nv, nv) [kg m^2] and Jacobians (n, m, nv) [m/rad],
+    (n, m, m) [1/kg]: the inverse of the task-space (operational-space) inertia, the ellipsoid of gyration."""
+    return jacobian @ _solve_spd(mass_matrix, np.swapaxes(jacobian, -1, -2))
 
 
 def _solve_spd(matrix: np.ndarray, rhs: np.ndarray) -> np.ndarray:
@@ -1109,6 +1110,33 @@ def _random_q(model: Any, joints: list[_JointKinematics], rng: np.random.Generat
         else:
             q[joint.idx_q : joint.idx_q + 2] = np.cos(angle), np.sin(angle)
     return q
+
+
+@functools.lru_cache(maxsize=16)
+def _example_robot_cached(name: str) -> tuple[Any, str]:
+    try:
+        import example_robot_data
+    except ImportError as error:  # pragma: no cover - a declared dependency
+        raise InvalidParameter(
+            "name", name, "an installed example-robot-data", "pip install example-robot-data"
+        ) from error
+    try:
+        robot = example_robot_data.load(name)
+    except Exception as error:  # the loader raises plain ValueErrors for unknown names
+        raise InvalidParameter(
+            "name",
+            name,
+            "a robot of example-robot-data, e.g. 'ur5', 'panda', 'double_pendulum', 'solo12'",
+            str(error),
+        ) from None
+    return robot.model, str(robot.urdf)
+
+
+def _example_robot(name: str) -> tuple[Any, str]:
+    """The Pinocchio model (a copy) and URDF path of an example-robot-data robot; loading parses meshes and is
+    slow, so it happens once per name."""
+    model, urdf = _example_robot_cached(name)
+    return model.copy(), urdf
 
 
 def _locked(model: Any, locked_joints: Sequence[str], robot: str) -> Any:
