@@ -703,6 +703,7 @@ def effective_parameters(
     *,
     config_index: Any = None,
     motor_mass: Any = None,
+    finger_joint_inertia: Any = None,
     stiffness_form: str = "compliance",
     joint_threshold: Any = None,
     task_stiffness: Any = None,
@@ -722,6 +723,10 @@ def effective_parameters(
     torque_limit: largest output torque per joint [N m], > 0, ``inf`` allowed.
     config_index: (n_samples,) configuration of each paired sample; None for the grid.
     motor_mass: motor mass per joint [kg], added to the structure as ``sum_i m_i A_i``; None for none.
+    finger_joint_inertia: joint-space inertia per joint [kg m^2] that acts rigidly on the link side during the
+        impact, added to the finger's mass matrix as ``diag(...)``: the reflected rotor inertia of a stiff
+        transmission whose compliance sits at the contact (the paper's geared A8). None for none (the paper's
+        arm model, reflected inertia in the robot mass only).
     stiffness_form: ``"compliance"`` (default) or ``"paper"`` (square Jacobians only), see
         :data:`STIFFNESS_FORMS`.
     joint_threshold: joint torque at which a joint detects the contact [N m] (a motor-current threshold
@@ -765,6 +770,8 @@ def effective_parameters(
 
     jac = samples.jacobian
     structure = samples.structure_mass_matrix(motor_mass)
+    if finger_joint_inertia is not None:
+        structure = structure + np.diag(_joint_array("finger_joint_inertia", finger_joint_inertia, nv))
     jac_t = np.swapaxes(jac, 1, 2)
     # Task-space inverse inertias and compliances, once per configuration: G = J X^-1 J^T, stacked as
     # (structure, actuators, stiffness, mechanical stiffness).
