@@ -117,3 +117,50 @@ def test_spatial_surface_on_the_sphere():
     # Opposite directions give equal impulses: every effective parameter is even in u.
     flipped = reflex_surface(ur5, q, 0.2, 5.0, directions=-surface.directions)
     np.testing.assert_allclose(flipped.impulse, surface.impulse, rtol=1e-12)
+
+
+# Table tab:motor_params: the Omni+ scaled to 10 mm and 100 mm stator diameter with 1.3 N m required.
+@pytest.mark.parametrize(
+    "diameter, ratio, reflected",
+    [(0.010, 88.18, 1.33e-4), (0.060, 1.0, 2.21e-5), (0.100, 1.0, 1.71e-4)],
+    ids=["M1", "M2", "M3"],
+)
+def test_scaled_motors_reproduce_the_paper_table(arm, diameter, ratio, reflected):
+    scaled = arm.with_scaled_motors(diameter, 1.3, mechanical_stiffness=K_JOINT)
+    assert scaled.actuators[0].gear_ratio == pytest.approx(ratio, rel=1e-3)  # table rounds to 4 digits
+    np.testing.assert_allclose(scaled.model.armature, reflected, rtol=5e-3)
+    np.testing.assert_allclose(
+        scaled.torque_limit, max(1.3, scaled.actuators[0].motor.peak_torque), rtol=1e-12
+    )
+
+
+def test_scaling_the_base_motor_leaves_the_radial_direction_unchanged(arm):
+    """With real scaled motors (masses included): joint 1's motor sits on the fixed base, so a different
+    motor there changes the impulse only where joint 1 moves the contact, never along the radial line."""
+    reference = arm.with_scaled_motors(0.060, 1.3, mechanical_stiffness=K_JOINT)
+    small = arm.with_scaled_motors(0.010, 1.3, mechanical_stiffness=K_JOINT)
+    mixed = arm.with_actuators([small.actuators[0], reference.actuators[1]])
+    q = [0.0, np.radians(45.0)]
+    jac = _two_link_kinematics(q)
+    radial = np.array([0.30 + 0.25 * np.cos(q[1]), 0.25 * np.sin(q[1])])
+    radial /= np.linalg.norm(radial)
+    assert abs(radial @ jac[:, 0]) < 1e-12  # (J^T u)_1 = 0 along the radial line
+    directions = np.vstack([radial, [[0.0, 1.0], [1.0, 0.0]]])
+    before = reflex_surface(reference, q, 0.5, F_S, task_stiffness=K_TASK, directions=directions)
+    after = reflex_surface(mixed, q, 0.5, F_S, task_stiffness=K_TASK, directions=directions)
+    np.testing.assert_allclose(after.impulse[0], before.impulse[0], rtol=1e-12)
+    assert np.all(np.abs(after.impulse[1:] / before.impulse[1:] - 1) > 1e-6)
+
+
+def test_surface_uses_the_actuators_sensing(arm):
+    from collision_reflex.actuators import CurrentThreshold, ForceThreshold
+
+    forced = arm.with_scaled_motors(0.060, 1.3, mechanical_stiffness=K_JOINT, sensing=ForceThreshold(4.0))
+    surface = reflex_surface(forced, [0.0, 1.0], 0.5, directions=8)
+    np.testing.assert_allclose(surface.impulses.threshold, 4.0)
+    current = arm.with_scaled_motors(0.010, 1.3, mechanical_stiffness=K_JOINT, sensing=CurrentThreshold(0.01))
+    surface = reflex_surface(current, [0.0, 1.0], 0.5, directions=8)
+    # The first joint to reach N tau_s detects: F_s = min_i N tau_s / |(J^T u)_i|.
+    moments = np.abs(surface.directions @ _two_link_kinematics([0.0, 1.0]))
+    ratio = current.actuators[0].gear_ratio
+    np.testing.assert_allclose(surface.impulses.threshold, (ratio * 0.01) / moments.max(axis=1), rtol=1e-12)

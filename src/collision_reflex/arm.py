@@ -318,9 +318,12 @@ class Arm:
         if params.size != model.nv:
             raise InvalidParameter("actuators", params.size, f"{model.nv} joints' parameters")
         self.joint_parameters = params
-        self.actuators = (
-            actuators if actuators is not None and not isinstance(actuators, JointParameters) else None
-        )
+        if actuators is None or isinstance(actuators, JointParameters):
+            self.actuators: tuple[Any, ...] | None = None
+        else:
+            self.actuators = (
+                tuple(actuators) if isinstance(actuators, list | tuple) else (actuators,) * model.nv
+            )
 
         self._source_model = model
         self.model = model.copy()
@@ -424,6 +427,77 @@ class Arm:
             self.urdf_path,
             self.package_dirs,
         )
+
+    def with_scaled_motors(
+        self,
+        stator_diameter: float,
+        torque_required: Any = None,
+        *,
+        reference: Any = None,
+        law: str = "haddadin",
+        mechanical_stiffness: Any = np.inf,
+        software_stiffness: Any = np.inf,
+        sensing: Any = None,
+    ) -> Arm:
+        """The same arm with a scaled motor at every joint, geared to meet a torque requirement (the paper's
+        sweep of ``tab:motor_params``): ``N_i = max(1, tau_req,i / tau_p(r))``.
+
+        Parameters
+        ----------
+        stator_diameter: stator outer diameter of every motor [m] (the paper's ``r_m``).
+        torque_required: output torque per joint [N m] (scalar or (nv,)); default the URDF effort limits.
+        reference: the motor scaled from; default the Omni+ OPN-060-013-A (``motors.reference_motor``).
+        law: scaling law name (``motors.SCALING_LAWS``).
+        mechanical_stiffness, software_stiffness: joint springs [N m/rad] (scalar or (nv,)).
+        sensing: a sensing scheme of :mod:`collision_reflex.actuators` for every joint; default a 3 N force
+            threshold.
+        """
+        from .actuators import Actuator, ForceThreshold, gear_ratio_for
+        from .motors import reference_motor
+
+        required = self.torque_limit if torque_required is None else torque_required
+        required = _joint_array("torque_required", required, self.nv)
+        motor = (reference if reference is not None else reference_motor()).scaled(
+            stator_diameter=stator_diameter, law=law
+        )
+        ratios = np.atleast_1d(gear_ratio_for(required, motor.peak_torque))
+        k_mech = _joint_array("mechanical_stiffness", mechanical_stiffness, self.nv, allow_inf=True)
+        k_soft = _joint_array("software_stiffness", software_stiffness, self.nv, allow_inf=True)
+        scheme = ForceThreshold() if sensing is None else sensing
+        actuators = [
+            Actuator(motor, float(ratios[i]), float(k_mech[i]), float(k_soft[i]), scheme)
+            for i in range(self.nv)
+        ]
+        return self.with_actuators(actuators)
+
+    def threshold(self) -> dict[str, Any]:
+        """The sensing of this arm's actuators as keyword arguments: ``{"sensing": "force", "threshold": F_s}``
+        for force thresholds at the contact, or ``{"sensing": "joint_torque", "joint_threshold": tau_s}`` [N m]
+        for the joint-side schemes (position error, motor current), where the first joint to reach its
+        threshold detects the contact."""
+        from .actuators import ForceThreshold
+
+        if not self.actuators:
+            raise InvalidParameter(
+                "actuators", None, "Actuator objects with sensing schemes", "give the threshold explicitly"
+            )
+        schemes = [actuator.sensing for actuator in self.actuators]
+        if all(isinstance(scheme, ForceThreshold) for scheme in schemes):
+            forces = {float(scheme.force) for scheme in schemes}
+            if len(forces) > 1:
+                raise InvalidParameter(
+                    "actuators", sorted(forces), "one contact-force threshold for the whole arm"
+                )
+            return {"sensing": "force", "threshold": forces.pop()}
+        if any(isinstance(scheme, ForceThreshold) for scheme in schemes):
+            raise InvalidParameter(
+                "actuators", [type(s).__name__ for s in schemes], "force thresholds at every joint or at none"
+            )
+        torques = [
+            scheme.joint_threshold_torque(actuator)
+            for scheme, actuator in zip(schemes, self.actuators, strict=True)
+        ]
+        return {"sensing": "joint_torque", "joint_threshold": np.array(torques)}
 
     def visual_model(self) -> Any:
         """Pinocchio visual ``GeometryModel`` of the URDF, meshes resolved through ``package_dirs``."""

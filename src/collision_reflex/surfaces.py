@@ -83,7 +83,7 @@ def reflex_surface(
     threshold: Any = None,
     *,
     directions: Any = None,
-    sensing: str = "force",
+    sensing: str | None = None,
     reaction: str = "at_rest",
     task_stiffness: Any = None,
     stiffness_form: str = "compliance",
@@ -97,7 +97,9 @@ def reflex_surface(
     q: (nq,) configuration.
     v0: approach velocity [m/s], > 0.
     threshold: the sensing threshold, a force [N] (``sensing="force"``) or a position error [m]
-        (``"position"``); joint torques [N m] for ``"joint_torque"`` go in ``joint_threshold``.
+        (``"position"``); joint torques [N m] for ``"joint_torque"`` go in ``joint_threshold``. When neither
+        ``threshold``, ``sensing`` nor ``joint_threshold`` is given, the arm's actuators' sensing schemes are used
+        (:meth:`collision_reflex.arm.Arm.threshold`).
     directions: a count, names or vectors (see :func:`collision_reflex.directions.unit_directions`); default
         :data:`DEFAULT_DIRECTION_COUNT` evenly spread.
     sensing, reaction: see :func:`collision_reflex.arm.collision_impulses`.
@@ -111,6 +113,12 @@ def reflex_surface(
         raise InvalidParameter("q", configuration.shape, f"one configuration of shape ({arm.nq},)")
     spec = DEFAULT_DIRECTION_COUNT[arm.task_dim] if directions is None else directions
     units = unit_directions(spec, arm.task_dim, arm.plane)
+    if threshold is None and sensing is None and joint_threshold is None:
+        detection = arm.threshold()
+        sensing = detection["sensing"]
+        threshold = detection.get("threshold")
+        joint_threshold = detection.get("joint_threshold")
+    sensing = sensing or ("joint_torque" if joint_threshold is not None else "force")
     samples = arm.kinematics(configuration[None])
     params = arm.effective_parameters(
         samples,
