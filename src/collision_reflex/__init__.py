@@ -15,7 +15,7 @@ from .actuators import (
     PositionThreshold,
     gear_ratio_for,
 )
-from .errors import CatalogueError, CollisionReflexError, InvalidParameter, UnknownMotor
+from .errors import CatalogueError, CollisionReflexError, InvalidParameter, SolverFailed, UnknownMotor
 from .gearboxes import GEARBOX_KINDS, Gearbox
 from .impulse import (
     REACTION_MODES,
@@ -39,40 +39,69 @@ from .motors import (
     scaled_motor_quantities,
     scaling_law,
 )
+from .optimize import (
+    OBJECTIVES,
+    ActuatorTechnology,
+    Bounds,
+    Constraints,
+    ContactSamples,
+    Design,
+    DesignProblem,
+    DesignResult,
+    DesignSpace,
+    ParetoSet,
+    build_problem,
+    pareto_front,
+    solve,
+)
 
 __version__ = "0.1.0"
 
 __all__ = [
     "GEARBOX_KINDS",
+    "OBJECTIVES",
     "REACTION_MODES",
     "REFLECTED_INERTIA_PLACEMENTS",
     "SCALING_LAWS",
     "Actuator",
+    "ActuatorTechnology",
+    "Bounds",
     "CatalogueError",
     "CollisionParameters",
     "CollisionReflexError",
+    "Constraints",
+    "ContactSamples",
     "CurrentThreshold",
+    "Design",
+    "DesignProblem",
+    "DesignResult",
+    "DesignSpace",
     "ForceThreshold",
     "Gearbox",
     "InvalidParameter",
     "Motor",
     "MotorQuantities",
+    "ParetoSet",
     "PhaseImpulses",
     "PositionThreshold",
     "ScalingLaw",
+    "SolverFailed",
     "UnknownMotor",
     "__version__",
+    "build_problem",
     "collision_times",
     "force_profile",
     "gear_ratio_for",
     "load_catalogue",
     "minimum_impulse",
     "optimal_velocity",
+    "pareto_front",
     "phase_impulses",
     "reference_motor",
     "scaled_motor_quantities",
     "scaling_law",
     "series_stiffness",
+    "solve",
     "total_impulse",
     "velocity_coefficients",
 ]

@@ -32,9 +32,19 @@ def evaluate_design(problem: DesignProblem, design: Design) -> np.ndarray:
         mechanical_stiffness=design.mechanical_stiffness,
         torque_limit=design.peak_torque,
         motor_mass=design.motor_mass,
-        finger_joint_inertia=(design.reflected_inertia
-                              if problem.technology.reflected_inertia_in == "finger" else None),
+        finger_joint_inertia=(
+            design.reflected_inertia if problem.technology.reflected_inertia_in == "finger" else None
+        ),
     )
     threshold = design.threshold if design.sensing == "force" else params.k * design.threshold
-    return np.asarray(total_impulse(params.m_f, params.k, params.k_m, threshold, params.a,
-                                    design.approach_velocity, problem.technology.reaction))
+    return np.asarray(
+        total_impulse(
+            params.m_f,
+            params.k,
+            params.k_m,
+            threshold,
+            params.a,
+            design.approach_velocity,
+            problem.technology.reaction,
+        )
+    )

@@ -54,8 +54,15 @@ class ParetoSet:
             for name in OBJECTIVES:
                 row[f"{name} [{OBJECTIVES[name][1]}]"] = result.numpy_objectives[name]
             design = result.design
-            for name in ("stator_diameter", "stack_length", "gear_ratio", "software_stiffness",
-                         "reflected_inertia", "peak_torque", "motor_mass"):
+            for name in (
+                "stator_diameter",
+                "stack_length",
+                "gear_ratio",
+                "software_stiffness",
+                "reflected_inertia",
+                "peak_torque",
+                "motor_mass",
+            ):
                 for joint, value in zip(design.joint_names, getattr(design, name), strict=True):
                     row[f"{name}[{joint}]"] = value
             for joint, value in zip(design.joint_names, result.torque_margin, strict=True):
@@ -78,8 +85,9 @@ class ParetoSet:
     def hypervolume(self, reference: Sequence[float]) -> float:
         """Hypervolume dominated by the front up to ``reference`` (objective units; maximised objectives are
         negated, as everything here is minimised)."""
-        return hypervolume(_minimised(self.values(), self.objectives), _minimised(np.array([reference]),
-                                                                                   self.objectives)[0])
+        return hypervolume(
+            _minimised(self.values(), self.objectives), _minimised(np.array([reference]), self.objectives)[0]
+        )
 
     def plot(self, path: str | os.PathLike[str]) -> Any:
         """Draw the front (2 objectives: a line plot; 3: a scatter coloured by the third)."""
@@ -139,7 +147,9 @@ def pareto_front(
         for other in (o for o in names if o != name):
             bound = _loosened(name, anchor.objectives[name])
             try:
-                anchor = solve(problems[other], epsilon={name: bound}, x0=anchor.x, ipopt_options=ipopt_options)
+                anchor = solve(
+                    problems[other], epsilon={name: bound}, x0=anchor.x, ipopt_options=ipopt_options
+                )
             except SolverFailed as error:
                 failed.append(({name: bound}, error.status))
             tick()
@@ -160,8 +170,14 @@ def pareto_front(
         tick()
 
     front, dominated = _non_dominated(results, names)
-    return ParetoSet(names, tuple(front), tuple(failed), tuple(dominated), time.perf_counter() - started,
-                     solver_builds=len(problems))
+    return ParetoSet(
+        names,
+        tuple(front),
+        tuple(failed),
+        tuple(dominated),
+        time.perf_counter() - started,
+        solver_builds=len(problems),
+    )
 
 
 def _loosened(name: str, value: float) -> float:
@@ -170,7 +186,9 @@ def _loosened(name: str, value: float) -> float:
     return value * (1 + sense * ANCHOR_SLACK) if value > 0 else value + sense * ANCHOR_SLACK
 
 
-def _epsilon_grid(anchors: dict[str, DesignResult], bounded: Sequence[str], count: int) -> list[dict[str, float]]:
+def _epsilon_grid(
+    anchors: dict[str, DesignResult], bounded: Sequence[str], count: int
+) -> list[dict[str, float]]:
     """Bounds on the bounded objectives spread between their values at the anchors, ordered so that each point
     is near the previous one (a snake through the grid for three objectives)."""
     if count <= 0:
@@ -184,7 +202,7 @@ def _epsilon_grid(anchors: dict[str, DesignResult], bounded: Sequence[str], coun
         loose, tight = ranges[name]
         # Interior points only: the anchors already hold the ends.
         return [{name: float(value)} for value in np.linspace(loose, tight, count + 2)[1:-1]]
-    per_axis = max(2, int(round(np.sqrt(count))))
+    per_axis = max(2, round(np.sqrt(count)))
     axes = [np.linspace(*ranges[name], per_axis + 2)[1:-1] for name in bounded]
     grid = []
     for i, first in enumerate(axes[0]):
@@ -198,8 +216,9 @@ def _minimised(values: np.ndarray, names: Sequence[str]) -> np.ndarray:
     return values * np.array([OBJECTIVES[name][0] for name in names], dtype=float)
 
 
-def _non_dominated(results: list[DesignResult], names: Sequence[str],
-                   tolerance: float = 1e-9) -> tuple[list[DesignResult], list[DesignResult]]:
+def _non_dominated(
+    results: list[DesignResult], names: Sequence[str], tolerance: float = 1e-9
+) -> tuple[list[DesignResult], list[DesignResult]]:
     """Split results into the non-dominated ones (sorted by the first objective) and the dominated ones.
 
     ``a`` dominates ``b`` if it is no worse in every objective and better by more than ``tolerance`` (relative)
@@ -248,4 +267,3 @@ def hypervolume(points: np.ndarray, reference: np.ndarray) -> float:
             volume += hypervolume(active[:, :2], reference[:2]) * (high - low)
         return float(volume)
     raise InvalidParameter("points", points.shape, "2 or 3 objectives")
-

@@ -36,10 +36,19 @@ import casadi as ca
 import numpy as np
 
 from .. import _validate
+from ..actuators import REFLECTED_INERTIA_PLACEMENTS
 from ..errors import InvalidParameter
 from ..impulse import REACTION_MODES, phase_impulses, series_stiffness
 from ..motors import Motor, scaled_motor_quantities
-from .space import GLOBAL_VARIABLES, PER_JOINT_VARIABLES, SENSING_SCHEMES, Bounds, Constraints, ContactSamples, DesignSpace
+from .space import (
+    GLOBAL_VARIABLES,
+    PER_JOINT_VARIABLES,
+    SENSING_SCHEMES,
+    Bounds,
+    Constraints,
+    ContactSamples,
+    DesignSpace,
+)
 
 TIE_BREAK_WEIGHT = 1e-3
 """Weight of the (start-normalised) mean impulse added to every objective. A worst case leaves the samples that
@@ -54,9 +63,6 @@ OBJECTIVES: dict[str, tuple[int, str, str]] = {
     "actuator_mass": (1, "kg", "total mass of the motors"),
     "approach_velocity": (-1, "m/s", "approach velocity (maximised: shorter cycle time)"),
 }
-
-
-REFLECTED_INERTIA_PLACES = ("robot", "finger")
 
 
 @dataclass(frozen=True)
@@ -87,7 +93,7 @@ class ActuatorTechnology:
         _validate.positive("mechanical_stiffness", np.asarray(self.mechanical_stiffness, dtype=float))
         _validate.choice("sensing", self.sensing, SENSING_SCHEMES)
         _validate.choice("reaction", self.reaction, REACTION_MODES)
-        _validate.choice("reflected_inertia_in", self.reflected_inertia_in, REFLECTED_INERTIA_PLACES)
+        _validate.choice("reflected_inertia_in", self.reflected_inertia_in, REFLECTED_INERTIA_PLACEMENTS)
 
     def joint_mechanical_stiffness(self, n_joints: int) -> np.ndarray:
         stiffness = np.broadcast_to(np.asarray(self.mechanical_stiffness, dtype=float), (n_joints,)).copy()
@@ -117,8 +123,10 @@ class _Layout:
         """Each variable as an MX column (exp of its log variable, or its fixed value)."""
         out = {}
         for name, bounds in self.bounds.items():
-            parts = [ca.exp(x[i]) if i is not None else ca.MX(b.lower)
-                     for i, b in zip(self.slices[name], bounds, strict=True)]
+            parts = [
+                ca.exp(x[i]) if i is not None else ca.MX(b.lower)
+                for i, b in zip(self.slices[name], bounds, strict=True)
+            ]
             out[name] = ca.vertcat(*parts)
         return out
 
@@ -132,9 +140,15 @@ class _Layout:
 
     def values(self, x: np.ndarray) -> dict[str, np.ndarray]:
         """Numeric values [SI] of every variable at ``x``."""
-        return {name: np.array([math.exp(x[i]) if i is not None else b.lower
-                                for i, b in zip(self.slices[name], bounds, strict=True)])
-                for name, bounds in self.bounds.items()}
+        return {
+            name: np.array(
+                [
+                    math.exp(x[i]) if i is not None else b.lower
+                    for i, b in zip(self.slices[name], bounds, strict=True)
+                ]
+            )
+            for name, bounds in self.bounds.items()
+        }
 
 
 @dataclass
@@ -172,6 +186,8 @@ class DesignProblem:
     lifted_scale: np.ndarray
     build_time: float
     _joint_numbers: Any = field(repr=False, default=None)
+    _sample_function: Any = field(repr=False, default=None)
+    _sample_data: Any = field(repr=False, default=None)
     _solvers: dict[str, Any] = field(default_factory=dict, repr=False)
 
     @property
@@ -183,21 +199,58 @@ class DesignProblem:
         the design in ``x``, so that evaluating there gives the model's values to machine precision."""
         x = np.array(x, dtype=float)
         masses, torques, finger = (np.asarray(v).ravel() for v in self._joint_numbers(x))
-        x[self.lifted_index] = (lifted_solution(self.samples, masses, finger) / self.lifted_scale[:, None]).ravel()
+        x[self.lifted_index] = (
+            lifted_solution(self.samples, masses, finger) / self.lifted_scale[:, None]
+        ).ravel()
         x[self.capacity_index] = np.log(reaction_compliance(self.samples, torques))
         if self.epigraph_index is not None:
             impulses = np.asarray(self.evaluate(x)[0]).ravel()
             x[self.epigraph_index] = impulses.max() / self.objective_scale["worst_case_impulse"]
         return x
 
+    def impulse_function(self) -> Any:
+        """The collision impulse of every sample as a CasADi function of the design variables alone.
+
+        Input ``z``: the design variables as optimised, ``log`` of each free variable (the first
+        ``layout.size`` entries of the NLP's ``x``). Output: (1, n_samples) impulses [N*s]. The per-sample
+        auxiliaries take their exact values (a symbolic solve for the finger mass, the maximum over joints for
+        the reaction compliance), so this is the model the NLP optimises, with exact derivatives for
+        sensitivity studies; it is slower to differentiate than the NLP itself.
+        """
+        n = self.n_joints
+        z = ca.MX.sym("z", self.layout.size)
+        _, design_column, motor_mass, peak_torque, finger_inertia = _design_quantities(
+            self.layout, z, self.technology, self.technology.joint_mechanical_stiffness(n)
+        )
+        w = self.samples.joint_moment_arms
+        kin = self.samples.kinematics
+        loaded = loaded_joints(self.samples)
+        impulses = []
+        for s_index, config in enumerate(self.samples.config_index):
+            structure = ca.DM(kin.mass_matrix[config]) + ca.diag(finger_inertia)
+            for i in range(n):
+                structure += motor_mass[i] * ca.DM(kin.motor_mass_influence[config, i])
+            y = ca.solve(structure, ca.DM(w[s_index]))
+            direction = y / ca.dot(ca.DM(w[s_index]), y)
+            ratios = [abs(w[s_index, i]) / peak_torque[i] for i in range(n) if loaded[s_index, i]]
+            compliance = ca.mmax(ca.vertcat(*ratios))
+            impulse, _, _ = self._sample_function(
+                design_column, direction, compliance, ca.DM(self._sample_data[:, s_index])
+            )
+            impulses.append(impulse)
+        return ca.Function("design_impulses", [z], [ca.horzcat(*impulses)], ["z"], ["impulses"])
+
     def parameters(self, epsilon: Mapping[str, float] | None = None) -> np.ndarray:
         """NLP parameter vector bounding the objectives in ``epsilon`` (unbounded: +inf in scaled units)."""
         epsilon = dict(epsilon or {})
         unknown = set(epsilon) - set(self.bounded_objectives)
         if unknown:
-            raise InvalidParameter("epsilon", sorted(unknown),
-                                   f"objectives built as bounded: {list(self.bounded_objectives)}",
-                                   "pass bounded_objectives=... to build_problem")
+            raise InvalidParameter(
+                "epsilon",
+                sorted(unknown),
+                f"objectives built as bounded: {list(self.bounded_objectives)}",
+                "pass bounded_objectives=... to build_problem",
+            )
         values = []
         for name in self.bounded_objectives:
             sense = OBJECTIVES[name][0]
@@ -261,21 +314,10 @@ def build_problem(
     x = ca.MX.sym("x", lifted_index.stop)
     p = ca.MX.sym("p", len(bounded))
 
-    values = layout.expressions(x[:n_design])
-    motor = scaled_motor_quantities(reference, values["stator_diameter"], values["stack_length"],
-                                    technology.scaling_law)
-    gear = values["gear_ratio"]
     k_mech = technology.joint_mechanical_stiffness(n_joints)
-    motor_mass = motor.mass
-    peak_torque = gear * motor.peak_torque
-    design_column = ca.vertcat(
-        motor_mass,
-        gear**2 * motor.rotor_inertia,  # reflected inertia N^2 J_m
-        series_stiffness(ca.DM(k_mech), values["software_stiffness"]),
-        values["threshold"],
-        values["approach_velocity"],
+    values, design_column, motor_mass, peak_torque, finger_inertia = _design_quantities(
+        layout, x[:n_design], technology, k_mech
     )
-    finger_inertia = gear**2 * motor.rotor_inertia if technology.reflected_inertia_in == "finger" else 0 * gear
     joint_numbers = ca.Function("joint_numbers", [x], [motor_mass, peak_torque, finger_inertia])
 
     # Start point: log-midpoints of the bounds; auxiliaries at their exact values there.
@@ -289,8 +331,10 @@ def build_problem(
     ubx[capacity_index] = np.log(reaction_compliance(samples, weakest))
 
     data = _sample_data(samples, k_mech)
-    per_sample = _sample_function(n_joints, technology.sensing, technology.reaction,
-                                  technology.reflected_inertia_in).map(n_samples)
+    sample_function = _sample_function(
+        n_joints, technology.sensing, technology.reaction, technology.reflected_inertia_in
+    )
+    per_sample = sample_function.map(n_samples)
     # x_s is scaled per sample by its size at the start: across samples it spans orders of magnitude.
     start_lifted = lifted_solution(samples, start_mass, start_finger)
     lifted_scale = np.maximum(np.abs(start_lifted).max(axis=1), 1e-300)
@@ -300,9 +344,18 @@ def build_problem(
     actuator_mass = ca.sum1(motor_mass)
     required_torque = _required_torque_function(samples, constraints, n_joints)
     evaluate = ca.Function(
-        "evaluate", [x],
-        [impulses, actuator_mass, values["approach_velocity"], thresholds, required_torque(motor_mass), peak_torque],
-        ["x"], ["impulses", "actuator_mass", "approach_velocity", "thresholds", "required_torque", "peak_torque"],
+        "evaluate",
+        [x],
+        [
+            impulses,
+            actuator_mass,
+            values["approach_velocity"],
+            thresholds,
+            required_torque(motor_mass),
+            peak_torque,
+        ],
+        ["x"],
+        ["impulses", "actuator_mass", "approach_velocity", "thresholds", "required_torque", "peak_torque"],
     )
     x0[lifted_index] = (start_lifted / lifted_scale[:, None]).ravel()
     x0[capacity_index] = np.log(reaction_compliance(samples, start_torque))
@@ -312,9 +365,11 @@ def build_problem(
         "worst_case_impulse": float(start_impulses.max()),
         "mean_impulse": float(start_impulses.mean()),
         "actuator_mass": float(start_mass.sum()),
-        "approach_velocity": float(np.exp(x0[layout.slices["approach_velocity"][0]])
-                                   if layout.slices["approach_velocity"][0] is not None
-                                   else layout.bounds["approach_velocity"][0].lower),
+        "approach_velocity": float(
+            np.exp(x0[layout.slices["approach_velocity"][0]])
+            if layout.slices["approach_velocity"][0] is not None
+            else layout.bounds["approach_velocity"][0].lower
+        ),
     }
     expressions: dict[str, Any] = {
         "mean_impulse": ca.sum2(impulses) / n_samples,
@@ -337,18 +392,27 @@ def build_problem(
         t = x[epigraph_index] * scale["worst_case_impulse"]
         x0[epigraph_index] = 1.0
         lbx[epigraph_index] = 0.0
-        add(ca.transpose(t - impulses) / scale["worst_case_impulse"], 0.0, np.inf,
-            [f"worst-case bound >= impulse of sample {s}" for s in range(n_samples)])
+        add(
+            ca.transpose(t - impulses) / scale["worst_case_impulse"],
+            0.0,
+            np.inf,
+            [f"worst-case bound >= impulse of sample {s}" for s in range(n_samples)],
+        )
         expressions["worst_case_impulse"] = t
 
     # g_s + log tau_i >= log|w_si| for every loaded (sample, joint), i.e. 1/F_a >= |w_si| / tau_i.
     loaded = loaded_joints(samples)
     pair_sample, pair_joint = np.nonzero(loaded)
     log_arm = np.log(np.abs(samples.joint_moment_arms[pair_sample, pair_joint]))
-    add(x[capacity_index][pair_sample.tolist()] + ca.log(peak_torque)[pair_joint.tolist()] - log_arm,
-        0.0, np.inf,
-        [f"reaction capacity of sample {s} within the torque of {joint_names[j]}"
-         for s, j in zip(pair_sample, pair_joint, strict=True)])
+    add(
+        x[capacity_index][pair_sample.tolist()] + ca.log(peak_torque)[pair_joint.tolist()] - log_arm,
+        0.0,
+        np.inf,
+        [
+            f"reaction capacity of sample {s} within the torque of {joint_names[j]}"
+            for s, j in zip(pair_sample, pair_joint, strict=True)
+        ],
+    )
 
     add(ca.transpose(normalisation), 1.0, 1.0, [f"w^T x = 1 at sample {s}" for s in range(n_samples)])
 
@@ -358,29 +422,85 @@ def build_problem(
     rows, demand_labels = _torque_requirement_rows(samples, constraints, joint_names)
     for (base, per_motor), label in zip(rows, demand_labels, strict=True):
         demand = ca.DM(base) + ca.mtimes(ca.DM(per_motor), motor_mass)
-        add((peak_torque - demand) / torque_scale, 0.0, np.inf,
-            [f"peak torque of {name} >= {label}" for name in joint_names])
+        add(
+            (peak_torque - demand) / torque_scale,
+            0.0,
+            np.inf,
+            [f"peak torque of {name} >= {label}" for name in joint_names],
+        )
 
     if technology.sensing == "position" and constraints.threshold_floor > 0:
-        add(ca.transpose(thresholds) / constraints.threshold_floor, 1.0, np.inf,
-            [f"contact threshold of sample {s} >= noise floor" for s in range(n_samples)])
+        add(
+            ca.transpose(thresholds) / constraints.threshold_floor,
+            1.0,
+            np.inf,
+            [f"contact threshold of sample {s} >= noise floor" for s in range(n_samples)],
+        )
 
     for k, name in enumerate(bounded):
-        add(OBJECTIVES[name][0] * expressions[name] / scale[name] - p[k], -np.inf, 0.0,
-            [f"{name} within its bound"])
+        add(
+            OBJECTIVES[name][0] * expressions[name] / scale[name] - p[k],
+            -np.inf,
+            0.0,
+            [f"{name} within its bound"],
+        )
 
-    f = sum(weight * OBJECTIVES[name][0] * expressions[name] / scale[name] for name, weight in weights.items())
+    f = sum(
+        weight * OBJECTIVES[name][0] * expressions[name] / scale[name] for name, weight in weights.items()
+    )
     f += TIE_BREAK_WEIGHT * expressions["mean_impulse"] / scale["mean_impulse"]
     nlp = {"x": x, "f": f, "g": ca.vertcat(*g_parts), "p": p}
     return DesignProblem(
-        nlp=nlp, x0=x0, lbx=lbx, ubx=ubx, lbg=np.concatenate(lbg_parts), ubg=np.concatenate(ubg_parts),
-        constraint_labels=labels, objective=weights, bounded_objectives=bounded, objective_scale=scale,
-        evaluate=evaluate, layout=layout, samples=samples, space=space, technology=technology,
-        constraints=constraints, joint_names=joint_names, required_torque_function=required_torque,
-        epigraph_index=epigraph_index, capacity_index=capacity_index,
-        lifted_index=lifted_index, lifted_scale=lifted_scale, build_time=time.perf_counter() - started,
+        nlp=nlp,
+        x0=x0,
+        lbx=lbx,
+        ubx=ubx,
+        lbg=np.concatenate(lbg_parts),
+        ubg=np.concatenate(ubg_parts),
+        constraint_labels=labels,
+        objective=weights,
+        bounded_objectives=bounded,
+        objective_scale=scale,
+        evaluate=evaluate,
+        layout=layout,
+        samples=samples,
+        space=space,
+        technology=technology,
+        constraints=constraints,
+        joint_names=joint_names,
+        required_torque_function=required_torque,
+        epigraph_index=epigraph_index,
+        capacity_index=capacity_index,
+        lifted_index=lifted_index,
+        lifted_scale=lifted_scale,
+        build_time=time.perf_counter() - started,
         _joint_numbers=joint_numbers,
+        _sample_function=sample_function,
+        _sample_data=data,
     )
+
+
+def _design_quantities(
+    layout: _Layout, z: Any, technology: ActuatorTechnology, k_mech: np.ndarray
+) -> tuple[dict[str, Any], Any, Any, Any, Any]:
+    """Symbolic joint quantities of the design variables ``z`` (log values): the variables themselves, the
+    per-sample function's design column, motor masses [kg], peak output torques [N m] and the reflected inertia
+    acting on the finger [kg m^2] (zero unless ``reflected_inertia_in == "finger"``)."""
+    values = layout.expressions(z)
+    motor = scaled_motor_quantities(
+        technology.reference_motor, values["stator_diameter"], values["stack_length"], technology.scaling_law
+    )
+    gear = values["gear_ratio"]
+    reflected = gear**2 * motor.rotor_inertia  # N^2 J_m
+    design_column = ca.vertcat(
+        motor.mass,
+        reflected,
+        series_stiffness(ca.DM(k_mech), values["software_stiffness"]),
+        values["threshold"],
+        values["approach_velocity"],
+    )
+    finger_inertia = reflected if technology.reflected_inertia_in == "finger" else 0 * gear
+    return values, design_column, motor.mass, gear * motor.peak_torque, finger_inertia
 
 
 def _objective_weights(objective: str | Mapping[str, float]) -> dict[str, float]:
@@ -393,8 +513,14 @@ def _objective_weights(objective: str | Mapping[str, float]) -> dict[str, float]
     return weights
 
 
-def _feasible_gear_start(x0: np.ndarray, layout: _Layout, joint_numbers: Any, samples: ContactSamples,
-                         constraints: Constraints, joint_names: tuple[str, ...]) -> None:
+def _feasible_gear_start(
+    x0: np.ndarray,
+    layout: _Layout,
+    joint_numbers: Any,
+    samples: ContactSamples,
+    constraints: Constraints,
+    joint_names: tuple[str, ...],
+) -> None:
     """Move the start's free gear ratios up to where the peak torque covers the requirement (with 10 % to
     spare), within their bounds: IPOPT converges much faster from a torque-feasible start."""
     masses, torques, _ = (np.asarray(v).ravel() for v in joint_numbers(x0))
@@ -402,8 +528,10 @@ def _feasible_gear_start(x0: np.ndarray, layout: _Layout, joint_numbers: Any, sa
     required = np.max([base + per_motor @ masses for base, per_motor in rows], axis=0)
     for joint, index in enumerate(layout.slices["gear_ratio"]):
         if index is not None and required[joint] > torques[joint]:
-            x0[index] = min(x0[index] + math.log(1.1 * required[joint] / torques[joint]),
-                            math.log(layout.bounds["gear_ratio"][joint].upper))
+            x0[index] = min(
+                x0[index] + math.log(1.1 * required[joint] / torques[joint]),
+                math.log(layout.bounds["gear_ratio"][joint].upper),
+            )
 
 
 def _with_noise_floor(bounds: Bounds, floor: float) -> Bounds:
@@ -411,9 +539,12 @@ def _with_noise_floor(bounds: Bounds, floor: float) -> Bounds:
     if floor <= 0:
         return bounds
     if bounds.upper < floor:
-        raise InvalidParameter("threshold bounds", (bounds.lower, bounds.upper),
-                               f"an upper bound >= the sensing noise floor {floor} N",
-                               "raise the threshold's upper bound or lower the floor")
+        raise InvalidParameter(
+            "threshold bounds",
+            (bounds.lower, bounds.upper),
+            f"an upper bound >= the sensing noise floor {floor} N",
+            "raise the threshold's upper bound or lower the floor",
+        )
     return Bounds(max(bounds.lower, floor), bounds.upper, "threshold")
 
 
@@ -431,14 +562,14 @@ def _sample_function(n_joints: int, sensing: str, reaction: str, reflected_inert
     direction = ca.SX.sym("x", n)
     compliance = ca.SX.sym("c")
     data = ca.SX.sym("data", n + n * n + n**3 + 1)
-    mass, inertia, stiffness = (design[i * n:(i + 1) * n] for i in range(3))
+    mass, inertia, stiffness = (design[i * n : (i + 1) * n] for i in range(3))
     threshold_variable, velocity = design[3 * n], design[3 * n + 1]
     w = data[:n]
     offset = n + n * n
     # x^T M_f x with M_f = M_bb0 + sum_i m_i A_i (+ diag(N^2 J_m)), each term a quadratic form in x.
     finger_mass = ca.bilin(ca.reshape(data[n:offset], n, n), direction, direction)
     for i in range(n):
-        influence = ca.reshape(data[offset + i * n * n:offset + (i + 1) * n * n], n, n)
+        influence = ca.reshape(data[offset + i * n * n : offset + (i + 1) * n * n], n, n)
         finger_mass += mass[i] * ca.bilin(influence, direction, direction)
     if reflected_inertia_in == "finger":
         finger_mass += ca.dot(inertia, direction**2)
@@ -450,8 +581,11 @@ def _sample_function(n_joints: int, sensing: str, reaction: str, reflected_inert
     force_threshold = threshold_variable if sensing == "force" else k * threshold_variable
     acceleration = 1 / (compliance * robot_mass)  # a = F_a / m_r
     impulse = phase_impulses(finger_mass, k, k_mech, force_threshold, acceleration, velocity, reaction).total
-    return ca.Function("sample_impulse", [design, direction, compliance, data],
-                       [impulse, force_threshold, ca.dot(w, direction)])
+    return ca.Function(
+        "sample_impulse",
+        [design, direction, compliance, data],
+        [impulse, force_threshold, ca.dot(w, direction)],
+    )
 
 
 def _sample_data(samples: ContactSamples, k_mech: np.ndarray) -> np.ndarray:
@@ -462,12 +596,16 @@ def _sample_data(samples: ContactSamples, k_mech: np.ndarray) -> np.ndarray:
     unreachable = ~np.any(loaded_joints(samples), axis=1)
     if np.any(unreachable):
         bad = int(np.flatnonzero(unreachable)[0])
-        raise InvalidParameter(f"sample {bad}", samples.directions[bad],
-                               "a direction the arm can move along (J^T u != 0)",
-                               "drop samples at singular configurations along their singular direction")
+        raise InvalidParameter(
+            f"sample {bad}",
+            samples.directions[bad],
+            "a direction the arm can move along (J^T u != 0)",
+            "drop samples at singular configurations along their singular direction",
+        )
     structure = kin.mass_matrix[samples.config_index].reshape(n_samples, n * n, order="F")
-    influence = kin.motor_mass_influence[samples.config_index].transpose(0, 1, 3, 2).reshape(
-        n_samples, n * n * n)
+    influence = (
+        kin.motor_mass_influence[samples.config_index].transpose(0, 1, 3, 2).reshape(n_samples, n * n * n)
+    )
     k_mech_effective = 1 / np.sum(w**2 / k_mech, axis=1)
     return np.column_stack([w, structure, influence, k_mech_effective]).T
 
@@ -478,8 +616,9 @@ def reaction_compliance(samples: ContactSamples, peak_torque: np.ndarray) -> np.
     return np.max(np.abs(samples.joint_moment_arms) / np.asarray(peak_torque, dtype=float), axis=1)
 
 
-def lifted_solution(samples: ContactSamples, motor_mass: np.ndarray,
-                    finger_joint_inertia: np.ndarray | None = None) -> np.ndarray:
+def lifted_solution(
+    samples: ContactSamples, motor_mass: np.ndarray, finger_joint_inertia: np.ndarray | None = None
+) -> np.ndarray:
     """The minimiser ``x_s = M_f^-1 w_s / (w_s^T M_f^-1 w_s)`` of ``x^T M_f x`` with ``w_s^T x = 1`` for every
     sample, (n_samples, n_joints): ``M_f`` the structure mass matrix with motor masses ``m`` [kg] and, when the
     reflected inertia acts on the finger, ``diag(N^2 J_m)`` [kg m^2]."""
@@ -543,6 +682,9 @@ def _required_torque_function(samples: ContactSamples, constraints: Constraints,
 def _check_finite(values: np.ndarray, what: str, samples: ContactSamples) -> None:
     if not np.all(np.isfinite(values)):
         bad = int(np.flatnonzero(~np.isfinite(values))[0])
-        raise InvalidParameter(what, f"non-finite at sample {bad} (direction {samples.directions[bad]})",
-                               "finite values at every sample",
-                               "check the arm's mass matrix and the bounds, or drop singular samples")
+        raise InvalidParameter(
+            what,
+            f"non-finite at sample {bad} (direction {samples.directions[bad]})",
+            "finite values at every sample",
+            "check the arm's mass matrix and the bounds, or drop singular samples",
+        )

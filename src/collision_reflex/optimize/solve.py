@@ -69,8 +69,11 @@ class Design:
         """Plain lists and floats, for JSON."""
         out: dict[str, Any] = {}
         for name, value in self.__dict__.items():
-            out[name] = value.tolist() if isinstance(value, np.ndarray) else (
-                list(value) if isinstance(value, tuple) else value)
+            out[name] = (
+                value.tolist()
+                if isinstance(value, np.ndarray)
+                else (list(value) if isinstance(value, tuple) else value)
+            )
         return out
 
 
@@ -139,10 +142,20 @@ def solve(
     if isinstance(x0, DesignResult):
         x0 = x0.x
     start = np.clip(problem.x0 if x0 is None else np.asarray(x0, dtype=float), problem.lbx, problem.ubx)
-    multipliers = {"lam_x0": warm.multipliers[0], "lam_g0": warm.multipliers[1]} if warm else {}
+    warm_multipliers = warm.multipliers if warm is not None else None
+    multipliers = (
+        {"lam_x0": warm_multipliers[0], "lam_g0": warm_multipliers[1]} if warm_multipliers is not None else {}
+    )
     started = time.perf_counter()
-    solution = solver(x0=start, lbx=problem.lbx, ubx=problem.ubx, lbg=problem.lbg, ubg=problem.ubg,
-                      p=parameters, **multipliers)
+    solution = solver(
+        x0=start,
+        lbx=problem.lbx,
+        ubx=problem.ubx,
+        lbg=problem.lbg,
+        ubg=problem.ubg,
+        p=parameters,
+        **multipliers,
+    )
     elapsed = time.perf_counter() - started
     stats = solver.stats()
     status = str(stats.get("return_status", "unknown"))
@@ -155,14 +168,24 @@ def solve(
             + (f": could not meet {what}" if what else "")
             + ". Widen the bounds (gear ratio, motor size), lower the payload or safety factor, or relax the "
             "objective bounds.",
-            status, dict(stats), violated, problem,
+            status,
+            dict(stats),
+            violated,
+            problem,
         )
     multipliers_out = (np.asarray(solution["lam_x"]).ravel(), np.asarray(solution["lam_g"]).ravel())
     return _result(problem, x, status, stats, elapsed, dict(epsilon or {}), multipliers_out)
 
 
-def _result(problem: DesignProblem, x: np.ndarray, status: str, stats: dict, elapsed: float,
-            epsilon: dict[str, float], multipliers: tuple[np.ndarray, np.ndarray]) -> DesignResult:
+def _result(
+    problem: DesignProblem,
+    x: np.ndarray,
+    status: str,
+    stats: dict,
+    elapsed: float,
+    epsilon: dict[str, float],
+    multipliers: tuple[np.ndarray, np.ndarray],
+) -> DesignResult:
     design = design_at(problem, x)
     evaluated = problem.evaluate(problem.exact_point(x))
     impulses = np.asarray(evaluated[0]).ravel()
@@ -182,14 +205,25 @@ def _result(problem: DesignProblem, x: np.ndarray, status: str, stats: dict, ela
     for name in OBJECTIVES:
         a, b = objectives[name], numpy_objectives[name]
         if abs(a - b) > AGREEMENT_TOLERANCE * max(abs(a), abs(b)):
-            warnings.warn(f"CasADi and NumPy evaluations of {name} differ: {a!r} vs {b!r}", RuntimeWarning,
-                          stacklevel=3)
+            warnings.warn(
+                f"CasADi and NumPy evaluations of {name} differ: {a!r} vs {b!r}", RuntimeWarning, stacklevel=3
+            )
     required = np.asarray(evaluated[4]).ravel()
     return DesignResult(
-        design=design, objectives=objectives, numpy_objectives=numpy_objectives, impulses=numpy_impulses,
-        required_torque=required, torque_margin=design.peak_torque / np.maximum(required, 1e-300) - 1,
-        status=status, success=True, iterations=int(stats.get("iter_count", -1)), solve_time=elapsed,
-        build_time=problem.build_time, epsilon=epsilon, x=x, multipliers=multipliers,
+        design=design,
+        objectives=objectives,
+        numpy_objectives=numpy_objectives,
+        impulses=numpy_impulses,
+        required_torque=required,
+        torque_margin=design.peak_torque / np.maximum(required, 1e-300) - 1,
+        status=status,
+        success=True,
+        iterations=int(stats.get("iter_count", -1)),
+        solve_time=elapsed,
+        build_time=problem.build_time,
+        epsilon=epsilon,
+        x=x,
+        multipliers=multipliers,
     )
 
 
@@ -199,12 +233,15 @@ def design_at(problem: DesignProblem, x: np.ndarray) -> Design:
 
     values = problem.layout.values(np.asarray(x, dtype=float))
     technology = problem.technology
-    motor = scaled_motor_quantities(technology.reference_motor, values["stator_diameter"],
-                                    values["stack_length"], technology.scaling_law)
+    motor = scaled_motor_quantities(
+        technology.reference_motor, values["stator_diameter"], values["stack_length"], technology.scaling_law
+    )
     gear = values["gear_ratio"]
     return Design(
         joint_names=problem.joint_names,
-        stator_diameter=values["stator_diameter"], stack_length=values["stack_length"], gear_ratio=gear,
+        stator_diameter=values["stator_diameter"],
+        stack_length=values["stack_length"],
+        gear_ratio=gear,
         software_stiffness=values["software_stiffness"],
         mechanical_stiffness=technology.joint_mechanical_stiffness(problem.n_joints),
         rotor_inertia=np.asarray(motor.rotor_inertia, dtype=float),
@@ -212,7 +249,8 @@ def design_at(problem: DesignProblem, x: np.ndarray) -> Design:
         motor_peak_torque=np.asarray(motor.peak_torque, dtype=float),
         peak_torque=gear * np.asarray(motor.peak_torque, dtype=float),
         motor_mass=np.asarray(motor.mass, dtype=float),
-        threshold=float(values["threshold"][0]), approach_velocity=float(values["approach_velocity"][0]),
+        threshold=float(values["threshold"][0]),
+        approach_velocity=float(values["approach_velocity"][0]),
         sensing=technology.sensing,
     )
 

@@ -93,8 +93,9 @@ class DesignSpace:
             if default is None:
                 raise InvalidParameter(name, value, "bounds or a value")
             value = default
-        if isinstance(value, Sequence) and not (isinstance(value, tuple) and len(value) == 2
-                                                and all(isinstance(v, (int, float)) for v in value)):
+        if isinstance(value, Sequence) and not (
+            isinstance(value, tuple) and len(value) == 2 and all(isinstance(v, (int, float)) for v in value)
+        ):
             if len(value) != n_joints:
                 raise InvalidParameter(name, value, f"one bounds for all joints or a sequence of {n_joints}")
             bounds = [as_bounds(v, f"{name}[{i}]") for i, v in enumerate(value)]
@@ -136,7 +137,9 @@ class Constraints:
         if self.torque_required is not None:
             required = np.asarray(self.torque_required, dtype=float)
             if required.ndim != 1 or not np.all(np.isfinite(required) & (required >= 0)):
-                raise InvalidParameter("torque_required", self.torque_required, "one torque >= 0 per joint [N m]")
+                raise InvalidParameter(
+                    "torque_required", self.torque_required, "one torque >= 0 per joint [N m]"
+                )
 
 
 @dataclass(frozen=True)

@@ -22,8 +22,14 @@ def plot_pareto(pareto: Any, path: str | os.PathLike[str]) -> Path:
     if values.shape[1] == 2:
         order = np.argsort(values[:, 0])
         ax.plot(values[order, 0], values[order, 1], "-o", color="tab:blue", ms=4, label="Pareto designs")
-        ax.plot(values[order[[0, -1]], 0], values[order[[0, -1]], 1], "s", color="tab:orange", ms=7,
-                label="anchors")
+        ax.plot(
+            values[order[[0, -1]], 0],
+            values[order[[0, -1]], 1],
+            "s",
+            color="tab:orange",
+            ms=7,
+            label="anchors",
+        )
         ax.legend(fontsize=8)
     else:
         scatter = ax.scatter(values[:, 0], values[:, 1], c=values[:, 2], cmap="viridis", s=25)
