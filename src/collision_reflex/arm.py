@@ -348,6 +348,8 @@ class Arm:
             [_support_mask(self._structure, supports[jk.parent]) for jk in self._joints]
         )
         self.plane = _plane_basis(self._structure, self._joints)
+        self.reference_configuration: np.ndarray = np.array(pin.neutral(model))
+        """A configuration to start from [rad, m]: the robot's reference pose when known, else neutral."""
         self._pin = pin
 
     # ------------------------------------------------------------------ construction
@@ -397,7 +399,8 @@ class Arm:
         ``a1``) at the front-left foot with the base fixed to the world. Other robots need ``contact_frame``.
         ``locked_joints`` replaces the default list of locked joints (``()`` locks none).
         """
-        model, urdf = _example_robot(name)
+        full_model, urdf, q0 = _example_robot(name)
+        model = full_model
         defaults = _ROBOT_DEFAULTS.get(name, {})
         if contact_frame is None:
             if "contact_frame" not in defaults:
@@ -414,11 +417,13 @@ class Arm:
             model = _load_urdf(urdf)
         locked = defaults.get("locked_joints", ()) if locked_joints is None else tuple(locked_joints)
         model = _locked(model, locked, name)
-        return cls(model, contact_frame, contact_offset, actuators, name, urdf)
+        arm = cls(model, contact_frame, contact_offset, actuators, name, urdf)
+        arm.reference_configuration = _configuration_by_name(full_model, q0, model)
+        return arm
 
     def with_actuators(self, actuators: Any) -> Arm:
         """The same arm and contact point with other actuators (see :class:`Arm`)."""
-        return Arm(
+        arm = Arm(
             self._source_model,
             self.contact_frame,
             self.contact_offset,
@@ -427,6 +432,8 @@ class Arm:
             self.urdf_path,
             self.package_dirs,
         )
+        arm.reference_configuration = self.reference_configuration.copy()
+        return arm
 
     def with_scaled_motors(
         self,
@@ -1194,7 +1201,7 @@ def _random_q(model: Any, joints: list[_JointKinematics], rng: np.random.Generat
 
 
 @functools.lru_cache(maxsize=16)
-def _example_robot_cached(name: str) -> tuple[Any, str]:
+def _example_robot_cached(name: str) -> tuple[Any, str, np.ndarray]:
     try:
         import example_robot_data
     except ImportError as error:  # pragma: no cover - a declared dependency
@@ -1210,14 +1217,28 @@ def _example_robot_cached(name: str) -> tuple[Any, str]:
             "a robot of example-robot-data, e.g. 'ur5', 'panda', 'double_pendulum', 'solo12'",
             str(error),
         ) from None
-    return robot.model, str(robot.urdf)
+    return robot.model, str(robot.urdf), np.array(robot.q0, dtype=float)
 
 
-def _example_robot(name: str) -> tuple[Any, str]:
-    """The Pinocchio model (a copy) and URDF path of an example-robot-data robot; loading parses meshes and is
-    slow, so it happens once per name."""
-    model, urdf = _example_robot_cached(name)
-    return model.copy(), urdf
+def _example_robot(name: str) -> tuple[Any, str, np.ndarray]:
+    """The Pinocchio model (a copy), URDF path and reference configuration of an example-robot-data robot;
+    loading parses meshes and is slow, so it happens once per name."""
+    model, urdf, q0 = _example_robot_cached(name)
+    return model.copy(), urdf, q0.copy()
+
+
+def _configuration_by_name(source: Any, q_source: np.ndarray, target: Any) -> np.ndarray:
+    """A configuration of ``target`` taking each joint's coordinates from ``q_source`` of ``source`` (same joint
+    names), neutral for joints ``source`` does not have."""
+    import pinocchio as pin
+
+    q = np.array(pin.neutral(target))
+    names = list(source.names)
+    for j in range(1, target.njoints):
+        if target.names[j] in names:
+            joint, origin = target.joints[j], source.joints[names.index(target.names[j])]
+            q[joint.idx_q : joint.idx_q + joint.nq] = q_source[origin.idx_q : origin.idx_q + origin.nq]
+    return q
 
 
 def _locked(model: Any, locked_joints: Sequence[str], robot: str) -> Any:
