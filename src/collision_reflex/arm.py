@@ -417,7 +417,12 @@ class Arm:
             model = _load_urdf(urdf)
         locked = defaults.get("locked_joints", ()) if locked_joints is None else tuple(locked_joints)
         model = _locked(model, locked, name)
-        arm = cls(model, contact_frame, contact_offset, actuators, name, urdf)
+        # The robots' URDFs name their meshes package://example-robot-data/robots/...: the package directory
+        # is two levels above the "robots" directory.
+        share = Path(urdf).resolve()
+        while share.name != "robots" and share != share.parent:
+            share = share.parent
+        arm = cls(model, contact_frame, contact_offset, actuators, name, urdf, [share.parent.parent])
         arm.reference_configuration = _configuration_by_name(full_model, q0, model)
         return arm
 
@@ -515,7 +520,10 @@ class Arm:
         with _captured_stderr() as captured:
             try:
                 geometry = pin.buildGeomFromUrdf(
-                    self._structure, str(self.urdf_path), pin.GeometryType.VISUAL, list(self.package_dirs)
+                    self._structure,
+                    str(self.urdf_path),
+                    pin.GeometryType.VISUAL,
+                    package_dirs=list(self.package_dirs) or None,
                 )
             except (ValueError, RuntimeError) as error:
                 failure = error
