@@ -254,3 +254,21 @@ def test_visual_model_resolves_package_meshes():
     bare = Arm.from_urdf(ur5.urdf_path, "tool0")  # no package directories: the parser's reason
     with pytest.raises(UrdfError, match="could not be found"):
         bare.visual_model()
+
+
+@pytest.mark.parametrize(
+    "name, nv, task_dim, frame",
+    [
+        ("ur5", 6, 3, "tool0"),
+        ("panda", 7, 3, "panda_hand_tcp"),
+        ("double_pendulum", 2, 2, "link2"),
+        ("solo12", 12, 3, "FL_FOOT"),
+        ("a1", 12, 3, "FL_foot"),
+    ],
+    ids=["ur5", "panda", "double_pendulum", "solo12", "a1"],
+)
+def test_example_robots_load_with_default_contacts(name, nv, task_dim, frame):
+    arm = Arm.from_example_robot_data(name)  # legged robots: base fixed to the world
+    assert (arm.nv, arm.task_dim, arm.contact_frame) == (nv, task_dim, frame)
+    samples = arm.kinematics(arm.sample_configurations(2, np.random.default_rng(1)))
+    assert np.all(np.isfinite(samples.jacobian)) and np.any(samples.jacobian != 0)

@@ -164,3 +164,10 @@ def test_surface_uses_the_actuators_sensing(arm):
     moments = np.abs(surface.directions @ _two_link_kinematics([0.0, 1.0]))
     ratio = current.actuators[0].gear_ratio
     np.testing.assert_allclose(surface.impulses.threshold, (ratio * 0.01) / moments.max(axis=1), rtol=1e-12)
+
+
+def test_rescaling_starts_from_the_urdf_torques(arm):
+    """The torque requirement defaults to the URDF's effort limits, not to the current actuators' torque."""
+    big = arm.with_scaled_motors(0.100)  # torque 4.661 N m, more than the 1.3 N m the URDF asks for
+    small = big.with_scaled_motors(0.010)
+    assert small.actuators[0].gear_ratio == pytest.approx(88.18, rel=1e-3)  # tab:motor_params, M1

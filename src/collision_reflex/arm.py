@@ -300,17 +300,19 @@ class Arm:
         # The contact point in its parent joint's frame.
         self._contact_local = np.asarray(frame.placement.act(offset), dtype=float)
 
+        effort = np.asarray(model.effortLimit, dtype=float)
+        # URDFs often leave effort at 0 (unknown); Pinocchio reports "no limit" as the largest double.
+        unknown = (effort <= 0) | (effort > 1e300) | ~np.isfinite(effort)
+        self.urdf_torque_limit: np.ndarray = np.where(unknown, np.nan, effort)
+        """The URDF's effort limit per joint [N m], ``nan`` where it gives none."""
         if isinstance(actuators, JointParameters):
             params = actuators
         elif actuators is not None:
             params = JointParameters.from_actuators(actuators, model.nv)
         else:
-            effort = np.asarray(model.effortLimit, dtype=float)
-            # URDFs often leave effort at 0 (unknown); Pinocchio reports "no limit" as the largest double.
-            unknown = (effort <= 0) | (effort > 1e300) | ~np.isfinite(effort)
             params = JointParameters(
                 reflected_inertia=np.asarray(model.armature, dtype=float),
-                torque_limit=np.where(unknown, np.nan, effort),
+                torque_limit=self.urdf_torque_limit,
                 stiffness=np.full(model.nv, np.inf),
                 mechanical_stiffness=np.full(model.nv, np.inf),
                 motor_mass=np.zeros(model.nv),
@@ -457,7 +459,8 @@ class Arm:
         Parameters
         ----------
         stator_diameter: stator outer diameter of every motor [m] (the paper's ``r_m``).
-        torque_required: output torque per joint [N m] (scalar or (nv,)); default the URDF effort limits.
+        torque_required: output torque per joint [N m] (scalar or (nv,)); default the URDF effort limits
+            (:attr:`urdf_torque_limit`).
         reference: the motor scaled from; default the Omni+ OPN-060-013-A (``motors.reference_motor``).
         law: scaling law name (``motors.SCALING_LAWS``).
         mechanical_stiffness, software_stiffness: joint springs [N m/rad] (scalar or (nv,)).
@@ -467,7 +470,7 @@ class Arm:
         from .actuators import Actuator, ForceThreshold, gear_ratio_for
         from .motors import reference_motor
 
-        required = self.torque_limit if torque_required is None else torque_required
+        required = self.urdf_torque_limit if torque_required is None else torque_required
         required = _joint_array("torque_required", required, self.nv)
         motor = (reference if reference is not None else reference_motor()).scaled(
             stator_diameter=stator_diameter, law=law
@@ -482,7 +485,7 @@ class Arm:
         ]
         return self.with_actuators(actuators)
 
-    def threshold(self) -> dict[str, Any]:
+    def sensing_options(self) -> dict[str, Any]:
         """The sensing of this arm's actuators as keyword arguments: ``{"sensing": "force", "threshold": F_s}``
         for force thresholds at the contact, or ``{"sensing": "joint_torque", "joint_threshold": tau_s}`` [N m]
         for the joint-side schemes (position error, motor current), where the first joint to reach its

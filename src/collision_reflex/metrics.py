@@ -99,7 +99,8 @@ def generalized_inertia_ellipsoid(
 def dynamic_manipulability_ellipsoid(
     samples: ArmSamples, reflected_inertia: Any = None, motor_mass: Any = None
 ) -> Ellipsoid:
-    """``Lambda_d = J (M^T M)^-1 J^T`` [1/kg^2 per ...]: task accelerations reachable with unit joint torques."""
+    """``Lambda_d = J (M^T M)^-1 J^T`` [(m/s^2)^2 per (N m)^2]: the task accelerations reachable with joint
+    torques of unit norm lie in this ellipsoid."""
     mass = full_mass_matrix(samples, reflected_inertia, motor_mass)
     return Ellipsoid(task_inverse_inertia(np.swapaxes(mass, 1, 2) @ mass, samples.jacobian))
 

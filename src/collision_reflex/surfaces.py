@@ -99,7 +99,7 @@ def reflex_surface(
     threshold: the sensing threshold, a force [N] (``sensing="force"``) or a position error [m]
         (``"position"``); joint torques [N m] for ``"joint_torque"`` go in ``joint_threshold``. When neither
         ``threshold``, ``sensing`` nor ``joint_threshold`` is given, the arm's actuators' sensing schemes are used
-        (:meth:`collision_reflex.arm.Arm.threshold`).
+        (:meth:`collision_reflex.arm.Arm.sensing_options`).
     directions: a count, names or vectors (see :func:`collision_reflex.directions.unit_directions`); default
         :data:`DEFAULT_DIRECTION_COUNT` evenly spread.
     sensing, reaction: see :func:`collision_reflex.arm.collision_impulses`.
@@ -114,7 +114,7 @@ def reflex_surface(
     spec = DEFAULT_DIRECTION_COUNT[arm.task_dim] if directions is None else directions
     units = unit_directions(spec, arm.task_dim, arm.plane)
     if threshold is None and sensing is None and joint_threshold is None:
-        detection = arm.threshold()
+        detection = arm.sensing_options()
         sensing = detection["sensing"]
         threshold = detection.get("threshold")
         joint_threshold = detection.get("joint_threshold")

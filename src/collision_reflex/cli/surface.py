@@ -219,7 +219,7 @@ def run(args: argparse.Namespace) -> int:
             path, args.frame or "tip", args.package_dir, args.offset, locked_joints=args.lock or ()
         )
     q = _configuration(arm, args.q)
-    if args.torque is None and np.any(np.isnan(arm.torque_limit)):
+    if args.torque is None and np.any(np.isnan(arm.urdf_torque_limit)):
         raise InvalidParameter(
             "--torque",
             None,
