@@ -9,7 +9,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from collision_reflex.arm import Arm, _example_robot, effective_parameters
+from collision_reflex._robots import example_robot
+from collision_reflex.arm import Arm, effective_parameters
 from collision_reflex.directions import circle_directions, sphere_directions
 from collision_reflex.errors import FrameNotFound, InvalidParameter
 from collision_reflex.metrics import (
@@ -88,7 +89,7 @@ def test_redundant_arm_ellipsoids():
 def test_impact_mitigation_against_a_locked_model(robot):
     result = impact_mitigation_factor(robot, 0.01)
     # Independent locked system: Pinocchio's reduced model with every actuated joint locked (one rigid body).
-    model = _example_robot(robot)[0]
+    model = example_robot(robot)[0]
     locked = pin.buildReducedModel(model, list(range(2, model.njoints)), result.q)
     data = locked.createData()
     q_base = result.q[:7]

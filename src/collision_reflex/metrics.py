@@ -20,14 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from .arm import (
-    _ROBOT_DEFAULTS,
-    ArmSamples,
-    _example_robot,
-    _joint_array,
-    _unit_directions,
-    task_inverse_inertia,
-)
+from ._robots import ROBOT_DEFAULTS, example_robot
+from .arm import ArmSamples, _joint_array, _unit_directions, task_inverse_inertia
 from .errors import FrameNotFound, InvalidParameter
 
 
@@ -159,7 +153,7 @@ def impact_mitigation_factor(
 
     name, model = _floating_base_model(robot)
     if contact_frame is None:
-        contact_frame = _ROBOT_DEFAULTS.get(name, {}).get("contact_frame")
+        contact_frame = ROBOT_DEFAULTS.get(name, {}).get("contact_frame")
         if contact_frame is None:
             raise InvalidParameter("contact_frame", None, f"a frame name for {name!r} (no default is known)")
     if not model.existFrame(contact_frame):
@@ -198,7 +192,7 @@ def impact_mitigation_factor(
 
 def _floating_base_model(robot: str | Any) -> tuple[str, Any]:
     if isinstance(robot, str):
-        model, name = _example_robot(robot)[0], robot
+        model, name = example_robot(robot)[0], robot
     else:
         model, name = robot, str(robot.name)
     if model.njoints < 2 or model.joints[1].nv != 6:
