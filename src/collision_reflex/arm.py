@@ -250,6 +250,8 @@ class Arm:
         ``peak_torque``, ``stiffness``, ``mechanical_stiffness`` and ``mass``); or a :class:`JointParameters`.
         Default: the model's armature and URDF effort limits, rigid joints and no motor masses.
     name: a name for messages and figures.
+    urdf_path: the URDF the model came from (for :meth:`visual_model`).
+    package_dirs: directories that resolve the URDF's ``package://`` mesh references.
     """
 
     def __init__(
