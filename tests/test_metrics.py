@@ -1,4 +1,8 @@
-"""Transparency metrics: inertia and manipulability ellipsoids, effective mass, impact mitigation factor."""
+"""Transparency metrics: inertia and manipulability ellipsoids, effective mass, impact mitigation factor.
+
+Tolerances: 1e-12 for the same arithmetic in another order; 1e-10 to 1e-9 for other algorithms (explicit
+inverses, another Pinocchio model) on small, well-conditioned matrices.
+"""
 
 from __future__ import annotations
 
