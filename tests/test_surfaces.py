@@ -62,8 +62,9 @@ def test_low_velocity_approaches_a_circle(arm):
     # 100 N/m Cartesian spring in series with ~1000 N/m joint springs keeps within ~10 % of a circle.
     slow = _surface(arm, v0=0.005)
     compliance = 1 / slow.parameters.k
-    # At 5 mm/s the impact and reaction phases still add about 1 % to the sensing phase: 2 % tolerance.
-    assert aspects[0.005] == pytest.approx(compliance.max() / compliance.min(), rel=0.02)
+    # At 5 mm/s the impact and reaction phases add about 1e-4 of the sensing phase (m_f v0 = 2.5e-4 N s
+    # against F_s^2 / (2 k v0) = 10 N s; I3 ~ 1e-3 N s): 1e-3 tolerance.
+    assert aspects[0.005] == pytest.approx(compliance.max() / compliance.min(), rel=1e-3)
     assert aspects[0.005] < 1.15
 
 
@@ -72,9 +73,10 @@ def test_high_velocity_takes_the_shape_of_the_effective_mass(arm):
     surface, whatever the actuators."""
     fast = _surface(arm, v0=50.0)
     mass = fast.parameters.m_f
-    # At 50 m/s the sensing and reaction phases are about 1 % of the impact phase: 2 % tolerance.
-    np.testing.assert_allclose(fast.impulse / fast.impulse.max(), mass / mass.max(), atol=0.02)
-    assert _aspect(fast) == pytest.approx(mass.max() / mass.min(), rel=0.02)
+    # At 50 m/s the sensing and reaction phases (about 1e-3 N s) are below 1e-3 of the impact phase (m_f v0,
+    # several N s): 5e-3 tolerance.
+    np.testing.assert_allclose(fast.impulse / fast.impulse.max(), mass / mass.max(), atol=5e-3)
+    assert _aspect(fast) == pytest.approx(mass.max() / mass.min(), rel=5e-3)
 
 
 def _two_link_kinematics(q) -> np.ndarray:
