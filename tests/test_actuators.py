@@ -33,7 +33,12 @@ def test_stiffness_is_series_and_mass_adds_gearbox():
     assert actuator.stiffness == pytest.approx(200.0, rel=1e-15)  # 1/(1/300 + 1/600)
     assert cr.Actuator(MOTOR).stiffness == math.inf
     gearbox = cr.Gearbox("harmonic", diameter=0.05, length=0.03, mass=0.25, inertia=1e-6, rated_torque=20.0)
-    assert cr.Actuator(MOTOR, 30.0, gearbox=gearbox).mass == pytest.approx(0.65, rel=1e-15)
+    geared = cr.Actuator(MOTOR, 30.0, gearbox=gearbox)
+    assert geared.mass == pytest.approx(0.65, rel=1e-15)
+    assert (
+        geared.peak_torque == pytest.approx(45.0) and geared.torque_limit == 20.0
+    )  # the gearbox's rating caps
+    assert cr.Actuator(MOTOR, 10.0, gearbox=gearbox).torque_limit == pytest.approx(15.0)
 
 
 def test_gearbox_inertia_is_optional():
@@ -78,3 +83,29 @@ def test_sensing_thresholds():
     # motor-side 0.01 N m through N = 10, plus 0.05 N m joint friction: 0.15 N m, 1.5 N at 0.1 m
     current = cr.Actuator(**base, sensing=cr.CurrentThreshold(0.01, 0.05)).contact_parameters(lever, 0.1)
     assert current.F_s == pytest.approx((10 * 0.01 + 0.05) / lever, rel=1e-15)
+
+
+def test_contact_parameters_refuse_impossible_setups():
+    rigid = cr.Actuator(MOTOR, sensing=cr.PositionThreshold(0.01))
+    with pytest.raises(cr.InvalidParameter, match="mechanical_stiffness"):
+        rigid.contact_parameters(0.1, finger_mass=0.1)  # rigid joint on a rigid constraint: infinite force
+    with pytest.raises(cr.InvalidParameter, match="stiffness"):
+        rigid.sensing.joint_threshold_torque(rigid)  # a rigid joint never builds a position error
+    soft = cr.Actuator(MOTOR, mechanical_stiffness=10.0)
+    with pytest.raises(cr.InvalidParameter, match="finger_mass"):
+        soft.contact_parameters(0.1, finger_mass=0.0)  # nothing hits the constraint in the impact phase
+    assert soft.contact_parameters(0.1, 0.0, reflected_inertia_in="finger").m_f == pytest.approx(2e-5 / 0.01)
+
+
+def test_current_threshold_grows_with_gear_ratio():
+    # The paper's A8 (U8 + 9:1) detects at ~40 N against ~3 N for the U8: a motor-side threshold is N times
+    # larger at the joint. Same motor-side threshold, N = 1 vs 9: exactly 9x the contact force.
+    sensing = cr.CurrentThreshold(3.0 * 0.1143)
+    direct = cr.Actuator(MOTOR, 1.0, mechanical_stiffness=10.0, sensing=sensing).contact_parameters(
+        0.1143, 0.1
+    )
+    geared = cr.Actuator(MOTOR, 9.0, mechanical_stiffness=10.0, sensing=sensing).contact_parameters(
+        0.1143, 0.1
+    )
+    assert direct.F_s == pytest.approx(3.0, rel=1e-14)
+    assert geared.F_s == pytest.approx(27.0, rel=1e-14)

@@ -63,7 +63,10 @@ class _Entry(BaseModel):
         if isinstance(value, bool):
             raise ValueError("expected a number or a quantity with units, got a boolean")
         if isinstance(value, str):
-            return _quantity(value, unit)
+            try:  # YAML 1.1 reads "1e-5" (no dot) as text: a plain number is still SI
+                return float(value)
+            except ValueError:
+                return _quantity(value, unit)
         if isinstance(value, int | float):
             return float(value)
         raise ValueError(f"expected a number (SI, {unit}) or a quantity string such as '60 mm'")

@@ -188,7 +188,7 @@ class CollisionParameters:
     a: float
     F_a: float
 
-    def impulse_arguments(self) -> dict[str, float]:
+    def impulse_arguments(self) -> dict[str, Any]:
         """Keyword arguments for :func:`collision_reflex.phase_impulses` (all but ``v0``)."""
         return {"m_f": self.m_f, "k": self.k, "k_m": self.k_m, "F_s": self.F_s, "a": self.a}
 
@@ -256,8 +256,15 @@ class Actuator:
 
     @property
     def peak_torque(self) -> float:
-        """Peak output torque ``N tau_p`` [N m]."""
+        """Peak output torque ``N tau_p`` [N m] of the motor (see :attr:`torque_limit` for the gearbox's cap)."""
         return self.gear_ratio * self.motor.peak_torque
+
+    @property
+    def torque_limit(self) -> float:
+        """Largest output torque [N m]: ``N tau_p``, capped by the gearbox's rated torque if there is one."""
+        if self.gearbox is None:
+            return self.peak_torque
+        return min(self.peak_torque, self.gearbox.rated_torque)
 
     @property
     def continuous_torque(self) -> float:
@@ -289,7 +296,7 @@ class Actuator:
         torque as ``tau/L``. The reflected inertia always counts in the robot mass that the reaction
         accelerates away; ``reflected_inertia_in`` says whether it also reaches the contact in the impact:
 
-        - ``"robot"`` (MODEL.md's arm model): the compliance sits between the rotor and the finger, so the
+        - ``"robot"`` (the arm model's placement): the compliance sits between the rotor and the finger, so the
           finger mass is only ``finger_mass``;
         - ``"finger"``: a rigid transmission with the compliance at the contact (like the paper's geared A8,
           whose fitted finger mass was 20 kg), so ``N**2 J_m / L**2`` is added to the finger mass too.

@@ -50,7 +50,7 @@ class ScalingLaw:
 
     def __post_init__(self) -> None:
         for field in ("mass_exponent", "inertia_exponent", "torque_exponent"):
-            _validate.positive(f"ScalingLaw.{field}", getattr(self, field))
+            _validate.non_negative(f"ScalingLaw.{field}", getattr(self, field))
 
     @property
     def inertia_torque_exponent(self) -> float:
