@@ -15,7 +15,25 @@ from .actuators import (
     PositionThreshold,
     gear_ratio_for,
 )
-from .errors import CatalogueError, CollisionReflexError, InvalidParameter, SolverFailed, UnknownMotor
+from .arm import (
+    Arm,
+    ArmSamples,
+    CollisionImpulses,
+    EffectiveParameters,
+    JointParameters,
+    collision_impulses,
+    effective_parameters,
+)
+from .directions import circle_directions, sphere_directions, unit_directions
+from .errors import (
+    CatalogueError,
+    CollisionReflexError,
+    FrameNotFound,
+    InvalidParameter,
+    SolverFailed,
+    UnknownMotor,
+    UrdfError,
+)
 from .gearboxes import GEARBOX_KINDS, Gearbox
 from .impulse import (
     REACTION_MODES,
@@ -28,6 +46,15 @@ from .impulse import (
     series_stiffness,
     total_impulse,
     velocity_coefficients,
+)
+from .metrics import (
+    Ellipsoid,
+    ImpactMitigation,
+    dynamic_manipulability_ellipsoid,
+    effective_mass,
+    ellipsoid_of_gyration,
+    generalized_inertia_ellipsoid,
+    impact_mitigation_factor,
 )
 from .motors import (
     SCALING_LAWS,
@@ -54,6 +81,7 @@ from .optimize import (
     pareto_front,
     solve,
 )
+from .surfaces import ReflexSurface, reflex_surface
 
 __version__ = "0.1.0"
 
@@ -65,8 +93,11 @@ __all__ = [
     "SCALING_LAWS",
     "Actuator",
     "ActuatorTechnology",
+    "Arm",
+    "ArmSamples",
     "Bounds",
     "CatalogueError",
+    "CollisionImpulses",
     "CollisionParameters",
     "CollisionReflexError",
     "Constraints",
@@ -76,32 +107,50 @@ __all__ = [
     "DesignProblem",
     "DesignResult",
     "DesignSpace",
+    "EffectiveParameters",
+    "Ellipsoid",
     "ForceThreshold",
+    "FrameNotFound",
     "Gearbox",
+    "ImpactMitigation",
     "InvalidParameter",
+    "JointParameters",
     "Motor",
     "MotorQuantities",
     "ParetoSet",
     "PhaseImpulses",
     "PositionThreshold",
+    "ReflexSurface",
     "ScalingLaw",
     "SolverFailed",
     "UnknownMotor",
+    "UrdfError",
     "__version__",
     "build_problem",
+    "circle_directions",
+    "collision_impulses",
     "collision_times",
+    "dynamic_manipulability_ellipsoid",
+    "effective_mass",
+    "effective_parameters",
+    "ellipsoid_of_gyration",
     "force_profile",
     "gear_ratio_for",
+    "generalized_inertia_ellipsoid",
+    "impact_mitigation_factor",
     "load_catalogue",
     "minimum_impulse",
     "optimal_velocity",
     "pareto_front",
     "phase_impulses",
     "reference_motor",
+    "reflex_surface",
     "scaled_motor_quantities",
     "scaling_law",
     "series_stiffness",
     "solve",
+    "sphere_directions",
     "total_impulse",
+    "unit_directions",
     "velocity_coefficients",
 ]

@@ -14,10 +14,11 @@ from .. import __version__
 from ..errors import CollisionReflexError
 from . import impulse as _impulse
 from . import motors as _motors
+from . import surface as _surface
 from . import sweep as _sweep
 
 # Subcommand modules, in the order `crx --help` lists them.
-_SUBCOMMANDS = [_impulse, _motors, _sweep]
+_SUBCOMMANDS = [_impulse, _motors, _sweep, _surface]
 
 
 def build_parser() -> argparse.ArgumentParser:
