@@ -189,6 +189,7 @@ class DesignProblem:
     _sample_function: Any = field(repr=False, default=None)
     _sample_data: Any = field(repr=False, default=None)
     _solvers: dict[str, Any] = field(default_factory=dict, repr=False)
+    _objective: Any = field(default=None, repr=False)
 
     @property
     def n_joints(self) -> int:
@@ -239,6 +240,12 @@ class DesignProblem:
             )
             impulses.append(impulse)
         return ca.Function("design_impulses", [z], [ca.horzcat(*impulses)], ["z"], ["impulses"])
+
+    def objective_value(self, x: np.ndarray) -> float:
+        """The NLP's (scaled) objective at ``x``, auxiliaries at their exact values: for comparing results."""
+        if self._objective is None:
+            self._objective = ca.Function("objective", [self.nlp["x"]], [self.nlp["f"]])
+        return float(self._objective(self.exact_point(x)))
 
     def parameters(self, epsilon: Mapping[str, float] | None = None) -> np.ndarray:
         """NLP parameter vector bounding the objectives in ``epsilon`` (unbounded: +inf in scaled units)."""
@@ -424,8 +431,12 @@ def build_problem(
     torque_scale = np.maximum(np.asarray(required_torque(start_mass)).ravel(), 1e-3)
     for j, (bases, slopes, demand_labels) in enumerate(torque_demands):
         demand = ca.DM(bases) + ca.mtimes(ca.DM(slopes), motor_mass)
-        add((peak_torque[j] - demand) / torque_scale[j], 0.0, np.inf,
-            [f"peak torque of {joint_names[j]} >= {label}" for label in demand_labels])
+        add(
+            (peak_torque[j] - demand) / torque_scale[j],
+            0.0,
+            np.inf,
+            [f"peak torque of {joint_names[j]} >= {label}" for label in demand_labels],
+        )
 
     if technology.sensing == "position" and constraints.threshold_floor > 0:
         add(
@@ -665,7 +676,10 @@ def _torque_requirement_rows(
 
 
 def _binding_torque_demands(
-    samples: ContactSamples, constraints: Constraints, joint_names: tuple[str, ...], mass_low: np.ndarray,
+    samples: ContactSamples,
+    constraints: Constraints,
+    joint_names: tuple[str, ...],
+    mass_low: np.ndarray,
     mass_high: np.ndarray,
 ) -> list[tuple[np.ndarray, np.ndarray, list[str]]]:
     """Per joint, the torque demands ``b + S m`` [N m] that can bind: ``(b (R,), S (R, n), labels)``.
@@ -682,7 +696,9 @@ def _binding_torque_demands(
         low = bases + np.minimum(slopes * mass_low, slopes * mass_high).sum(axis=1)
         high = bases + np.maximum(slopes * mass_low, slopes * mass_high).sum(axis=1)
         keep = high >= low.max() - 1e-12 * abs(low.max())
-        demands.append((bases[keep], slopes[keep], [label for label, k in zip(labels, keep, strict=True) if k]))
+        demands.append(
+            (bases[keep], slopes[keep], [label for label, k in zip(labels, keep, strict=True) if k])
+        )
     return demands
 
 
