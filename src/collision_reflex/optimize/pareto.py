@@ -102,7 +102,7 @@ def pareto_front(
     points: int = 20,
     ipopt_options: dict[str, Any] | None = None,
     progress: Callable[[int, int], None] | None = None,
-    anchor_starts: int = 4,
+    anchor_starts: int = 1,
 ) -> ParetoSet:
     """Pareto set of two or three objectives by epsilon-constraint sweeps.
 
@@ -115,8 +115,8 @@ def pareto_front(
     points: number of points requested on the front (anchors included); for three objectives the bounds form
         a grid of about that many points.
     progress: called as ``progress(done, total)`` after each solve.
-    anchor_starts: start points of each anchor's first solve (multi-start, see :func:`solve`): the anchors fix
-        the range of the sweep, so they are worth the extra solves.
+    anchor_starts: start points of each anchor's first solve (multi-start, see :func:`solve`); more starts
+        make the anchors more robust against local optima, at the cost of a solve each.
 
     Anchors first: each objective is minimised, then (lexicographically) the others are minimised with it held
     at its optimum, so every anchor is non-dominated. The bounds on the other objectives are then spread
