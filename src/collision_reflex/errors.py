@@ -60,8 +60,14 @@ class SolverFailed(CollisionReflexError):
     problem: the problem that was solved, for inspection.
     """
 
-    def __init__(self, message: str, status: str, stats: dict, violated: list[tuple[str, float]],
-                 problem: object = None) -> None:
+    def __init__(
+        self,
+        message: str,
+        status: str,
+        stats: dict,
+        violated: list[tuple[str, float]],
+        problem: object = None,
+    ) -> None:
         self.status = status
         self.stats = stats
         self.violated = violated
