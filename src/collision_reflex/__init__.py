@@ -6,7 +6,8 @@ Actuation"). This package evaluates it from structure, actuation, stiffness and 
 URDF arms, and optimises actuator designs against it.
 """
 
-from .errors import CollisionReflexError, InvalidParameter
+from . import experiments
+from .errors import CollisionReflexError, FitFailed, InvalidParameter, TraceError
 from .impulse import (
     REACTION_MODES,
     PhaseImpulses,
@@ -25,15 +26,18 @@ __version__ = "0.1.0"
 __all__ = [
     "REACTION_MODES",
     "CollisionReflexError",
+    "FitFailed",
     "InvalidParameter",
     "PhaseImpulses",
     "__version__",
     "collision_times",
+    "experiments",
     "force_profile",
     "minimum_impulse",
     "optimal_velocity",
     "phase_impulses",
     "series_stiffness",
     "total_impulse",
+    "TraceError",
     "velocity_coefficients",
 ]

@@ -12,10 +12,11 @@ from collections.abc import Sequence
 
 from .. import __version__
 from ..errors import CollisionReflexError
+from . import fit as _fit
 from . import impulse as _impulse
 
 # Subcommand modules, in the order `crx --help` lists them.
-_SUBCOMMANDS = [_impulse]
+_SUBCOMMANDS = [_impulse, _fit]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -125,13 +125,16 @@ EXAMPLE_VELOCITIES: Mapping[str, tuple[float, ...]] = {
 EXAMPLE_SEED = 20210607
 EXAMPLE_SAMPLING_RATE = 3500.0  # Hz, the paper's
 EXAMPLE_BANDWIDTH = 1000.0  # Hz, low-pass of the example sensor
+EXAMPLE_SPREAD = 0.1  # trial-to-trial spread of the parameters (lognormal sigma): repeated trials differ
 
 
 def write_example_dataset(directory: str | os.PathLike[str], seed: int = EXAMPLE_SEED) -> list[Path]:
     """Write the example data set: one CSV per trial, a folder per system of :data:`PAPER_SYSTEMS`.
 
     Traces at 3500 Hz through a 1 kHz second-order low-pass with :data:`MINI40_NOISE` noise and a small
-    bias, at the velocities of :data:`EXAMPLE_VELOCITIES`. The same seed gives the same files.
+    bias, at the velocities of :data:`EXAMPLE_VELOCITIES`. Each trial's parameters scatter around the system's
+    by a lognormal factor of sigma :data:`EXAMPLE_SPREAD` (real trials repeat imperfectly), so the aggregated
+    fits have a spread as in ``tab:one_shot``. The same seed gives the same files.
     """
     rng = np.random.default_rng(seed)
     sensor = SensorModel(EXAMPLE_SAMPLING_RATE, EXAMPLE_BANDWIDTH)
@@ -140,8 +143,12 @@ def write_example_dataset(directory: str | os.PathLike[str], seed: int = EXAMPLE
         folder = Path(directory) / system.lower().replace(" ", "_")
         for velocity in EXAMPLE_VELOCITIES[system]:
             name = f"{system.lower().replace(' ', '_')}_v{velocity * 1000:g}mm"
+            factors = np.exp(rng.normal(0.0, EXAMPLE_SPREAD, 4))
+            trial_truth = TrueParameters(
+                truth.m_f * factors[0], truth.k_s * factors[1], truth.F_s * factors[2], truth.a * factors[3], truth.k_m
+            )
             trace = synthetic_trace(
-                truth,
+                trial_truth,
                 velocity,
                 sensor,
                 rng,
