@@ -80,14 +80,20 @@ def test_nshot_fit_recovers_coefficients_and_v_star(truth):
     fit = fit_velocity_law(velocity, exact)  # noiseless: exact up to rounding
     np.testing.assert_allclose((fit.A, fit.B, fit.C), coefficients, rtol=1e-8)
     assert fit.v_star == pytest.approx(v_star, rel=1e-8)
-    assert fit.minimum_impulse == pytest.approx(cr.minimum_impulse(truth.m_f, truth.k, truth.k_m, truth.F_s, truth.a), rel=1e-8)
+    assert fit.minimum_impulse == pytest.approx(
+        cr.minimum_impulse(truth.m_f, truth.k, truth.k_m, truth.F_s, truth.a), rel=1e-8
+    )
 
     # With 1 % noise on each impulse, stated as the uncertainty: each coefficient and v* within 4 stderr.
     rng = np.random.default_rng(17)
     sigma = 0.01 * exact
     noisy = fit_velocity_law(velocity, exact + rng.normal(0.0, sigma), sigma)
-    for got, err, expected in ((noisy.A, noisy.stderr_A, coefficients[0]), (noisy.B, noisy.stderr_B, coefficients[1]),
-                               (noisy.C, noisy.stderr_C, coefficients[2]), (noisy.v_star, noisy.stderr_v_star, v_star)):
+    for got, err, expected in (
+        (noisy.A, noisy.stderr_A, coefficients[0]),
+        (noisy.B, noisy.stderr_B, coefficients[1]),
+        (noisy.C, noisy.stderr_C, coefficients[2]),
+        (noisy.v_star, noisy.stderr_v_star, v_star),
+    ):
         assert abs(got - expected) <= 4 * err
 
 

@@ -17,9 +17,14 @@ from collision_reflex.experiments import (
 )
 
 RATE = 3500.0  # Hz, the paper's sampling rate
-CASES = {name: (truth, v0) for name, truth, v0 in [("u8-soft", PAPER_SYSTEMS["U8 soft"], 0.08),
-                                                    ("u8-stiff", PAPER_SYSTEMS["U8 stiff"], 0.12),
-                                                    ("a8", PAPER_SYSTEMS["A8"], 0.01)]}
+CASES = {
+    name: (truth, v0)
+    for name, truth, v0 in [
+        ("u8-soft", PAPER_SYSTEMS["U8 soft"], 0.08),
+        ("u8-stiff", PAPER_SYSTEMS["U8 stiff"], 0.12),
+        ("a8", PAPER_SYSTEMS["A8"], 0.01),
+    ]
+}
 
 
 def _model(truth, v0):
@@ -31,13 +36,15 @@ def test_interval_means_match_brute_force_averaging(truth, v0):
     # Independent check of the Gauss-Legendre splitting: average force_profile over 40000 points per sample.
     # The pulse ends with a jump of m_f v0 w, so the brute-force mean itself is good to ~(jump / 40000).
     sensor = SensorModel(RATE)
-    t1, t2 = cr.collision_times(*_model(truth, v0))
+    _, t2 = cr.collision_times(*_model(truth, v0))
     impact = 0.00337
     times = np.arange(int((impact + t2) * RATE) + 5) / RATE
     fast = model_samples(times, *_model(truth, v0), impact, sensor)
     offsets = (np.arange(40000) + 0.5) / 40000 - 0.5
     jump = truth.m_f * v0 * np.sqrt(truth.k_m / truth.m_f)
-    for i in np.linspace(0, times.size - 1, 40).astype(int).tolist() + list(range(int(impact * RATE) - 1, int(impact * RATE) + 8)):
+    for i in np.linspace(0, times.size - 1, 40).astype(int).tolist() + list(
+        range(int(impact * RATE) - 1, int(impact * RATE) + 8)
+    ):
         brute = cr.force_profile(times[i] - impact + offsets / RATE, *_model(truth, v0)).mean()
         assert fast[i] == pytest.approx(brute, abs=2 * jump / 40000 + 1e-9)
 

@@ -27,14 +27,21 @@ SHIPPED = Path(__file__).resolve().parents[1] / "studies" / "traces"
 
 
 def _trace(v0=0.08, seed=1, **kwargs):
-    return synthetic_trace(PAPER_SYSTEMS["U8 stiff"], v0, SensorModel(RATE), np.random.default_rng(seed), **kwargs)
+    return synthetic_trace(
+        PAPER_SYSTEMS["U8 stiff"], v0, SensorModel(RATE), np.random.default_rng(seed), **kwargs
+    )
 
 
 def test_units_in_headers_and_metadata_are_converted(tmp_path):
     trace = _trace()
     path = tmp_path / "trial.csv"
-    lines = ["# velocity: 80 mm/s", "# system: U8 stiff", "# sensor stiffness: 20 N/um", "# operator: someone",
-             "Time (ms), Force [mN]"]
+    lines = [
+        "# velocity: 80 mm/s",
+        "# system: U8 stiff",
+        "# sensor stiffness: 20 N/um",
+        "# operator: someone",
+        "Time (ms), Force [mN]",
+    ]
     lines += [f"{t * 1e3:.9g},{f * 1e3:.9g}" for t, f in zip(trace.time, trace.force, strict=True)]
     path.write_text("\n".join(lines) + "\n")
     (read,) = read_traces(path)
@@ -49,8 +56,17 @@ def test_units_given_by_the_caller_and_many_trials_per_file(tmp_path):
     rows = []
     for name, v0 in (("slow", 0.05), ("fast", 0.12)):
         trace = _trace(v0)
-        rows.append(pd.DataFrame({"trial": name, "time": trace.time * 1e3, "force": trace.force,
-                                  "velocity [mm/s]": v0 * 1e3, "system": "U8 stiff"}))
+        rows.append(
+            pd.DataFrame(
+                {
+                    "trial": name,
+                    "time": trace.time * 1e3,
+                    "force": trace.force,
+                    "velocity [mm/s]": v0 * 1e3,
+                    "system": "U8 stiff",
+                }
+            )
+        )
     path = tmp_path / "many.csv"
     pd.concat(rows).to_csv(path, index=False)
     traces = read_traces(path, time_unit="ms")
@@ -65,7 +81,9 @@ def _write_bad_traces(folder: Path) -> dict[str, str]:
     write_trace(folder / "good.csv", good)
     write_trace(folder / "short.csv", cr.experiments.Trace(good.time[:12], good.force[:12], velocity=0.08))
     quiet = _trace(seed=3)
-    write_trace(folder / "no_contact.csv", cr.experiments.Trace(quiet.time[:60], quiet.force[:60], velocity=0.08))
+    write_trace(
+        folder / "no_contact.csv", cr.experiments.Trace(quiet.time[:60], quiet.force[:60], velocity=0.08)
+    )
     clipped = _trace(seed=4, noise=0.05)
     clipped_sensor = SensorModel(RATE, 1000.0, full_scale=2.5)  # saturates below F_s = 3.03 N
     clipped = synthetic_trace(PAPER_SYSTEMS["U8 stiff"], 0.08, clipped_sensor, np.random.default_rng(4))
@@ -77,7 +95,9 @@ def _write_bad_traces(folder: Path) -> dict[str, str]:
     holes[50] = np.nan
     write_trace(folder / "nan.csv", cr.experiments.Trace(good.time, holes, velocity=0.08))
     cut = _trace(seed=5)
-    write_trace(folder / "unfinished.csv", cr.experiments.Trace(cut.time[:150], cut.force[:150], velocity=0.08))
+    write_trace(
+        folder / "unfinished.csv", cr.experiments.Trace(cut.time[:150], cut.force[:150], velocity=0.08)
+    )
     (folder / "columns.csv").write_text("seconds,newtons\n0,1\n")
     (folder / "text.csv").write_text(
         (folder / "good.csv").read_text().replace("\n0.571428571,", "\n0.571428571,oops\n0.6,", 1)
@@ -112,8 +132,11 @@ def test_each_bad_trace_gets_its_reason_and_the_good_one_is_processed(tmp_path):
 def test_cli_reports_bad_traces_and_writes_outputs(tmp_path):
     _write_bad_traces(tmp_path / "in")
     out = tmp_path / "out"
-    done = subprocess.run([sys.executable, "-m", "collision_reflex", "fit", str(tmp_path / "in"), "--out", str(out)],
-                          capture_output=True, text=True)
+    done = subprocess.run(
+        [sys.executable, "-m", "collision_reflex", "fit", str(tmp_path / "in"), "--out", str(out)],
+        capture_output=True,
+        text=True,
+    )
     assert done.returncode == 0, done.stderr
     skipped = [line for line in done.stderr.splitlines() if line.startswith("crx fit: skipped")]
     assert len(skipped) == 8 and "Traceback" not in done.stderr
@@ -132,15 +155,21 @@ def test_cli_reports_bad_traces_and_writes_outputs(tmp_path):
 
 def test_cli_with_no_usable_trace_exits_2_with_one_line(tmp_path):
     (tmp_path / "bad.csv").write_text("time,force\n0,nan\n")
-    done = subprocess.run([sys.executable, "-m", "collision_reflex", "fit", str(tmp_path / "bad.csv")],
-                          capture_output=True, text=True)
+    done = subprocess.run(
+        [sys.executable, "-m", "collision_reflex", "fit", str(tmp_path / "bad.csv")],
+        capture_output=True,
+        text=True,
+    )
     assert done.returncode == 2
     assert done.stderr.count("\n") == 2  # the skipped trace, then the error
     assert "crx fit: error: no usable trial" in done.stderr and "Traceback" not in done.stderr
 
 
 def test_cli_on_the_shipped_example_recovers_the_paper_systems(tmp_path, capsys):
-    assert main(["fit", str(SHIPPED / "u8_soft"), "--bandwidth", "1000", "--out", str(tmp_path), "--no-figures"]) == 0
+    assert (
+        main(["fit", str(SHIPPED / "u8_soft"), "--bandwidth", "1000", "--out", str(tmp_path), "--no-figures"])
+        == 0
+    )
     summary = pd.read_csv(tmp_path / "one_shot.csv").set_index("parameter")
     truth = PAPER_SYSTEMS["U8 soft"]
     # Trials scatter by a lognormal 10 % around the system (EXAMPLE_SPREAD): 5 trials put the mean within

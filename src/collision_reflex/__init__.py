@@ -29,6 +29,7 @@ __all__ = [
     "FitFailed",
     "InvalidParameter",
     "PhaseImpulses",
+    "TraceError",
     "__version__",
     "collision_times",
     "experiments",
@@ -38,6 +39,5 @@ __all__ = [
     "phase_impulses",
     "series_stiffness",
     "total_impulse",
-    "TraceError",
     "velocity_coefficients",
 ]

@@ -7,9 +7,13 @@ import math
 import re
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..errors import CollisionReflexError
 from ._args import positive_float
+
+if TYPE_CHECKING:
+    from ..experiments import ExperimentResults
 
 _DEFAULT_K_M = 2e7  # N/m, the paper's ATI Mini40 along its sensing axis
 
@@ -69,7 +73,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         default="at_rest",
         help="reaction model fitted (default %(default)s, the paper's)",
     )
-    add("--out", default=None, metavar="DIR", help="write trials.csv, one_shot.csv, nshot.csv, rejected.csv and figures here")
+    add(
+        "--out",
+        default=None,
+        metavar="DIR",
+        help="write trials.csv, one_shot.csv, nshot.csv, rejected.csv and figures here",
+    )
     add("--no-figures", action="store_true", help="with --out, write the tables only")
     add("--strict", action="store_true", help="exit with status 2 if any trace is rejected")
     parser.set_defaults(run=run)
@@ -105,9 +114,11 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _print_trials(results) -> None:  # type: ignore[no-untyped-def]
-    print(f"{'system':<12}{'trial':<22}{'v0 [m/s]':>10}{'I [N*s]':>12}{'+-':>10}{'trapz':>12}"
-          f"{'m_f [kg]':>11}{'k_s [N/m]':>11}{'F_s [N]':>9}{'a [m/s^2]':>11}")
+def _print_trials(results: ExperimentResults) -> None:
+    print(
+        f"{'system':<12}{'trial':<22}{'v0 [m/s]':>10}{'I [N*s]':>12}{'+-':>10}{'trapz':>12}"
+        f"{'m_f [kg]':>11}{'k_s [N/m]':>11}{'F_s [N]':>9}{'a [m/s^2]':>11}"
+    )
     for t in results.trials:
         v0 = f"{t.trace.velocity:>10.4g}" if t.trace.velocity is not None else f"{'-':>10}"
         line = (
@@ -121,7 +132,7 @@ def _print_trials(results) -> None:  # type: ignore[no-untyped-def]
         print(line)
 
 
-def _print_summary(results) -> None:  # type: ignore[no-untyped-def]
+def _print_summary(results: ExperimentResults) -> None:
     summary = results.one_shot_summary()
     print()
     print("one-shot fits, mean ± std over trials (tab:one_shot):")
@@ -150,7 +161,7 @@ def _print_summary(results) -> None:  # type: ignore[no-untyped-def]
             print(f"  {system or '(no system)'}: {problems[system]}")
 
 
-def _write_outputs(out: Path, results, figures: bool) -> None:  # type: ignore[no-untyped-def]
+def _write_outputs(out: Path, results: ExperimentResults, figures: bool) -> None:
     from .._io import atomic_open
 
     tables = {

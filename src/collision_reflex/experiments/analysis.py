@@ -172,7 +172,10 @@ class ExperimentResults:
         import pandas as pd
 
         return pd.DataFrame(
-            [{"source": r.source, "trial": r.trial, "line": r.line, "reason": r.reason} for r in self.rejected],
+            [
+                {"source": r.source, "trial": r.trial, "line": r.line, "reason": r.reason}
+                for r in self.rejected
+            ],
             columns=["source", "trial", "line", "reason"],
         )
 

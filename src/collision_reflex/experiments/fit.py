@@ -115,7 +115,16 @@ class OneShotFit:
     def samples_at(self, times: np.ndarray) -> np.ndarray:
         """What the fitted model has the sensor report at ``times`` [s] (floor subtracted) [N]."""
         return model_samples(
-            times, self.m_f, self.k, self.k_m, self.F_s, self.a, self.v0, self.impact_time, self.sensor, self.reaction
+            times,
+            self.m_f,
+            self.k,
+            self.k_m,
+            self.F_s,
+            self.a,
+            self.v0,
+            self.impact_time,
+            self.sensor,
+            self.reaction,
         )
 
 
@@ -148,7 +157,7 @@ def fit_one_shot(
     _validate.choice("reaction", reaction, REACTION_MODES)
     if trace.velocity is None:
         trace.fail("no pre-impact velocity: give it as '# velocity: ...' in the file or with --velocity")
-    v0 = float(trace.velocity)  # type: ignore[arg-type]
+    v0 = float(trace.velocity)
     k_m = float(trace.k_m if trace.k_m is not None else k_m)
     _validate.positive("k_m", k_m)
     sensor = _sensor_for(trace, bandwidth)
@@ -177,18 +186,23 @@ def fit_one_shot(
     x0 = np.array([math.log(start[name]) for name in PARAMETERS] + [0.0, 0.0])
     wide = math.log(1e3)  # parameters are searched within three decades of the initial guess
     offset = 10.0  # the floor's level is known from the pre-impact samples to far better than 10 sigma
-    bounds = (x0 - [wide, wide, wide, wide, t_span, offset], x0 + [wide, wide, wide, wide, t_span, offset])
-    # A pulse shorter than a sample leaves the cost flat in the impact time while the model's pulse sits
-    # inside one sampling interval, so a local solver can stall there. Scan the impact time first (the
-    # other parameters at their guesses), then refine from the best scanned phase and from the guess.
+    half_range = np.array([wide, wide, wide, wide, t_span, offset])
+    bounds = (x0 - half_range, x0 + half_range)
+
+    def shifted(x: np.ndarray, shift: float) -> np.ndarray:
+        """``x`` with the impact time moved by ``shift`` samples."""
+        moved = x.copy()
+        moved[4] += shift
+        return moved
+
     def solve(x_start: np.ndarray) -> Any:
         x_start = np.clip(x_start, bounds[0], bounds[1])
         return least_squares(residuals, x_start, bounds=bounds, method="trf", max_nfev=200)
 
     # Scan the impact time (the other parameters at their guesses) and refine from the best phase.
     shifts = np.linspace(-1.5, 1.5, 61)  # the centroid guess is good to a fraction of a sample
-    scan = [float(np.sum(residuals(x0 + [0, 0, 0, 0, shift, 0]) ** 2)) for shift in shifts]
-    best = solve(x0 + [0, 0, 0, 0, shifts[int(np.argmin(scan))], 0])
+    scan = [float(np.sum(residuals(shifted(x0, shift)) ** 2)) for shift in shifts]
+    best = solve(shifted(x0, float(shifts[int(np.argmin(scan))])))
     # A pulse shorter than a sample that lies inside one sampling interval leaves the cost flat in the impact
     # time, and the solver stops anywhere on that plateau. The data may want the pulse to spill a little
     # into the previous or the next sample: try both ends of the plateau.
@@ -212,7 +226,9 @@ def fit_one_shot(
     covariance = np.linalg.pinv(jac.T @ jac) * residual_variance
     m_f, k_s, F_s, a, t0 = unpack(best.x)
     log_stderr = np.sqrt(np.clip(np.diag(covariance), 0.0, None))
-    stderr = {name: value * s for name, value, s in zip(PARAMETERS, (m_f, k_s, F_s, a), log_stderr, strict=False)}
+    stderr = {
+        name: value * s for name, value, s in zip(PARAMETERS, (m_f, k_s, F_s, a), log_stderr, strict=False)
+    }
     stderr["impact_time"] = float(log_stderr[4] * period)
     phase_stderr = _phase_stderr(best.x, covariance, k_m, v0, reaction)
     return OneShotFit(

@@ -161,7 +161,9 @@ def model_samples(
         means[plain] = force @ weights / 2
     if np.any(split):
         lo, hi = lower[split], upper[split]
-        edges = np.concatenate([lo[:, None], np.clip(breakpoints[None, :], lo[:, None], hi[:, None]), hi[:, None]], axis=1)
+        edges = np.concatenate(
+            [lo[:, None], np.clip(breakpoints[None, :], lo[:, None], hi[:, None]), hi[:, None]], axis=1
+        )
         edges.sort(axis=1)
         left, right = edges[:, :-1], edges[:, 1:]
         nodes, weights = np.polynomial.legendre.leggauss(_GAUSS_NODES)

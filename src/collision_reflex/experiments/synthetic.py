@@ -145,7 +145,11 @@ def write_example_dataset(directory: str | os.PathLike[str], seed: int = EXAMPLE
             name = f"{system.lower().replace(' ', '_')}_v{velocity * 1000:g}mm"
             factors = np.exp(rng.normal(0.0, EXAMPLE_SPREAD, 4))
             trial_truth = TrueParameters(
-                truth.m_f * factors[0], truth.k_s * factors[1], truth.F_s * factors[2], truth.a * factors[3], truth.k_m
+                truth.m_f * factors[0],
+                truth.k_s * factors[1],
+                truth.F_s * factors[2],
+                truth.a * factors[3],
+                truth.k_m,
             )
             trace = synthetic_trace(
                 trial_truth,

@@ -31,7 +31,7 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 import numpy as np
 
@@ -96,7 +96,7 @@ class Trace:
         """File line of sample ``index``, if known."""
         return None if self.lines is None else int(self.lines[index])
 
-    def fail(self, reason: str, index: int | None = None) -> None:
+    def fail(self, reason: str, index: int | None = None) -> NoReturn:
         """Raise a :class:`TraceError` for this trace, at sample ``index`` if given."""
         raise TraceError(self.source, self.name, reason, None if index is None else self.line_of(index))
 
@@ -131,7 +131,9 @@ def _registry() -> Any:
     return pint.UnitRegistry()
 
 
-def to_si(value: str | float, default_unit: str, what: str, source: str = "", line: int | None = None) -> float:
+def to_si(
+    value: str | float, default_unit: str, what: str, source: str = "", line: int | None = None
+) -> float:
     """A number with an optional unit (``"100 mm/s"``, ``"2e7"``) in SI, as a float.
 
     ``default_unit`` is the unit of a plain number and also fixes the dimension expected.
@@ -146,7 +148,10 @@ def to_si(value: str | float, default_unit: str, what: str, source: str = "", li
         return float(quantity.to(ureg.Quantity(1.0, default_unit).to_base_units().units).magnitude)
     except (pint.errors.PintError, ValueError, TypeError, AttributeError) as error:
         raise TraceError(
-            source, "", f"{what} = {value!r} is not a quantity in {default_unit} or a compatible unit ({error})", line
+            source,
+            "",
+            f"{what} = {value!r} is not a quantity in {default_unit} or a compatible unit ({error})",
+            line,
         ) from None
 
 
@@ -156,10 +161,15 @@ def unit_factor(unit: str, default_unit: str, what: str, source: str = "") -> fl
 
     ureg = _registry()
     try:
-        return float(ureg.Quantity(1.0, unit).to(ureg.Quantity(1.0, default_unit).to_base_units().units).magnitude)
+        return float(
+            ureg.Quantity(1.0, unit).to(ureg.Quantity(1.0, default_unit).to_base_units().units).magnitude
+        )
     except (pint.errors.PintError, ValueError, TypeError, AttributeError) as error:
         raise TraceError(
-            source, "", f"the {what} column's unit {unit!r} is not a unit of {default_unit}'s kind ({error})", 1
+            source,
+            "",
+            f"the {what} column's unit {unit!r} is not a unit of {default_unit}'s kind ({error})",
+            1,
         ) from None
 
 
@@ -217,7 +227,9 @@ def read_traces(
             skipinitialspace=True,
         )
     except (pd.errors.ParserError, pd.errors.EmptyDataError) as error:
-        raise TraceError(source, "", f"not a CSV table ({error})".replace("\n", " "), header_line + 1) from None
+        raise TraceError(
+            source, "", f"not a CSV table ({error})".replace("\n", " "), header_line + 1
+        ) from None
     # Drop trailing blank lines, keep blank lines inside the data (they are reported as missing values).
     blank = (table == "").all(axis=1).to_numpy()
     last = len(blank) - int(np.argmin(blank[::-1])) if not blank.all() else 0
@@ -238,7 +250,9 @@ def read_traces(
         "k_m": _meta_value(metadata, "sensor stiffness", "N/m", k_m, source),
         "system": metadata.get("system", default_system),
     }
-    others = {k: v for k, v in metadata.items() if k not in ("velocity", "sensor stiffness", "system", "trial")}
+    others = {
+        k: v for k, v in metadata.items() if k not in ("velocity", "sensor stiffness", "system", "trial")
+    }
     if "trial" not in columns:
         return [
             Trace(
@@ -328,7 +342,11 @@ def _find(columns: Mapping[str, str], names: tuple[str, ...], what: str, source:
 def _column_factor(column: str, default_unit: str, what: str, source: str) -> float:
     match = _HEADER.match(column)
     unit = match.group("unit") if match else None
-    return unit_factor(unit, default_unit, what, source) if unit else unit_factor(default_unit, default_unit, what)
+    return (
+        unit_factor(unit, default_unit, what, source)
+        if unit
+        else unit_factor(default_unit, default_unit, what)
+    )
 
 
 def _meta_value(

@@ -41,17 +41,25 @@ def plot_trace_fit(path: str | os.PathLike[str], trial: TrialResult) -> Path:
         t_impact, t1_abs, t2_abs = fit.impact_time, fit.impact_time + t1, fit.impact_time + t2
         phases = fit.phases
         ax.axvspan(
-            t_impact * 1e3, t1_abs * 1e3, color="tab:blue", alpha=0.12, label=f"sensing {phases.sensing:.3g} N·s"
+            t_impact * 1e3,
+            t1_abs * 1e3,
+            color="tab:blue",
+            alpha=0.12,
+            label=f"sensing {phases.sensing:.3g} N·s",
         )
         ax.axvspan(
-            t1_abs * 1e3, t2_abs * 1e3, color="tab:green", alpha=0.12, label=f"reaction {phases.reaction:.3g} N·s"
+            t1_abs * 1e3,
+            t2_abs * 1e3,
+            color="tab:green",
+            alpha=0.12,
+            label=f"reaction {phases.reaction:.3g} N·s",
         )
         ax.axvline(t_impact * 1e3, color="tab:orange", lw=1, label=f"impact {phases.initial:.3g} N·s")
         ax.axhline(fit.F_s, color="gray", ls="--", lw=0.8)
-        ax.annotate("$F_s$", (time[0] * 1e3, fit.F_s), xytext=(2, 3), textcoords="offset points", color="gray")
-        title += (
-            f"  (m_f = {fit.m_f:.3g} kg, k_s = {fit.k_s:.3g} N/m, F_s = {fit.F_s:.3g} N, a = {fit.a:.3g} m/s²)"
+        ax.annotate(
+            "$F_s$", (time[0] * 1e3, fit.F_s), xytext=(2, 3), textcoords="offset points", color="gray"
         )
+        title += f"  (m_f = {fit.m_f:.3g} kg, k_s = {fit.k_s:.3g} N/m, F_s = {fit.F_s:.3g} N, a = {fit.a:.3g} m/s²)"
     ax.set_xlabel("time [ms]")
     ax.set_ylabel("force [N]")
     ax.set_title(title, fontsize=9)
