@@ -1,7 +1,8 @@
 """One-shot least-squares fit of the model's force profile to one trace (the paper's ``tab:one_shot``).
 
 Fitted: finger mass ``m_f`` [kg], software stiffness ``k_s`` [N/m], sensing threshold ``F_s`` [N], reaction
-acceleration ``a`` [m/s^2] and the time of impact on the trace's clock [s]. Given: the mechanical (sensor)
+acceleration ``a`` [m/s^2], the time of impact on the trace's clock [s], and (a nuisance parameter) a small
+offset of the noise floor, so that the floor's uncertainty reaches the parameters' uncertainties. Given: the mechanical (sensor)
 stiffness ``k_m`` (the paper: 2e7 N/m, the ATI Mini40's) and the pre-impact velocity ``v0`` (from the trial's
 metadata). The model is :func:`collision_reflex.force_profile` seen through the sensor
 (:func:`~collision_reflex.experiments.model_samples`: interval means, then the sensor's low-pass), so the fit
@@ -19,6 +20,9 @@ What the samples identify
 - ``a``: only through ``a k_m``, the curvature of the reaction parabola ``F_s - k_m a tau^2 / 2`` (equivalently
   its duration ``sqrt(2 F_s / (a k_m))``); hence ``k_m`` must be given, and an error in ``k_m`` moves ``a``
   in inverse proportion. A reaction shorter than a couple of samples leaves ``a`` poorly determined.
+- The impact time is pinned to a fraction of a sample by the ramp's start and by how the pulse's area splits
+  between neighbouring samples; while the pulse lies wholly inside one sampling interval its position there
+  is not determined (the fit tries both ends of that plateau) and its stated uncertainty is not meaningful.
 - Not identifiable: ``k_m`` itself, ``m_r`` (only ``a = F_a / m_r`` appears), and ``m_f`` or ``k`` without a
   known ``v0`` (only ``m_f v0`` and ``k v0`` appear).
 
