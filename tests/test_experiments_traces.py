@@ -99,6 +99,7 @@ def _write_bad_traces(folder: Path) -> dict[str, str]:
         folder / "unfinished.csv", cr.experiments.Trace(cut.time[:150], cut.force[:150], velocity=0.08)
     )
     (folder / "columns.csv").write_text("seconds,newtons\n0,1\n")
+    (folder / "unit.csv").write_text((folder / "good.csv").read_text().replace("time [ms]", "time [kg]"))
     (folder / "text.csv").write_text(
         (folder / "good.csv").read_text().replace("\n0.571428571,", "\n0.571428571,oops\n0.6,", 1)
     )
@@ -110,6 +111,7 @@ def _write_bad_traces(folder: Path) -> dict[str, str]:
         "nan.csv": "missing or non-numeric force",
         "unfinished.csv": "contact still on at the end",
         "columns.csv": "no time column",
+        "unit.csv": "unit 'kg' is not a unit of s's kind",
         "text.csv": "missing or non-numeric",
     }
 
@@ -139,11 +141,11 @@ def test_cli_reports_bad_traces_and_writes_outputs(tmp_path):
     )
     assert done.returncode == 0, done.stderr
     skipped = [line for line in done.stderr.splitlines() if line.startswith("crx fit: skipped")]
-    assert len(skipped) == 8 and "Traceback" not in done.stderr
+    assert len(skipped) == 9 and "Traceback" not in done.stderr
     assert "good" in done.stdout and "tab:one_shot" in done.stdout
     trials = pd.read_csv(out / "trials.csv")
     assert list(trials["trial"]) == ["good"]
-    assert len(pd.read_csv(out / "rejected.csv")) == 8
+    assert len(pd.read_csv(out / "rejected.csv")) == 9
     assert (out / "traces").is_dir() and any((out / "traces").iterdir())
     # --strict: the same report, but a rejected trace makes the exit status 2.
     small = tmp_path / "small"
@@ -188,3 +190,14 @@ def test_shipped_example_dataset_is_what_the_generator_writes(tmp_path):
         # Same seed, same files: numbers agree to the 6 significant digits written.
         ours, theirs = (pd.read_csv(p, comment="#").to_numpy() for p in (path, shipped))
         np.testing.assert_allclose(ours, theirs, rtol=1e-5, atol=1e-6)
+
+
+def test_help_names_units():
+    done = subprocess.run(
+        [sys.executable, "-m", "collision_reflex", "fit", "--help"],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    for unit in ("[N/m]", "[Hz]", "[m/s]"):
+        assert unit in done.stdout

@@ -143,7 +143,7 @@ def to_si(
     ureg = _registry()
     try:
         quantity = ureg.Quantity(value) if isinstance(value, str) else ureg.Quantity(float(value))
-        if quantity.dimensionless and not isinstance(quantity.magnitude, bool):
+        if quantity.dimensionless:  # a plain number is in the default unit
             quantity = ureg.Quantity(float(quantity.magnitude), default_unit)
         return float(quantity.to(ureg.Quantity(1.0, default_unit).to_base_units().units).magnitude)
     except (pint.errors.PintError, ValueError, TypeError, AttributeError) as error:
