@@ -6,6 +6,7 @@ Actuation"). This package evaluates it from structure, actuation, stiffness and 
 URDF arms, and optimises actuator designs against it.
 """
 
+from . import experiments
 from .actuators import (
     REFLECTED_INERTIA_PLACEMENTS,
     Actuator,
@@ -28,9 +29,11 @@ from .directions import circle_directions, sphere_directions, unit_directions
 from .errors import (
     CatalogueError,
     CollisionReflexError,
+    FitFailed,
     FrameNotFound,
     InvalidParameter,
     SolverFailed,
+    TraceError,
     UnknownMotor,
     UrdfError,
 )
@@ -109,6 +112,7 @@ __all__ = [
     "DesignSpace",
     "EffectiveParameters",
     "Ellipsoid",
+    "FitFailed",
     "ForceThreshold",
     "FrameNotFound",
     "Gearbox",
@@ -123,6 +127,7 @@ __all__ = [
     "ReflexSurface",
     "ScalingLaw",
     "SolverFailed",
+    "TraceError",
     "UnknownMotor",
     "UrdfError",
     "__version__",
@@ -134,6 +139,7 @@ __all__ = [
     "effective_mass",
     "effective_parameters",
     "ellipsoid_of_gyration",
+    "experiments",
     "force_profile",
     "gear_ratio_for",
     "generalized_inertia_ellipsoid",
