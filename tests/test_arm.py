@@ -159,6 +159,7 @@ def test_armature_is_the_reflected_inertia():
     data = arm.model.createData()
     for s in range(3):
         difference = pin.crba(arm.model, data, q[s]) - samples.mass_matrix[s]
+        # Entries of order 1e-2 minus themselves: rounding leaves ~1e-17; the armature itself is exact.
         np.testing.assert_allclose(difference, np.diag(reflected), rtol=1e-9, atol=1e-15)
 
 
@@ -224,3 +225,51 @@ def test_bad_urdf_gives_the_parser_reason(tmp_path, text, reason):
 def test_missing_urdf(tmp_path):
     with pytest.raises(UrdfError, match="no such file"):
         Arm.from_urdf(tmp_path / "none.urdf", "tip")
+
+
+def test_unbounded_joints_stored_as_cosine_and_sine():
+    arm = Arm.from_example_robot_data("double_pendulum_continuous", "link2", [0.0, 0.0, 0.2])
+    assert (arm.nq, arm.nv) == (4, 2)
+    angles = np.array([[0.3, -1.2], [2.0, 0.5]])
+    q = arm.configuration(angles)
+    np.testing.assert_allclose(arm.joint_coordinates(q), angles, atol=1e-15)
+    samples = arm.kinematics(q)
+    model, data = arm.model, arm.model.createData()
+    frame = model.getFrameId("link2")
+    for s in range(2):
+        pin.computeJointJacobians(model, data, q[s])
+        pin.updateFramePlacements(model, data)
+        jac = pin.getFrameJacobian(model, data, frame, pin.LOCAL_WORLD_ALIGNED)
+        offset = data.oMf[frame].rotation @ np.array([0.0, 0.0, 0.2])
+        expected = jac[:3] + np.cross(jac[3:].T, offset).T  # the offset point moves with the link
+        np.testing.assert_allclose(arm.plane @ samples.jacobian[s], expected, atol=1e-12)
+
+
+def test_visual_model_of_a_urdf_without_meshes(two_link):
+    assert two_link.visual_model().ngeoms == 0
+
+
+def test_visual_model_resolves_package_meshes():
+    ur5 = Arm.from_example_robot_data("ur5")
+    assert ur5.visual_model().ngeoms > 0  # meshes found through the package directory
+    bare = Arm.from_urdf(ur5.urdf_path, "tool0")  # no package directories: the parser's reason
+    with pytest.raises(UrdfError, match="could not be found"):
+        bare.visual_model()
+
+
+@pytest.mark.parametrize(
+    "name, nv, task_dim, frame",
+    [
+        ("ur5", 6, 3, "tool0"),
+        ("panda", 7, 3, "panda_hand_tcp"),
+        ("double_pendulum", 2, 2, "link2"),
+        ("solo12", 12, 3, "FL_FOOT"),
+        ("a1", 12, 3, "FL_foot"),
+    ],
+    ids=["ur5", "panda", "double_pendulum", "solo12", "a1"],
+)
+def test_example_robots_load_with_default_contacts(name, nv, task_dim, frame):
+    arm = Arm.from_example_robot_data(name)  # legged robots: base fixed to the world
+    assert (arm.nv, arm.task_dim, arm.contact_frame) == (nv, task_dim, frame)
+    samples = arm.kinematics(arm.sample_configurations(2, np.random.default_rng(1)))
+    assert np.all(np.isfinite(samples.jacobian)) and np.any(samples.jacobian != 0)

@@ -6,6 +6,7 @@ Actuation"). This package evaluates it from structure, actuation, stiffness and 
 URDF arms, and optimises actuator designs against it.
 """
 
+from . import experiments
 from .actuators import (
     REFLECTED_INERTIA_PLACEMENTS,
     Actuator,
@@ -15,14 +16,29 @@ from .actuators import (
     PositionThreshold,
     gear_ratio_for,
 )
+from .arm import (
+    Arm,
+    ArmSamples,
+    CollisionImpulses,
+    EffectiveParameters,
+    JointParameters,
+    collision_impulses,
+    effective_parameters,
+)
+from .directions import circle_directions, sphere_directions, unit_directions
 from .errors import (
     CatalogueError,
     CollisionReflexError,
+    FitFailed,
+    FrameNotFound,
     InvalidParameter,
     SolverFailed,
     StudyFileError,
     StudyProblem,
+    StudyRunFailed,
+    TraceError,
     UnknownMotor,
+    UrdfError,
 )
 from .gearboxes import GEARBOX_KINDS, Gearbox
 from .impulse import (
@@ -36,6 +52,15 @@ from .impulse import (
     series_stiffness,
     total_impulse,
     velocity_coefficients,
+)
+from .metrics import (
+    Ellipsoid,
+    ImpactMitigation,
+    dynamic_manipulability_ellipsoid,
+    effective_mass,
+    ellipsoid_of_gyration,
+    generalized_inertia_ellipsoid,
+    impact_mitigation_factor,
 )
 from .motors import (
     SCALING_LAWS,
@@ -62,6 +87,7 @@ from .optimize import (
     pareto_front,
     solve,
 )
+from .surfaces import ReflexSurface, reflex_surface
 from .study import load_study, study_json_schema
 from .study.runner import run_study
 
@@ -75,8 +101,11 @@ __all__ = [
     "SCALING_LAWS",
     "Actuator",
     "ActuatorTechnology",
+    "Arm",
+    "ArmSamples",
     "Bounds",
     "CatalogueError",
+    "CollisionImpulses",
     "CollisionParameters",
     "CollisionReflexError",
     "Constraints",
@@ -86,24 +115,43 @@ __all__ = [
     "DesignProblem",
     "DesignResult",
     "DesignSpace",
+    "EffectiveParameters",
+    "Ellipsoid",
+    "FitFailed",
     "ForceThreshold",
+    "FrameNotFound",
     "Gearbox",
+    "ImpactMitigation",
     "InvalidParameter",
+    "JointParameters",
     "Motor",
     "MotorQuantities",
     "ParetoSet",
     "PhaseImpulses",
     "PositionThreshold",
+    "ReflexSurface",
     "ScalingLaw",
     "SolverFailed",
     "StudyFileError",
     "StudyProblem",
+    "StudyRunFailed",
+    "TraceError",
     "UnknownMotor",
+    "UrdfError",
     "__version__",
     "build_problem",
+    "circle_directions",
+    "collision_impulses",
     "collision_times",
+    "dynamic_manipulability_ellipsoid",
+    "effective_mass",
+    "effective_parameters",
+    "ellipsoid_of_gyration",
+    "experiments",
     "force_profile",
     "gear_ratio_for",
+    "generalized_inertia_ellipsoid",
+    "impact_mitigation_factor",
     "load_catalogue",
     "load_study",
     "minimum_impulse",
@@ -112,11 +160,14 @@ __all__ = [
     "phase_impulses",
     "reference_motor",
     "run_study",
+    "reflex_surface",
     "scaled_motor_quantities",
     "scaling_law",
     "series_stiffness",
-    "solve",
     "study_json_schema",
+    "solve",
+    "sphere_directions",
     "total_impulse",
+    "unit_directions",
     "velocity_coefficients",
 ]

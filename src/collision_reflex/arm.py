@@ -16,12 +16,8 @@ separately and linearly (``M_bb(q; m) = M_bb0(q) + sum_i m_i A_i(q)``).
 
 from __future__ import annotations
 
-import contextlib
 import os
-import sys
-import tempfile
-import xml.etree.ElementTree as ElementTree
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -29,23 +25,16 @@ from typing import Any
 import numpy as np
 
 from . import _validate
+from ._robots import (
+    ROBOT_DEFAULTS,
+    captured_stderr,
+    configuration_by_name,
+    example_robot,
+    load_urdf,
+    parser_reason,
+    with_locked_joints,
+)
 from .errors import FrameNotFound, InvalidParameter, UrdfError
-
-# Sensible contact points and locked joints of the example-robot-data robots most used as arms. The double
-# pendulum's URDF has no tip frame: its second link is about 0.2 m long (its centre of mass sits at 0.10 m
-# along z), so the tip is taken 0.2 m along that link's z axis.
-_ROBOT_DEFAULTS: dict[str, dict[str, Any]] = {
-    "panda": {
-        "contact_frame": "panda_hand_tcp",
-        "locked_joints": ("panda_finger_joint1", "panda_finger_joint2"),
-    },
-    "ur5": {"contact_frame": "tool0"},
-    "ur3": {"contact_frame": "tool0"},
-    "ur10": {"contact_frame": "tool0"},
-    "double_pendulum": {"contact_frame": "link2", "contact_offset": (0.0, 0.0, 0.2)},
-    "solo12": {"contact_frame": "FL_FOOT"},
-    "a1": {"contact_frame": "FL_foot"},
-}
 
 # Joints whose limits are missing or meaningless (URDF "continuous", or lower >= upper) are sampled on a full
 # turn; limits beyond this magnitude are treated as missing.
@@ -261,6 +250,8 @@ class Arm:
         ``peak_torque``, ``stiffness``, ``mechanical_stiffness`` and ``mass``); or a :class:`JointParameters`.
         Default: the model's armature and URDF effort limits, rigid joints and no motor masses.
     name: a name for messages and figures.
+    urdf_path: the URDF the model came from (for :meth:`visual_model`).
+    package_dirs: directories that resolve the URDF's ``package://`` mesh references.
     """
 
     def __init__(
@@ -299,17 +290,19 @@ class Arm:
         # The contact point in its parent joint's frame.
         self._contact_local = np.asarray(frame.placement.act(offset), dtype=float)
 
+        effort = np.asarray(model.effortLimit, dtype=float)
+        # URDFs often leave effort at 0 (unknown); Pinocchio reports "no limit" as the largest double.
+        unknown = (effort <= 0) | (effort > 1e300) | ~np.isfinite(effort)
+        self.urdf_torque_limit: np.ndarray = np.where(unknown, np.nan, effort)
+        """The URDF's effort limit per joint [N m], ``nan`` where it gives none."""
         if isinstance(actuators, JointParameters):
             params = actuators
         elif actuators is not None:
             params = JointParameters.from_actuators(actuators, model.nv)
         else:
-            effort = np.asarray(model.effortLimit, dtype=float)
-            # URDFs often leave effort at 0 (unknown); Pinocchio reports "no limit" as the largest double.
-            unknown = (effort <= 0) | (effort > 1e300) | ~np.isfinite(effort)
             params = JointParameters(
                 reflected_inertia=np.asarray(model.armature, dtype=float),
-                torque_limit=np.where(unknown, np.nan, effort),
+                torque_limit=self.urdf_torque_limit,
                 stiffness=np.full(model.nv, np.inf),
                 mechanical_stiffness=np.full(model.nv, np.inf),
                 motor_mass=np.zeros(model.nv),
@@ -317,9 +310,12 @@ class Arm:
         if params.size != model.nv:
             raise InvalidParameter("actuators", params.size, f"{model.nv} joints' parameters")
         self.joint_parameters = params
-        self.actuators = (
-            actuators if actuators is not None and not isinstance(actuators, JointParameters) else None
-        )
+        if actuators is None or isinstance(actuators, JointParameters):
+            self.actuators: tuple[Any, ...] | None = None
+        else:
+            self.actuators = (
+                tuple(actuators) if isinstance(actuators, list | tuple) else (actuators,) * model.nv
+            )
 
         self._source_model = model
         self.model = model.copy()
@@ -344,6 +340,8 @@ class Arm:
             [_support_mask(self._structure, supports[jk.parent]) for jk in self._joints]
         )
         self.plane = _plane_basis(self._structure, self._joints)
+        self.reference_configuration: np.ndarray = np.array(pin.neutral(model))
+        """A configuration to start from [rad, m]: the robot's reference pose when known, else neutral."""
         self._pin = pin
 
     # ------------------------------------------------------------------ construction
@@ -370,8 +368,8 @@ class Arm:
         actuators: see :class:`Arm`.
         locked_joints: names of joints to lock at zero (``pinocchio.buildReducedModel``), e.g. gripper fingers.
         """
-        model = _load_urdf(path)
-        model = _locked(model, locked_joints, str(path))
+        model = load_urdf(path)
+        model = with_locked_joints(model, locked_joints, str(path))
         return cls(
             model, contact_frame, contact_offset, actuators, name or Path(path).stem, path, package_dirs
         )
@@ -393,44 +391,37 @@ class Arm:
         ``a1``) at the front-left foot with the base fixed to the world. Other robots need ``contact_frame``.
         ``locked_joints`` replaces the default list of locked joints (``()`` locks none).
         """
-        try:
-            import example_robot_data
-        except ImportError as error:  # pragma: no cover - a declared dependency
-            raise InvalidParameter(
-                "name", name, "an installed example-robot-data", "pip install example-robot-data"
-            ) from error
-        try:
-            robot = example_robot_data.load(name)
-        except Exception as error:  # the loader raises plain ValueErrors for unknown names
-            raise InvalidParameter(
-                "name",
-                name,
-                "a robot of example-robot-data, e.g. 'ur5', 'panda', 'double_pendulum'",
-                str(error),
-            ) from None
-        defaults = _ROBOT_DEFAULTS.get(name, {})
+        full_model, urdf, q0 = example_robot(name)
+        model = full_model
+        defaults = ROBOT_DEFAULTS.get(name, {})
         if contact_frame is None:
             if "contact_frame" not in defaults:
                 raise InvalidParameter(
                     "contact_frame",
                     None,
                     f"a frame name for {name!r} (no default is known)",
-                    "frames: " + ", ".join(f.name for f in robot.model.frames),
+                    "frames: " + ", ".join(f.name for f in model.frames),
                 )
             contact_frame = defaults["contact_frame"]
             if contact_offset is None:
                 contact_offset = defaults.get("contact_offset")
-        model = robot.model
         if model.njoints > 1 and model.joints[1].nq == 7:  # free-flyer root: fix the base to the world
-            model = _load_urdf(robot.urdf)
-        locked = defaults.get("locked_joints", ()) if locked_joints is None else tuple(locked_joints)
-        model = _locked(model, locked, name)
-        return cls(model, contact_frame, contact_offset, actuators, name, robot.urdf)
+            model = load_urdf(urdf)
+        to_lock = defaults.get("locked_joints", ()) if locked_joints is None else tuple(locked_joints)
+        model = with_locked_joints(model, to_lock, name)
+        # The robots' URDFs name their meshes package://example-robot-data/robots/...: the package directory
+        # is two levels above the "robots" directory.
+        share = Path(urdf).resolve()
+        while share.name != "robots" and share != share.parent:
+            share = share.parent
+        arm = cls(model, contact_frame, contact_offset, actuators, name, urdf, [share.parent.parent])
+        arm.reference_configuration = configuration_by_name(full_model, q0, model)
+        return arm
 
     def with_actuators(self, actuators: Any) -> Arm:
         """The same arm and contact point with other actuators (see :class:`Arm`)."""
-        return Arm(
-            self._structure,
+        arm = Arm(
+            self._source_model,
             self.contact_frame,
             self.contact_offset,
             actuators,
@@ -438,6 +429,80 @@ class Arm:
             self.urdf_path,
             self.package_dirs,
         )
+        arm.reference_configuration = self.reference_configuration.copy()
+        return arm
+
+    def with_scaled_motors(
+        self,
+        stator_diameter: float,
+        torque_required: Any = None,
+        *,
+        reference: Any = None,
+        law: str = "haddadin",
+        mechanical_stiffness: Any = np.inf,
+        software_stiffness: Any = np.inf,
+        sensing: Any = None,
+    ) -> Arm:
+        """The same arm with a scaled motor at every joint, geared to meet a torque requirement (the paper's
+        sweep of ``tab:motor_params``): ``N_i = max(1, tau_req,i / tau_p(r))``.
+
+        Parameters
+        ----------
+        stator_diameter: stator outer diameter of every motor [m] (the paper's ``r_m``).
+        torque_required: output torque per joint [N m] (scalar or (nv,)); default the URDF effort limits
+            (:attr:`urdf_torque_limit`).
+        reference: the motor scaled from; default the Omni+ OPN-060-013-A (``motors.reference_motor``).
+        law: scaling law name (``motors.SCALING_LAWS``).
+        mechanical_stiffness, software_stiffness: joint springs [N m/rad] (scalar or (nv,)).
+        sensing: a sensing scheme of :mod:`collision_reflex.actuators` for every joint; default a 3 N force
+            threshold.
+        """
+        from .actuators import Actuator, ForceThreshold, gear_ratio_for
+        from .motors import reference_motor
+
+        required = self.urdf_torque_limit if torque_required is None else torque_required
+        required = _joint_array("torque_required", required, self.nv)
+        motor = (reference if reference is not None else reference_motor()).scaled(
+            stator_diameter=stator_diameter, law=law
+        )
+        ratios = np.atleast_1d(gear_ratio_for(required, motor.peak_torque))
+        k_mech = _joint_array("mechanical_stiffness", mechanical_stiffness, self.nv, allow_inf=True)
+        k_soft = _joint_array("software_stiffness", software_stiffness, self.nv, allow_inf=True)
+        scheme = ForceThreshold() if sensing is None else sensing
+        actuators = [
+            Actuator(motor, float(ratios[i]), float(k_mech[i]), float(k_soft[i]), scheme)
+            for i in range(self.nv)
+        ]
+        return self.with_actuators(actuators)
+
+    def sensing_options(self) -> dict[str, Any]:
+        """The sensing of this arm's actuators as keyword arguments: ``{"sensing": "force", "threshold": F_s}``
+        for force thresholds at the contact, or ``{"sensing": "joint_torque", "joint_threshold": tau_s}`` [N m]
+        for the joint-side schemes (position error, motor current), where the first joint to reach its
+        threshold detects the contact."""
+        from .actuators import ForceThreshold
+
+        if not self.actuators:
+            raise InvalidParameter(
+                "actuators", None, "Actuator objects with sensing schemes", "give the threshold explicitly"
+            )
+        schemes = [actuator.sensing for actuator in self.actuators]
+        if all(isinstance(scheme, ForceThreshold) for scheme in schemes):
+            forces = {float(scheme.force) for scheme in schemes}
+            if len(forces) > 1:
+                raise InvalidParameter(
+                    "actuators", sorted(forces), "one contact-force threshold for the whole arm"
+                )
+            return {"sensing": "force", "threshold": forces.pop()}
+        if any(isinstance(scheme, ForceThreshold) for scheme in schemes):
+            raise InvalidParameter(
+                "actuators", [type(s).__name__ for s in schemes], "force thresholds at every joint or at none"
+            )
+        torques = [
+            scheme.joint_threshold_torque(actuator)
+            for scheme, actuator in zip(schemes, self.actuators, strict=True)
+        ]
+        return {"sensing": "joint_torque", "joint_threshold": np.array(torques)}
 
     def visual_model(self) -> Any:
         """Pinocchio visual ``GeometryModel`` of the URDF, meshes resolved through ``package_dirs``."""
@@ -445,15 +510,18 @@ class Arm:
             raise InvalidParameter("urdf_path", None, "an arm loaded from a URDF file")
         pin = self._pin
         failure: Exception | None = None
-        with _captured_stderr() as captured:
+        with captured_stderr() as captured:
             try:
                 geometry = pin.buildGeomFromUrdf(
-                    self._structure, str(self.urdf_path), pin.GeometryType.VISUAL, list(self.package_dirs)
+                    self._structure,
+                    str(self.urdf_path),
+                    pin.GeometryType.VISUAL,
+                    package_dirs=list(self.package_dirs) or None,
                 )
             except (ValueError, RuntimeError) as error:
                 failure = error
         if failure is not None:
-            raise UrdfError(self.urdf_path, _reason(failure, captured.text))
+            raise UrdfError(self.urdf_path, parser_reason(failure, captured.text))
         return geometry
 
     # ------------------------------------------------------------------ properties
@@ -720,6 +788,7 @@ def effective_parameters(
     finger_joint_inertia: Any = None,
     stiffness_form: str = "compliance",
     joint_threshold: Any = None,
+    task_stiffness: Any = None,
     singular_tolerance: float = 1e-12,
 ) -> EffectiveParameters:
     """Effective 1D collision parameters for many configurations and directions at once (MODEL.md §3).
@@ -744,6 +813,9 @@ def effective_parameters(
         :data:`STIFFNESS_FORMS`.
     joint_threshold: joint torque at which a joint detects the contact [N m] (a motor-current threshold
         reflected through the transmission); fills ``joint_threshold_force``.
+    task_stiffness: stiffness of a Cartesian (task-space) controller [N/m], the same in every direction, in
+        series with the joint springs while sensing (``1/k = u^T J K^-1 J^T u + 1/k_task``); None for none.
+        With stiff joints it makes the sensing phase isotropic, as the paper's two-link example assumes.
     singular_tolerance: a direction is singular where ``u^T J M_bb^-1 J^T u`` is below this fraction of
         ``trace(J M_bb^-1 J^T)`` (an effective-mass ratio above ``1 / singular_tolerance``).
 
@@ -787,7 +859,7 @@ def effective_parameters(
     # (structure, actuators, stiffness, mechanical stiffness).
     task = np.stack(
         [
-            jac @ _solve_spd(structure, jac_t),
+            task_inverse_inertia(structure, jac),
             (jac / inertia) @ jac_t,
             (jac / joint_k) @ jac_t,
             (jac / joint_km) @ jac_t,
@@ -828,6 +900,11 @@ def effective_parameters(
             if value is not None:
                 value[singular] = np.inf
         a[singular] = 0.0
+    if task_stiffness is not None:
+        from .impulse import series_stiffness
+
+        _validate.positive("task_stiffness", task_stiffness)
+        k = np.where(singular, np.inf, series_stiffness(k, task_stiffness))
     return EffectiveParameters(m_f, m_r, k, k_m, F_a, a, singular, joint_force)
 
 
@@ -954,6 +1031,12 @@ def _unit_directions(directions: Any, task_dim: int) -> np.ndarray:
     if not np.all(np.isfinite(norms) & (norms > 0)):
         raise InvalidParameter("directions", directions, "non-zero finite vectors")
     return units / norms[:, None]
+
+
+def task_inverse_inertia(mass_matrix: np.ndarray, jacobian: np.ndarray) -> np.ndarray:
+    """``J M^-1 J^T`` for stacked mass matrices (n, nv, nv) [kg m^2] and Jacobians (n, m, nv) [m/rad],
+    (n, m, m) [1/kg]: the inverse of the task-space (operational-space) inertia, the ellipsoid of gyration."""
+    return jacobian @ _solve_spd(mass_matrix, np.swapaxes(jacobian, -1, -2))
 
 
 def _solve_spd(matrix: np.ndarray, rhs: np.ndarray) -> np.ndarray:
@@ -1116,69 +1199,3 @@ def _random_q(model: Any, joints: list[_JointKinematics], rng: np.random.Generat
         else:
             q[joint.idx_q : joint.idx_q + 2] = np.cos(angle), np.sin(angle)
     return q
-
-
-def _locked(model: Any, locked_joints: Sequence[str], robot: str) -> Any:
-    """The model with ``locked_joints`` fixed at their neutral position."""
-    import pinocchio as pin
-
-    if not locked_joints:
-        return model
-    names = list(model.names)
-    ids = []
-    for name in locked_joints:
-        if name not in names:
-            raise FrameNotFound(name, names[1:], "joint", robot)
-        ids.append(names.index(name))
-    return pin.buildReducedModel(model, ids, pin.neutral(model))
-
-
-def _load_urdf(path: str | os.PathLike[str]) -> Any:
-    """Parse a URDF with Pinocchio; a missing or malformed file raises :class:`UrdfError` with the reason."""
-    import pinocchio as pin
-
-    target = Path(path)
-    if not target.is_file():
-        raise UrdfError(target, "no such file")
-    try:
-        ElementTree.parse(target)
-    except ElementTree.ParseError as error:  # XML syntax: the parser's message carries line and column
-        raise UrdfError(target, f"not well-formed XML: {error}") from None
-    failure: Exception | None = None
-    with _captured_stderr() as captured:
-        try:
-            model = pin.buildModelFromUrdf(str(target))
-        except (ValueError, RuntimeError) as error:
-            failure = error
-    if failure is not None:
-        raise UrdfError(target, _reason(failure, captured.text))
-    return model
-
-
-def _reason(error: Exception, messages: str) -> str:
-    """The URDF parser's own explanation (it prints it to stderr), else the exception's text."""
-    lines = [line.strip() for line in messages.splitlines() if line.strip().startswith("Error:")]
-    reasons = [line.removeprefix("Error:").strip() for line in lines]
-    return "; ".join(reasons) if reasons else str(error).strip()
-
-
-class _Captured:
-    text = ""
-
-
-@contextlib.contextmanager
-def _captured_stderr() -> Iterator[_Captured]:
-    """Capture what C++ code writes to the process's stderr (file descriptor 2) while the block runs; the text
-    is in the yielded object's ``text`` once the block has ended."""
-    captured = _Captured()
-    sys.stderr.flush()
-    with tempfile.TemporaryFile(mode="w+b") as sink:
-        saved = os.dup(2)
-        try:
-            os.dup2(sink.fileno(), 2)
-            yield captured
-        finally:
-            os.dup2(saved, 2)
-            os.close(saved)
-            sink.seek(0)
-            captured.text = sink.read().decode(errors="replace")

@@ -41,6 +41,23 @@ def sphere_directions(count: int) -> np.ndarray:
     return np.stack([radius * np.cos(azimuth), radius * np.sin(azimuth), z], axis=1)
 
 
+COORDINATE_PLANES: tuple[str, ...] = ("x-y", "x-z", "y-z")
+
+
+def coordinate_plane(name: str) -> np.ndarray:
+    """(3, 2) world basis of a coordinate plane named ``"x-y"``, ``"x-z"`` or ``"y-z"``."""
+    if name not in COORDINATE_PLANES:
+        raise InvalidParameter("plane", name, "one of " + ", ".join(COORDINATE_PLANES))
+    index = {"x": 0, "y": 1, "z": 2}
+    first, second = (index[axis] for axis in name.split("-"))
+    return np.eye(3)[:, [first, second]]
+
+
+def plane_directions(name: str, count: int) -> np.ndarray:
+    """``count`` world unit vectors (count, 3) evenly spread on the great circle of a coordinate plane."""
+    return circle_directions(count) @ coordinate_plane(name).T
+
+
 def unit_directions(spec: Any, task_dim: int, plane: np.ndarray | None = None) -> np.ndarray:
     """Directions from a specification, as unit vectors (d, task_dim).
 
