@@ -87,9 +87,9 @@ from .optimize import (
     pareto_front,
     solve,
 )
-from .surfaces import ReflexSurface, reflex_surface
 from .study import load_study, study_json_schema
 from .study.runner import run_study
+from .surfaces import ReflexSurface, reflex_surface
 
 __version__ = "0.1.0"
 
@@ -159,14 +159,14 @@ __all__ = [
     "pareto_front",
     "phase_impulses",
     "reference_motor",
-    "run_study",
     "reflex_surface",
+    "run_study",
     "scaled_motor_quantities",
     "scaling_law",
     "series_stiffness",
-    "study_json_schema",
     "solve",
     "sphere_directions",
+    "study_json_schema",
     "total_impulse",
     "unit_directions",
     "velocity_coefficients",
