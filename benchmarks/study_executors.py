@@ -34,8 +34,15 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         for executor in ("serial", "processes", "dask"):
             started = time.perf_counter()
-            result = run_study(args.study, Path(tmp) / executor, quiet=True, smoke=args.smoke, executor=executor,
-                               workers=args.workers, figures=False)
+            result = run_study(
+                args.study,
+                Path(tmp) / executor,
+                quiet=True,
+                smoke=args.smoke,
+                executor=executor,
+                workers=args.workers,
+                figures=False,
+            )
             elapsed = time.perf_counter() - started
             table = pd.read_csv(result.folder / "pareto.csv")
             values = table[[c for c in table.columns if c.endswith(("[N*s]", "[kg]"))]].to_numpy(dtype=float)
