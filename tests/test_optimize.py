@@ -286,3 +286,13 @@ def test_multi_start_is_never_worse_and_reproducible(arm):
     np.testing.assert_array_equal(multi.x, again.x)
     with pytest.raises(cr.InvalidParameter, match="starts"):
         cr.solve(problem, starts=0)
+
+
+def test_solver_failed_message_and_pickling():
+    import pickle
+
+    error = cr.SolverFailed("could not meet x", "Infeasible_Problem_Detected", {"iter_count": 3}, [("x", 1.0)],
+                            problem=object())
+    assert str(error) == "could not meet x"
+    copy = pickle.loads(pickle.dumps(error))
+    assert (str(copy), copy.status, copy.violated, copy.problem) == (str(error), error.status, error.violated, None)

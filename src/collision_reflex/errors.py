@@ -74,6 +74,11 @@ class SolverFailed(CollisionReflexError):
         self.stats = stats
         self.violated = violated
         self.problem = problem
+        super().__init__(message)
+
+    def __reduce__(self) -> tuple:
+        # The problem holds CasADi functions, which do not cross process boundaries; the rest does.
+        return (type(self), (str(self), self.status, self.stats, self.violated, None))
 
 @dataclass(frozen=True)
 class StudyProblem:
