@@ -47,3 +47,8 @@ def _describe(value: Any) -> str:
     except Exception:  # describing must never itself fail
         pass
     return repr(value)
+
+
+class SimulationError(CollisionReflexError):
+    """A time-domain simulation could not produce a result (nothing detected, the contact never ended, the
+    integrator failed); the message says what happened and what to change."""
