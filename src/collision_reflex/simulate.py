@@ -577,6 +577,17 @@ class _Collision:
             add(lambda t, y: self.k_c * y[_XF] + self.c_c * y[_VF], -1, "finger leaves the wall")
         else:
             add(lambda t, y: y[_XF] - (0.0 if self.rigid else y[_SURF]), 1, "finger hits the wall")
+        if self.drive == "kinematic" and self.half_gap > 0 and math.isfinite(self.k_s):
+            # Taking up or opening the play changes the ideal robot's velocity at once: stop there so that the
+            # controller's impulsive work is booked.
+            total = y0[_DEFL] + y0[_ERR]
+            if total > self.half_gap or (total == self.half_gap and self.v0 > y0[_VF]):
+                add(lambda t, y: y[_DEFL] + y[_ERR] - self.half_gap, -1, "play opens")
+            elif total < -self.half_gap or (total == -self.half_gap and self.v0 < y0[_VF]):
+                add(lambda t, y: y[_DEFL] + y[_ERR] + self.half_gap, 1, "play opens")
+            else:
+                add(lambda t, y: y[_DEFL] + y[_ERR] - self.half_gap, 1, "play taken up")
+                add(lambda t, y: y[_DEFL] + y[_ERR] + self.half_gap, -1, "play taken up")
         if self.drive != "kinematic" and self.s.coulomb_friction > 0:
             if self.robot_stuck:
 
@@ -696,18 +707,18 @@ def simulate(setup: CollisionSetup) -> SimulationResult:
     if sim.sampled and setup.drive == "impedance":
         sim.held_force = sim.impedance_law(y)
 
-    def next_sample(after: float) -> float:
-        """First control sample at or after ``after`` [s]."""
+    def next_sample(after: float, strictly: bool = False) -> float:
+        """First control sample at (or strictly after) ``after`` [s]."""
         assert rate is not None
-        index = max(math.ceil(after * rate - setup.sample_phase - 1e-9), 0)
-        return (index + setup.sample_phase) / rate
+        position = after * rate - setup.sample_phase
+        index = math.floor(position + 1e-9) + 1 if strictly else math.ceil(position - 1e-9)
+        return (max(index, 0) + setup.sample_phase) / rate
 
     def detect(t: float, y: np.ndarray) -> None:
         nonlocal detection_time, reaction_time, impulse_at_detection
         detection_time = t
         impulse_at_detection = float(y[_IMP])
         reaction_time = t + setup.delay if rate is None else next_sample(t + setup.delay)
-        sim.events.append((t, "detection"))
 
     times: list[np.ndarray] = [np.array([0.0])]
     states: list[np.ndarray] = [y[:, None]]
@@ -727,6 +738,8 @@ def simulate(setup: CollisionSetup) -> SimulationResult:
         if t >= watch_end - tiny:
             break
         if t >= duration - tiny:
+            if math.isfinite(watch_end):
+                break  # the contact has ended; the watch for a new one is cut short by the duration
             if detecting and math.isinf(detection_time):
                 raise SimulationError(
                     f"nothing was detected within {duration:.3g} s: the {kind} threshold {threshold:g} is "
@@ -738,7 +751,7 @@ def simulate(setup: CollisionSetup) -> SimulationResult:
             )
         sample_time = math.inf
         if sim.sampled and sim.drive != "reaction" and (sim.drive == "impedance" or math.isinf(detection_time)):
-            sample_time = next_sample(t + tiny)
+            sample_time = next_sample(t, strictly=True)
         pending_reaction = reaction_time if detecting and sim.drive != "reaction" else math.inf
         t_stop = min(duration, watch_end, sample_time, pending_reaction)
         events = sim.mode_events(detecting and math.isinf(detection_time), start, y)
@@ -760,6 +773,10 @@ def simulate(setup: CollisionSetup) -> SimulationResult:
         modes.extend([sim.contact] * (solution.t.size - 1))
         t = float(solution.t[-1])
         y = sim.resolved(solution.y[:, -1])
+        if sim.drive == "kinematic":
+            # The integrated robot velocity follows the ideal one between jumps; book the controller's
+            # impulsive work at a jump (play taken up or opened).
+            y[_WORK] += 0.5 * setup.robot_mass * (y[_VR] ** 2 - solution.y[_VR, -1] ** 2)
         if solution.status == 1:
             name = next(name for (_, name), hits in zip(events, solution.t_events, strict=True) if hits.size)
             sim.events.append((t, name))
@@ -774,10 +791,10 @@ def simulate(setup: CollisionSetup) -> SimulationResult:
             elif name == "detection":
                 detect(t, y)
             elif name == "robot stops":
+                y[_VR] = 0.0  # exactly, so that the next segment starts from rest
                 f = sim.forces(t, y)
                 if abs(f["actuator"] - f["spring"]) <= setup.coulomb_friction:
                     sim.robot_stuck = True
-                    y[_VR] = 0.0
             elif name == "robot breaks away":
                 sim.robot_stuck = False
             if states[-1].shape[1]:
@@ -788,6 +805,7 @@ def simulate(setup: CollisionSetup) -> SimulationResult:
                 sim.held_force = sim.impedance_law(y)
             if detecting and math.isinf(detection_time) and sim.measurement(t, y, start) >= threshold:
                 detect(t, y)
+                sim.events.append((t, "detection"))
     else:
         raise SimulationError("the simulation changed mode 100000 times without ending (a chattering contact)")
 
