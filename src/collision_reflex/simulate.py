@@ -206,7 +206,7 @@ class CollisionSetup:
         if self.max_step is not None:
             _validate.positive("max_step", self.max_step)
             contact_time = self.contact_time
-            if self.max_step > contact_time / 4:
+            if contact_time > 0 and self.max_step > contact_time / 4:
                 raise InvalidParameter(
                     "max_step",
                     self.max_step,
