@@ -69,9 +69,16 @@ def test_ideal_limit_reproduces_closed_form(case, ratio):
     assert result.impulse_to_detection == pytest.approx(closed.initial + closed.sensing, rel=1e-8)
     assert result.impacts[0] == (0.0, pytest.approx(M_F * setup.velocity, rel=1e-14))
     t1, t2 = cr.collision_times(
-        M_F, setup.lumped_stiffness, k_m, F_S, A, setup.velocity, reaction, None if reaction == "at_rest" else (
-            setup.detection_robot_velocity if v_r == "detection" else setup.velocity
-        )
+        M_F,
+        setup.lumped_stiffness,
+        k_m,
+        F_S,
+        A,
+        setup.velocity,
+        reaction,
+        None
+        if reaction == "at_rest"
+        else (setup.detection_robot_velocity if v_r == "detection" else setup.velocity),
     )
     assert result.detection_time == pytest.approx(t1, rel=1e-8)
     if case != "at-rest":
@@ -116,7 +123,9 @@ def test_free_elastic_collision_conserves_energy_and_balances_momentum():
     assert result.final_energy == pytest.approx(result.initial_energy, rel=1e-8)  # rtol 1e-10, ~900 steps
     # The wall's impulse is the momentum the two masses lost.
     v0 = setup.velocity
-    momentum_lost = M_F * (v0 - result.finger_velocity[-1]) + setup.robot_mass * (v0 - result.robot_velocity[-1])
+    momentum_lost = M_F * (v0 - result.finger_velocity[-1]) + setup.robot_mass * (
+        v0 - result.robot_velocity[-1]
+    )
     assert result.impulse == pytest.approx(momentum_lost, rel=1e-8)
     # The pair leaves with about its approach speed (some energy stays in the spring's vibration).
     assert result.impulse == pytest.approx(2 * (M_F + setup.robot_mass) * v0, rel=1e-3)
@@ -126,7 +135,9 @@ BOOKKEEPING_CASES = {
     "ideal-rigid": {},
     "impedance-sampled": dict(drive="impedance", software_damping=5.0, control_rate=1000.0),
     "friction": dict(drive="impedance", software_damping=5.0, coulomb_friction=1.0, viscous_friction=0.5),
-    "restitution": dict(contact_stiffness=1e5, contact_damping=contact_damping_for_restitution(0.5, M_F, 1e5)),
+    "restitution": dict(
+        contact_stiffness=1e5, contact_damping=contact_damping_for_restitution(0.5, M_F, 1e5)
+    ),
     "play": dict(backlash=0.004, delay=0.005),
 }
 
@@ -229,7 +240,9 @@ def test_restitution_round_trip_and_limits():
 
 def test_stiff_plastic_contact_approaches_the_rigid_wall():
     rigid = simulate(soft_setup())
-    stiff = simulate(soft_setup(contact_stiffness=1e7, contact_damping=contact_damping_for_restitution(0.01, M_F, 1e7)))
+    stiff = simulate(
+        soft_setup(contact_stiffness=1e7, contact_damping=contact_damping_for_restitution(0.01, M_F, 1e7))
+    )
     # A 1% rebound of the finger's m_f v0 = 0.05 N*s is gathered back by the spring; what remains is the
     # few-percent change of the contact's timing.
     assert stiff.impulse == pytest.approx(rigid.impulse, rel=0.02)
@@ -240,7 +253,10 @@ def test_stiff_plastic_contact_approaches_the_rigid_wall():
     [
         (dict(finger_mass=-0.1), "finger_mass = -0.1 is invalid"),
         (dict(robot_mass=0.0), "robot_mass = 0.0 is invalid"),
-        (dict(delay=0.5, duration=0.2), "delay = 0.5 is invalid: expected shorter than the simulated duration"),
+        (
+            dict(delay=0.5, duration=0.2),
+            "delay = 0.5 is invalid: expected shorter than the simulated duration",
+        ),
         (dict(contact_stiffness=1e6, max_step=1e-3), "use max_step <= 0.000351 s"),
         (dict(drive="impedance", software_stiffness=math.inf), "use drive='ideal'"),
         (dict(coulomb_friction=20.0), "below force_limit = 10 N"),

@@ -42,7 +42,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -391,7 +391,9 @@ def contact_restitution(damping_ratio: float) -> float:
     return -position_velocity(t_end)[1]
 
 
-def contact_damping_for_restitution(restitution: float, finger_mass: float, contact_stiffness: float) -> float:
+def contact_damping_for_restitution(
+    restitution: float, finger_mass: float, contact_stiffness: float
+) -> float:
     """Contact damping [N*s/m] giving ``restitution`` (in (0, 1]) to the finger alone on the contact.
 
     Parameters
@@ -680,7 +682,9 @@ def simulate(setup: CollisionSetup) -> SimulationResult:
     yield_scale = F_ref / setup.software_stiffness if math.isfinite(setup.software_stiffness) else 0.0
     finger_scale = deflection_scale
     if not sim.rigid:
-        finger_scale = max(finger_scale, setup.velocity * math.sqrt(setup.finger_mass / setup.contact_stiffness))
+        finger_scale = max(
+            finger_scale, setup.velocity * math.sqrt(setup.finger_mass / setup.contact_stiffness)
+        )
     impulse_scale = setup.finger_mass * setup.velocity + F_ref**2 / (k * setup.velocity)
     energy_scale = 0.5 * (setup.finger_mass + setup.robot_mass) * setup.velocity**2 + F_ref * deflection_scale
     scales = [finger_scale, setup.velocity, deflection_scale, setup.velocity]
@@ -750,7 +754,11 @@ def simulate(setup: CollisionSetup) -> SimulationResult:
                 "lengthen duration, or check that the force limit can pull the robot away"
             )
         sample_time = math.inf
-        if sim.sampled and sim.drive != "reaction" and (sim.drive == "impedance" or math.isinf(detection_time)):
+        if (
+            sim.sampled
+            and sim.drive != "reaction"
+            and (sim.drive == "impedance" or math.isinf(detection_time))
+        ):
             sample_time = next_sample(t, strictly=True)
         pending_reaction = reaction_time if detecting and sim.drive != "reaction" else math.inf
         t_stop = min(duration, watch_end, sample_time, pending_reaction)
@@ -768,8 +776,11 @@ def simulate(setup: CollisionSetup) -> SimulationResult:
         if solution.status < 0:
             raise SimulationError(f"the integrator failed at t = {t:.6g} s: {solution.message}")
         times.append(solution.t[1:])
-        states.append(np.stack([sim.resolved(column) for column in solution.y.T[1:]], axis=1)
-                      if solution.t.size > 1 else np.zeros((_NSTATE, 0)))
+        states.append(
+            np.stack([sim.resolved(column) for column in solution.y.T[1:]], axis=1)
+            if solution.t.size > 1
+            else np.zeros((_NSTATE, 0))
+        )
         modes.extend([sim.contact] * (solution.t.size - 1))
         t = float(solution.t[-1])
         y = sim.resolved(solution.y[:, -1])
@@ -807,7 +818,9 @@ def simulate(setup: CollisionSetup) -> SimulationResult:
                 detect(t, y)
                 sim.events.append((t, "detection"))
     else:
-        raise SimulationError("the simulation changed mode 100000 times without ending (a chattering contact)")
+        raise SimulationError(
+            "the simulation changed mode 100000 times without ending (a chattering contact)"
+        )
 
     trace_t = np.concatenate(times)
     trace_y = np.concatenate(states, axis=1)
@@ -817,7 +830,8 @@ def simulate(setup: CollisionSetup) -> SimulationResult:
         spring,
         np.where(
             np.array(modes) == "pressed",
-            (0.0 if sim.rigid else setup.contact_stiffness) * trace_y[_XF] + setup.contact_damping * trace_y[_VF],
+            (0.0 if sim.rigid else setup.contact_stiffness) * trace_y[_XF]
+            + setup.contact_damping * trace_y[_VF],
             0.0,
         ),
     )
@@ -857,3 +871,94 @@ def _contact_time_estimate(setup: CollisionSetup, F_ref: float) -> float:
     reaction = (v + math.sqrt(v * v + 2 * a * F_ref / setup.mechanical_stiffness)) / a
     free = 2 * math.pi * math.sqrt((setup.finger_mass + setup.robot_mass) / setup.mechanical_stiffness)
     return t1 + reaction + free + setup.backlash / v
+
+
+SWEEP_PARAMETERS: tuple[str, ...] = ("delay", "backlash")
+"""Setup fields that :func:`sweep` can vary besides the velocity."""
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """Simulated impulses against the closed form over approach velocities (and optionally a second parameter).
+
+    Arrays have shape ``(len(values), len(velocities))``; ``values`` is ``[None]`` without a second parameter.
+
+    Attributes
+    ----------
+    velocities: approach velocities [m/s].
+    parameter: the second parameter's name (``"delay"`` [s] or ``"backlash"`` [m]) or None.
+    values: its values.
+    simulated: simulated impulse [N*s].
+    closed_form: the closed form's impulse for the same setup [N*s] (it knows no delay or backlash).
+    reaction: the closed form's reaction variant compared against.
+    tolerance: relative difference beyond which the two are said to part.
+    """
+
+    velocities: np.ndarray
+    parameter: str | None
+    values: tuple[Any, ...]
+    simulated: np.ndarray
+    closed_form: np.ndarray
+    reaction: str
+    tolerance: float
+
+    @property
+    def relative_difference(self) -> np.ndarray:
+        """``simulated / closed_form - 1``."""
+        return self.simulated / self.closed_form - 1
+
+    @property
+    def parted(self) -> np.ndarray:
+        """True where ``|relative_difference| > tolerance``."""
+        return np.abs(self.relative_difference) > self.tolerance
+
+
+def sweep(
+    setup: CollisionSetup,
+    velocities: Any,
+    parameter: str | None = None,
+    values: Any = None,
+    reaction: str = "at_rest",
+    v_r: float | None = None,
+    tolerance: float = 0.05,
+) -> Sweep:
+    """Simulate ``setup`` at each approach velocity (and each value of ``parameter``) and evaluate the
+    closed form (:meth:`CollisionSetup.closed_form`) alongside.
+
+    Parameters
+    ----------
+    setup: the collision; its ``velocity`` (and the swept parameter) are replaced.
+    velocities: approach velocities [m/s], > 0.
+    parameter: ``"delay"`` [s] or ``"backlash"`` [m] to sweep as well, or None.
+    values: the parameter's values (>= 0); with ``"backlash"``, half of each is open at impact unless
+        ``setup.initial_play`` says otherwise (it is then capped at the backlash).
+    reaction, v_r: the closed form's reaction variant, as :func:`collision_reflex.phase_impulses`.
+    tolerance: relative difference that counts as parting, > 0.
+    """
+    speeds = np.atleast_1d(np.asarray(velocities, dtype=float))
+    _validate.positive("velocities", speeds)
+    _validate.positive("tolerance", tolerance)
+    if parameter is None:
+        levels: tuple[Any, ...] = (None,)
+    else:
+        _validate.choice("parameter", parameter, SWEEP_PARAMETERS)
+        if values is None:
+            raise InvalidParameter("values", values, f"the values of {parameter} to sweep")
+        array = np.atleast_1d(np.asarray(values, dtype=float))
+        _validate.non_negative(parameter, array)
+        levels = tuple(float(v) for v in array)
+    simulated = np.empty((len(levels), speeds.size))
+    closed = np.empty_like(simulated)
+    for i, level in enumerate(levels):
+        changes: dict[str, Any] = {}
+        if parameter == "delay":
+            changes["delay"] = level
+        elif parameter == "backlash":
+            changes["backlash"] = level
+            if setup.initial_play is not None:
+                changes["initial_play"] = min(setup.initial_play, level)
+        for j, v0 in enumerate(speeds):
+            case = replace(setup, velocity=float(v0), **changes)
+            simulated[i, j] = simulate(case).impulse
+            closed[i, j] = float(case.closed_form(reaction, v_r).total)
+    return Sweep(speeds, parameter, levels, simulated, closed, reaction, float(tolerance))

@@ -13,9 +13,10 @@ from collections.abc import Sequence
 from .. import __version__
 from ..errors import CollisionReflexError
 from . import impulse as _impulse
+from . import simulate as _simulate
 
 # Subcommand modules, in the order `crx --help` lists them.
-_SUBCOMMANDS = [_impulse]
+_SUBCOMMANDS = [_impulse, _simulate]
 
 
 def build_parser() -> argparse.ArgumentParser:
