@@ -23,6 +23,7 @@ CASES = {
 def test_series_stiffness_hand_values():
     assert cr.series_stiffness(1000.0, 100.0) == pytest.approx(1000 * 100 / 1100, rel=1e-15)
     assert cr.series_stiffness(np.inf, 250.0) == 250.0  # a rigid structure leaves the software spring
+    assert cr.series_stiffness(np.inf, np.inf) == np.inf
     np.testing.assert_allclose(cr.series_stiffness(np.array([1.0, 2.0]), 2.0), [2 / 3, 1.0], rtol=1e-15)
 
 

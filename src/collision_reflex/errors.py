@@ -49,6 +49,104 @@ def _describe(value: Any) -> str:
     return repr(value)
 
 
+class SolverFailed(CollisionReflexError):
+    """The optimiser did not converge, or found the problem infeasible.
+
+    Attributes
+    ----------
+    status: IPOPT's return status (e.g. ``"Infeasible_Problem_Detected"``).
+    stats: the solver statistics (iterations, timings, ...).
+    violated: ``(label, violation)`` pairs of the constraints that could not be met, worst first.
+    problem: the problem that was solved, for inspection.
+    """
+
+    def __init__(self, message: str, status: str, stats: dict, violated: list[tuple[str, float]],
+                 problem: object = None) -> None:
+        self.status = status
+        self.stats = stats
+        self.violated = violated
+        self.problem = problem
+        super().__init__(message)
+
+
+class FrameNotFound(CollisionReflexError, ValueError):
+    """A contact frame (or joint) name does not exist in the robot model.
+
+    Attributes
+    ----------
+    name: the name asked for.
+    available: the names that do exist.
+    kind: ``"frame"`` or ``"joint"``.
+    """
+
+    def __init__(self, name: str, available: Any, kind: str = "frame", robot: str = "") -> None:
+        self.name = name
+        self.available = tuple(available)
+        self.kind = kind
+        where = f" of {robot}" if robot else ""
+        super().__init__(
+            f"{kind} {name!r} not found in the model{where}; the {kind}s that exist are: "
+            + ", ".join(self.available)
+        )
+
+
+class UrdfError(CollisionReflexError, ValueError):
+    """A URDF file is missing or does not parse into a robot model.
+
+    Attributes
+    ----------
+    path: the file.
+    reason: the parser's own explanation (with its line number when it gives one).
+    """
+
+    def __init__(self, path: Any, reason: str) -> None:
+        self.path = str(path)
+        self.reason = reason
+        super().__init__(f"cannot load URDF {self.path}: {reason}")
+
+
+class UnknownMotor(CollisionReflexError, KeyError, ValueError):
+    """A motor name that a catalogue does not hold.
+
+    Attributes
+    ----------
+    name: the name asked for.
+    available: the catalogue's names.
+    path: the catalogue file.
+    """
+
+    def __init__(self, name: str, available: list[str], path: str) -> None:
+        self.name = name
+        self.available = available
+        self.path = path
+        super().__init__(name)
+
+    def __str__(self) -> str:
+        shown = ", ".join(self.available) if self.available else "none"
+        return f"motor {self.name!r} is not in the catalogue {self.path} (it has: {shown}); `crx motors` lists it"
+
+
+class CatalogueError(CollisionReflexError, ValueError):
+    """A motor catalogue file that cannot be read: bad YAML, a missing field, a wrong type or value.
+
+    Attributes
+    ----------
+    path: the file.
+    line: 1-based line of the offending entry or field (None if unknown).
+    field: the offending field, dotted from the top (e.g. ``"motors.M1.peak_torque"``), or "".
+    reason: what is wrong and what to do.
+    """
+
+    def __init__(self, path: str, line: int | None, field: str, reason: str) -> None:
+        self.path = path
+        self.line = line
+        self.field = field
+        self.reason = reason
+        where = f"{path}:{line}" if line is not None else path
+        subject = f"{field}: " if field else ""
+        super().__init__(f"{where}: {subject}{reason}")
+
+
 class SimulationError(CollisionReflexError):
     """A time-domain simulation could not produce a result (nothing detected, the contact never ended, the
     integrator failed); the message says what happened and what to change."""

@@ -59,8 +59,12 @@ def series_stiffness(k_m: Any, k_s: Any) -> Any:
     """
     _validate.positive("k_m", k_m, allow_inf=True)
     _validate.positive("k_s", k_s, allow_inf=True)
-    # Compliances add; written this way an infinite stiffness simply drops out.
-    return 1 / (1 / k_m + 1 / k_s)
+    # Compliances add; written this way an infinite stiffness simply drops out (and two give inf).
+    if is_symbolic(k_m, k_s):
+        return 1 / (1 / k_m + 1 / k_s)
+    with np.errstate(divide="ignore"):
+        lumped = 1 / (1 / np.asarray(k_m, dtype=float) + 1 / np.asarray(k_s, dtype=float))
+    return lumped if lumped.ndim else float(lumped)
 
 
 def phase_impulses(

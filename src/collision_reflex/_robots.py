@@ -1,0 +1,141 @@
+"""Loading robot models: URDF files through Pinocchio (with the parser's own reasons for failures) and the
+robots of ``example-robot-data`` (with sensible contact points and locked joints)."""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import os
+import sys
+import tempfile
+import xml.etree.ElementTree as ElementTree
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .errors import FrameNotFound, InvalidParameter, UrdfError
+
+# Sensible contact points and locked joints of the example-robot-data robots most used as arms. The double
+# pendulum's URDF has no tip frame: its second link is about 0.2 m long (its centre of mass sits at 0.10 m
+# along z), so the tip is taken 0.2 m along that link's z axis.
+ROBOT_DEFAULTS: dict[str, dict[str, Any]] = {
+    "panda": {
+        "contact_frame": "panda_hand_tcp",
+        "locked_joints": ("panda_finger_joint1", "panda_finger_joint2"),
+    },
+    "ur5": {"contact_frame": "tool0"},
+    "ur3": {"contact_frame": "tool0"},
+    "ur10": {"contact_frame": "tool0"},
+    "double_pendulum": {"contact_frame": "link2", "contact_offset": (0.0, 0.0, 0.2)},
+    "solo12": {"contact_frame": "FL_FOOT"},
+    "a1": {"contact_frame": "FL_foot"},
+}
+
+
+@functools.lru_cache(maxsize=16)
+def _cachedexample_robot(name: str) -> tuple[Any, str, np.ndarray]:
+    try:
+        import example_robot_data
+    except ImportError as error:  # pragma: no cover - a declared dependency
+        raise InvalidParameter(
+            "name", name, "an installed example-robot-data", "pip install example-robot-data"
+        ) from error
+    try:
+        robot = example_robot_data.load(name)
+    except Exception as error:  # the loader raises plain ValueErrors for unknown names
+        raise InvalidParameter(
+            "name",
+            name,
+            "a robot of example-robot-data, e.g. 'ur5', 'panda', 'double_pendulum', 'solo12'",
+            str(error),
+        ) from None
+    return robot.model, str(robot.urdf), np.array(robot.q0, dtype=float)
+
+
+def example_robot(name: str) -> tuple[Any, str, np.ndarray]:
+    """The Pinocchio model (a copy), URDF path and reference configuration of an example-robot-data robot;
+    loading parses meshes and is slow, so it happens once per name."""
+    model, urdf, q0 = _cachedexample_robot(name)
+    return model.copy(), urdf, q0.copy()
+
+
+def configuration_by_name(source: Any, q_source: np.ndarray, target: Any) -> np.ndarray:
+    """A configuration of ``target`` taking each joint's coordinates from ``q_source`` of ``source`` (same joint
+    names), neutral for joints ``source`` does not have."""
+    import pinocchio as pin
+
+    q = np.array(pin.neutral(target))
+    names = list(source.names)
+    for j in range(1, target.njoints):
+        if target.names[j] in names:
+            joint, origin = target.joints[j], source.joints[names.index(target.names[j])]
+            q[joint.idx_q : joint.idx_q + joint.nq] = q_source[origin.idx_q : origin.idx_q + origin.nq]
+    return q
+
+
+def with_locked_joints(model: Any, locked_joints: Sequence[str], robot: str) -> Any:
+    """The model with ``locked_joints`` fixed at their neutral position."""
+    import pinocchio as pin
+
+    if not locked_joints:
+        return model
+    names = list(model.names)
+    ids = []
+    for name in locked_joints:
+        if name not in names:
+            raise FrameNotFound(name, names[1:], "joint", robot)
+        ids.append(names.index(name))
+    return pin.buildReducedModel(model, ids, pin.neutral(model))
+
+
+def load_urdf(path: str | os.PathLike[str]) -> Any:
+    """Parse a URDF with Pinocchio; a missing or malformed file raises :class:`UrdfError` with the reason."""
+    import pinocchio as pin
+
+    target = Path(path)
+    if not target.is_file():
+        raise UrdfError(target, "no such file")
+    try:
+        ElementTree.parse(target)
+    except ElementTree.ParseError as error:  # XML syntax: the parser's message carries line and column
+        raise UrdfError(target, f"not well-formed XML: {error}") from None
+    failure: Exception | None = None
+    with captured_stderr() as captured:
+        try:
+            model = pin.buildModelFromUrdf(str(target))
+        except (ValueError, RuntimeError) as error:
+            failure = error
+    if failure is not None:
+        raise UrdfError(target, parser_reason(failure, captured.text))
+    return model
+
+
+def parser_reason(error: Exception, messages: str) -> str:
+    """The URDF parser's own explanation (it prints it to stderr), else the exception's text."""
+    lines = [line.strip() for line in messages.splitlines() if line.strip().startswith("Error:")]
+    reasons = [line.removeprefix("Error:").strip() for line in lines]
+    return "; ".join(reasons) if reasons else str(error).strip()
+
+
+class _Captured:
+    text = ""
+
+
+@contextlib.contextmanager
+def captured_stderr() -> Iterator[_Captured]:
+    """Capture what C++ code writes to the process's stderr (file descriptor 2) while the block runs; the text
+    is in the yielded object's ``text`` once the block has ended."""
+    captured = _Captured()
+    sys.stderr.flush()
+    with tempfile.TemporaryFile(mode="w+b") as sink:
+        saved = os.dup(2)
+        try:
+            os.dup2(sink.fileno(), 2)
+            yield captured
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            sink.seek(0)
+            captured.text = sink.read().decode(errors="replace")

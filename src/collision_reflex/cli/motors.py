@@ -1,0 +1,116 @@
+"""``crx motors``: list a motor catalogue; ``crx motors scale``: the paper's ``tab:motor_params`` for any sizes."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..actuators import Actuator, gear_ratio_for
+from ..motors import DEFAULT_SCALING_LAW, REFERENCE_MOTOR_NAME, SCALING_LAWS, get_motor, load_catalogue
+from ._args import positive_float, value_range
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "motors",
+        help="list the motor catalogue; 'motors scale' scales a motor (tab:motor_params)",
+        description=(
+            "List the motors of a catalogue (default: the packaged one, with the paper's reference motor, "
+            "Celera Motion Omni+ OPN-060-013-A). Quantities in SI units."
+        ),
+    )
+    parser.add_argument(
+        "--catalogue", default=None, metavar="FILE", help="a motor catalogue YAML file (default: packaged)"
+    )
+    parser.set_defaults(run=run_list)
+    actions = parser.add_subparsers(dest="motors_command", metavar="ACTION")
+    scale = actions.add_parser(
+        "scale",
+        help="scale a motor to other stator diameters and gear it to a torque requirement",
+        description=(
+            "Scale a catalogue motor to other stator diameters (and stack length) by a scaling law of the "
+            "paper's tab:scaling_laws, and pick the gear ratio N = max(1, tau_req / tau_p) that meets a torque "
+            "requirement. The defaults reproduce the paper's tab:motor_params (M1, M2, M3): the Omni+ scaled "
+            "to 10, 60 and 100 mm by the Haddadin law with 1.3 N m required. Sizes in metres."
+        ),
+    )
+    scale.add_argument(
+        "--catalogue", default=None, metavar="FILE", help="a motor catalogue YAML file (default: packaged)"
+    )
+    scale.add_argument(
+        "--motor",
+        default=REFERENCE_MOTOR_NAME,
+        help="catalogue motor to scale from (default %(default)s)",
+    )
+    scale.add_argument(
+        "--diameters",
+        type=value_range,
+        default=value_range("0.010,0.060,0.100"),
+        metavar="RANGE",
+        help="stator outer diameters [m]: a list d1,d2,... or START:STOP:N log-spaced (default 0.010,0.060,0.100)",
+    )
+    scale.add_argument(
+        "--stack-length",
+        type=positive_float,
+        default=None,
+        metavar="M",
+        help="stack length [m] (default: the motor's own)",
+    )
+    scale.add_argument(
+        "--law",
+        choices=tuple(SCALING_LAWS),
+        default=DEFAULT_SCALING_LAW,
+        help="motor scaling law (default %(default)s, the paper's choice)",
+    )
+    scale.add_argument(
+        "--torque",
+        type=positive_float,
+        default=1.3,
+        metavar="N*M",
+        help="output torque requirement tau_req [N m] (default %(default)s)",
+    )
+    scale.set_defaults(run=run_scale)
+
+
+def run_list(args: argparse.Namespace) -> int:
+    catalogue = load_catalogue(args.catalogue)
+    header = (
+        f"{'name':<18}{'stator OD [mm]':>15}{'stack [mm]':>11}{'J_m [kg m^2]':>14}"
+        f"{'tau_p [N m]':>12}{'tau_c [N m]':>12}{'mass [kg]':>10}"
+    )
+    print(header)
+    for name, motor in catalogue.items():
+        print(
+            f"{name:<18}{motor.stator_diameter * 1e3:>15.4g}{motor.stack_length * 1e3:>11.4g}"
+            f"{motor.rotor_inertia:>14.4g}{motor.peak_torque:>12.4g}{motor.continuous_torque:>12.4g}"
+            f"{motor.mass:>10.4g}"
+        )
+    print()
+    for name, motor in catalogue.items():
+        print(f"{name}: {motor.source}")
+    return 0
+
+
+def run_scale(args: argparse.Namespace) -> int:
+    reference = get_motor(args.motor, args.catalogue)
+    motors = [reference.scaled(float(d), args.stack_length, args.law) for d in args.diameters]
+    actuators = [Actuator(m, float(gear_ratio_for(args.torque, m.peak_torque))) for m in motors]
+    rows = [
+        ("Stator OD (r_m)", "mm", [m.stator_diameter * 1e3 for m in motors]),
+        ("Stack height (l)", "mm", [m.stack_length * 1e3 for m in motors]),
+        ("Rotor inertia (J_m)", "kg m^2", [m.rotor_inertia for m in motors]),
+        ("Cont. torque (tau_c)", "N m", [m.continuous_torque for m in motors]),
+        ("Peak torque (tau_p)", "N m", [m.peak_torque for m in motors]),
+        ("Mass", "kg", [m.mass for m in motors]),
+        ("Gear ratio (N)", "-", [a.gear_ratio for a in actuators]),
+        ("Inertia (N^2 J_m)", "kg m^2", [a.reflected_inertia for a in actuators]),
+        ("Peak torque out (N tau_p)", "N m", [a.peak_torque for a in actuators]),
+    ]
+    print(
+        f"{reference.name} scaled by the {args.law} law, output torque requirement {args.torque:g} N m "
+        "(gearbox inertia ignored, as in the paper)"
+    )
+    print(f"{'parameter':<27}{'unit':<8}" + "".join(f"{f'M{i + 1}':>12}" for i in range(len(motors))))
+    for label, unit, values in rows:
+        print(f"{label:<27}{unit:<8}" + "".join(f"{v:>12.4g}" for v in values))
+    print(f"\nmass of {reference.name}: {reference.mass:g} kg ({reference.source})")
+    return 0

@@ -1,0 +1,358 @@
+"""``crx surface``: collision-reflex surfaces of a URDF arm (the paper's ``fig:two_link``)."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ._args import positive_float
+
+# Defaults of the paper's two-link example (fig:two_link; fig:motor_scale_modeling for stiffness and threshold):
+# Omni+ motors of 60 mm stator diameter geared to the URDF's torque limits, q2 = 45 deg, v0 = 0.5 m/s, a 3 N
+# force threshold, 100 N/m Cartesian controller stiffness, joint springs of 250 N m/rad (about 1000 N/m at the
+# 0.5 m reach of the two-link design).
+_DEFAULT_URDF = Path("designs") / "planar_two_link.urdf"
+_SECOND_JOINT = 1  # the paper's q2: the second joint of the chain
+_DEFAULTS = {
+    "motor_size": 60.0,
+    "velocity": 0.5,
+    "threshold": 3.0,
+    "task_stiffness": 100.0,
+    "mech_stiffness": 250.0,
+    "soft_stiffness": math.inf,
+    "q2_values": "90,45,20,5,0",
+    "motor_sizes": "10,30,60,100",
+    "velocities": "0.1,0.25,0.5,1,2",
+}
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "surface",
+        help="collision-reflex surfaces of a URDF arm (impulse over contact directions)",
+        description=(
+            "The collision impulse of a URDF arm swept over contact directions at one configuration. A planar "
+            "arm gets the paper's grid (fig:two_link): rows varying the second joint angle, the motor size and "
+            "the approach velocity, with the arm drawn under each polar surface; a spatial arm gets a 3D surface "
+            "and its x-y, x-z and y-z sections. Every joint gets the Omni+ OPN-060-013-A scaled to --motor-size "
+            "(Haddadin law) and geared to the joint's torque requirement (N = max(1, tau_req / tau_p)). "
+            f"Default arm: {_DEFAULT_URDF} (relative to the current directory), contact frame 'tip'."
+        ),
+    )
+    add = parser.add_argument
+    source = parser.add_mutually_exclusive_group()
+    source.add_argument(
+        "--urdf", type=Path, default=None, metavar="FILE", help=f"URDF file (default {_DEFAULT_URDF})"
+    )
+    source.add_argument(
+        "--robot",
+        default=None,
+        metavar="NAME",
+        help="an example-robot-data robot: ur5, panda, double_pendulum, ...",
+    )
+    add(
+        "--frame",
+        default=None,
+        metavar="NAME",
+        help="contact frame (default 'tip' for a URDF, per robot otherwise)",
+    )
+    add(
+        "--offset",
+        type=float,
+        nargs=3,
+        default=None,
+        metavar=("X", "Y", "Z"),
+        help="contact point in the frame [m]",
+    )
+    add(
+        "--package-dir",
+        action="append",
+        default=None,
+        metavar="DIR",
+        help="package:// directory (repeatable)",
+    )
+    add(
+        "--lock",
+        nargs="*",
+        default=None,
+        metavar="JOINT",
+        help="joints to lock (default: per robot, e.g. Panda fingers)",
+    )
+    add(
+        "--q",
+        type=float,
+        nargs="+",
+        default=None,
+        metavar="DEG",
+        help="joint angles [deg] (prismatic joints [m]); default q1 = 0, q2 = 45 for a planar arm, the robot's "
+        "reference pose otherwise",
+    )
+    add(
+        "--motor-size",
+        type=positive_float,
+        default=_DEFAULTS["motor_size"],
+        metavar="MM",
+        help="stator diameter [mm] (default %(default)g)",
+    )
+    add(
+        "--torque",
+        type=positive_float,
+        nargs="+",
+        default=None,
+        metavar="N*M",
+        help="torque requirement per joint [N m] (default: URDF effort limits)",
+    )
+    add(
+        "--mech-stiffness",
+        type=positive_float,
+        default=_DEFAULTS["mech_stiffness"],
+        metavar="NM/RAD",
+        help="joint mechanical stiffness [N m/rad] (default %(default)g)",
+    )
+    add(
+        "--soft-stiffness",
+        type=positive_float,
+        default=_DEFAULTS["soft_stiffness"],
+        metavar="NM/RAD",
+        help="joint software stiffness [N m/rad] (default: none, inf)",
+    )
+    add(
+        "--task-stiffness",
+        type=_stiffness_or_none,
+        default=_DEFAULTS["task_stiffness"],
+        metavar="N/M",
+        help="Cartesian controller stiffness [N/m], 'none' for none (default %(default)g)",
+    )
+    add(
+        "--threshold",
+        type=positive_float,
+        default=_DEFAULTS["threshold"],
+        metavar="N",
+        help="contact-force threshold F_s [N] (default %(default)g)",
+    )
+    add(
+        "--velocity",
+        type=positive_float,
+        default=_DEFAULTS["velocity"],
+        metavar="M/S",
+        help="approach velocity v0 [m/s] (default %(default)g)",
+    )
+    add(
+        "--stiffness-form",
+        choices=("compliance", "paper"),
+        default="compliance",
+        help="effective stiffness form (default %(default)s)",
+    )
+    add(
+        "--directions",
+        type=int,
+        default=None,
+        metavar="N",
+        help="directions swept (default 360 planar, 2000 spatial)",
+    )
+    add(
+        "--q2-values",
+        type=_number_list,
+        default=_DEFAULTS["q2_values"],
+        metavar="DEG,...",
+        help="second joint angles of the grid's first row [deg] (default %(default)s)",
+    )
+    add(
+        "--motor-sizes",
+        type=_number_list,
+        default=_DEFAULTS["motor_sizes"],
+        metavar="MM,...",
+        help="motor sizes of the second row [mm] (default %(default)s)",
+    )
+    add(
+        "--velocities",
+        type=_number_list,
+        default=_DEFAULTS["velocities"],
+        metavar="M/S,...",
+        help="approach velocities of the third row [m/s] (default %(default)s)",
+    )
+    add(
+        "--output",
+        "-o",
+        default="reflex_surface.png",
+        metavar="FILE",
+        help="figure (.png, .svg or .pdf; default %(default)s)",
+    )
+    add(
+        "--table",
+        default=None,
+        metavar="FILE.csv",
+        help="also write the baseline surface, one row per direction",
+    )
+    parser.set_defaults(run=run)
+
+
+def _number_list(text: str) -> list[float]:
+    try:
+        values = [float(part) for part in text.split(",") if part.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a comma-separated list of numbers") from None
+    if not values or not all(math.isfinite(v) and v >= 0 for v in values):
+        raise argparse.ArgumentTypeError(f"{text!r}: expected finite numbers >= 0")
+    return values
+
+
+def _stiffness_or_none(text: str) -> float | None:
+    return None if text.strip().lower() == "none" else positive_float(text)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..arm import Arm
+    from ..errors import InvalidParameter
+    from ..plots import check_figure_path
+    from ..surfaces import reflex_surface
+
+    check_figure_path(args.output)
+    if args.robot is not None:
+        arm = Arm.from_example_robot_data(args.robot, args.frame, args.offset, locked_joints=args.lock)
+    else:
+        path = args.urdf if args.urdf is not None else _DEFAULT_URDF
+        arm = Arm.from_urdf(
+            path, args.frame or "tip", args.package_dir, args.offset, locked_joints=args.lock or ()
+        )
+    q = _configuration(arm, args.q)
+    if args.torque is None and np.any(np.isnan(arm.urdf_torque_limit)):
+        raise InvalidParameter(
+            "--torque",
+            None,
+            f"a torque requirement [N m] for the joints of {arm.name}",
+            "its URDF gives no effort limits; pass --torque T (one value or one per joint)",
+        )
+    if args.torque is not None and len(args.torque) not in (1, arm.nv):
+        raise InvalidParameter("--torque", args.torque, f"one value or {arm.nv} values [N m]")
+    options = {
+        "task_stiffness": args.task_stiffness,
+        "stiffness_form": args.stiffness_form,
+        "directions": args.directions,
+    }
+    if args.directions is not None and args.directions < 3:
+        raise InvalidParameter("--directions", args.directions, "at least 3")
+
+    def actuated(size_mm: float) -> Arm:
+        from ..actuators import ForceThreshold
+
+        return arm.with_scaled_motors(
+            size_mm * 1e-3,
+            args.torque if args.torque is None or len(args.torque) > 1 else args.torque[0],
+            mechanical_stiffness=args.mech_stiffness,
+            software_stiffness=args.soft_stiffness,
+            sensing=ForceThreshold(args.threshold),
+        )
+
+    base_arm = actuated(args.motor_size)
+    baseline = reflex_surface(base_arm, q, args.velocity, **options)
+    _print_summary(base_arm, baseline)
+    if args.table is not None:
+        _write_table(args.table, baseline)
+        print(f"wrote {args.table}")
+
+    if arm.task_dim == 2:
+        from ..plots.surface import SurfaceRow, plot_planar_grid
+
+        if arm.nv < 2:
+            raise InvalidParameter("arm", arm.name, "at least two joints for the grid's second-joint row")
+        angle_row = []
+        for angle in args.q2_values:
+            varied = q.copy()
+            varied[_SECOND_JOINT] = math.radians(angle)
+            angle_row.append(reflex_surface(base_arm, varied, args.velocity, **options))
+        motor_row = [reflex_surface(actuated(size), q, args.velocity, **options) for size in args.motor_sizes]
+        velocity_row = [reflex_surface(base_arm, q, v, **options) for v in args.velocities]
+        rows = [
+            SurfaceRow("second joint angle", angle_row, [f"q2 = {a:g}°" for a in args.q2_values]),
+            SurfaceRow("motor size", motor_row, [f"r_m = {s:g} mm" for s in args.motor_sizes]),
+            SurfaceRow("approach velocity", velocity_row, [f"v0 = {v:g} m/s" for v in args.velocities]),
+        ]
+        title = (
+            f"{arm.name}: q2 = {math.degrees(q[_SECOND_JOINT]):g}°, r_m = {args.motor_size:g} mm, "
+            f"v0 = {args.velocity:g} m/s unless stated; F_s = {args.threshold:g} N"
+        )
+        written = plot_planar_grid(args.output, rows, title)
+    else:
+        from ..directions import COORDINATE_PLANES, plane_directions
+        from ..plots.surface import plot_spatial_surface
+
+        count = args.directions or 360
+        sections = {
+            name: reflex_surface(
+                base_arm, q, args.velocity, **{**options, "directions": plane_directions(name, count)}
+            )
+            for name in COORDINATE_PLANES
+        }
+        title = f"{arm.name} at q = {np.round(np.degrees(q), 1).tolist()} deg, r_m = {args.motor_size:g} mm, v0 = {args.velocity:g} m/s"
+        written = plot_spatial_surface(args.output, baseline, sections, title)
+    print(f"wrote {written}")
+    return 0
+
+
+def _configuration(arm, degrees: list[float] | None) -> np.ndarray:
+    from ..errors import InvalidParameter
+
+    if degrees is None:
+        if arm.task_dim == 2 and not np.any(arm.reference_configuration):
+            angles = np.zeros(arm.nv)
+            angles[1] = math.radians(45.0)
+            return arm.configuration(angles)
+        return arm.reference_configuration.copy()
+    if len(degrees) != arm.nv:
+        raise InvalidParameter("--q", degrees, f"{arm.nv} joint angles [deg], one per joint of {arm.name}")
+    return arm.configuration(np.radians(degrees))
+
+
+def _print_summary(arm, surface) -> None:
+    impulse = surface.impulse
+    finite = np.isfinite(impulse)
+    smallest, largest = surface.extremes()
+    print(
+        f"{arm!r}: {surface.directions.shape[0]} directions, v0 = {surface.v0:g} m/s, "
+        f"gear ratios {np.round([a.gear_ratio for a in arm.actuators], 2).tolist()}"
+    )
+    print(f"smallest impulse {impulse.min():.4g} N*s along {np.round(smallest, 3).tolist()}")
+    if np.all(finite):
+        print(f"largest impulse  {impulse.max():.4g} N*s along {np.round(largest, 3).tolist()}")
+    else:
+        print(
+            f"largest finite impulse {impulse[finite].max():.4g} N*s; {int((~finite).sum())} singular "
+            f"direction(s) with infinite impulse, e.g. {np.round(largest, 3).tolist()}"
+        )
+    v_star = surface.impulses.v_star[finite]
+    print(
+        f"optimal approach velocity v* from {v_star.min():.4g} to {v_star.max():.4g} m/s over the directions"
+    )
+
+
+def _write_table(path: str, surface) -> None:
+    import csv
+
+    from .._io import atomic_open
+
+    p, i = surface.parameters, surface.impulses
+    columns = {
+        **{f"u{axis}": surface.directions[:, axis] for axis in range(surface.task_dim)},
+        "m_f_kg": p.m_f,
+        "m_r_kg": p.m_r,
+        "k_N_per_m": p.k,
+        "k_m_N_per_m": p.k_m,
+        "F_a_N": p.F_a,
+        "a_m_per_s2": p.a,
+        "F_s_N": i.threshold,
+        "impulse_initial_Ns": i.initial,
+        "impulse_sensing_Ns": i.sensing,
+        "impulse_reaction_Ns": i.reaction,
+        "impulse_total_Ns": i.total,
+        "v_star_m_per_s": i.v_star,
+        "singular": p.singular.astype(int),
+    }
+    with atomic_open(path, newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(columns)
+        for row in zip(*columns.values(), strict=True):
+            writer.writerow([f"{float(value):.9g}" for value in row])

@@ -1,0 +1,129 @@
+"""Gearboxes and their scaling laws (Saerens et al. 2019, as tabulated in ``tab:scaling_laws`` of "Reacting to
+Contact: Transparency and Collision Reflex in Actuation").
+
+A scaling law says how a quantity changes with the gearbox's outer diameter ``r``, length ``l`` and number of
+stages ``a``, relative to a reference gearbox: ``q = q0 (l/l0)**p (r/r0)**e (a/a0)**s``. So a gearbox is
+described by a real one (its own mass, inertia and rated torque at its size, with a source), and
+:meth:`Gearbox.scaled` moves it to another size. No reference values are built in: gearbox data vary too much
+between makers for one default to be honest, and the paper ignores gearbox inertia (as does
+:class:`~collision_reflex.actuators.Actuator` unless asked).
+
+Inertia convention: ``inertia`` is the gearbox's own inertia seen at its input (motor) shaft [kg m^2], so its
+reflected inertia at the output is ``N**2 inertia`` (the table's ``l r^4 N^2``); a ball screw's ``inertia`` is
+already the reflected one (the table's ``l r^4``, without ``N``).
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import dataclass
+from typing import Any
+
+from . import _validate
+from .errors import InvalidParameter
+
+__all__ = ["GEARBOX_KINDS", "GEARBOX_SCALING", "Gearbox", "GearboxScaling"]
+
+
+@dataclass(frozen=True)
+class GearboxScaling:
+    """Exponents ``(p, e, s)`` of length, diameter and stages for one quantity of one kind of gearbox."""
+
+    length: float
+    diameter: float
+    stages: float
+
+    def factor(self, length_ratio: Any, diameter_ratio: Any, stages_ratio: Any) -> Any:
+        return length_ratio**self.length * diameter_ratio**self.diameter * stages_ratio**self.stages
+
+
+# kind -> (mass, inertia, torque) exponents, from tab:scaling_laws (Saerens et al. 2019).
+GEARBOX_SCALING: dict[str, tuple[GearboxScaling, GearboxScaling, GearboxScaling]] = {
+    "parallel_shaft": (GearboxScaling(1, 2, 0), GearboxScaling(1, 4, -1), GearboxScaling(1, 2, -1)),
+    "planetary": (GearboxScaling(1, 2, 0), GearboxScaling(1, 4, -1), GearboxScaling(1, 2, -1)),
+    "harmonic": (GearboxScaling(1, 2, 0), GearboxScaling(1, 4, 0), GearboxScaling(0, 3, 0)),
+    "cycloidal": (GearboxScaling(1, 2, 0), GearboxScaling(1, 4, 0), GearboxScaling(-1, 4, 0)),
+    "ball_screw": (GearboxScaling(1, 2, 0), GearboxScaling(1, 4, 0), GearboxScaling(0, 3, 0)),
+}
+GEARBOX_KINDS: tuple[str, ...] = tuple(GEARBOX_SCALING)
+_STAGED = ("parallel_shaft", "planetary")
+
+
+@dataclass(frozen=True)
+class Gearbox:
+    """A gearbox of a given kind and size, with the figures of a real unit to scale from.
+
+    Parameters
+    ----------
+    kind: one of :data:`GEARBOX_KINDS`.
+    stages: number of stages ``a`` (parallel shaft and planetary only; 1 for the others).
+    diameter: outer diameter ``r`` [m].
+    length: length ``l`` [m].
+    mass: mass [kg].
+    inertia: inertia at the input shaft [kg m^2] (a ball screw: its reflected inertia, see the module).
+    rated_torque: rated output torque [N m].
+    source: where the figures come from.
+    """
+
+    kind: str
+    stages: int = 1
+    diameter: float = math.nan
+    length: float = math.nan
+    mass: float = math.nan
+    inertia: float = math.nan
+    rated_torque: float = math.nan
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        _validate.choice("Gearbox.kind", self.kind, GEARBOX_KINDS)
+        if isinstance(self.stages, bool) or not isinstance(self.stages, numbers.Integral) or self.stages < 1:
+            raise InvalidParameter("Gearbox.stages", self.stages, "an integer >= 1")
+        if self.stages != 1 and self.kind not in _STAGED:
+            raise InvalidParameter(
+                "Gearbox.stages",
+                self.stages,
+                f"1 for a {self.kind} gearbox",
+                "only parallel-shaft and planetary gearboxes have a number of stages in the scaling laws",
+            )
+        for field in ("diameter", "length", "mass", "inertia", "rated_torque"):
+            value = getattr(self, field)
+            if isinstance(value, bool) or not isinstance(value, numbers.Real):
+                raise InvalidParameter(f"Gearbox.{field}", value, "a number (SI units)")
+            if math.isnan(value):
+                raise InvalidParameter(
+                    f"Gearbox.{field}",
+                    value,
+                    "a finite number > 0",
+                    "give the figures of a real gearbox of this kind (from its datasheet), then use "
+                    ".scaled(...) to move it to another size",
+                )
+            _validate.positive(f"Gearbox.{field}", value)
+            object.__setattr__(self, field, float(value))
+
+    def reflected_inertia(self, gear_ratio: Any) -> Any:
+        """Gearbox inertia seen at the output [kg m^2]: ``N**2 inertia`` (ball screw: ``inertia``)."""
+        _validate.positive("gear_ratio", gear_ratio)
+        return self.inertia if self.kind == "ball_screw" else gear_ratio**2 * self.inertia
+
+    def scaled(
+        self, diameter: float | None = None, length: float | None = None, stages: int | None = None
+    ) -> Gearbox:
+        """This gearbox moved to another diameter [m], length [m] and/or number of stages by its scaling law."""
+        new_diameter = self.diameter if diameter is None else diameter
+        new_length = self.length if length is None else length
+        new_stages = self.stages if stages is None else stages
+        _validate.positive("diameter", new_diameter)
+        _validate.positive("length", new_length)
+        ratios = (new_length / self.length, new_diameter / self.diameter, new_stages / self.stages)
+        mass_law, inertia_law, torque_law = GEARBOX_SCALING[self.kind]
+        return Gearbox(
+            kind=self.kind,
+            stages=new_stages,
+            diameter=float(new_diameter),
+            length=float(new_length),
+            mass=self.mass * mass_law.factor(*ratios),
+            inertia=self.inertia * inertia_law.factor(*ratios),
+            rated_torque=self.rated_torque * torque_law.factor(*ratios),
+            source=f"scaled by the {self.kind} law of Saerens et al. 2019 from: {self.source}",
+        )

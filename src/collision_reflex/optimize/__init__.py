@@ -1,0 +1,30 @@
+"""Actuator design optimisation: CasADi + IPOPT over motor size, gear ratio, stiffness, threshold and approach
+velocity for a URDF arm, and Pareto sets by epsilon-constraint sweeps.
+
+Build and solve are separate: :func:`build_problem` returns an inspectable :class:`DesignProblem`, :func:`solve`
+runs IPOPT and returns a :class:`DesignResult`; :func:`pareto_front` sweeps objectives into a
+:class:`ParetoSet`.
+"""
+
+from .pareto import ParetoSet, hypervolume, pareto_front
+from .problem import OBJECTIVES, ActuatorTechnology, DesignProblem, build_problem
+from .solve import Design, DesignResult, design_at, solve
+from .space import Bounds, Constraints, ContactSamples, DesignSpace
+
+__all__ = [
+    "OBJECTIVES",
+    "ActuatorTechnology",
+    "Bounds",
+    "Constraints",
+    "ContactSamples",
+    "Design",
+    "DesignProblem",
+    "DesignResult",
+    "DesignSpace",
+    "ParetoSet",
+    "build_problem",
+    "design_at",
+    "hypervolume",
+    "pareto_front",
+    "solve",
+]

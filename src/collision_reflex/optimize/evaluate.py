@@ -1,0 +1,50 @@
+"""Evaluate a design on the problem's samples through the NumPy path, independently of the CasADi model.
+
+The CasADi model takes the maximum over joints of per-joint reaction impulses (its epigraph form); this path
+computes the reaction capacity as the minimum over joints, ``F_a = min_i tau_i / |w_i|`` (MODEL.md §3), and
+then the 1D impulse once. Agreement of the two checks the reformulation as well as the code.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..impulse import series_stiffness, total_impulse
+
+if TYPE_CHECKING:
+    from .problem import DesignProblem
+    from .solve import Design
+
+
+def evaluate_design(problem: DesignProblem, design: Design) -> np.ndarray:
+    """Collision impulse [N*s] of ``design`` at each of the problem's samples, shape (n_samples,)."""
+    from ..arm import effective_parameters
+
+    samples = problem.samples
+    params = effective_parameters(
+        samples.kinematics,
+        samples.directions,
+        config_index=samples.config_index,
+        reflected_inertia=design.reflected_inertia,
+        stiffness=series_stiffness(design.mechanical_stiffness, design.software_stiffness),
+        mechanical_stiffness=design.mechanical_stiffness,
+        torque_limit=design.peak_torque,
+        motor_mass=design.motor_mass,
+        finger_joint_inertia=(
+            design.reflected_inertia if problem.technology.reflected_inertia_in == "finger" else None
+        ),
+    )
+    threshold = design.threshold if design.sensing == "force" else params.k * design.threshold
+    return np.asarray(
+        total_impulse(
+            params.m_f,
+            params.k,
+            params.k_m,
+            threshold,
+            params.a,
+            design.approach_velocity,
+            problem.technology.reaction,
+        )
+    )

@@ -1,0 +1,705 @@
+"""Build the actuator-design NLP for a URDF arm (CasADi, exact derivatives).
+
+Structure (see the README's "Design optimisation" section):
+
+- Design variables, all positive, are optimised as their logarithms: per joint the stator diameter (and
+  optionally stack length) of a motor scaled from a reference motor, the gear ratio and the software stiffness;
+  globally the sensing threshold and the approach velocity.
+- Per contact sample ``s`` (configuration, direction ``u``) the effective parameters of MODEL.md §3 are formed
+  from the numeric Pinocchio data (``M_bb0``, motor-mass influence matrices, ``w = J^T u``) and the symbolic
+  actuator quantities, and the 1D impulse of :mod:`collision_reflex.impulse` is applied. One SX function per
+  sample is mapped over all samples inside an MX NLP.
+- The reaction capacity ``F_a = min_i tau_i / |w_i|`` is a minimum over joints (non-smooth). Each sample gets a
+  variable ``g_s = log(1/F_a)`` with ``g_s >= log|w_si| - log tau_i`` for every joint its direction loads --
+  linear in the log design variables -- and the impulse is evaluated with ``F_a = exp(-g_s)``. The impulse grows
+  with ``g_s``, so at an optimum ``g_s`` sits on the largest ratio, i.e. ``F_a`` on the minimum: exact, smooth,
+  and the 1D impulse is evaluated once per sample.
+- The finger mass ``m_f = 1 / (w^T M_f^-1 w)`` has motor masses (and optionally reflected inertias) inside
+  ``M_f``. It is also ``min x^T M_f x`` over ``x`` with ``w^T x = 1`` (attained at ``x = M_f^-1 w / w^T M_f^-1
+  w``). The impulse grows with ``m_f``, so each sample gets a variable ``x_s`` with the linear constraint
+  ``w_s^T x_s = 1`` and uses ``x_s^T M_f x_s``: minimising over the design and ``x`` together is exact, and
+  avoids both a symbolic inverse and a badly conditioned bilinear equality.
+- The worst case is an epigraph ``t >= I_s``.
+- Objectives can be bounded (``f_k <= eps_k``) through NLP parameters, so one solver serves a whole
+  epsilon-constraint Pareto sweep.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from .. import _validate
+from ..actuators import REFLECTED_INERTIA_PLACEMENTS
+from ..errors import InvalidParameter
+from ..impulse import REACTION_MODES, phase_impulses, series_stiffness
+from ..motors import Motor, scaled_motor_quantities
+from .space import (
+    GLOBAL_VARIABLES,
+    PER_JOINT_VARIABLES,
+    SENSING_SCHEMES,
+    Bounds,
+    Constraints,
+    ContactSamples,
+    DesignSpace,
+)
+
+TIE_BREAK_WEIGHT = 1e-3
+"""Weight of the (start-normalised) mean impulse added to every objective. A worst case leaves the samples that
+do not bind it, and the joints that do not affect it, undetermined; this small pull toward a lower mean picks a
+definite design among the equals and pins the per-sample auxiliary variables, at a cost of about this relative
+amount in the main objective."""
+
+OBJECTIVES: dict[str, tuple[int, str, str]] = {
+    # name: (sense: +1 minimise / -1 maximise, unit, description)
+    "worst_case_impulse": (1, "N*s", "largest collision impulse over the samples"),
+    "mean_impulse": (1, "N*s", "mean over the samples of the collision impulse"),
+    "actuator_mass": (1, "kg", "total mass of the motors"),
+    "approach_velocity": (-1, "m/s", "approach velocity (maximised: shorter cycle time)"),
+}
+
+
+@dataclass(frozen=True)
+class ActuatorTechnology:
+    """The fixed choices of actuation the design varies within.
+
+    reference_motor: motor every joint's motor is scaled from.
+    scaling_law: motor scaling law name (see :data:`collision_reflex.motors.SCALING_LAWS`).
+    mechanical_stiffness: joint mechanical stiffness [N m/rad], one value or one per joint, finite > 0: it is
+        the only spring left in the reaction phase.
+    sensing: ``"force"`` (contact-force threshold) or ``"position"`` (contact position-error threshold).
+    reaction: reaction-phase model, ``"at_rest"`` (the paper's) or ``"moving"``.
+    reflected_inertia_in: where the reflected rotor inertia ``N^2 J_m`` acts. ``"robot"`` (default, the paper's
+        arm model): behind the joint springs, in the robot mass ``m_r`` of the reaction phase only.
+        ``"finger"``: also rigidly on the link side, in the finger mass ``m_f`` of the impact phase -- a stiff
+        transmission with the compliance at the contact, as the paper measured for its geared A8 actuator
+        (fitted finger mass 20 kg against 0.12 kg direct-drive).
+    """
+
+    reference_motor: Motor
+    mechanical_stiffness: float | Sequence[float]
+    scaling_law: str = "haddadin"
+    sensing: str = "force"
+    reaction: str = "at_rest"
+    reflected_inertia_in: str = "robot"
+
+    def __post_init__(self) -> None:
+        _validate.positive("mechanical_stiffness", np.asarray(self.mechanical_stiffness, dtype=float))
+        _validate.choice("sensing", self.sensing, SENSING_SCHEMES)
+        _validate.choice("reaction", self.reaction, REACTION_MODES)
+        _validate.choice("reflected_inertia_in", self.reflected_inertia_in, REFLECTED_INERTIA_PLACEMENTS)
+
+    def joint_mechanical_stiffness(self, n_joints: int) -> np.ndarray:
+        stiffness = np.broadcast_to(np.asarray(self.mechanical_stiffness, dtype=float), (n_joints,)).copy()
+        return stiffness
+
+
+@dataclass
+class _Layout:
+    """Where each design variable lives: a slice of the NLP's ``x`` (log values) or a fixed value."""
+
+    bounds: dict[str, list[Bounds]] = field(default_factory=dict)
+    slices: dict[str, list[int | None]] = field(default_factory=dict)
+    size: int = 0
+
+    def add(self, name: str, bounds: list[Bounds]) -> None:
+        self.bounds[name] = bounds
+        indices: list[int | None] = []
+        for b in bounds:
+            if b.is_fixed:
+                indices.append(None)
+            else:
+                indices.append(self.size)
+                self.size += 1
+        self.slices[name] = indices
+
+    def expressions(self, x: Any) -> dict[str, Any]:
+        """Each variable as an MX column (exp of its log variable, or its fixed value)."""
+        out = {}
+        for name, bounds in self.bounds.items():
+            parts = [
+                ca.exp(x[i]) if i is not None else ca.MX(b.lower)
+                for i, b in zip(self.slices[name], bounds, strict=True)
+            ]
+            out[name] = ca.vertcat(*parts)
+        return out
+
+    def log_bounds(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        lower, upper, start = (np.empty(self.size) for _ in range(3))
+        for name, bounds in self.bounds.items():
+            for i, b in zip(self.slices[name], bounds, strict=True):
+                if i is not None:
+                    lower[i], upper[i], start[i] = math.log(b.lower), math.log(b.upper), math.log(b.midpoint)
+        return lower, upper, start
+
+    def values(self, x: np.ndarray) -> dict[str, np.ndarray]:
+        """Numeric values [SI] of every variable at ``x``."""
+        return {
+            name: np.array(
+                [
+                    math.exp(x[i]) if i is not None else b.lower
+                    for i, b in zip(self.slices[name], bounds, strict=True)
+                ]
+            )
+            for name, bounds in self.bounds.items()
+        }
+
+
+@dataclass
+class DesignProblem:
+    """An actuator-design NLP, built and ready to inspect or solve.
+
+    ``nlp`` is CasADi's ``{"x", "f", "g", "p"}``; ``lbx``/``ubx``/``x0``/``lbg``/``ubg`` its bounds and start;
+    ``constraint_labels[i]`` names constraint ``g[i]``; ``objective_scale`` the value each objective is divided
+    by in the NLP; ``evaluate`` a CasADi function of ``x`` giving ``impulses`` (1 x n_samples), ``actuator_mass``,
+    ``approach_velocity``, ``thresholds`` (1 x n_samples), ``required_torque`` and ``peak_torque`` (n_joints);
+    use :meth:`exact_point` first so that the auxiliary variables hold their exact values.
+    """
+
+    nlp: dict[str, Any]
+    x0: np.ndarray
+    lbx: np.ndarray
+    ubx: np.ndarray
+    lbg: np.ndarray
+    ubg: np.ndarray
+    constraint_labels: list[str]
+    objective: dict[str, float]
+    bounded_objectives: tuple[str, ...]
+    objective_scale: dict[str, float]
+    evaluate: Any
+    layout: _Layout
+    samples: ContactSamples
+    space: DesignSpace
+    technology: ActuatorTechnology
+    constraints: Constraints
+    joint_names: tuple[str, ...]
+    required_torque_function: Any
+    epigraph_index: int | None
+    capacity_index: slice
+    lifted_index: slice
+    lifted_scale: np.ndarray
+    build_time: float
+    _joint_numbers: Any = field(repr=False, default=None)
+    _sample_function: Any = field(repr=False, default=None)
+    _sample_data: Any = field(repr=False, default=None)
+    _solvers: dict[str, Any] = field(default_factory=dict, repr=False)
+
+    @property
+    def n_joints(self) -> int:
+        return len(self.joint_names)
+
+    def exact_point(self, x: np.ndarray) -> np.ndarray:
+        """``x`` with the auxiliary variables (``y``, ``c`` and the epigraph ``t``) set to their exact values for
+        the design in ``x``, so that evaluating there gives the model's values to machine precision."""
+        x = np.array(x, dtype=float)
+        masses, torques, finger = (np.asarray(v).ravel() for v in self._joint_numbers(x))
+        x[self.lifted_index] = (
+            lifted_solution(self.samples, masses, finger) / self.lifted_scale[:, None]
+        ).ravel()
+        x[self.capacity_index] = np.log(reaction_compliance(self.samples, torques))
+        if self.epigraph_index is not None:
+            impulses = np.asarray(self.evaluate(x)[0]).ravel()
+            x[self.epigraph_index] = impulses.max() / self.objective_scale["worst_case_impulse"]
+        return x
+
+    def impulse_function(self) -> Any:
+        """The collision impulse of every sample as a CasADi function of the design variables alone.
+
+        Input ``z``: the design variables as optimised, ``log`` of each free variable (the first
+        ``layout.size`` entries of the NLP's ``x``). Output: (1, n_samples) impulses [N*s]. The per-sample
+        auxiliaries take their exact values (a symbolic solve for the finger mass, the maximum over joints for
+        the reaction compliance), so this is the model the NLP optimises, with exact derivatives for
+        sensitivity studies; it is slower to differentiate than the NLP itself.
+        """
+        n = self.n_joints
+        z = ca.MX.sym("z", self.layout.size)
+        _, design_column, motor_mass, peak_torque, finger_inertia = _design_quantities(
+            self.layout, z, self.technology, self.technology.joint_mechanical_stiffness(n)
+        )
+        w = self.samples.joint_moment_arms
+        kin = self.samples.kinematics
+        loaded = loaded_joints(self.samples)
+        impulses = []
+        for s_index, config in enumerate(self.samples.config_index):
+            structure = ca.DM(kin.mass_matrix[config]) + ca.diag(finger_inertia)
+            for i in range(n):
+                structure += motor_mass[i] * ca.DM(kin.motor_mass_influence[config, i])
+            y = ca.solve(structure, ca.DM(w[s_index]))
+            direction = y / ca.dot(ca.DM(w[s_index]), y)
+            ratios = [abs(w[s_index, i]) / peak_torque[i] for i in range(n) if loaded[s_index, i]]
+            compliance = ca.mmax(ca.vertcat(*ratios))
+            impulse, _, _ = self._sample_function(
+                design_column, direction, compliance, ca.DM(self._sample_data[:, s_index])
+            )
+            impulses.append(impulse)
+        return ca.Function("design_impulses", [z], [ca.horzcat(*impulses)], ["z"], ["impulses"])
+
+    def parameters(self, epsilon: Mapping[str, float] | None = None) -> np.ndarray:
+        """NLP parameter vector bounding the objectives in ``epsilon`` (unbounded: +inf in scaled units)."""
+        epsilon = dict(epsilon or {})
+        unknown = set(epsilon) - set(self.bounded_objectives)
+        if unknown:
+            raise InvalidParameter(
+                "epsilon",
+                sorted(unknown),
+                f"objectives built as bounded: {list(self.bounded_objectives)}",
+                "pass bounded_objectives=... to build_problem",
+            )
+        values = []
+        for name in self.bounded_objectives:
+            sense = OBJECTIVES[name][0]
+            bound = epsilon.get(name)
+            values.append(1e20 if bound is None else sense * bound / self.objective_scale[name])
+        return np.array(values)
+
+
+def build_problem(
+    arm: Any,
+    samples: ContactSamples,
+    space: DesignSpace,
+    technology: ActuatorTechnology,
+    objective: str | Mapping[str, float] = "worst_case_impulse",
+    constraints: Constraints | None = None,
+    bounded_objectives: Sequence[str] = (),
+) -> DesignProblem:
+    """Build the NLP that chooses actuators for ``arm`` to minimise ``objective`` on ``samples``.
+
+    Parameters
+    ----------
+    arm: the :class:`collision_reflex.arm.Arm` (joint names; ``samples.kinematics`` must come from it).
+    samples: contact cases: configurations (with their Pinocchio data) and directions.
+    space: bounds of the design variables.
+    technology: reference motor, scaling law, mechanical stiffness, sensing scheme, reaction model.
+    objective: an objective name of :data:`OBJECTIVES` or a weighted sum ``{name: weight}``; each objective is
+        divided by its value at the start point, so weights compare relative changes.
+    constraints: torque requirement (gravity over the samples + payload, times a safety factor, or given
+        values) and the threshold noise floor.
+    bounded_objectives: objectives that may be bounded per solve (epsilon-constraint Pareto sweeps).
+    """
+    started = time.perf_counter()
+    constraints = constraints or Constraints()
+    weights = _objective_weights(objective)
+    for name in bounded_objectives:
+        _validate.choice("bounded objective", name, tuple(OBJECTIVES))
+    bounded = tuple(bounded_objectives)
+    n_joints = samples.kinematics.mass_matrix.shape[1]
+    joint_names = tuple(getattr(arm, "joint_names", [f"joint{i + 1}" for i in range(n_joints)]))
+    if len(joint_names) != n_joints:
+        raise InvalidParameter("arm", len(joint_names), f"{n_joints} joint names to match the samples")
+
+    layout = _Layout()
+    reference = technology.reference_motor
+    defaults = {"stack_length": reference.stack_length}
+    for name in PER_JOINT_VARIABLES:
+        layout.add(name, space.per_joint(name, n_joints, defaults.get(name)))
+    for name in GLOBAL_VARIABLES:
+        bounds = space.global_bounds(name)
+        if name == "threshold" and technology.sensing == "force":
+            bounds = _with_noise_floor(bounds, constraints.threshold_floor)
+        layout.add(name, [bounds])
+
+    # Variables: design (log values) | epigraph t (if needed) | g = log(1/F_a) (n_samples) |
+    # finger-mass directions x (n_joints * n_samples).
+    n_samples, n_design = samples.size, layout.size
+    epigraph_index = n_design if "worst_case_impulse" in set(weights) | set(bounded) else None
+    capacity_start = n_design + (epigraph_index is not None)
+    capacity_index = slice(capacity_start, capacity_start + n_samples)
+    lifted_index = slice(capacity_index.stop, capacity_index.stop + n_joints * n_samples)
+    x = ca.MX.sym("x", lifted_index.stop)
+    p = ca.MX.sym("p", len(bounded))
+
+    k_mech = technology.joint_mechanical_stiffness(n_joints)
+    values, design_column, motor_mass, peak_torque, finger_inertia = _design_quantities(
+        layout, x[:n_design], technology, k_mech
+    )
+    joint_numbers = ca.Function("joint_numbers", [x], [motor_mass, peak_torque, finger_inertia])
+
+    # Start point: log-midpoints of the bounds; auxiliaries at their exact values there.
+    lbx, ubx, x0 = (np.full(x.shape[0], value) for value in (-np.inf, np.inf, 0.0))
+    lbx[:n_design], ubx[:n_design], x0[:n_design] = layout.log_bounds()
+    _feasible_gear_start(x0, layout, joint_numbers, samples, constraints, joint_names)
+    start_mass, start_torque, start_finger = (np.asarray(v).ravel() for v in joint_numbers(x0))
+    # log(1/F_a) lies between its values at the weakest and the strongest actuators the bounds allow.
+    weakest, strongest = (np.asarray(joint_numbers(bound)[1]).ravel() for bound in (lbx, ubx))
+    lbx[capacity_index] = np.log(reaction_compliance(samples, strongest))
+    ubx[capacity_index] = np.log(reaction_compliance(samples, weakest))
+
+    data = _sample_data(samples, k_mech)
+    sample_function = _sample_function(
+        n_joints, technology.sensing, technology.reaction, technology.reflected_inertia_in
+    )
+    per_sample = sample_function.map(n_samples)
+    # x_s is scaled per sample by its size at the start: across samples it spans orders of magnitude.
+    start_lifted = lifted_solution(samples, start_mass, start_finger)
+    lifted_scale = np.maximum(np.abs(start_lifted).max(axis=1), 1e-300)
+    lifted = ca.reshape(x[lifted_index], n_joints, n_samples) * ca.DM(np.tile(lifted_scale, (n_joints, 1)))
+    compliance = ca.exp(ca.transpose(x[capacity_index]))
+    impulses, thresholds, normalisation = per_sample(design_column, lifted, compliance, ca.DM(data))
+    actuator_mass = ca.sum1(motor_mass)
+    mass_bounds = [np.asarray(joint_numbers(bound)[0]).ravel() for bound in (lbx, ubx)]
+    torque_demands = _binding_torque_demands(samples, constraints, joint_names, *mass_bounds)
+    required_torque = _required_torque_function(torque_demands, n_joints)
+    evaluate = ca.Function(
+        "evaluate",
+        [x],
+        [
+            impulses,
+            actuator_mass,
+            values["approach_velocity"],
+            thresholds,
+            required_torque(motor_mass),
+            peak_torque,
+        ],
+        ["x"],
+        ["impulses", "actuator_mass", "approach_velocity", "thresholds", "required_torque", "peak_torque"],
+    )
+    x0[lifted_index] = (start_lifted / lifted_scale[:, None]).ravel()
+    x0[capacity_index] = np.log(reaction_compliance(samples, start_torque))
+    start_impulses = np.asarray(evaluate(x0)[0]).ravel()
+    _check_finite(start_impulses, "impulse at the start point", samples)
+    scale = {
+        "worst_case_impulse": float(start_impulses.max()),
+        "mean_impulse": float(start_impulses.mean()),
+        "actuator_mass": float(start_mass.sum()),
+        "approach_velocity": float(
+            np.exp(x0[layout.slices["approach_velocity"][0]])
+            if layout.slices["approach_velocity"][0] is not None
+            else layout.bounds["approach_velocity"][0].lower
+        ),
+    }
+    expressions: dict[str, Any] = {
+        "mean_impulse": ca.sum2(impulses) / n_samples,
+        "actuator_mass": actuator_mass,
+        "approach_velocity": values["approach_velocity"],
+    }
+
+    g_parts: list[Any] = []
+    lbg_parts: list[np.ndarray] = []
+    ubg_parts: list[np.ndarray] = []
+    labels: list[str] = []
+
+    def add(expression: Any, lower: float, upper: float, names: list[str]) -> None:
+        g_parts.append(expression)
+        lbg_parts.append(np.full(len(names), lower))
+        ubg_parts.append(np.full(len(names), upper))
+        labels.extend(names)
+
+    if epigraph_index is not None:
+        t = x[epigraph_index] * scale["worst_case_impulse"]
+        x0[epigraph_index] = 1.0
+        lbx[epigraph_index] = 0.0
+        add(
+            ca.transpose(t - impulses) / scale["worst_case_impulse"],
+            0.0,
+            np.inf,
+            [f"worst-case bound >= impulse of sample {s}" for s in range(n_samples)],
+        )
+        expressions["worst_case_impulse"] = t
+
+    # g_s + log tau_i >= log|w_si| for every loaded (sample, joint), i.e. 1/F_a >= |w_si| / tau_i.
+    loaded = loaded_joints(samples)
+    pair_sample, pair_joint = np.nonzero(loaded)
+    log_arm = np.log(np.abs(samples.joint_moment_arms[pair_sample, pair_joint]))
+    add(
+        x[capacity_index][pair_sample.tolist()] + ca.log(peak_torque)[pair_joint.tolist()] - log_arm,
+        0.0,
+        np.inf,
+        [
+            f"reaction capacity of sample {s} within the torque of {joint_names[j]}"
+            for s, j in zip(pair_sample, pair_joint, strict=True)
+        ],
+    )
+
+    add(ca.transpose(normalisation), 1.0, 1.0, [f"w^T x = 1 at sample {s}" for s in range(n_samples)])
+
+    # Torque: peak output torque covers the requirement in every sampled configuration, as linear constraints
+    # scaled by the requirement at the start; only demands that can be the largest somewhere in the box of
+    # motor masses allowed by the bounds can bind, the others are dropped (exactly).
+    torque_scale = np.maximum(np.asarray(required_torque(start_mass)).ravel(), 1e-3)
+    for j, (bases, slopes, demand_labels) in enumerate(torque_demands):
+        demand = ca.DM(bases) + ca.mtimes(ca.DM(slopes), motor_mass)
+        add((peak_torque[j] - demand) / torque_scale[j], 0.0, np.inf,
+            [f"peak torque of {joint_names[j]} >= {label}" for label in demand_labels])
+
+    if technology.sensing == "position" and constraints.threshold_floor > 0:
+        add(
+            ca.transpose(thresholds) / constraints.threshold_floor,
+            1.0,
+            np.inf,
+            [f"contact threshold of sample {s} >= noise floor" for s in range(n_samples)],
+        )
+
+    for k, name in enumerate(bounded):
+        add(
+            OBJECTIVES[name][0] * expressions[name] / scale[name] - p[k],
+            -np.inf,
+            0.0,
+            [f"{name} within its bound"],
+        )
+
+    f = sum(
+        weight * OBJECTIVES[name][0] * expressions[name] / scale[name] for name, weight in weights.items()
+    )
+    f += TIE_BREAK_WEIGHT * expressions["mean_impulse"] / scale["mean_impulse"]
+    nlp = {"x": x, "f": f, "g": ca.vertcat(*g_parts), "p": p}
+    return DesignProblem(
+        nlp=nlp,
+        x0=x0,
+        lbx=lbx,
+        ubx=ubx,
+        lbg=np.concatenate(lbg_parts),
+        ubg=np.concatenate(ubg_parts),
+        constraint_labels=labels,
+        objective=weights,
+        bounded_objectives=bounded,
+        objective_scale=scale,
+        evaluate=evaluate,
+        layout=layout,
+        samples=samples,
+        space=space,
+        technology=technology,
+        constraints=constraints,
+        joint_names=joint_names,
+        required_torque_function=required_torque,
+        epigraph_index=epigraph_index,
+        capacity_index=capacity_index,
+        lifted_index=lifted_index,
+        lifted_scale=lifted_scale,
+        build_time=time.perf_counter() - started,
+        _joint_numbers=joint_numbers,
+        _sample_function=sample_function,
+        _sample_data=data,
+    )
+
+
+def _design_quantities(
+    layout: _Layout, z: Any, technology: ActuatorTechnology, k_mech: np.ndarray
+) -> tuple[dict[str, Any], Any, Any, Any, Any]:
+    """Symbolic joint quantities of the design variables ``z`` (log values): the variables themselves, the
+    per-sample function's design column, motor masses [kg], peak output torques [N m] and the reflected inertia
+    acting on the finger [kg m^2] (zero unless ``reflected_inertia_in == "finger"``)."""
+    values = layout.expressions(z)
+    motor = scaled_motor_quantities(
+        technology.reference_motor, values["stator_diameter"], values["stack_length"], technology.scaling_law
+    )
+    gear = values["gear_ratio"]
+    reflected = gear**2 * motor.rotor_inertia  # N^2 J_m
+    design_column = ca.vertcat(
+        motor.mass,
+        reflected,
+        series_stiffness(ca.DM(k_mech), values["software_stiffness"]),
+        values["threshold"],
+        values["approach_velocity"],
+    )
+    finger_inertia = reflected if technology.reflected_inertia_in == "finger" else 0 * gear
+    return values, design_column, motor.mass, gear * motor.peak_torque, finger_inertia
+
+
+def _objective_weights(objective: str | Mapping[str, float]) -> dict[str, float]:
+    weights = {objective: 1.0} if isinstance(objective, str) else dict(objective)
+    if not weights:
+        raise InvalidParameter("objective", objective, "an objective name or a non-empty {name: weight}")
+    for name, weight in weights.items():
+        _validate.choice("objective", name, tuple(OBJECTIVES))
+        _validate.positive(f"weight of {name}", weight)
+    return weights
+
+
+def _feasible_gear_start(
+    x0: np.ndarray,
+    layout: _Layout,
+    joint_numbers: Any,
+    samples: ContactSamples,
+    constraints: Constraints,
+    joint_names: tuple[str, ...],
+) -> None:
+    """Move the start's free gear ratios up to where the peak torque covers the requirement (with 10 % to
+    spare), within their bounds: IPOPT converges much faster from a torque-feasible start."""
+    masses, torques, _ = (np.asarray(v).ravel() for v in joint_numbers(x0))
+    rows, _ = _torque_requirement_rows(samples, constraints, joint_names)
+    required = np.max([base + per_motor @ masses for base, per_motor in rows], axis=0)
+    for joint, index in enumerate(layout.slices["gear_ratio"]):
+        if index is not None and required[joint] > torques[joint]:
+            x0[index] = min(
+                x0[index] + math.log(1.1 * required[joint] / torques[joint]),
+                math.log(layout.bounds["gear_ratio"][joint].upper),
+            )
+
+
+def _with_noise_floor(bounds: Bounds, floor: float) -> Bounds:
+    """With force sensing the noise floor [N] is a lower bound on the threshold variable itself."""
+    if floor <= 0:
+        return bounds
+    if bounds.upper < floor:
+        raise InvalidParameter(
+            "threshold bounds",
+            (bounds.lower, bounds.upper),
+            f"an upper bound >= the sensing noise floor {floor} N",
+            "raise the threshold's upper bound or lower the floor",
+        )
+    return Bounds(max(bounds.lower, floor), bounds.upper, "threshold")
+
+
+def _sample_function(n_joints: int, sensing: str, reaction: str, reflected_inertia_in: str) -> Any:
+    """SX function of one contact sample.
+
+    Inputs: the design column (motor masses, reflected inertias, joint stiffnesses (n each), threshold,
+    approach velocity), the finger-mass direction ``x`` (n, with ``w^T x = 1``), the reaction compliance ``c``
+    (``1/F_a`` [1/N]) and the sample's data (``w = J^T u`` (n), ``M_bb0`` (n*n), motor-mass influence matrices
+    (n*n*n), effective mechanical stiffness). Outputs: the impulse [N*s], the contact-force threshold [N] and
+    ``w^T x``.
+    """
+    n = n_joints
+    design = ca.SX.sym("design", 3 * n + 2)
+    direction = ca.SX.sym("x", n)
+    compliance = ca.SX.sym("c")
+    data = ca.SX.sym("data", n + n * n + n**3 + 1)
+    mass, inertia, stiffness = (design[i * n : (i + 1) * n] for i in range(3))
+    threshold_variable, velocity = design[3 * n], design[3 * n + 1]
+    w = data[:n]
+    offset = n + n * n
+    # x^T M_f x with M_f = M_bb0 + sum_i m_i A_i (+ diag(N^2 J_m)), each term a quadratic form in x.
+    finger_mass = ca.bilin(ca.reshape(data[n:offset], n, n), direction, direction)
+    for i in range(n):
+        influence = ca.reshape(data[offset + i * n * n : offset + (i + 1) * n * n], n, n)
+        finger_mass += mass[i] * ca.bilin(influence, direction, direction)
+    if reflected_inertia_in == "finger":
+        finger_mass += ca.dot(inertia, direction**2)
+    k_mech = data[-1]
+
+    # Effective parameters along u (MODEL.md §3), compliance forms.
+    robot_mass = 1 / ca.sum1(w**2 / inertia)
+    k = 1 / ca.sum1(w**2 / stiffness)
+    force_threshold = threshold_variable if sensing == "force" else k * threshold_variable
+    acceleration = 1 / (compliance * robot_mass)  # a = F_a / m_r
+    impulse = phase_impulses(finger_mass, k, k_mech, force_threshold, acceleration, velocity, reaction).total
+    return ca.Function(
+        "sample_impulse",
+        [design, direction, compliance, data],
+        [impulse, force_threshold, ca.dot(w, direction)],
+    )
+
+
+def _sample_data(samples: ContactSamples, k_mech: np.ndarray) -> np.ndarray:
+    """Numeric data column per sample (see :func:`_sample_function`), shape (rows, n_samples)."""
+    kin = samples.kinematics
+    w = samples.joint_moment_arms
+    n_samples, n = w.shape
+    unreachable = ~np.any(loaded_joints(samples), axis=1)
+    if np.any(unreachable):
+        bad = int(np.flatnonzero(unreachable)[0])
+        raise InvalidParameter(
+            f"sample {bad}",
+            samples.directions[bad],
+            "a direction the arm can move along (J^T u != 0)",
+            "drop samples at singular configurations along their singular direction",
+        )
+    structure = kin.mass_matrix[samples.config_index].reshape(n_samples, n * n, order="F")
+    influence = (
+        kin.motor_mass_influence[samples.config_index].transpose(0, 1, 3, 2).reshape(n_samples, n * n * n)
+    )
+    k_mech_effective = 1 / np.sum(w**2 / k_mech, axis=1)
+    return np.column_stack([w, structure, influence, k_mech_effective]).T
+
+
+def reaction_compliance(samples: ContactSamples, peak_torque: np.ndarray) -> np.ndarray:
+    """``1 / F_a = max_i |w_i| / tau_i`` per sample [1/N]: the inverse of the largest contact force the joints
+    can push back with before the first saturates (MODEL.md §3)."""
+    return np.max(np.abs(samples.joint_moment_arms) / np.asarray(peak_torque, dtype=float), axis=1)
+
+
+def lifted_solution(
+    samples: ContactSamples, motor_mass: np.ndarray, finger_joint_inertia: np.ndarray | None = None
+) -> np.ndarray:
+    """The minimiser ``x_s = M_f^-1 w_s / (w_s^T M_f^-1 w_s)`` of ``x^T M_f x`` with ``w_s^T x = 1`` for every
+    sample, (n_samples, n_joints): ``M_f`` the structure mass matrix with motor masses ``m`` [kg] and, when the
+    reflected inertia acts on the finger, ``diag(N^2 J_m)`` [kg m^2]."""
+    kin = samples.kinematics
+    index = samples.config_index
+    structure = kin.mass_matrix[index] + np.einsum("i,sijk->sjk", motor_mass, kin.motor_mass_influence[index])
+    if finger_joint_inertia is not None:
+        structure = structure + np.diag(finger_joint_inertia)
+    w = samples.joint_moment_arms
+    y = np.linalg.solve(structure, w[..., None])[..., 0]
+    return y / np.einsum("sj,sj->s", w, y)[:, None]
+
+
+def loaded_joints(samples: ContactSamples) -> np.ndarray:
+    """(n_samples, n_joints) True where a contact force along the sample's direction loads the joint, so its
+    torque limit bounds the reaction force; ``|w_i|`` below 1e-12 of the largest counts as unloaded."""
+    w = np.abs(samples.joint_moment_arms)
+    return w > 1e-12 * np.maximum(w.max(axis=1, keepdims=True), 1e-300)
+
+
+def _torque_requirement_rows(
+    samples: ContactSamples, constraints: Constraints, joint_names: tuple[str, ...]
+) -> tuple[list[tuple[np.ndarray, np.ndarray]], list[str]]:
+    """Affine torque demands ``d0 + D m`` [N m] (``m``: motor masses [kg]) the peak torques must cover.
+
+    Given torques: one demand. Otherwise, per sampled configuration, plus and minus the gravity torque of the
+    structure, the motors (linear in their masses) and the payload at the contact point, all times the safety
+    factor.
+    """
+    n = len(joint_names)
+    factor = constraints.safety_factor
+    if constraints.torque_required is not None:
+        given = np.asarray(constraints.torque_required, dtype=float)
+        if given.shape != (n,):
+            raise InvalidParameter("torque_required", given.shape, f"{n} values, one per joint")
+        return [(factor * given, np.zeros((n, n)))], ["the given required torque"]
+    kin = samples.kinematics
+    rows, labels = [], []
+    for c in np.unique(samples.config_index):
+        base = kin.gravity[c] + constraints.payload * kin.contact_gravity[c]
+        per_motor = kin.motor_gravity[c].T  # (joint j, motor i)
+        for sign, word in ((1.0, "+"), (-1.0, "-")):
+            rows.append((sign * factor * base, sign * factor * per_motor))
+            labels.append(f"{word}gravity torque at configuration {c}")
+    return rows, labels
+
+
+def _binding_torque_demands(
+    samples: ContactSamples, constraints: Constraints, joint_names: tuple[str, ...], mass_low: np.ndarray,
+    mass_high: np.ndarray,
+) -> list[tuple[np.ndarray, np.ndarray, list[str]]]:
+    """Per joint, the torque demands ``b + S m`` [N m] that can bind: ``(b (R,), S (R, n), labels)``.
+
+    A demand whose largest value over the box of motor masses ``[mass_low, mass_high]`` [kg] is below another
+    demand's smallest value there never sets the requirement, so it is left out: an exact reduction (on arms,
+    from two rows per sampled configuration to a handful).
+    """
+    rows, labels = _torque_requirement_rows(samples, constraints, joint_names)
+    demands = []
+    for j in range(len(joint_names)):
+        bases = np.array([base[j] for base, _ in rows])
+        slopes = np.array([per_motor[j] for _, per_motor in rows])
+        low = bases + np.minimum(slopes * mass_low, slopes * mass_high).sum(axis=1)
+        high = bases + np.maximum(slopes * mass_low, slopes * mass_high).sum(axis=1)
+        keep = high >= low.max() - 1e-12 * abs(low.max())
+        demands.append((bases[keep], slopes[keep], [label for label, k in zip(labels, keep, strict=True) if k]))
+    return demands
+
+
+def _required_torque_function(demands: list[tuple[np.ndarray, np.ndarray, list[str]]], n_joints: int) -> Any:
+    """CasADi function: motor masses [kg] -> required peak torque per joint [N m], the largest binding demand
+    (safety factor included), for reporting."""
+    masses = ca.MX.sym("motor_mass", n_joints)
+    required = [ca.mmax(ca.DM(bases) + ca.mtimes(ca.DM(slopes), masses)) for bases, slopes, _ in demands]
+    return ca.Function("required_torque", [masses], [ca.vertcat(*required)])
+
+
+def _check_finite(values: np.ndarray, what: str, samples: ContactSamples) -> None:
+    if not np.all(np.isfinite(values)):
+        bad = int(np.flatnonzero(~np.isfinite(values))[0])
+        raise InvalidParameter(
+            what,
+            f"non-finite at sample {bad} (direction {samples.directions[bad]})",
+            "finite values at every sample",
+            "check the arm's mass matrix and the bounds, or drop singular samples",
+        )

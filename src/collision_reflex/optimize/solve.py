@@ -1,0 +1,267 @@
+"""Solve a :class:`DesignProblem` with IPOPT and return the design with every objective and margin."""
+
+from __future__ import annotations
+
+import time
+import warnings
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from ..errors import SolverFailed
+from .evaluate import evaluate_design
+from .problem import OBJECTIVES, DesignProblem
+
+DEFAULT_IPOPT_OPTIONS: dict[str, Any] = {
+    # Expanding the MX graph (mapped per-sample functions) to SX once makes every derivative evaluation an
+    # order of magnitude cheaper; the solver is built once per problem and reused across Pareto points.
+    "expand": True,
+    "ipopt.print_level": 0,
+    "ipopt.sb": "yes",
+    "print_time": False,
+    "ipopt.tol": 1e-8,
+    "ipopt.max_iter": 500,
+    # Monotone barrier from mu = 1e-2: on arm problems about half the iterations of the adaptive strategy,
+    # to the same optimum (benchmarks/optimize_panda.py).
+    "ipopt.mu_strategy": "monotone",
+    "ipopt.mu_init": 1e-2,
+    "ipopt.linear_solver": "mumps",
+}
+WARM_START_OPTIONS: dict[str, Any] = {
+    # Start from a neighbouring solution's primal and dual point, close to the central path.
+    "ipopt.warm_start_init_point": "yes",
+    "ipopt.warm_start_bound_push": 1e-6,
+    "ipopt.warm_start_mult_bound_push": 1e-6,
+    "ipopt.mu_init": 1e-4,
+}
+AGREEMENT_TOLERANCE = 1e-6
+"""Largest relative difference allowed between the CasADi and NumPy evaluations of a design's objectives:
+both evaluate the same closed forms in double precision, so any larger difference is a modelling bug."""
+
+
+@dataclass(frozen=True)
+class Design:
+    """An actuator design for every joint of an arm, with the quantities derived from it (SI units).
+
+    Per joint (arrays of length n_joints): ``stator_diameter`` [m], ``stack_length`` [m], ``gear_ratio`` [-],
+    ``software_stiffness`` and ``mechanical_stiffness`` [N m/rad], ``rotor_inertia`` [kg m^2],
+    ``reflected_inertia`` = N^2 J_m [kg m^2], ``motor_peak_torque`` [N m], ``peak_torque`` = N tau_p [N m],
+    ``motor_mass`` [kg]. Global: ``threshold`` ([N] for force sensing, [m] for position sensing) and
+    ``approach_velocity`` [m/s].
+    """
+
+    joint_names: tuple[str, ...]
+    stator_diameter: np.ndarray
+    stack_length: np.ndarray
+    gear_ratio: np.ndarray
+    software_stiffness: np.ndarray
+    mechanical_stiffness: np.ndarray
+    rotor_inertia: np.ndarray
+    reflected_inertia: np.ndarray
+    motor_peak_torque: np.ndarray
+    peak_torque: np.ndarray
+    motor_mass: np.ndarray
+    threshold: float
+    approach_velocity: float
+    sensing: str
+
+    def as_dict(self) -> dict[str, Any]:
+        """Plain lists and floats, for JSON."""
+        out: dict[str, Any] = {}
+        for name, value in self.__dict__.items():
+            out[name] = (
+                value.tolist()
+                if isinstance(value, np.ndarray)
+                else (list(value) if isinstance(value, tuple) else value)
+            )
+        return out
+
+
+@dataclass(frozen=True)
+class DesignResult:
+    """An optimised design and how it was found.
+
+    objectives: every objective of :data:`OBJECTIVES` from the CasADi model [its unit].
+    numpy_objectives: the same re-evaluated through the NumPy path; the two agree to
+        :data:`AGREEMENT_TOLERANCE` (relative).
+    impulses: (n_samples,) collision impulse per sample [N*s] (NumPy path).
+    required_torque, torque_margin: per joint, the required peak torque [N m] (safety factor included) and
+        ``peak_torque / required_torque - 1``.
+    status, success, iterations, solve_time [s], build_time [s]: solver statistics.
+    """
+
+    design: Design
+    objectives: dict[str, float]
+    numpy_objectives: dict[str, float]
+    impulses: np.ndarray
+    required_torque: np.ndarray
+    torque_margin: np.ndarray
+    status: str
+    success: bool
+    iterations: int
+    solve_time: float
+    build_time: float
+    epsilon: dict[str, float] = field(default_factory=dict)
+    x: np.ndarray = field(default_factory=lambda: np.empty(0), repr=False)
+    multipliers: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)
+
+    @property
+    def worst_sample(self) -> int:
+        """Index of the sample with the largest impulse."""
+        return int(np.argmax(self.impulses))
+
+
+def solve(
+    problem: DesignProblem,
+    epsilon: Mapping[str, float] | None = None,
+    x0: np.ndarray | DesignResult | None = None,
+    ipopt_options: Mapping[str, Any] | None = None,
+) -> DesignResult:
+    """Solve ``problem`` with IPOPT (exact Hessian, MUMPS).
+
+    Parameters
+    ----------
+    epsilon: upper bounds on objectives built as bounded (lower bound for ``approach_velocity``) [their units].
+    x0: start point in the NLP's variables, or a neighbouring :class:`DesignResult` of the same problem, whose
+        point and multipliers then warm-start IPOPT; default the problem's start point.
+    ipopt_options: options merged over :data:`DEFAULT_IPOPT_OPTIONS` (e.g. ``{"ipopt.max_iter": 100}``).
+
+    Raises
+    ------
+    SolverFailed: IPOPT did not reach a (locally) optimal point; it carries the status, the statistics and the
+        constraints that could not be met.
+    """
+    warm = x0 if isinstance(x0, DesignResult) and x0.multipliers is not None else None
+    options = {**DEFAULT_IPOPT_OPTIONS, **(WARM_START_OPTIONS if warm else {}), **(ipopt_options or {})}
+    key = repr(sorted(options.items()))
+    solver = problem._solvers.get(key)
+    if solver is None:
+        solver = ca.nlpsol("actuator_design", "ipopt", problem.nlp, options)
+        problem._solvers[key] = solver
+    parameters = problem.parameters(epsilon)
+    if isinstance(x0, DesignResult):
+        x0 = x0.x
+    start = np.clip(problem.x0 if x0 is None else np.asarray(x0, dtype=float), problem.lbx, problem.ubx)
+    warm_multipliers = warm.multipliers if warm is not None else None
+    multipliers = (
+        {"lam_x0": warm_multipliers[0], "lam_g0": warm_multipliers[1]} if warm_multipliers is not None else {}
+    )
+    started = time.perf_counter()
+    solution = solver(
+        x0=start,
+        lbx=problem.lbx,
+        ubx=problem.ubx,
+        lbg=problem.lbg,
+        ubg=problem.ubg,
+        p=parameters,
+        **multipliers,
+    )
+    elapsed = time.perf_counter() - started
+    stats = solver.stats()
+    status = str(stats.get("return_status", "unknown"))
+    x = np.asarray(solution["x"]).ravel()
+    if not stats.get("success", False) and status not in ("Solved_To_Acceptable_Level",):
+        violated = _violations(problem, np.asarray(solution["g"]).ravel())
+        what = "; ".join(f"{label} (short by {amount:.3g})" for label, amount in violated[:3])
+        raise SolverFailed(
+            f"the optimiser stopped with status {status} after {stats.get('iter_count')} iterations"
+            + (f": could not meet {what}" if what else "")
+            + ". Widen the bounds (gear ratio, motor size), lower the payload or safety factor, or relax the "
+            "objective bounds.",
+            status,
+            dict(stats),
+            violated,
+            problem,
+        )
+    multipliers_out = (np.asarray(solution["lam_x"]).ravel(), np.asarray(solution["lam_g"]).ravel())
+    return _result(problem, x, status, stats, elapsed, dict(epsilon or {}), multipliers_out)
+
+
+def _result(
+    problem: DesignProblem,
+    x: np.ndarray,
+    status: str,
+    stats: dict,
+    elapsed: float,
+    epsilon: dict[str, float],
+    multipliers: tuple[np.ndarray, np.ndarray],
+) -> DesignResult:
+    design = design_at(problem, x)
+    evaluated = problem.evaluate(problem.exact_point(x))
+    impulses = np.asarray(evaluated[0]).ravel()
+    objectives = {
+        "worst_case_impulse": float(impulses.max()),
+        "mean_impulse": float(impulses.mean()),
+        "actuator_mass": float(evaluated[1]),
+        "approach_velocity": float(evaluated[2]),
+    }
+    numpy_impulses = evaluate_design(problem, design)
+    numpy_objectives = {
+        "worst_case_impulse": float(numpy_impulses.max()),
+        "mean_impulse": float(numpy_impulses.mean()),
+        "actuator_mass": float(design.motor_mass.sum()),
+        "approach_velocity": float(design.approach_velocity),
+    }
+    for name in OBJECTIVES:
+        a, b = objectives[name], numpy_objectives[name]
+        if abs(a - b) > AGREEMENT_TOLERANCE * max(abs(a), abs(b)):
+            warnings.warn(
+                f"CasADi and NumPy evaluations of {name} differ: {a!r} vs {b!r}", RuntimeWarning, stacklevel=3
+            )
+    required = np.asarray(evaluated[4]).ravel()
+    return DesignResult(
+        design=design,
+        objectives=objectives,
+        numpy_objectives=numpy_objectives,
+        impulses=numpy_impulses,
+        required_torque=required,
+        torque_margin=design.peak_torque / np.maximum(required, 1e-300) - 1,
+        status=status,
+        success=True,
+        iterations=int(stats.get("iter_count", -1)),
+        solve_time=elapsed,
+        build_time=problem.build_time,
+        epsilon=epsilon,
+        x=x,
+        multipliers=multipliers,
+    )
+
+
+def design_at(problem: DesignProblem, x: np.ndarray) -> Design:
+    """The design (and its derived actuator quantities) at NLP point ``x``."""
+    from ..motors import scaled_motor_quantities
+
+    values = problem.layout.values(np.asarray(x, dtype=float))
+    technology = problem.technology
+    motor = scaled_motor_quantities(
+        technology.reference_motor, values["stator_diameter"], values["stack_length"], technology.scaling_law
+    )
+    gear = values["gear_ratio"]
+    return Design(
+        joint_names=problem.joint_names,
+        stator_diameter=values["stator_diameter"],
+        stack_length=values["stack_length"],
+        gear_ratio=gear,
+        software_stiffness=values["software_stiffness"],
+        mechanical_stiffness=technology.joint_mechanical_stiffness(problem.n_joints),
+        rotor_inertia=np.asarray(motor.rotor_inertia, dtype=float),
+        reflected_inertia=gear**2 * np.asarray(motor.rotor_inertia, dtype=float),
+        motor_peak_torque=np.asarray(motor.peak_torque, dtype=float),
+        peak_torque=gear * np.asarray(motor.peak_torque, dtype=float),
+        motor_mass=np.asarray(motor.mass, dtype=float),
+        threshold=float(values["threshold"][0]),
+        approach_velocity=float(values["approach_velocity"][0]),
+        sensing=technology.sensing,
+    )
+
+
+def _violations(problem: DesignProblem, g: np.ndarray) -> list[tuple[str, float]]:
+    """Constraints violated at ``g``, worst first, as ``(label, amount)`` in the NLP's scaled units."""
+    below = problem.lbg - g
+    above = g - problem.ubg
+    amount = np.maximum(np.where(np.isfinite(below), below, 0.0), np.where(np.isfinite(above), above, 0.0))
+    order = np.argsort(-amount)
+    return [(problem.constraint_labels[i], float(amount[i])) for i in order if amount[i] > 1e-6][:10]

@@ -1,0 +1,270 @@
+"""The design optimiser against finite differences, brute-force grids and the properties of Pareto sets."""
+
+from __future__ import annotations
+
+import itertools
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import collision_reflex as cr
+from collision_reflex.arm import Arm
+from collision_reflex.optimize import hypervolume
+from collision_reflex.optimize.evaluate import evaluate_design
+from collision_reflex.optimize.problem import TIE_BREAK_WEIGHT
+from collision_reflex.optimize.solve import design_at
+
+TWO_LINK = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
+
+
+@pytest.fixture(scope="module")
+def arm():
+    return Arm.from_urdf(TWO_LINK, "tip")
+
+
+def _samples(arm, n_config=3, n_direction=4, seed=0):
+    rng = np.random.default_rng(seed)
+    kin = arm.kinematics(arm.sample_configurations(n_config, rng))
+    angles = np.linspace(0, 2 * np.pi, n_direction, endpoint=False) + 0.3
+    return cr.ContactSamples.grid(kin, np.c_[np.cos(angles), np.sin(angles)])
+
+
+FREE_SPACE = cr.DesignSpace(
+    stator_diameter=(0.02, 0.12),
+    gear_ratio=(1, 30),
+    software_stiffness=(5, 500),
+    threshold=(1, 10),
+    approach_velocity=(0.05, 1.0),
+)
+
+
+def _technology(**kwargs):
+    return cr.ActuatorTechnology(cr.reference_motor(), mechanical_stiffness=200.0, **kwargs)
+
+
+def _numpy_impulses(problem, z):
+    x = np.zeros(problem.layout.size)
+    x[:] = z
+    return evaluate_design(problem, design_at(problem, x))
+
+
+@pytest.mark.parametrize(
+    "technology",
+    [
+        dict(reflected_inertia_in="robot"),
+        dict(reflected_inertia_in="finger"),
+        dict(sensing="position", reaction="moving"),
+    ],
+    ids=["robot", "finger", "position-moving"],
+)
+def test_casadi_derivatives_match_numpy_finite_differences(arm, technology):
+    space = FREE_SPACE
+    if technology.get("sensing") == "position":
+        space = cr.DesignSpace(**{**FREE_SPACE.__dict__, "threshold": (1e-3, 2e-2)})
+    problem = cr.build_problem(
+        arm,
+        _samples(arm, 2, 3),
+        space,
+        _technology(**technology),
+        constraints=cr.Constraints(torque_required=[2.0, 1.0]),
+    )
+    function = problem.impulse_function()
+    z0 = problem.x0[: problem.layout.size] + 0.05  # off the bound midpoints
+    weights = np.random.default_rng(1).uniform(0.5, 1.5, problem.samples.size)
+
+    value = float(function(z0) @ weights)
+    assert value == pytest.approx(_numpy_impulses(problem, z0) @ weights, rel=1e-12)
+
+    import casadi as ca
+
+    z = ca.MX.sym("z", z0.size)
+    objective = ca.mtimes(function(z), ca.DM(weights))
+    hessian, gradient = ca.hessian(objective, z)
+    derivatives = ca.Function("d", [z], [gradient, hessian])
+    grad, hess = (np.asarray(v) for v in derivatives(z0))
+
+    def numpy_objective(point):
+        return float(_numpy_impulses(problem, point) @ weights)
+
+    # Central differences in the log design variables. Gradient: truncation ~h^2 f''' ~ 1e-10 and rounding
+    # ~eps f / h ~ 1e-11 (relative), so 1e-6 relative is safe. Hessian: second differences with h = 1e-4
+    # have truncation and rounding errors near 1e-8 relative to f; 1e-4 relative to the largest entry.
+    h = 1e-5
+    eye = np.eye(z0.size)
+    fd_grad = np.array([(numpy_objective(z0 + h * e) - numpy_objective(z0 - h * e)) / (2 * h) for e in eye])
+    np.testing.assert_allclose(grad.ravel(), fd_grad, rtol=1e-6, atol=1e-9 * abs(value))
+    h2 = 1e-4
+    fd_hess = np.empty((z0.size, z0.size))
+    for i, j in itertools.product(range(z0.size), repeat=2):
+        ei, ej = h2 * eye[i], h2 * eye[j]
+        fd_hess[i, j] = (
+            numpy_objective(z0 + ei + ej)
+            - numpy_objective(z0 + ei - ej)
+            - numpy_objective(z0 - ei + ej)
+            + numpy_objective(z0 - ei - ej)
+        ) / (4 * h2**2)
+    np.testing.assert_allclose(hess, fd_hess, rtol=0, atol=1e-4 * np.abs(fd_hess).max())
+
+
+def _brute_force_problem(arm, objective):
+    space = cr.DesignSpace(
+        stator_diameter=(0.02, 0.12),
+        gear_ratio=5.0,
+        software_stiffness=100.0,
+        threshold=3.0,
+        approach_velocity=(0.05, 1.0),
+    )
+    technology = _technology(reflected_inertia_in="finger")
+    constraints = cr.Constraints(torque_required=[3.0, 1.5])
+    return cr.build_problem(arm, _samples(arm, 2, 3), space, technology, objective, constraints)
+
+
+@pytest.mark.parametrize("objective", ["mean_impulse", "worst_case_impulse"])
+def test_optimum_agrees_with_brute_force_grid(arm, objective):
+    problem = _brute_force_problem(arm, objective)
+    result = cr.solve(problem)
+    assert result.success
+
+    # 25 log-spaced values per free variable (two diameters, the velocity): every design on the grid.
+    lower, upper, _ = problem.layout.log_bounds()
+    axes = [np.linspace(lo, hi, 25) for lo, hi in zip(lower, upper, strict=True)]
+    best_value, best_point = np.inf, None
+    for point in itertools.product(*axes):
+        z = np.array(point)
+        design = design_at(problem, z)
+        if np.any(design.peak_torque < np.array([3.0, 1.5])):
+            continue  # infeasible: not enough torque
+        impulses = evaluate_design(problem, design)
+        value = impulses.mean() if objective == "mean_impulse" else impulses.max()
+        if value < best_value:
+            best_value, best_point = value, z
+    found = result.numpy_objectives[objective]
+    # No grid point beats the optimum. The mean objective is exact; the worst case carries the tie-break pull
+    # toward a lower mean, which may cost up to about TIE_BREAK_WEIGHT of the worst case.
+    slack = 1e-9 if objective == "mean_impulse" else 2 * TIE_BREAK_WEIGHT
+    assert found <= best_value * (1 + slack)
+    # ... and the optimum lies within one grid step of the best grid point in every variable.
+    step = np.array([axis[1] - axis[0] for axis in axes])
+    z_found = result.x[: problem.layout.size]
+    assert np.all(np.abs(z_found - best_point) <= 1.0 * step + 1e-9), (z_found, best_point, step)
+
+
+def test_pareto_front_is_non_dominated_feasible_and_consistent(arm, tmp_path):
+    samples = _samples(arm, 3, 4)
+    technology = _technology(reflected_inertia_in="finger")
+    constraints = cr.Constraints(torque_required=[3.0, 1.5], safety_factor=1.2)
+    space = cr.DesignSpace(
+        stator_diameter=(0.02, 0.12),
+        gear_ratio=(1, 30),
+        software_stiffness=(5, 500),
+        threshold=(1, 10),
+        approach_velocity=0.3,
+    )
+
+    def build(objective, bounded):
+        return cr.build_problem(arm, samples, space, technology, objective, constraints, bounded)
+
+    pareto = cr.pareto_front(build, ("worst_case_impulse", "actuator_mass"), points=6)
+    values = pareto.values()
+    assert len(pareto.points) >= 4
+    for i, j in itertools.permutations(range(len(values)), 2):
+        dominates = np.all(values[i] <= values[j]) and np.any(values[i] < values[j] * (1 - 1e-9))
+        assert not dominates, (values[i], values[j])
+    for result in pareto.points:
+        assert np.all(result.torque_margin >= -1e-6)  # peak torque covers 1.2 x the requirement
+        np.testing.assert_allclose(result.required_torque, [3.6, 1.8], rtol=1e-12)
+        for name in ("worst_case_impulse", "actuator_mass"):
+            assert result.objectives[name] == pytest.approx(result.numpy_objectives[name], rel=1e-6)
+        for name, bound in result.epsilon.items():
+            assert result.numpy_objectives[name] <= bound * (1 + 1e-5)
+        d = result.design
+        assert np.all((d.stator_diameter >= 0.02 - 1e-9) & (d.stator_diameter <= 0.12 + 1e-9))
+        assert np.all(d.gear_ratio >= 1 - 1e-9)
+    # The front spans a real trade-off: lighter designs give larger impulses.
+    assert values[0, 1] > values[-1, 1] and values[0, 0] < values[-1, 0]
+
+    frame = pareto.to_frame()
+    assert len(frame) == len(pareto.points)
+    pareto.to_csv(tmp_path / "pareto.csv")
+    assert (tmp_path / "pareto.csv").read_text().count("\n") == len(pareto.points) + 1
+    pareto.plot(tmp_path / "front.svg")
+    assert (tmp_path / "front.svg").stat().st_size > 1000
+
+
+def test_hypervolume_against_hand_computation():
+    # Staircase of (1,3), (2,2), (3,1) to reference (4,4): 3*1 + 2*1 + 1*1 = 6.
+    assert hypervolume(np.array([[1, 3], [2, 2], [3, 1]]), np.array([4, 4])) == pytest.approx(6.0)
+    assert hypervolume(np.array([[1, 3], [2, 2], [3, 1], [3, 3]]), np.array([4, 4])) == pytest.approx(6.0)
+    # 3D: one box (1,1,1)-(2,2,2) -> 1; two overlapping boxes -> union.
+    assert hypervolume(np.array([[1.0, 1.0, 1.0]]), np.array([2.0, 2.0, 2.0])) == pytest.approx(1.0)
+    points = np.array([[0.0, 1.0, 1.0], [1.0, 0.0, 1.0]])
+    assert hypervolume(points, np.array([2.0, 2.0, 2.0])) == pytest.approx(2 + 2 - 1)
+
+
+def test_infeasible_torque_requirement_names_the_constraint(arm):
+    space = cr.DesignSpace(
+        stator_diameter=(0.02, 0.04),
+        gear_ratio=(1, 2),
+        software_stiffness=100.0,
+        threshold=3.0,
+        approach_velocity=0.3,
+    )
+    problem = cr.build_problem(
+        arm,
+        _samples(arm, 2, 2),
+        space,
+        _technology(),
+        constraints=cr.Constraints(torque_required=[50.0, 1.0]),
+    )
+    with pytest.raises(cr.SolverFailed) as info:
+        cr.solve(problem, ipopt_options={"ipopt.max_iter": 200})
+    assert "peak torque of joint1" in str(info.value)
+    assert info.value.violated and info.value.violated[0][0].startswith("peak torque of joint1")
+    assert info.value.stats["iter_count"] > 0
+
+
+@pytest.mark.parametrize(
+    ("space_change", "message"),
+    [
+        (dict(stator_diameter=(0.1, 0.02)), "lower <= upper"),
+        (dict(gear_ratio=(0.5, 10)), "gear ratio >= 1"),
+        (dict(threshold=(-1.0, 3.0)), "finite number > 0"),
+        (dict(approach_velocity=(0.1, float("nan"))), "finite number > 0"),
+    ],
+    ids=["swapped", "gear<1", "negative", "nan"],
+)
+def test_bad_bounds_are_clear_errors(arm, space_change, message):
+    space = cr.DesignSpace(**{**FREE_SPACE.__dict__, **space_change})
+    with pytest.raises(cr.InvalidParameter, match=message):
+        cr.build_problem(arm, _samples(arm, 1, 2), space, _technology())
+
+
+def test_bad_objective_and_floor(arm):
+    with pytest.raises(cr.InvalidParameter, match="objective"):
+        cr.build_problem(arm, _samples(arm, 1, 2), FREE_SPACE, _technology(), "fastest")
+    with pytest.raises(cr.InvalidParameter, match="noise floor"):
+        cr.build_problem(
+            arm,
+            _samples(arm, 1, 2),
+            FREE_SPACE,
+            _technology(),
+            constraints=cr.Constraints(threshold_floor=50.0),
+        )
+    with pytest.raises(cr.InvalidParameter, match="mechanical_stiffness"):
+        _technology().__class__(cr.reference_motor(), mechanical_stiffness=float("inf"))
+
+
+def test_threshold_floor_and_bounds_are_respected(arm):
+    problem = cr.build_problem(
+        arm,
+        _samples(arm, 2, 3),
+        FREE_SPACE,
+        _technology(),
+        constraints=cr.Constraints(torque_required=[2.0, 1.0], threshold_floor=4.0),
+    )
+    result = cr.solve(problem)
+    assert result.design.threshold >= 4.0 * (1 - 1e-9)
+    # Lower thresholds lower the impulse (sensing and reaction phases), so the floor binds; an interior-point
+    # solution sits a few 1e-6 (relative) inside an active bound.
+    assert result.design.threshold == pytest.approx(4.0, rel=1e-5)
