@@ -47,7 +47,9 @@ def test_slow_approach_matches_arm_closed_form(arm, q, angle):
     # The closed form it is compared with is issue 4's effective parameters through collision_reflex.impulse.
     samples = arm.kinematics(np.array(q)[None])
     ref = cr.effective_parameters(samples, u[None], 2.2e-3, 50.0, 50.0, 1.3)
-    closed = cr.total_impulse(ref.m_f[0, 0], ref.k[0, 0], ref.k_m[0, 0], 3.0, ref.a[0, 0], 0.1 * v_star, "moving")
+    closed = cr.total_impulse(
+        ref.m_f[0, 0], ref.k[0, 0], ref.k_m[0, 0], 3.0, ref.a[0, 0], 0.1 * v_star, "moving"
+    )
     assert result.closed_form == pytest.approx(float(closed), rel=1e-12)
     assert result.impulse == pytest.approx(result.closed_form, rel=0.05)
     # Detection where the sensing ramp k v0 t reaches the threshold, to the same accuracy.
@@ -56,7 +58,9 @@ def test_slow_approach_matches_arm_closed_form(arm, q, angle):
 
 def test_rigid_joints_are_refused(arm):
     with pytest.raises(InvalidParameter, match="give mechanical_stiffness"):
-        simulate_arm_collision(arm, [0.3, 1.2], [1.0, 0.0], 0.1, 3.0, reflected_inertia=2.2e-3, torque_limit=1.3)
+        simulate_arm_collision(
+            arm, [0.3, 1.2], [1.0, 0.0], 0.1, 3.0, reflected_inertia=2.2e-3, torque_limit=1.3
+        )
 
 
 def test_bad_direction_is_refused(arm):

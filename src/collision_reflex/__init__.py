@@ -30,6 +30,7 @@ from .errors import (
     CollisionReflexError,
     FrameNotFound,
     InvalidParameter,
+    SimulationError,
     SolverFailed,
     UnknownMotor,
     UrdfError,
@@ -81,6 +82,17 @@ from .optimize import (
     pareto_front,
     solve,
 )
+from .simulate import (
+    CollisionSetup,
+    Detection,
+    SimulationResult,
+    contact_damping_for_restitution,
+    contact_restitution,
+)
+from .simulate import Sweep as SimulationSweep
+from .simulate import simulate as simulate_collision
+from .simulate import sweep as simulation_sweep
+from .simulate_arm import ArmCollision, simulate_arm_collision
 from .surfaces import ReflexSurface, reflex_surface
 
 __version__ = "0.1.0"
@@ -94,12 +106,14 @@ __all__ = [
     "Actuator",
     "ActuatorTechnology",
     "Arm",
+    "ArmCollision",
     "ArmSamples",
     "Bounds",
     "CatalogueError",
     "CollisionImpulses",
     "CollisionParameters",
     "CollisionReflexError",
+    "CollisionSetup",
     "Constraints",
     "ContactSamples",
     "CurrentThreshold",
@@ -107,6 +121,7 @@ __all__ = [
     "DesignProblem",
     "DesignResult",
     "DesignSpace",
+    "Detection",
     "EffectiveParameters",
     "Ellipsoid",
     "ForceThreshold",
@@ -122,6 +137,9 @@ __all__ = [
     "PositionThreshold",
     "ReflexSurface",
     "ScalingLaw",
+    "SimulationError",
+    "SimulationResult",
+    "SimulationSweep",
     "SolverFailed",
     "UnknownMotor",
     "UrdfError",
@@ -130,6 +148,8 @@ __all__ = [
     "circle_directions",
     "collision_impulses",
     "collision_times",
+    "contact_damping_for_restitution",
+    "contact_restitution",
     "dynamic_manipulability_ellipsoid",
     "effective_mass",
     "effective_parameters",
@@ -148,6 +168,9 @@ __all__ = [
     "scaled_motor_quantities",
     "scaling_law",
     "series_stiffness",
+    "simulate_arm_collision",
+    "simulate_collision",
+    "simulation_sweep",
     "solve",
     "sphere_directions",
     "total_impulse",

@@ -132,21 +132,32 @@ def simulate_arm_collision(
     nv = int(arm.nv)
     if arm.nq != nv:
         raise InvalidParameter(
-            "arm", arm.name, "one configuration coordinate per joint", "continuous joints are not supported here"
+            "arm",
+            arm.name,
+            "one configuration coordinate per joint",
+            "continuous joints are not supported here",
         )
     params = arm.joint_parameters
-    k_m = _joint("mechanical_stiffness", params.mechanical_stiffness if mechanical_stiffness is None
-                 else mechanical_stiffness, nv, allow_inf=True)
+    k_m = _joint(
+        "mechanical_stiffness",
+        params.mechanical_stiffness if mechanical_stiffness is None else mechanical_stiffness,
+        nv,
+        allow_inf=True,
+    )
     if not np.all(np.isfinite(k_m)):
         raise InvalidParameter(
-            "mechanical_stiffness", k_m, "finite joint stiffnesses [N m/rad]",
+            "mechanical_stiffness",
+            k_m,
+            "finite joint stiffnesses [N m/rad]",
             "the joints must be elastic: give mechanical_stiffness",
         )
     k_s = _joint("software_stiffness", software_stiffness, nv, allow_inf=True)
-    inertia = _joint("reflected_inertia", params.reflected_inertia if reflected_inertia is None
-                     else reflected_inertia, nv)
-    tau_max = _joint("torque_limit", params.torque_limit if torque_limit is None else torque_limit, nv,
-                     allow_inf=True)
+    inertia = _joint(
+        "reflected_inertia", params.reflected_inertia if reflected_inertia is None else reflected_inertia, nv
+    )
+    tau_max = _joint(
+        "torque_limit", params.torque_limit if torque_limit is None else torque_limit, nv, allow_inf=True
+    )
     q0 = np.asarray(q, dtype=float).reshape(-1)
     if q0.shape != (nv,) or not np.all(np.isfinite(q0)):
         raise InvalidParameter("q", q, f"{nv} finite joint angles [rad]")
@@ -160,19 +171,34 @@ def simulate_arm_collision(
     # collision_reflex.impulse).
     samples = arm.kinematics(q0[None])
     effective = effective_parameters(
-        samples, u[None], inertia, lumped, k_m, tau_max,
+        samples,
+        u[None],
+        inertia,
+        lumped,
+        k_m,
+        tau_max,
         motor_mass=params.motor_mass if np.any(params.motor_mass > 0) else None,
     )
     eff = {name: float(getattr(effective, name)[0, 0]) for name in ("m_f", "m_r", "k", "k_m", "F_a", "a")}
     if bool(effective.singular[0, 0]):
-        raise InvalidParameter("direction", direction, "a direction the arm can move along at q", "q is singular there")
+        raise InvalidParameter(
+            "direction", direction, "a direction the arm can move along at q", "q is singular there"
+        )
     jac0 = samples.jacobian[0]
     share = np.where(np.isinf(k_s), 1.0, k_s / np.where(np.isinf(k_s), 1.0, k_s + k_m))
     reference_rate = np.linalg.pinv(jac0) @ u * velocity  # theta_ref' [rad/s]
     robot_velocity = float(u @ jac0 @ (share * reference_rate))
     closed = float(
-        total_impulse(eff["m_f"], eff["k"], eff["k_m"], threshold, eff["a"], velocity, reaction,
-                      robot_velocity if reaction == "moving" else None)
+        total_impulse(
+            eff["m_f"],
+            eff["k"],
+            eff["k_m"],
+            threshold,
+            eff["a"],
+            velocity,
+            reaction,
+            robot_velocity if reaction == "moving" else None,
+        )
     )
 
     # Link-side model: structure only (no armature), no gravity, motor masses carried by the parent links,
@@ -191,7 +217,12 @@ def simulate_arm_collision(
     frame = model.frames[model.getFrameId(arm.contact_frame)]
     local = np.asarray(frame.placement.act(np.asarray(arm.contact_offset, dtype=float)))
     contact_id = model.addFrame(
-        pin.Frame("collision_reflex_wall_contact", frame.parentJoint, pin.SE3(np.eye(3), local), pin.FrameType.OP_FRAME)
+        pin.Frame(
+            "collision_reflex_wall_contact",
+            frame.parentJoint,
+            pin.SE3(np.eye(3), local),
+            pin.FrameType.OP_FRAME,
+        )
     )
     data = model.createData()
     plane = arm.plane  # (3, 2) orthonormal basis of a planar arm's plane (columns), or None
@@ -214,8 +245,11 @@ def simulate_arm_collision(
 
     def motors(t: float, qs: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         reference = q0 + v_ref * t
-        theta = np.where(np.isinf(k_s), reference, (np.where(np.isinf(k_s), 0, k_s) * reference + k_m * qs)
-                         / np.where(np.isinf(k_s), 1, k_s + k_m))
+        theta = np.where(
+            np.isinf(k_s),
+            reference,
+            (np.where(np.isinf(k_s), 0, k_s) * reference + k_m * qs) / np.where(np.isinf(k_s), 1, k_s + k_m),
+        )
         dtheta = share * v_ref + (1 - share) * dq
         return theta, dtheta
 
@@ -271,7 +305,11 @@ def simulate_arm_collision(
     ]
     max_step = min(periods) / 16
     t1_estimate = threshold / (eff["k"] * velocity)
-    duration = 50 * (t1_estimate + delay) + 50 * math.sqrt(2 * threshold / (eff["a"] * eff["k_m"]) + 1e-30) + 20 * max(periods)
+    duration = (
+        50 * (t1_estimate + delay)
+        + 50 * math.sqrt(2 * threshold / (eff["a"] * eff["k_m"]) + 1e-30)
+        + 20 * max(periods)
+    )
 
     y = np.zeros(4 * nv + 1)
     y[:nv] = q0
@@ -281,7 +319,11 @@ def simulate_arm_collision(
 
     def record(solution: Any) -> None:
         times.append(solution.t[1:])
-        forces.append(np.array([wall_force(*contact_kinematics(col[:nv]), col[nv : 2 * nv]) for col in solution.y.T[1:]]))
+        forces.append(
+            np.array(
+                [wall_force(*contact_kinematics(col[:nv]), col[nv : 2 * nv]) for col in solution.y.T[1:]]
+            )
+        )
 
     # 1. Impact and sensing until the estimated force reaches the threshold.
     solution = solve_ivp(rhs, (0.0, duration), y, events=detected, **options)
@@ -347,8 +389,10 @@ def simulate_arm_collision(
 
 
 def _joint(name: str, value: Any, nv: int, allow_inf: bool = False) -> np.ndarray:
-    array = np.broadcast_to(np.asarray(value, dtype=float), (nv,)).copy() if np.ndim(value) == 0 else (
-        np.asarray(value, dtype=float).reshape(-1)
+    array = (
+        np.broadcast_to(np.asarray(value, dtype=float), (nv,)).copy()
+        if np.ndim(value) == 0
+        else (np.asarray(value, dtype=float).reshape(-1))
     )
     if array.shape != (nv,):
         raise InvalidParameter(name, value, f"one value or {nv} values, one per joint")
