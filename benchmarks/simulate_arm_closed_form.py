@@ -18,7 +18,13 @@ from collision_reflex.simulate_arm import simulate_arm_collision
 
 URDF = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
 JOINTS = dict(mechanical_stiffness=50.0, reflected_inertia=2.2e-3, torque_limit=1.3)
-CASES = [([0.3, 1.2], 0.0), ([0.3, 1.2], 2.0), ([-0.5, 2.0], 0.0), ([-0.5, 2.0], 2.0), ([0.0, np.pi / 2], 0.0)]
+CASES = [
+    ([0.3, 1.2], 0.0),
+    ([0.3, 1.2], 2.0),
+    ([-0.5, 2.0], 0.0),
+    ([-0.5, 2.0], 2.0),
+    ([0.0, np.pi / 2], 0.0),
+]
 RATIOS = (0.1, 0.3, 1.0, 3.0)
 
 
@@ -39,8 +45,12 @@ def main() -> None:
             worst[ratio] = max(worst[ratio], abs(difference))
             cells.append(f"{100 * difference:>+9.1f}%")
             count += 1
-        print(f"{np.array2string(np.asarray(q), precision=2):>16}{angle:>9.2f}{v_star:>10.3g}" + "".join(cells))
-    print("largest |I_sim / I_closed - 1|: " + ", ".join(f"{100 * w:.1f} % at {r} v*" for r, w in worst.items()))
+        print(
+            f"{np.array2string(np.asarray(q), precision=2):>16}{angle:>9.2f}{v_star:>10.3g}" + "".join(cells)
+        )
+    print(
+        "largest |I_sim / I_closed - 1|: " + ", ".join(f"{100 * w:.1f} % at {r} v*" for r, w in worst.items())
+    )
     print(f"{1e3 * (time.perf_counter() - start) / count:.0f} ms per simulation")
 
 
