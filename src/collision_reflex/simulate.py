@@ -919,7 +919,7 @@ def sweep(
     parameter: str | None = None,
     values: Any = None,
     reaction: str = "at_rest",
-    v_r: float | None = None,
+    v_r: float | str | None = None,
     tolerance: float = 0.05,
 ) -> Sweep:
     """Simulate ``setup`` at each approach velocity (and each value of ``parameter``) and evaluate the
@@ -932,7 +932,9 @@ def sweep(
     parameter: ``"delay"`` [s] or ``"backlash"`` [m] to sweep as well, or None.
     values: the parameter's values (>= 0); with ``"backlash"``, half of each is open at impact unless
         ``setup.initial_play`` says otherwise (it is then capped at the backlash).
-    reaction, v_r: the closed form's reaction variant, as :func:`collision_reflex.phase_impulses`.
+    reaction, v_r: the closed form's reaction variant, as :func:`collision_reflex.phase_impulses`; ``v_r`` may
+        also be ``"detected"``: the robot's velocity at detection in the ideal limit, ``v0 k / k_m``, per
+        velocity (with ``reaction="moving"``).
     tolerance: relative difference that counts as parting, > 0.
     """
     speeds = np.atleast_1d(np.asarray(velocities, dtype=float))
@@ -960,5 +962,7 @@ def sweep(
         for j, v0 in enumerate(speeds):
             case = replace(setup, velocity=float(v0), **changes)
             simulated[i, j] = simulate(case).impulse
-            closed[i, j] = float(case.closed_form(reaction, v_r).total)
-    return Sweep(speeds, parameter, levels, simulated, closed, reaction, float(tolerance))
+            robot_velocity = case.detection_robot_velocity if v_r == "detected" else v_r
+            closed[i, j] = float(case.closed_form(reaction, robot_velocity).total)  # type: ignore[arg-type]
+    label = "moving at v0 k/k_m" if v_r == "detected" else reaction
+    return Sweep(speeds, parameter, levels, simulated, closed, label, float(tolerance))

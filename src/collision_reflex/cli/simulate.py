@@ -248,34 +248,14 @@ def run(args: argparse.Namespace) -> int:
     velocities = (
         args.velocities if args.velocities is not None else np.geomspace(0.1, 10, args.count) * v_star
     )
-    reaction, v_r = args.reaction, None
-    if reaction == "detected":
-        reaction, v_r = "moving", None  # per velocity, below
+    reaction, v_r = (args.reaction, None) if args.reaction != "detected" else ("moving", "detected")
     parameter, values = None, None
     if args.delays is not None:
         parameter, values = "delay", args.delays
     elif args.backlashes is not None:
         parameter, values = "backlash", args.backlashes
 
-    if args.reaction == "detected":
-        # v_r = v0 k / k_m depends on the velocity: sweep one velocity at a time.
-        parts = [
-            sweep(setup, [v], parameter, values, "moving", v * k / args.k_m, args.tolerance)
-            for v in velocities
-        ]
-        from ..simulate import Sweep
-
-        result = Sweep(
-            np.asarray(velocities, dtype=float),
-            parameter,
-            parts[0].values,
-            np.concatenate([p.simulated for p in parts], axis=1),
-            np.concatenate([p.closed_form for p in parts], axis=1),
-            "moving at v0 k/k_m",
-            args.tolerance,
-        )
-    else:
-        result = sweep(setup, velocities, parameter, values, reaction, v_r, args.tolerance)
+    result = sweep(setup, velocities, parameter, values, reaction, v_r, args.tolerance)
 
     print(
         f"m_f = {args.m_f:g} kg, m_r = {args.m_r:g} kg, k_m = {args.k_m:g} N/m, k_s = {args.k_s:g} N/m "
