@@ -318,6 +318,8 @@ class SimulationResult:
     actuator_work: work done by the actuator on the robot mass [J].
     dissipated: energy lost in contact damping, plastic impacts and friction [J].
     initial_energy, final_energy: kinetic plus elastic energy at the start and the end [J].
+    events: ``(time [s], what)`` of every mode change (impacts, contact loss, detection, reaction, play,
+        stiction), in order.
     """
 
     setup: CollisionSetup
@@ -745,9 +747,12 @@ def simulate(setup: CollisionSetup) -> SimulationResult:
             if math.isfinite(watch_end):
                 break  # the contact has ended; the watch for a new one is cut short by the duration
             if detecting and math.isinf(detection_time):
+                limited = ""
+                if setup.drive == "impedance" and kind != "position" and threshold >= setup.force_limit:
+                    limited = f" (the impedance controller pushes with at most force_limit = {setup.force_limit:g} N)"
                 raise SimulationError(
                     f"nothing was detected within {duration:.3g} s: the {kind} threshold {threshold:g} is "
-                    "never reached; lower the threshold or lengthen duration"
+                    f"never reached{limited}; lower the threshold or lengthen duration"
                 )
             raise SimulationError(
                 f"the contact had not ended after {duration:.3g} s (reaction at {reaction_time:.3g} s); "
