@@ -288,7 +288,7 @@ def test_undetectable_threshold_says_so():
     with pytest.raises(SimulationError, match="never reached"):
         simulate(soft_setup(drive="impedance", detection=Detection("current", 9.9), duration=0.2))
     with pytest.raises(SimulationError, match="pushes with at most force_limit = 2 N"):
-        simulate(soft_setup(drive="impedance", force_limit=2.0, duration=0.5))
+        simulate(soft_setup(drive="impedance", force_limit=2.0, velocity=0.01, duration=1.0))
 
 
 def test_detection_kind_and_threshold_checked():
