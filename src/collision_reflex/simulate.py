@@ -64,6 +64,7 @@ DETECTION_KINDS: tuple[str, ...] = ("force", "position", "current")
 # tolerances resolve a spring compression of nanometres while the reference travels centimetres.
 _XF, _VF, _DEFL, _VR, _ERR, _SURF, _IMP, _WORK, _LOSS = range(9)
 _NSTATE = 9
+_TRACE_POINTS = 40  # interpolated trace points per integration segment
 
 
 @dataclass(frozen=True)
@@ -777,16 +778,27 @@ def simulate(setup: CollisionSetup) -> SimulationResult:
             rtol=setup.rtol,
             atol=atol,
             max_step=min(sim.max_step(), t_stop - t),
+            dense_output=True,
         )
         if solution.status < 0:
             raise SimulationError(f"the integrator failed at t = {t:.6g} s: {solution.message}")
-        times.append(solution.t[1:])
+        # The trace: the integrator's steps plus evenly spaced points from its interpolant, so that a segment
+        # covered in a few long steps (a linear ramp) is still drawn smoothly where it bends later.
+        trace_times = solution.t[1:]
+        if solution.t.size > 1:
+            extra = np.linspace(solution.t[0], solution.t[-1], _TRACE_POINTS)[1:-1]
+            trace_times = np.union1d(trace_times, extra)
+            trace_states = solution.sol(trace_times)
+            trace_states[:, -1] = solution.y[:, -1]
+        else:
+            trace_states = np.zeros((_NSTATE, 0))
+        times.append(trace_times)
         states.append(
-            np.stack([sim.resolved(column) for column in solution.y.T[1:]], axis=1)
-            if solution.t.size > 1
+            np.stack([sim.resolved(column) for column in trace_states.T], axis=1)
+            if trace_times.size
             else np.zeros((_NSTATE, 0))
         )
-        modes.extend([sim.contact] * (solution.t.size - 1))
+        modes.extend([sim.contact] * trace_times.size)
         t = float(solution.t[-1])
         y = sim.resolved(solution.y[:, -1])
         if sim.drive == "kinematic":

@@ -197,14 +197,28 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     add("--plot", default=None, metavar="FILE", help="draw the comparison to FILE (.png, .svg or .pdf)")
     add("--csv", default=None, metavar="FILE", help="write the numbers to FILE (CSV)")
+    add(
+        "--trace",
+        default=None,
+        metavar="FILE",
+        help="also draw one simulated force trace over the closed form's profile to FILE (.png, .svg or .pdf)",
+    )
+    add(
+        "--trace-velocity",
+        type=positive_float,
+        default=None,
+        metavar="M/S",
+        help="approach velocity of that trace [m/s] (default v*; first value of --delays/--backlashes)",
+    )
     parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.plot is not None:
-        from ..plots import check_figure_path
+    for figure in (args.plot, args.trace):
+        if figure is not None:
+            from ..plots import check_figure_path
 
-        check_figure_path(args.plot)
+            check_figure_path(figure)  # refuse a bad name before doing any work
     if args.delays is not None and args.backlashes is not None:
         raise InvalidParameter(
             "--delays, --backlashes", "both", "one of them", "sweep one parameter at a time"
@@ -310,5 +324,18 @@ def run(args: argparse.Namespace) -> int:
         else:
             curve = total_impulse(args.m_f, k, args.k_m, F_s, setup.acceleration, dense, reaction)
         path = plot_sweep(args.plot, result, (dense, curve))
+        print(f"wrote {path}")
+    if args.trace is not None:
+        from dataclasses import replace
+
+        from ..plots.simulation import plot_trace
+        from ..simulate import simulate
+
+        changes: dict = {"velocity": args.trace_velocity or v_star}
+        if parameter is not None:
+            changes[parameter] = float(result.values[0])
+        traced = simulate(replace(setup, **changes))
+        robot_velocity = traced.setup.detection_robot_velocity if v_r == "detected" else None
+        path = plot_trace(args.trace, traced, reaction, robot_velocity)
         print(f"wrote {path}")
     return 0

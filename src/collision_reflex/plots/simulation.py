@@ -65,3 +65,63 @@ def _format(parameter: str | None, value: float) -> str:
     if parameter == "backlash":
         return f"{1e3 * value:g} mm"
     return f"{value:g}"
+
+
+def plot_trace(path: str | os.PathLike[str], result: Any, reaction: str = "at_rest", v_r: Any = None) -> Path:
+    """Draw a simulated force trace (:class:`collision_reflex.simulate.SimulationResult`) over the closed form's
+    force profile (:func:`collision_reflex.force_profile`) for the same setup, with the detection, reaction and
+    contact-end times marked and the rigid impacts' impulses noted."""
+    from ..impulse import force_profile
+
+    setup = result.setup
+    end = float(result.contact_end) if np.isfinite(result.contact_end) else float(result.t[-1])
+    fig, ax = new_figure(figsize=(7, 3.6))
+    ax.plot(result.t, result.contact_force, color="tab:blue", lw=1.2, label="simulated contact force")
+    t = np.linspace(0.0, 1.3 * end, 800)
+    closed = force_profile(
+        t,
+        setup.finger_mass,
+        setup.lumped_stiffness,
+        setup.mechanical_stiffness,
+        setup.equivalent_threshold,
+        setup.acceleration,
+        setup.velocity,
+        reaction,
+        v_r,
+    )
+    ax.plot(t, closed, color="black", lw=1.0, ls="--", label=f"closed form ({reaction})")
+    for height, (name, time, style) in enumerate(
+        (
+            ("detection", result.detection_time, ":"),
+            ("reaction", result.reaction_time, "-."),
+            ("contact ends", result.contact_end, "-"),
+        )
+    ):
+        if np.isfinite(time):
+            ax.axvline(time, color="gray", ls=style, lw=0.8)
+            # Staggered so that labels of close events do not overprint.
+            ax.annotate(
+                name,
+                (time, 0.03 + 0.08 * height),
+                xycoords=("data", "axes fraction"),
+                xytext=(3, 0),
+                textcoords="offset points",
+                color="gray",
+                fontsize=8,
+            )
+    impacts = sum(impulse for _, impulse in result.impacts)
+    note = f"I = {result.impulse:.4g} N·s"
+    if impacts:
+        note += f" (rigid impacts {impacts:.3g} N·s, not drawn)"
+    ax.set_title(f"Simulated collision at v0 = {setup.velocity:.3g} m/s: {note}", fontsize=10)
+    ax.set_xlabel("time since impact [s]")
+    ax.set_ylabel("contact force [N]")
+    spring_peak = float(np.max(result.spring_force)) if result.spring_force.size else 0.0
+    top = max(spring_peak, float(np.max(closed[t > 1e-3 * end])) if np.any(t > 1e-3 * end) else 0.0)
+    if result.peak_force > 3 * max(top, 1e-12):
+        ax.set_ylim(0.0, 1.5 * top)  # clip a brief, tall impact pulse so the rest shows
+    else:
+        ax.set_ylim(bottom=0.0)
+    ax.set_xlim(-0.02 * end, 1.3 * end)
+    ax.legend(fontsize=8, loc="upper right")
+    return save_figure(fig, path)
