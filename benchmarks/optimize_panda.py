@@ -40,13 +40,18 @@ def main() -> None:
     directions = rng.normal(size=(4, 3))
     samples = cr.ContactSamples.grid(kinematics, directions)
     space = cr.DesignSpace(
-        stator_diameter=(0.02, 0.15), gear_ratio=(1.0, 100.0), software_stiffness=(100.0, 1e4),
-        threshold=(5.0, 40.0), approach_velocity=(0.05, 1.0),
+        stator_diameter=(0.02, 0.15),
+        gear_ratio=(1.0, 100.0),
+        software_stiffness=(100.0, 1e4),
+        threshold=(5.0, 40.0),
+        approach_velocity=(0.05, 1.0),
     )
     constraints = cr.Constraints(payload=1.0, safety_factor=1.5, threshold_floor=5.0)
 
     def technology(place: str) -> cr.ActuatorTechnology:
-        return cr.ActuatorTechnology(cr.reference_motor(), mechanical_stiffness=5000.0, reflected_inertia_in=place)
+        return cr.ActuatorTechnology(
+            cr.reference_motor(), mechanical_stiffness=5000.0, reflected_inertia_in=place
+        )
 
     def builder(place: str):
         def build(objective: str, bounded: tuple[str, ...]) -> cr.DesignProblem:
@@ -62,35 +67,49 @@ def main() -> None:
     started = time.perf_counter()
     first = cr.solve(problem)
     first_total = time.perf_counter() - started
-    second = cr.solve(problem)  # the solver is cached on the problem: a second solve excludes its construction
-    print(f"one solve: build {built:.2f} s, first solve {first_total:.2f} s (IPOPT {first.solve_time:.2f} s, "
-          f"{first.iterations} iterations, including solver construction), repeat solve {second.solve_time:.2f} s")
-    print(f"  worst-case impulse {first.objectives['worst_case_impulse']:.4f} N*s (NumPy path "
-          f"{first.numpy_objectives['worst_case_impulse']:.4f}), motor mass {first.objectives['actuator_mass']:.3f} kg")
+    second = cr.solve(
+        problem
+    )  # the solver is cached on the problem: a second solve excludes its construction
+    print(
+        f"one solve: build {built:.2f} s, first solve {first_total:.2f} s (IPOPT {first.solve_time:.2f} s, "
+        f"{first.iterations} iterations, including solver construction), repeat solve {second.solve_time:.2f} s"
+    )
+    print(
+        f"  worst-case impulse {first.objectives['worst_case_impulse']:.4f} N*s (NumPy path "
+        f"{first.numpy_objectives['worst_case_impulse']:.4f}), motor mass {first.objectives['actuator_mass']:.3f} kg"
+    )
 
     started = time.perf_counter()
     pareto = cr.pareto_front(builder("finger"), ("worst_case_impulse", "actuator_mass"), points=points)
     pareto_time = time.perf_counter() - started
     iterations = [r.iterations for r in pareto.points]
-    print(f"Pareto front: {len(pareto.points)} non-dominated of {points} requested in {pareto_time:.1f} s "
-          f"({pareto.solver_builds} problems built; {len(pareto.failed)} failed, {len(pareto.dominated)} dominated; "
-          f"iterations per point: median {int(np.median(iterations))}, max {max(iterations)})")
+    print(
+        f"Pareto front: {len(pareto.points)} non-dominated of {points} requested in {pareto_time:.1f} s "
+        f"({pareto.solver_builds} problems built; {len(pareto.failed)} failed, {len(pareto.dominated)} dominated; "
+        f"iterations per point: median {int(np.median(iterations))}, max {max(iterations)})"
+    )
 
     started = time.perf_counter()
     genetic = nsga2_front(problem, ("worst_case_impulse", "actuator_mass"), population, generations, seed=1)
-    print(f"NSGA-II ({population} x {generations}): {len(genetic.values)} non-dominated designs, "
-          f"{genetic.evaluations} evaluations in {time.perf_counter() - started:.1f} s")
+    print(
+        f"NSGA-II ({population} x {generations}): {len(genetic.values)} non-dominated designs, "
+        f"{genetic.evaluations} evaluations in {time.perf_counter() - started:.1f} s"
+    )
 
     ours = pareto.values()
     reference = 1.05 * np.maximum(ours.max(axis=0), genetic.values.max(axis=0))
     hv_ours, hv_genetic = hypervolume(ours, reference), hypervolume(genetic.values, reference)
-    print(f"hypervolume (reference {reference[0]:.4f} N*s, {reference[1]:.4f} kg): epsilon-constraint "
-          f"{hv_ours:.5f}, NSGA-II {hv_genetic:.5f}, ratio {hv_ours / hv_genetic:.3f}")
+    print(
+        f"hypervolume (reference {reference[0]:.4f} N*s, {reference[1]:.4f} kg): epsilon-constraint "
+        f"{hv_ours:.5f}, NSGA-II {hv_genetic:.5f}, ratio {hv_ours / hv_genetic:.3f}"
+    )
 
     robot = cr.pareto_front(builder("robot"), ("worst_case_impulse", "actuator_mass"), points=5)
     spread = robot.values()
-    print(f"paper's arm model (reflected inertia in the reaction only): {len(robot.points)} non-dominated "
-          f"point(s); worst-case impulse {spread[:, 0].min():.4f}-{spread[:, 0].max():.4f} N*s")
+    print(
+        f"paper's arm model (reflected inertia in the reaction only): {len(robot.points)} non-dominated "
+        f"point(s); worst-case impulse {spread[:, 0].min():.4f}-{spread[:, 0].max():.4f} N*s"
+    )
 
 
 if __name__ == "__main__":

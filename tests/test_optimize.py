@@ -268,3 +268,21 @@ def test_threshold_floor_and_bounds_are_respected(arm):
     # Lower thresholds lower the impulse (sensing and reaction phases), so the floor binds; an interior-point
     # solution sits a few 1e-6 (relative) inside an active bound.
     assert result.design.threshold == pytest.approx(4.0, rel=1e-5)
+
+
+def test_multi_start_is_never_worse_and_reproducible(arm):
+    problem = cr.build_problem(
+        arm,
+        _samples(arm, 3, 4),
+        FREE_SPACE,
+        _technology(),
+        constraints=cr.Constraints(torque_required=[2.0, 1.0]),
+    )
+    single = cr.solve(problem)
+    multi = cr.solve(problem, starts=4, rng=np.random.default_rng(3))
+    again = cr.solve(problem, starts=4, rng=np.random.default_rng(3))
+    # The best of several local optima includes the single start's own.
+    assert problem.objective_value(multi.x) <= problem.objective_value(single.x) * (1 + 1e-9)
+    np.testing.assert_array_equal(multi.x, again.x)
+    with pytest.raises(cr.InvalidParameter, match="starts"):
+        cr.solve(problem, starts=0)

@@ -6,6 +6,7 @@ Actuation"). This package evaluates it from structure, actuation, stiffness and 
 URDF arms, and optimises actuator designs against it.
 """
 
+from . import experiments
 from .actuators import (
     REFLECTED_INERTIA_PLACEMENTS,
     Actuator,
@@ -28,10 +29,12 @@ from .directions import circle_directions, sphere_directions, unit_directions
 from .errors import (
     CatalogueError,
     CollisionReflexError,
+    FitFailed,
     FrameNotFound,
     InvalidParameter,
     SimulationError,
     SolverFailed,
+    TraceError,
     UnknownMotor,
     UrdfError,
 )
@@ -124,6 +127,7 @@ __all__ = [
     "Detection",
     "EffectiveParameters",
     "Ellipsoid",
+    "FitFailed",
     "ForceThreshold",
     "FrameNotFound",
     "Gearbox",
@@ -141,6 +145,7 @@ __all__ = [
     "SimulationResult",
     "SimulationSweep",
     "SolverFailed",
+    "TraceError",
     "UnknownMotor",
     "UrdfError",
     "__version__",
@@ -154,6 +159,7 @@ __all__ = [
     "effective_mass",
     "effective_parameters",
     "ellipsoid_of_gyration",
+    "experiments",
     "force_profile",
     "gear_ratio_for",
     "generalized_inertia_ellipsoid",

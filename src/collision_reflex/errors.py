@@ -60,8 +60,14 @@ class SolverFailed(CollisionReflexError):
     problem: the problem that was solved, for inspection.
     """
 
-    def __init__(self, message: str, status: str, stats: dict, violated: list[tuple[str, float]],
-                 problem: object = None) -> None:
+    def __init__(
+        self,
+        message: str,
+        status: str,
+        stats: dict,
+        violated: list[tuple[str, float]],
+        problem: object = None,
+    ) -> None:
         self.status = status
         self.stats = stats
         self.violated = violated
@@ -145,6 +151,45 @@ class CatalogueError(CollisionReflexError, ValueError):
         where = f"{path}:{line}" if line is not None else path
         subject = f"{field}: " if field else ""
         super().__init__(f"{where}: {subject}{reason}")
+
+
+class TraceError(CollisionReflexError, ValueError):
+    """A force-time trace cannot be used: unreadable, malformed, or without a usable contact.
+
+    Attributes
+    ----------
+    source: the file the trace came from (``""`` for an in-memory trace).
+    trial: the trial's name within that file (``""`` if the file holds one trial).
+    reason: what is wrong, in a short phrase (e.g. ``"no contact: ..."``).
+    line: the file line (1-based) where the problem is, or ``None`` when it is not one line.
+    """
+
+    def __init__(self, source: str, trial: str, reason: str, line: int | None = None) -> None:
+        self.source = source
+        self.trial = trial
+        self.reason = reason
+        self.line = line
+        where = source or "trace"
+        if line is not None:
+            where += f", line {line}"
+        if trial:
+            where += f" (trial {trial!r})"
+        super().__init__(f"{where}: {reason}")
+
+
+class FitFailed(CollisionReflexError):
+    """A least-squares fit did not converge or its result is not usable.
+
+    Attributes
+    ----------
+    what: which fit (e.g. ``"one-shot fit"``).
+    reason: the solver's message or the check that failed.
+    """
+
+    def __init__(self, what: str, reason: str) -> None:
+        self.what = what
+        self.reason = reason
+        super().__init__(f"{what} failed: {reason}")
 
 
 class SimulationError(CollisionReflexError):

@@ -12,6 +12,7 @@ from collections.abc import Sequence
 
 from .. import __version__
 from ..errors import CollisionReflexError
+from . import fit as _fit
 from . import impulse as _impulse
 from . import motors as _motors
 from . import simulate as _simulate
@@ -19,7 +20,7 @@ from . import surface as _surface
 from . import sweep as _sweep
 
 # Subcommand modules, in the order `crx --help` lists them.
-_SUBCOMMANDS = [_impulse, _motors, _sweep, _surface, _simulate]
+_SUBCOMMANDS = [_impulse, _motors, _sweep, _surface, _fit, _simulate]
 
 
 def build_parser() -> argparse.ArgumentParser:

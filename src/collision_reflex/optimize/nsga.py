@@ -80,8 +80,9 @@ def nsga2_front(
 
     class _Design(ElementwiseProblem):
         def __init__(self) -> None:
-            super().__init__(n_var=lower.size, n_obj=len(names), n_ieq_constr=problem.n_joints, xl=lower,
-                             xu=upper)
+            super().__init__(
+                n_var=lower.size, n_obj=len(names), n_ieq_constr=problem.n_joints, xl=lower, xu=upper
+            )
 
         def _evaluate(self, z: np.ndarray, out: dict[str, Any], *args: Any, **kwargs: Any) -> None:
             out["F"], out["G"] = evaluate(z)
@@ -91,5 +92,10 @@ def nsga2_front(
     if result.F is None:
         raise CollisionReflexError("NSGA-II found no design that meets the torque requirement")
     values = np.atleast_2d(result.F) * senses
-    return GeneticFront(names, values, np.atleast_2d(result.X), int(result.algorithm.evaluator.n_eval),
-                        time.perf_counter() - started)
+    return GeneticFront(
+        names,
+        values,
+        np.atleast_2d(result.X),
+        int(result.algorithm.evaluator.n_eval),
+        time.perf_counter() - started,
+    )

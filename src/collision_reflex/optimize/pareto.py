@@ -102,6 +102,7 @@ def pareto_front(
     points: int = 20,
     ipopt_options: dict[str, Any] | None = None,
     progress: Callable[[int, int], None] | None = None,
+    anchor_starts: int = 1,
 ) -> ParetoSet:
     """Pareto set of two or three objectives by epsilon-constraint sweeps.
 
@@ -114,6 +115,8 @@ def pareto_front(
     points: number of points requested on the front (anchors included); for three objectives the bounds form
         a grid of about that many points.
     progress: called as ``progress(done, total)`` after each solve.
+    anchor_starts: start points of each anchor's first solve (multi-start, see :func:`solve`); more starts
+        make the anchors more robust against local optima, at the cost of a solve each.
 
     Anchors first: each objective is minimised, then (lexicographically) the others are minimised with it held
     at its optimum, so every anchor is non-dominated. The bounds on the other objectives are then spread
@@ -128,7 +131,7 @@ def pareto_front(
     if not isinstance(points, int) or points < 2:
         raise InvalidParameter("points", points, "an integer >= 2")
     problems = {name: build(name, tuple(other for other in names if other != name)) for name in names}
-    total = points + len(names) * (len(names) - 1)
+    total = points + len(names) * (len(names) - 1) + len(names) * (anchor_starts - 1)
     done = 0
 
     def tick() -> None:
@@ -141,7 +144,7 @@ def pareto_front(
     failed: list[tuple[dict[str, float], str]] = []
     anchors = {}
     for name in names:
-        anchor = solve(problems[name], ipopt_options=ipopt_options)
+        anchor = solve(problems[name], ipopt_options=ipopt_options, starts=anchor_starts)
         tick()
         # Lexicographic: hold this objective at its optimum, minimise the others in turn.
         for other in (o for o in names if o != name):

@@ -96,8 +96,7 @@ class ActuatorTechnology:
         _validate.choice("reflected_inertia_in", self.reflected_inertia_in, REFLECTED_INERTIA_PLACEMENTS)
 
     def joint_mechanical_stiffness(self, n_joints: int) -> np.ndarray:
-        stiffness = np.broadcast_to(np.asarray(self.mechanical_stiffness, dtype=float), (n_joints,)).copy()
-        return stiffness
+        return np.broadcast_to(np.asarray(self.mechanical_stiffness, dtype=float), (n_joints,)).copy()
 
 
 @dataclass
@@ -181,28 +180,30 @@ class DesignProblem:
     joint_names: tuple[str, ...]
     required_torque_function: Any
     epigraph_index: int | None
-    capacity_index: slice
-    lifted_index: slice
-    lifted_scale: np.ndarray
+    compliance_index: slice
+    direction_index: slice
+    direction_scale: np.ndarray
     build_time: float
     _joint_numbers: Any = field(repr=False, default=None)
     _sample_function: Any = field(repr=False, default=None)
     _sample_data: Any = field(repr=False, default=None)
     _solvers: dict[str, Any] = field(default_factory=dict, repr=False)
+    _objective: Any = field(default=None, repr=False)
 
     @property
     def n_joints(self) -> int:
         return len(self.joint_names)
 
     def exact_point(self, x: np.ndarray) -> np.ndarray:
-        """``x`` with the auxiliary variables (``y``, ``c`` and the epigraph ``t``) set to their exact values for
-        the design in ``x``, so that evaluating there gives the model's values to machine precision."""
+        """``x`` with the auxiliary variables (finger-mass directions, reaction compliances and the epigraph
+        ``t``) set to their exact values for the design in ``x``, so that evaluating there gives the model's
+        values to machine precision."""
         x = np.array(x, dtype=float)
         masses, torques, finger = (np.asarray(v).ravel() for v in self._joint_numbers(x))
-        x[self.lifted_index] = (
-            lifted_solution(self.samples, masses, finger) / self.lifted_scale[:, None]
+        x[self.direction_index] = (
+            finger_mass_directions(self.samples, masses, finger) / self.direction_scale[:, None]
         ).ravel()
-        x[self.capacity_index] = np.log(reaction_compliance(self.samples, torques))
+        x[self.compliance_index] = np.log(reaction_compliance(self.samples, torques))
         if self.epigraph_index is not None:
             impulses = np.asarray(self.evaluate(x)[0]).ravel()
             x[self.epigraph_index] = impulses.max() / self.objective_scale["worst_case_impulse"]
@@ -239,6 +240,12 @@ class DesignProblem:
             )
             impulses.append(impulse)
         return ca.Function("design_impulses", [z], [ca.horzcat(*impulses)], ["z"], ["impulses"])
+
+    def objective_value(self, x: np.ndarray) -> float:
+        """The NLP's (scaled) objective at ``x``, auxiliaries at their exact values: for comparing results."""
+        if self._objective is None:
+            self._objective = ca.Function("objective", [self.nlp["x"]], [self.nlp["f"]])
+        return float(self._objective(self.exact_point(x)))
 
     def parameters(self, epsilon: Mapping[str, float] | None = None) -> np.ndarray:
         """NLP parameter vector bounding the objectives in ``epsilon`` (unbounded: +inf in scaled units)."""
@@ -308,10 +315,10 @@ def build_problem(
     # finger-mass directions x (n_joints * n_samples).
     n_samples, n_design = samples.size, layout.size
     epigraph_index = n_design if "worst_case_impulse" in set(weights) | set(bounded) else None
-    capacity_start = n_design + (epigraph_index is not None)
-    capacity_index = slice(capacity_start, capacity_start + n_samples)
-    lifted_index = slice(capacity_index.stop, capacity_index.stop + n_joints * n_samples)
-    x = ca.MX.sym("x", lifted_index.stop)
+    compliance_start = n_design + (epigraph_index is not None)
+    compliance_index = slice(compliance_start, compliance_start + n_samples)
+    direction_index = slice(compliance_index.stop, compliance_index.stop + n_joints * n_samples)
+    x = ca.MX.sym("x", direction_index.stop)
     p = ca.MX.sym("p", len(bounded))
 
     k_mech = technology.joint_mechanical_stiffness(n_joints)
@@ -327,8 +334,8 @@ def build_problem(
     start_mass, start_torque, start_finger = (np.asarray(v).ravel() for v in joint_numbers(x0))
     # log(1/F_a) lies between its values at the weakest and the strongest actuators the bounds allow.
     weakest, strongest = (np.asarray(joint_numbers(bound)[1]).ravel() for bound in (lbx, ubx))
-    lbx[capacity_index] = np.log(reaction_compliance(samples, strongest))
-    ubx[capacity_index] = np.log(reaction_compliance(samples, weakest))
+    lbx[compliance_index] = np.log(reaction_compliance(samples, strongest))
+    ubx[compliance_index] = np.log(reaction_compliance(samples, weakest))
 
     data = _sample_data(samples, k_mech)
     sample_function = _sample_function(
@@ -336,11 +343,13 @@ def build_problem(
     )
     per_sample = sample_function.map(n_samples)
     # x_s is scaled per sample by its size at the start: across samples it spans orders of magnitude.
-    start_lifted = lifted_solution(samples, start_mass, start_finger)
-    lifted_scale = np.maximum(np.abs(start_lifted).max(axis=1), 1e-300)
-    lifted = ca.reshape(x[lifted_index], n_joints, n_samples) * ca.DM(np.tile(lifted_scale, (n_joints, 1)))
-    compliance = ca.exp(ca.transpose(x[capacity_index]))
-    impulses, thresholds, normalisation = per_sample(design_column, lifted, compliance, ca.DM(data))
+    start_directions = finger_mass_directions(samples, start_mass, start_finger)
+    direction_scale = np.maximum(np.abs(start_directions).max(axis=1), 1e-300)
+    directions = ca.reshape(x[direction_index], n_joints, n_samples) * ca.DM(
+        np.tile(direction_scale, (n_joints, 1))
+    )
+    compliance = ca.exp(ca.transpose(x[compliance_index]))
+    impulses, thresholds, normalisation = per_sample(design_column, directions, compliance, ca.DM(data))
     actuator_mass = ca.sum1(motor_mass)
     mass_bounds = [np.asarray(joint_numbers(bound)[0]).ravel() for bound in (lbx, ubx)]
     torque_demands = _binding_torque_demands(samples, constraints, joint_names, *mass_bounds)
@@ -359,8 +368,8 @@ def build_problem(
         ["x"],
         ["impulses", "actuator_mass", "approach_velocity", "thresholds", "required_torque", "peak_torque"],
     )
-    x0[lifted_index] = (start_lifted / lifted_scale[:, None]).ravel()
-    x0[capacity_index] = np.log(reaction_compliance(samples, start_torque))
+    x0[direction_index] = (start_directions / direction_scale[:, None]).ravel()
+    x0[compliance_index] = np.log(reaction_compliance(samples, start_torque))
     start_impulses = np.asarray(evaluate(x0)[0]).ravel()
     _check_finite(start_impulses, "impulse at the start point", samples)
     scale = {
@@ -407,7 +416,7 @@ def build_problem(
     pair_sample, pair_joint = np.nonzero(loaded)
     log_arm = np.log(np.abs(samples.joint_moment_arms[pair_sample, pair_joint]))
     add(
-        x[capacity_index][pair_sample.tolist()] + ca.log(peak_torque)[pair_joint.tolist()] - log_arm,
+        x[compliance_index][pair_sample.tolist()] + ca.log(peak_torque)[pair_joint.tolist()] - log_arm,
         0.0,
         np.inf,
         [
@@ -424,8 +433,12 @@ def build_problem(
     torque_scale = np.maximum(np.asarray(required_torque(start_mass)).ravel(), 1e-3)
     for j, (bases, slopes, demand_labels) in enumerate(torque_demands):
         demand = ca.DM(bases) + ca.mtimes(ca.DM(slopes), motor_mass)
-        add((peak_torque[j] - demand) / torque_scale[j], 0.0, np.inf,
-            [f"peak torque of {joint_names[j]} >= {label}" for label in demand_labels])
+        add(
+            (peak_torque[j] - demand) / torque_scale[j],
+            0.0,
+            np.inf,
+            [f"peak torque of {joint_names[j]} >= {label}" for label in demand_labels],
+        )
 
     if technology.sensing == "position" and constraints.threshold_floor > 0:
         add(
@@ -468,9 +481,9 @@ def build_problem(
         joint_names=joint_names,
         required_torque_function=required_torque,
         epigraph_index=epigraph_index,
-        capacity_index=capacity_index,
-        lifted_index=lifted_index,
-        lifted_scale=lifted_scale,
+        compliance_index=compliance_index,
+        direction_index=direction_index,
+        direction_scale=direction_scale,
         build_time=time.perf_counter() - started,
         _joint_numbers=joint_numbers,
         _sample_function=sample_function,
@@ -614,7 +627,7 @@ def reaction_compliance(samples: ContactSamples, peak_torque: np.ndarray) -> np.
     return np.max(np.abs(samples.joint_moment_arms) / np.asarray(peak_torque, dtype=float), axis=1)
 
 
-def lifted_solution(
+def finger_mass_directions(
     samples: ContactSamples, motor_mass: np.ndarray, finger_joint_inertia: np.ndarray | None = None
 ) -> np.ndarray:
     """The minimiser ``x_s = M_f^-1 w_s / (w_s^T M_f^-1 w_s)`` of ``x^T M_f x`` with ``w_s^T x = 1`` for every
@@ -665,7 +678,10 @@ def _torque_requirement_rows(
 
 
 def _binding_torque_demands(
-    samples: ContactSamples, constraints: Constraints, joint_names: tuple[str, ...], mass_low: np.ndarray,
+    samples: ContactSamples,
+    constraints: Constraints,
+    joint_names: tuple[str, ...],
+    mass_low: np.ndarray,
     mass_high: np.ndarray,
 ) -> list[tuple[np.ndarray, np.ndarray, list[str]]]:
     """Per joint, the torque demands ``b + S m`` [N m] that can bind: ``(b (R,), S (R, n), labels)``.
@@ -682,7 +698,9 @@ def _binding_torque_demands(
         low = bases + np.minimum(slopes * mass_low, slopes * mass_high).sum(axis=1)
         high = bases + np.maximum(slopes * mass_low, slopes * mass_high).sum(axis=1)
         keep = high >= low.max() - 1e-12 * abs(low.max())
-        demands.append((bases[keep], slopes[keep], [label for label, k in zip(labels, keep, strict=True) if k]))
+        demands.append(
+            (bases[keep], slopes[keep], [label for label, k in zip(labels, keep, strict=True) if k])
+        )
     return demands
 
 

@@ -11,7 +11,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-from ..errors import SolverFailed
+from ..errors import InvalidParameter, SolverFailed
 from .evaluate import evaluate_design
 from .problem import OBJECTIVES, DesignProblem
 
@@ -119,6 +119,8 @@ def solve(
     epsilon: Mapping[str, float] | None = None,
     x0: np.ndarray | DesignResult | None = None,
     ipopt_options: Mapping[str, Any] | None = None,
+    starts: int = 1,
+    rng: np.random.Generator | None = None,
 ) -> DesignResult:
     """Solve ``problem`` with IPOPT (exact Hessian, MUMPS).
 
@@ -128,6 +130,10 @@ def solve(
     x0: start point in the NLP's variables, or a neighbouring :class:`DesignResult` of the same problem, whose
         point and multipliers then warm-start IPOPT; default the problem's start point.
     ipopt_options: options merged over :data:`DEFAULT_IPOPT_OPTIONS` (e.g. ``{"ipopt.max_iter": 100}``).
+    starts: number of start points (multi-start). The problem is not convex (a worst case over samples) and
+        IPOPT finds a local optimum; with ``starts > 1`` it is also started from ``starts - 1`` points drawn
+        log-uniformly within the bounds and the best feasible result is returned.
+    rng: random generator for the extra starts (default ``numpy.random.default_rng(0)``, reproducible).
 
     Raises
     ------
@@ -135,6 +141,10 @@ def solve(
         constraints that could not be met.
     """
     warm = x0 if isinstance(x0, DesignResult) and x0.multipliers is not None else None
+    if not isinstance(starts, int) or starts < 1:
+        raise InvalidParameter("starts", starts, "an integer >= 1")
+    if starts > 1:
+        return _multi_start(problem, epsilon, x0, ipopt_options, starts, rng or np.random.default_rng(0))
     options = {**DEFAULT_IPOPT_OPTIONS, **(WARM_START_OPTIONS if warm else {}), **(ipopt_options or {})}
     key = repr(sorted(options.items()))
     solver = problem._solvers.get(key)
@@ -178,6 +188,39 @@ def solve(
         )
     multipliers_out = (np.asarray(solution["lam_x"]).ravel(), np.asarray(solution["lam_g"]).ravel())
     return _result(problem, x, status, stats, elapsed, dict(epsilon or {}), multipliers_out)
+
+
+def _multi_start(
+    problem: DesignProblem,
+    epsilon: Mapping[str, float] | None,
+    x0: np.ndarray | DesignResult | None,
+    ipopt_options: Mapping[str, Any] | None,
+    starts: int,
+    rng: np.random.Generator,
+) -> DesignResult:
+    """Best feasible result over the given (or default) start and ``starts - 1`` random ones."""
+    n_design = problem.layout.size
+    points: list[Any] = [x0]
+    for _ in range(starts - 1):
+        point = problem.x0.copy()
+        point[:n_design] = rng.uniform(problem.lbx[:n_design], problem.ubx[:n_design])
+        points.append(problem.exact_point(point))
+    best: DesignResult | None = None
+    best_value = np.inf
+    failure: SolverFailed | None = None
+    for point in points:
+        try:
+            result = solve(problem, epsilon, point, ipopt_options)
+        except SolverFailed as error:
+            failure = error
+            continue
+        value = problem.objective_value(result.x)
+        if value < best_value:
+            best, best_value = result, value
+    if best is None:
+        assert failure is not None  # every start failed
+        raise failure
+    return best
 
 
 def _result(
