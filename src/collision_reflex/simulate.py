@@ -58,7 +58,9 @@ DRIVES: tuple[str, ...] = ("ideal", "impedance", "free")
 DETECTION_KINDS: tuple[str, ...] = ("force", "position", "current")
 """``"force"``: the mechanical spring's force (a force sensor measures its own deflection) [N];
 ``"position"``: the output (finger) position lag behind the reference, beyond its pre-contact value [m];
-``"current"``: the actuator force, i.e. motor current times torque constant, seen at the output [N]."""
+``"current"``: the actuator force, i.e. motor current times torque constant, seen at the output [N] (with the
+ideal drive: spring force plus friction plus ``m_r`` times the robot's acceleration; the ideal controller's
+impulsive force at the instant the finger stops is not counted, as a real current loop would filter it)."""
 
 # State layout. Deflections are states of their own (not differences of absolute positions) so that the
 # tolerances resolve a spring compression of nanometres while the reference travels centimetres.
