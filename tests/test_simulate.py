@@ -139,6 +139,18 @@ BOOKKEEPING_CASES = {
         contact_stiffness=1e5, contact_damping=contact_damping_for_restitution(0.5, M_F, 1e5)
     ),
     "play": dict(backlash=0.004, delay=0.005),
+    # Regressions: the play taken up exactly at a control sample; stiction released by a sampled force step;
+    # a bouncing finger crossing the play.
+    "play-on-sample": dict(backlash=0.003, control_rate=500.0, delay=0.004, velocity=0.05),
+    "stiction-sampled": dict(
+        drive="impedance", software_damping=5.0, coulomb_friction=1.0, control_rate=500.0, velocity=0.05
+    ),
+    "bounce-in-play": dict(
+        contact_stiffness=1e5,
+        contact_damping=contact_damping_for_restitution(0.3, M_F, 1e5),
+        backlash=0.003,
+        velocity=1.0,
+    ),
 }
 
 

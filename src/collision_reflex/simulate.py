@@ -734,6 +734,8 @@ def simulate(setup: CollisionSetup) -> SimulationResult:
     modes: list[str] = [sim.contact]
     t = 0.0
     tiny = 1e-12 * duration
+    last_event: tuple[float, str] = (math.nan, "")
+    repeats = 0
     for _ in range(100_000):
         # Transitions due now.
         if detecting and sim.drive != "reaction" and t >= reaction_time - tiny:
@@ -761,6 +763,11 @@ def simulate(setup: CollisionSetup) -> SimulationResult:
                 f"the contact had not ended after {duration:.3g} s (reaction at {reaction_time:.3g} s); "
                 "lengthen duration, or check that the force limit can pull the robot away"
             )
+        if sim.robot_stuck:
+            # A force that changed at a sample (or at the reaction) may now exceed stiction.
+            f = sim.forces(t, y)
+            if abs(f["actuator"] - f["spring"]) > setup.coulomb_friction:
+                sim.robot_stuck = False
         sample_time = math.inf
         if (
             sim.sampled
@@ -827,6 +834,21 @@ def simulate(setup: CollisionSetup) -> SimulationResult:
                     sim.robot_stuck = True
             elif name == "robot breaks away":
                 sim.robot_stuck = False
+            elif name in ("play taken up", "play opens"):
+                # Snap the chain exactly onto the edge of the play: a rounding error on the gap side would
+                # re-fire the same event at once.
+                edge = sim.half_gap if y[_DEFL] + y[_ERR] > 0 else -sim.half_gap
+                v_r_before = y[_VR]
+                y[_DEFL], y[_ERR] = edge, 0.0
+                y = sim.resolved(y)
+                y[_WORK] += 0.5 * setup.robot_mass * (y[_VR] ** 2 - v_r_before**2)  # the ideal controller's
+            repeats = repeats + 1 if (t, name) == last_event else 0
+            last_event = (t, name)
+            if repeats > 20:
+                raise SimulationError(
+                    f"the event {name!r} keeps firing at t = {t:.9g} s without the simulation advancing; "
+                    "change rtol or the parameters slightly"
+                )
             if states[-1].shape[1]:
                 states[-1][:, -1] = y
             continue
