@@ -32,6 +32,7 @@ from .errors import (
     FitFailed,
     FrameNotFound,
     InvalidParameter,
+    SimulationError,
     SolverFailed,
     StudyFileError,
     StudyProblem,
@@ -87,6 +88,17 @@ from .optimize import (
     pareto_front,
     solve,
 )
+from .simulate import (
+    CollisionSetup,
+    Detection,
+    SimulationResult,
+    contact_damping_for_restitution,
+    contact_restitution,
+)
+from .simulate import Sweep as SimulationSweep
+from .simulate import simulate as simulate_collision
+from .simulate import sweep as simulation_sweep
+from .simulate_arm import ArmCollision, simulate_arm_collision
 from .study import load_study, study_json_schema
 from .study.runner import run_study
 from .surfaces import ReflexSurface, reflex_surface
@@ -102,12 +114,14 @@ __all__ = [
     "Actuator",
     "ActuatorTechnology",
     "Arm",
+    "ArmCollision",
     "ArmSamples",
     "Bounds",
     "CatalogueError",
     "CollisionImpulses",
     "CollisionParameters",
     "CollisionReflexError",
+    "CollisionSetup",
     "Constraints",
     "ContactSamples",
     "CurrentThreshold",
@@ -115,6 +129,7 @@ __all__ = [
     "DesignProblem",
     "DesignResult",
     "DesignSpace",
+    "Detection",
     "EffectiveParameters",
     "Ellipsoid",
     "FitFailed",
@@ -131,6 +146,9 @@ __all__ = [
     "PositionThreshold",
     "ReflexSurface",
     "ScalingLaw",
+    "SimulationError",
+    "SimulationResult",
+    "SimulationSweep",
     "SolverFailed",
     "StudyFileError",
     "StudyProblem",
@@ -143,6 +161,8 @@ __all__ = [
     "circle_directions",
     "collision_impulses",
     "collision_times",
+    "contact_damping_for_restitution",
+    "contact_restitution",
     "dynamic_manipulability_ellipsoid",
     "effective_mass",
     "effective_parameters",
@@ -164,6 +184,9 @@ __all__ = [
     "scaled_motor_quantities",
     "scaling_law",
     "series_stiffness",
+    "simulate_arm_collision",
+    "simulate_collision",
+    "simulation_sweep",
     "solve",
     "sphere_directions",
     "study_json_schema",

@@ -80,6 +80,7 @@ class SolverFailed(CollisionReflexError):
         # The problem holds CasADi functions, which do not cross process boundaries; the rest does.
         return (type(self), (str(self), self.status, self.stats, self.violated, None))
 
+
 @dataclass(frozen=True)
 class StudyProblem:
     """One problem found in a study file.
@@ -265,3 +266,8 @@ class StudyRunFailed(CollisionReflexError):
 
     def __reduce__(self) -> tuple[Any, ...]:
         return (type(self), (str(self), self.what, self.status))
+
+
+class SimulationError(CollisionReflexError):
+    """A time-domain simulation could not produce a result (nothing detected, the contact never ended, the
+    integrator failed); the message says what happened and what to change."""

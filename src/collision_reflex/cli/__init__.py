@@ -18,12 +18,13 @@ from . import motors as _motors
 from . import report as _report
 from . import run as _run
 from . import schema as _schema
+from . import simulate as _simulate
 from . import surface as _surface
 from . import sweep as _sweep
 from . import validate as _validate
 
 # Subcommand modules, in the order `crx --help` lists them.
-_SUBCOMMANDS = [_impulse, _motors, _sweep, _surface, _fit, _validate, _schema, _run, _report]
+_SUBCOMMANDS = [_impulse, _motors, _sweep, _surface, _fit, _simulate, _validate, _schema, _run, _report]
 
 
 def build_parser() -> argparse.ArgumentParser:
