@@ -7,7 +7,7 @@ then the 1D impulse once. Agreement of the two checks the reformulation as well 
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -18,8 +18,9 @@ if TYPE_CHECKING:
     from .solve import Design
 
 
-def evaluate_design(problem: DesignProblem, design: Design) -> np.ndarray:
-    """Collision impulse [N*s] of ``design`` at each of the problem's samples, shape (n_samples,)."""
+def design_collision_parameters(problem: DesignProblem, design: Design) -> tuple[Any, np.ndarray]:
+    """Effective 1D parameters (:class:`collision_reflex.arm.EffectiveParameters`) of ``design`` at each of the
+    problem's samples, and the contact-force threshold [N] per sample."""
     from ..arm import effective_parameters
 
     samples = problem.samples
@@ -37,6 +38,12 @@ def evaluate_design(problem: DesignProblem, design: Design) -> np.ndarray:
         ),
     )
     threshold = design.threshold if design.sensing == "force" else params.k * design.threshold
+    return params, np.broadcast_to(np.asarray(threshold, dtype=float), params.m_f.shape)
+
+
+def evaluate_design(problem: DesignProblem, design: Design) -> np.ndarray:
+    """Collision impulse [N*s] of ``design`` at each of the problem's samples, shape (n_samples,)."""
+    params, threshold = design_collision_parameters(problem, design)
     return np.asarray(
         total_impulse(
             params.m_f,

@@ -353,28 +353,11 @@ def _bound_text(name: str, value: float) -> str:
 
 def design_record(setup: ArmSetup, problem: Any, result: Any, label: str) -> dict[str, Any]:
     """A design and everything the report shows about it, as JSON types (SI units)."""
-    from ..arm import effective_parameters
+    from ..optimize.evaluate import design_collision_parameters
 
     design = result.design
-    samples = problem.samples
-    # The same effective parameters as the optimiser's NumPy check (optimize.evaluate), kept for the phases.
-    finger = (
-        {"finger_joint_inertia": design.reflected_inertia}
-        if setup.study.reflected_inertia_in == "finger"
-        else {}
-    )
-    params = effective_parameters(
-        samples.kinematics,
-        samples.directions,
-        config_index=samples.config_index,
-        reflected_inertia=design.reflected_inertia,
-        stiffness=series_stiffness(design.mechanical_stiffness, design.software_stiffness),
-        mechanical_stiffness=design.mechanical_stiffness,
-        torque_limit=design.peak_torque,
-        motor_mass=design.motor_mass,
-        **finger,
-    )
-    threshold = design.threshold if design.sensing == "force" else params.k * design.threshold
+    # The optimiser's own NumPy check (optimize.evaluate), kept here for the phases.
+    params, threshold = design_collision_parameters(problem, design)
     phases = phase_impulses(
         params.m_f, params.k, params.k_m, threshold, params.a, design.approach_velocity, setup.study.reaction
     )
