@@ -148,7 +148,7 @@ def pareto_front(
         tick()
         # Lexicographic: hold this objective at its optimum, minimise the others in turn.
         for other in (o for o in names if o != name):
-            bound = _loosened(name, anchor.objectives[name])
+            bound = anchor_bound(name, anchor.objectives[name])
             try:
                 anchor = solve(
                     problems[other], epsilon={name: bound}, x0=anchor.x, ipopt_options=ipopt_options
@@ -160,7 +160,7 @@ def pareto_front(
         results.append(anchor)
 
     primary, bounded = names[0], names[1:]
-    grid = _epsilon_grid(anchors, bounded, points - len(names))
+    grid = epsilon_grid(anchors, bounded, points - len(names))
     start = anchors[primary]
     for epsilon in grid:
         try:
@@ -172,7 +172,7 @@ def pareto_front(
             start = result
         tick()
 
-    front, dominated = _non_dominated(results, names)
+    front, dominated = non_dominated(results, names)
     return ParetoSet(
         names,
         tuple(front),
@@ -183,13 +183,13 @@ def pareto_front(
     )
 
 
-def _loosened(name: str, value: float) -> float:
+def anchor_bound(name: str, value: float) -> float:
     """The anchor's bound on ``name``: its optimum with a relative slack toward feasibility."""
     sense = OBJECTIVES[name][0]
     return value * (1 + sense * ANCHOR_SLACK) if value > 0 else value + sense * ANCHOR_SLACK
 
 
-def _epsilon_grid(
+def epsilon_grid(
     anchors: dict[str, DesignResult], bounded: Sequence[str], count: int
 ) -> list[dict[str, float]]:
     """Bounds on the bounded objectives spread between their values at the anchors, ordered so that each point
@@ -219,7 +219,7 @@ def _minimised(values: np.ndarray, names: Sequence[str]) -> np.ndarray:
     return values * np.array([OBJECTIVES[name][0] for name in names], dtype=float)
 
 
-def _non_dominated(
+def non_dominated(
     results: list[DesignResult], names: Sequence[str], tolerance: float = 1e-9
 ) -> tuple[list[DesignResult], list[DesignResult]]:
     """Split results into the non-dominated ones (sorted by the first objective) and the dominated ones.

@@ -250,7 +250,7 @@ def solve_anchor(resolved_text: str, objective: str, objectives: tuple[str, ...]
     anchor found so far (the dominance filter then judges it) and is recorded in ``lexicographic_failed``."""
     from ..errors import SolverFailed, StudyRunFailed
     from ..optimize import solve
-    from ..optimize.pareto import _loosened
+    from ..optimize.pareto import anchor_bound
 
     setup = _setup_from_text(resolved_text)
     others = tuple(o for o in objectives if o != objective)
@@ -262,7 +262,7 @@ def solve_anchor(resolved_text: str, objective: str, objectives: tuple[str, ...]
             f"anchor: {objective}",
             error.status,
         ) from None
-    held = _loosened(objective, result.objectives[objective])
+    held = anchor_bound(objective, result.objectives[objective])
     failed = []
     for other in others:
         bounded = tuple(o for o in objectives if o != other)
@@ -299,10 +299,10 @@ def epsilon_grid(
     anchors: dict[str, dict[str, Any]], objectives: tuple[str, ...], count: int
 ) -> list[dict[str, float]]:
     """The sweep's objective bounds between the saved anchors: the optimiser's own epsilon grid."""
-    from ..optimize.pareto import _epsilon_grid
+    from ..optimize import pareto
 
     saved: dict[str, Any] = {name: _Saved(a) for name, a in anchors.items()}
-    return _epsilon_grid(saved, objectives[1:], count)
+    return pareto.epsilon_grid(saved, objectives[1:], count)
 
 
 def non_dominated(
@@ -310,14 +310,14 @@ def non_dominated(
 ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     """Saved records split by the optimiser's dominance filter into the front (sorted by the first objective)
     and the dominated rest."""
-    from ..optimize.pareto import _non_dominated
+    from ..optimize import pareto
 
     if not records:
         return [], []
     saved: list[Any] = [
         _Saved(r) for r in records
     ]  # duck-typed as DesignResult: only numpy_objectives is read
-    front, dropped = _non_dominated(saved, names)
+    front, dropped = pareto.non_dominated(saved, names)
     return [s.record for s in front], [s.record for s in dropped]  # type: ignore[attr-defined]
 
 
