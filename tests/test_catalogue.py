@@ -89,7 +89,7 @@ def test_bad_catalogue_names_field_and_line(tmp_path, text, line, field, words):
 
 
 def test_unknown_motor_lists_the_catalogue():
-    from collision_reflex.motors import get_motor
+    from collision_reflex.hardware.motors import get_motor
 
     with pytest.raises(cr.UnknownMotor, match="OPN-060-013-A"):
         get_motor("OPN-999")

@@ -10,7 +10,7 @@ import pytest
 
 import collision_reflex as cr
 from collision_reflex.cli import main
-from collision_reflex.simulate import CollisionSetup, Detection, simulate
+from collision_reflex.simulate.collision import CollisionSetup, Detection, simulate
 
 
 def test_csv_matches_simulator_and_closed_form(tmp_path, capsys):
@@ -35,7 +35,7 @@ def test_csv_matches_simulator_and_closed_form(tmp_path, capsys):
         v0, delay = float(row["v0_m_per_s"]), float(row["delay"])
         setup = CollisionSetup(0.2, 0.5, 1000.0, 100.0, 10.0, v0, Detection("force", 3.0), delay=delay)
         assert float(row["impulse_simulated_Ns"]) == pytest.approx(simulate(setup).impulse, rel=1e-10)
-        # The closed form comes from collision_reflex.impulse (the CLI never re-derives it).
+        # The closed form comes from collision_reflex.model.impulse (the CLI never re-derives it).
         closed = cr.total_impulse(0.2, k, 1000.0, 3.0, 20.0, v0)
         assert float(row["impulse_closed_form_Ns"]) == pytest.approx(closed, rel=1e-10)
         difference = float(row["impulse_simulated_Ns"]) / closed - 1

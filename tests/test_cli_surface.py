@@ -11,10 +11,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from collision_reflex.actuators import ForceThreshold
-from collision_reflex.arm import Arm
+from collision_reflex.arm.core import Arm
+from collision_reflex.arm.surfaces import reflex_surface
 from collision_reflex.cli import main
-from collision_reflex.surfaces import reflex_surface
+from collision_reflex.hardware.actuators import ForceThreshold
 
 REPO = Path(__file__).resolve().parents[1]
 TWO_LINK = REPO / "designs" / "planar_two_link.urdf"

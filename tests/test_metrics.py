@@ -13,17 +13,17 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from collision_reflex._robots import example_robot
-from collision_reflex.arm import Arm, effective_parameters
-from collision_reflex.directions import circle_directions, sphere_directions
-from collision_reflex.errors import FrameNotFound, InvalidParameter
-from collision_reflex.metrics import (
+from collision_reflex.arm.core import Arm, effective_parameters
+from collision_reflex.arm.directions import circle_directions, sphere_directions
+from collision_reflex.arm.metrics import (
     dynamic_manipulability_ellipsoid,
     effective_mass,
     ellipsoid_of_gyration,
     generalized_inertia_ellipsoid,
     impact_mitigation_factor,
 )
+from collision_reflex.arm.robots import example_robot
+from collision_reflex.errors import FrameNotFound, InvalidParameter
 
 TWO_LINK = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
 ROTOR = np.array([2e-3, 1e-3])  # reflected rotor inertia of the two joints [kg m^2]

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import collision_reflex as cr
-from collision_reflex.arm import Arm
+from collision_reflex.arm.core import Arm
 from collision_reflex.optimize import hypervolume
 from collision_reflex.optimize.evaluate import evaluate_design
 from collision_reflex.optimize.problem import TIE_BREAK_WEIGHT
@@ -291,8 +291,14 @@ def test_multi_start_is_never_worse_and_reproducible(arm):
 def test_solver_failed_message_and_pickling():
     import pickle
 
-    error = cr.SolverFailed("could not meet x", "Infeasible_Problem_Detected", {"iter_count": 3}, [("x", 1.0)],
-                            problem=object())
+    error = cr.SolverFailed(
+        "could not meet x", "Infeasible_Problem_Detected", {"iter_count": 3}, [("x", 1.0)], problem=object()
+    )
     assert str(error) == "could not meet x"
     copy = pickle.loads(pickle.dumps(error))
-    assert (str(copy), copy.status, copy.violated, copy.problem) == (str(error), error.status, error.violated, None)
+    assert (str(copy), copy.status, copy.violated, copy.problem) == (
+        str(error),
+        error.status,
+        error.violated,
+        None,
+    )

@@ -12,7 +12,7 @@ from scipy.integrate import solve_ivp
 
 import collision_reflex as cr
 from collision_reflex.errors import InvalidParameter, SimulationError
-from collision_reflex.simulate import (
+from collision_reflex.simulate.collision import (
     CollisionSetup,
     Detection,
     contact_damping_for_restitution,

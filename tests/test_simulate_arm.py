@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 import collision_reflex as cr
-from collision_reflex.arm import Arm
+from collision_reflex.arm.core import Arm
 from collision_reflex.errors import InvalidParameter
-from collision_reflex.simulate_arm import simulate_arm_collision
+from collision_reflex.simulate.arm import simulate_arm_collision
 
 URDF = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
 # Joint springs of 50 N m/rad, a direct-drive rotor with a 10:1 reduction (100 x 2.21e-5 kg m^2) and the URDF's
@@ -44,7 +44,7 @@ def test_slow_approach_matches_arm_closed_form(arm, q, angle):
     eff = probe.effective
     v_star = float(cr.optimal_velocity(eff["m_f"], eff["k"], 3.0))
     result = simulate_arm_collision(arm, q, u, 0.1 * v_star, 3.0, **JOINTS)
-    # The closed form it is compared with is issue 4's effective parameters through collision_reflex.impulse.
+    # The closed form it is compared with is issue 4's effective parameters through collision_reflex.model.impulse.
     samples = arm.kinematics(np.array(q)[None])
     ref = cr.effective_parameters(samples, u[None], 2.2e-3, 50.0, 50.0, 1.3)
     closed = cr.total_impulse(

@@ -10,7 +10,7 @@ from concurrent.futures import Future
 import numpy as np
 import pytest
 
-from collision_reflex.impulse import phase_impulses, series_stiffness
+from collision_reflex.model.impulse import phase_impulses, series_stiffness
 from collision_reflex.report.html import number
 from collision_reflex.study._optimizer import epsilon_grid, non_dominated
 from collision_reflex.study.actuator_study import sensing_scheme
@@ -134,8 +134,8 @@ def test_lever_mapping_equals_the_rotary_collision(reaction):
 
 
 def test_sensing_schemes_map_to_the_contact():
-    from collision_reflex.actuators import Actuator
-    from collision_reflex.motors import reference_motor
+    from collision_reflex.hardware.actuators import Actuator
+    from collision_reflex.hardware.motors import reference_motor
 
     lever = 0.1143
     motor = reference_motor()

@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from collision_reflex.arm import Arm, JointParameters
+from collision_reflex.arm.core import Arm, JointParameters
+from collision_reflex.arm.surfaces import reflex_surface
 from collision_reflex.errors import InvalidParameter
-from collision_reflex.surfaces import reflex_surface
 
 TWO_LINK = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
 # Direct-drive Omni+ OPN-060-013-A at both joints (tab:motor_params, M2): J_m [kg m^2], peak torque [N m];
@@ -157,7 +157,7 @@ def test_scaling_the_base_motor_leaves_the_radial_direction_unchanged(arm):
 
 
 def test_surface_uses_the_actuators_sensing(arm):
-    from collision_reflex.actuators import CurrentThreshold, ForceThreshold
+    from collision_reflex.hardware.actuators import CurrentThreshold, ForceThreshold
 
     forced = arm.with_scaled_motors(0.060, 1.3, mechanical_stiffness=K_JOINT, sensing=ForceThreshold(4.0))
     surface = reflex_surface(forced, [0.0, 1.0], 0.5, directions=8)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import collision_reflex as cr
-from collision_reflex.sweeps import radius_velocity_sweep, stiffness_sweep
+from collision_reflex.hardware.sweeps import radius_velocity_sweep, stiffness_sweep
 
 LEVER, FINGER = 0.1143, 0.1  # the documented defaults
 

@@ -7,16 +7,7 @@ URDF arms, and optimises actuator designs against it.
 """
 
 from . import experiments
-from .actuators import (
-    REFLECTED_INERTIA_PLACEMENTS,
-    Actuator,
-    CollisionParameters,
-    CurrentThreshold,
-    ForceThreshold,
-    PositionThreshold,
-    gear_ratio_for,
-)
-from .arm import (
+from .arm.core import (
     Arm,
     ArmSamples,
     CollisionImpulses,
@@ -25,7 +16,17 @@ from .arm import (
     collision_impulses,
     effective_parameters,
 )
-from .directions import circle_directions, sphere_directions, unit_directions
+from .arm.directions import circle_directions, sphere_directions, unit_directions
+from .arm.metrics import (
+    Ellipsoid,
+    ImpactMitigation,
+    dynamic_manipulability_ellipsoid,
+    effective_mass,
+    ellipsoid_of_gyration,
+    generalized_inertia_ellipsoid,
+    impact_mitigation_factor,
+)
+from .arm.surfaces import ReflexSurface, reflex_surface
 from .errors import (
     CatalogueError,
     CollisionReflexError,
@@ -41,8 +42,27 @@ from .errors import (
     UnknownMotor,
     UrdfError,
 )
-from .gearboxes import GEARBOX_KINDS, Gearbox
-from .impulse import (
+from .hardware.actuators import (
+    REFLECTED_INERTIA_PLACEMENTS,
+    Actuator,
+    CollisionParameters,
+    CurrentThreshold,
+    ForceThreshold,
+    PositionThreshold,
+    gear_ratio_for,
+)
+from .hardware.gearboxes import GEARBOX_KINDS, Gearbox
+from .hardware.motors import (
+    SCALING_LAWS,
+    Motor,
+    MotorQuantities,
+    ScalingLaw,
+    load_catalogue,
+    reference_motor,
+    scaled_motor_quantities,
+    scaling_law,
+)
+from .model.impulse import (
     REACTION_MODES,
     PhaseImpulses,
     collision_times,
@@ -53,25 +73,6 @@ from .impulse import (
     series_stiffness,
     total_impulse,
     velocity_coefficients,
-)
-from .metrics import (
-    Ellipsoid,
-    ImpactMitigation,
-    dynamic_manipulability_ellipsoid,
-    effective_mass,
-    ellipsoid_of_gyration,
-    generalized_inertia_ellipsoid,
-    impact_mitigation_factor,
-)
-from .motors import (
-    SCALING_LAWS,
-    Motor,
-    MotorQuantities,
-    ScalingLaw,
-    load_catalogue,
-    reference_motor,
-    scaled_motor_quantities,
-    scaling_law,
 )
 from .optimize import (
     OBJECTIVES,
@@ -88,20 +89,19 @@ from .optimize import (
     pareto_front,
     solve,
 )
-from .simulate import (
+from .simulate.arm import ArmCollision, simulate_arm_collision
+from .simulate.collision import (
     CollisionSetup,
     Detection,
     SimulationResult,
     contact_damping_for_restitution,
     contact_restitution,
 )
-from .simulate import Sweep as SimulationSweep
-from .simulate import simulate as simulate_collision
-from .simulate import sweep as simulation_sweep
-from .simulate_arm import ArmCollision, simulate_arm_collision
+from .simulate.collision import Sweep as SimulationSweep
+from .simulate.collision import simulate as simulate_collision
+from .simulate.collision import sweep as simulation_sweep
 from .study import load_study, study_json_schema
 from .study.runner import run_study
-from .surfaces import ReflexSurface, reflex_surface
 
 __version__ = "0.1.0"
 

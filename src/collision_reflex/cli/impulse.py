@@ -6,7 +6,7 @@ import argparse
 
 import numpy as np
 
-from ..impulse import (
+from ..model.impulse import (
     REACTION_MODES,
     collision_times,
     minimum_impulse,

@@ -4,8 +4,14 @@ from __future__ import annotations
 
 import argparse
 
-from ..actuators import Actuator, gear_ratio_for
-from ..motors import DEFAULT_SCALING_LAW, REFERENCE_MOTOR_NAME, SCALING_LAWS, get_motor, load_catalogue
+from ..hardware.actuators import Actuator, gear_ratio_for
+from ..hardware.motors import (
+    DEFAULT_SCALING_LAW,
+    REFERENCE_MOTOR_NAME,
+    SCALING_LAWS,
+    get_motor,
+    load_catalogue,
+)
 from ._args import positive_float, value_range
 
 

@@ -10,8 +10,14 @@ import numpy as np
 
 from .._io import atomic_open
 from ..errors import InvalidParameter
-from ..impulse import REACTION_MODES, optimal_velocity, total_impulse
-from ..simulate import DETECTION_KINDS, CollisionSetup, Detection, contact_damping_for_restitution, sweep
+from ..model.impulse import REACTION_MODES, optimal_velocity, total_impulse
+from ..simulate.collision import (
+    DETECTION_KINDS,
+    CollisionSetup,
+    Detection,
+    contact_damping_for_restitution,
+    sweep,
+)
 from ._args import non_negative_float, positive_float, value_range
 
 # Defaults: a light direct-drive finger (the README's example) whose robot mass the spring does push back.
@@ -329,7 +335,7 @@ def run(args: argparse.Namespace) -> int:
         from dataclasses import replace
 
         from ..plots.simulation import plot_trace
-        from ..simulate import simulate
+        from ..simulate.collision import simulate
 
         changes: dict = {"velocity": args.trace_velocity or v_star}
         if parameter is not None:

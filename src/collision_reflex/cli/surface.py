@@ -205,10 +205,10 @@ def _stiffness_or_none(text: str) -> float | None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..arm import Arm
+    from ..arm.core import Arm
+    from ..arm.surfaces import reflex_surface
     from ..errors import InvalidParameter
     from ..plots import check_figure_path
-    from ..surfaces import reflex_surface
 
     check_figure_path(args.output)
     if args.robot is not None:
@@ -237,7 +237,7 @@ def run(args: argparse.Namespace) -> int:
         raise InvalidParameter("--directions", args.directions, "at least 3")
 
     def actuated(size_mm: float) -> Arm:
-        from ..actuators import ForceThreshold
+        from ..hardware.actuators import ForceThreshold
 
         return arm.with_scaled_motors(
             size_mm * 1e-3,
@@ -277,7 +277,7 @@ def run(args: argparse.Namespace) -> int:
         )
         written = plot_planar_grid(args.output, rows, title)
     else:
-        from ..directions import COORDINATE_PLANES, plane_directions
+        from ..arm.directions import COORDINATE_PLANES, plane_directions
         from ..plots.surface import plot_spatial_surface
 
         count = args.directions or 360

@@ -5,10 +5,10 @@ from __future__ import annotations
 import argparse
 import math
 
-from ..actuators import REFLECTED_INERTIA_PLACEMENTS
-from ..impulse import REACTION_MODES
-from ..motors import REFERENCE_MOTOR_NAME, SCALING_LAWS, get_motor
-from ..sweeps import SWEEP_DEFAULTS
+from ..hardware.actuators import REFLECTED_INERTIA_PLACEMENTS
+from ..hardware.motors import REFERENCE_MOTOR_NAME, SCALING_LAWS, get_motor
+from ..hardware.sweeps import SWEEP_DEFAULTS
+from ..model.impulse import REACTION_MODES
 from ._args import non_negative_float, positive_float, value_range
 
 _PLACEMENT_HELP = (
@@ -208,8 +208,8 @@ def _print_assumptions(assumptions: dict) -> None:
 
 
 def run_radius_velocity(args: argparse.Namespace) -> int:
+    from ..hardware.sweeps import radius_velocity_sweep
     from ..plots.sweeps import check_heat_map_grid, plot_radius_velocity
-    from ..sweeps import radius_velocity_sweep
 
     _check_outputs(args)
     check_heat_map_grid(args.diameters.size, args.velocities.size)
@@ -248,8 +248,8 @@ def run_radius_velocity(args: argparse.Namespace) -> int:
 
 
 def run_stiffness(args: argparse.Namespace) -> int:
+    from ..hardware.sweeps import stiffness_sweep
     from ..plots.sweeps import plot_stiffness
-    from ..sweeps import stiffness_sweep
 
     _check_outputs(args)
     sweep = stiffness_sweep(

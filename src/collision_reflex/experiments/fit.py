@@ -44,7 +44,7 @@ import numpy as np
 
 from .. import _validate
 from ..errors import FitFailed
-from ..impulse import REACTION_MODES, PhaseImpulses, phase_impulses, series_stiffness
+from ..model.impulse import REACTION_MODES, PhaseImpulses, phase_impulses, series_stiffness
 from .sensor import SensorModel, model_samples, pulse_duration
 from .traces import Trace
 from .window import ContactWindow

@@ -29,7 +29,7 @@ import numpy as np
 
 from .. import _validate
 from ..errors import InvalidParameter
-from ..impulse import collision_times, force_profile
+from ..model.impulse import collision_times, force_profile
 
 # 8 Gauss-Legendre nodes integrate the pulse's sine over a quarter period to ~1e-13 relative and the ramp
 # and the reaction's parabola exactly.

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import _validate
-from ..impulse import collision_times, series_stiffness
+from ..model.impulse import collision_times, series_stiffness
 from .fit import PAPER_SENSOR_STIFFNESS
 from .sensor import SensorModel, model_samples
 from .traces import Trace, write_trace

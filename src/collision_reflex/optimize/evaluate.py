@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..impulse import series_stiffness, total_impulse
+from ..model.impulse import series_stiffness, total_impulse
 
 if TYPE_CHECKING:
     from .problem import DesignProblem
@@ -19,9 +19,9 @@ if TYPE_CHECKING:
 
 
 def design_collision_parameters(problem: DesignProblem, design: Design) -> tuple[Any, np.ndarray]:
-    """Effective 1D parameters (:class:`collision_reflex.arm.EffectiveParameters`) of ``design`` at each of the
+    """Effective 1D parameters (:class:`collision_reflex.arm.core.EffectiveParameters`) of ``design`` at each of the
     problem's samples, and the contact-force threshold [N] per sample."""
-    from ..arm import effective_parameters
+    from ..arm.core import effective_parameters
 
     samples = problem.samples
     params = effective_parameters(

@@ -7,7 +7,7 @@ Structure (see the README's "Design optimisation" section):
   globally the sensing threshold and the approach velocity.
 - Per contact sample ``s`` (configuration, direction ``u``) the effective parameters of MODEL.md §3 are formed
   from the numeric Pinocchio data (``M_bb0``, motor-mass influence matrices, ``w = J^T u``) and the symbolic
-  actuator quantities, and the 1D impulse of :mod:`collision_reflex.impulse` is applied. One SX function per
+  actuator quantities, and the 1D impulse of :mod:`collision_reflex.model.impulse` is applied. One SX function per
   sample is mapped over all samples inside an MX NLP.
 - The reaction capacity ``F_a = min_i tau_i / |w_i|`` is a minimum over joints (non-smooth). Each sample gets a
   variable ``g_s = log(1/F_a)`` with ``g_s >= log|w_si| - log tau_i`` for every joint its direction loads --
@@ -36,10 +36,10 @@ import casadi as ca
 import numpy as np
 
 from .. import _validate
-from ..actuators import REFLECTED_INERTIA_PLACEMENTS
 from ..errors import InvalidParameter
-from ..impulse import REACTION_MODES, phase_impulses, series_stiffness
-from ..motors import Motor, scaled_motor_quantities
+from ..hardware.actuators import REFLECTED_INERTIA_PLACEMENTS
+from ..hardware.motors import Motor, scaled_motor_quantities
+from ..model.impulse import REACTION_MODES, phase_impulses, series_stiffness
 from .space import (
     GLOBAL_VARIABLES,
     PER_JOINT_VARIABLES,
@@ -70,7 +70,7 @@ class ActuatorTechnology:
     """The fixed choices of actuation the design varies within.
 
     reference_motor: motor every joint's motor is scaled from.
-    scaling_law: motor scaling law name (see :data:`collision_reflex.motors.SCALING_LAWS`).
+    scaling_law: motor scaling law name (see :data:`collision_reflex.hardware.motors.SCALING_LAWS`).
     mechanical_stiffness: joint mechanical stiffness [N m/rad], one value or one per joint, finite > 0: it is
         the only spring left in the reaction phase.
     sensing: ``"force"`` (contact-force threshold) or ``"position"`` (contact position-error threshold).
@@ -279,7 +279,7 @@ def build_problem(
 
     Parameters
     ----------
-    arm: the :class:`collision_reflex.arm.Arm` (joint names; ``samples.kinematics`` must come from it).
+    arm: the :class:`collision_reflex.arm.core.Arm` (joint names; ``samples.kinematics`` must come from it).
     samples: contact cases: configurations (with their Pinocchio data) and directions.
     space: bounds of the design variables.
     technology: reference motor, scaling law, mechanical stiffness, sensing scheme, reaction model.

@@ -275,7 +275,7 @@ def _result(
 
 def design_at(problem: DesignProblem, x: np.ndarray) -> Design:
     """The design (and its derived actuator quantities) at NLP point ``x``."""
-    from ..motors import scaled_motor_quantities
+    from ..hardware.motors import scaled_motor_quantities
 
     values = problem.layout.values(np.asarray(x, dtype=float))
     technology = problem.technology

@@ -147,7 +147,7 @@ class ContactSamples:
     """Contact cases the design is evaluated on: sample ``s`` is configuration ``config_index[s]`` of
     ``kinematics`` hit along unit direction ``directions[s]`` (world-aligned, ``task_dim`` components).
 
-    kinematics: :class:`collision_reflex.arm.ArmSamples` of the configurations.
+    kinematics: :class:`collision_reflex.arm.core.ArmSamples` of the configurations.
     directions: (n_samples, task_dim) unit vectors.
     config_index: (n_samples,) index into the configurations.
     """

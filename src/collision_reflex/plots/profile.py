@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..impulse import collision_times, force_profile, phase_impulses
+from ..model.impulse import collision_times, force_profile, phase_impulses
 from . import new_figure, save_figure
 
 

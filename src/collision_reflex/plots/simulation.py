@@ -12,7 +12,7 @@ from . import new_figure, save_figure
 
 
 def plot_sweep(path: str | os.PathLike[str], result: Any, closed_form_curve: Any = None) -> Path:
-    """Draw a :class:`collision_reflex.simulate.Sweep`: simulated impulses as markers (one series per value of
+    """Draw a :class:`collision_reflex.simulate.collision.Sweep`: simulated impulses as markers (one series per value of
     the swept parameter), the closed form as a line, and the points whose relative difference exceeds the
     tolerance circled in red. ``closed_form_curve`` is an optional ``(velocities, impulses)`` pair drawn as a
     smooth line; otherwise the closed form at the simulated velocities is drawn.
@@ -68,10 +68,10 @@ def _format(parameter: str | None, value: float) -> str:
 
 
 def plot_trace(path: str | os.PathLike[str], result: Any, reaction: str = "at_rest", v_r: Any = None) -> Path:
-    """Draw a simulated force trace (:class:`collision_reflex.simulate.SimulationResult`) over the closed form's
+    """Draw a simulated force trace (:class:`collision_reflex.simulate.collision.SimulationResult`) over the closed form's
     force profile (:func:`collision_reflex.force_profile`) for the same setup, with the detection, reaction and
     contact-end times marked and the rigid impacts' impulses noted."""
-    from ..impulse import force_profile
+    from ..model.impulse import force_profile
 
     setup = result.setup
     end = float(result.contact_end) if np.isfinite(result.contact_end) else float(result.t[-1])

@@ -10,8 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..directions import coordinate_plane
-from ..surfaces import ReflexSurface
+from ..arm.directions import coordinate_plane
+from ..arm.surfaces import ReflexSurface
 from . import new_figure, save_figure
 
 # Impulses above this multiple of the grid's median are drawn clipped (singular directions are infinite).

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InvalidParameter
-from ..sweeps import RadiusVelocitySweep, StiffnessSweep
+from ..hardware.sweeps import RadiusVelocitySweep, StiffnessSweep
 from . import check_figure_path, new_figure, save_figure
 
 

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..impulse import collision_times
+from ..model.impulse import collision_times
 from . import new_figure, save_figure
 
 if TYPE_CHECKING:

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import StudyFileError, StudyProblem
-from ..impulse import optimal_velocity, phase_impulses, series_stiffness
+from ..model.impulse import optimal_velocity, phase_impulses, series_stiffness
 from .load import LoadedStudy, parse_study
 from .prepare import check_motors, joint_actuators, per_joint_bounds
 from .robot import load_arm
@@ -72,7 +72,7 @@ def _casadi_openblas_controller() -> Any:
 class ArmSetup:
     """Everything an arm study's solves need, built once per process.
 
-    arm: the :class:`collision_reflex.arm.Arm`; catalogue: the motor catalogue by name; configurations: (n, nq)
+    arm: the :class:`collision_reflex.arm.core.Arm`; catalogue: the motor catalogue by name; configurations: (n, nq)
     [rad]; directions: (m, task_dim) unit vectors; samples: the optimiser's contact samples (every configuration
     with every direction); space, technology, constraints: the optimiser's inputs.
     """
@@ -464,7 +464,7 @@ def checked_setup(loaded: LoadedStudy, resolved_text: str) -> ArmSetup:
 def _torque_out_of_reach(loaded: LoadedStudy, setup: ArmSetup) -> list[StudyProblem]:
     """Given torque requirements no design within the bounds can meet: the largest motor at the largest gear
     ratio (torque grows with motor size under every scaling law) short of the safety factor times the need."""
-    from ..motors import scaled_motor_quantities
+    from ..hardware.motors import scaled_motor_quantities
 
     required = setup.study.constraints.torque_required
     if required is None:

@@ -1,6 +1,6 @@
 """Actuator studies: single-joint actuators compared in a 1D collision at a lever (no arm, no optimiser).
 
-Each candidate is a :class:`collision_reflex.actuators.Actuator`; its ``contact_parameters`` map it to the contact
+Each candidate is a :class:`collision_reflex.hardware.actuators.Actuator`; its ``contact_parameters`` map it to the contact
 at the study's lever (MODEL.md §2: inertia ``J / L²``, stiffness ``k / L²``, torque ``τ / L``, the threshold by
 its sensing scheme). The object hit (``load.contact_stiffness``, e.g. a force sensor) is a spring in series with
 the joint's, during sensing and reaction alike.
@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import CollisionReflexError
-from ..impulse import minimum_impulse, optimal_velocity, phase_impulses, series_stiffness
+from ..model.impulse import minimum_impulse, optimal_velocity, phase_impulses, series_stiffness
 from .load import LoadedStudy
 from .prepare import check_motors, gearbox_for, motor_for
 from .schema import ActuatorCandidate, ActuatorStudy, SensingSpec
@@ -45,7 +45,7 @@ def check_actuator_study(loaded: LoadedStudy) -> dict[str, Any]:
 def _actuator(
     candidate: ActuatorCandidate, sensing: SensingSpec, lever: float, catalogue: dict[str, Any]
 ) -> Any:
-    from ..actuators import Actuator
+    from ..hardware.actuators import Actuator
 
     return Actuator(
         motor_for(candidate.motor, catalogue),
@@ -61,7 +61,7 @@ def _actuator(
 def sensing_scheme(sensing: SensingSpec, lever: float) -> Any:
     """The actuator model's sensing scheme for a study's sensing; a contact position error ``e`` [m] is the
     joint error ``e / L`` [rad]."""
-    from ..actuators import CurrentThreshold, ForceThreshold, PositionThreshold
+    from ..hardware.actuators import CurrentThreshold, ForceThreshold, PositionThreshold
 
     if sensing.scheme == "force":
         return ForceThreshold(sensing.value)

@@ -26,7 +26,7 @@ def _motor_specs(study: ArmStudy | ActuatorStudy) -> Iterator[tuple[tuple[Any, .
 
 def check_motors(loaded: LoadedStudy, catalogue: dict[str, Any] | None = None) -> dict[str, Any]:
     """The motor catalogue, after checking that every motor the study names is in it."""
-    from ..motors import load_catalogue
+    from ..hardware.motors import load_catalogue
 
     catalogue = catalogue if catalogue is not None else load_catalogue()
     problems: list[StudyProblem] = []
@@ -55,7 +55,7 @@ def _written_as_mapping(loaded: LoadedStudy, path: tuple[Any, ...]) -> bool:
 
 
 def motor_for(spec: MotorSpec, catalogue: dict[str, Any]) -> Any:
-    """The :class:`collision_reflex.motors.Motor` a spec describes: the catalogue motor, scaled if asked."""
+    """The :class:`collision_reflex.hardware.motors.Motor` a spec describes: the catalogue motor, scaled if asked."""
     motor = catalogue[spec.reference]
     if spec.stator_diameter is None and spec.stack_length is None:
         return motor
@@ -65,10 +65,10 @@ def motor_for(spec: MotorSpec, catalogue: dict[str, Any]) -> Any:
 
 
 def gearbox_for(spec: GearboxSpec | None) -> Any:
-    """The :class:`collision_reflex.actuators.Gearbox` of a spec (``None`` for direct drive)."""
+    """The :class:`collision_reflex.hardware.actuators.Gearbox` of a spec (``None`` for direct drive)."""
     if spec is None:
         return None
-    from ..gearboxes import Gearbox
+    from ..hardware.gearboxes import Gearbox
 
     return Gearbox(
         spec.kind,

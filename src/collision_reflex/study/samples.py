@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from ..directions import circle_directions, sphere_directions, unit_directions
+from ..arm.directions import circle_directions, sphere_directions, unit_directions
 from ..errors import InvalidParameter
 from .load import LoadedStudy
 from .schema import ArmStudy, ConfigurationSamples, DirectionSamples
@@ -21,8 +21,8 @@ def direction_samples(loaded: LoadedStudy, arm: Any) -> np.ndarray:
     """The contact directions of an arm study, unit vectors (n, task_dim) in the arm's task coordinates.
 
     ``circle: n`` spreads n directions evenly over the arm's plane (planar arms) or the world x-y plane;
-    ``sphere: n`` over the sphere (:func:`collision_reflex.directions.sphere_directions`); named directions and
-    listed vectors go through :func:`collision_reflex.directions.unit_directions` (world vectors are projected
+    ``sphere: n`` over the sphere (:func:`collision_reflex.arm.directions.sphere_directions`); named directions and
+    listed vectors go through :func:`collision_reflex.arm.directions.unit_directions` (world vectors are projected
     into a planar arm's plane). A direction the arm cannot use is reported at its line.
     """
     study = loaded.study

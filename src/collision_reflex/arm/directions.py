@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from .errors import InvalidParameter
+from ..errors import InvalidParameter
 
 NAMED_DIRECTIONS: dict[str, tuple[float, float, float]] = {
     "x": (1.0, 0.0, 0.0),

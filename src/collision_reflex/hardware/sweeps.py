@@ -5,8 +5,8 @@
 - :func:`stiffness_sweep`: the impulse over mechanical stiffness for force-threshold and position-threshold
   sensing (``fig:stiff-sensing-impulse``).
 
-Both build :class:`~collision_reflex.actuators.Actuator` objects for a rotary joint acting on a contact at a
-lever ``L`` and evaluate the 1D model of :mod:`collision_reflex.impulse`. Stiffnesses and thresholds are given
+Both build :class:`~collision_reflex.hardware.actuators.Actuator` objects for a rotary joint acting on a contact at a
+lever ``L`` and evaluate the 1D model of :mod:`collision_reflex.model.impulse`. Stiffnesses and thresholds are given
 at the contact [N/m, N] as in the paper and converted to the joint (``k L**2``) for the actuator.
 
 Assumptions the paper does not state are parameters with documented defaults (:data:`SWEEP_DEFAULTS`):
@@ -30,8 +30,10 @@ from typing import Any
 
 import numpy as np
 
-from . import _validate
-from ._io import atomic_open
+from .. import _validate
+from .._io import atomic_open
+from ..errors import InvalidParameter
+from ..model.impulse import REACTION_MODES, minimum_impulse, optimal_velocity, phase_impulses
 from .actuators import (
     REFLECTED_INERTIA_PLACEMENTS,
     Actuator,
@@ -40,9 +42,7 @@ from .actuators import (
     PositionThreshold,
     gear_ratio_for,
 )
-from .errors import InvalidParameter
 from .gearboxes import Gearbox
-from .impulse import REACTION_MODES, minimum_impulse, optimal_velocity, phase_impulses
 from .motors import DEFAULT_SCALING_LAW, Motor, reference_motor, scaling_law
 
 __all__ = [

@@ -1,9 +1,9 @@
 """Actuators: a motor, a transmission, joint stiffness and a collision-sensing scheme.
 
-An :class:`Actuator` turns a motor (:mod:`collision_reflex.motors`), a gear ratio ``N`` and an optional gearbox
+An :class:`Actuator` turns a motor (:mod:`collision_reflex.hardware.motors`), a gear ratio ``N`` and an optional gearbox
 into joint quantities: reflected inertia ``N**2 J_m``, peak output torque ``N tau_p``, the series joint
 stiffness of its mechanical and software springs, and its mass. For a rotary joint acting on a contact point at
-lever ``L`` it gives the 1D collision parameters of the model in :mod:`collision_reflex.impulse` (mass
+lever ``L`` it gives the 1D collision parameters of the model in :mod:`collision_reflex.model.impulse` (mass
 ``J/L**2``, stiffness ``k_rot/L**2``, force ``tau/L``), with the sensing threshold from its sensing scheme:
 
 - :class:`ForceThreshold`: a fixed contact force ``F_s`` (a force sensor or an external-force observer);
@@ -21,10 +21,10 @@ import numbers
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
-from . import _validate
-from .errors import InvalidParameter
+from .. import _validate
+from ..errors import InvalidParameter
+from ..model.impulse import series_stiffness
 from .gearboxes import Gearbox
-from .impulse import series_stiffness
 from .motors import Motor
 
 __all__ = [

@@ -18,8 +18,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, NamedTuple
 
-from . import _validate
-from .errors import InvalidParameter
+from .. import _validate
+from ..errors import InvalidParameter
 
 __all__ = [
     "DEFAULT_SCALING_LAW",
@@ -238,7 +238,7 @@ def load_catalogue(path: str | os.PathLike[str] | None = None) -> dict[str, Moto
     strings with units, e.g. ``"60 mm"``, ``"1.3 N*m"``) and a ``source``. A missing or mistyped field raises
     :class:`~collision_reflex.errors.CatalogueError` naming the field, the file and the line.
     """
-    from ._catalogue import read_catalogue
+    from .catalogue import read_catalogue
 
     target = Path(path) if path is not None else default_catalogue_path()
     entries = read_catalogue(target)
@@ -247,7 +247,7 @@ def load_catalogue(path: str | os.PathLike[str] | None = None) -> dict[str, Moto
 
 def default_catalogue_path() -> Path:
     """The packaged motor catalogue, ``designs/motors.yaml``."""
-    from ._catalogue import packaged_catalogue_path
+    from .catalogue import packaged_catalogue_path
 
     return packaged_catalogue_path()
 
@@ -259,7 +259,7 @@ def reference_motor() -> Motor:
 
 def get_motor(name: str, path: str | os.PathLike[str] | None = None) -> Motor:
     """The motor called ``name`` in a catalogue (default: the packaged one)."""
-    from .errors import UnknownMotor
+    from ..errors import UnknownMotor
 
     catalogue = load_catalogue(path)
     try:

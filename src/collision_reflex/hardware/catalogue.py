@@ -1,6 +1,6 @@
 """Reading motor catalogue files: YAML with line numbers, validated by pydantic, units converted by pint.
 
-Kept apart from :mod:`collision_reflex.motors` so that the scaling arithmetic imports nothing heavy.
+Kept apart from :mod:`collision_reflex.hardware.motors` so that the scaling arithmetic imports nothing heavy.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from typing import Any
 import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError, field_validator
 
-from .errors import CatalogueError
+from ..errors import CatalogueError
 
 # Field -> the unit a plain number is taken in (SI), and the pint dimensionality a quantity string must have.
 _UNITS = {
@@ -31,12 +31,12 @@ def packaged_catalogue_path() -> Path:
     Looked for inside the package (a wheel that includes the ``designs`` data) and then in the source tree
     (a checkout or an editable install).
     """
-    here = Path(__file__).resolve().parent
-    for candidate in (here / "designs" / "motors.yaml", here.parents[1] / "designs" / "motors.yaml"):
+    package = Path(__file__).resolve().parents[1]
+    for candidate in (package / "designs" / "motors.yaml", package.parents[1] / "designs" / "motors.yaml"):
         if candidate.is_file():
             return candidate
     raise CatalogueError(
-        str(here.parents[1] / "designs" / "motors.yaml"),
+        str(package.parents[1] / "designs" / "motors.yaml"),
         None,
         "",
         "the packaged motor catalogue is missing; reinstall collision-reflex or pass a catalogue file",
@@ -107,7 +107,7 @@ def _quantity(text: str, unit: str) -> float:
 
 
 def read_catalogue(path: Path) -> dict[str, dict[str, Any]]:
-    """The entries of a catalogue file, each a dict of :class:`~collision_reflex.motors.Motor` fields (SI)."""
+    """The entries of a catalogue file, each a dict of :class:`~collision_reflex.hardware.motors.Motor` fields (SI)."""
     name = str(path)
     try:
         text = path.read_text(encoding="utf-8")

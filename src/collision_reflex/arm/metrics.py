@@ -20,9 +20,9 @@ from typing import Any
 
 import numpy as np
 
-from ._robots import ROBOT_DEFAULTS, example_robot
-from .arm import ArmSamples, _joint_array, _unit_directions, task_inverse_inertia
-from .errors import FrameNotFound, InvalidParameter
+from ..errors import FrameNotFound, InvalidParameter
+from .core import ArmSamples, _joint_array, _unit_directions, task_inverse_inertia
+from .robots import ROBOT_DEFAULTS, example_robot
 
 
 @dataclass(frozen=True)

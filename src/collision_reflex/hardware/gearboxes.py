@@ -6,7 +6,7 @@ stages ``a``, relative to a reference gearbox: ``q = q0 (l/l0)**p (r/r0)**e (a/a
 described by a real one (its own mass, inertia and rated torque at its size, with a source), and
 :meth:`Gearbox.scaled` moves it to another size. No reference values are built in: gearbox data vary too much
 between makers for one default to be honest, and the paper ignores gearbox inertia (as does
-:class:`~collision_reflex.actuators.Actuator` unless asked).
+:class:`~collision_reflex.hardware.actuators.Actuator` unless asked).
 
 Inertia convention: ``inertia`` is the gearbox's own inertia seen at its input (motor) shaft [kg m^2], so its
 reflected inertia at the output is ``N**2 inertia`` (the table's ``l r^4 N^2``); a ball screw's ``inertia`` is
@@ -20,8 +20,8 @@ import numbers
 from dataclasses import dataclass
 from typing import Any
 
-from . import _validate
-from .errors import InvalidParameter
+from .. import _validate
+from ..errors import InvalidParameter
 
 __all__ = ["GEARBOX_KINDS", "GEARBOX_SCALING", "Gearbox", "GearboxScaling"]
 

@@ -5,7 +5,7 @@ actuation (reflected inertia, stiffness, torque limit, motor mass). :meth:`Arm.k
 configuration-dependent quantities once per configuration with Pinocchio and returns them stacked
 (:class:`ArmSamples`); :func:`effective_parameters` then maps them, for many directions at once, to the 1D
 collision parameters of the paper's section "Collision Reflex in Higher Dimensions" (``eq:eff_mf`` to
-``eq:eff_a``), and :func:`collision_impulses` to impulses through :mod:`collision_reflex.impulse`.
+``eq:eff_a``), and :func:`collision_impulses` to impulses through :mod:`collision_reflex.model.impulse`.
 
 Conventions (SI throughout): the contact Jacobian is the translational Jacobian of the contact point in
 world-aligned axes; a planar arm (all joint axes parallel) is described in the plane perpendicular to its axes
@@ -24,8 +24,9 @@ from typing import Any
 
 import numpy as np
 
-from . import _validate
-from ._robots import (
+from .. import _validate
+from ..errors import FrameNotFound, InvalidParameter, UrdfError
+from .robots import (
     ROBOT_DEFAULTS,
     captured_stderr,
     configuration_by_name,
@@ -34,7 +35,6 @@ from ._robots import (
     parser_reason,
     with_locked_joints,
 )
-from .errors import FrameNotFound, InvalidParameter, UrdfError
 
 # Joints whose limits are missing or meaningless (URDF "continuous", or lower >= upper) are sampled on a full
 # turn; limits beyond this magnitude are treated as missing.
@@ -83,7 +83,7 @@ class JointParameters:
         """From one actuator per joint, or one actuator used at every joint.
 
         An actuator is anything with ``reflected_inertia`` [kg m^2], ``peak_torque`` [N m], ``stiffness`` and
-        ``mechanical_stiffness`` [N m/rad] and ``mass`` [kg] (:class:`collision_reflex.actuators.Actuator`).
+        ``mechanical_stiffness`` [N m/rad] and ``mass`` [kg] (:class:`collision_reflex.hardware.actuators.Actuator`).
         """
         items = list(actuators) if isinstance(actuators, list | tuple) else [actuators] * nv
         if len(items) != nv:
@@ -454,11 +454,11 @@ class Arm:
         reference: the motor scaled from; default the Omni+ OPN-060-013-A (``motors.reference_motor``).
         law: scaling law name (``motors.SCALING_LAWS``).
         mechanical_stiffness, software_stiffness: joint springs [N m/rad] (scalar or (nv,)).
-        sensing: a sensing scheme of :mod:`collision_reflex.actuators` for every joint; default a 3 N force
+        sensing: a sensing scheme of :mod:`collision_reflex.hardware.actuators` for every joint; default a 3 N force
             threshold.
         """
-        from .actuators import Actuator, ForceThreshold, gear_ratio_for
-        from .motors import reference_motor
+        from ..hardware.actuators import Actuator, ForceThreshold, gear_ratio_for
+        from ..hardware.motors import reference_motor
 
         required = self.urdf_torque_limit if torque_required is None else torque_required
         required = _joint_array("torque_required", required, self.nv)
@@ -480,7 +480,7 @@ class Arm:
         for force thresholds at the contact, or ``{"sensing": "joint_torque", "joint_threshold": tau_s}`` [N m]
         for the joint-side schemes (position error, motor current), where the first joint to reach its
         threshold detects the contact."""
-        from .actuators import ForceThreshold
+        from ..hardware.actuators import ForceThreshold
 
         if not self.actuators:
             raise InvalidParameter(
@@ -901,7 +901,7 @@ def effective_parameters(
                 value[singular] = np.inf
         a[singular] = 0.0
     if task_stiffness is not None:
-        from .impulse import series_stiffness
+        from ..model.impulse import series_stiffness
 
         _validate.positive("task_stiffness", task_stiffness)
         k = np.where(singular, np.inf, series_stiffness(k, task_stiffness))
@@ -942,7 +942,7 @@ def collision_impulses(
     sensing: str = "force",
     reaction: str = "at_rest",
 ) -> CollisionImpulses:
-    """Collision impulses from effective parameters, through :mod:`collision_reflex.impulse`.
+    """Collision impulses from effective parameters, through :mod:`collision_reflex.model.impulse`.
 
     Parameters
     ----------
@@ -953,7 +953,7 @@ def collision_impulses(
     sensing: one of :data:`SENSING_SCHEMES`.
     reaction: ``"at_rest"`` (the paper's) or ``"moving"``, see :func:`collision_reflex.phase_impulses`.
     """
-    from .impulse import optimal_velocity, phase_impulses
+    from ..model.impulse import optimal_velocity, phase_impulses
 
     _validate.choice("sensing", sensing, SENSING_SCHEMES)
     shape = params.shape
@@ -1128,7 +1128,7 @@ def _joint_kinematics(model: Any, robot: str) -> list[_JointKinematics]:
                 "model",
                 f"joint {model.names[j]!r} ({joint.shortname()}, nq={joint.nq}, nv={joint.nv})",
                 "a fixed-base robot whose joints are revolute or prismatic",
-                "floating-base robots: use collision_reflex.metrics for the impact mitigation factor, or load "
+                "floating-base robots: use collision_reflex.arm.metrics for the impact mitigation factor, or load "
                 "the URDF without a root joint",
             )
         local = np.asarray(pin.getJointJacobian(model, data, j, pin.LOCAL))[:, joint.idx_v]

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from .errors import FrameNotFound, InvalidParameter, UrdfError
+from ..errors import FrameNotFound, InvalidParameter, UrdfError
 
 # Sensible contact points and locked joints of the example-robot-data robots most used as arms. The double
 # pendulum's URDF has no tip frame: its second link is about 0.2 m long (its centre of mass sits at 0.10 m

@@ -23,9 +23,9 @@ from typing import Any
 
 import numpy as np
 
-from . import _validate
-from ._backend import is_symbolic, sin, sqrt, where
-from .errors import InvalidParameter
+from .. import _validate
+from .._backend import is_symbolic, sin, sqrt, where
+from ..errors import InvalidParameter
 
 REACTION_MODES: tuple[str, ...] = ("at_rest", "moving")
 """``"at_rest"``: the paper's reaction, robot mass at rest at detection (its default).

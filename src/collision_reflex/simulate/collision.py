@@ -12,7 +12,7 @@ control sample, the reaction: the software spring is zeroed and the actuator pus
 its force limit ``F_a``. The simulation ends when the finger has left the wall for good; the impulse is the
 integral of the contact force (plus the impulses of rigid plastic impacts).
 
-The ideal limit and the closed form (:mod:`collision_reflex.impulse`)
+The ideal limit and the closed form (:mod:`collision_reflex.model.impulse`)
 ----------------------------------------------------------------------
 The closed form assumes a plastic impact, a robot that tracks its reference ideally while sensing, instant
 detection and a constant reaction acceleration ``a``. In this model that is ``drive="ideal"``: the robot mass
@@ -48,9 +48,9 @@ from typing import Any
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from . import _validate
-from .errors import InvalidParameter, SimulationError
-from .impulse import PhaseImpulses, phase_impulses, series_stiffness
+from .. import _validate
+from ..errors import InvalidParameter, SimulationError
+from ..model.impulse import PhaseImpulses, phase_impulses, series_stiffness
 
 DRIVES: tuple[str, ...] = ("ideal", "impedance", "free")
 """Robot-side drive during the approach: see the module docstring."""

@@ -10,7 +10,7 @@ Each joint is a link side and a motor side coupled by the joint's mechanical spr
 ``f`` the wall force, a stiff Kelvin-Voigt contact that cannot pull (the wall is frictionless: the contact point
 may slide along it). Gravity is left out, as in the closed form.
 
-Approach and sensing follow the 1D ideal drive (:mod:`collision_reflex.simulate`) joint by joint: each motor is
+Approach and sensing follow the 1D ideal drive (:mod:`collision_reflex.simulate.collision`) joint by joint: each motor is
 ideally velocity-controlled along ``theta_ref' = J(q0)^+ u v0`` (the contact point approaches along ``u`` at
 ``v0``) and its software stiffness ``k_s,i`` acts as an admittance, so that the joint springs are the series
 ``K = K_m K_s / (K_m + K_s)`` of the closed form. Detection is on the contact force estimated from the joint
@@ -33,9 +33,9 @@ from typing import Any
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from . import _validate
-from .errors import InvalidParameter, SimulationError
-from .impulse import total_impulse
+from .. import _validate
+from ..errors import InvalidParameter, SimulationError
+from ..model.impulse import total_impulse
 
 ARM_REACTIONS: tuple[str, ...] = ("at_rest", "moving")
 
@@ -114,7 +114,7 @@ def simulate_arm_collision(
     torque_limit: output torque limit per joint [N m], > 0; default the arm's.
     wall_stiffness: the wall's contact stiffness [N/m].
     wall_damping_ratio: its damping as a ratio of critical for the effective finger mass (2 gives a
-        restitution of 0.02, see :func:`collision_reflex.simulate.contact_restitution`).
+        restitution of 0.02, see :func:`collision_reflex.simulate.collision.contact_restitution`).
     delay: sensing delay [s], >= 0.
     reaction: the closed form's variant to compare with, ``"moving"`` (with the robot velocity at detection)
         or ``"at_rest"``.
@@ -122,7 +122,7 @@ def simulate_arm_collision(
     """
     import pinocchio as pin
 
-    from .arm import effective_parameters
+    from ..arm.core import effective_parameters
 
     _validate.choice("reaction", reaction, ARM_REACTIONS)
     for name, value in (("velocity", velocity), ("threshold", threshold), ("wall_stiffness", wall_stiffness)):
@@ -168,7 +168,7 @@ def simulate_arm_collision(
     lumped = 1 / (1 / k_m + 1 / k_s)
 
     # The closed form at the impact configuration (issue 4's effective parameters; the impulse from
-    # collision_reflex.impulse).
+    # collision_reflex.model.impulse).
     samples = arm.kinematics(q0[None])
     effective = effective_parameters(
         samples,
