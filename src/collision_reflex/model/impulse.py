@@ -185,11 +185,32 @@ def force_profile(
     t1 = F_s / (k * v0)
     duration, _ = _reaction_phase(F_s, k_m, a, v_r)
     tau = t - t1
-    pulse = where(t >= 0, where(t <= np.pi / (2 * omega), m_f * v0 * omega * sin(omega * t), 0.0), 0.0)
-    ramp = where(t >= 0, where(t < t1, k * v0 * t, 0.0), 0.0)
+    pulse_end = impact_pulse_duration(m_f, k_m)
+    pulse = where(t >= 0, where(t <= pulse_end, m_f * v0 * omega * sin(omega * t), 0.0), 0.0)
+    ramp = where(t >= 0, where(t < t1, sensing_force(t, k, v0), 0.0), 0.0)
     reaction_force = k_m * (F_s / k_m + v_r * tau - a * tau**2 / 2)
     reaction_part = where(tau >= 0, where(tau <= duration, reaction_force, 0.0), 0.0)
     return pulse + ramp + reaction_part
+
+
+def impact_pulse_duration(m_f: Any, k_m: Any) -> Any:
+    """Duration of the impact pulse [s]: the compression quarter-period ``pi / (2 w)`` of the finger mass
+    ``m_f`` [kg] on the mechanical spring ``k_m`` [N/m], ``w = sqrt(k_m / m_f)``."""
+    return np.pi / (2 * sqrt(k_m / m_f))
+
+
+def sensing_force(t: Any, k: Any, v0: Any) -> Any:
+    """Contact force of the sensing ramp at time ``t`` [s] after impact [N]: the velocity-controlled robot
+    compresses the lumped spring ``k`` [N/m] at ``v0`` [m/s], ``F = k v0 t`` (valid until detection, ``t1``)."""
+    return k * v0 * t
+
+
+def reaction_duration(F_s: Any, k_m: Any, a: Any, v_r: Any = 0.0) -> Any:
+    """Duration ``t2 - t1`` of the reaction phase [s]: from detection at ``F_s`` [N] until the mechanical
+    spring ``k_m`` [N/m] is unloaded, the robot mass accelerating away at ``a`` [m/s^2] from a velocity ``v_r``
+    [m/s] toward the constraint (0: the paper's robot at rest, ``sqrt(2 F_s / (a k_m))``)."""
+    duration, _ = _reaction_phase(F_s, k_m, a, v_r)
+    return duration
 
 
 def _reaction_phase(F_s: Any, k_m: Any, a: Any, v_r: Any) -> tuple[Any, Any]:
