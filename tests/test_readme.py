@@ -8,6 +8,7 @@ paper value or a hand computation, a second test checks the README's numbers aga
 
 from __future__ import annotations
 
+import contextlib
 import io
 import math
 import re
@@ -105,8 +106,6 @@ def _expected_numbers(example_id: str) -> list[list[float]]:
 
 def _run(example: Example) -> list[str]:
     """Run an example in a fresh namespace; its printed lines. A deprecated keyword in it is an error."""
-    import contextlib
-
     out = io.StringIO()
     # Blank lines in front so that a traceback names the README's line numbers.
     code = compile("\n" * (example.line - 1) + example.code, str(README), "exec")
@@ -118,6 +117,7 @@ def _run(example: Example) -> list[str]:
 
 def test_readme_has_examples_with_printed_values():
     assert len(EXAMPLES) >= 6, "the README lost Python examples"
+    assert set(RTOL) <= set(BY_ID), "a tolerance names no README example (a section was renamed?)"
     for example in EXAMPLES:
         assert example.expected, f"{example.id} (README line {example.line}) shows no expected output"
 
