@@ -13,10 +13,10 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from collision_reflex.model import impulse
 from collision_reflex.arm.core import Arm, JointParameters, collision_impulses, effective_parameters
 from collision_reflex.arm.directions import circle_directions, sphere_directions, unit_directions
 from collision_reflex.errors import InvalidParameter
+from collision_reflex.model import impulse
 
 TWO_LINK = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
 
