@@ -86,7 +86,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "reference pose otherwise",
     )
     options.STATOR_DIAMETER.add(parser, _DEFAULTS["stator_diameter"], aliases=[Alias("--motor-size", "mm")])
-    options.TORQUE_REQUIRED.add(parser, nargs="+", note="one value or one per joint", shown="the URDF effort limits")
+    options.TORQUE_REQUIRED.add(
+        parser, nargs="+", note="one value or one per joint", shown="the URDF effort limits"
+    )
     options.JOINT_MECH_STIFFNESS.add(parser, _DEFAULTS["mechanical_stiffness"], aliases=["--mech-stiffness"])
     options.JOINT_SOFT_STIFFNESS.add(parser, _DEFAULTS["software_stiffness"], aliases=["--soft-stiffness"])
     options.TASK_STIFFNESS.add(parser, _DEFAULTS["task_stiffness"])
