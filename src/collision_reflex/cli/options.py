@@ -290,7 +290,7 @@ class Option:
         if self.form != "one":
             metavar = "RANGE" if self.form == "range" else "LIST"
         if isinstance(nargs, int):
-            metavar = tuple(f"{axis}" for axis in "XYZ"[:nargs])
+            metavar = tuple("XYZ"[:nargs])
         extra: dict[str, Any] = {} if nargs is None else {"nargs": nargs}
         add_with_aliases(
             parser,
