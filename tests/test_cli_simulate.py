@@ -120,7 +120,17 @@ def test_help_names_units():
 
 def test_trace_figure_written(tmp_path, capsys):
     target = tmp_path / "trace.svg"
-    argv = ["simulate", "--count", "2", "--delays", "0.01", "--trace", str(target), "--trace-velocity", "0.3"]
+    argv = [
+        "simulate",
+        "--count",
+        "2",
+        "--delays",
+        "0.01",
+        "--trace-plot",
+        str(target),
+        "--trace-velocity",
+        "0.3",
+    ]
     assert main(argv) == 0
     assert target.stat().st_size > 1000
     assert f"wrote {target}" in capsys.readouterr().out

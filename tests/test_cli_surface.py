@@ -19,13 +19,22 @@ from collision_reflex.hardware.actuators import ForceThreshold
 REPO = Path(__file__).resolve().parents[1]
 TWO_LINK = REPO / "designs" / "planar_two_link.urdf"
 # Small sweeps keep the test fast; the defaults draw 360 directions per cell.
-FAST = ["--directions", "24", "--q2-values", "45,0", "--motor-sizes", "10,60", "--velocities", "0.1,1"]
+FAST = [
+    "--directions",
+    "24",
+    "--q2-values",
+    "45,0",
+    "--stator-diameters",
+    "0.01,0.06",
+    "--velocities",
+    "0.1,1",
+]
 
 
 @pytest.mark.parametrize("suffix", [".png", ".svg"], ids=["png", "svg"])
 def test_planar_grid_figure_and_table(tmp_path, capsys, suffix):
     figure, table = tmp_path / f"grid{suffix}", tmp_path / "surface.csv"
-    code = main(["surface", "--urdf", str(TWO_LINK), "-o", str(figure), "--table", str(table), *FAST])
+    code = main(["surface", "--urdf", str(TWO_LINK), "--plot", str(figure), "--csv", str(table), *FAST])
     assert code == 0
     assert figure.stat().st_size > 1000
     out = capsys.readouterr().out
@@ -44,7 +53,7 @@ def test_planar_grid_figure_and_table(tmp_path, capsys, suffix):
 
 def test_spatial_figure(tmp_path, capsys):
     figure = tmp_path / "ur5.png"
-    assert main(["surface", "--robot", "ur5", "--directions", "60", "-o", str(figure)]) == 0
+    assert main(["surface", "--robot", "ur5", "--directions", "60", "--plot", str(figure)]) == 0
     assert figure.stat().st_size > 1000
     assert "ur5" in capsys.readouterr().out
 
@@ -56,13 +65,13 @@ def test_spatial_figure(tmp_path, capsys):
         (["--urdf", str(TWO_LINK), "--frame", "gripper"], "tip_joint, tip"),
         (["--robot", "double_pendulum"], "--torque"),
         (["--urdf", str(TWO_LINK), "--q", "10"], "2 joint angles"),
-        (["--urdf", str(TWO_LINK), "-o", "figure.txt"], ".png"),
+        (["--urdf", str(TWO_LINK), "--plot", "figure.txt"], ".png"),
     ],
     ids=["missing-urdf", "unknown-frame", "no-torque", "wrong-q", "bad-figure-name"],
 )
 def test_bad_input_is_one_line_and_status_2(tmp_path, monkeypatch, capsys, arguments, message):
     monkeypatch.chdir(tmp_path)
-    output = [] if "-o" in arguments else ["-o", str(tmp_path / "f.png")]
+    output = [] if "--plot" in arguments else ["--plot", str(tmp_path / "f.png")]
     assert main(["surface", *arguments, *output]) == 2
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("crx surface: error:") and message in lines[0], lines
@@ -70,7 +79,7 @@ def test_bad_input_is_one_line_and_status_2(tmp_path, monkeypatch, capsys, argum
 
 def test_command_line_error_has_no_traceback(tmp_path):
     result = subprocess.run(
-        [sys.executable, "-m", "collision_reflex", "surface", "--urdf", "missing.urdf", "-o", "f.png"],
+        [sys.executable, "-m", "collision_reflex", "surface", "--urdf", "missing.urdf", "--plot", "f.png"],
         capture_output=True,
         text=True,
         cwd=tmp_path,

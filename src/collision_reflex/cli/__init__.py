@@ -1,7 +1,8 @@
 """The ``crx`` command line: one module per subcommand, each with ``register(subparsers)``.
 
-Errors raised on purpose (:class:`~collision_reflex.errors.CollisionReflexError`) are printed as one line and
-exit with status 2; argparse's usage errors exit with status 2 as well.
+Every option is declared once in :mod:`.options` (flag, unit, parser, range). Errors raised on purpose
+(:class:`~collision_reflex.errors.CollisionReflexError`) and usage errors are printed as one line on stderr and
+exit with status 2.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from ..errors import CollisionReflexError
 from . import fit as _fit
 from . import impulse as _impulse
 from . import motors as _motors
+from . import options
 from . import report as _report
 from . import run as _run
 from . import schema as _schema
@@ -28,12 +30,13 @@ _SUBCOMMANDS = [_impulse, _motors, _sweep, _surface, _fit, _simulate, _validate,
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = options.Parser(
         prog="crx",
         description=(
             "collision-reflex: evaluate and optimise the impulse a robot transfers in a surprise contact "
-            "(detect, stop, back away). All plain numbers are SI: kg, m, s, N, N/m, N*s."
+            "(detect, stop, back away)."
         ),
+        epilog=options.UNITS_EPILOG,
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
@@ -43,8 +46,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """Run ``crx`` with ``argv`` (default: the process's arguments) and return its exit status."""
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as done:  # --help, --version, or a usage error already printed as one line
+        return done.code if isinstance(done.code, int) else 0 if done.code is None else 2
     try:
         return int(args.run(args) or 0)
     except CollisionReflexError as error:

@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..errors import CollisionReflexError
-from ._args import positive_float
+from . import options
 
 if TYPE_CHECKING:
     from ..experiments import ExperimentResults
@@ -19,7 +19,8 @@ _DEFAULT_K_M = 2e7  # N/m, the paper's ATI Mini40 along its sensing axis
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    parser = subparsers.add_parser(
+    parser = options.add_subcommand(
+        subparsers,
         "fit",
         help="impulse and model fit of measured force-time traces (CSV)",
         description=(
@@ -34,51 +35,22 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     add = parser.add_argument
     add("traces", nargs="+", metavar="TRACES", help="CSV files, or folders searched for *.csv")
-    add(
-        "--k-m",
-        dest="k_m",
-        type=positive_float,
-        default=_DEFAULT_K_M,
-        metavar="N/M",
-        help="mechanical (sensor) stiffness k_m [N/m] for trials that do not give it (default %(default)g)",
+    options.MECH_STIFFNESS.add(
+        parser, _DEFAULT_K_M, note="the sensor's, for trials that do not give it", aliases=["--k-m"]
     )
-    add(
-        "--bandwidth",
-        type=positive_float,
-        default=None,
-        metavar="HZ",
-        help="cutoff of the sensor's low-pass filter [Hz] (2nd-order Butterworth); default: unfiltered",
-    )
-    add(
-        "--velocity",
-        type=positive_float,
-        default=None,
-        metavar="M/S",
-        help="pre-impact velocity [m/s] for trials whose file does not give one",
-    )
+    options.BANDWIDTH.add(parser, note="Butterworth", shown="unfiltered")
+    options.APPROACH_VELOCITY.add(parser, note="for trials whose file does not give one")
     add("--system", default=None, metavar="NAME", help="system name for trials whose file gives none")
     add("--time-unit", default="s", metavar="UNIT", help="unit of a time column without one (default s)")
     add("--force-unit", default="N", metavar="UNIT", help="unit of a force column without one (default N)")
-    add(
-        "--threshold-sigmas",
-        dest="n_sigma",
-        type=positive_float,
-        default=5.0,
-        metavar="N",
-        help="contact threshold above the noise floor, in noise standard deviations (default %(default)g)",
-    )
+    options.NOISE_SIGMAS.add(parser, 5.0)
     add(
         "--reaction",
         choices=("at_rest", "moving"),
         default="at_rest",
         help="reaction model fitted (default %(default)s, the paper's)",
     )
-    add(
-        "--out",
-        default=None,
-        metavar="DIR",
-        help="write trials.csv, one_shot.csv, nshot.csv, rejected.csv and figures here",
-    )
+    options.add_out_dir(parser, what="trials.csv, one_shot.csv, nshot.csv, rejected.csv and figures")
     add("--no-figures", action="store_true", help="with --out, write the tables only")
     add("--strict", action="store_true", help="exit with status 2 if any trace is rejected")
     parser.set_defaults(run=run)
@@ -91,7 +63,7 @@ def run(args: argparse.Namespace) -> int:
         args.traces,
         time_unit=args.time_unit,
         force_unit=args.force_unit,
-        velocity=args.velocity,
+        velocity=args.v0,
         system=args.system,
         k_m=args.k_m,
         bandwidth=args.bandwidth,

@@ -14,7 +14,7 @@ from ..model.impulse import (
     phase_impulses,
     series_stiffness,
 )
-from ._args import non_negative_float, positive_float, value_range
+from . import options
 
 # Defaults: the paper's direct-drive U8 actuator in its soft setting (one-shot fit, tab:one_shot), against
 # the ATI Mini40 sensor's stiffness.
@@ -22,7 +22,8 @@ _DEFAULTS = {"m_f": 0.1, "k_m": 2e7, "k_s": 440.0, "F_s": 3.0, "a": 4.7e-5, "v0"
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    parser = subparsers.add_parser(
+    parser = options.add_subcommand(
+        subparsers,
         "impulse",
         help="phase impulses, total, v* and I* of a 1D collision",
         description=(
@@ -32,90 +33,22 @@ def register(subparsers: argparse._SubParsersAction) -> None:
             "against a force sensor of stiffness 2e7 N/m."
         ),
     )
-    add = parser.add_argument
-    add(
-        "--finger-mass",
-        dest="m_f",
-        type=positive_float,
-        default=_DEFAULTS["m_f"],
-        metavar="KG",
-        help="finger (sprung) mass m_f [kg] (default %(default)s)",
-    )
-    add(
-        "--mech-stiffness",
-        dest="k_m",
-        type=positive_float,
-        default=_DEFAULTS["k_m"],
-        metavar="N/M",
-        help="mechanical stiffness k_m, the spring left during the reaction [N/m] (default %(default)g)",
-    )
-    add(
-        "--soft-stiffness",
-        dest="k_s",
-        type=positive_float,
-        default=_DEFAULTS["k_s"],
-        metavar="N/M",
-        help="software (controller) stiffness k_s, in series with k_m while sensing [N/m] (default %(default)s)",
-    )
-    add(
-        "--stiffness",
-        dest="k",
-        type=positive_float,
-        default=None,
-        metavar="N/M",
-        help="lumped sensing stiffness k [N/m]; overrides the series combination of k_m and k_s",
-    )
-    add(
-        "--threshold",
-        dest="F_s",
-        type=positive_float,
-        default=_DEFAULTS["F_s"],
-        metavar="N",
-        help="sensing threshold F_s, the contact force at detection [N] (default %(default)s)",
-    )
-    add(
-        "--accel",
-        dest="a",
-        type=positive_float,
-        default=_DEFAULTS["a"],
-        metavar="M/S2",
-        help="reaction acceleration a of the robot mass away from the contact [m/s^2] (default %(default)g)",
-    )
-    add(
-        "--velocity",
-        dest="v0",
-        type=positive_float,
-        default=_DEFAULTS["v0"],
-        metavar="M/S",
-        help="pre-impact (approach) velocity v0 [m/s] (default %(default)s)",
-    )
-    add(
+    options.FINGER_MASS.add(parser, _DEFAULTS["m_f"])
+    options.MECH_STIFFNESS.add(parser, _DEFAULTS["k_m"], note="the spring left during the reaction")
+    options.SOFT_STIFFNESS.add(parser, _DEFAULTS["k_s"], note="in series with k_m while sensing")
+    options.STIFFNESS.add(parser, note="overrides the series combination of k_m and k_s")
+    options.THRESHOLD.add(parser, _DEFAULTS["F_s"])
+    options.ACCEL.add(parser, _DEFAULTS["a"])
+    options.APPROACH_VELOCITY.add(parser, _DEFAULTS["v0"])
+    parser.add_argument(
         "--reaction",
         choices=REACTION_MODES,
         default="at_rest",
         help="reaction model: robot mass at rest at detection (the paper's) or still moving (default %(default)s)",
     )
-    add(
-        "--robot-velocity",
-        dest="v_r",
-        type=non_negative_float,
-        default=None,
-        metavar="M/S",
-        help="robot-mass velocity toward the contact at detection [m/s], with --reaction moving (default v0)",
-    )
-    add(
-        "--velocities",
-        type=value_range,
-        default=None,
-        metavar="RANGE",
-        help="also tabulate I(v0) over START:STOP:N (N log-spaced values) or a list v1,v2,... [m/s]",
-    )
-    add(
-        "--plot",
-        default=None,
-        metavar="FILE",
-        help="draw the force-time profile with the phases shaded to FILE (.png, .svg or .pdf)",
-    )
+    options.ROBOT_VELOCITY.add(parser, note="with --reaction moving", shown="v0")
+    options.APPROACH_VELOCITIES.add(parser, note="also tabulate I(v0) over them")
+    options.add_plot(parser, what="the force-time profile with the phases shaded")
     parser.set_defaults(run=run)
 
 

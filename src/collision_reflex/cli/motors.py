@@ -12,11 +12,12 @@ from ..hardware.motors import (
     get_motor,
     load_catalogue,
 )
-from ._args import positive_float, value_range
+from . import options
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    parser = subparsers.add_parser(
+    parser = options.add_subcommand(
+        subparsers,
         "motors",
         help="list the motor catalogue; 'motors scale' scales a motor (tab:motor_params)",
         description=(
@@ -24,56 +25,35 @@ def register(subparsers: argparse._SubParsersAction) -> None:
             "Celera Motion Omni+ OPN-060-013-A). Quantities in SI units."
         ),
     )
-    parser.add_argument(
-        "--catalogue", default=None, metavar="FILE", help="a motor catalogue YAML file (default: packaged)"
-    )
+    options.add_catalogue(parser)
     parser.set_defaults(run=run_list)
     actions = parser.add_subparsers(dest="motors_command", metavar="ACTION")
-    scale = actions.add_parser(
+    scale = options.add_subcommand(
+        actions,
         "scale",
         help="scale a motor to other stator diameters and gear it to a torque requirement",
         description=(
             "Scale a catalogue motor to other stator diameters (and stack length) by a scaling law of the "
             "paper's tab:scaling_laws, and pick the gear ratio N = max(1, tau_req / tau_p) that meets a torque "
             "requirement. The defaults reproduce the paper's tab:motor_params (M1, M2, M3): the Omni+ scaled "
-            "to 10, 60 and 100 mm by the Haddadin law with 1.3 N m required. Sizes in metres."
+            "to 10, 60 and 100 mm by the Haddadin law with 1.3 N m required."
         ),
     )
-    scale.add_argument(
-        "--catalogue", default=None, metavar="FILE", help="a motor catalogue YAML file (default: packaged)"
-    )
+    options.add_catalogue(scale)
     scale.add_argument(
         "--motor",
         default=REFERENCE_MOTOR_NAME,
         help="catalogue motor to scale from (default %(default)s)",
     )
-    scale.add_argument(
-        "--diameters",
-        type=value_range,
-        default=value_range("0.010,0.060,0.100"),
-        metavar="RANGE",
-        help="stator outer diameters [m]: a list d1,d2,... or START:STOP:N log-spaced (default 0.010,0.060,0.100)",
-    )
-    scale.add_argument(
-        "--stack-length",
-        type=positive_float,
-        default=None,
-        metavar="M",
-        help="stack length [m] (default: the motor's own)",
-    )
+    options.STATOR_DIAMETERS.add(scale, "10mm,60mm,100mm", aliases=["--diameters"])
+    options.STACK_LENGTH.add(scale, shown="the motor's own")
     scale.add_argument(
         "--law",
         choices=tuple(SCALING_LAWS),
         default=DEFAULT_SCALING_LAW,
         help="motor scaling law (default %(default)s, the paper's choice)",
     )
-    scale.add_argument(
-        "--torque",
-        type=positive_float,
-        default=1.3,
-        metavar="N*M",
-        help="output torque requirement tau_req [N m] (default %(default)s)",
-    )
+    options.TORQUE_REQUIRED.add(scale, 1.3)
     scale.set_defaults(run=run_scale)
 
 
@@ -98,7 +78,7 @@ def run_list(args: argparse.Namespace) -> int:
 
 def run_scale(args: argparse.Namespace) -> int:
     reference = get_motor(args.motor, args.catalogue)
-    motors = [reference.scaled(float(d), args.stack_length, args.law) for d in args.diameters]
+    motors = [reference.scaled(float(d), args.stack_length, args.law) for d in args.stator_diameters]
     actuators = [Actuator(m, float(gear_ratio_for(args.torque, m.peak_torque))) for m in motors]
     rows = [
         ("Stator OD (r_m)", "mm", [m.stator_diameter * 1e3 for m in motors]),

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import sys
 
+from . import options
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
@@ -18,7 +20,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         ),
     )
     parser.add_argument("study", metavar="STUDY", help="study file (YAML)")
-    parser.add_argument("--out", metavar="DIR", default=None, help="output folder (default: results/NAME)")
+    options.add_out_dir(parser, what="the results and the report", shown="results/NAME")
     parser.add_argument("--quiet", action="store_true", help="no progress bars; print only the report's path")
     parser.add_argument(
         "--scheduler",

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import json
 
+from . import options
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
@@ -15,8 +17,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
             "first line '# yaml-language-server: $schema=study.schema.json'."
         ),
     )
-    parser.add_argument(
-        "--out", metavar="FILE", default=None, help="write to FILE (atomically) instead of stdout"
+    options.add_with_aliases(
+        parser,
+        ["--json"],
+        ["--out"],
+        metavar="FILE",
+        default=None,
+        help="write to FILE (atomically) instead of stdout",
     )
     parser.set_defaults(run=run)
 
@@ -25,12 +32,12 @@ def run(args: argparse.Namespace) -> int:
     from ..study import study_json_schema
 
     text = json.dumps(study_json_schema(), indent=2) + "\n"
-    if args.out is None:
+    if args.json is None:
         print(text, end="")
     else:
         from .._io import atomic_open
 
-        with atomic_open(args.out, "w", encoding="utf-8") as handle:
+        with atomic_open(args.json, "w", encoding="utf-8") as handle:
             handle.write(text)
-        print(f"wrote {args.out}")
+        print(f"wrote {args.json}")
     return 0

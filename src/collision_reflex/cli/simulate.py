@@ -15,34 +15,19 @@ from ..simulate.collision import (
     DETECTION_KINDS,
     CollisionSetup,
     Detection,
+    Sweep,
     contact_damping_for_restitution,
     sweep,
 )
-from ._args import non_negative_float, positive_float, value_range
+from . import options
 
 # Defaults: a light direct-drive finger (the README's example) whose robot mass the spring does push back.
 _DEFAULTS = {"m_f": 0.2, "m_r": 0.5, "k_m": 1000.0, "k_s": 100.0, "F_s": 3.0, "F_a": 10.0}
 
 
-def _stiffness(text: str) -> float:
-    """A finite number > 0, or ``inf``."""
-    if text.strip().lower() in ("inf", "infinity"):
-        return math.inf
-    return positive_float(text)
-
-
-def _non_negative_list(text: str) -> np.ndarray:
-    try:
-        values = np.array([float(part) for part in text.split(",")])
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a comma-separated list of numbers") from None
-    if not np.all(np.isfinite(values) & (values >= 0)):
-        raise argparse.ArgumentTypeError(f"{text!r}: every value must be a finite number >= 0")
-    return values
-
-
 def register(subparsers: argparse._SubParsersAction) -> None:
-    parser = subparsers.add_parser(
+    parser = options.add_subcommand(
+        subparsers,
         "simulate",
         help="time-domain simulation against the closed form, over approach velocity",
         description=(
@@ -53,68 +38,20 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         ),
     )
     add = parser.add_argument
-    add(
-        "--finger-mass",
-        dest="m_f",
-        type=positive_float,
-        default=_DEFAULTS["m_f"],
-        metavar="KG",
-        help="finger (sprung) mass m_f [kg] (default %(default)s)",
-    )
-    add(
-        "--robot-mass",
-        dest="m_r",
-        type=positive_float,
-        default=_DEFAULTS["m_r"],
-        metavar="KG",
-        help="robot (unsprung + reflected rotor) mass m_r [kg] (default %(default)s)",
-    )
-    add(
-        "--mech-stiffness",
-        dest="k_m",
-        type=positive_float,
-        default=_DEFAULTS["k_m"],
-        metavar="N/M",
-        help="mechanical stiffness k_m [N/m] (default %(default)g)",
-    )
-    add(
-        "--soft-stiffness",
-        dest="k_s",
-        type=_stiffness,
-        default=_DEFAULTS["k_s"],
-        metavar="N/M",
-        help="software stiffness k_s [N/m], 'inf' for an ideally velocity-controlled robot (default %(default)s)",
-    )
-    add(
-        "--soft-damping",
-        dest="d_s",
-        type=non_negative_float,
-        default=0.0,
-        metavar="N*S/M",
-        help="software damping d_s [N*s/m], --drive impedance only (default %(default)s)",
-    )
-    add(
-        "--force-limit",
-        dest="F_a",
-        type=positive_float,
-        default=_DEFAULTS["F_a"],
-        metavar="N",
-        help="actuator force limit F_a [N]; the reaction acceleration is a = F_a / m_r (default %(default)s)",
-    )
-    add(
-        "--threshold",
-        dest="threshold",
-        type=positive_float,
-        default=_DEFAULTS["F_s"],
-        metavar="VALUE",
-        help="detection threshold: [N] for force and current, [m] for position (default %(default)s)",
-    )
+    options.FINGER_MASS.add(parser, _DEFAULTS["m_f"])
+    options.ROBOT_MASS.add(parser, _DEFAULTS["m_r"], note="with the reflected rotor inertia")
+    options.MECH_STIFFNESS.add(parser, _DEFAULTS["k_m"])
+    options.SOFT_STIFFNESS.add(parser, _DEFAULTS["k_s"], note="inf: an ideally velocity-controlled robot")
+    options.SOFT_DAMPING.add(parser, 0.0, note="--drive impedance only")
+    options.FORCE_LIMIT.add(parser, _DEFAULTS["F_a"])
     add(
         "--detection",
         choices=DETECTION_KINDS,
-        default="force",
-        help="what the detector watches (default %(default)s)",
+        default=None,
+        help="what the detector watches (default: position with --position-error, force otherwise)",
     )
+    options.THRESHOLD.add(parser, note="force and current detection", shown=f"{_DEFAULTS['F_s']:g}")
+    options.POSITION_ERROR.add(parser, note="position detection")
     add(
         "--drive",
         choices=("ideal", "impedance"),
@@ -122,13 +59,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="ideal velocity-controlled robot (the closed form's) or a physical impedance controller "
         "(default %(default)s)",
     )
-    add(
-        "--velocities",
-        type=value_range,
-        default=None,
-        metavar="RANGE",
-        help="approach velocities [m/s]: START:STOP:N (log-spaced) or v1,v2,...; default 0.1 v* to 10 v*",
-    )
+    options.APPROACH_VELOCITIES.add(parser, shown="0.1 v* to 10 v*")
     add(
         "--count",
         type=int,
@@ -136,57 +67,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         metavar="N",
         help="number of velocities of the default range (default %(default)s)",
     )
-    add("--delay", type=non_negative_float, default=0.0, metavar="S", help="sensing delay [s] (default 0)")
-    add(
-        "--delays",
-        type=_non_negative_list,
-        default=None,
-        metavar="LIST",
-        help="sweep sensing delays d1,d2,... [s] as well (one curve each)",
-    )
-    add("--backlash", type=non_negative_float, default=0.0, metavar="M", help="backlash [m] (default 0)")
-    add(
-        "--backlashes",
-        type=_non_negative_list,
-        default=None,
-        metavar="LIST",
-        help="sweep backlash b1,b2,... [m] as well (one curve each; half of it open at impact)",
-    )
-    add(
-        "--control-rate",
-        type=positive_float,
-        default=None,
-        metavar="HZ",
-        help="sampled control at this rate [Hz] (default: continuous)",
-    )
-    add(
-        "--contact-stiffness",
-        type=_stiffness,
-        default=math.inf,
-        metavar="N/M",
-        help="wall contact stiffness [N/m] (default inf: a rigid, plastic wall)",
-    )
-    add(
-        "--restitution",
-        type=positive_float,
-        default=None,
-        metavar="E",
-        help="coefficient of restitution of a compliant contact, in (0, 1] (default: undamped, 1)",
-    )
-    add(
-        "--coulomb",
-        type=non_negative_float,
-        default=0.0,
-        metavar="N",
-        help="Coulomb friction on the robot mass [N]",
-    )
-    add(
-        "--viscous",
-        type=non_negative_float,
-        default=0.0,
-        metavar="N*S/M",
-        help="viscous friction on the robot mass [N*s/m]",
-    )
+    options.DELAY.add(parser, 0.0)
+    options.DELAYS.add(parser, note="swept as well, one curve each")
+    options.BACKLASH.add(parser, 0.0)
+    options.BACKLASHES.add(parser, note="swept as well, one curve each; half of it open at impact")
+    options.CONTROL_RATE.add(parser, shown="continuous")
+    options.CONTACT_STIFFNESS.add(parser, math.inf)
+    options.RESTITUTION.add(parser, note="of a compliant contact", shown="undamped, 1")
+    options.COULOMB.add(parser, 0.0)
+    options.VISCOUS.add(parser, 0.0)
     add(
         "--reaction",
         choices=(*REACTION_MODES, "detected"),
@@ -194,43 +83,44 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="closed-form variant to compare with: at_rest (the paper's), moving (robot at v0), or detected "
         "(moving at the robot's velocity at detection, v0 k/k_m) (default %(default)s)",
     )
-    add(
-        "--tolerance",
-        type=positive_float,
-        default=0.05,
-        metavar="FRACTION",
-        help="relative difference counted as parting (default %(default)s)",
+    options.TOLERANCE.add(parser, 0.05)
+    options.add_plot(parser, what="the comparison")
+    options.add_csv(parser)
+    options.add_plot(
+        parser,
+        what="one simulated force trace over the closed form's profile",
+        flag="--trace-plot",
+        aliases=["--trace"],
     )
-    add("--plot", default=None, metavar="FILE", help="draw the comparison to FILE (.png, .svg or .pdf)")
-    add("--csv", default=None, metavar="FILE", help="write the numbers to FILE (CSV)")
-    add(
-        "--trace",
-        default=None,
-        metavar="FILE",
-        help="also draw one simulated force trace over the closed form's profile to FILE (.png, .svg or .pdf)",
-    )
-    add(
-        "--trace-velocity",
-        type=positive_float,
-        default=None,
-        metavar="M/S",
-        help="approach velocity of that trace [m/s] (default v*; first value of --delays/--backlashes)",
-    )
+    options.TRACE_VELOCITY.add(parser, shown="v*")
     parser.set_defaults(run=run)
 
 
-def run(args: argparse.Namespace) -> int:
-    for figure in (args.plot, args.trace):
-        if figure is not None:
-            from ..plots import check_figure_path
-
-            check_figure_path(figure)  # refuse a bad name before doing any work
-    if args.delays is not None and args.backlashes is not None:
+def _detection(args: argparse.Namespace) -> Detection:
+    """The detector: a force threshold [N] (force, current) or a position-error threshold [m] (position)."""
+    kind = args.detection or ("position" if args.e_th is not None else "force")
+    if kind == "position":
+        if args.F_s is not None:
+            raise InvalidParameter(
+                "--threshold",
+                args.F_s,
+                "a force threshold [N], for force or current detection",
+                "a position-error threshold is --position-error [m]",
+            )
+        if args.e_th is None:
+            raise InvalidParameter(
+                "--position-error", None, "a position-error threshold [m] for position detection"
+            )
+        return Detection(kind, args.e_th)
+    if args.e_th is not None:
         raise InvalidParameter(
-            "--delays, --backlashes", "both", "one of them", "sweep one parameter at a time"
+            "--position-error", args.e_th, f"no position-error threshold for {kind} detection"
         )
-    if args.count < 2:
-        raise InvalidParameter("--count", args.count, "at least 2")
+    return Detection(kind, args.F_s if args.F_s is not None else _DEFAULTS["F_s"])
+
+
+def _setup(args: argparse.Namespace) -> CollisionSetup:
+    """The simulated collision at a unit approach velocity (the sweep sets the velocity)."""
     contact_damping = 0.0
     if args.restitution is not None:
         if math.isinf(args.contact_stiffness):
@@ -241,14 +131,14 @@ def run(args: argparse.Namespace) -> int:
                 "a rigid wall is perfectly plastic",
             )
         contact_damping = contact_damping_for_restitution(args.restitution, args.m_f, args.contact_stiffness)
-    setup = CollisionSetup(
+    return CollisionSetup(
         finger_mass=args.m_f,
         robot_mass=args.m_r,
         mechanical_stiffness=args.k_m,
         software_stiffness=args.k_s,
         force_limit=args.F_a,
         velocity=1.0,
-        detection=Detection(args.detection, args.threshold),
+        detection=_detection(args),
         drive=args.drive,
         software_damping=args.d_s,
         delay=args.delay,
@@ -259,10 +149,26 @@ def run(args: argparse.Namespace) -> int:
         viscous_friction=args.viscous,
         backlash=args.backlash,
     )
+
+
+def run(args: argparse.Namespace) -> int:
+    for figure in (args.plot, args.trace_plot):
+        if figure is not None:
+            from ..plots import check_figure_path
+
+            check_figure_path(figure)  # refuse a bad name before doing any work
+    if args.delays is not None and args.backlashes is not None:
+        raise InvalidParameter(
+            "--delays, --backlashes", "both", "one of them", "sweep one parameter at a time"
+        )
+    if args.count < 2:
+        raise InvalidParameter("--count", args.count, "at least 2")
+    setup = _setup(args)
     k, F_s = setup.lumped_stiffness, setup.equivalent_threshold
     if F_s <= 0:
+        flag = "--position-error" if setup.detection.kind == "position" else "--threshold"
         raise InvalidParameter(
-            "--threshold", args.threshold, "above the play and the friction it must overcome"
+            flag, setup.detection.threshold, "above the play and the friction it must overcome"
         )
     v_star = float(optimal_velocity(args.m_f, k, F_s))
     velocities = (
@@ -276,15 +182,48 @@ def run(args: argparse.Namespace) -> int:
         parameter, values = "backlash", args.backlashes
 
     result = sweep(setup, velocities, parameter, values, reaction, v_r, args.tolerance)
-
+    threshold_unit = "m" if setup.detection.kind == "position" else "N"
     print(
         f"m_f = {args.m_f:g} kg, m_r = {args.m_r:g} kg, k_m = {args.k_m:g} N/m, k_s = {args.k_s:g} N/m "
-        f"(k = {k:g} N/m), F_a = {args.F_a:g} N (a = {setup.acceleration:g} m/s^2), {args.detection} "
-        f"threshold {args.threshold:g} (F_s = {F_s:g} N), drive {args.drive}"
+        f"(k = {k:g} N/m), F_a = {args.F_a:g} N (a = {setup.acceleration:g} m/s^2), {setup.detection.kind} "
+        f"threshold {setup.detection.threshold:g} {threshold_unit} (F_s = {F_s:g} N), drive {args.drive}"
     )
     print(
         f"v* = {v_star:.6g} m/s; closed form: {result.reaction}; parting tolerance {100 * args.tolerance:g} %"
     )
+    rows = _print_table(result, parameter, v_star, args.tolerance)
+    if args.csv is not None:
+        _write_csv(args.csv, parameter, rows)
+    if args.plot is not None:
+        from ..plots.simulation import plot_sweep
+
+        dense = np.geomspace(result.velocities.min(), result.velocities.max(), 200)
+        if args.reaction == "detected":
+            curve = total_impulse(
+                args.m_f, k, args.k_m, F_s, setup.acceleration, dense, "moving", dense * k / args.k_m
+            )
+        else:
+            curve = total_impulse(args.m_f, k, args.k_m, F_s, setup.acceleration, dense, reaction)
+        path = plot_sweep(args.plot, result, (dense, curve))
+        print(f"wrote {path}")
+    if args.trace_plot is not None:
+        from dataclasses import replace
+
+        from ..plots.simulation import plot_trace
+        from ..simulate.collision import simulate
+
+        changes: dict = {"velocity": args.trace_velocity or v_star}
+        if parameter is not None:
+            changes[parameter] = float(result.values[0])
+        traced = simulate(replace(setup, **changes))
+        robot_velocity = traced.setup.detection_robot_velocity if v_r == "detected" else None
+        path = plot_trace(args.trace_plot, traced, reaction, robot_velocity)
+        print(f"wrote {path}")
+    return 0
+
+
+def _print_table(result: Sweep, parameter: str | None, v_star: float, tolerance: float) -> list[tuple]:
+    """Print one line per simulated point and return the rows (v0, level, simulated, closed, difference, parted)."""
     print()
     header = f"{'v0 [m/s]':>12}{'v0/v*':>9}"
     if parameter is not None:
@@ -307,41 +246,17 @@ def run(args: argparse.Namespace) -> int:
     worst = np.unravel_index(np.argmax(np.abs(difference)), difference.shape)
     print(
         f"\nlargest difference {100 * difference[worst]:.3g} % at v0 = {result.velocities[worst[1]]:.4g} m/s; "
-        f"{int(parted.sum())} of {parted.size} points part by more than {100 * args.tolerance:g} %"
+        f"{int(parted.sum())} of {parted.size} points part by more than {100 * tolerance:g} %"
     )
+    return rows
 
-    if args.csv is not None:
-        with atomic_open(args.csv, newline="") as handle:
-            handle.write(
-                f"v0_m_per_s,{parameter or 'none'},impulse_simulated_Ns,impulse_closed_form_Ns,relative_difference,parted\n"
-            )
-            for v0, value, sim, closed, diff, part in rows:
-                level = "" if value is None else f"{value:.9g}"
-                handle.write(f"{v0:.9g},{level},{sim:.12g},{closed:.12g},{diff:.6g},{int(part)}\n")
-        print(f"wrote {args.csv}")
-    if args.plot is not None:
-        from ..plots.simulation import plot_sweep
 
-        dense = np.geomspace(result.velocities.min(), result.velocities.max(), 200)
-        if args.reaction == "detected":
-            curve = total_impulse(
-                args.m_f, k, args.k_m, F_s, setup.acceleration, dense, "moving", dense * k / args.k_m
-            )
-        else:
-            curve = total_impulse(args.m_f, k, args.k_m, F_s, setup.acceleration, dense, reaction)
-        path = plot_sweep(args.plot, result, (dense, curve))
-        print(f"wrote {path}")
-    if args.trace is not None:
-        from dataclasses import replace
-
-        from ..plots.simulation import plot_trace
-        from ..simulate.collision import simulate
-
-        changes: dict = {"velocity": args.trace_velocity or v_star}
-        if parameter is not None:
-            changes[parameter] = float(result.values[0])
-        traced = simulate(replace(setup, **changes))
-        robot_velocity = traced.setup.detection_robot_velocity if v_r == "detected" else None
-        path = plot_trace(args.trace, traced, reaction, robot_velocity)
-        print(f"wrote {path}")
-    return 0
+def _write_csv(path: str, parameter: str | None, rows: list[tuple]) -> None:
+    with atomic_open(path, newline="") as handle:
+        handle.write(
+            f"v0_m_per_s,{parameter or 'none'},impulse_simulated_Ns,impulse_closed_form_Ns,relative_difference,parted\n"
+        )
+        for v0, value, sim, closed, diff, part in rows:
+            level = "" if value is None else f"{value:.9g}"
+            handle.write(f"{v0:.9g},{level},{sim:.12g},{closed:.12g},{diff:.6g},{int(part)}\n")
+    print(f"wrote {path}")

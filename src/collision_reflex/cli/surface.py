@@ -8,7 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ._args import positive_float
+from . import options
+from .options import Alias
 
 # Defaults of the paper's two-link example (fig:two_link; fig:motor_scale_modeling for stiffness and threshold):
 # Omni+ motors of 60 mm stator diameter geared to the URDF's torque limits, q2 = 45 deg, v0 = 0.5 m/s, a 3 N
@@ -17,27 +18,28 @@ from ._args import positive_float
 _DEFAULT_URDF = Path("designs") / "planar_two_link.urdf"
 _SECOND_JOINT = 1  # the paper's q2: the second joint of the chain
 _DEFAULTS = {
-    "motor_size": 60.0,
-    "velocity": 0.5,
-    "threshold": 3.0,
+    "stator_diameter": 0.060,
+    "v0": 0.5,
+    "F_s": 3.0,
     "task_stiffness": 100.0,
-    "mech_stiffness": 250.0,
-    "soft_stiffness": math.inf,
+    "mechanical_stiffness": 250.0,
+    "software_stiffness": math.inf,
     "q2_values": "90,45,20,5,0",
-    "motor_sizes": "10,30,60,100",
+    "stator_diameters": "10mm,30mm,60mm,100mm",
     "velocities": "0.1,0.25,0.5,1,2",
 }
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    parser = subparsers.add_parser(
+    parser = options.add_subcommand(
+        subparsers,
         "surface",
         help="collision-reflex surfaces of a URDF arm (impulse over contact directions)",
         description=(
             "The collision impulse of a URDF arm swept over contact directions at one configuration. A planar "
             "arm gets the paper's grid (fig:two_link): rows varying the second joint angle, the motor size and "
             "the approach velocity, with the arm drawn under each polar surface; a spatial arm gets a 3D surface "
-            "and its x-y, x-z and y-z sections. Every joint gets the Omni+ OPN-060-013-A scaled to --motor-size "
+            "and its x-y, x-z and y-z sections. Every joint gets the Omni+ OPN-060-013-A scaled to --stator-diameter "
             "(Haddadin law) and geared to the joint's torque requirement (N = max(1, tau_req / tau_p)). "
             f"Default arm: {_DEFAULT_URDF} (relative to the current directory), contact frame 'tip'."
         ),
@@ -59,14 +61,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         metavar="NAME",
         help="contact frame (default 'tip' for a URDF, per robot otherwise)",
     )
-    add(
-        "--offset",
-        type=float,
-        nargs=3,
-        default=None,
-        metavar=("X", "Y", "Z"),
-        help="contact point in the frame [m]",
-    )
+    options.CONTACT_OFFSET.add(parser, nargs=3, shown="the frame's origin")
     add(
         "--package-dir",
         action="append",
@@ -90,56 +85,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="joint angles [deg] (prismatic joints [m]); default q1 = 0, q2 = 45 for a planar arm, the robot's "
         "reference pose otherwise",
     )
-    add(
-        "--motor-size",
-        type=positive_float,
-        default=_DEFAULTS["motor_size"],
-        metavar="MM",
-        help="stator diameter [mm] (default %(default)g)",
+    options.STATOR_DIAMETER.add(parser, _DEFAULTS["stator_diameter"], aliases=[Alias("--motor-size", "mm")])
+    options.TORQUE_REQUIRED.add(
+        parser, nargs="+", note="one value or one per joint", shown="the URDF effort limits"
     )
-    add(
-        "--torque",
-        type=positive_float,
-        nargs="+",
-        default=None,
-        metavar="N*M",
-        help="torque requirement per joint [N m] (default: URDF effort limits)",
-    )
-    add(
-        "--mech-stiffness",
-        type=positive_float,
-        default=_DEFAULTS["mech_stiffness"],
-        metavar="NM/RAD",
-        help="joint mechanical stiffness [N m/rad] (default %(default)g)",
-    )
-    add(
-        "--soft-stiffness",
-        type=positive_float,
-        default=_DEFAULTS["soft_stiffness"],
-        metavar="NM/RAD",
-        help="joint software stiffness [N m/rad] (default: none, inf)",
-    )
-    add(
-        "--task-stiffness",
-        type=_stiffness_or_none,
-        default=_DEFAULTS["task_stiffness"],
-        metavar="N/M",
-        help="Cartesian controller stiffness [N/m], 'none' for none (default %(default)g)",
-    )
-    add(
-        "--threshold",
-        type=positive_float,
-        default=_DEFAULTS["threshold"],
-        metavar="N",
-        help="contact-force threshold F_s [N] (default %(default)g)",
-    )
-    add(
-        "--velocity",
-        type=positive_float,
-        default=_DEFAULTS["velocity"],
-        metavar="M/S",
-        help="approach velocity v0 [m/s] (default %(default)g)",
-    )
+    options.JOINT_MECH_STIFFNESS.add(parser, _DEFAULTS["mechanical_stiffness"], aliases=["--mech-stiffness"])
+    options.JOINT_SOFT_STIFFNESS.add(parser, _DEFAULTS["software_stiffness"], aliases=["--soft-stiffness"])
+    options.TASK_STIFFNESS.add(parser, _DEFAULTS["task_stiffness"])
+    options.THRESHOLD.add(parser, _DEFAULTS["F_s"])
+    options.APPROACH_VELOCITY.add(parser, _DEFAULTS["v0"])
     add(
         "--stiffness-form",
         choices=("compliance", "paper"),
@@ -153,55 +107,17 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         metavar="N",
         help="directions swept (default 360 planar, 2000 spatial)",
     )
-    add(
-        "--q2-values",
-        type=_number_list,
-        default=_DEFAULTS["q2_values"],
-        metavar="DEG,...",
-        help="second joint angles of the grid's first row [deg] (default %(default)s)",
+    options.SECOND_JOINT_ANGLES.add(parser, _DEFAULTS["q2_values"])
+    options.STATOR_DIAMETERS.add(
+        parser,
+        _DEFAULTS["stator_diameters"],
+        note="the grid's second row",
+        aliases=[Alias("--motor-sizes", "mm")],
     )
-    add(
-        "--motor-sizes",
-        type=_number_list,
-        default=_DEFAULTS["motor_sizes"],
-        metavar="MM,...",
-        help="motor sizes of the second row [mm] (default %(default)s)",
-    )
-    add(
-        "--velocities",
-        type=_number_list,
-        default=_DEFAULTS["velocities"],
-        metavar="M/S,...",
-        help="approach velocities of the third row [m/s] (default %(default)s)",
-    )
-    add(
-        "--output",
-        "-o",
-        default="reflex_surface.png",
-        metavar="FILE",
-        help="figure (.png, .svg or .pdf; default %(default)s)",
-    )
-    add(
-        "--table",
-        default=None,
-        metavar="FILE.csv",
-        help="also write the baseline surface, one row per direction",
-    )
+    options.APPROACH_VELOCITIES.add(parser, _DEFAULTS["velocities"], note="the grid's third row")
+    options.add_plot(parser, "reflex_surface.png", aliases=["--output", "-o"])
+    options.add_csv(parser, what="the baseline surface, one row per direction,", aliases=["--table"])
     parser.set_defaults(run=run)
-
-
-def _number_list(text: str) -> list[float]:
-    try:
-        values = [float(part) for part in text.split(",") if part.strip()]
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a comma-separated list of numbers") from None
-    if not values or not all(math.isfinite(v) and v >= 0 for v in values):
-        raise argparse.ArgumentTypeError(f"{text!r}: expected finite numbers >= 0")
-    return values
-
-
-def _stiffness_or_none(text: str) -> float | None:
-    return None if text.strip().lower() == "none" else positive_float(text)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -210,7 +126,7 @@ def run(args: argparse.Namespace) -> int:
     from ..errors import InvalidParameter
     from ..plots import check_figure_path
 
-    check_figure_path(args.output)
+    check_figure_path(args.plot)
     if args.robot is not None:
         arm = Arm.from_example_robot_data(args.robot, args.frame, args.offset, locked_joints=args.lock)
     else:
@@ -228,7 +144,7 @@ def run(args: argparse.Namespace) -> int:
         )
     if args.torque is not None and len(args.torque) not in (1, arm.nv):
         raise InvalidParameter("--torque", args.torque, f"one value or {arm.nv} values [N m]")
-    options = {
+    settings = {
         "task_stiffness": args.task_stiffness,
         "stiffness_form": args.stiffness_form,
         "directions": args.directions,
@@ -236,23 +152,23 @@ def run(args: argparse.Namespace) -> int:
     if args.directions is not None and args.directions < 3:
         raise InvalidParameter("--directions", args.directions, "at least 3")
 
-    def actuated(size_mm: float) -> Arm:
+    def actuated(stator_diameter: float) -> Arm:
         from ..hardware.actuators import ForceThreshold
 
         return arm.with_scaled_motors(
-            size_mm * 1e-3,
+            stator_diameter,
             args.torque if args.torque is None or len(args.torque) > 1 else args.torque[0],
-            mechanical_stiffness=args.mech_stiffness,
-            software_stiffness=args.soft_stiffness,
-            sensing=ForceThreshold(args.threshold),
+            mechanical_stiffness=args.mechanical_stiffness,
+            software_stiffness=args.software_stiffness,
+            sensing=ForceThreshold(args.F_s),
         )
 
-    base_arm = actuated(args.motor_size)
-    baseline = reflex_surface(base_arm, q, args.velocity, **options)
+    base_arm = actuated(args.stator_diameter)
+    baseline = reflex_surface(base_arm, q, args.v0, **settings)
     _print_summary(base_arm, baseline)
-    if args.table is not None:
-        _write_table(args.table, baseline)
-        print(f"wrote {args.table}")
+    if args.csv is not None:
+        _write_table(args.csv, baseline)
+        print(f"wrote {args.csv}")
 
     if arm.task_dim == 2:
         from ..plots.surface import SurfaceRow, plot_planar_grid
@@ -263,19 +179,19 @@ def run(args: argparse.Namespace) -> int:
         for angle in args.q2_values:
             varied = q.copy()
             varied[_SECOND_JOINT] = math.radians(angle)
-            angle_row.append(reflex_surface(base_arm, varied, args.velocity, **options))
-        motor_row = [reflex_surface(actuated(size), q, args.velocity, **options) for size in args.motor_sizes]
-        velocity_row = [reflex_surface(base_arm, q, v, **options) for v in args.velocities]
+            angle_row.append(reflex_surface(base_arm, varied, args.v0, **settings))
+        motor_row = [reflex_surface(actuated(d), q, args.v0, **settings) for d in args.stator_diameters]
+        velocity_row = [reflex_surface(base_arm, q, v, **settings) for v in args.velocities]
         rows = [
             SurfaceRow("second joint angle", angle_row, [f"q2 = {a:g}°" for a in args.q2_values]),
-            SurfaceRow("motor size", motor_row, [f"r_m = {s:g} mm" for s in args.motor_sizes]),
+            SurfaceRow("motor size", motor_row, [f"r_m = {d * 1e3:g} mm" for d in args.stator_diameters]),
             SurfaceRow("approach velocity", velocity_row, [f"v0 = {v:g} m/s" for v in args.velocities]),
         ]
         title = (
-            f"{arm.name}: q2 = {math.degrees(q[_SECOND_JOINT]):g}°, r_m = {args.motor_size:g} mm, "
-            f"v0 = {args.velocity:g} m/s unless stated; F_s = {args.threshold:g} N"
+            f"{arm.name}: q2 = {math.degrees(q[_SECOND_JOINT]):g}°, r_m = {args.stator_diameter * 1e3:g} mm, "
+            f"v0 = {args.v0:g} m/s unless stated; F_s = {args.F_s:g} N"
         )
-        written = plot_planar_grid(args.output, rows, title)
+        written = plot_planar_grid(args.plot, rows, title)
     else:
         from ..arm.directions import COORDINATE_PLANES, plane_directions
         from ..plots.surface import plot_spatial_surface
@@ -283,12 +199,12 @@ def run(args: argparse.Namespace) -> int:
         count = args.directions or 360
         sections = {
             name: reflex_surface(
-                base_arm, q, args.velocity, **{**options, "directions": plane_directions(name, count)}
+                base_arm, q, args.v0, **{**settings, "directions": plane_directions(name, count)}
             )
             for name in COORDINATE_PLANES
         }
-        title = f"{arm.name} at q = {np.round(np.degrees(q), 1).tolist()} deg, r_m = {args.motor_size:g} mm, v0 = {args.velocity:g} m/s"
-        written = plot_spatial_surface(args.output, baseline, sections, title)
+        title = f"{arm.name} at q = {np.round(np.degrees(q), 1).tolist()} deg, r_m = {args.stator_diameter * 1e3:g} mm, v0 = {args.v0:g} m/s"
+        written = plot_spatial_surface(args.plot, baseline, sections, title)
     print(f"wrote {written}")
     return 0
 

@@ -9,7 +9,7 @@ from ..hardware.actuators import REFLECTED_INERTIA_PLACEMENTS
 from ..hardware.motors import REFERENCE_MOTOR_NAME, SCALING_LAWS, get_motor
 from ..hardware.sweeps import SWEEP_DEFAULTS
 from ..model.impulse import REACTION_MODES
-from ._args import non_negative_float, positive_float, value_range
+from . import options
 
 _PLACEMENT_HELP = (
     "where the reflected rotor inertia N^2 J_m sits in the 1D model: 'finger' (it reaches the contact in the "
@@ -21,40 +21,25 @@ _PLACEMENT_HELP = (
 
 
 def _common(parser: argparse.ArgumentParser) -> None:
-    add = parser.add_argument
-    add("--catalogue", default=None, metavar="FILE", help="a motor catalogue YAML file (default: packaged)")
-    add("--motor", default=REFERENCE_MOTOR_NAME, help="catalogue motor (default %(default)s)")
-    add(
-        "--threshold",
-        type=positive_float,
-        default=SWEEP_DEFAULTS["threshold"],
-        metavar="N",
-        help="force threshold F_s at the contact [N] (default %(default)s)",
+    options.add_catalogue(parser)
+    parser.add_argument("--motor", default=REFERENCE_MOTOR_NAME, help="catalogue motor (default %(default)s)")
+    options.THRESHOLD.add(parser, SWEEP_DEFAULTS["threshold"])
+    options.LEVER.add(
+        parser,
+        SWEEP_DEFAULTS["lever"],
+        note="the paper does not state it: the default is the characteristic length of its 1D experiment",
     )
-    add(
-        "--lever",
-        type=positive_float,
-        default=SWEEP_DEFAULTS["lever"],
-        metavar="M",
-        help="joint axis to contact distance L [m]; the paper does not state it: default %(default)s, the "
-        "characteristic length of its 1D experiment",
+    options.FINGER_MASS.add(
+        parser,
+        SWEEP_DEFAULTS["finger_mass"],
+        bound="non-negative",
+        note="the link's, besides any reflected inertia; the paper does not state it: the default is its U8 "
+        "fit (tab:one_shot)",
     )
-    add(
-        "--finger-mass",
-        type=non_negative_float,
-        default=SWEEP_DEFAULTS["finger_mass"],
-        metavar="KG",
-        help="link (sprung) mass at the contact [kg]; the paper does not state it: default %(default)s, its "
-        "U8 fit (tab:one_shot)",
+    options.ROBOT_MASS.add(
+        parser, SWEEP_DEFAULTS["robot_mass"], bound="non-negative", note="besides the reflected inertia"
     )
-    add(
-        "--robot-mass",
-        type=non_negative_float,
-        default=SWEEP_DEFAULTS["robot_mass"],
-        metavar="KG",
-        help="unsprung mass at the contact besides the reflected inertia [kg] (default %(default)s)",
-    )
-    add(
+    parser.add_argument(
         "--reflected-inertia-in",
         choices=REFLECTED_INERTIA_PLACEMENTS,
         default=SWEEP_DEFAULTS["reflected_inertia_in"],
@@ -70,7 +55,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     kinds = parser.add_subparsers(dest="sweep_command", metavar="SWEEP", required=True)
 
-    radius = kinds.add_parser(
+    radius = options.add_subcommand(
+        kinds,
         "radius-velocity",
         help="impulse over motor stator diameter x approach velocity (fig:motor_scale_modeling)",
         description=(
@@ -84,65 +70,24 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         ),
     )
     _common(radius)
-    add = radius.add_argument
-    add(
-        "--diameters",
-        type=value_range,
-        default=value_range("0.005:0.2:60"),
-        metavar="RANGE",
-        help="stator diameters [m], START:STOP:N log-spaced or a list (default 0.005:0.2:60)",
-    )
-    add(
-        "--velocities",
-        type=value_range,
-        default=value_range("0.01:3:60"),
-        metavar="RANGE",
-        help="approach velocities [m/s], START:STOP:N log-spaced or a list (default 0.01:3:60)",
-    )
-    add(
+    options.STATOR_DIAMETERS.add(radius, "5mm:200mm:60", aliases=["--diameters"])
+    options.APPROACH_VELOCITIES.add(radius, "0.01:3:60")
+    radius.add_argument(
         "--law",
         choices=tuple(SCALING_LAWS),
         default=SWEEP_DEFAULTS["law"],
         help="scaling law (default %(default)s)",
     )
-    add(
-        "--stack-length",
-        type=positive_float,
-        default=None,
-        metavar="M",
-        help="stack length [m] (default: motor's)",
-    )
-    add(
-        "--torque",
-        type=positive_float,
-        default=SWEEP_DEFAULTS["torque_required"],
-        metavar="N*M",
-        help="output torque requirement [N m] (default %(default)s)",
-    )
-    add(
-        "--k-m",
-        type=positive_float,
-        default=SWEEP_DEFAULTS["mechanical_stiffness"],
-        metavar="N/M",
-        help="mechanical stiffness at the contact [N/m] (default %(default)g)",
-    )
-    add(
-        "--k-s",
-        type=positive_float,
-        default=SWEEP_DEFAULTS["software_stiffness"],
-        metavar="N/M",
-        help="software stiffness at the contact [N/m] (default %(default)g)",
-    )
-    add(
-        "--plot",
-        default="radius_velocity.png",
-        metavar="FILE",
-        help="figure (.png/.svg/.pdf; default %(default)s)",
-    )
-    add("--csv", default="radius_velocity.csv", metavar="FILE", help="grid as CSV (default %(default)s)")
+    options.STACK_LENGTH.add(radius, shown="the motor's own")
+    options.TORQUE_REQUIRED.add(radius, SWEEP_DEFAULTS["torque_required"])
+    options.MECH_STIFFNESS.add(radius, SWEEP_DEFAULTS["mechanical_stiffness"], aliases=["--k-m"])
+    options.SOFT_STIFFNESS.add(radius, SWEEP_DEFAULTS["software_stiffness"], aliases=["--k-s"])
+    options.add_plot(radius, "radius_velocity.png", what="the heat map")
+    options.add_csv(radius, "radius_velocity.csv", what="the grid")
     radius.set_defaults(run=run_radius_velocity)
 
-    stiffness = kinds.add_parser(
+    stiffness = options.add_subcommand(
+        kinds,
         "stiffness",
         help="impulse over mechanical stiffness, force vs position-error threshold (fig:stiff-sensing-impulse)",
         description=(
@@ -153,41 +98,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         ),
     )
     _common(stiffness)
-    add = stiffness.add_argument
-    add(
-        "--stiffnesses",
-        type=value_range,
-        default=value_range("100:1e5:40"),
-        metavar="RANGE",
-        help="mechanical stiffnesses at the contact [N/m] (default 100:1e5:40)",
+    options.MECH_STIFFNESSES.add(stiffness, "100:1e5:40", aliases=["--stiffnesses"])
+    options.APPROACH_VELOCITY.add(stiffness, 0.1)
+    options.POSITION_ERROR.add(stiffness, shown="F_s / k at the middle stiffness")
+    options.SOFT_STIFFNESS.add(stiffness, math.inf, shown="inf: rigid", aliases=["--k-s"])
+    options.GEAR_RATIO.add(stiffness, 1.0)
+    stiffness.add_argument(
+        "--reaction", choices=REACTION_MODES, default="at_rest", help="reaction model (default %(default)s)"
     )
-    add(
-        "--velocity",
-        type=positive_float,
-        default=0.1,
-        metavar="M/S",
-        help="approach velocity (default %(default)s)",
-    )
-    add(
-        "--position-error",
-        type=positive_float,
-        default=None,
-        metavar="M",
-        help="position-error threshold at the contact [m] (default: F_s / k at the middle stiffness)",
-    )
-    add(
-        "--k-s",
-        type=positive_float,
-        default=math.inf,
-        metavar="N/M",
-        help="software stiffness at the contact [N/m] (default inf: rigid)",
-    )
-    add("--gear-ratio", type=positive_float, default=1.0, metavar="N", help="gear ratio N >= 1 (default 1)")
-    add("--reaction", choices=REACTION_MODES, default="at_rest", help="reaction model (default %(default)s)")
-    add(
-        "--plot", default="stiffness.png", metavar="FILE", help="figure (.png/.svg/.pdf; default %(default)s)"
-    )
-    add("--csv", default="stiffness.csv", metavar="FILE", help="table as CSV (default %(default)s)")
+    options.add_plot(stiffness, "stiffness.png")
+    options.add_csv(stiffness, "stiffness.csv", what="the table")
     stiffness.set_defaults(run=run_stiffness)
 
 
@@ -212,19 +132,19 @@ def run_radius_velocity(args: argparse.Namespace) -> int:
     from ..plots.sweeps import check_heat_map_grid, plot_radius_velocity
 
     _check_outputs(args)
-    check_heat_map_grid(args.diameters.size, args.velocities.size)
+    check_heat_map_grid(args.stator_diameters.size, args.velocities.size)
     sweep = radius_velocity_sweep(
-        args.diameters,
+        args.stator_diameters,
         args.velocities,
         reference=get_motor(args.motor, args.catalogue),
         law=args.law,
         torque_required=args.torque,
         mechanical_stiffness=args.k_m,
         software_stiffness=args.k_s,
-        threshold=args.threshold,
+        threshold=args.F_s,
         lever=args.lever,
-        finger_mass=args.finger_mass,
-        robot_mass=args.robot_mass,
+        finger_mass=args.m_f,
+        robot_mass=args.m_r,
         reflected_inertia_in=args.reflected_inertia_in,
         stack_length=args.stack_length,
     )
@@ -253,16 +173,16 @@ def run_stiffness(args: argparse.Namespace) -> int:
 
     _check_outputs(args)
     sweep = stiffness_sweep(
-        args.stiffnesses,
-        velocity=args.velocity,
-        threshold=args.threshold,
-        position_error=args.position_error,
+        args.k_m_values,
+        velocity=args.v0,
+        threshold=args.F_s,
+        position_error=args.e_th,
         software_stiffness=args.k_s,
         motor=get_motor(args.motor, args.catalogue),
         gear_ratio=args.gear_ratio,
         lever=args.lever,
-        finger_mass=args.finger_mass,
-        robot_mass=args.robot_mass,
+        finger_mass=args.m_f,
+        robot_mass=args.m_r,
         reflected_inertia_in=args.reflected_inertia_in,
         reaction=args.reaction,
     )

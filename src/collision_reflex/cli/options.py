@@ -1,0 +1,493 @@
+"""Command-line options shared by every subcommand: each quantity declared once, with its flag, unit, parser and
+range check; figures, tables and folders under one flag each; deprecated spellings through one mechanism.
+
+Rules, the same for every subcommand:
+
+- A bare number is in the option's unit, shown in brackets in ``--help``: SI everywhere (m, kg, N, N/m,
+  N*m/rad, m/s, s, Hz), angles in degrees. Any value may carry a unit instead (``60mm``, ``"2e7 N/m"``,
+  ``10ms``), read by the study files' pint parser; a unit of another dimension is an error naming the option.
+- A contact-level quantity (1D, along the contact direction) and a joint-level one are different quantities
+  with different flags: ``--mech-stiffness`` [N/m] at the contact, ``--joint-mech-stiffness`` [N*m/rad] at a
+  joint.
+- ``--plot FILE`` for a figure, ``--csv FILE`` for a table, ``--out DIR`` for an output folder.
+- An old spelling is a hidden alias that still works and prints one deprecation line on stderr.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from typing import Any, Literal, NoReturn
+
+import numpy as np
+
+UNITS_EPILOG = (
+    "A bare number is in the unit shown in brackets (SI; angles in degrees). Any physical value may carry a "
+    "unit instead: 60mm, '2e7 N/m', 10ms, '1.3 N*m' (quote values with spaces)."
+)
+
+
+class Parser(argparse.ArgumentParser):
+    """An ``ArgumentParser`` whose usage errors are one line on stderr (exit status 2)."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def add_subcommand(
+    subparsers: argparse._SubParsersAction, name: str, *, help: str, description: str
+) -> argparse.ArgumentParser:
+    """A subcommand's parser, with the unit rules in its ``--help``."""
+    parser: argparse.ArgumentParser = subparsers.add_parser(
+        name, help=help, description=description, epilog=UNITS_EPILOG
+    )
+    return parser
+
+
+# --- quantities --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Quantity:
+    """What an option measures: the unit of a bare number, and how to name it in messages.
+
+    ``unit`` is a pint unit expression; ``shown`` is how ``--help`` writes it (``-`` for a pure number).
+    """
+
+    unit: str
+    what: str
+    example: str
+    metavar: str
+    shown: str = ""
+
+    @property
+    def label(self) -> str:
+        return self.shown or self.unit
+
+
+LENGTH = Quantity("m", "a length", "60mm", "M")
+MASS = Quantity("kg", "a mass", "0.2 kg", "KG")
+FORCE = Quantity("N", "a force", "3 N", "N")
+TORQUE = Quantity("N*m", "a torque", "1.3 N*m", "N*M")
+LINEAR_STIFFNESS = Quantity("N/m", "a linear stiffness", "1000 N/m", "N/M")
+ROTARY_STIFFNESS = Quantity("N*m/rad", "a rotary stiffness", "250 N*m/rad", "N*M/RAD")
+VELOCITY = Quantity("m/s", "a velocity", "0.5 m/s", "M/S")
+ACCELERATION = Quantity("m/s^2", "an acceleration", "20 m/s^2", "M/S2")
+DAMPING = Quantity("N*s/m", "a damping", "5 N*s/m", "N*S/M")
+TIME = Quantity("s", "a time", "10ms", "S")
+FREQUENCY = Quantity("Hz", "a frequency", "1 kHz", "HZ")
+ANGLE = Quantity("deg", "an angle", "45deg", "DEG")
+NUMBER = Quantity("", "a pure number", "0.5", "X", shown="-")
+
+Bound = Literal["positive", "non-negative", "any"]
+Form = Literal["one", "range", "list"]
+_BOUND_TEXT = {"positive": "> 0", "non-negative": ">= 0", "any": ""}
+
+
+@dataclass(frozen=True)
+class QuantityParser:
+    """Text -> float in ``quantity.unit`` (``form="one"``), or an array: ``"range"`` is ``START:STOP:N``
+    (N log-spaced values, both ends included) or ``v1,v2,...``; ``"list"`` is ``v1,v2,...`` only.
+
+    ``bare_unit`` is the unit of a bare number when it is not ``quantity.unit`` (old spellings only).
+    """
+
+    quantity: Quantity
+    bound: Bound = "positive"
+    allow_inf: bool = False
+    allow_none: bool = False
+    form: Form = "one"
+    bare_unit: str | None = None
+
+    def __call__(self, text: str) -> Any:
+        if self.form == "one":
+            if self.allow_none and text.strip().lower() == "none":
+                return None
+            return self.one(text)
+        if self.form == "range" and ":" in text:
+            return self._log_range(text)
+        parts = [part.strip() for part in text.split(",") if part.strip()]
+        if not parts:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a comma-separated list")
+        _same_unit_rule(text, parts)
+        if self.form == "list":
+            try:
+                return np.array([self.one(part) for part in parts])
+            except argparse.ArgumentTypeError:
+                raise argparse.ArgumentTypeError(
+                    f"{text!r}: every value must be a finite number {_BOUND_TEXT[self.bound]}"
+                ) from None
+        return np.array([self.one(part) for part in parts])
+
+    def one(self, text: str) -> float:
+        """One value, checked against the bound."""
+        stripped = text.strip()
+        if self.allow_inf and stripped.lower() in ("inf", "infinity"):
+            return math.inf
+        try:
+            value = float(stripped)
+        except ValueError:
+            value = self._with_unit(stripped)
+        else:
+            if self.bare_unit is not None:
+                value = self._with_unit(f"{stripped} {self.bare_unit}")
+        if not math.isfinite(value) or not self._in_bounds(value):
+            raise argparse.ArgumentTypeError(f"{text!r} is not a finite number {_BOUND_TEXT[self.bound]}")
+        return value
+
+    def _in_bounds(self, value: float) -> bool:
+        return {"positive": value > 0, "non-negative": value >= 0, "any": True}[self.bound]
+
+    def _with_unit(self, text: str) -> float:
+        from pydantic_core import PydanticCustomError
+
+        from ..study.quantities import to_si
+
+        q = self.quantity
+        try:
+            return to_si(text, q.unit, q.what, q.example)
+        except PydanticCustomError as error:
+            expected = f"{q.what} in {q.label}, e.g. {q.example!r} (a bare number is in {q.label})"
+            if error.type == "quantity_dimension":
+                found = (error.context or {}).get("found_dimension", "another dimension")
+                raise argparse.ArgumentTypeError(f"{text!r} is {found}: expected {expected}") from None
+            raise argparse.ArgumentTypeError(f"{text!r} is not a quantity: expected {expected}") from None
+
+    def _log_range(self, text: str) -> np.ndarray:
+        try:
+            start_text, stop_text, count_text = text.split(":")
+            count = int(count_text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"{text!r} is neither START:STOP:N nor a comma-separated list of numbers > 0"
+            ) from None
+        _same_unit_rule(text, [start_text, stop_text])
+        start, stop = self.one(start_text), self.one(stop_text)
+        if count < 1:
+            raise argparse.ArgumentTypeError(f"{text!r}: N must be at least 1")
+        if count > 1 and stop <= start:
+            raise argparse.ArgumentTypeError(f"{text!r}: STOP must be greater than START")
+        return np.geomspace(start, stop, count)
+
+
+def _same_unit_rule(text: str, parts: Sequence[str]) -> None:
+    """Refuse ``10,60,100mm``: a unit on only some values is likely meant for all of them."""
+    bare = [_is_number(part) for part in parts]
+    if any(bare) and not all(bare):
+        raise argparse.ArgumentTypeError(f"{text!r}: give a unit on every value or on none")
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+# --- options -----------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Alias:
+    """An old spelling of an option; ``bare_unit`` when its bare numbers were in another unit (``mm``)."""
+
+    flag: str
+    bare_unit: str | None = None
+
+
+class _DeprecatedSpelling(argparse.Action):
+    """Stores like the option it replaces, after one line on stderr naming the new spelling."""
+
+    def __init__(self, option_strings: list[str], dest: str, replacement: str, **kwargs: Any) -> None:
+        super().__init__(option_strings, dest, **kwargs)
+        self.replacement = replacement
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: Any,
+        option_string: str | None = None,
+    ) -> None:
+        print(
+            f"{parser.prog}: warning: {option_string} is deprecated; use {self.replacement}", file=sys.stderr
+        )
+        setattr(namespace, self.dest, values)
+
+
+def add_with_aliases(
+    parser: argparse.ArgumentParser,
+    flags: Sequence[str],
+    aliases: Sequence[str | Alias] = (),
+    **kwargs: Any,
+) -> None:
+    """``parser.add_argument(*flags, **kwargs)`` plus a hidden, warning action for each old spelling."""
+    action = parser.add_argument(*flags, **kwargs)
+    parse = action.type
+    unit = f" [{parse.quantity.label}]" if isinstance(parse, QuantityParser) else ""
+    for alias in aliases:
+        alias = alias if isinstance(alias, Alias) else Alias(alias)
+        alias_kwargs = {k: v for k, v in kwargs.items() if k not in ("default", "help", "dest", "action")}
+        replacement = flags[0] + unit
+        if alias.bare_unit is not None and isinstance(parse, QuantityParser):
+            alias_kwargs["type"] = replace(parse, bare_unit=alias.bare_unit)
+            replacement += (
+                f" (its bare numbers are in {parse.quantity.label}, this one's in {alias.bare_unit})"
+            )
+        parser.add_argument(
+            alias.flag,
+            action=_DeprecatedSpelling,
+            replacement=replacement,
+            dest=action.dest,
+            default=argparse.SUPPRESS,
+            help=argparse.SUPPRESS,
+            **alias_kwargs,
+        )
+
+
+@dataclass(frozen=True)
+class Option:
+    """A physical option, declared once: flag, destination, quantity, description and range."""
+
+    flag: str
+    dest: str
+    quantity: Quantity
+    what: str
+    bound: Bound = "positive"
+    allow_inf: bool = False
+    allow_none: bool = False
+    form: Form = "one"
+    hint: str = ""
+
+    def add(
+        self,
+        parser: argparse.ArgumentParser,
+        default: Any = None,
+        *,
+        note: str = "",
+        shown: str | None = None,
+        bound: Bound | None = None,
+        nargs: int | str | None = None,
+        aliases: Sequence[str | Alias] = (),
+    ) -> None:
+        """Add the option to ``parser``.
+
+        ``default`` is a value in the option's unit (or text, parsed like the command line); ``shown`` is how
+        the help writes it (default: the value itself); ``note`` follows the unit in the help.
+        """
+        parse = QuantityParser(self.quantity, bound or self.bound, self.allow_inf, self.allow_none, self.form)
+        text = f"{self.what} [{self.quantity.label}]"
+        text += "".join(f"; {part}" for part in (self.hint, note) if part)
+        if shown is None and default is not None:
+            shown = default if isinstance(default, str) else f"{default:g}"
+        if shown is not None:
+            text += f" (default {shown})"
+        metavar: str | tuple[str, ...] = self.quantity.metavar
+        if self.form != "one":
+            metavar = "RANGE" if self.form == "range" else "LIST"
+        if isinstance(nargs, int):
+            metavar = tuple("XYZ"[:nargs])
+        extra: dict[str, Any] = {} if nargs is None else {"nargs": nargs}
+        add_with_aliases(
+            parser,
+            [self.flag],
+            aliases,
+            dest=self.dest,
+            type=parse,
+            default=default,
+            metavar=metavar,
+            help=text.replace("%", "%%"),
+            **extra,
+        )
+
+
+_RANGE_HINT = "START:STOP:N (N log-spaced values) or v1,v2,..."
+
+# Contact-level quantities (1D, along the contact direction): the paper's symbols as destinations.
+FINGER_MASS = Option("--finger-mass", "m_f", MASS, "finger (sprung) mass m_f at the contact")
+ROBOT_MASS = Option("--robot-mass", "m_r", MASS, "robot (unsprung) mass m_r at the contact")
+MECH_STIFFNESS = Option(
+    "--mech-stiffness", "k_m", LINEAR_STIFFNESS, "mechanical stiffness k_m at the contact"
+)
+MECH_STIFFNESSES = Option(
+    "--mech-stiffnesses",
+    "k_m_values",
+    LINEAR_STIFFNESS,
+    "mechanical stiffnesses k_m at the contact",
+    form="range",
+    hint=_RANGE_HINT,
+)
+SOFT_STIFFNESS = Option(
+    "--soft-stiffness",
+    "k_s",
+    LINEAR_STIFFNESS,
+    "software (controller) stiffness k_s at the contact",
+    allow_inf=True,
+    hint="'inf' for a rigid one",
+)
+STIFFNESS = Option(
+    "--stiffness", "k", LINEAR_STIFFNESS, "lumped sensing stiffness k at the contact (k_m and k_s in series)"
+)
+TASK_STIFFNESS = Option(
+    "--task-stiffness",
+    "task_stiffness",
+    LINEAR_STIFFNESS,
+    "Cartesian controller stiffness",
+    allow_none=True,
+    hint="'none' for none",
+)
+CONTACT_STIFFNESS = Option(
+    "--contact-stiffness",
+    "contact_stiffness",
+    LINEAR_STIFFNESS,
+    "wall contact stiffness",
+    allow_inf=True,
+    hint="'inf' for a rigid, plastic wall",
+)
+THRESHOLD = Option("--threshold", "F_s", FORCE, "force threshold F_s", hint="the contact force at detection")
+POSITION_ERROR = Option(
+    "--position-error", "e_th", LENGTH, "position-error threshold e_th at the contact", hint="F_s = k e_th"
+)
+ACCEL = Option(
+    "--accel", "a", ACCELERATION, "reaction acceleration a of the robot mass away from the contact"
+)
+FORCE_LIMIT = Option(
+    "--force-limit",
+    "F_a",
+    FORCE,
+    "actuator force limit F_a at the contact",
+    hint="the reaction is a = F_a / m_r",
+)
+APPROACH_VELOCITY = Option("--velocity", "v0", VELOCITY, "approach (pre-impact) velocity v0")
+APPROACH_VELOCITIES = Option(
+    "--velocities", "velocities", VELOCITY, "approach velocities", form="range", hint=_RANGE_HINT
+)
+TRACE_VELOCITY = Option(
+    "--trace-velocity", "trace_velocity", VELOCITY, "approach velocity of the --trace-plot simulation"
+)
+ROBOT_VELOCITY = Option(
+    "--robot-velocity",
+    "v_r",
+    VELOCITY,
+    "robot-mass velocity v_r toward the contact at detection",
+    bound="non-negative",
+)
+SOFT_DAMPING = Option("--soft-damping", "d_s", DAMPING, "software damping d_s", bound="non-negative")
+COULOMB = Option("--coulomb", "coulomb", FORCE, "Coulomb friction on the robot mass", bound="non-negative")
+VISCOUS = Option("--viscous", "viscous", DAMPING, "viscous friction on the robot mass", bound="non-negative")
+BACKLASH = Option("--backlash", "backlash", LENGTH, "backlash", bound="non-negative")
+BACKLASHES = Option(
+    "--backlashes",
+    "backlashes",
+    LENGTH,
+    "backlash values",
+    bound="non-negative",
+    form="list",
+    hint="b1,b2,...",
+)
+DELAY = Option("--delay", "delay", TIME, "sensing delay", bound="non-negative")
+DELAYS = Option(
+    "--delays", "delays", TIME, "sensing delays", bound="non-negative", form="list", hint="d1,d2,..."
+)
+RESTITUTION = Option("--restitution", "restitution", NUMBER, "coefficient of restitution", hint="in (0, 1]")
+TOLERANCE = Option("--tolerance", "tolerance", NUMBER, "relative difference counted as parting")
+CONTROL_RATE = Option("--control-rate", "control_rate", FREQUENCY, "rate of the sampled control")
+BANDWIDTH = Option("--bandwidth", "bandwidth", FREQUENCY, "cutoff of the sensor's 2nd-order low-pass filter")
+NOISE_SIGMAS = Option(
+    "--threshold-sigmas",
+    "n_sigma",
+    NUMBER,
+    "contact threshold above the noise floor",
+    hint="in noise standard deviations",
+)
+LEVER = Option("--lever", "lever", LENGTH, "joint axis to contact distance L")
+
+# Joint- and actuator-level quantities: spelled-out names in joint units.
+STATOR_DIAMETER = Option("--stator-diameter", "stator_diameter", LENGTH, "motor stator outer diameter")
+STATOR_DIAMETERS = Option(
+    "--stator-diameters",
+    "stator_diameters",
+    LENGTH,
+    "motor stator outer diameters",
+    form="range",
+    hint=_RANGE_HINT,
+)
+STACK_LENGTH = Option("--stack-length", "stack_length", LENGTH, "motor stack length")
+TORQUE_REQUIRED = Option("--torque", "torque", TORQUE, "output torque requirement tau_req")
+GEAR_RATIO = Option("--gear-ratio", "gear_ratio", NUMBER, "gear ratio N", hint=">= 1")
+JOINT_MECH_STIFFNESS = Option(
+    "--joint-mech-stiffness", "mechanical_stiffness", ROTARY_STIFFNESS, "joint mechanical stiffness"
+)
+JOINT_SOFT_STIFFNESS = Option(
+    "--joint-soft-stiffness",
+    "software_stiffness",
+    ROTARY_STIFFNESS,
+    "joint software stiffness",
+    allow_inf=True,
+    hint="'inf' for none",
+)
+CONTACT_OFFSET = Option("--offset", "offset", LENGTH, "contact point in the contact frame", bound="any")
+SECOND_JOINT_ANGLES = Option(
+    "--q2-values",
+    "q2_values",
+    ANGLE,
+    "second joint angles of the grid's first row",
+    bound="non-negative",
+    form="list",
+    hint="a1,a2,...",
+)
+
+
+# --- files and folders -------------------------------------------------------------------------------------
+
+
+def add_plot(
+    parser: argparse.ArgumentParser,
+    default: str | None = None,
+    *,
+    what: str = "the figure",
+    flag: str = "--plot",
+    aliases: Sequence[str] = (),
+) -> None:
+    """``--plot FILE``: a figure (.png, .svg or .pdf)."""
+    shown = f" (default {default})" if default else ""
+    add_with_aliases(
+        parser,
+        [flag],
+        aliases,
+        dest=flag.lstrip("-").replace("-", "_"),
+        default=default,
+        metavar="FILE",
+        help=f"draw {what} to FILE (.png, .svg or .pdf){shown}",
+    )
+
+
+def add_csv(
+    parser: argparse.ArgumentParser,
+    default: str | None = None,
+    *,
+    what: str = "the numbers",
+    aliases: Sequence[str] = (),
+) -> None:
+    """``--csv FILE``: a table."""
+    shown = f" (default {default})" if default else ""
+    add_with_aliases(
+        parser, ["--csv"], aliases, default=default, metavar="FILE", help=f"write {what} to FILE (CSV){shown}"
+    )
+
+
+def add_out_dir(parser: argparse.ArgumentParser, *, what: str, shown: str = "") -> None:
+    """``--out DIR``: an output folder."""
+    default = f" (default {shown})" if shown else ""
+    parser.add_argument("--out", default=None, metavar="DIR", help=f"write {what} to the folder DIR{default}")
+
+
+def add_catalogue(parser: argparse.ArgumentParser) -> None:
+    """``--catalogue FILE``: a motor catalogue."""
+    parser.add_argument(
+        "--catalogue", default=None, metavar="FILE", help="a motor catalogue YAML file (default: packaged)"
+    )
