@@ -180,3 +180,14 @@ def test_every_pair_of_objectives_is_a_valid_pareto_spec():
         assert ParetoSpec(objectives=list(pair)).points == 20
     with pytest.raises(ValueError, match="different"):
         ParetoSpec(objectives=["mean_impulse", "mean_impulse"])
+
+
+def test_wrong_dimension_message_names_the_value():
+    """The message shows the text that was given (pydantic fills plain {name} fields only)."""
+    from pydantic_core import PydanticCustomError
+
+    from collision_reflex.study.quantities import _parse
+
+    with pytest.raises(PydanticCustomError) as caught:
+        _parse("3 N", "kg", "mass", "a mass in kg")
+    assert "'3 N' is [mass] * [length] / [time] ** 2, not [mass]" in str(caught.value)

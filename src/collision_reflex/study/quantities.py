@@ -58,10 +58,10 @@ def _parse(text: str, unit: str, what: str, expected: str) -> float:
     if quantity.dimensionality != target.dimensionality:
         raise PydanticCustomError(
             "quantity_dimension",
-            "{expected} ({found!r} is {found_dimension}, not {dimension})",
+            "{expected} ({found} is {found_dimension}, not {dimension})",
             {
                 "expected": expected,
-                "found": text,
+                "found": repr(text),  # pydantic fills {name} only, without format specs
                 "found_dimension": _dimension(quantity),
                 "dimension": _dimension(target),
             },
