@@ -1,5 +1,7 @@
-"""Deprecated keyword spellings: one decorator, so an old name keeps working with a warning that names the new
-one."""
+"""Deprecated keyword spellings, handled by one decorator.
+
+An old name keeps working, with a warning that names the new one.
+"""
 
 from __future__ import annotations
 

@@ -109,8 +109,9 @@ class StudyProblem:
 
 
 class StudyFileError(CollisionReflexError, ValueError):
-    """A study file cannot be used: every problem found, each with its file, line, field path, what was found and
-    what was expected.
+    """A study file cannot be used: every problem found, each located.
+
+    Each problem has its file, line, field path, what was found and what was expected.
 
     Attributes
     ----------
@@ -250,8 +251,10 @@ class FitFailed(CollisionReflexError):
 
 
 class StudyRunFailed(CollisionReflexError):
-    """A study's design could not be found: the optimiser failed on a solve the study cannot do without (its
-    optimum or a Pareto anchor). Plain data only, so that it crosses process boundaries.
+    """A study's design could not be found.
+
+    The optimiser failed on a solve the study cannot do without (its optimum or a Pareto anchor). Plain data
+    only, so that it crosses process boundaries.
 
     Attributes
     ----------
@@ -269,5 +272,8 @@ class StudyRunFailed(CollisionReflexError):
 
 
 class SimulationError(CollisionReflexError):
-    """A time-domain simulation could not produce a result (nothing detected, the contact never ended, the
-    integrator failed); the message says what happened and what to change."""
+    """A time-domain simulation could not produce a result.
+
+    Nothing was detected, the contact never ended, or the integrator failed; the message says what happened
+    and what to change.
+    """

@@ -30,6 +30,7 @@ _SUBCOMMANDS = [_impulse, _motors, _sweep, _surface, _fit, _simulate, _validate,
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``crx`` parser with every subcommand."""
     parser = options.Parser(
         prog="crx",
         description=(

@@ -19,6 +19,7 @@ _DEFAULT_K_M = 2e7  # N/m, the paper's ATI Mini40 along its sensing axis
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``crx fit`` and its options to ``subparsers``."""
     parser = options.add_subcommand(
         subparsers,
         "fit",
@@ -57,6 +58,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``crx fit`` with parsed ``args``; return the exit status."""
     from ..experiments import analyse_files
 
     results = analyse_files(

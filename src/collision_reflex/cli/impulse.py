@@ -22,6 +22,7 @@ _DEFAULTS = {"m_f": 0.1, "k_m": 2e7, "k_s": 440.0, "F_s": 3.0, "a": 4.7e-5, "v0"
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``crx impulse`` and its options to ``subparsers``."""
     parser = options.add_subcommand(
         subparsers,
         "impulse",
@@ -53,6 +54,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``crx impulse`` with parsed ``args``; return the exit status."""
     if args.plot is not None:
         from ..plots import check_figure_path
 

@@ -16,6 +16,7 @@ from . import options
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``crx motors`` and its options to ``subparsers``."""
     parser = options.add_subcommand(
         subparsers,
         "motors",
@@ -58,6 +59,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run_list(args: argparse.Namespace) -> int:
+    """Run ``crx motors list``: print the catalogue; return the exit status."""
     catalogue = load_catalogue(args.catalogue)
     header = (
         f"{'name':<18}{'stator OD [mm]':>15}{'stack [mm]':>11}{'J_m [kg m^2]':>14}"
@@ -77,6 +79,7 @@ def run_list(args: argparse.Namespace) -> int:
 
 
 def run_scale(args: argparse.Namespace) -> int:
+    """Run ``crx motors scale`` (the reference scaled to each diameter); return the exit status."""
     reference = get_motor(args.motor, args.catalogue)
     motors = [reference.scaled(float(d), args.stack_length, args.law) for d in args.stator_diameters]
     actuators = [Actuator(m, float(gear_ratio_for(args.torque, m.peak_torque))) for m in motors]

@@ -1,5 +1,7 @@
-"""Command-line options shared by every subcommand: each quantity declared once, with its flag, unit, parser and
-range check; figures, tables and folders under one flag each; deprecated spellings through one mechanism.
+"""Command-line options shared by every subcommand.
+
+Each quantity is declared once, with its flag, unit, parser and range check; figures, tables and folders have
+one flag each; deprecated spellings go through one mechanism.
 
 Rules, the same for every subcommand:
 
@@ -34,6 +36,7 @@ class Parser(argparse.ArgumentParser):
     """An ``ArgumentParser`` whose usage errors are one line on stderr (exit status 2)."""
 
     def error(self, message: str) -> NoReturn:
+        """Print ``message`` as one line on stderr and exit with status 2."""
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
@@ -65,6 +68,7 @@ class Quantity:
 
     @property
     def label(self) -> str:
+        """The unit as ``--help`` shows it."""
         return self.shown or self.unit
 
 
@@ -89,8 +93,10 @@ _BOUND_TEXT = {"positive": "> 0", "non-negative": ">= 0", "any": ""}
 
 @dataclass(frozen=True)
 class QuantityParser:
-    """Text -> float in ``quantity.unit`` (``form="one"``), or an array: ``"range"`` is ``START:STOP:N``
-    (N log-spaced values, both ends included) or ``v1,v2,...``; ``"list"`` is ``v1,v2,...`` only.
+    """Text to a float in ``quantity.unit`` (``form="one"``) or to an array.
+
+    ``"range"`` is ``START:STOP:N`` (N log-spaced values, both ends included) or ``v1,v2,...``; ``"list"`` is
+    ``v1,v2,...`` only.
 
     ``bare_unit`` is the unit of a bare number when it is not ``quantity.unit`` (old spellings only).
     """
@@ -103,6 +109,7 @@ class QuantityParser:
     bare_unit: str | None = None
 
     def __call__(self, text: str) -> Any:
+        """Parse ``text``; a bad value raises ``argparse.ArgumentTypeError`` with the expected unit."""
         if self.form == "one":
             if self.allow_none and text.strip().lower() == "none":
                 return None

@@ -6,6 +6,7 @@ import argparse
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``crx report`` and its options to ``subparsers``."""
     parser = subparsers.add_parser(
         "report",
         help="re-render figures and report.html from a run's saved results",
@@ -17,6 +18,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``crx report`` with parsed ``args``; return the exit status."""
     from pathlib import Path
 
     from ..report import render_report

@@ -9,6 +9,7 @@ from . import options
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``crx run`` and its options to ``subparsers``."""
     parser = subparsers.add_parser(
         "run",
         help="run a design study (YAML) end to end: designs, Pareto front, figures, report.html",
@@ -46,6 +47,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``crx run`` with parsed ``args``; return the exit status."""
     from ..study.runner import run_study
 
     if args.workers is not None and args.workers < 1:

@@ -9,6 +9,7 @@ from . import options
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``crx schema`` and its options to ``subparsers``."""
     parser = subparsers.add_parser(
         "schema",
         help="print the JSON Schema of study files",
@@ -29,6 +30,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``crx schema`` with parsed ``args``; return the exit status."""
     from ..study import study_json_schema
 
     text = json.dumps(study_json_schema(), indent=2) + "\n"

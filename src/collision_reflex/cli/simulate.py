@@ -1,5 +1,7 @@
-"""``crx simulate``: sweep the time-domain simulation over approach velocity (and optionally delay or backlash)
-and compare it with the closed form."""
+"""``crx simulate``: the time-domain simulation against the closed form.
+
+Swept over approach velocity, and optionally over delay or backlash.
+"""
 
 from __future__ import annotations
 
@@ -26,6 +28,7 @@ _DEFAULTS = {"m_f": 0.2, "m_r": 0.5, "k_m": 1000.0, "k_s": 100.0, "F_s": 3.0, "F
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``crx simulate`` and its options to ``subparsers``."""
     parser = options.add_subcommand(
         subparsers,
         "simulate",
@@ -152,6 +155,7 @@ def _setup(args: argparse.Namespace) -> CollisionSetup:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``crx simulate`` with parsed ``args``; return the exit status."""
     for figure in (args.plot, args.trace_plot):
         if figure is not None:
             from ..plots import check_figure_path

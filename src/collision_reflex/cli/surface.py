@@ -31,6 +31,7 @@ _DEFAULTS = {
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``crx surface`` and its options to ``subparsers``."""
     parser = options.add_subcommand(
         subparsers,
         "surface",
@@ -121,6 +122,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``crx surface`` with parsed ``args``; return the exit status."""
     from ..arm.core import Arm
     from ..arm.surfaces import reflex_surface
     from ..errors import InvalidParameter

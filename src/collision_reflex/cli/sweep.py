@@ -48,6 +48,7 @@ def _common(parser: argparse.ArgumentParser) -> None:
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``crx sweep`` and its options to ``subparsers``."""
     parser = subparsers.add_parser(
         "sweep",
         help="the paper's 1D actuator sweeps: motor size x velocity, stiffness x sensing",
@@ -128,6 +129,7 @@ def _print_assumptions(assumptions: dict) -> None:
 
 
 def run_radius_velocity(args: argparse.Namespace) -> int:
+    """Run ``crx sweep radius-velocity`` (impulse over motor size and velocity); return the exit status."""
     from ..hardware.sweeps import radius_velocity_sweep
     from ..plots.sweeps import check_heat_map_grid, plot_radius_velocity
 
@@ -168,6 +170,7 @@ def run_radius_velocity(args: argparse.Namespace) -> int:
 
 
 def run_stiffness(args: argparse.Namespace) -> int:
+    """Run ``crx sweep stiffness``: impulse over mechanical stiffness; return the exit status."""
     from ..hardware.sweeps import stiffness_sweep
     from ..plots.sweeps import plot_stiffness
 

@@ -9,6 +9,7 @@ from ..errors import StudyFileError
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``crx validate`` and its options to ``subparsers``."""
     parser = subparsers.add_parser(
         "validate",
         help="check study files (schema, units, robot, frames, joints); every problem with its line",
@@ -30,6 +31,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``crx validate`` with parsed ``args``; return the exit status."""
     from ..study import load_study, resolved_yaml
     from ..study.prepare import describe_study
 
