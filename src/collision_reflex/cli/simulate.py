@@ -11,7 +11,7 @@ import numpy as np
 from .._io import atomic_open
 from ..errors import InvalidParameter
 from ..model.impulse import REACTION_MODES, optimal_velocity, total_impulse
-from ..simulate.collision import (
+from ..simulate import (
     DETECTION_KINDS,
     CollisionSetup,
     Detection,
@@ -335,9 +335,9 @@ def run(args: argparse.Namespace) -> int:
         from dataclasses import replace
 
         from ..plots.simulation import plot_trace
-        from ..simulate.collision import simulate
+        from ..simulate import simulate
 
-        changes: dict = {"velocity": args.trace_velocity or v_star}
+        changes: dict = {"v0": args.trace_velocity or v_star}
         if parameter is not None:
             changes[parameter] = float(result.values[0])
         traced = simulate(replace(setup, **changes))
