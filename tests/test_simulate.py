@@ -19,6 +19,7 @@ from collision_reflex.simulate import (
     contact_restitution,
     simulate,
 )
+from collision_reflex.simulate.setup import RENAMED_FIELDS
 
 M_F, F_S, A = 0.2, 3.0, 20.0
 # A robot mass so large that the spring's push (at most ~60 N here) is < 3e-6 of the force limit m_r a: the
@@ -123,9 +124,7 @@ def test_free_elastic_collision_conserves_energy_and_balances_momentum():
     assert result.final_energy == pytest.approx(result.initial_energy, rel=1e-8)  # rtol 1e-10, ~900 steps
     # The wall's impulse is the momentum the two masses lost.
     v0 = setup.v0
-    momentum_lost = M_F * (v0 - result.finger_velocity[-1]) + setup.m_r * (
-        v0 - result.robot_velocity[-1]
-    )
+    momentum_lost = M_F * (v0 - result.finger_velocity[-1]) + setup.m_r * (v0 - result.robot_velocity[-1])
     assert result.impulse == pytest.approx(momentum_lost, rel=1e-8)
     # The pair leaves with about its approach speed (some energy stays in the spring's vibration).
     assert result.impulse == pytest.approx(2 * (M_F + setup.m_r) * v0, rel=1e-3)
@@ -308,3 +307,17 @@ def test_detection_kind_and_threshold_checked():
         Detection("smell", 1.0)
     with pytest.raises(InvalidParameter, match="detection threshold"):
         Detection("force", -1.0)
+
+
+def test_old_keywords_still_build_the_same_setup():
+    """The spelled-out keywords are deprecated aliases of the paper's symbols: same setup, with a warning."""
+    new = soft_setup()
+    old_names = {old: getattr(new, field) for old, field in RENAMED_FIELDS.items()}
+    with pytest.warns(DeprecationWarning, match="'finger_mass' is deprecated; call it 'm_f'"):
+        old = CollisionSetup(detection=new.detection, **old_names)
+    assert old == new
+    with pytest.raises(TypeError, match="both 'velocity' and 'v0'"):
+        CollisionSetup(**old_names | {"v0": 1.0}, detection=new.detection)
+    with pytest.warns(DeprecationWarning, match="'finger_mass' is deprecated"):
+        damping = contact_damping_for_restitution(0.3, finger_mass=0.2, contact_stiffness=1e6)
+    assert damping == contact_damping_for_restitution(0.3, 0.2, 1e6)

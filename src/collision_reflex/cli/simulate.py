@@ -242,12 +242,12 @@ def run(args: argparse.Namespace) -> int:
             )
         contact_damping = contact_damping_for_restitution(args.restitution, args.m_f, args.contact_stiffness)
     setup = CollisionSetup(
-        finger_mass=args.m_f,
-        robot_mass=args.m_r,
-        mechanical_stiffness=args.k_m,
-        software_stiffness=args.k_s,
-        force_limit=args.F_a,
-        velocity=1.0,
+        m_f=args.m_f,
+        m_r=args.m_r,
+        k_m=args.k_m,
+        k_s=args.k_s,
+        F_a=args.F_a,
+        v0=1.0,
         detection=Detection(args.detection, args.threshold),
         drive=args.drive,
         software_damping=args.d_s,

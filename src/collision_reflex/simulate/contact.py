@@ -75,4 +75,10 @@ def contact_damping_for_restitution(restitution: float, m_f: float, contact_stif
                 "restitution", restitution, "at least 1e-12", "use a rigid wall for a plastic contact"
             )
     zeta = brentq(lambda z: contact_restitution(z) - restitution, 0.0, zeta_max, xtol=1e-14)
-    return 2 * zeta * math.sqrt(contact_stiffness * m_f)
+    return damping_from_ratio(zeta, m_f, contact_stiffness)
+
+
+def damping_from_ratio(damping_ratio: float, mass: float, stiffness: float) -> float:
+    """Damping [N*s/m] that is ``damping_ratio`` (dimensionless) times critical, ``2 sqrt(k m)``, for a mass
+    [kg] on a stiffness [N/m]."""
+    return 2 * damping_ratio * math.sqrt(stiffness * mass)

@@ -227,7 +227,11 @@ class _Run:
         """The next control sample the run must stop at [s]: while the impedance law is sampled, or while a
         sampled detector watches."""
         sim = self.sim
-        if sim.sampled and sim.drive != "reaction" and (sim.drive == "impedance" or math.isinf(self.detection_time)):
+        if (
+            sim.sampled
+            and sim.drive != "reaction"
+            and (sim.drive == "impedance" or math.isinf(self.detection_time))
+        ):
             return self._sample_at(self.t, strictly=True)
         return math.inf
 
@@ -310,7 +314,10 @@ class _Run:
         sim, setup = self.sim, self.setup
         if sim.drive == "impedance":
             sim.held_force = sim.impedance_law(self.y)
-        if self._watching_for_detection() and sim.measurement(self.t, self.y, self.start) >= setup.detection.threshold:
+        if (
+            self._watching_for_detection()
+            and sim.measurement(self.t, self.y, self.start) >= setup.detection.threshold
+        ):
             self._detect(self.y)
             sim.events.append((self.t, "detection"))
 
