@@ -4,6 +4,7 @@ analytic effects of delay, sampling and play, a brute-force contact model, and i
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import replace
 
 import numpy as np
@@ -310,14 +311,17 @@ def test_detection_kind_and_threshold_checked():
 
 
 def test_old_keywords_still_build_the_same_setup():
-    """The spelled-out keywords are deprecated aliases of the paper's symbols: same setup, with a warning."""
+    """The spelled-out keywords are deprecated aliases of the paper's symbols: same setup, one warning each."""
     new = soft_setup()
     old_names = {old: getattr(new, field) for old, field in RENAMED_FIELDS.items()}
-    with pytest.warns(DeprecationWarning, match="'finger_mass' is deprecated; call it 'm_f'"):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
         old = CollisionSetup(detection=new.detection, **old_names)
+        with pytest.raises(TypeError, match="both 'velocity' and 'v0'"):
+            CollisionSetup(**old_names | {"v0": 1.0}, detection=new.detection)
     assert old == new
-    with pytest.raises(TypeError, match="both 'velocity' and 'v0'"):
-        CollisionSetup(**old_names | {"v0": 1.0}, detection=new.detection)
-    with pytest.warns(DeprecationWarning, match="'finger_mass' is deprecated"):
+    deprecated = {str(w.message).split("'")[1] for w in caught if w.category is DeprecationWarning}
+    assert deprecated == set(RENAMED_FIELDS)
+    with pytest.warns(DeprecationWarning, match="'finger_mass' is deprecated; call it 'm_f'"):
         damping = contact_damping_for_restitution(0.3, finger_mass=0.2, contact_stiffness=1e6)
     assert damping == contact_damping_for_restitution(0.3, 0.2, 1e6)
