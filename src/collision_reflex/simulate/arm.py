@@ -89,7 +89,8 @@ class ArmCollision:
         return self.impulse / self.closed_form - 1
 
 
-ArmCollision.__init__ = renamed_keywords(velocity="approach_velocity")(ArmCollision.__init__)  # type: ignore[method-assign]
+_renamed = renamed_keywords(velocity="approach_velocity")
+ArmCollision.__init__ = _renamed(ArmCollision.__init__)  # type: ignore[method-assign]
 
 
 @renamed_keywords(**_RENAMED_KEYWORDS)
@@ -401,6 +402,7 @@ class _ArmDynamics:
         return max(self.contact_stiffness * depth + self.contact_damping * rate, 0.0)
 
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
+        """Time derivative of the state at ``t`` [s]: link and motor accelerations, the wall force."""
         nv = self.nv
         qs, dq = y[:nv], y[nv : 2 * nv]
         theta, dtheta = self.motor_state(t, y)
@@ -442,9 +444,9 @@ class _ArmDynamics:
         y = y.copy()
         y[2 * nv : 3 * nv], y[3 * nv : 4 * nv] = self.motors(t, y[:nv], y[nv : 2 * nv])
         lever = self.contact_kinematics(y[:nv])[1].T @ self.normal
-        force_limit = float(np.min(self.tau_max / np.maximum(np.abs(lever), 1e-300)))
+        F_a = float(np.min(self.tau_max / np.maximum(np.abs(lever), 1e-300)))
         self.reacting = True
-        self.push = -force_limit * lever
+        self.push = -F_a * lever
         self.torque = self.push
         return y
 

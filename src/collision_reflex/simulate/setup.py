@@ -202,8 +202,9 @@ class CollisionSetup:
         return phase_impulses(self.m_f, k, self.k_m, F_s, a, self.v0, reaction, v_r)
 
 
-# The old spellings keep working through the one deprecation mechanism; `dataclasses.replace` needs the new ones.
-CollisionSetup.__init__ = renamed_keywords(**RENAMED_FIELDS)(CollisionSetup.__init__)  # type: ignore[method-assign]
+# The old spellings keep working (with a warning); `dataclasses.replace` needs the new ones.
+_renamed = renamed_keywords(**RENAMED_FIELDS)
+CollisionSetup.__init__ = _renamed(CollisionSetup.__init__)  # type: ignore[method-assign]
 
 
 def _check_signs(setup: CollisionSetup) -> None:
