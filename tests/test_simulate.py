@@ -325,3 +325,20 @@ def test_old_keywords_still_build_the_same_setup():
     with pytest.warns(DeprecationWarning, match="'finger_mass' is deprecated; call it 'm_f'"):
         damping = contact_damping_for_restitution(0.3, finger_mass=0.2, contact_stiffness=1e6)
     assert damping == contact_damping_for_restitution(0.3, 0.2, 1e6)
+
+
+def test_time_scales_and_shares_against_their_textbook_forms():
+    """The helpers the simulation takes its steps, watch and admittance from, against the plain formulas."""
+    from collision_reflex.simulate.contact import damping_from_ratio
+    from collision_reflex.simulate.dynamics import admittance_share
+    from collision_reflex.simulate.setup import oscillation_period
+
+    assert oscillation_period(0.2, 1000.0) == pytest.approx(2 * math.pi * math.sqrt(0.2 / 1000.0), rel=1e-15)
+    # The admittance follows k_s / (k_s + k_m) of the reference: the series stiffness over k_m.
+    share = admittance_share(np.array([1000.0, 1000.0]), np.array([100.0, math.inf]))
+    np.testing.assert_allclose(share, [cr.series_stiffness(1000.0, 100.0) / 1000.0, 1.0], rtol=1e-15)
+    assert damping_from_ratio(1.0, 0.2, 1e6) == pytest.approx(2 * math.sqrt(0.2e6), rel=1e-15)  # critical
+    # An undamped contact lasts half a period of the finger on it.
+    assert soft_setup(contact_stiffness=1e6).contact_time == pytest.approx(
+        math.pi * math.sqrt(0.2e-6), rel=1e-15
+    )

@@ -152,6 +152,7 @@ class _Run:
         self.trace = _Trace(self.y, self.sim.contact)
 
     def run(self) -> SimulationResult:
+        """Integrate segment by segment, applying each mode change, until the watch ends."""
         sim = self.sim
         for _ in range(_MAX_SEGMENTS):
             self._react_if_due()
@@ -202,7 +203,8 @@ class _Run:
             return False
         if math.isfinite(self.watch_end):
             return True  # the contact has ended; the watch for a new one is cut short by the duration
-        setup, (kind, threshold) = self.setup, (self.setup.detection.kind, self.setup.detection.threshold)
+        setup = self.setup
+        kind, threshold = setup.detection.kind, setup.detection.threshold
         if self._watching_for_detection():
             limited = ""
             if setup.drive == "impedance" and kind != "position" and threshold >= setup.F_a:
