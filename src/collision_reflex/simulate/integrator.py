@@ -34,7 +34,7 @@ def simulate(setup: CollisionSetup) -> SimulationResult:
     return _Run(setup).run()
 
 
-def reference_force(setup: CollisionSetup) -> float:
+def _reference_force(setup: CollisionSetup) -> float:
     """Spring force [N] at which the detector trips in the ideal limit, ignoring play and friction: the scale
     of the forces in the run."""
     threshold = setup.detection.threshold
@@ -42,10 +42,10 @@ def reference_force(setup: CollisionSetup) -> float:
     return setup.lumped_stiffness * threshold if setup.detection.kind == "position" else threshold
 
 
-def default_duration(setup: CollisionSetup) -> float:
+def _default_duration(setup: CollisionSetup) -> float:
     """Simulated time limit when ``setup.duration`` is unset [s]: 20 generous contact times, twice the delay,
     the watch after the contact, and ten control periods."""
-    F_ref = reference_force(setup)
+    F_ref = _reference_force(setup)
     # The closed form's contact time with the robot still moving at v0, plus a period of both masses on the
     # spring and the time to take up the play.
     _, t2 = collision_times(
@@ -65,7 +65,7 @@ def _watch_time(setup: CollisionSetup) -> float:
 
 def _absolute_tolerances(setup: CollisionSetup) -> np.ndarray:
     """Absolute tolerance of each state, from its scale."""
-    F_ref, k, v0 = reference_force(setup), setup.lumped_stiffness, setup.v0
+    F_ref, k, v0 = _reference_force(setup), setup.lumped_stiffness, setup.v0
     deflection = F_ref / setup.k_m
     admittance_yield = F_ref / setup.k_s if math.isfinite(setup.k_s) else 0.0
     finger = deflection
@@ -126,7 +126,7 @@ class _Run:
     def __init__(self, setup: CollisionSetup) -> None:
         self.setup = setup
         self.sim = HybridCollision(setup)
-        self.duration = setup.duration if setup.duration is not None else default_duration(setup)
+        self.duration = setup.duration if setup.duration is not None else _default_duration(setup)
         self.atol = _absolute_tolerances(setup)
         self.tiny = 1e-12 * self.duration
         self.detecting = setup.drive != "free"
