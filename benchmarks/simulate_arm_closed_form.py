@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 import collision_reflex as cr
-from collision_reflex.simulate.arm import simulate_arm_collision
+from collision_reflex.simulate import simulate_arm_collision
 
 URDF = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
 JOINTS = dict(mechanical_stiffness=50.0, reflected_inertia=2.2e-3, torque_limit=1.3)

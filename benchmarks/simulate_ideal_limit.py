@@ -1,7 +1,7 @@
 """Largest relative difference between the simulated impulse in the ideal limit and the closed form.
 
 Sweeps v0 over 0.1 v* to 10 v* (41 log-spaced values) for the closed form's reaction variants, each in the
-limit where it holds (see :mod:`collision_reflex.simulate.collision`), and prints the largest |I_sim / I_closed - 1|
+limit where it holds (see :mod:`collision_reflex.simulate`), and prints the largest |I_sim / I_closed - 1|
 and the time per simulation. Run: ``PYTHONPATH=src python benchmarks/simulate_ideal_limit.py``.
 """
 
@@ -13,7 +13,7 @@ import time
 import numpy as np
 
 import collision_reflex as cr
-from collision_reflex.simulate.collision import CollisionSetup, Detection, simulate
+from collision_reflex.simulate import CollisionSetup, Detection, simulate
 
 M_F, F_S, A, ROBOT_MASS = 0.2, 3.0, 20.0, 1e6
 

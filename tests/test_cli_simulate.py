@@ -10,7 +10,7 @@ import pytest
 
 import collision_reflex as cr
 from collision_reflex.cli import main
-from collision_reflex.simulate.collision import CollisionSetup, Detection, simulate
+from collision_reflex.simulate import CollisionSetup, Detection, simulate
 
 
 def test_csv_matches_simulator_and_closed_form(tmp_path, capsys):

@@ -4,6 +4,7 @@ analytic effects of delay, sampling and play, a brute-force contact model, and i
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import replace
 
 import numpy as np
@@ -12,13 +13,14 @@ from scipy.integrate import solve_ivp
 
 import collision_reflex as cr
 from collision_reflex.errors import InvalidParameter, SimulationError
-from collision_reflex.simulate.collision import (
+from collision_reflex.simulate import (
     CollisionSetup,
     Detection,
     contact_damping_for_restitution,
     contact_restitution,
     simulate,
 )
+from collision_reflex.simulate.setup import RENAMED_FIELDS
 
 M_F, F_S, A = 0.2, 3.0, 20.0
 # A robot mass so large that the spring's push (at most ~60 N here) is < 3e-6 of the force limit m_r a: the
@@ -40,12 +42,12 @@ IDEAL_TOLERANCE = {"at-rest": 2e-5, "moving": 1e-5, "series": 1e-5}
 
 def ideal_setup(k_s: float, k_m: float, v0: float, **changes) -> CollisionSetup:
     setup = CollisionSetup(
-        finger_mass=M_F,
-        robot_mass=HEAVY,
-        mechanical_stiffness=k_m,
-        software_stiffness=k_s,
-        force_limit=HEAVY * A,
-        velocity=v0,
+        m_f=M_F,
+        m_r=HEAVY,
+        k_m=k_m,
+        k_s=k_s,
+        F_a=HEAVY * A,
+        v0=v0,
         detection=Detection("force", F_S),
     )
     return replace(setup, **changes)
@@ -67,18 +69,18 @@ def test_ideal_limit_reproduces_closed_form(case, ratio):
     assert result.impulse == pytest.approx(closed.total, rel=IDEAL_TOLERANCE[case])
     # Phase by phase: the impact and sensing impulses up to detection are exact (plastic impact, linear ramp).
     assert result.impulse_to_detection == pytest.approx(closed.initial + closed.sensing, rel=1e-8)
-    assert result.impacts[0] == (0.0, pytest.approx(M_F * setup.velocity, rel=1e-14))
+    assert result.impacts[0] == (0.0, pytest.approx(M_F * setup.v0, rel=1e-14))
     t1, t2 = cr.collision_times(
         M_F,
         setup.lumped_stiffness,
         k_m,
         F_S,
         A,
-        setup.velocity,
+        setup.v0,
         reaction,
         None
         if reaction == "at_rest"
-        else (setup.detection_robot_velocity if v_r == "detection" else setup.velocity),
+        else (setup.detection_robot_velocity if v_r == "detection" else setup.v0),
     )
     assert result.detection_time == pytest.approx(t1, rel=1e-8)
     if case != "at-rest":
@@ -89,11 +91,11 @@ def test_ideal_limit_error_shrinks_with_the_force_limit():
     """The only idealisation left in the 'moving' case is the spring's push on the robot, F/F_a: ten times
     the robot mass (and force limit, a fixed) must cut the difference about ten times."""
     errors = []
-    for robot_mass in (1e2, 1e3):
+    for m_r in (1e2, 1e3):
         setup = replace(
             ideal_setup(math.inf, 1000.0, 3 * v_star(math.inf, 1000.0)),
-            robot_mass=robot_mass,
-            force_limit=robot_mass * A,
+            m_r=m_r,
+            F_a=m_r * A,
         )
         errors.append(abs(simulate(setup).impulse / setup.closed_form("moving").total - 1))
     assert errors[0] / errors[1] == pytest.approx(10.0, rel=0.05)  # first order in F/F_a
@@ -103,12 +105,12 @@ def soft_setup(**changes) -> CollisionSetup:
     """A light direct-drive robot where the spring does push the robot back (F_a = 10 N)."""
     k = cr.series_stiffness(1000.0, 100.0)
     base = CollisionSetup(
-        finger_mass=M_F,
-        robot_mass=0.5,
-        mechanical_stiffness=1000.0,
-        software_stiffness=100.0,
-        force_limit=10.0,
-        velocity=float(cr.optimal_velocity(M_F, k, F_S)),
+        m_f=M_F,
+        m_r=0.5,
+        k_m=1000.0,
+        k_s=100.0,
+        F_a=10.0,
+        v0=float(cr.optimal_velocity(M_F, k, F_S)),
         detection=Detection("force", F_S),
     )
     return replace(base, **changes)
@@ -122,13 +124,11 @@ def test_free_elastic_collision_conserves_energy_and_balances_momentum():
     assert result.dissipated == pytest.approx(0.0, abs=1e-12)
     assert result.final_energy == pytest.approx(result.initial_energy, rel=1e-8)  # rtol 1e-10, ~900 steps
     # The wall's impulse is the momentum the two masses lost.
-    v0 = setup.velocity
-    momentum_lost = M_F * (v0 - result.finger_velocity[-1]) + setup.robot_mass * (
-        v0 - result.robot_velocity[-1]
-    )
+    v0 = setup.v0
+    momentum_lost = M_F * (v0 - result.finger_velocity[-1]) + setup.m_r * (v0 - result.robot_velocity[-1])
     assert result.impulse == pytest.approx(momentum_lost, rel=1e-8)
     # The pair leaves with about its approach speed (some energy stays in the spring's vibration).
-    assert result.impulse == pytest.approx(2 * (M_F + setup.robot_mass) * v0, rel=1e-3)
+    assert result.impulse == pytest.approx(2 * (M_F + setup.m_r) * v0, rel=1e-3)
 
 
 BOOKKEEPING_CASES = {
@@ -141,15 +141,15 @@ BOOKKEEPING_CASES = {
     "play": dict(backlash=0.004, delay=0.005),
     # Regressions: the play taken up exactly at a control sample; stiction released by a sampled force step;
     # a bouncing finger crossing the play.
-    "play-on-sample": dict(backlash=0.003, control_rate=500.0, delay=0.004, velocity=0.05),
+    "play-on-sample": dict(backlash=0.003, control_rate=500.0, delay=0.004, v0=0.05),
     "stiction-sampled": dict(
-        drive="impedance", software_damping=5.0, coulomb_friction=1.0, control_rate=500.0, velocity=0.05
+        drive="impedance", software_damping=5.0, coulomb_friction=1.0, control_rate=500.0, v0=0.05
     ),
     "bounce-in-play": dict(
         contact_stiffness=1e5,
         contact_damping=contact_damping_for_restitution(0.3, M_F, 1e5),
         backlash=0.003,
-        velocity=1.0,
+        v0=1.0,
     ),
 }
 
@@ -168,7 +168,7 @@ def test_delay_acts_as_a_higher_threshold_in_the_ideal_limit():
     with threshold F_s + k v0 d, and it grows with the delay."""
     k_s, k_m = 100.0, 1000.0
     base = ideal_setup(k_s, k_m, v_star(k_s, k_m))
-    k, v0 = base.lumped_stiffness, base.velocity
+    k, v0 = base.lumped_stiffness, base.v0
     impulses = []
     for delay in (0.0, 0.005, 0.02, 0.05):
         result = simulate(replace(base, delay=delay))
@@ -223,7 +223,7 @@ def test_play_only_delays_a_plastic_collision():
     is the same collision shifted by play / v0."""
     plain = simulate(soft_setup())
     played = simulate(soft_setup(backlash=0.004, initial_play=0.003))
-    shift = 0.003 / plain.setup.velocity
+    shift = 0.003 / plain.setup.v0
     assert played.detection_time == pytest.approx(plain.detection_time + shift, rel=1e-8)
     assert played.impulse == pytest.approx(plain.impulse, rel=1e-7)
 
@@ -263,15 +263,15 @@ def test_stiff_plastic_contact_approaches_the_rigid_wall():
 @pytest.mark.parametrize(
     ("changes", "message"),
     [
-        (dict(finger_mass=-0.1), "finger_mass = -0.1 is invalid"),
-        (dict(robot_mass=0.0), "robot_mass = 0.0 is invalid"),
+        (dict(m_f=-0.1), "m_f = -0.1 is invalid"),
+        (dict(m_r=0.0), "m_r = 0.0 is invalid"),
         (
             dict(delay=0.5, duration=0.2),
             "delay = 0.5 is invalid: expected shorter than the simulated duration",
         ),
         (dict(contact_stiffness=1e6, max_step=1e-3), "use max_step <= 0.000351 s"),
-        (dict(drive="impedance", software_stiffness=math.inf), "use drive='ideal'"),
-        (dict(coulomb_friction=20.0), "below force_limit = 10 N"),
+        (dict(drive="impedance", k_s=math.inf), "use drive='ideal'"),
+        (dict(coulomb_friction=20.0), "below F_a = 10 N"),
         (dict(backlash=0.001, initial_play=0.002), "at most backlash"),
         (dict(detection=Detection("current", 0.5), coulomb_friction=1.0), "above the actuator force"),
         (dict(drive="teleport"), "one of 'ideal', 'impedance', 'free'"),
@@ -299,8 +299,8 @@ def test_bad_parameters_are_refused_with_the_fix(changes, message):
 def test_undetectable_threshold_says_so():
     with pytest.raises(SimulationError, match="never reached"):
         simulate(soft_setup(drive="impedance", detection=Detection("current", 9.9), duration=0.2))
-    with pytest.raises(SimulationError, match="pushes with at most force_limit = 2 N"):
-        simulate(soft_setup(drive="impedance", force_limit=2.0, velocity=0.01, duration=1.0))
+    with pytest.raises(SimulationError, match="pushes with at most F_a = 2 N"):
+        simulate(soft_setup(drive="impedance", F_a=2.0, v0=0.01, duration=1.0))
 
 
 def test_detection_kind_and_threshold_checked():
@@ -308,3 +308,37 @@ def test_detection_kind_and_threshold_checked():
         Detection("smell", 1.0)
     with pytest.raises(InvalidParameter, match="detection threshold"):
         Detection("force", -1.0)
+
+
+def test_old_keywords_still_build_the_same_setup():
+    """The spelled-out keywords are deprecated aliases of the paper's symbols: same setup, one warning each."""
+    new = soft_setup()
+    old_names = {old: getattr(new, field) for old, field in RENAMED_FIELDS.items()}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        old = CollisionSetup(detection=new.detection, **old_names)
+        with pytest.raises(TypeError, match="both 'velocity' and 'v0'"):
+            CollisionSetup(**old_names | {"v0": 1.0}, detection=new.detection)
+    assert old == new
+    deprecated = {str(w.message).split("'")[1] for w in caught if w.category is DeprecationWarning}
+    assert deprecated == set(RENAMED_FIELDS)
+    with pytest.warns(DeprecationWarning, match="'finger_mass' is deprecated; call it 'm_f'"):
+        damping = contact_damping_for_restitution(0.3, finger_mass=0.2, contact_stiffness=1e6)
+    assert damping == contact_damping_for_restitution(0.3, 0.2, 1e6)
+
+
+def test_time_scales_and_shares_against_their_textbook_forms():
+    """The helpers the simulation takes its steps, watch and admittance from, against the plain formulas."""
+    from collision_reflex.simulate.contact import damping_from_ratio
+    from collision_reflex.simulate.dynamics import admittance_share
+    from collision_reflex.simulate.setup import oscillation_period
+
+    assert oscillation_period(0.2, 1000.0) == pytest.approx(2 * math.pi * math.sqrt(0.2 / 1000.0), rel=1e-15)
+    # The admittance follows k_s / (k_s + k_m) of the reference: the series stiffness over k_m.
+    share = admittance_share(np.array([1000.0, 1000.0]), np.array([100.0, math.inf]))
+    np.testing.assert_allclose(share, [cr.series_stiffness(1000.0, 100.0) / 1000.0, 1.0], rtol=1e-15)
+    assert damping_from_ratio(1.0, 0.2, 1e6) == pytest.approx(2 * math.sqrt(0.2e6), rel=1e-15)  # critical
+    # An undamped contact lasts half a period of the finger on it.
+    assert soft_setup(contact_stiffness=1e6).contact_time == pytest.approx(
+        math.pi * math.sqrt(0.2e-6), rel=1e-15
+    )

@@ -89,17 +89,18 @@ from .optimize import (
     pareto_front,
     solve,
 )
-from .simulate.arm import ArmCollision, simulate_arm_collision
-from .simulate.collision import (
+from .simulate import (
+    ArmCollision,
     CollisionSetup,
     Detection,
     SimulationResult,
     contact_damping_for_restitution,
     contact_restitution,
+    simulate_arm_collision,
 )
-from .simulate.collision import Sweep as SimulationSweep
-from .simulate.collision import simulate as simulate_collision
-from .simulate.collision import sweep as simulation_sweep
+from .simulate import Sweep as SimulationSweep
+from .simulate import simulate as simulate_collision
+from .simulate import sweep as simulation_sweep
 from .study import load_study, study_json_schema
 from .study.runner import run_study
 

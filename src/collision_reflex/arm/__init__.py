@@ -1,5 +1,6 @@
 """Arms through Pinocchio: loading URDFs and stock robots, contact samples, effective parameters along a
-direction, transparency metrics and collision reflex surfaces."""
+direction, transparency metrics and collision reflex surfaces.
+"""
 
 from .core import (
     Arm,

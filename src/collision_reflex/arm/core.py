@@ -479,7 +479,8 @@ class Arm:
         """The sensing of this arm's actuators as keyword arguments: ``{"sensing": "force", "threshold": F_s}``
         for force thresholds at the contact, or ``{"sensing": "joint_torque", "joint_threshold": tau_s}`` [N m]
         for the joint-side schemes (position error, motor current), where the first joint to reach its
-        threshold detects the contact."""
+        threshold detects the contact.
+        """
         from ..hardware.actuators import ForceThreshold
 
         if not self.actuators:
@@ -582,7 +583,8 @@ class Arm:
 
     def configuration(self, angles: Any) -> np.ndarray:
         """Configurations (..., nq) from joint coordinates (..., nv) [rad or m] (unbounded revolute joints are
-        stored by Pinocchio as cosine and sine)."""
+        stored by Pinocchio as cosine and sine).
+        """
         angles = np.asarray(angles, dtype=float)
         if angles.shape[-1:] != (self.nv,):
             raise InvalidParameter("angles", angles.shape, f"a last axis of {self.nv} joint coordinates")
@@ -679,7 +681,8 @@ class Arm:
         self, samples: ArmSamples, directions: Any, **options: Any
     ) -> EffectiveParameters:
         """:func:`effective_parameters` with this arm's joint parameters (motor masses included); keyword
-        ``options`` are passed on and may override any of them."""
+        ``options`` are passed on and may override any of them.
+        """
         params = self.joint_parameters
         kwargs: dict[str, Any] = {
             "reflected_inertia": params.reflected_inertia,
@@ -704,7 +707,8 @@ class Arm:
     ) -> tuple[list[np.ndarray], list[np.ndarray], list[np.ndarray]]:
         """Joint frames for all configurations at once, one array per joint: rotations (n, 3, 3) and origins
         (n, 3) of the joint frames, and the parent-side points of the joint origins (n, 3), where the motors
-        sit [m]."""
+        sit [m].
+        """
         n = q.shape[0]
         rotations: list[np.ndarray] = []
         origins: list[np.ndarray] = []
@@ -979,7 +983,8 @@ def collision_impulses(
 
     def stand_in(value: Any) -> Any:
         """Finite stand-ins along singular directions (their results are replaced below), so that the 1D
-        model sees only valid numbers; scalars pass as they are."""
+        model sees only valid numbers; scalars pass as they are.
+        """
         value = np.asarray(value, dtype=float)
         return np.where(singular, 1.0, value) if any_singular and value.ndim else value
 
@@ -1035,7 +1040,8 @@ def _unit_directions(directions: Any, task_dim: int) -> np.ndarray:
 
 def task_inverse_inertia(mass_matrix: np.ndarray, jacobian: np.ndarray) -> np.ndarray:
     """``J M^-1 J^T`` for stacked mass matrices (n, nv, nv) [kg m^2] and Jacobians (n, m, nv) [m/rad],
-    (n, m, m) [1/kg]: the inverse of the task-space (operational-space) inertia, the ellipsoid of gyration."""
+    (n, m, m) [1/kg]: the inverse of the task-space (operational-space) inertia, the ellipsoid of gyration.
+    """
     return jacobian @ _solve_spd(mass_matrix, np.swapaxes(jacobian, -1, -2))
 
 
@@ -1075,7 +1081,8 @@ def _paper_stiffness(
     jac: np.ndarray, joint_k: np.ndarray, units: np.ndarray, index: np.ndarray | None
 ) -> np.ndarray:
     """``u^T J^-T K J^-1 u`` (``eq:eff_k``) for square Jacobians, through the SVD so that a singular Jacobian
-    gives ``inf`` along its singular direction and the finite limit perpendicular to it."""
+    gives ``inf`` along its singular direction and the finite limit perpendicular to it.
+    """
     if not np.all(np.isfinite(joint_k)):
         raise InvalidParameter("stiffness", joint_k, "finite joint stiffnesses for stiffness_form='paper'")
     left, sigma, right_t = np.linalg.svd(jac)
@@ -1156,7 +1163,8 @@ def _joint_kinematics(model: Any, robot: str) -> list[_JointKinematics]:
 
 def _plane_basis(model: Any, joints: list[_JointKinematics]) -> np.ndarray | None:
     """(3, 2) world basis of the plane of motion when every revolute axis is parallel (and every prismatic
-    axis perpendicular to them) in all configurations; None for a spatial arm."""
+    axis perpendicular to them) in all configurations; None for a spatial arm.
+    """
     import pinocchio as pin
 
     data = model.createData()

@@ -28,7 +28,8 @@ from .robots import ROBOT_DEFAULTS, example_robot
 @dataclass(frozen=True)
 class Ellipsoid:
     """Stacked ellipsoids ``{x : x^T A^-1 x <= 1}`` given by symmetric positive semi-definite matrices ``A``
-    (n, m, m); the semi-axes are the square roots of the eigenvalues of ``A``."""
+    (n, m, m); the semi-axes are the square roots of the eigenvalues of ``A``.
+    """
 
     matrix: np.ndarray
 
@@ -52,7 +53,8 @@ def full_mass_matrix(
     samples: ArmSamples, reflected_inertia: Any = None, motor_mass: Any = None
 ) -> np.ndarray:
     """``M = M_bb(q; m) + diag(N^2 J_m)`` (n, nv, nv): structure, motor masses [kg] and reflected rotor
-    inertia [kg m^2] (each default zero)."""
+    inertia [kg m^2] (each default zero).
+    """
     mass = samples.structure_mass_matrix(motor_mass)
     if reflected_inertia is None:
         return mass
@@ -94,7 +96,8 @@ def dynamic_manipulability_ellipsoid(
     samples: ArmSamples, reflected_inertia: Any = None, motor_mass: Any = None
 ) -> Ellipsoid:
     """``Lambda_d = J (M^T M)^-1 J^T`` [(m/s^2)^2 per (N m)^2]: the task accelerations reachable with joint
-    torques of unit norm lie in this ellipsoid."""
+    torques of unit norm lie in this ellipsoid.
+    """
     mass = full_mass_matrix(samples, reflected_inertia, motor_mass)
     return Ellipsoid(task_inverse_inertia(np.swapaxes(mass, 1, 2) @ mass, samples.jacobian))
 
@@ -103,7 +106,8 @@ def effective_mass(
     samples: ArmSamples, directions: Any, reflected_inertia: Any = None, motor_mass: Any = None
 ) -> np.ndarray:
     """Effective mass ``(u^T J M^-1 J^T u)^-1`` [kg] of the whole arm (rotor inertia included) along each
-    direction, (n, d); ``inf`` along singular directions."""
+    direction, (n, d); ``inf`` along singular directions.
+    """
     gyration = ellipsoid_of_gyration(samples, reflected_inertia, motor_mass)
     inverse = gyration.along(directions)
     scale = np.trace(gyration.matrix, axis1=1, axis2=2)[:, None]

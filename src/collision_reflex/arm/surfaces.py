@@ -61,7 +61,8 @@ class ReflexSurface:
 
     def points(self, scale: float = 1.0, cap: float | None = None) -> np.ndarray:
         """Surface points ``scale * min(I(u), cap) * u`` relative to the contact point, (d, task_dim)
-        [m per N s times ``scale``]; ``cap`` [N s] bounds the infinite values of singular directions."""
+        [m per N s times ``scale``]; ``cap`` [N s] bounds the infinite values of singular directions.
+        """
         radius = self.impulse if cap is None else np.minimum(self.impulse, cap)
         return scale * radius[:, None] * self.directions
 

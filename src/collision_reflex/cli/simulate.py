@@ -13,7 +13,7 @@ import numpy as np
 from .._io import atomic_open
 from ..errors import InvalidParameter
 from ..model.impulse import REACTION_MODES, optimal_velocity, total_impulse
-from ..simulate.collision import (
+from ..simulate import (
     DETECTION_KINDS,
     CollisionSetup,
     Detection,
@@ -135,12 +135,12 @@ def _setup(args: argparse.Namespace) -> CollisionSetup:
             )
         contact_damping = contact_damping_for_restitution(args.restitution, args.m_f, args.contact_stiffness)
     return CollisionSetup(
-        finger_mass=args.m_f,
-        robot_mass=args.m_r,
-        mechanical_stiffness=args.k_m,
-        software_stiffness=args.k_s,
-        force_limit=args.F_a,
-        velocity=1.0,
+        m_f=args.m_f,
+        m_r=args.m_r,
+        k_m=args.k_m,
+        k_s=args.k_s,
+        F_a=args.F_a,
+        v0=1.0,
         detection=_detection(args),
         drive=args.drive,
         software_damping=args.d_s,
@@ -214,9 +214,9 @@ def run(args: argparse.Namespace) -> int:
         from dataclasses import replace
 
         from ..plots.simulation import plot_trace
-        from ..simulate.collision import simulate
+        from ..simulate import simulate
 
-        changes: dict = {"velocity": args.trace_velocity or v_star}
+        changes: dict = {"v0": args.trace_velocity or v_star}
         if parameter is not None:
             changes[parameter] = float(result.values[0])
         traced = simulate(replace(setup, **changes))

@@ -100,7 +100,8 @@ class ExperimentResults:
 
     def one_shot_summary(self) -> Any:
         """Mean and standard deviation of each fitted parameter over the trials of each system, as the
-        paper's ``tab:one_shot`` (a pandas DataFrame, one row per system and parameter)."""
+        paper's ``tab:one_shot`` (a pandas DataFrame, one row per system and parameter).
+        """
         import pandas as pd
 
         rows = []

@@ -84,7 +84,8 @@ class ParetoSet:
 
     def hypervolume(self, reference: Sequence[float]) -> float:
         """Hypervolume dominated by the front up to ``reference`` (objective units; maximised objectives are
-        negated, as everything here is minimised)."""
+        negated, as everything here is minimised).
+        """
         return hypervolume(
             _minimised(self.values(), self.objectives), _minimised(np.array([reference]), self.objectives)[0]
         )
@@ -193,7 +194,8 @@ def epsilon_grid(
     anchors: dict[str, DesignResult], bounded: Sequence[str], count: int
 ) -> list[dict[str, float]]:
     """Bounds on the bounded objectives spread between their values at the anchors, ordered so that each point
-    is near the previous one (a snake through the grid for three objectives)."""
+    is near the previous one (a snake through the grid for three objectives).
+    """
     if count <= 0:
         return []
     ranges = {}

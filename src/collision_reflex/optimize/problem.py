@@ -197,7 +197,8 @@ class DesignProblem:
     def exact_point(self, x: np.ndarray) -> np.ndarray:
         """``x`` with the auxiliary variables (finger-mass directions, reaction compliances and the epigraph
         ``t``) set to their exact values for the design in ``x``, so that evaluating there gives the model's
-        values to machine precision."""
+        values to machine precision.
+        """
         x = np.array(x, dtype=float)
         masses, torques, finger = (np.asarray(v).ravel() for v in self._joint_numbers(x))
         x[self.direction_index] = (
@@ -496,7 +497,8 @@ def _design_quantities(
 ) -> tuple[dict[str, Any], Any, Any, Any, Any]:
     """Symbolic joint quantities of the design variables ``z`` (log values): the variables themselves, the
     per-sample function's design column, motor masses [kg], peak output torques [N m] and the reflected inertia
-    acting on the finger [kg m^2] (zero unless ``reflected_inertia_in == "finger"``)."""
+    acting on the finger [kg m^2] (zero unless ``reflected_inertia_in == "finger"``).
+    """
     values = layout.expressions(z)
     motor = scaled_motor_quantities(
         technology.reference_motor, values["stator_diameter"], values["stack_length"], technology.scaling_law
@@ -533,7 +535,8 @@ def _feasible_gear_start(
     joint_names: tuple[str, ...],
 ) -> None:
     """Move the start's free gear ratios up to where the peak torque covers the requirement (with 10 % to
-    spare), within their bounds: IPOPT converges much faster from a torque-feasible start."""
+    spare), within their bounds: IPOPT converges much faster from a torque-feasible start.
+    """
     masses, torques, _ = (np.asarray(v).ravel() for v in joint_numbers(x0))
     rows, _ = _torque_requirement_rows(samples, constraints, joint_names)
     required = np.max([base + per_motor @ masses for base, per_motor in rows], axis=0)
@@ -623,7 +626,8 @@ def _sample_data(samples: ContactSamples, k_mech: np.ndarray) -> np.ndarray:
 
 def reaction_compliance(samples: ContactSamples, peak_torque: np.ndarray) -> np.ndarray:
     """``1 / F_a = max_i |w_i| / tau_i`` per sample [1/N]: the inverse of the largest contact force the joints
-    can push back with before the first saturates (MODEL.md §3)."""
+    can push back with before the first saturates (MODEL.md §3).
+    """
     return np.max(np.abs(samples.joint_moment_arms) / np.asarray(peak_torque, dtype=float), axis=1)
 
 
@@ -632,7 +636,8 @@ def finger_mass_directions(
 ) -> np.ndarray:
     """The minimiser ``x_s = M_f^-1 w_s / (w_s^T M_f^-1 w_s)`` of ``x^T M_f x`` with ``w_s^T x = 1`` for every
     sample, (n_samples, n_joints): ``M_f`` the structure mass matrix with motor masses ``m`` [kg] and, when the
-    reflected inertia acts on the finger, ``diag(N^2 J_m)`` [kg m^2]."""
+    reflected inertia acts on the finger, ``diag(N^2 J_m)`` [kg m^2].
+    """
     kin = samples.kinematics
     index = samples.config_index
     structure = kin.mass_matrix[index] + np.einsum("i,sijk->sjk", motor_mass, kin.motor_mass_influence[index])
@@ -645,7 +650,8 @@ def finger_mass_directions(
 
 def loaded_joints(samples: ContactSamples) -> np.ndarray:
     """(n_samples, n_joints) True where a contact force along the sample's direction loads the joint, so its
-    torque limit bounds the reaction force; ``|w_i|`` below 1e-12 of the largest counts as unloaded."""
+    torque limit bounds the reaction force; ``|w_i|`` below 1e-12 of the largest counts as unloaded.
+    """
     w = np.abs(samples.joint_moment_arms)
     return w > 1e-12 * np.maximum(w.max(axis=1, keepdims=True), 1e-300)
 
@@ -706,7 +712,8 @@ def _binding_torque_demands(
 
 def _required_torque_function(demands: list[tuple[np.ndarray, np.ndarray, list[str]]], n_joints: int) -> Any:
     """CasADi function: motor masses [kg] -> required peak torque per joint [N m], the largest binding demand
-    (safety factor included), for reporting."""
+    (safety factor included), for reporting.
+    """
     masses = ca.MX.sym("motor_mass", n_joints)
     required = [ca.mmax(ca.DM(bases) + ca.mtimes(ca.DM(slopes), masses)) for bases, slopes, _ in demands]
     return ca.Function("required_torque", [masses], [ca.vertcat(*required)])

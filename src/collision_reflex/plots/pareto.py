@@ -13,7 +13,8 @@ from . import new_figure, save_figure
 
 def plot_pareto(pareto: Any, path: str | os.PathLike[str]) -> Path:
     """Draw a :class:`collision_reflex.optimize.ParetoSet`: 2 objectives as a front line with the anchors
-    marked, 3 as a scatter of the first two coloured by the third."""
+    marked, 3 as a scatter of the first two coloured by the third.
+    """
     from ..optimize.problem import OBJECTIVES
 
     values = pareto.values()

@@ -12,7 +12,7 @@ from . import new_figure, save_figure
 
 
 def plot_sweep(path: str | os.PathLike[str], result: Any, closed_form_curve: Any = None) -> Path:
-    """Draw a :class:`collision_reflex.simulate.collision.Sweep`: simulated impulses as markers (one series per value of
+    """Draw a :class:`collision_reflex.simulate.Sweep`: simulated impulses as markers (one series per value of
     the swept parameter), the closed form as a line, and the points whose relative difference exceeds the
     tolerance circled in red. ``closed_form_curve`` is an optional ``(velocities, impulses)`` pair drawn as a
     smooth line; otherwise the closed form at the simulated velocities is drawn.
@@ -68,9 +68,10 @@ def _format(parameter: str | None, value: float) -> str:
 
 
 def plot_trace(path: str | os.PathLike[str], result: Any, reaction: str = "at_rest", v_r: Any = None) -> Path:
-    """Draw a simulated force trace (:class:`collision_reflex.simulate.collision.SimulationResult`) over the closed form's
+    """Draw a simulated force trace (:class:`collision_reflex.simulate.SimulationResult`) over the closed form's
     force profile (:func:`collision_reflex.force_profile`) for the same setup, with the detection, reaction and
-    contact-end times marked and the rigid impacts' impulses noted."""
+    contact-end times marked and the rigid impacts' impulses noted.
+    """
     from ..model.impulse import force_profile
 
     setup = result.setup
@@ -80,12 +81,12 @@ def plot_trace(path: str | os.PathLike[str], result: Any, reaction: str = "at_re
     t = np.linspace(0.0, 1.3 * end, 800)
     closed = force_profile(
         t,
-        setup.finger_mass,
+        setup.m_f,
         setup.lumped_stiffness,
-        setup.mechanical_stiffness,
+        setup.k_m,
         setup.equivalent_threshold,
         setup.acceleration,
-        setup.velocity,
+        setup.v0,
         reaction,
         v_r,
     )
@@ -113,7 +114,7 @@ def plot_trace(path: str | os.PathLike[str], result: Any, reaction: str = "at_re
     note = f"I = {result.impulse:.4g} N·s"
     if impacts:
         note += f" (rigid impacts {impacts:.3g} N·s, not drawn)"
-    ax.set_title(f"Simulated collision at v0 = {setup.velocity:.3g} m/s: {note}", fontsize=10)
+    ax.set_title(f"Simulated collision at v0 = {setup.v0:.3g} m/s: {note}", fontsize=10)
     ax.set_xlabel("time since impact [s]")
     ax.set_ylabel("contact force [N]")
     spring_peak = float(np.max(result.spring_force)) if result.spring_force.size else 0.0

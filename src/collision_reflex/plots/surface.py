@@ -1,5 +1,6 @@
 """Collision-reflex surfaces: the paper's ``fig:two_link`` grid for planar arms (polar impulse surfaces drawn
-around the contact point, the arm under each), and a 3D surface with orthogonal sections for spatial arms."""
+around the contact point, the arm under each), and a 3D surface with orthogonal sections for spatial arms.
+"""
 
 from __future__ import annotations
 

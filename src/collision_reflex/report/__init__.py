@@ -1,5 +1,6 @@
 """Run results as files: ``designs.json``, ``pareto.csv``, figures and the self-contained HTML (and PDF)
-actuator sizing report."""
+actuator sizing report.
+"""
 
 from .outputs import pareto_rows, render_report, write_outputs
 

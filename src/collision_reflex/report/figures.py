@@ -1,5 +1,6 @@
 """The report's figures, drawn from saved results into ``figures/`` (PNG and/or SVG files) and returned as SVG
-text for inlining in the HTML report."""
+text for inlining in the HTML report.
+"""
 
 from __future__ import annotations
 
@@ -18,7 +19,8 @@ from .outputs import objective_unit
 @contextlib.contextmanager
 def _unique_svg_ids(name: str) -> Iterator[None]:
     """Matplotlib names SVG elements by hashes salted with ``svg.hashsalt``; a salt per figure keeps ids unique
-    when several figures are inlined in one HTML page (and identical between runs)."""
+    when several figures are inlined in one HTML page (and identical between runs).
+    """
     import matplotlib
 
     with matplotlib.rc_context({"svg.hashsalt": name}):

@@ -10,7 +10,7 @@ Each joint is a link side and a motor side coupled by the joint's mechanical spr
 ``f`` the wall force, a stiff Kelvin-Voigt contact that cannot pull (the wall is frictionless: the contact point
 may slide along it). Gravity is left out, as in the closed form.
 
-Approach and sensing follow the 1D ideal drive (:mod:`collision_reflex.simulate.collision`) joint by joint: each motor is
+Approach and sensing follow the 1D ideal drive (:mod:`collision_reflex.simulate`) joint by joint: each motor is
 ideally velocity-controlled along ``theta_ref' = J(q0)^+ u v0`` (the contact point approaches along ``u`` at
 ``v0``) and its software stiffness ``k_s,i`` acts as an admittance, so that the joint springs are the series
 ``K = K_m K_s / (K_m + K_s)`` of the closed form. Detection is on the contact force estimated from the joint
@@ -34,10 +34,20 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from .. import _validate
+from .._compat import renamed_keywords
 from ..errors import InvalidParameter, SimulationError
-from ..model.impulse import total_impulse
+from ..model.impulse import collision_times, series_stiffness, total_impulse
+from .contact import damping_from_ratio
+from .dynamics import admittance_share
+from .setup import oscillation_period
 
 ARM_REACTIONS: tuple[str, ...] = ("at_rest", "moving")
+_MAX_REBOUNDS = 50  # contacts after the reaction before the finger is taken to keep hitting the wall
+_RENAMED_KEYWORDS = {
+    "velocity": "approach_velocity",
+    "wall_stiffness": "contact_stiffness",
+    "wall_damping_ratio": "contact_damping_ratio",
+}
 
 
 @dataclass(frozen=True)
@@ -48,7 +58,7 @@ class ArmCollision:
     ----------
     q: the configuration at impact (nq,) [rad].
     direction: the unit collision direction, in the arm's task coordinates (task_dim,).
-    velocity: approach velocity of the contact point [m/s].
+    approach_velocity: approach velocity of the contact point [m/s] (formerly ``velocity``).
     t: trace times [s], impact at 0; contact_force: the wall force at ``t`` [N].
     impulse: simulated impulse on the wall [N*s].
     detection_time, reaction_time, contact_end: [s].
@@ -61,7 +71,7 @@ class ArmCollision:
 
     q: np.ndarray
     direction: np.ndarray
-    velocity: float
+    approach_velocity: float
     t: np.ndarray
     contact_force: np.ndarray
     impulse: float
@@ -79,24 +89,30 @@ class ArmCollision:
         return self.impulse / self.closed_form - 1
 
 
+_renamed = renamed_keywords(velocity="approach_velocity")
+ArmCollision.__init__ = _renamed(ArmCollision.__init__)  # type: ignore[method-assign]
+
+
+@renamed_keywords(**_RENAMED_KEYWORDS)
 def simulate_arm_collision(
     arm: Any,
     q: Any,
     direction: Any,
-    velocity: float,
+    approach_velocity: float,
     threshold: float,
     *,
     software_stiffness: Any = math.inf,
     mechanical_stiffness: Any = None,
     reflected_inertia: Any = None,
     torque_limit: Any = None,
-    wall_stiffness: float = 1e6,
-    wall_damping_ratio: float = 2.0,
+    contact_stiffness: float = 1e6,
+    contact_damping_ratio: float = 2.0,
     delay: float = 0.0,
     reaction: str = "moving",
     rtol: float = 1e-9,
 ) -> ArmCollision:
-    """Drive the arm's contact point along ``direction`` into a wall at ``velocity`` and simulate the collision.
+    """Drive the arm's contact point along ``direction`` into a wall at ``approach_velocity`` and simulate the
+    collision.
 
     Parameters
     ----------
@@ -104,7 +120,7 @@ def simulate_arm_collision(
     q: configuration at impact (nq,) [rad].
     direction: collision direction in the arm's task coordinates (task_dim,), normalised here; it is the
         wall's inward normal.
-    velocity: approach velocity of the contact point [m/s], > 0.
+    approach_velocity: approach velocity of the contact point [m/s], > 0 (formerly ``velocity``).
     threshold: contact-force threshold of the detector [N], > 0.
     software_stiffness: joint software stiffness [N m/rad] (scalar or (nv,)); ``inf`` (default) for ideally
         velocity-controlled motors.
@@ -112,23 +128,73 @@ def simulate_arm_collision(
         the arm's joint parameters.
     reflected_inertia: motor-side inertia ``N^2 J_m`` per joint [kg m^2], > 0; default the arm's.
     torque_limit: output torque limit per joint [N m], > 0; default the arm's.
-    wall_stiffness: the wall's contact stiffness [N/m].
-    wall_damping_ratio: its damping as a ratio of critical for the effective finger mass (2 gives a
-        restitution of 0.02, see :func:`collision_reflex.simulate.collision.contact_restitution`).
+    contact_stiffness: the wall's contact stiffness [N/m] (formerly ``wall_stiffness``).
+    contact_damping_ratio: its damping as a ratio of critical for the effective finger mass (dimensionless;
+        2 gives a restitution of 0.02, see :func:`collision_reflex.simulate.contact_restitution`; formerly
+        ``wall_damping_ratio``).
     delay: sensing delay [s], >= 0.
     reaction: the closed form's variant to compare with, ``"moving"`` (with the robot velocity at detection)
         or ``"at_rest"``.
     rtol: the integrator's relative tolerance.
     """
-    import pinocchio as pin
-
-    from ..arm.core import effective_parameters
-
     _validate.choice("reaction", reaction, ARM_REACTIONS)
-    for name, value in (("velocity", velocity), ("threshold", threshold), ("wall_stiffness", wall_stiffness)):
+    for name, value in (
+        ("approach_velocity", approach_velocity),
+        ("threshold", threshold),
+        ("contact_stiffness", contact_stiffness),
+    ):
         _validate.positive(name, value)
     _validate.non_negative("delay", delay)
-    _validate.positive("wall_damping_ratio", wall_damping_ratio)
+    _validate.positive("contact_damping_ratio", contact_damping_ratio)
+    joints = _joints(
+        arm, q, direction, software_stiffness, mechanical_stiffness, reflected_inertia, torque_limit
+    )
+    closed = _closed_form(arm, joints, float(approach_velocity), float(threshold), reaction)
+    dynamics = _ArmDynamics(arm, joints, closed, contact_stiffness, contact_damping_ratio)
+    trace = _integrate(dynamics, closed, float(approach_velocity), float(threshold), delay, rtol)
+    return ArmCollision(
+        q=joints.q0,
+        direction=joints.u,
+        approach_velocity=float(approach_velocity),
+        t=np.concatenate(trace.times),
+        contact_force=np.concatenate(trace.forces),
+        impulse=trace.impulse,
+        detection_time=trace.detection_time,
+        reaction_time=trace.reaction_time,
+        contact_end=trace.contact_end,
+        effective=closed.effective,
+        robot_velocity=closed.robot_velocity,
+        closed_form=closed.impulse,
+        reaction=reaction,
+    )
+
+
+@dataclass(frozen=True)
+class _Joints:
+    """The validated inputs: impact configuration (nv,) [rad], unit direction (task_dim,), and per joint (nv,)
+    the mechanical and software stiffness [N m/rad], the reflected inertia [kg m^2] and the torque limit
+    [N m]; the arm's motor masses (nv,) [kg].
+    """
+
+    q0: np.ndarray
+    u: np.ndarray
+    k_m: np.ndarray
+    k_s: np.ndarray
+    inertia: np.ndarray
+    tau_max: np.ndarray
+    motor_mass: np.ndarray
+
+
+def _joints(
+    arm: Any,
+    q: Any,
+    direction: Any,
+    software_stiffness: Any,
+    mechanical_stiffness: Any,
+    reflected_inertia: Any,
+    torque_limit: Any,
+) -> _Joints:
+    """Check the configuration, the direction and the joint parameters (the arm's where not given)."""
     nv = int(arm.nv)
     if arm.nq != nv:
         raise InvalidParameter(
@@ -165,46 +231,88 @@ def simulate_arm_collision(
     if u.shape != (arm.task_dim,) or not np.all(np.isfinite(u)) or np.linalg.norm(u) == 0:
         raise InvalidParameter("direction", direction, f"a nonzero vector of {arm.task_dim} task coordinates")
     u = u / np.linalg.norm(u)
-    lumped = 1 / (1 / k_m + 1 / k_s)
+    return _Joints(q0, u, k_m, k_s, inertia, tau_max, np.asarray(params.motor_mass, dtype=float))
 
-    # The closed form at the impact configuration (issue 4's effective parameters; the impulse from
-    # collision_reflex.model.impulse).
-    samples = arm.kinematics(q0[None])
+
+def _joint(name: str, value: Any, nv: int, allow_inf: bool = False) -> np.ndarray:
+    """One value per joint (nv,), a scalar broadcast, each > 0."""
+    array = (
+        np.broadcast_to(np.asarray(value, dtype=float), (nv,)).copy()
+        if np.ndim(value) == 0
+        else (np.asarray(value, dtype=float).reshape(-1))
+    )
+    if array.shape != (nv,):
+        raise InvalidParameter(name, value, f"one value or {nv} values, one per joint")
+    _validate.positive(name, array, allow_inf=allow_inf)
+    return array
+
+
+@dataclass(frozen=True)
+class _ClosedForm:
+    """The arm-level closed form at the impact configuration, and the reference motion it assumes.
+
+    effective: the effective 1D parameters (``m_f, m_r, k, k_m, F_a, a``; SI).
+    share: per joint, the share of the reference velocity the admittance follows (nv,).
+    reference_rate: the motors' reference velocity ``J(q0)^+ u v0`` (nv,) [rad/s].
+    robot_velocity: the robot velocity at detection along ``u`` [m/s].
+    impulse: the closed form's impulse [N*s].
+    """
+
+    effective: dict[str, float]
+    share: np.ndarray
+    reference_rate: np.ndarray
+    robot_velocity: float
+    impulse: float
+
+
+def _closed_form(
+    arm: Any, joints: _Joints, approach_velocity: float, threshold: float, reaction: str
+) -> _ClosedForm:
+    """Issue 4's effective parameters at ``q0`` along ``u`` through :mod:`collision_reflex.model.impulse`."""
+    from ..arm.core import effective_parameters
+
+    u = joints.u
+    samples = arm.kinematics(joints.q0[None])
     effective = effective_parameters(
         samples,
         u[None],
-        inertia,
-        lumped,
-        k_m,
-        tau_max,
-        motor_mass=params.motor_mass if np.any(params.motor_mass > 0) else None,
+        joints.inertia,
+        series_stiffness(joints.k_m, joints.k_s),
+        joints.k_m,
+        joints.tau_max,
+        motor_mass=joints.motor_mass if np.any(joints.motor_mass > 0) else None,
     )
     eff = {name: float(getattr(effective, name)[0, 0]) for name in ("m_f", "m_r", "k", "k_m", "F_a", "a")}
     if bool(effective.singular[0, 0]):
         raise InvalidParameter(
-            "direction", direction, "a direction the arm can move along at q", "q is singular there"
+            "direction", u, "a direction the arm can move along at q", "q is singular there"
         )
     jac0 = samples.jacobian[0]
-    share = np.where(np.isinf(k_s), 1.0, k_s / np.where(np.isinf(k_s), 1.0, k_s + k_m))
-    reference_rate = np.linalg.pinv(jac0) @ u * velocity  # theta_ref' [rad/s]
+    share = admittance_share(joints.k_m, joints.k_s)
+    reference_rate = np.linalg.pinv(jac0) @ u * approach_velocity  # theta_ref' [rad/s]
     robot_velocity = float(u @ jac0 @ (share * reference_rate))
-    closed = float(
-        total_impulse(
-            eff["m_f"],
-            eff["k"],
-            eff["k_m"],
-            threshold,
-            eff["a"],
-            velocity,
-            reaction,
-            robot_velocity if reaction == "moving" else None,
-        )
+    impulse = total_impulse(
+        eff["m_f"],
+        eff["k"],
+        eff["k_m"],
+        threshold,
+        eff["a"],
+        approach_velocity,
+        reaction,
+        robot_velocity if reaction == "moving" else None,
     )
+    return _ClosedForm(eff, share, reference_rate, robot_velocity, float(impulse))
 
-    # Link-side model: structure only (no armature), no gravity, motor masses carried by the parent links,
-    # and a frame at the contact point.
+
+def _link_model(arm: Any) -> tuple[Any, Any, int]:
+    """Pinocchio's link-side model: structure only (no armature), no gravity, motor masses carried by the
+    parent links, and a frame at the contact point. Returns ``(model, data, contact frame id)``.
+    """
+    import pinocchio as pin
+
+    params = arm.joint_parameters
     model = arm.model.copy()
-    model.armature = np.zeros(nv)
+    model.armature = np.zeros(model.nv)
     model.gravity.linear = np.zeros(3)
     for joint_id in range(1, model.njoints):
         mass = float(params.motor_mass[joint_id - 1])
@@ -224,177 +332,245 @@ def simulate_arm_collision(
             pin.FrameType.OP_FRAME,
         )
     )
-    data = model.createData()
-    plane = arm.plane  # (3, 2) orthonormal basis of a planar arm's plane (columns), or None
-    normal = plane @ u if plane is not None else u  # world-aligned wall normal
+    return model, model.createData(), contact_id
 
-    def contact_kinematics(qs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+
+class _ArmDynamics:
+    """Links, motors and wall: the right-hand side of the state ``(q, q', theta, theta', impulse)``, and the
+    estimated contact force. Before the reaction ``theta`` is algebraic (ideal admittance).
+    """
+
+    def __init__(
+        self,
+        arm: Any,
+        joints: _Joints,
+        closed: _ClosedForm,
+        contact_stiffness: float,
+        contact_damping_ratio: float,
+    ) -> None:
+        import pinocchio as pin
+
+        self.pin = pin
+        self.model, self.data, self.contact_id = _link_model(arm)
+        self.nv = joints.q0.size
+        self.q0, self.k_m, self.k_s, self.inertia = joints.q0, joints.k_m, joints.k_s, joints.inertia
+        self.share, self.v_ref = closed.share, closed.reference_rate
+        plane = arm.plane  # (3, 2) orthonormal basis of a planar arm's plane (columns), or None
+        self.normal = plane @ joints.u if plane is not None else joints.u  # world-aligned wall normal
+        self.p0, _ = self.contact_kinematics(joints.q0)
+        self.contact_stiffness = contact_stiffness
+        self.contact_damping = damping_from_ratio(
+            contact_damping_ratio, closed.effective["m_f"], contact_stiffness
+        )
+        self.tau_max = joints.tau_max
+        self.reacting = False
+        self.torque = np.zeros(self.nv)  # motor torques of the reaction [N m]
+        self.push = self.torque  # the reaction's torques, kept for a rebound
+
+    def contact_kinematics(self, qs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Contact point position [m] (3,) and translational Jacobian (3, nv), world-aligned."""
+        pin, model, data = self.pin, self.model, self.data
         pin.forwardKinematics(model, data, qs)
-        pin.updateFramePlacement(model, data, contact_id)
-        position = np.asarray(data.oMf[contact_id].translation).copy()
-        jac = pin.computeFrameJacobian(model, data, qs, contact_id, pin.LOCAL_WORLD_ALIGNED)[:3]
+        pin.updateFramePlacement(model, data, self.contact_id)
+        position = np.asarray(data.oMf[self.contact_id].translation).copy()
+        jac = pin.computeFrameJacobian(model, data, qs, self.contact_id, pin.LOCAL_WORLD_ALIGNED)[:3]
         return position, np.asarray(jac)
 
-    p0, _ = contact_kinematics(q0)
-    w_f = 1 / eff["m_f"]
-    wall_damping = 2 * wall_damping_ratio * math.sqrt(wall_stiffness / w_f)
-    v_ref = reference_rate
-
-    # State: q, q', theta, theta', impulse. Before the reaction theta is algebraic (ideal admittance).
-    state = {"reacting": False, "torque": np.zeros(nv)}
-
-    def motors(t: float, qs: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        reference = q0 + v_ref * t
+    def motors(self, t: float, qs: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Motor angles [rad] and velocities [rad/s] of the ideal admittance drive at ``t`` [s]."""
+        k_s, k_m = self.k_s, self.k_m
+        reference = self.q0 + self.v_ref * t
+        infinite = np.isinf(k_s)
         theta = np.where(
-            np.isinf(k_s),
+            infinite,
             reference,
-            (np.where(np.isinf(k_s), 0, k_s) * reference + k_m * qs) / np.where(np.isinf(k_s), 1, k_s + k_m),
+            (np.where(infinite, 0, k_s) * reference + k_m * qs) / np.where(infinite, 1, k_s + k_m),
         )
-        dtheta = share * v_ref + (1 - share) * dq
+        dtheta = self.share * self.v_ref + (1 - self.share) * dq
         return theta, dtheta
 
-    def wall_force(position: np.ndarray, jac: np.ndarray, dq: np.ndarray) -> float:
-        depth = float(normal @ (position - p0))
+    def motor_state(self, t: float, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Motor angles and velocities: integrated during the reaction, the admittance's before."""
+        nv = self.nv
+        if self.reacting:
+            return y[2 * nv : 3 * nv], y[3 * nv : 4 * nv]
+        return self.motors(t, y[:nv], y[nv : 2 * nv])
+
+    def wall_force(self, position: np.ndarray, jac: np.ndarray, dq: np.ndarray) -> float:
+        """Kelvin-Voigt wall force [N], zero out of contact and never pulling."""
+        depth = float(self.normal @ (position - self.p0))
         if depth <= 0:
             return 0.0
-        return max(wall_stiffness * depth + wall_damping * float(normal @ (jac @ dq)), 0.0)
+        rate = float(self.normal @ (jac @ dq))
+        return max(self.contact_stiffness * depth + self.contact_damping * rate, 0.0)
 
-    def rhs(t: float, y: np.ndarray) -> np.ndarray:
+    def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
+        """Time derivative of the state at ``t`` [s]: link and motor accelerations, the wall force."""
+        nv = self.nv
         qs, dq = y[:nv], y[nv : 2 * nv]
-        if state["reacting"]:
-            theta, dtheta = y[2 * nv : 3 * nv], y[3 * nv : 4 * nv]
-        else:
-            theta, dtheta = motors(t, qs, dq)
-        position, jac = contact_kinematics(qs)
-        force = wall_force(position, jac, dq)
-        spring = k_m * (theta - qs)
-        ddq = pin.aba(model, data, qs, dq, spring - jac.T @ normal * force)
+        theta, dtheta = self.motor_state(t, y)
+        position, jac = self.contact_kinematics(qs)
+        force = self.wall_force(position, jac, dq)
+        spring = self.k_m * (theta - qs)
+        ddq = self.pin.aba(self.model, self.data, qs, dq, spring - jac.T @ self.normal * force)
         out = np.empty_like(y)
         out[:nv] = dq
         out[nv : 2 * nv] = ddq
         out[2 * nv : 3 * nv] = dtheta
-        out[3 * nv : 4 * nv] = (state["torque"] - spring) / inertia if state["reacting"] else 0.0
+        out[3 * nv : 4 * nv] = (self.torque - spring) / self.inertia if self.reacting else 0.0
         out[-1] = force
         return out
 
-    def estimate(t: float, y: np.ndarray) -> float:
-        qs, dq = y[:nv], y[nv : 2 * nv]
-        theta = y[2 * nv : 3 * nv] if state["reacting"] else motors(t, qs, dq)[0]
-        _, jac = contact_kinematics(qs)
-        lever = jac.T @ normal
-        return float(lever @ (k_m * (theta - qs)) / (lever @ lever))
+    def force_estimate(self, t: float, y: np.ndarray) -> float:
+        """Contact force along ``u`` estimated from the joint spring torques [N]."""
+        qs = y[: self.nv]
+        theta, _ = self.motor_state(t, y)
+        _, jac = self.contact_kinematics(qs)
+        lever = jac.T @ self.normal
+        return float(lever @ (self.k_m * (theta - qs)) / (lever @ lever))
+
+    def penetration(self, y: np.ndarray) -> float:
+        """Depth of the contact point beyond the wall [m]."""
+        position, _ = self.contact_kinematics(y[: self.nv])
+        return float(self.normal @ (position - self.p0))
+
+    def wall_forces(self, solution: Any) -> np.ndarray:
+        """Wall force [N] at each step of a solution but the first."""
+        nv = self.nv
+        columns = solution.y.T[1:]
+        return np.array([self.wall_force(*self.contact_kinematics(c[:nv]), c[nv : 2 * nv]) for c in columns])
+
+    def start_reaction(self, t: float, y: np.ndarray) -> np.ndarray:
+        """Switch the admittance off: the motors take over its state (returned) and push at the force limit
+        along -u, ``F_a = min_i tau_max,i / |(J^T u)_i|`` at the current configuration.
+        """
+        nv = self.nv
+        y = y.copy()
+        y[2 * nv : 3 * nv], y[3 * nv : 4 * nv] = self.motors(t, y[:nv], y[nv : 2 * nv])
+        lever = self.contact_kinematics(y[:nv])[1].T @ self.normal
+        F_a = float(np.min(self.tau_max / np.maximum(np.abs(lever), 1e-300)))
+        self.reacting = True
+        self.push = -F_a * lever
+        self.torque = self.push
+        return y
+
+
+@dataclass
+class _ArmTrace:
+    """What the integration records: trace segments and the phase times [s], the impulse [N*s]."""
+
+    times: list[np.ndarray]
+    forces: list[np.ndarray]
+    detection_time: float = math.nan
+    reaction_time: float = math.nan
+    contact_end: float = math.nan
+    impulse: float = math.nan
+
+    def add(self, solution: Any, dynamics: _ArmDynamics) -> None:
+        self.times.append(solution.t[1:])
+        self.forces.append(dynamics.wall_forces(solution))
+
+
+def _time_scales(
+    dynamics: _ArmDynamics, closed: _ClosedForm, approach_velocity: float, threshold: float, delay: float
+) -> tuple[float, float, float]:
+    """Largest step, simulated time limit and the finger's period on the joint springs [s]."""
+    eff = closed.effective
+    finger_period = oscillation_period(eff["m_f"], eff["k_m"])
+    periods = [
+        oscillation_period(eff["m_f"], dynamics.contact_stiffness),
+        finger_period,
+        oscillation_period(eff["m_r"], eff["k_m"]),
+        min(oscillation_period(b, k) for b, k in zip(dynamics.inertia, dynamics.k_m, strict=True)),
+    ]
+    max_step = min(periods) / 16  # a sixteenth of the shortest period in play
+    # Fifty closed-form contacts (paper's reaction) and delays, and twenty of the longest periods.
+    _, t2 = collision_times(eff["m_f"], eff["k"], eff["k_m"], threshold, eff["a"], approach_velocity)
+    duration = 50 * (t2 + delay) + 20 * max(periods)
+    return max_step, float(duration), finger_period
+
+
+def _integrate(
+    dynamics: _ArmDynamics,
+    closed: _ClosedForm,
+    approach_velocity: float,
+    threshold: float,
+    delay: float,
+    rtol: float,
+) -> _ArmTrace:
+    """Impact and sensing until detection, the delay, then the reaction until the finger has left the wall for
+    good.
+    """
+    max_step, duration, finger_period = _time_scales(dynamics, closed, approach_velocity, threshold, delay)
+    nv = dynamics.nv
+    y = np.zeros(4 * nv + 1)
+    y[:nv] = dynamics.q0
+    y[nv : 2 * nv] = dynamics.v_ref  # the links move with the motors before the impact
+    options: dict[str, Any] = {"method": "DOP853", "rtol": rtol, "atol": 1e-12, "max_step": max_step}
+    trace = _ArmTrace([np.array([0.0])], [np.array([0.0])])
 
     def detected(t: float, y: np.ndarray) -> float:
-        return estimate(t, y) - threshold
+        return dynamics.force_estimate(t, y) - threshold
 
     detected.terminal, detected.direction = True, 1  # type: ignore[attr-defined]
 
-    def separated(t: float, y: np.ndarray) -> float:
-        position, _ = contact_kinematics(y[:nv])
-        return float(normal @ (position - p0))
-
-    separated.terminal, separated.direction = True, -1  # type: ignore[attr-defined]
-
-    # Steps: a sixteenth of the shortest period in play (wall contact, link and motor on the joint springs).
-    m_r = eff["m_r"]
-    periods = [
-        2 * math.pi * math.sqrt(eff["m_f"] / wall_stiffness),
-        2 * math.pi * math.sqrt(eff["m_f"] / eff["k_m"]),
-        2 * math.pi * math.sqrt(m_r / eff["k_m"]),
-        2 * math.pi * math.sqrt(float(np.min(inertia / k_m))),
-    ]
-    max_step = min(periods) / 16
-    t1_estimate = threshold / (eff["k"] * velocity)
-    duration = (
-        50 * (t1_estimate + delay)
-        + 50 * math.sqrt(2 * threshold / (eff["a"] * eff["k_m"]) + 1e-30)
-        + 20 * max(periods)
-    )
-
-    y = np.zeros(4 * nv + 1)
-    y[:nv] = q0
-    y[nv : 2 * nv] = v_ref  # the links move with the motors before the impact
-    options: dict[str, Any] = {"method": "DOP853", "rtol": rtol, "atol": 1e-12, "max_step": max_step}
-    times, forces = [np.array([0.0])], [np.array([0.0])]
-
-    def record(solution: Any) -> None:
-        times.append(solution.t[1:])
-        forces.append(
-            np.array(
-                [wall_force(*contact_kinematics(col[:nv]), col[nv : 2 * nv]) for col in solution.y.T[1:]]
-            )
-        )
-
     # 1. Impact and sensing until the estimated force reaches the threshold.
-    solution = solve_ivp(rhs, (0.0, duration), y, events=detected, **options)
-    record(solution)
+    solution = solve_ivp(dynamics.rhs, (0.0, duration), y, events=detected, **options)
+    trace.add(solution, dynamics)
     if solution.status != 1:
         raise SimulationError(
             f"the contact force never reached the threshold {threshold:g} N within {duration:.3g} s; lower it"
         )
-    detection_time = float(solution.t[-1])
+    t = trace.detection_time = float(solution.t[-1])
     y = solution.y[:, -1].copy()
     # 2. The delay, still tracking the reference.
-    t = detection_time
     if delay > 0:
-        solution = solve_ivp(rhs, (t, t + delay), y, **options)
-        record(solution)
+        solution = solve_ivp(dynamics.rhs, (t, t + delay), y, **options)
+        trace.add(solution, dynamics)
         y, t = solution.y[:, -1].copy(), t + delay
-    reaction_time = t
+    trace.reaction_time = t
     # 3. The reaction: admittance off, the motors push at the force limit along -u.
-    theta, dtheta = motors(t, y[:nv], y[nv : 2 * nv])
-    y[2 * nv : 3 * nv], y[3 * nv : 4 * nv] = theta, dtheta
-    _, jac_now = contact_kinematics(y[:nv])
-    lever = jac_now.T @ normal
-    force_limit = float(np.min(tau_max / np.maximum(np.abs(lever), 1e-300)))
-    state["reacting"] = True
-    state["torque"] = -force_limit * lever
-    contact_end = math.nan
-    finger_period = 2 * math.pi * math.sqrt(eff["m_f"] / eff["k_m"])
-    for _ in range(50):
-        solution = solve_ivp(rhs, (t, duration), y, events=separated, **options)
-        record(solution)
+    y = dynamics.start_reaction(t, y)
+    _react(dynamics, trace, t, y, duration, 2 * finger_period, options)
+    return trace
+
+
+def _react(
+    dynamics: _ArmDynamics,
+    trace: _ArmTrace,
+    t: float,
+    y: np.ndarray,
+    duration: float,
+    watch: float,
+    options: dict[str, Any],
+) -> None:
+    """Push until the finger leaves the wall; then the reflex is over: the motors stop pushing and coast away.
+    Watch ``watch`` [s] for a rebound into the wall before stopping (a constant torque kept on would spin the
+    arm round into the wall again, which is no part of the reflex), and push again if there is one.
+    """
+
+    def separated(t: float, y: np.ndarray) -> float:
+        return dynamics.penetration(y)
+
+    separated.terminal, separated.direction = True, -1  # type: ignore[attr-defined]
+
+    for _ in range(_MAX_REBOUNDS):
+        solution = solve_ivp(dynamics.rhs, (t, duration), y, events=separated, **options)
+        trace.add(solution, dynamics)
         y, t = solution.y[:, -1].copy(), float(solution.t[-1])
         if solution.status != 1:
             raise SimulationError(f"the contact had not ended after {duration:.3g} s; lengthen it")
-        contact_end = t
-        # The reflex is over: the motors stop pushing and coast away. Watch two periods of the finger on its
-        # springs for a rebound into the wall before stopping (a constant torque kept on would spin the arm
-        # round into the wall again, which is no part of the reflex).
-        state["torque"] = np.zeros(nv)
-        watch = solve_ivp(rhs, (t, t + 2 * finger_period), y, **options)
-        record(watch)
-        rebound = watch.y[-1, -1] > y[-1]
-        y, t = watch.y[:, -1].copy(), float(watch.t[-1])
+        trace.contact_end = t
+        dynamics.torque = np.zeros(dynamics.nv)
+        coast = solve_ivp(dynamics.rhs, (t, t + watch), y, **options)
+        trace.add(coast, dynamics)
+        rebound = coast.y[-1, -1] > y[-1]
+        y, t = coast.y[:, -1].copy(), float(coast.t[-1])
         if not rebound:
             break
-        state["torque"] = -force_limit * lever
+        dynamics.torque = dynamics.push
     else:
-        raise SimulationError("the finger kept hitting the wall again after the reaction (50 rebounds)")
-    return ArmCollision(
-        q=q0,
-        direction=u,
-        velocity=float(velocity),
-        t=np.concatenate(times),
-        contact_force=np.concatenate(forces),
-        impulse=float(y[-1]),
-        detection_time=detection_time,
-        reaction_time=reaction_time,
-        contact_end=contact_end,
-        effective=eff,
-        robot_velocity=robot_velocity,
-        closed_form=closed,
-        reaction=reaction,
-    )
-
-
-def _joint(name: str, value: Any, nv: int, allow_inf: bool = False) -> np.ndarray:
-    array = (
-        np.broadcast_to(np.asarray(value, dtype=float), (nv,)).copy()
-        if np.ndim(value) == 0
-        else (np.asarray(value, dtype=float).reshape(-1))
-    )
-    if array.shape != (nv,):
-        raise InvalidParameter(name, value, f"one value or {nv} values, one per joint")
-    _validate.positive(name, array, allow_inf=allow_inf)
-    return array
+        raise SimulationError(
+            f"the finger kept hitting the wall again after the reaction ({_MAX_REBOUNDS} rebounds)"
+        )
+    trace.impulse = float(y[-1])

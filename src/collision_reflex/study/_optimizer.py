@@ -189,7 +189,8 @@ def _setup_from_text(resolved_text: str) -> ArmSetup:
 @functools.lru_cache(maxsize=16)
 def problem_for(resolved_text: str, objective: str, bounded: tuple[str, ...]) -> Any:
     """The design problem minimising ``objective`` with ``bounded`` objectives, built once per process (its
-    solvers are reused by later tasks; the results do not depend on which task came first)."""
+    solvers are reused by later tasks; the results do not depend on which task came first).
+    """
     from ..optimize import build_problem
 
     setup = _setup_from_text(resolved_text)
@@ -247,7 +248,8 @@ def _weighted_problem(resolved_text: str, key: Any) -> Any:
 def solve_anchor(resolved_text: str, objective: str, objectives: tuple[str, ...]) -> dict[str, Any]:
     """A Pareto anchor: ``objective`` optimised, then (lexicographically) each other objective with it held at
     its optimum, so that the anchor is not dominated. A lexicographic step the solver cannot do keeps the
-    anchor found so far (the dominance filter then judges it) and is recorded in ``lexicographic_failed``."""
+    anchor found so far (the dominance filter then judges it) and is recorded in ``lexicographic_failed``.
+    """
     from ..errors import SolverFailed, StudyRunFailed
     from ..optimize import solve
     from ..optimize.pareto import anchor_bound
@@ -309,7 +311,8 @@ def non_dominated(
     records: list[dict[str, Any]], names: tuple[str, ...]
 ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     """Saved records split by the optimiser's dominance filter into the front (sorted by the first objective)
-    and the dominated rest."""
+    and the dominated rest.
+    """
     from ..optimize import pareto
 
     if not records:
@@ -326,7 +329,8 @@ def solve_point(
     resolved_text: str, objectives: tuple[str, ...], epsilon: dict[str, float], start: list[float]
 ) -> dict[str, Any]:
     """One epsilon-constraint point: the first objective minimised with the others bounded by ``epsilon``,
-    started from ``start`` (the first objective's anchor, so the result does not depend on the order of work)."""
+    started from ``start`` (the first objective's anchor, so the result does not depend on the order of work).
+    """
     from ..errors import SolverFailed
     from ..optimize import solve
 
@@ -419,7 +423,8 @@ def design_record(setup: ArmSetup, problem: Any, result: Any, label: str) -> dic
 
 def nearest_catalogue_motor(catalogue: dict[str, Any], peak_torque: float, rotor_inertia: float) -> str:
     """The catalogue motor closest to a scaled motor in (log peak torque, log rotor inertia): the off-the-shelf
-    part a designer would start from."""
+    part a designer would start from.
+    """
     best, best_distance = "", math.inf
     for name, motor in catalogue.items():
         distance = math.hypot(
@@ -445,7 +450,8 @@ def sample_layout(setup: ArmSetup) -> dict[str, Any]:
 def checked_setup(loaded: LoadedStudy, resolved_text: str) -> ArmSetup:
     """The setup of a study, with its problem built once: every input problem (robot, frames, samples on which
     the arm cannot move, impossible bounds) is raised here, located in the study file, before a run writes
-    anything."""
+    anything.
+    """
     from ..errors import InvalidParameter
 
     setup = arm_setup(loaded)  # located errors for the robot, motors and names
@@ -463,7 +469,8 @@ def checked_setup(loaded: LoadedStudy, resolved_text: str) -> ArmSetup:
 
 def _torque_out_of_reach(loaded: LoadedStudy, setup: ArmSetup) -> list[StudyProblem]:
     """Given torque requirements no design within the bounds can meet: the largest motor at the largest gear
-    ratio (torque grows with motor size under every scaling law) short of the safety factor times the need."""
+    ratio (torque grows with motor size under every scaling law) short of the safety factor times the need.
+    """
     from ..hardware.motors import scaled_motor_quantities
 
     required = setup.study.constraints.torque_required

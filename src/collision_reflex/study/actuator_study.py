@@ -60,7 +60,8 @@ def _actuator(
 
 def sensing_scheme(sensing: SensingSpec, lever: float) -> Any:
     """The actuator model's sensing scheme for a study's sensing; a contact position error ``e`` [m] is the
-    joint error ``e / L`` [rad]."""
+    joint error ``e / L`` [rad].
+    """
     from ..hardware.actuators import CurrentThreshold, ForceThreshold, PositionThreshold
 
     if sensing.scheme == "force":
@@ -86,7 +87,8 @@ def _contact(actuator: Any, candidate: ActuatorCandidate, study: ActuatorStudy) 
 
 def evaluate_actuator_study(loaded: LoadedStudy) -> dict[str, Any]:
     """Every candidate's 1D collision: parameters at the contact, impulse and phases at the study's approach
-    velocity and over its velocity range, optimal velocity and minimum impulse. Plain data (SI units)."""
+    velocity and over its velocity range, optimal velocity and minimum impulse. Plain data (SI units).
+    """
     study = loaded.study
     assert isinstance(study, ActuatorStudy)
     actuators = check_actuator_study(loaded)

@@ -47,7 +47,8 @@ class RunResult:
 
 def smoke_study(data: dict[str, Any]) -> dict[str, Any]:
     """A resolved study shrunk for a quick run: a few configurations, directions, Pareto points and
-    velocities. The shrunk study is what the run records as its resolved study."""
+    velocities. The shrunk study is what the run records as its resolved study.
+    """
     data = {**data}
     if data.get("kind") == "actuator":
         data["velocities"] = {**data["velocities"], "count": min(data["velocities"]["count"], 12)}
@@ -169,7 +170,8 @@ def _dump(data: dict[str, Any]) -> str:
 
 def _prepare(loaded: LoadedStudy, text: str) -> None:
     """Check everything a run needs; problems are located in ``loaded`` (the file as written), while the
-    problem is built from ``text`` (the resolved study that runs)."""
+    problem is built from ``text`` (the resolved study that runs).
+    """
     if isinstance(loaded.study, ArmStudy):
         from . import _optimizer
 
@@ -220,7 +222,8 @@ def _gather(
 ) -> tuple[dict[str, Any], int]:
     """Run each named piece of work not finished yet, at most ``window`` at a time, saving each as it
     completes (so an interruption loses only the pieces in flight). Returns every record (finished before and
-    now) and how many were computed now."""
+    now) and how many were computed now.
+    """
     records: dict[str, Any] = {}
     queue: list[tuple[str, tuple[Callable[..., Any], tuple[Any, ...]]]] = []
     for name, job in work.items():

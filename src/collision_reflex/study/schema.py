@@ -148,7 +148,8 @@ class ActuatorsSpec(_Model):
 
 class SensingSpec(_Model):
     """How contact is detected (MODEL.md §2): a contact-force threshold, a position-error threshold (``F_s = k e``)
-    or a motor-current threshold (joint-side threshold torque ``N tau_s``)."""
+    or a motor-current threshold (joint-side threshold torque ``N tau_s``).
+    """
 
     scheme: Literal["force", "position", "current"]
     threshold: Force | None = Field(None, gt=0, description="contact-force threshold [N] (scheme: force)")
@@ -206,7 +207,8 @@ class ConfigurationSamples(_Model):
 
 class DirectionSamples(_Model):
     """Exactly one of ``circle`` (n directions in the plane: the arm's plane, or the world x-y plane), ``sphere``
-    (n directions spread evenly over the sphere), ``named`` or ``list`` (vectors, normalised)."""
+    (n directions spread evenly over the sphere), ``named`` or ``list`` (vectors, normalised).
+    """
 
     circle: PositiveInt | None = None
     sphere: PositiveInt | None = None
@@ -308,7 +310,8 @@ PER_JOINT_DESIGN_VARIABLES = ("stator_diameter", "stack_length", "gear_ratio", "
 
 class DesignSpec(_Model):
     """Design variables the optimiser may change; any not listed keeps the value of its section
-    (``actuators``, ``sensing``, ``approach_velocity``). Per-joint variables take ``joints: {name: {...}}``."""
+    (``actuators``, ``sensing``, ``approach_velocity``). Per-joint variables take ``joints: {name: {...}}``.
+    """
 
     stator_diameter: StatorDiameterVariable | None = None  # type: ignore[valid-type]
     stack_length: StackLengthVariable | None = None  # type: ignore[valid-type]
@@ -450,7 +453,8 @@ class VelocityRange(_Model):
 
 class ActuatorStudy(_Model):
     """Single-joint actuators compared in a 1D collision at a lever (the paper's direct-drive U8 against the
-    geared A8, for example)."""
+    geared A8, for example).
+    """
 
     kind: Literal["actuator"]
     name: Name

@@ -47,7 +47,8 @@ class StudySource:
 
     def resolve_path(self, path: Sequence[Any]) -> PathKey:
         """``path`` with the components that do not exist in the file dropped (validators insert the names of
-        union branches or wrapper functions into error locations)."""
+        union branches or wrapper functions into error locations).
+        """
         kept: list[Any] = []
         node = self.data
         for key in path:
@@ -76,7 +77,8 @@ def _looks_internal(key: Any) -> bool:
 
 def format_path(path: Sequence[Any]) -> str:
     """``("actuators", "joints", "j2", "gear_ratio")`` -> ``"actuators.joints.j2.gear_ratio"``; list indices as
-    ``[i]``."""
+    ``[i]``.
+    """
     text = ""
     for key in path:
         if isinstance(key, int):
@@ -88,7 +90,8 @@ def format_path(path: Sequence[Any]) -> str:
 
 def read_study_source(path: str | os.PathLike[str]) -> StudySource:
     """Read a study file. A missing or unreadable file, or YAML that does not parse, raises
-    :class:`~collision_reflex.errors.StudyFileError` with the line."""
+    :class:`~collision_reflex.errors.StudyFileError` with the line.
+    """
     name = str(path)
     try:
         text = Path(path).read_text(encoding="utf-8")
@@ -185,7 +188,8 @@ def _index_children(
 
 def _constructed_key(key_node: yaml.Node, raw: Any) -> Any:
     """The key as the safe loader constructs it (``1`` for ``1``, ``True`` for ``yes``...), so that paths from
-    the data and from the node tree agree."""
+    the data and from the node tree agree.
+    """
     if not isinstance(key_node, yaml.ScalarNode):
         return raw
     try:
