@@ -1,5 +1,7 @@
-"""Time-domain collision models that show where the closed form holds: the 1D collision (contact, controller,
-detection, reaction) and the elastic-joint arm against a compliant wall.
+"""Time-domain collision models that show where the closed form holds.
+
+They are the 1D collision (contact, controller, detection, reaction) and the elastic-joint arm against a
+compliant wall.
 
 The 1D collision, from the wall outwards (positions positive toward the wall)::
 

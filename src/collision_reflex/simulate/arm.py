@@ -1,5 +1,7 @@
-"""Time-domain collision of an arm with elastic joints against a compliant wall, compared with the arm-level
-closed form (MODEL.md §3, the paper's section "Collision Reflex in Higher Dimensions").
+"""Time-domain collision of an arm with elastic joints against a compliant wall.
+
+It is compared with the arm-level closed form (MODEL.md §3, the paper's section "Collision Reflex in Higher
+Dimensions").
 
 Each joint is a link side and a motor side coupled by the joint's mechanical spring ``k_m,i``::
 
@@ -111,8 +113,9 @@ def simulate_arm_collision(
     reaction: str = "moving",
     rtol: float = 1e-9,
 ) -> ArmCollision:
-    """Drive the arm's contact point along ``direction`` into a wall at ``approach_velocity`` and simulate the
-    collision.
+    """Simulate the collision of the arm's contact point with a wall.
+
+    The contact point is driven along ``direction`` into the wall at ``approach_velocity``.
 
     Parameters
     ----------
@@ -171,9 +174,11 @@ def simulate_arm_collision(
 
 @dataclass(frozen=True)
 class _Joints:
-    """The validated inputs: impact configuration (nv,) [rad], unit direction (task_dim,), and per joint (nv,)
-    the mechanical and software stiffness [N m/rad], the reflected inertia [kg m^2] and the torque limit
-    [N m]; the arm's motor masses (nv,) [kg].
+    """The validated inputs of an arm collision.
+
+    Impact configuration (nv,) [rad], unit direction (task_dim,), and per joint (nv,) the mechanical and
+    software stiffness [N m/rad], the reflected inertia [kg m^2] and the torque limit [N m]; the arm's motor
+    masses (nv,) [kg].
     """
 
     q0: np.ndarray
@@ -305,8 +310,10 @@ def _closed_form(
 
 
 def _link_model(arm: Any) -> tuple[Any, Any, int]:
-    """Pinocchio's link-side model: structure only (no armature), no gravity, motor masses carried by the
-    parent links, and a frame at the contact point. Returns ``(model, data, contact frame id)``.
+    """Pinocchio's link-side model of ``arm``.
+
+    Structure only (no armature), no gravity, motor masses carried by the parent links, and a frame at the
+    contact point. Returns ``(model, data, contact frame id)``.
     """
     import pinocchio as pin
 
@@ -336,8 +343,9 @@ def _link_model(arm: Any) -> tuple[Any, Any, int]:
 
 
 class _ArmDynamics:
-    """Links, motors and wall: the right-hand side of the state ``(q, q', theta, theta', impulse)``, and the
-    estimated contact force. Before the reaction ``theta`` is algebraic (ideal admittance).
+    """Links, motors and wall: the right-hand side of the state ``(q, q', theta, theta', impulse)``.
+
+    It also gives the estimated contact force. Before the reaction ``theta`` is algebraic (ideal admittance).
     """
 
     def __init__(
@@ -441,8 +449,9 @@ class _ArmDynamics:
         return np.array([self.wall_force(*self.contact_kinematics(c[:nv]), c[nv : 2 * nv]) for c in columns])
 
     def start_reaction(self, t: float, y: np.ndarray) -> np.ndarray:
-        """Switch the admittance off: the motors take over its state (returned) and push at the force limit
-        along -u, ``F_a = min_i tau_max,i / |(J^T u)_i|`` at the current configuration.
+        """Switch the admittance off: the motors take over its state (returned) and push at the force limit.
+
+        They push along -u, ``F_a = min_i tau_max,i / |(J^T u)_i|`` at the current configuration.
         """
         nv = self.nv
         y = y.copy()
@@ -498,7 +507,9 @@ def _integrate(
     delay: float,
     rtol: float,
 ) -> _ArmTrace:
-    """Impact and sensing until detection, the delay, then the reaction until the finger has left the wall for
+    """Integrate the arm's collision, phase by phase.
+
+    Impact and sensing until detection, the delay, then the reaction until the finger has left the wall for
     good.
     """
     max_step, duration, finger_period = _time_scales(dynamics, closed, approach_velocity, threshold, delay)
@@ -545,6 +556,7 @@ def _react(
     options: dict[str, Any],
 ) -> None:
     """Push until the finger leaves the wall; then the reflex is over: the motors stop pushing and coast away.
+
     Watch ``watch`` [s] for a rebound into the wall before stopping (a constant torque kept on would spin the
     arm round into the wall again, which is no part of the reflex), and push again if there is one.
     """

@@ -79,7 +79,8 @@ def contact_damping_for_restitution(restitution: float, m_f: float, contact_stif
 
 
 def damping_from_ratio(damping_ratio: float, mass: float, stiffness: float) -> float:
-    """Damping [N*s/m] that is ``damping_ratio`` (dimensionless) times critical, ``2 sqrt(k m)``, for a mass
-    [kg] on a stiffness [N/m].
+    """Damping [N*s/m] that is ``damping_ratio`` (dimensionless) times critical, ``2 sqrt(k m)``.
+
+    Here ``mass`` [kg] is on a spring of ``stiffness`` [N/m].
     """
     return 2 * damping_ratio * math.sqrt(stiffness * mass)

@@ -1,5 +1,6 @@
-"""The collision as a hybrid system: its state, its forces and equations of motion in each mode, the events
-that leave a mode and the jumps at them (impacts, contact loss, play, stiction).
+"""The collision as a hybrid system: its state, its forces and equations of motion in each mode.
+
+It also holds the events that leave a mode and the jumps at them (impacts, contact loss, play, stiction).
 
 Topology, from the wall outwards (positions positive toward the wall)::
 
@@ -25,8 +26,10 @@ NSTATE = 9
 
 
 def admittance_share(k_m: Any, k_s: Any) -> Any:
-    """Share ``k_s / (k_s + k_m)`` of the reference velocity that an admittance-controlled drive follows while
-    its springs ``k_m``, ``k_s`` [N/m] are loaded (the rest follows the finger); 1 where ``k_s`` is infinite.
+    """Share ``k_s / (k_s + k_m)`` of the reference velocity that an admittance-controlled drive follows.
+
+    This holds while its springs ``k_m``, ``k_s`` [N/m] are loaded (the rest follows the finger); 1 where
+    ``k_s`` is infinite.
     """
     k_s = np.asarray(k_s, dtype=float)
     finite = np.where(np.isinf(k_s), 1.0, k_s)
@@ -73,8 +76,10 @@ class HybridCollision:
         return self.s.coulomb_friction * float(np.sign(velocity)) + self.s.viscous_friction * velocity
 
     def kinematic(self, total: float, v_f: float) -> tuple[float, float, float, float]:
-        """Ideal drive: split the chain deflection ``total`` (spring deflection + admittance yield) between the
-        spring and the admittance. Returns ``(deflection, yield, robot velocity, d v_r / d a_f)``.
+        """Ideal drive: split the chain deflection ``total`` between the spring and the admittance.
+
+        ``total`` is the spring deflection + admittance yield. Returns
+        ``(deflection, yield, robot velocity, d v_r / d a_f)``.
         """
         if math.isinf(self.k_s):
             return total, 0.0, self.v0, 0.0
@@ -90,6 +95,7 @@ class HybridCollision:
         return deflection, total - deflection, share * self.v0 + (1 - share) * v_f, 1 - share
 
     def impedance_law(self, y: np.ndarray) -> float:
+        """Impedance force ``k_s e + d_s (v0 - v_r)`` on the robot mass, saturated at ``F_a`` [N]."""
         force = self.k_s * y[ERR] + self.s.software_damping * (self.v0 - y[VR])
         return float(np.clip(force, -self.s.F_a, self.s.F_a))
 
@@ -129,6 +135,7 @@ class HybridCollision:
         return {"spring": spring, "contact": contact, "actuator": actuator, "a_f": a_f, "a_r": a_r}
 
     def rhs(self, t: float, y_raw: np.ndarray) -> np.ndarray:
+        """Time derivative of the state in the current mode, for ``solve_ivp``."""
         y = self.resolved(y_raw)
         f = self.forces(t, y)
         v_f, v_r = y[VF], y[VR]
@@ -170,8 +177,10 @@ class HybridCollision:
 
     # -- events ----------------------------------------------------------------------------------------------
     def mode_events(self, detecting: bool, start: np.ndarray, y0: np.ndarray) -> list[tuple[Any, str]]:
-        """Terminal events leaving the current mode. Each is written so that it is not at zero, or is moving
-        away from zero, at the start of the segment (solve_ivp counts a zero as a crossing).
+        """Terminal events leaving the current mode.
+
+        Each is written so that it is not at zero, or is moving away from zero, at the start of the segment
+        (solve_ivp counts a zero as a crossing).
         """
         events: list[tuple[Any, str]] = []
 
@@ -220,6 +229,7 @@ class HybridCollision:
         return events
 
     def max_step(self) -> float:
+        """Largest integrator step [s]: ``setup.max_step``, or 1/16 of the shortest period of the mode."""
         if self.s.max_step is not None:
             return self.s.max_step
         periods = [math.inf]
@@ -234,8 +244,9 @@ class HybridCollision:
 
     # -- transitions -----------------------------------------------------------------------------------------
     def touch(self, t: float, y: np.ndarray) -> np.ndarray:
-        """The finger reaches the wall: a perfectly plastic impact on a rigid wall, or the start of a
-        compliant contact.
+        """The finger reaches the wall.
+
+        On a rigid wall this is a perfectly plastic impact; on a compliant one, the start of the contact.
         """
         y = self.resolved(y)
         if not self.rigid:
@@ -260,6 +271,7 @@ class HybridCollision:
         return y
 
     def leave(self, y: np.ndarray) -> np.ndarray:
+        """The finger leaves the wall: the contact becomes ``"free"``; returns the resolved state."""
         y = self.resolved(y)
         if self.contact == "pressed":
             y[SURF] = y[XF]

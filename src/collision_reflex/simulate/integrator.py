@@ -1,5 +1,6 @@
-"""Event-driven integration of the hybrid collision: SciPy's ``solve_ivp`` between mode changes, with the
-control samples, the delayed reaction and the end of the watch as segment boundaries.
+"""Event-driven integration of the hybrid collision: SciPy's ``solve_ivp`` between mode changes.
+
+The control samples, the delayed reaction and the end of the watch are segment boundaries as well.
 """
 
 from __future__ import annotations
@@ -36,8 +37,9 @@ def simulate(setup: CollisionSetup) -> SimulationResult:
 
 
 def _reference_force(setup: CollisionSetup) -> float:
-    """Spring force [N] at which the detector trips in the ideal limit, ignoring play and friction: the scale
-    of the forces in the run.
+    """Spring force [N] at which the detector trips in the ideal limit, ignoring play and friction.
+
+    It is the scale of the forces in the run.
     """
     threshold = setup.detection.threshold
     # same as model.sensing: a position threshold e_th trips at k e_th
@@ -45,8 +47,10 @@ def _reference_force(setup: CollisionSetup) -> float:
 
 
 def _default_duration(setup: CollisionSetup) -> float:
-    """Simulated time limit when ``setup.duration`` is unset [s]: 20 generous contact times, twice the delay,
-    the watch after the contact, and ten control periods.
+    """Simulated time limit when ``setup.duration`` is unset [s].
+
+    It covers 20 generous contact times, twice the delay, the watch after the contact, and ten control
+    periods.
     """
     F_ref = _reference_force(setup)
     # The closed form's contact time with the robot still moving at v0, plus a period of both masses on the
@@ -92,8 +96,10 @@ class _Trace:
         self.modes: list[str] = [contact]
 
     def add(self, solution: Any, sim: HybridCollision) -> None:
-        """The integrator's steps plus evenly spaced points from its interpolant, so that a segment covered in
-        a few long steps (a linear ramp) is still drawn smoothly where it bends later.
+        """Add the integrator's steps plus evenly spaced points from its interpolant to the trace.
+
+        The evenly spaced points are there so that a segment covered in a few long steps (a linear ramp) is
+        still drawn smoothly where it bends later.
         """
         t, y, sol = solution.t, solution.y, solution.sol
         trace_times = t[1:]
@@ -230,8 +236,9 @@ class _Run:
                 self.sim.robot_stuck = False
 
     def _next_control_sample(self) -> float:
-        """The next control sample the run must stop at [s]: while the impedance law is sampled, or while a
-        sampled detector watches.
+        """The next control sample the run must stop at [s].
+
+        The run stops at samples while the impedance law is sampled, or while a sampled detector watches.
         """
         sim = self.sim
         if (

@@ -1,5 +1,7 @@
-"""One simulated 1D collision: how the contact is detected, the setup's parameters and their checks, and the
-quantities derived from them (the closed form's inputs and the time scales of the simulation).
+"""One simulated 1D collision: how the contact is detected, the setup's parameters and their checks.
+
+It also gives the quantities derived from them (the closed form's inputs and the time scales of the
+simulation).
 
 Contact-level quantities carry the paper's symbols (``m_f``, ``m_r``, ``k_m``, ``k_s``, ``F_a``, ``v0``); the
 older spelled-out keywords (``finger_mass``, ...) still work, with a ``DeprecationWarning``.
@@ -153,8 +155,9 @@ class CollisionSetup:
 
     @property
     def contact_time(self) -> float:
-        """Duration ``pi sqrt(m_f / k_c)`` of an undamped contact of the finger alone, compression and
-        restitution [s] (0 when rigid).
+        """Duration ``pi sqrt(m_f / k_c)`` of an undamped contact of the finger alone [s] (0 when rigid).
+
+        It spans compression and restitution.
         """
         return 2 * float(impact_pulse_duration(self.m_f, self.contact_stiffness))
 
@@ -165,8 +168,9 @@ class CollisionSetup:
 
     @property
     def detection_robot_velocity(self) -> float:
-        """Robot-mass velocity toward the wall while the finger is held there, ``v0 k / k_m`` [m/s]
-        (``drive="ideal"``); the closed form's reaction starts from it.
+        """Robot-mass velocity toward the wall while the finger is held there, ``v0 k / k_m`` [m/s].
+
+        This is for ``drive="ideal"``; the closed form's reaction starts from it.
         """
         return self.v0 * self.lumped_stiffness / self.k_m
 

@@ -61,8 +61,9 @@ def sweep(
     v_r: float | str | None = None,
     tolerance: float = 0.05,
 ) -> Sweep:
-    """Simulate ``setup`` at each approach velocity (and each value of ``parameter``) and evaluate the
-    closed form (:meth:`~collision_reflex.simulate.CollisionSetup.closed_form`) alongside.
+    """Simulate ``setup`` at each approach velocity (and each value of ``parameter``) against the closed form.
+
+    The closed form (:meth:`~collision_reflex.simulate.CollisionSetup.closed_form`) is evaluated alongside.
 
     Parameters
     ----------
