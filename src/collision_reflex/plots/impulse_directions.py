@@ -1,5 +1,7 @@
-"""Collision impulse by contact direction: the collision-reflex surface of one design over sampled
-configurations (a polar curve per configuration for a planar arm, a direction map for a spatial one).
+"""Collision impulse by contact direction: the collision-reflex surface of one design.
+
+It is drawn over sampled configurations: a polar curve per configuration for a planar arm, a direction map for
+a spatial one.
 """
 
 from __future__ import annotations

@@ -1,5 +1,6 @@
-"""Measured impulse against pre-impact velocity, per system, with the fitted ``I(v)`` and ``v*`` (the
-paper's ``fig:1d_experiment_nshot``; log impulse axis).
+"""Measured impulse against pre-impact velocity, per system, with the fitted ``I(v)`` and ``v*``.
+
+This is the paper's ``fig:1d_experiment_nshot``, on a log impulse axis.
 """
 
 from __future__ import annotations
@@ -22,8 +23,10 @@ if TYPE_CHECKING:
 def plot_impulse_velocity(
     path: str | os.PathLike[str], results: ExperimentResults, fits: Mapping[str, VelocityLawFit] | None = None
 ) -> Path:
-    """One colour per system: measured impulses with error bars, the fitted ``A v + B/v + C`` and ``v*``
-    (marked when inside the plotted range). ``fits`` defaults to :meth:`ExperimentResults.velocity_laws`.
+    """One colour per system: measured impulses with error bars, the fitted ``A v + B/v + C`` and ``v*``.
+
+    ``v*`` is marked when inside the plotted range. ``fits`` defaults to
+    :meth:`ExperimentResults.velocity_laws`.
     """
     if fits is None:
         fits, _ = results.velocity_laws()

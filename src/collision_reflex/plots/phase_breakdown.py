@@ -1,5 +1,6 @@
-"""Phase breakdown of collision impulses: impact, sensing and reaction as stacked bars, one bar per design or
-actuator.
+"""Phase breakdown of collision impulses: impact, sensing and reaction as stacked bars.
+
+There is one bar per design or actuator.
 """
 
 from __future__ import annotations

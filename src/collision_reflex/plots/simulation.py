@@ -12,10 +12,12 @@ from . import new_figure, save_figure
 
 
 def plot_sweep(path: str | os.PathLike[str], result: Any, closed_form_curve: Any = None) -> Path:
-    """Draw a :class:`collision_reflex.simulate.Sweep`: simulated impulses as markers (one series per value of
-    the swept parameter), the closed form as a line, and the points whose relative difference exceeds the
-    tolerance circled in red. ``closed_form_curve`` is an optional ``(velocities, impulses)`` pair drawn as a
-    smooth line; otherwise the closed form at the simulated velocities is drawn.
+    """Draw a :class:`collision_reflex.simulate.Sweep`: simulated impulses against the closed form.
+
+    The simulated impulses are markers (one series per value of the swept parameter), the closed form is a
+    line, and the points whose relative difference exceeds the tolerance are circled in red.
+    ``closed_form_curve`` is an optional ``(velocities, impulses)`` pair drawn as a smooth line; otherwise the
+    closed form at the simulated velocities is drawn.
     """
     fig, (top, bottom) = new_figure(2, 1, figsize=(7, 6), sharex=True, gridspec_kw={"height_ratios": [3, 2]})
     if closed_form_curve is not None:
@@ -68,9 +70,11 @@ def _format(parameter: str | None, value: float) -> str:
 
 
 def plot_trace(path: str | os.PathLike[str], result: Any, reaction: str = "at_rest", v_r: Any = None) -> Path:
-    """Draw a simulated force trace (:class:`collision_reflex.simulate.SimulationResult`) over the closed form's
-    force profile (:func:`collision_reflex.force_profile`) for the same setup, with the detection, reaction and
-    contact-end times marked and the rigid impacts' impulses noted.
+    """Draw a simulated force trace over the closed form's force profile for the same setup.
+
+    The trace is a :class:`collision_reflex.simulate.SimulationResult` and the profile is
+    :func:`collision_reflex.force_profile`; the detection, reaction and contact-end times are marked and the
+    rigid impacts' impulses noted.
     """
     from ..model.impulse import force_profile
 

@@ -1,5 +1,7 @@
-"""Collision-reflex surfaces: the paper's ``fig:two_link`` grid for planar arms (polar impulse surfaces drawn
-around the contact point, the arm under each), and a 3D surface with orthogonal sections for spatial arms.
+"""Collision-reflex surfaces of planar and spatial arms.
+
+For planar arms, the paper's ``fig:two_link`` grid: polar impulse surfaces drawn around the contact point, the
+arm under each. For spatial arms, a 3D surface with orthogonal sections.
 """
 
 from __future__ import annotations

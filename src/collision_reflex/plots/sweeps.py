@@ -1,5 +1,7 @@
-"""Figures of the 1D actuator design sweeps: impulse over motor diameter x velocity (the paper's
-``fig:motor_scale_modeling``) and over mechanical stiffness per sensing scheme (``fig:stiff-sensing-impulse``).
+"""Figures of the 1D actuator design sweeps.
+
+Impulse over motor diameter x velocity (the paper's ``fig:motor_scale_modeling``) and over mechanical
+stiffness per sensing scheme (``fig:stiff-sensing-impulse``).
 """
 
 from __future__ import annotations
@@ -15,8 +17,9 @@ from . import check_figure_path, new_figure, save_figure
 
 
 def plot_radius_velocity(sweep: RadiusVelocitySweep, path: str | os.PathLike[str]) -> Path:
-    """Heat map of the impulse on log axes (diameter in mm, velocity in m/s), with contour lines, the
-    per-diameter optimal velocity ``v*`` and the overall optimum marked.
+    """Heat map of the impulse on log axes (diameter in mm, velocity in m/s), with contour lines.
+
+    The per-diameter optimal velocity ``v*`` and the overall optimum are marked.
     """
     from matplotlib.colors import LogNorm
 

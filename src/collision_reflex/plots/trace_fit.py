@@ -16,8 +16,10 @@ if TYPE_CHECKING:
 
 
 def plot_trace_fit(path: str | os.PathLike[str], trial: TrialResult) -> Path:
-    """Draw the floor-corrected samples, the contact window, and, if fitted, the model as the sensor reports
-    it with the sensing and reaction phases shaded and ``F_s`` marked. ``path`` ends in .png, .svg or .pdf.
+    """Draw the floor-corrected samples, the contact window and, if fitted, the model.
+
+    The model is drawn as the sensor reports it, with the sensing and reaction phases shaded and ``F_s``
+    marked. ``path`` ends in .png, .svg or .pdf.
     """
     trace, window, impulse = trial.trace, trial.window, trial.impulse
     pad = max(10, (window.stop - window.start) // 10)
