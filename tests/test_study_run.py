@@ -19,7 +19,7 @@ import pytest
 from collision_reflex.cli import main
 from collision_reflex.errors import StudyFileError
 from collision_reflex.report.pdf import find_browser, headless_flags
-from collision_reflex.study import _optimizer
+from collision_reflex.optimize import pareto as sweep
 from collision_reflex.study.runner import run_study
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -162,7 +162,7 @@ def test_same_study_gives_the_same_numbers(runs, tmp_path):
 
 def test_interrupted_run_resumes_from_finished_points(runs, tmp_path, monkeypatch):
     folder = tmp_path / "interrupted"
-    original = _optimizer.solve_point
+    original = sweep.solve_point
     calls = {"n": 0}
 
     def interrupt_second_point(*args, **kwargs):
@@ -171,7 +171,7 @@ def test_interrupted_run_resumes_from_finished_points(runs, tmp_path, monkeypatc
             raise KeyboardInterrupt  # as Ctrl-C in the middle of the sweep
         return original(*args, **kwargs)
 
-    monkeypatch.setattr(_optimizer, "solve_point", interrupt_second_point)
+    monkeypatch.setattr(sweep, "solve_point", interrupt_second_point)
     with pytest.raises(KeyboardInterrupt):
         run_study(TWO_LINK, folder, quiet=True, smoke=True, executor="serial")
     assert json.loads((folder / "run.json").read_text())["status"] == "interrupted"
@@ -179,7 +179,7 @@ def test_interrupted_run_resumes_from_finished_points(runs, tmp_path, monkeypatc
     finished = sorted(p.name for p in (folder / "points").iterdir())
     assert "point-000.json" in finished and "point-001.json" not in finished
 
-    monkeypatch.setattr(_optimizer, "solve_point", original)
+    monkeypatch.setattr(sweep, "solve_point", original)
     result = run_study(TWO_LINK, folder, quiet=True, smoke=True, executor="serial")
     assert result.resumed and result.reused == len(finished) and result.computed >= 1
     pd.testing.assert_frame_equal(_numbers(folder), _numbers(runs["two_link_paper"]))
