@@ -186,6 +186,12 @@ def test_pareto_front_is_non_dominated_feasible_and_consistent(arm, tmp_path):
 
     frame = pareto.to_frame()
     assert len(frame) == len(pareto.points)
+    # Every number carries its unit in its column name; the threshold's is the force sensing's newton.
+    unitless = {"point", "label", "status", "iterations"}
+    assert all(c.endswith("]") and " [" in c for c in frame.columns if c not in unitless), list(frame.columns)
+    assert "threshold [N]" in frame and "gear_ratio[joint1] [-]" in frame
+    np.testing.assert_array_equal(frame["actuator_mass [kg]"], values[:, 1])
+    assert list(frame["label"][:1]) == ["anchor: worst_case_impulse"]
     pareto.to_csv(tmp_path / "pareto.csv")
     assert (tmp_path / "pareto.csv").read_text().count("\n") == len(pareto.points) + 1
     pareto.plot(tmp_path / "front.svg")
@@ -302,3 +308,48 @@ def test_solver_failed_message_and_pickling():
         error.violated,
         None,
     )
+
+
+def test_a_sweep_point_round_trips_through_json_bitwise(arm):
+    import json
+
+    from collision_reflex.optimize.results import SweepPoint, result_to_json
+
+    samples = _samples(arm, 2, 3)
+    problem = cr.build_problem(arm, samples, FREE_SPACE, _technology(), "worst_case_impulse")
+    result = cr.solve(problem)
+    point = SweepPoint("optimum", result)
+    again = SweepPoint.from_json(json.loads(json.dumps(point.to_json())))
+    assert again.label == "optimum" and again.failures == ()
+    assert result_to_json(again.result) == result_to_json(result)  # every float the same, to the last bit
+    np.testing.assert_array_equal(again.result.design.gear_ratio, result.design.gear_ratio)
+    np.testing.assert_array_equal(again.result.x, result.x)
+
+
+def test_dominating_matches_brute_force_dominance():
+    from types import SimpleNamespace
+
+    from collision_reflex.optimize.pareto import ParetoSet
+
+    names = ("worst_case_impulse", "approach_velocity")  # approach velocity is maximised
+    rng = np.random.default_rng(5)
+    front_values = rng.uniform(0.1, 1.0, size=(8, 2))
+    front = ParetoSet(
+        names,
+        tuple(SimpleNamespace(numpy_objectives=dict(zip(names, v, strict=True))) for v in front_values),
+    )
+    for candidate in rng.uniform(0.1, 1.0, size=(200, 2)):
+        beats = [
+            i
+            for i, (impulse, velocity) in enumerate(front_values)
+            if impulse <= candidate[0]
+            and velocity >= candidate[1]
+            and (impulse < candidate[0] or velocity > candidate[1])
+        ]
+        found = front.dominating(dict(zip(names, candidate, strict=True)))
+        assert found == (beats[0] if beats else None), (candidate, beats, found)
+    # Worse by less than the dominance tolerance (1e-9 relative) is a tie, not domination; by 1e-6 it is.
+    single = ParetoSet(names, (SimpleNamespace(numpy_objectives={names[0]: 1.0, names[1]: 0.5}),))
+    assert single.dominating({names[0]: 1.0 + 1e-12, names[1]: 0.5}) is None
+    assert single.dominating({names[0]: 1.0 + 1e-6, names[1]: 0.5}) == 0
+    assert single.dominating({names[0]: 1.0, names[1]: 0.5 - 1e-6}) == 0

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from collision_reflex.model.impulse import phase_impulses, series_stiffness
-from collision_reflex.report.html import number
 from collision_reflex.optimize.pareto import epsilon_grid, non_dominated
+from collision_reflex.report.html import number
 from collision_reflex.study.actuator_study import sensing_scheme
 from collision_reflex.study.executors import SerialExecutor, open_executor
 from collision_reflex.study.runner import smoke_study
@@ -50,10 +50,13 @@ def _result(**objectives: float) -> SimpleNamespace:
 def test_non_dominated_matches_brute_force():
     rng = np.random.default_rng(3)
     records = [
-        _result(worst_case_impulse=float(a), actuator_mass=float(b)) for a, b in rng.uniform(0, 1, size=(60, 2))
+        _result(worst_case_impulse=float(a), actuator_mass=float(b))
+        for a, b in rng.uniform(0, 1, size=(60, 2))
     ]
     front, dropped = non_dominated(records, ("worst_case_impulse", "actuator_mass"))
-    values = [(r.numpy_objectives["worst_case_impulse"], r.numpy_objectives["actuator_mass"]) for r in records]
+    values = [
+        (r.numpy_objectives["worst_case_impulse"], r.numpy_objectives["actuator_mass"]) for r in records
+    ]
     expected = {v for v in values if not any(o[0] <= v[0] and o[1] <= v[1] and o != v for o in values)}
     assert {
         (r.numpy_objectives["worst_case_impulse"], r.numpy_objectives["actuator_mass"]) for r in front

@@ -27,7 +27,7 @@ def single_threaded_blas() -> contextlib.AbstractContextManager[object]:
 def _casadi_openblas_controller() -> type:
     from threadpoolctl import OpenBLASController
 
-    class CasadiOpenBLAS(OpenBLASController):  # type: ignore[misc]
+    class CasadiOpenBLAS(OpenBLASController):
         """CasADi's bundled OpenBLAS, which threadpoolctl does not know by its file name."""
 
         internal_api = "casadi_openblas"

@@ -47,6 +47,8 @@ class ProblemBuilder(Protocol):
 
     def __call__(self, objective: Any, bounded: tuple[str, ...], /) -> DesignProblem: ...
 
+    def __hash__(self) -> int: ...
+
 
 FinishedHook = Callable[[str], Mapping[str, Any] | None]
 """``finished(name)``: the saved JSON of a finished piece of a sweep (``anchor-<objective>``, ``point-007``),
@@ -243,7 +245,9 @@ class _Sweep:
         if self.progress is not None:
             self.progress(self.done, self.total)
 
-    def run(self, tasks: dict[str, tuple[Callable[..., SweepPoint], tuple[Any, ...]]]) -> dict[str, SweepPoint]:
+    def run(
+        self, tasks: dict[str, tuple[Callable[..., SweepPoint], tuple[Any, ...]]]
+    ) -> dict[str, SweepPoint]:
         """Every task's :class:`SweepPoint`, in the order of ``tasks``."""
         out: dict[str, SweepPoint] = {}
         queue = []
@@ -356,18 +360,24 @@ def solve_point(
     try:
         result = solve(problem, epsilon=epsilon, x0=np.asarray(start), ipopt_options=ipopt_options)
     except SolverFailed as error:
-        return SweepPoint(label, None, (PointFailure(objectives[0], epsilon, error.status, str(error.args[0])),))
+        return SweepPoint(
+            label, None, (PointFailure(objectives[0], epsilon, error.status, str(error.args[0])),)
+        )
     return SweepPoint(label, result)
 
 
 @_one_at_a_time
-def solve_alone(build: ProblemBuilder, objective: Hashable, ipopt_options: dict[str, Any] | None) -> SweepPoint:
+def solve_alone(
+    build: ProblemBuilder, objective: Hashable, ipopt_options: dict[str, Any] | None
+) -> SweepPoint:
     """A single-objective optimum (``objective``: a name, or what ``build`` takes for a weighted one) as a
     piece run like the sweep's."""
     try:
         result = solve(built_problem(build, objective), ipopt_options=ipopt_options)
     except SolverFailed as error:
-        return SweepPoint("optimum", None, (PointFailure(str(objective), {}, error.status, str(error.args[0])),))
+        return SweepPoint(
+            "optimum", None, (PointFailure(str(objective), {}, error.status, str(error.args[0])),)
+        )
     return SweepPoint("optimum", result)
 
 
@@ -423,7 +433,9 @@ def _dominance(values: np.ndarray, tolerance: float) -> np.ndarray:
 def dominated_mask(values: np.ndarray, tolerance: float = DOMINANCE_TOLERANCE) -> np.ndarray:
     """(n,) booleans: which rows of ``values`` (n, m; every column minimised) another row dominates."""
     values = np.asarray(values, dtype=float)
-    return _dominance(values, tolerance).any(axis=0) if len(values) else np.zeros(0, dtype=bool)
+    if not len(values):
+        return np.zeros(0, dtype=bool)
+    return np.asarray(_dominance(values, tolerance).any(axis=0), dtype=bool)
 
 
 def non_dominated(
@@ -441,8 +453,8 @@ def non_dominated(
     same = np.all(np.abs((values[:, None, :] - values[None, :, :]) / scale) <= tolerance, axis=2)
     earlier_duplicate = np.tril(same, k=-1).any(axis=1)  # [i, j] with j < i
     dropped = _dominance(values, tolerance).any(axis=0) | earlier_duplicate
-    keep = sorted(np.flatnonzero(~dropped), key=lambda i: values[i, 0])
-    return [results[i] for i in keep], [results[i] for i in np.flatnonzero(dropped)]
+    keep = sorted(np.flatnonzero(~dropped).tolist(), key=lambda i: values[i, 0])
+    return [results[i] for i in keep], [results[i] for i in np.flatnonzero(dropped).tolist()]
 
 
 def hypervolume(points: np.ndarray, reference: np.ndarray) -> float:

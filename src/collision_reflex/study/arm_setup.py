@@ -149,7 +149,7 @@ def setup_from_text(resolved_text: str) -> ArmSetup:
         return arm_setup(parse_study(resolved_text, "resolved study"))
 
 
-def objective_key(objective: Mapping[str, float]) -> Hashable:
+def objective_key(objective: Mapping[str, float] | Mapping[Any, float]) -> Hashable:
     """A hashable form of a study's objective: its name alone when it is a single unweighted objective, else
     sorted ``(name, weight)`` pairs."""
     if len(objective) == 1 and next(iter(objective.values())) == 1.0:

@@ -5,9 +5,8 @@ from __future__ import annotations
 
 import contextlib
 import multiprocessing
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from concurrent.futures import Executor, ProcessPoolExecutor
-from typing import Any
 
 from ..errors import CollisionReflexError, InvalidParameter
 from ..optimize.serial import SerialExecutor
