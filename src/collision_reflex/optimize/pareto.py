@@ -226,6 +226,32 @@ def pareto_front(
     )
 
 
+def single_optimum(
+    build: ProblemBuilder,
+    objective: Hashable,
+    ipopt_options: dict[str, Any] | None = None,
+    progress: Callable[[int, int], None] | None = None,
+    *,
+    executor: Executor | None = None,
+    finished: FinishedHook | None = None,
+    save: SaveHook | None = None,
+) -> tuple[DesignResult, bool]:
+    """The optimum of one objective (a name, or what ``build`` takes for a weighted one), run, saved and found
+    again like a piece of :func:`pareto_front` (its name: ``optimum``). Returns the result and whether it was
+    found finished.
+
+    Raises
+    ------
+    SolverFailed: the solve failed.
+    """
+    pieces = _Sweep(executor or SerialExecutor(), 1, finished, save, progress, 1)
+    (point,) = pieces.run({"optimum": (solve_alone, (build, objective, ipopt_options))}).values()
+    if point.result is None:
+        failure = point.failures[0]
+        raise SolverFailed(failure.message, failure.status, {}, [])
+    return point.result, pieces.reused == 1
+
+
 class _Sweep:
     """Runs named pieces through an executor, a few at a time, reusing and saving finished ones."""
 
@@ -254,9 +280,9 @@ class _Sweep:
         out: dict[str, SweepPoint] = {}
         queue = []
         for name, task in tasks.items():
-            saved = self.finished(name) if self.finished is not None else None
+            saved = _reusable(self.finished(name)) if self.finished is not None else None
             if saved is not None:
-                out[name] = SweepPoint.from_json(saved)
+                out[name] = saved
                 self.reused += 1
                 self._tick()
             else:
@@ -280,6 +306,16 @@ class _Sweep:
                 future.cancel()
             raise
         return {name: out[name] for name in tasks}
+
+
+def _reusable(saved: Mapping[str, Any] | None) -> SweepPoint | None:
+    """A saved piece, or None if there is none or it is not one (another version's file): then it is redone."""
+    if saved is None:
+        return None
+    try:
+        return SweepPoint.from_json(saved)
+    except (KeyError, TypeError, ValueError):
+        return None
 
 
 # --- pieces of a sweep (run in workers: picklable arguments, a picklable SweepPoint back) ---------------------

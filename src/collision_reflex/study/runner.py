@@ -235,23 +235,23 @@ def _run_arm(
     """The study's optimum, and its Pareto front by the optimiser's one sweep; each piece saved as it
     finishes and found again when the run resumes."""
     from ..errors import SolverFailed, StudyRunFailed
-    from ..optimize.pareto import pareto_front, solve_alone
-    from ..optimize.results import SweepPoint
+    from ..optimize.pareto import pareto_front, single_optimum
     from .arm_setup import IPOPT_OPTIONS, StudyProblems
 
     problems = StudyProblems(text)
-    saved = folder.finished("optimum")
-    if saved is None:
-        advance = progress.stage("optimum of the study's objective", 1)
-        optimum = pool.submit(solve_alone, problems, problems.objective, IPOPT_OPTIONS).result()
-        folder.save("optimum", optimum.to_json())
-        advance()
-    else:
-        optimum = SweepPoint.from_json(saved)
-    computed, reused = (1, 0) if saved is None else (0, 1)
-    if optimum.result is None:
-        failure = optimum.failures[0]
-        raise StudyRunFailed(f"the optimum solve failed: {failure.message}", "optimum", failure.status)
+    try:
+        optimum, found = single_optimum(
+            problems,
+            problems.objective,
+            IPOPT_OPTIONS,
+            progress.counter("optimum of the study's objective"),
+            executor=pool,
+            finished=folder.finished,
+            save=folder.save,
+        )
+    except SolverFailed as error:
+        raise StudyRunFailed(f"the optimum solve failed: {error.args[0]}", "optimum", error.status) from None
+    computed, reused = (0, 1) if found else (1, 0)
     front = None
     if study.pareto is not None:
         try:
@@ -275,7 +275,7 @@ def _run_arm(
         "study": study.name,
         "description": study.description,
         "resolved": resolved_study(parse_study(text, "resolved study")),
-        **arm_results(problems, optimum.result, front),
+        **arm_results(problems, optimum, front),
     }
     return results, (computed, reused)
 
