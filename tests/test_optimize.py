@@ -353,3 +353,45 @@ def test_dominating_matches_brute_force_dominance():
     assert single.dominating({names[0]: 1.0 + 1e-12, names[1]: 0.5}) is None
     assert single.dominating({names[0]: 1.0 + 1e-6, names[1]: 0.5}) == 0
     assert single.dominating({names[0]: 1.0, names[1]: 0.5 - 1e-6}) == 0
+
+
+def test_failed_solves_are_recorded_in_one_vocabulary(arm, monkeypatch):
+    from collision_reflex.errors import SolverFailed
+    from collision_reflex.optimize import pareto
+    from collision_reflex.optimize.results import PointFailure
+
+    samples = _samples(arm, 2, 3)
+    space = cr.DesignSpace(
+        stator_diameter=(0.02, 0.12),
+        gear_ratio=(1, 30),
+        software_stiffness=(5, 500),
+        threshold=(1, 10),
+        approach_velocity=0.3,
+    )
+    technology, names = _technology(), ("worst_case_impulse", "actuator_mass")
+
+    def build(objective, bounded):
+        return cr.build_problem(arm, samples, space, technology, objective, cr.Constraints(), bounded)
+
+    original, calls = pareto.solve, []
+
+    def fail_some(problem, epsilon=None, *args, **kwargs):
+        calls.append(dict(epsilon or {}))
+        # The worst-case anchor's lexicographic step (mass minimised, impulse held), and the second point.
+        if (epsilon and problem.objective == {"actuator_mass": 1.0} and "worst_case_impulse" in epsilon) or (
+            len(calls) == 6
+        ):
+            raise SolverFailed("no way", "Infeasible_Problem_Detected", {}, [])
+        return original(problem, epsilon, *args, **kwargs)
+
+    monkeypatch.setattr(pareto, "solve", fail_some)
+    front = pareto.pareto_front(build, names, points=5)
+    lexicographic, point = front.failed
+    assert lexicographic == PointFailure(
+        "actuator_mass", calls[1], "Infeasible_Problem_Detected", "no way"
+    ) and set(calls[1]) == {"worst_case_impulse"}
+    assert point == PointFailure("worst_case_impulse", calls[5], "Infeasible_Problem_Detected", "no way")
+    # The anchor found before its failed step is kept (front or dominated); the failed point is in neither.
+    labels = front.labels + front.dominated_labels
+    assert "anchor: worst_case_impulse" in labels and len(labels) == 2 + 3 - 1
+    assert not any(r.epsilon == calls[5] for r in (*front.points, *front.dominated))

@@ -103,7 +103,7 @@ class ParetoSet:
         from .._io import atomic_open
 
         with atomic_open(path, "w", newline="") as handle:
-            self.to_frame().to_csv(handle, index=False, float_format="%.10g")
+            self.to_frame().to_csv(handle, index=False)
 
     def dominating(self, objectives: Mapping[str, float]) -> int | None:
         """Index of the first point that dominates a design with these objective values, or None."""
