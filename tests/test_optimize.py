@@ -395,3 +395,23 @@ def test_failed_solves_are_recorded_in_one_vocabulary(arm, monkeypatch):
     labels = front.labels + front.dominated_labels
     assert "anchor: worst_case_impulse" in labels and len(labels) == 2 + 3 - 1
     assert not any(r.epsilon == calls[5] for r in (*front.points, *front.dominated))
+
+
+@pytest.mark.parametrize(
+    ("keyword", "value"),
+    [
+        ("points", 1),
+        ("anchor_starts", 0),
+        ("anchor_starts", 1.5),
+        ("in_flight", 0),
+        ("objectives", ("mass",)),
+    ],
+)
+def test_pareto_front_refuses_bad_settings_before_building(keyword, value):
+    from collision_reflex.errors import InvalidParameter
+
+    def build(objective, bounded):
+        raise AssertionError("nothing is built for bad settings")
+
+    with pytest.raises(InvalidParameter):
+        cr.pareto_front(build, **{keyword: value})

@@ -179,8 +179,12 @@ def pareto_front(
         _validate.choice("objective", name, tuple(OBJECTIVES))
     if not isinstance(points, int) or isinstance(points, bool) or points < 2:
         raise InvalidParameter("points", points, "an integer >= 2")
-    if not isinstance(anchor_starts, int) or isinstance(anchor_starts, bool) or anchor_starts < 1:
-        raise InvalidParameter("anchor_starts", anchor_starts, "an integer >= 1")
+    for name, value in (
+        ("anchor_starts", anchor_starts),
+        ("in_flight", 1 if in_flight is None else in_flight),
+    ):
+        if not isinstance(value, int) or isinstance(value, bool) or value < 1:
+            raise InvalidParameter(name, value, "an integer >= 1")
     sweep = _Sweep(
         executor or SerialExecutor(),
         in_flight or (1 if executor is None else 10**6),
@@ -193,6 +197,7 @@ def pareto_front(
         f"anchor-{name}": (solve_anchor, (build, name, names, ipopt_options, anchor_starts)) for name in names
     }
     anchors = sweep.run(anchor_tasks)
+    by_objective: dict[str, DesignResult] = {}
     for name in names:
         anchor = anchors[f"anchor-{name}"]
         if anchor.result is None:
@@ -200,18 +205,17 @@ def pareto_front(
             raise SolverFailed(
                 f"the Pareto anchor of {name} could not be solved: {failure.message}", failure.status, {}, []
             )
-    by_objective = {name: anchors[f"anchor-{name}"].result for name in names}
-    grid = epsilon_grid(by_objective, names[1:], points - len(names))  # type: ignore[arg-type]
-    start = np.asarray(by_objective[names[0]].x)  # type: ignore[union-attr]
+        by_objective[name] = anchor.result
+    grid = epsilon_grid(by_objective, names[1:], points - len(names))
+    start = by_objective[names[0]].x
     sweep.total = len(names) + len(grid)
     point_tasks = {
         f"point-{i:03d}": (solve_point, (build, names, epsilon, start, ipopt_options))
         for i, epsilon in enumerate(grid)
     }
     pieces = [*anchors.values(), *sweep.run(point_tasks).values()]
-    solved = [p for p in pieces if p.result is not None]
-    front, dominated = non_dominated([p.result for p in solved], names)  # type: ignore[misc]
-    label = {id(p.result): p.label for p in solved}
+    label = {id(p.result): p.label for p in pieces if p.result is not None}
+    front, dominated = non_dominated([p.result for p in pieces if p.result is not None], names)
     return ParetoSet(
         names,
         tuple(front),
