@@ -230,11 +230,14 @@ def design_record(
         "reaction": np.broadcast_to(phases.reaction, params.m_f.shape).tolist(),
     }
     record["optimal_velocity"] = np.asarray(v_star, dtype=float).tolist()
-    if catalogue:
-        for i, joint in enumerate(record["joints"]):
-            joint["nearest_catalogue_motor"] = nearest_catalogue_motor(
+    for i, joint in enumerate(record["joints"]):
+        joint["nearest_catalogue_motor"] = (
+            nearest_catalogue_motor(
                 catalogue, float(design.motor_peak_torque[i]), float(design.rotor_inertia[i])
             )
+            if catalogue
+            else None
+        )
     return record
 
 
