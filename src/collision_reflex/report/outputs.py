@@ -9,7 +9,6 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import CollisionReflexError
-from ..optimize.results import record_row
 from .files import DESIGNS, PARETO, REPORT, ResultsMissing, read_json, write_json, write_text
 
 
@@ -23,6 +22,8 @@ def objective_unit(name: str) -> str:
 def pareto_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
     """The rows of ``pareto.csv``: one per Pareto design (arm studies; the chosen design if there is no front)
     or per candidate actuator (actuator studies)."""
+    from ..optimize.results import record_row
+
     if results["kind"] == "actuator":
         return _actuator_rows(results)
     points = results["pareto"]["points"] or [results["chosen"]]
