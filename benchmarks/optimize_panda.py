@@ -7,7 +7,8 @@ stiffness; a global free force threshold and approach velocity; 64 random config
 Prints: the build and solve times and iterations of one solve (target: solve < 5 s), a 20-point Pareto front of
 worst-case impulse against total motor mass (target: < 60 s), and the hypervolume of that front against pymoo's
 NSGA-II (population 100, 200 generations) on the same problem and the same reference point (target: at least
-NSGA-II's). Run: ``python benchmarks/optimize_panda.py`` (``--quick`` for 5 Pareto points and a short GA).
+NSGA-II's), and the sweep's warm-start policy (every point from the first anchor) against chaining each point
+from its neighbour's solution and multipliers. Run: ``python benchmarks/optimize_panda.py`` (``--quick`` for 5 Pareto points and a short GA).
 
 The reflected rotor inertia is placed on the finger (``reflected_inertia_in="finger"``: a stiff transmission,
 the regime of the paper's geared A8): with the paper's arm model, where it acts in the reaction phase only, the
@@ -24,7 +25,7 @@ import numpy as np
 
 import collision_reflex as cr
 from collision_reflex.arm.core import Arm
-from collision_reflex.optimize import hypervolume
+from collision_reflex.optimize import hypervolume, pareto
 from collision_reflex.optimize.nsga import nsga2_front
 
 
@@ -89,6 +90,8 @@ def main() -> None:
         f"iterations per point: median {int(np.median(iterations))}, max {max(iterations)})"
     )
 
+    compare_warm_starts(builder("finger"), ("worst_case_impulse", "actuator_mass"), points)
+
     started = time.perf_counter()
     genetic = nsga2_front(problem, ("worst_case_impulse", "actuator_mass"), population, generations, seed=1)
     print(
@@ -109,6 +112,32 @@ def main() -> None:
     print(
         f"paper's arm model (reflected inertia in the reaction only): {len(robot.points)} non-dominated "
         f"point(s); worst-case impulse {spread[:, 0].min():.4f}-{spread[:, 0].max():.4f} N*s"
+    )
+
+
+def compare_warm_starts(build, names: tuple[str, ...], points: int) -> None:
+    """Solve the same epsilon points from the first anchor (the sweep's policy: independent, parallel) and
+    chained from the neighbour (the old library policy: sequential); print time, iterations and agreement."""
+    anchors = {name: pareto.solve_anchor(build, name, names, None).result for name in names}
+    grid = pareto.epsilon_grid(anchors, names[1:], points - len(names))
+    primary = pareto.built_problem(build, names[0], names[1:])
+    started = time.perf_counter()
+    from_anchor = [pareto.solve_point(build, names, e, anchors[names[0]].x, None).result for e in grid]
+    anchor_time = time.perf_counter() - started
+    started, chained, start = time.perf_counter(), [], anchors[names[0]]
+    for epsilon in grid:
+        start = cr.solve(primary, epsilon=epsilon, x0=start)
+        chained.append(start)
+    chain_time = time.perf_counter() - started
+    difference = max(
+        abs(a.numpy_objectives[n] - b.numpy_objectives[n]) / abs(b.numpy_objectives[n])
+        for a, b in zip(from_anchor, chained, strict=True)
+        for n in names
+    )
+    print(
+        f"warm starts over {len(grid)} points: from the anchor {anchor_time:.1f} s, "
+        f"{sum(r.iterations for r in from_anchor)} iterations; chained from the neighbour {chain_time:.1f} s, "
+        f"{sum(r.iterations for r in chained)} iterations; objectives agree to {difference:.1e} (relative)"
     )
 
 

@@ -186,6 +186,12 @@ def test_pareto_front_is_non_dominated_feasible_and_consistent(arm, tmp_path):
 
     frame = pareto.to_frame()
     assert len(frame) == len(pareto.points)
+    # Every number carries its unit in its column name; the threshold's is the force sensing's newton.
+    unitless = {"point", "label", "status", "iterations"}
+    assert all(c.endswith("]") and " [" in c for c in frame.columns if c not in unitless), list(frame.columns)
+    assert "threshold [N]" in frame and "gear_ratio[joint1] [-]" in frame
+    np.testing.assert_array_equal(frame["actuator_mass [kg]"], values[:, 1])
+    assert list(frame["label"][:1]) == ["anchor: worst_case_impulse"]
     pareto.to_csv(tmp_path / "pareto.csv")
     assert (tmp_path / "pareto.csv").read_text().count("\n") == len(pareto.points) + 1
     pareto.plot(tmp_path / "front.svg")
@@ -302,3 +308,110 @@ def test_solver_failed_message_and_pickling():
         error.violated,
         None,
     )
+
+
+def test_a_sweep_point_round_trips_through_json_bitwise(arm):
+    import json
+
+    from collision_reflex.optimize.results import SweepPoint, result_to_json
+
+    samples = _samples(arm, 2, 3)
+    problem = cr.build_problem(arm, samples, FREE_SPACE, _technology(), "worst_case_impulse")
+    result = cr.solve(problem)
+    point = SweepPoint("optimum", result)
+    again = SweepPoint.from_json(json.loads(json.dumps(point.to_json())))
+    assert again.label == "optimum" and again.failures == ()
+    assert result_to_json(again.result) == result_to_json(result)  # every float the same, to the last bit
+    np.testing.assert_array_equal(again.result.design.gear_ratio, result.design.gear_ratio)
+    np.testing.assert_array_equal(again.result.x, result.x)
+
+
+def test_dominating_matches_brute_force_dominance():
+    from types import SimpleNamespace
+
+    from collision_reflex.optimize.pareto import ParetoSet
+
+    names = ("worst_case_impulse", "approach_velocity")  # approach velocity is maximised
+    rng = np.random.default_rng(5)
+    front_values = rng.uniform(0.1, 1.0, size=(8, 2))
+    front = ParetoSet(
+        names,
+        tuple(SimpleNamespace(numpy_objectives=dict(zip(names, v, strict=True))) for v in front_values),
+    )
+    for candidate in rng.uniform(0.1, 1.0, size=(200, 2)):
+        beats = [
+            i
+            for i, (impulse, velocity) in enumerate(front_values)
+            if impulse <= candidate[0]
+            and velocity >= candidate[1]
+            and (impulse < candidate[0] or velocity > candidate[1])
+        ]
+        found = front.dominating(dict(zip(names, candidate, strict=True)))
+        assert found == (beats[0] if beats else None), (candidate, beats, found)
+    # Worse by less than the dominance tolerance (1e-9 relative) is a tie, not domination; by 1e-6 it is.
+    single = ParetoSet(names, (SimpleNamespace(numpy_objectives={names[0]: 1.0, names[1]: 0.5}),))
+    assert single.dominating({names[0]: 1.0 + 1e-12, names[1]: 0.5}) is None
+    assert single.dominating({names[0]: 1.0 + 1e-6, names[1]: 0.5}) == 0
+    assert single.dominating({names[0]: 1.0, names[1]: 0.5 - 1e-6}) == 0
+
+
+def test_failed_solves_are_recorded_in_one_vocabulary(arm, monkeypatch):
+    from collision_reflex.errors import SolverFailed
+    from collision_reflex.optimize import pareto
+    from collision_reflex.optimize.results import PointFailure
+
+    samples = _samples(arm, 2, 3)
+    space = cr.DesignSpace(
+        stator_diameter=(0.02, 0.12),
+        gear_ratio=(1, 30),
+        software_stiffness=(5, 500),
+        threshold=(1, 10),
+        approach_velocity=0.3,
+    )
+    technology, names = _technology(), ("worst_case_impulse", "actuator_mass")
+
+    def build(objective, bounded):
+        return cr.build_problem(arm, samples, space, technology, objective, cr.Constraints(), bounded)
+
+    original, calls = pareto.solve, []
+
+    def fail_some(problem, epsilon=None, *args, **kwargs):
+        calls.append(dict(epsilon or {}))
+        # The worst-case anchor's lexicographic step (mass minimised, impulse held), and the second point.
+        if (epsilon and problem.objective == {"actuator_mass": 1.0} and "worst_case_impulse" in epsilon) or (
+            len(calls) == 6
+        ):
+            raise SolverFailed("no way", "Infeasible_Problem_Detected", {}, [])
+        return original(problem, epsilon, *args, **kwargs)
+
+    monkeypatch.setattr(pareto, "solve", fail_some)
+    front = pareto.pareto_front(build, names, points=5)
+    lexicographic, point = front.failed
+    assert lexicographic == PointFailure(
+        "actuator_mass", calls[1], "Infeasible_Problem_Detected", "no way"
+    ) and set(calls[1]) == {"worst_case_impulse"}
+    assert point == PointFailure("worst_case_impulse", calls[5], "Infeasible_Problem_Detected", "no way")
+    # The anchor found before its failed step is kept (front or dominated); the failed point is in neither.
+    labels = front.labels + front.dominated_labels
+    assert "anchor: worst_case_impulse" in labels and len(labels) == 2 + 3 - 1
+    assert not any(r.epsilon == calls[5] for r in (*front.points, *front.dominated))
+
+
+@pytest.mark.parametrize(
+    ("keyword", "value"),
+    [
+        ("points", 1),
+        ("anchor_starts", 0),
+        ("anchor_starts", 1.5),
+        ("in_flight", 0),
+        ("objectives", ("mass",)),
+    ],
+)
+def test_pareto_front_refuses_bad_settings_before_building(keyword, value):
+    from collision_reflex.errors import InvalidParameter
+
+    def build(objective, bounded):
+        raise AssertionError("nothing is built for bad settings")
+
+    with pytest.raises(InvalidParameter):
+        cr.pareto_front(build, **{keyword: value})

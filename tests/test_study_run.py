@@ -18,8 +18,8 @@ import pytest
 
 from collision_reflex.cli import main
 from collision_reflex.errors import StudyFileError
+from collision_reflex.optimize import pareto as sweep
 from collision_reflex.report.pdf import find_browser, headless_flags
-from collision_reflex.study import _optimizer
 from collision_reflex.study.runner import run_study
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -162,7 +162,7 @@ def test_same_study_gives_the_same_numbers(runs, tmp_path):
 
 def test_interrupted_run_resumes_from_finished_points(runs, tmp_path, monkeypatch):
     folder = tmp_path / "interrupted"
-    original = _optimizer.solve_point
+    original = sweep.solve_point
     calls = {"n": 0}
 
     def interrupt_second_point(*args, **kwargs):
@@ -171,7 +171,7 @@ def test_interrupted_run_resumes_from_finished_points(runs, tmp_path, monkeypatc
             raise KeyboardInterrupt  # as Ctrl-C in the middle of the sweep
         return original(*args, **kwargs)
 
-    monkeypatch.setattr(_optimizer, "solve_point", interrupt_second_point)
+    monkeypatch.setattr(sweep, "solve_point", interrupt_second_point)
     with pytest.raises(KeyboardInterrupt):
         run_study(TWO_LINK, folder, quiet=True, smoke=True, executor="serial")
     assert json.loads((folder / "run.json").read_text())["status"] == "interrupted"
@@ -179,7 +179,7 @@ def test_interrupted_run_resumes_from_finished_points(runs, tmp_path, monkeypatc
     finished = sorted(p.name for p in (folder / "points").iterdir())
     assert "point-000.json" in finished and "point-001.json" not in finished
 
-    monkeypatch.setattr(_optimizer, "solve_point", original)
+    monkeypatch.setattr(sweep, "solve_point", original)
     result = run_study(TWO_LINK, folder, quiet=True, smoke=True, executor="serial")
     assert result.resumed and result.reused == len(finished) and result.computed >= 1
     pd.testing.assert_frame_equal(_numbers(folder), _numbers(runs["two_link_paper"]))
@@ -381,3 +381,92 @@ def test_smoke_runs_locate_problems_in_the_file_as_written(tmp_path, capsys):
     study.write_text("# a comment that the resolved study does not have\n" + STUDY.replace("link2", "link9"))
     assert main(["run", str(study), "--out", str(tmp_path / "out"), "--quiet", "--smoke"]) == 2
     assert capsys.readouterr().err.startswith(f"crx run: error: {study}:5:3: robot.contact_frame")
+
+
+ARM_STUDIES = [p.stem for p in STUDIES if p.stem != ACTUATORS.stem]
+
+
+@pytest.mark.parametrize("name", ARM_STUDIES, ids=ARM_STUDIES)
+def test_study_sweep_is_the_library_sweep(runs, name):
+    """The run's front is what the optimiser's pareto_front gives on the same problem, called directly."""
+    from collision_reflex.study.arm_setup import IPOPT_OPTIONS, StudyProblems
+
+    folder = runs[name]
+    results = json.loads((folder / "designs.json").read_text())
+    saved, spec = results["pareto"], results["resolved"]["pareto"]
+    problems = StudyProblems((folder / "study.resolved.yaml").read_text(encoding="utf-8"))
+    front = sweep.pareto_front(
+        problems, spec["objectives"], spec["points"], IPOPT_OPTIONS, anchor_starts=spec["anchor_starts"]
+    )
+    assert len(front.points) == len(saved["points"]) >= 2
+    assert [f.as_dict() for f in front.failed] == saved["failed"]
+    for ours, theirs in zip(front.records(), saved["points"], strict=True):
+        assert ours["label"] == theirs["label"]
+        for objective, value in theirs["objectives"].items():
+            assert ours["objectives"][objective] == pytest.approx(value, rel=1e-9, abs=0), objective
+        for mine, other in zip(ours["joints"], theirs["joints"], strict=True):
+            for key in ("stator_diameter", "gear_ratio", "software_stiffness", "peak_torque", "motor_mass"):
+                assert mine[key] == pytest.approx(other[key], rel=1e-9, abs=0), (mine["joint"], key)
+        assert ours["threshold"] == pytest.approx(theirs["threshold"], rel=1e-9, abs=0)
+
+
+def _dominates(a, b, names, senses):
+    """Brute force: ``a`` no worse than ``b`` in every objective and better in one (by more than 1e-9
+    relative, the optimiser's tolerance for equal values)."""
+    better = worse = False
+    for name, sense in zip(names, senses, strict=True):
+        gap = sense * (b[name] - a[name]) / max(abs(a[name]), abs(b[name]))
+        better, worse = better or gap > 1e-9, worse or gap < -1e-9
+    return better and not worse
+
+
+@pytest.mark.parametrize("name", ARM_STUDIES, ids=ARM_STUDIES)
+def test_chosen_design_says_whether_a_pareto_design_dominates_it(runs, name):
+    from collision_reflex.optimize import OBJECTIVES
+
+    results = json.loads((runs[name] / "designs.json").read_text())
+    names = results["pareto"]["objectives"]
+    senses = [OBJECTIVES[n][0] for n in names]
+    chosen = results["chosen"]["objectives"]
+    beaten = [
+        i
+        for i, p in enumerate(results["pareto"]["points"])
+        if _dominates(p["objectives"], chosen, names, senses)
+    ]
+    assert results["chosen"]["dominated_by"] == (beaten[0] if beaten else None)
+
+
+def test_a_dominated_chosen_design_is_flagged_in_the_report(runs, tmp_path):
+    folder = tmp_path / "flagged"
+    shutil.copytree(runs["two_link_paper"], folder)
+    assert "not Pareto-optimal" not in (folder / "report.html").read_text()
+    results = json.loads((folder / "designs.json").read_text())
+    # The chosen design made heavier than the first Pareto design at the same impulse: that design dominates it.
+    first = results["pareto"]["points"][0]["objectives"]
+    results["chosen"]["objectives"] = {**first, "actuator_mass": 2 * first["actuator_mass"]}
+    results["chosen"]["dominated_by"] = 0
+    (folder / "designs.json").write_text(json.dumps(results))
+    assert main(["report", str(folder)]) == 0
+    html = (folder / "report.html").read_text()
+    assert "The chosen design is not Pareto-optimal: Pareto design 0" in html
+    assert "worst case impulse and actuator mass" in html
+
+
+def test_a_study_asks_for_multi_start_anchors(tmp_path, monkeypatch):
+    study = tmp_path / "two_link.yaml"
+    text = TWO_LINK.read_text().replace("points: 12}", "points: 4, anchor_starts: 2}")
+    study.write_text(text.replace("../designs/", f"{ROOT / 'designs'}/"))
+    starts = []
+    original = sweep.solve
+
+    def spy(problem, *args, **kwargs):
+        starts.append(kwargs.get("starts", 1))
+        return original(problem, *args, **kwargs)
+
+    monkeypatch.setattr(sweep, "solve", spy)
+    result = run_study(study, tmp_path / "out", quiet=True, smoke=True, executor="serial")
+    results = json.loads((result.folder / "designs.json").read_text())
+    assert results["resolved"]["pareto"]["anchor_starts"] == 2
+    # Two anchors, each started twice, then one lexicographic step each and two points from one start.
+    assert sorted(starts) == [1, 1, 1, 1, 1, 2, 2]
+    assert results["pareto"]["points"][0]["label"] == "anchor: worst_case_impulse"

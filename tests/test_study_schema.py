@@ -276,3 +276,19 @@ def test_readme_annotated_study_is_valid():
     # It lives in studies/ as far as its relative paths are concerned.
     study = parse_study(blocks[0], "README.md", STUDIES[0].parent).study
     assert isinstance(study, ArmStudy) and study.pareto is not None
+
+
+def test_multi_start_anchors_are_validated_and_in_the_json_schema():
+    pareto = "pareto: {objectives: [worst_case_impulse, actuator_mass], points: 6, anchor_starts: 3}\n"
+    study = parse_study(MINIMAL + pareto).study
+    assert isinstance(study, ArmStudy) and study.pareto is not None and study.pareto.anchor_starts == 3
+    default = parse_study(MINIMAL + pareto.replace(", anchor_starts: 3", "")).study
+    assert isinstance(default, ArmStudy) and default.pareto is not None and default.pareto.anchor_starts == 1
+    for bad, words in (("0", ["anchor_starts", "greater than or equal to 1"]), ("2.5", ["anchor_starts"])):
+        text = MINIMAL + pareto.replace("anchor_starts: 3", f"anchor_starts: {bad}")
+        (problem,) = _problems(text)
+        assert problem.line == len(text.splitlines()) and problem.path == "pareto.anchor_starts"
+        for word in words:
+            assert word in str(problem)
+    properties = study_json_schema()["$defs"]["ParetoSpec"]["properties"]
+    assert properties["anchor_starts"]["minimum"] == 1 and properties["anchor_starts"]["default"] == 1

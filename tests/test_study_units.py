@@ -6,13 +6,14 @@ from __future__ import annotations
 import itertools
 import math
 from concurrent.futures import Future
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from collision_reflex.model.impulse import phase_impulses, series_stiffness
+from collision_reflex.optimize.pareto import epsilon_grid, non_dominated
 from collision_reflex.report.html import number
-from collision_reflex.study._optimizer import epsilon_grid, non_dominated
 from collision_reflex.study.actuator_study import sensing_scheme
 from collision_reflex.study.executors import SerialExecutor, open_executor
 from collision_reflex.study.runner import smoke_study
@@ -41,33 +42,40 @@ def test_open_executor_refuses_unknown_kinds():
         pass
 
 
+def _result(**objectives: float) -> SimpleNamespace:
+    """A stand-in for a DesignResult: the sweep's helpers read its NumPy objectives only."""
+    return SimpleNamespace(numpy_objectives=objectives)
+
+
 def test_non_dominated_matches_brute_force():
     rng = np.random.default_rng(3)
     records = [
-        {"objectives": {"worst_case_impulse": float(a), "actuator_mass": float(b)}}
+        _result(worst_case_impulse=float(a), actuator_mass=float(b))
         for a, b in rng.uniform(0, 1, size=(60, 2))
     ]
     front, dropped = non_dominated(records, ("worst_case_impulse", "actuator_mass"))
-    values = [(r["objectives"]["worst_case_impulse"], r["objectives"]["actuator_mass"]) for r in records]
+    values = [
+        (r.numpy_objectives["worst_case_impulse"], r.numpy_objectives["actuator_mass"]) for r in records
+    ]
     expected = {v for v in values if not any(o[0] <= v[0] and o[1] <= v[1] and o != v for o in values)}
     assert {
-        (r["objectives"]["worst_case_impulse"], r["objectives"]["actuator_mass"]) for r in front
+        (r.numpy_objectives["worst_case_impulse"], r.numpy_objectives["actuator_mass"]) for r in front
     } == expected
     assert len(front) + len(dropped) == len(records)
-    first = [r["objectives"]["worst_case_impulse"] for r in front]
+    first = [r.numpy_objectives["worst_case_impulse"] for r in front]
     assert first == sorted(first)
     # A maximised objective (approach velocity) counts as better when larger.
-    fast = [{"objectives": {"worst_case_impulse": 1.0, "approach_velocity": v}} for v in (0.1, 0.5)]
+    fast = [_result(worst_case_impulse=1.0, approach_velocity=v) for v in (0.1, 0.5)]
     front, _ = non_dominated(fast, ("worst_case_impulse", "approach_velocity"))
-    assert [r["objectives"]["approach_velocity"] for r in front] == [0.5]
+    assert [r.numpy_objectives["approach_velocity"] for r in front] == [0.5]
 
 
 def test_epsilon_grid_spreads_bounds_between_saved_anchors():
     anchors = {
-        "worst_case_impulse": {"objectives": {"worst_case_impulse": 0.2, "actuator_mass": 1.0}},
-        "actuator_mass": {"objectives": {"worst_case_impulse": 0.5, "actuator_mass": 0.1}},
+        "worst_case_impulse": _result(worst_case_impulse=0.2, actuator_mass=1.0),
+        "actuator_mass": _result(worst_case_impulse=0.5, actuator_mass=0.1),
     }
-    grid = epsilon_grid(anchors, ("worst_case_impulse", "actuator_mass"), 3)
+    grid = epsilon_grid(anchors, ("actuator_mass",), 3)
     # Interior points only, evenly spaced from the loosest mass bound (1.0) to the tightest (0.1).
     assert [g["actuator_mass"] for g in grid] == pytest.approx([0.775, 0.55, 0.325], rel=1e-12)
 

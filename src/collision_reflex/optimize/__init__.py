@@ -3,7 +3,8 @@ velocity for a URDF arm, and Pareto sets by epsilon-constraint sweeps.
 
 Build and solve are separate: :func:`build_problem` returns an inspectable :class:`DesignProblem`, :func:`solve`
 runs IPOPT and returns a :class:`DesignResult`; :func:`pareto_front` sweeps objectives into a
-:class:`ParetoSet`.
+:class:`ParetoSet` (in-process or through any executor); :mod:`.results` makes the one result record and table
+row of a design.
 """
 
 from .pareto import ParetoSet, hypervolume, pareto_front

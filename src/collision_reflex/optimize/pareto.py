@@ -1,24 +1,62 @@
-"""Pareto sets of actuator designs by epsilon-constraint sweeps with lexicographic anchors and warm starts."""
+"""Pareto sets of actuator designs by epsilon-constraint sweeps with lexicographic anchors: the one sweep, for
+the library and for studies alike, in-process or through any :class:`concurrent.futures.Executor`.
+
+Warm-start policy (one for every caller): each anchor's lexicographic steps start from the anchor found so
+far; every epsilon point starts from the first objective's anchor (its point, not its multipliers). A point's
+result is then a pure function of the problem and its bounds, whatever the executor and the order in which the
+points finish; the points run in parallel. Starting from the neighbour (with its multipliers) instead chains
+the points, with no parallelism, and was not faster even in series: on the full shipped studies, one process,
+the same fronts to 3e-7, the neighbour chain took 0.77 / 8.5 / 133 s (two-link / Panda / UR5) where the anchor
+start takes 0.63 / 3.7 / 84 s (fewer iterations on UR5, more on the two-link arm, where each is cheap).
+"""
 
 from __future__ import annotations
 
+import functools
 import itertools
 import os
+import threading
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Hashable, Mapping, Sequence
+from concurrent.futures import FIRST_COMPLETED, Executor, Future, wait
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
 from .. import _validate
 from ..errors import InvalidParameter, SolverFailed
+from .blas import single_threaded_blas
 from .problem import OBJECTIVES, DesignProblem
+from .results import PointFailure, SweepPoint, record_row, result_record
+from .serial import SerialExecutor
 from .solve import DesignResult, solve
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 ANCHOR_SLACK = 1e-6
 """Relative slack on the first objective when the second is minimised at an anchor (lexicographic step): small
 enough not to move the anchor visibly, large enough for IPOPT to find an interior point."""
+
+DOMINANCE_TOLERANCE = 1e-9
+"""Relative difference (to each objective's largest magnitude) below which two objective values count as equal."""
+
+
+class ProblemBuilder(Protocol):
+    """``build(objective, bounded_objectives) -> DesignProblem``. Hashable (the problems are cached per process
+    by builder); picklable (a module-level function, or a frozen dataclass) to run through a process pool."""
+
+    def __call__(self, objective: Any, bounded: tuple[str, ...], /) -> DesignProblem: ...
+
+    def __hash__(self) -> int: ...
+
+
+FinishedHook = Callable[[str], Mapping[str, Any] | None]
+"""``finished(name)``: the saved JSON of a finished piece of a sweep (``anchor-<objective>``, ``point-007``),
+or None to compute it."""
+SaveHook = Callable[[str, dict[str, Any]], None]
+"""``save(name, data)``: keep a piece of a sweep as it finishes (JSON types)."""
 
 
 @dataclass(frozen=True)
@@ -26,54 +64,39 @@ class ParetoSet:
     """Non-dominated designs for two or three objectives.
 
     objectives: the objective names, the first one the sweep minimised.
-    points: the non-dominated results, sorted by the first objective.
-    failed: ``(epsilon, reason)`` of sweep points the solver could not solve (too tight bounds, ...).
-    dominated: results the sweep found that another point dominates (kept for inspection).
-    total_time: wall time of the sweep [s].
+    points: the non-dominated results, sorted by the first objective; labels: what each point solved.
+    failed: the solves that did not succeed (sweep points, anchors' lexicographic steps).
+    dominated: results the sweep found that another point dominates (kept for inspection), with their labels.
+    total_time: wall time of the sweep [s]; computed, reused: pieces of the sweep solved now and found finished.
     """
 
     objectives: tuple[str, ...]
     points: tuple[DesignResult, ...]
-    failed: tuple[tuple[dict[str, float], str], ...] = ()
+    failed: tuple[PointFailure, ...] = ()
     dominated: tuple[DesignResult, ...] = ()
     total_time: float = 0.0
     solver_builds: int = 0
+    labels: tuple[str, ...] = ()
+    dominated_labels: tuple[str, ...] = ()
+    computed: int = 0
+    reused: int = 0
 
     def values(self, numpy_path: bool = True) -> np.ndarray:
         """(n_points, n_objectives) objective values in their units (NumPy path by default)."""
         source = (lambda r: r.numpy_objectives) if numpy_path else (lambda r: r.objectives)
         return np.array([[source(r)[name] for name in self.objectives] for r in self.points])
 
-    def to_frame(self) -> Any:
-        """A pandas DataFrame: one row per design with its objectives, per-joint design and solver stats."""
+    def records(self) -> list[dict[str, Any]]:
+        """Every point as a result record (:func:`collision_reflex.optimize.results.result_record`)."""
+        labels = self.labels or ("",) * len(self.points)
+        return [result_record(r, label) for r, label in zip(self.points, labels, strict=True)]
+
+    def to_frame(self) -> pd.DataFrame:
+        """One row per design (:func:`collision_reflex.optimize.results.record_row`): objectives, per-joint
+        design and solver status, every column with its unit."""
         import pandas as pd
 
-        rows = []
-        for index, result in enumerate(self.points):
-            row: dict[str, Any] = {"point": index}
-            for name in OBJECTIVES:
-                row[f"{name} [{OBJECTIVES[name][1]}]"] = result.numpy_objectives[name]
-            design = result.design
-            for name in (
-                "stator_diameter",
-                "stack_length",
-                "gear_ratio",
-                "software_stiffness",
-                "reflected_inertia",
-                "peak_torque",
-                "motor_mass",
-            ):
-                for joint, value in zip(design.joint_names, getattr(design, name), strict=True):
-                    row[f"{name}[{joint}]"] = value
-            for joint, value in zip(design.joint_names, result.torque_margin, strict=True):
-                row[f"torque_margin[{joint}]"] = value
-            row["threshold"] = design.threshold
-            row["approach_velocity [m/s]"] = design.approach_velocity
-            row["status"] = result.status
-            row["iterations"] = result.iterations
-            row["solve_time [s]"] = result.solve_time
-            rows.append(row)
-        return pd.DataFrame(rows)
+        return pd.DataFrame([record_row(record, i) for i, record in enumerate(self.records())])
 
     def to_csv(self, path: str | os.PathLike[str]) -> None:
         """Write :meth:`to_frame` as CSV, atomically."""
@@ -81,6 +104,14 @@ class ParetoSet:
 
         with atomic_open(path, "w", newline="") as handle:
             self.to_frame().to_csv(handle, index=False)
+
+    def dominating(self, objectives: Mapping[str, float]) -> int | None:
+        """Index of the first point that dominates a design with these objective values, or None."""
+        if not self.points:
+            return None
+        values = np.vstack([self.values(), [[objectives[name] for name in self.objectives]]])
+        beaten = _dominance(_minimised(values, self.objectives), DOMINANCE_TOLERANCE)[:-1, -1]
+        return int(np.argmax(beaten)) if beaten.any() else None
 
     def hypervolume(self, reference: Sequence[float]) -> float:
         """Hypervolume dominated by the front up to ``reference`` (objective units; maximised objectives are
@@ -90,20 +121,27 @@ class ParetoSet:
             _minimised(self.values(), self.objectives), _minimised(np.array([reference]), self.objectives)[0]
         )
 
-    def plot(self, path: str | os.PathLike[str]) -> Any:
-        """Draw the front (2 objectives: a line plot; 3: a scatter coloured by the third)."""
-        from ..plots.pareto import plot_pareto
+    def plot(self, path: str | os.PathLike[str], chosen: Sequence[float] | None = None) -> Any:
+        """Draw the front (2 objectives: a line plot; 3: a scatter coloured by the third); ``chosen``: a design's
+        objective values to mark."""
+        from ..plots.design_front import plot_design_front
 
-        return plot_pareto(self, path)
+        units = [OBJECTIVES[name][1] for name in self.objectives]
+        return plot_design_front(path, self.objectives, units, self.values(), chosen)
 
 
 def pareto_front(
-    build: Callable[[str, Sequence[str]], DesignProblem],
+    build: ProblemBuilder,
     objectives: Sequence[str] = ("worst_case_impulse", "actuator_mass"),
     points: int = 20,
     ipopt_options: dict[str, Any] | None = None,
     progress: Callable[[int, int], None] | None = None,
     anchor_starts: int = 1,
+    *,
+    executor: Executor | None = None,
+    in_flight: int | None = None,
+    finished: FinishedHook | None = None,
+    save: SaveHook | None = None,
 ) -> ParetoSet:
     """Pareto set of two or three objectives by epsilon-constraint sweeps.
 
@@ -111,17 +149,28 @@ def pareto_front(
     ----------
     build: ``build(objective, bounded_objectives) -> DesignProblem``, e.g.
         ``lambda obj, bounded: build_problem(arm, samples, space, technology, obj, constraints, bounded)``.
-        It is called once per objective (each problem's solver is reused for every point).
+        Each objective's problem is built once per process (its solver is reused for every point); through a
+        process pool, ``build`` must be picklable (see :class:`ProblemBuilder`).
     objectives: 2 or 3 names of :data:`OBJECTIVES`; the sweep minimises the first and bounds the others.
     points: number of points requested on the front (anchors included); for three objectives the bounds form
         a grid of about that many points.
-    progress: called as ``progress(done, total)`` after each solve.
+    progress: called as ``progress(done, total)`` after each piece (an anchor or a point).
     anchor_starts: start points of each anchor's first solve (multi-start, see :func:`solve`); more starts
         make the anchors more robust against local optima, at the cost of a solve each.
+    executor: where the pieces run (default: in this process); a process pool or a Dask client's executor
+        give the same numbers.
+    in_flight: pieces submitted at a time (default 1 in-process, all otherwise); finished pieces are saved
+        while the others run.
+    finished, save: keep each finished piece (``save(name, json)``) and find it again (``finished(name)``), so
+        that a sweep resumed after an interruption redoes only the rest.
 
     Anchors first: each objective is minimised, then (lexicographically) the others are minimised with it held
     at its optimum, so every anchor is non-dominated. The bounds on the other objectives are then spread
-    evenly between the anchors, and each point is started from its neighbour's solution (warm start).
+    evenly between the anchors; every point starts from the first objective's anchor (module docstring).
+
+    Raises
+    ------
+    SolverFailed: an anchor's first solve failed (the bounds of the sweep are then unknown).
     """
     started = time.perf_counter()
     names = tuple(objectives)
@@ -129,59 +178,255 @@ def pareto_front(
         raise InvalidParameter("objectives", names, "2 or 3 different objective names")
     for name in names:
         _validate.choice("objective", name, tuple(OBJECTIVES))
-    if not isinstance(points, int) or points < 2:
+    if not isinstance(points, int) or isinstance(points, bool) or points < 2:
         raise InvalidParameter("points", points, "an integer >= 2")
-    problems = {name: build(name, tuple(other for other in names if other != name)) for name in names}
-    total = points + len(names) * (len(names) - 1) + len(names) * (anchor_starts - 1)
-    done = 0
-
-    def tick() -> None:
-        nonlocal done
-        done += 1
-        if progress is not None:
-            progress(done, total)
-
-    results: list[DesignResult] = []
-    failed: list[tuple[dict[str, float], str]] = []
-    anchors = {}
+    for name, value in (
+        ("anchor_starts", anchor_starts),
+        ("in_flight", 1 if in_flight is None else in_flight),
+    ):
+        if not isinstance(value, int) or isinstance(value, bool) or value < 1:
+            raise InvalidParameter(name, value, "an integer >= 1")
+    sweep = _Sweep(
+        executor or SerialExecutor(),
+        in_flight or (1 if executor is None else 10**6),
+        finished,
+        save,
+        progress,
+        points,
+    )
+    anchor_tasks = {
+        f"anchor-{name}": (solve_anchor, (build, name, names, ipopt_options, anchor_starts)) for name in names
+    }
+    anchors = sweep.run(anchor_tasks)
+    by_objective: dict[str, DesignResult] = {}
     for name in names:
-        anchor = solve(problems[name], ipopt_options=ipopt_options, starts=anchor_starts)
-        tick()
-        # Lexicographic: hold this objective at its optimum, minimise the others in turn.
-        for other in (o for o in names if o != name):
-            bound = anchor_bound(name, anchor.objectives[name])
-            try:
-                anchor = solve(
-                    problems[other], epsilon={name: bound}, x0=anchor.x, ipopt_options=ipopt_options
-                )
-            except SolverFailed as error:
-                failed.append(({name: bound}, error.status))
-            tick()
-        anchors[name] = anchor
-        results.append(anchor)
-
-    primary, bounded = names[0], names[1:]
-    grid = epsilon_grid(anchors, bounded, points - len(names))
-    start = anchors[primary]
-    for epsilon in grid:
-        try:
-            result = solve(problems[primary], epsilon=epsilon, x0=start, ipopt_options=ipopt_options)
-        except SolverFailed as error:
-            failed.append((epsilon, error.status))
-        else:
-            results.append(result)
-            start = result
-        tick()
-
-    front, dominated = non_dominated(results, names)
+        anchor = anchors[f"anchor-{name}"]
+        if anchor.result is None:
+            failure = anchor.failures[0]
+            raise SolverFailed(
+                f"the Pareto anchor of {name} could not be solved: {failure.message}", failure.status, {}, []
+            )
+        by_objective[name] = anchor.result
+    grid = epsilon_grid(by_objective, names[1:], points - len(names))
+    start = by_objective[names[0]].x
+    sweep.total = len(names) + len(grid)
+    point_tasks = {
+        f"point-{i:03d}": (solve_point, (build, names, epsilon, start, ipopt_options))
+        for i, epsilon in enumerate(grid)
+    }
+    pieces = [*anchors.values(), *sweep.run(point_tasks).values()]
+    label = {id(p.result): p.label for p in pieces if p.result is not None}
+    front, dominated = non_dominated([p.result for p in pieces if p.result is not None], names)
     return ParetoSet(
         names,
         tuple(front),
-        tuple(failed),
+        tuple(f for p in pieces for f in p.failures),
         tuple(dominated),
         time.perf_counter() - started,
-        solver_builds=len(problems),
+        solver_builds=len(names),
+        labels=tuple(label[id(r)] for r in front),
+        dominated_labels=tuple(label[id(r)] for r in dominated),
+        computed=sweep.computed,
+        reused=sweep.reused,
     )
+
+
+def single_optimum(
+    build: ProblemBuilder,
+    objective: Hashable,
+    ipopt_options: dict[str, Any] | None = None,
+    progress: Callable[[int, int], None] | None = None,
+    *,
+    executor: Executor | None = None,
+    finished: FinishedHook | None = None,
+    save: SaveHook | None = None,
+) -> tuple[DesignResult, bool]:
+    """The optimum of one objective (a name, or what ``build`` takes for a weighted one), run, saved and found
+    again like a piece of :func:`pareto_front` (its name: ``optimum``). Returns the result and whether it was
+    found finished.
+
+    Raises
+    ------
+    SolverFailed: the solve failed.
+    """
+    pieces = _Sweep(executor or SerialExecutor(), 1, finished, save, progress, 1)
+    (point,) = pieces.run({"optimum": (solve_alone, (build, objective, ipopt_options))}).values()
+    if point.result is None:
+        failure = point.failures[0]
+        raise SolverFailed(failure.message, failure.status, {}, [])
+    return point.result, pieces.reused == 1
+
+
+class _Sweep:
+    """Runs named pieces through an executor, a few at a time, reusing and saving finished ones."""
+
+    def __init__(
+        self,
+        executor: Executor,
+        in_flight: int,
+        finished: FinishedHook | None,
+        save: SaveHook | None,
+        progress: Callable[[int, int], None] | None,
+        total: int,
+    ) -> None:
+        self.executor, self.in_flight = executor, in_flight
+        self.finished, self.save, self.progress = finished, save, progress
+        self.total, self.done, self.computed, self.reused = total, 0, 0, 0
+
+    def _tick(self) -> None:
+        self.done += 1
+        if self.progress is not None:
+            self.progress(self.done, self.total)
+
+    def run(
+        self, tasks: dict[str, tuple[Callable[..., SweepPoint], tuple[Any, ...]]]
+    ) -> dict[str, SweepPoint]:
+        """Every task's :class:`SweepPoint`, in the order of ``tasks``."""
+        out: dict[str, SweepPoint] = {}
+        queue = []
+        for name, task in tasks.items():
+            saved = _reusable(self.finished(name)) if self.finished is not None else None
+            if saved is not None:
+                out[name] = saved
+                self.reused += 1
+                self._tick()
+            else:
+                queue.append((name, task))
+        pending: dict[Future, str] = {}
+        try:
+            while queue or pending:
+                while queue and len(pending) < self.in_flight:
+                    name, (function, args) = queue.pop(0)
+                    pending[self.executor.submit(function, *args)] = name
+                done, _ = wait(pending, return_when=FIRST_COMPLETED)
+                for future in sorted(done, key=lambda f: pending[f]):
+                    name = pending.pop(future)
+                    out[name] = future.result()
+                    if self.save is not None:
+                        self.save(name, out[name].to_json())
+                    self.computed += 1
+                    self._tick()
+        except BaseException:
+            for future in pending:
+                future.cancel()
+            raise
+        return {name: out[name] for name in tasks}
+
+
+def _reusable(saved: Mapping[str, Any] | None) -> SweepPoint | None:
+    """A saved piece, or None if there is none or it is not one (another version's file): then it is redone."""
+    if saved is None:
+        return None
+    try:
+        return SweepPoint.from_json(saved)
+    except (KeyError, TypeError, ValueError):
+        return None
+
+
+# --- pieces of a sweep (run in workers: picklable arguments, a picklable SweepPoint back) ---------------------
+
+_SOLVER_LOCK = threading.RLock()
+"""CasADi functions, IPOPT and (sequential) MUMPS are not thread-safe: within one process the pieces run one at a
+time (a Dask worker with several threads, for instance); parallelism comes from processes."""
+
+
+@functools.lru_cache(maxsize=16)
+def built_problem(build: Hashable, objective: Hashable, bounded: tuple[str, ...] = ()) -> DesignProblem:
+    """``build(objective, bounded)``, built once per process and builder (later pieces reuse its solvers; the
+    results do not depend on which piece came first)."""
+    problem: DesignProblem = build(objective, bounded)  # type: ignore[operator]
+    return problem
+
+
+def _one_at_a_time(function: Callable[..., SweepPoint]) -> Callable[..., SweepPoint]:
+    """Run a piece under the solver lock with single-threaded BLAS (the same numbers in every process)."""
+
+    @functools.wraps(function)
+    def locked(*args: Any, **kwargs: Any) -> SweepPoint:
+        with _SOLVER_LOCK, single_threaded_blas():
+            return function(*args, **kwargs)
+
+    return locked
+
+
+def _others(names: Sequence[str], name: str) -> tuple[str, ...]:
+    return tuple(other for other in names if other != name)
+
+
+@_one_at_a_time
+def solve_anchor(
+    build: ProblemBuilder,
+    objective: str,
+    objectives: tuple[str, ...],
+    ipopt_options: dict[str, Any] | None,
+    starts: int = 1,
+) -> SweepPoint:
+    """A Pareto anchor: ``objective`` minimised (from ``starts`` start points), then (lexicographically) each
+    other objective with it held at its optimum, so that the anchor is not dominated. A lexicographic step the
+    solver cannot do keeps the anchor found so far and is recorded among the failures."""
+    label = f"anchor: {objective}"
+    try:
+        result = solve(
+            built_problem(build, objective, _others(objectives, objective)),
+            ipopt_options=ipopt_options,
+            starts=starts,
+        )
+    except SolverFailed as error:
+        return SweepPoint(label, None, (PointFailure(objective, {}, error.status, str(error.args[0])),))
+    held = {objective: anchor_bound(objective, result.objectives[objective])}
+    failures = []
+    for other in _others(objectives, objective):
+        try:
+            result = solve(
+                built_problem(build, other, _others(objectives, other)),
+                epsilon=held,
+                x0=result.x,
+                ipopt_options=ipopt_options,
+            )
+        except SolverFailed as error:
+            failures.append(PointFailure(other, dict(held), error.status, str(error.args[0])))
+    return SweepPoint(label, result, tuple(failures))
+
+
+@_one_at_a_time
+def solve_point(
+    build: ProblemBuilder,
+    objectives: tuple[str, ...],
+    epsilon: dict[str, float],
+    start: np.ndarray,
+    ipopt_options: dict[str, Any] | None,
+) -> SweepPoint:
+    """One epsilon-constraint point: the first objective minimised with the others bounded by ``epsilon``
+    [their units], started from ``start`` (a point of the NLP's variables)."""
+    label = "epsilon: " + ", ".join(_bound_text(k, v) for k, v in epsilon.items())
+    problem = built_problem(build, objectives[0], objectives[1:])
+    try:
+        result = solve(problem, epsilon=epsilon, x0=np.asarray(start), ipopt_options=ipopt_options)
+    except SolverFailed as error:
+        return SweepPoint(
+            label, None, (PointFailure(objectives[0], epsilon, error.status, str(error.args[0])),)
+        )
+    return SweepPoint(label, result)
+
+
+@_one_at_a_time
+def solve_alone(
+    build: ProblemBuilder, objective: Hashable, ipopt_options: dict[str, Any] | None
+) -> SweepPoint:
+    """A single-objective optimum (``objective``: a name, or what ``build`` takes for a weighted one) as a
+    piece run like the sweep's."""
+    try:
+        result = solve(built_problem(build, objective), ipopt_options=ipopt_options)
+    except SolverFailed as error:
+        return SweepPoint(
+            "optimum", None, (PointFailure(str(objective), {}, error.status, str(error.args[0])),)
+        )
+    return SweepPoint("optimum", result)
+
+
+def _bound_text(name: str, value: float) -> str:
+    """``mass <= 0.1`` for a minimised objective, ``approach_velocity >= 0.4`` for a maximised one."""
+    return f"{name} {'<=' if OBJECTIVES[name][0] > 0 else '>='} {value:.4g}"
 
 
 def anchor_bound(name: str, value: float) -> float:
@@ -191,7 +436,7 @@ def anchor_bound(name: str, value: float) -> float:
 
 
 def epsilon_grid(
-    anchors: dict[str, DesignResult], bounded: Sequence[str], count: int
+    anchors: Mapping[str, DesignResult], bounded: Sequence[str], count: int
 ) -> list[dict[str, float]]:
     """Bounds on the bounded objectives spread between their values at the anchors, ordered so that each point
     is near the previous one (a snake through the grid for three objectives).
@@ -221,29 +466,39 @@ def _minimised(values: np.ndarray, names: Sequence[str]) -> np.ndarray:
     return values * np.array([OBJECTIVES[name][0] for name in names], dtype=float)
 
 
+def _dominance(values: np.ndarray, tolerance: float) -> np.ndarray:
+    """(n, n) booleans of minimised ``values`` (n, m): ``[i, j]`` if point i dominates point j (no worse in any
+    column and better in one, by more than ``tolerance`` of the column's largest magnitude)."""
+    scale = np.maximum(np.abs(values).max(axis=0), 1e-300)
+    diff = (values[:, None, :] - values[None, :, :]) / scale  # [i, j] < 0: i is better than j
+    return np.all(diff <= tolerance, axis=2) & np.any(diff < -tolerance, axis=2)
+
+
+def dominated_mask(values: np.ndarray, tolerance: float = DOMINANCE_TOLERANCE) -> np.ndarray:
+    """(n,) booleans: which rows of ``values`` (n, m; every column minimised) another row dominates."""
+    values = np.asarray(values, dtype=float)
+    if not len(values):
+        return np.zeros(0, dtype=bool)
+    return np.asarray(_dominance(values, tolerance).any(axis=0), dtype=bool)
+
+
 def non_dominated(
-    results: list[DesignResult], names: Sequence[str], tolerance: float = 1e-9
+    results: Sequence[DesignResult], names: Sequence[str], tolerance: float = DOMINANCE_TOLERANCE
 ) -> tuple[list[DesignResult], list[DesignResult]]:
     """Split results into the non-dominated ones (sorted by the first objective) and the dominated ones.
 
     ``a`` dominates ``b`` if it is no worse in every objective and better by more than ``tolerance`` (relative)
     in at least one; near-duplicates (equal within the tolerance) keep the first found.
     """
+    if not results:
+        return [], []
     values = _minimised(np.array([[r.numpy_objectives[n] for n in names] for r in results]), names)
     scale = np.maximum(np.abs(values).max(axis=0), 1e-300)
-    keep: list[int] = []
-    dropped: list[int] = []
-    for i in range(len(results)):
-        diff = (values - values[i]) / scale  # < 0: the other is better
-        no_worse = np.all(diff <= tolerance, axis=1)
-        better = np.any(diff < -tolerance, axis=1)
-        duplicate_before = np.all(np.abs(diff) <= tolerance, axis=1) & (np.arange(len(results)) < i)
-        if np.any(no_worse & better) or np.any(duplicate_before):
-            dropped.append(i)
-        else:
-            keep.append(i)
-    keep.sort(key=lambda i: values[i, 0])
-    return [results[i] for i in keep], [results[i] for i in dropped]
+    same = np.all(np.abs((values[:, None, :] - values[None, :, :]) / scale) <= tolerance, axis=2)
+    earlier_duplicate = np.tril(same, k=-1).any(axis=1)  # [i, j] with j < i
+    dropped = _dominance(values, tolerance).any(axis=0) | earlier_duplicate
+    keep = sorted(np.flatnonzero(~dropped).tolist(), key=lambda i: values[i, 0])
+    return [results[i] for i in keep], [results[i] for i in np.flatnonzero(dropped).tolist()]
 
 
 def hypervolume(points: np.ndarray, reference: np.ndarray) -> float:

@@ -1,7 +1,6 @@
 """A run's result files from its results (plain data): ``designs.json``, ``pareto.csv``, figures (PNG and SVG),
 ``report.html`` and optionally ``report.pdf``. :func:`render_report` redoes the figures and the report from a
-folder's saved ``designs.json`` alone.
-"""
+folder's saved ``designs.json`` alone."""
 
 from __future__ import annotations
 
@@ -10,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import CollisionReflexError
-from ..study.store import DESIGNS, PARETO, REPORT, ResultsMissing, read_json, write_json, write_text
+from .files import DESIGNS, PARETO, REPORT, ResultsMissing, read_json, write_json, write_text
 
 
 def objective_unit(name: str) -> str:
@@ -20,46 +19,19 @@ def objective_unit(name: str) -> str:
     return OBJECTIVES[name][1]
 
 
-# Per-joint columns of pareto.csv: (record key, column name, unit).
-JOINT_COLUMNS = (
-    ("stator_diameter", "stator_diameter", "m"),
-    ("stack_length", "stack_length", "m"),
-    ("gear_ratio", "gear_ratio", "-"),
-    ("software_stiffness", "software_stiffness", "N*m/rad"),
-    ("reflected_inertia", "reflected_inertia", "kg*m^2"),
-    ("peak_torque", "peak_torque", "N*m"),
-    ("required_torque", "required_torque", "N*m"),
-    ("motor_mass", "motor_mass", "kg"),
-)
-
-
 def pareto_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
     """The rows of ``pareto.csv``: one per Pareto design (arm studies; the chosen design if there is no front)
-    or per candidate actuator (actuator studies).
-    """
+    or per candidate actuator (actuator studies)."""
+    from ..optimize.results import record_row
+
     if results["kind"] == "actuator":
         return _actuator_rows(results)
     points = results["pareto"]["points"] or [results["chosen"]]
-    rows = []
-    for index, record in enumerate(points):
-        row: dict[str, Any] = {"point": index, "label": record["label"]}
-        for name, value in record["objectives"].items():
-            row[f"{name} [{objective_unit(name)}]"] = value
-        for key, column, unit in JOINT_COLUMNS:
-            for joint in record["joints"]:
-                row[f"{column}[{joint['joint']}] [{unit}]"] = joint[key]
-        unit = "N" if record["sensing"] == "force" else "m"
-        row[f"threshold [{unit}]"] = record["threshold"]
-        row["status"] = record["solver"]["status"]
-        row["iterations"] = record["solver"]["iterations"]
-        row["solve_time [s]"] = record["solver"]["solve_time"]
-        rows.append(row)
-    return rows
+    return [record_row(record, index) for index, record in enumerate(points)]
 
 
 def _actuator_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
     candidates = results["candidates"]
-    best = _non_dominated_candidates(candidates)
     rows = []
     for candidate in candidates:
         rows.append(
@@ -74,24 +46,10 @@ def _actuator_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
                 "impulse_at_v0 [N*s]": candidate["impulse"]["total"],
                 "optimal_velocity [m/s]": candidate["optimal_velocity"],
                 "minimum_impulse [N*s]": candidate["minimum_impulse"],
-                "pareto_optimal": candidate["name"] in best,
+                "pareto_optimal": candidate["pareto_optimal"],
             }
         )
     return rows
-
-
-def _non_dominated_candidates(candidates: list[dict[str, Any]]) -> set[str]:
-    """Candidates no other beats in both minimum impulse and mass."""
-    out = set()
-    for c in candidates:
-        if not any(
-            o["minimum_impulse"] <= c["minimum_impulse"]
-            and o["mass"] <= c["mass"]
-            and (o["minimum_impulse"] < c["minimum_impulse"] or o["mass"] < c["mass"])
-            for o in candidates
-        ):
-            out.add(c["name"])
-    return out
 
 
 def write_outputs(folder: str | os.PathLike[str], results: dict[str, Any], figures: bool = True) -> Path:
@@ -115,8 +73,7 @@ def render_report(
     folder: str | os.PathLike[str], results: dict[str, Any] | None = None, figures: bool = True
 ) -> Path:
     """(Re)draw the figures and write ``report.html`` (and ``report.pdf`` if the study asks) from the results
-    saved in ``folder``.
-    """
+    saved in ``folder``."""
     from .figures import draw_figures
     from .html import render_html
 

@@ -149,8 +149,13 @@ def evaluate_actuator_study(loaded: LoadedStudy) -> dict[str, Any]:
                 "an actuator with non-finite contact parameters",
                 "finite stiffness, inertia and torque",
             )
+    from ..optimize.pareto import dominated_mask
     from .resolve import resolved_study
 
+    # Pareto-optimal: no other candidate has both a lower minimum impulse and a lower mass (exact comparison).
+    values = np.array([[c["minimum_impulse"], c["mass"]] for c in candidates]).reshape(-1, 2)
+    for record, dominated in zip(candidates, dominated_mask(values, tolerance=0.0), strict=True):
+        record["pareto_optimal"] = not bool(dominated)
     return {
         "kind": "actuator",
         "study": study.name,

@@ -6,25 +6,14 @@ from __future__ import annotations
 
 import contextlib
 import multiprocessing
-from collections.abc import Callable, Iterator
-from concurrent.futures import Executor, Future, ProcessPoolExecutor
-from typing import Any
+from collections.abc import Iterator
+from concurrent.futures import Executor, ProcessPoolExecutor
 
 from ..errors import CollisionReflexError, InvalidParameter
+from ..optimize.serial import SerialExecutor
 
 EXECUTORS = ("serial", "processes", "dask")
-
-
-class SerialExecutor(Executor):
-    """Runs each task when it is submitted, in this process (the default: no start-up cost, easy to debug)."""
-
-    def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> Future:
-        future: Future = Future()
-        try:
-            future.set_result(fn(*args, **kwargs))
-        except Exception as error:  # delivered through the future, as a pool would; Ctrl-C stops at once
-            future.set_exception(error)
-        return future
+__all__ = ["EXECUTORS", "DaskUnavailable", "SerialExecutor", "open_executor"]
 
 
 class DaskUnavailable(CollisionReflexError):

@@ -11,11 +11,12 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable
-from concurrent.futures import FIRST_COMPLETED, Executor, Future, wait
+from concurrent.futures import Executor
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from .arm_results import arm_results
 from .executors import open_executor
 from .load import LoadedStudy, load_study, parse_study
 from .resolve import fingerprint, resolved_study, resolved_yaml
@@ -47,8 +48,7 @@ class RunResult:
 
 def smoke_study(data: dict[str, Any]) -> dict[str, Any]:
     """A resolved study shrunk for a quick run: a few configurations, directions, Pareto points and
-    velocities. The shrunk study is what the run records as its resolved study.
-    """
+    velocities. The shrunk study is what the run records as its resolved study."""
     data = {**data}
     if data.get("kind") == "actuator":
         data["velocities"] = {**data["velocities"], "count": min(data["velocities"]["count"], 12)}
@@ -170,12 +170,11 @@ def _dump(data: dict[str, Any]) -> str:
 
 def _prepare(loaded: LoadedStudy, text: str) -> None:
     """Check everything a run needs; problems are located in ``loaded`` (the file as written), while the
-    problem is built from ``text`` (the resolved study that runs).
-    """
+    problem is built from ``text`` (the resolved study that runs)."""
     if isinstance(loaded.study, ArmStudy):
-        from . import _optimizer
+        from .arm_setup import checked_setup
 
-        _optimizer.checked_setup(loaded, text)
+        checked_setup(loaded, text)
     else:
         from .actuator_study import check_actuator_study
 
@@ -206,51 +205,23 @@ class _Progress:
         task = self._bar.add_task(description, total=total, completed=done)
         return lambda: self._bar.advance(task)
 
+    def counter(self, description: str) -> Callable[[int, int], None]:
+        """A ``progress(done, total)`` callback drawing one bar."""
+        state: dict[str, Any] = {}
+
+        def update(done: int, total: int) -> None:
+            if self._bar is None:
+                return
+            if "task" not in state:
+                state["task"] = self._bar.add_task(description, total=total)
+            self._bar.update(state["task"], completed=done, total=total)
+
+        return update
+
     def stop(self) -> None:
         if self._bar is not None:
             self._bar.stop()
             self._bar = None
-
-
-def _gather(
-    pool: Executor,
-    folder: RunFolder,
-    work: dict[str, tuple[Callable[..., Any], tuple[Any, ...]]],
-    progress: _Progress,
-    description: str,
-    window: int,
-) -> tuple[dict[str, Any], int]:
-    """Run each named piece of work not finished yet, at most ``window`` at a time, saving each as it
-    completes (so an interruption loses only the pieces in flight). Returns every record (finished before and
-    now) and how many were computed now.
-    """
-    records: dict[str, Any] = {}
-    queue: list[tuple[str, tuple[Callable[..., Any], tuple[Any, ...]]]] = []
-    for name, job in work.items():
-        saved = folder.finished(name)
-        if saved is not None:
-            records[name] = saved
-        else:
-            queue.append((name, job))
-    computed = len(queue)
-    advance = progress.stage(description, len(work), len(records))
-    pending: dict[Future, str] = {}
-    try:
-        while queue or pending:
-            while queue and len(pending) < window:
-                name, (fn, args) = queue.pop(0)
-                pending[pool.submit(fn, *args)] = name
-            done, _ = wait(pending, return_when=FIRST_COMPLETED)
-            for future in sorted(done, key=lambda f: pending[f]):
-                name = pending.pop(future)
-                records[name] = future.result()
-                folder.save(name, records[name])
-                advance()
-    except BaseException:
-        for future in pending:
-            future.cancel()
-        raise
-    return {name: records[name] for name in work}, computed
 
 
 def _run_arm(
@@ -261,64 +232,50 @@ def _run_arm(
     progress: _Progress,
     window: int,
 ) -> tuple[dict[str, Any], tuple[int, int]]:
-    from . import _optimizer
+    """The study's optimum, and its Pareto front by the optimiser's one sweep; each piece saved as it
+    finishes and found again when the run resumes."""
+    from ..errors import SolverFailed, StudyRunFailed
+    from ..optimize.pareto import pareto_front, single_optimum
+    from .arm_setup import IPOPT_OPTIONS, StudyProblems
 
-    computed = reused = 0
-    chosen, n = _gather(
-        pool,
-        folder,
-        {"optimum": (_optimizer.solve_single, (text,))},
-        progress,
-        "optimum of the study's objective",
-        window,
-    )
-    computed += n
-    reused += 1 - n
-    pareto: dict[str, Any] = {"objectives": [], "points": [], "failed": [], "dominated": []}
+    problems = StudyProblems(text)
+    try:
+        optimum, found = single_optimum(
+            problems,
+            problems.objective,
+            IPOPT_OPTIONS,
+            progress.counter("optimum of the study's objective"),
+            executor=pool,
+            finished=folder.finished,
+            save=folder.save,
+        )
+    except SolverFailed as error:
+        raise StudyRunFailed(f"the optimum solve failed: {error.args[0]}", "optimum", error.status) from None
+    computed, reused = (0, 1) if found else (1, 0)
+    front = None
     if study.pareto is not None:
-        names = tuple(study.pareto.objectives)
-        anchors, n = _gather(
-            pool,
-            folder,
-            {f"anchor-{name}": (_optimizer.solve_anchor, (text, name, names)) for name in names},
-            progress,
-            "Pareto anchors",
-            window,
-        )
-        computed += n
-        reused += len(anchors) - n
-        by_objective: dict[str, dict[str, Any]] = {name: anchors[f"anchor-{name}"] for name in names}
-        grid = _optimizer.epsilon_grid(by_objective, names, study.pareto.points - len(names))
-        start = by_objective[names[0]]["x"]
-        points, n = _gather(
-            pool,
-            folder,
-            {
-                f"point-{i:03d}": (_optimizer.solve_point, (text, names, epsilon, start))
-                for i, epsilon in enumerate(grid)
-            },
-            progress,
-            "Pareto points",
-            window,
-        )
-        computed += n
-        reused += len(points) - n
-        solved = [*anchors.values(), *(p for p in points.values() if not p.get("failed"))]
-        front, dominated = _optimizer.non_dominated(solved, names)
-        pareto = {
-            "objectives": list(names),
-            "points": front,
-            "failed": [p for p in points.values() if p.get("failed")],
-            "dominated": dominated,
-        }
+        try:
+            front = pareto_front(
+                problems,
+                tuple(study.pareto.objectives),
+                study.pareto.points,
+                IPOPT_OPTIONS,
+                progress=progress.counter("Pareto sweep"),
+                anchor_starts=study.pareto.anchor_starts,
+                executor=pool,
+                in_flight=window,
+                finished=folder.finished,
+                save=folder.save,
+            )
+        except SolverFailed as error:
+            raise StudyRunFailed(str(error.args[0]), "anchor", error.status) from None
+        computed, reused = computed + front.computed, reused + front.reused
     results = {
         "kind": "arm",
         "study": study.name,
         "description": study.description,
         "resolved": resolved_study(parse_study(text, "resolved study")),
-        "samples": _optimizer.sample_layout(_optimizer.setup_from_text(text)),
-        "chosen": chosen["optimum"],
-        "pareto": pareto,
+        **arm_results(problems, optimum, front),
     }
     return results, (computed, reused)
 

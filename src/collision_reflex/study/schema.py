@@ -337,6 +337,15 @@ class ConstraintsSpec(_Model):
 class ParetoSpec(_Model):
     objectives: list[ObjectiveName] = Field(min_length=2, max_length=3)
     points: Annotated[int, Field(ge=2, le=400, strict=True)] = 20
+    anchor_starts: Annotated[
+        int,
+        Field(
+            ge=1,
+            le=50,
+            strict=True,
+            description="start points of each anchor's first solve (multi-start against local optima)",
+        ),
+    ] = 1
 
     @field_validator("objectives")
     @classmethod

@@ -13,44 +13,32 @@ Every file is written to a temporary name and renamed, so it is complete or abse
 
 from __future__ import annotations
 
-import json
-import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .._io import atomic_open
 from ..errors import CollisionReflexError
+from ..report.files import DESIGNS, PARETO, REPORT, ResultsMissing, read_json, write_json, write_text
 
 MANIFEST = "run.json"
 RESOLVED = "study.resolved.yaml"
-DESIGNS = "designs.json"
-PARETO = "pareto.csv"
-REPORT = "report.html"
+__all__ = [
+    "DESIGNS",
+    "MANIFEST",
+    "PARETO",
+    "REPORT",
+    "RESOLVED",
+    "OutputFolderInUse",
+    "ResultsMissing",
+    "RunFolder",
+    "read_json",
+    "write_json",
+    "write_text",
+]
 
 
 class OutputFolderInUse(CollisionReflexError):
     """The output folder holds results of a different study (or of the same study with other settings)."""
-
-
-class ResultsMissing(CollisionReflexError, FileNotFoundError):
-    """A folder has no saved results to report on."""
-
-
-def write_json(path: str | os.PathLike[str], data: Any) -> None:
-    """Write ``data`` as JSON, atomically (NaN refused: it is never a valid result)."""
-    with atomic_open(path, "w", encoding="utf-8") as handle:
-        json.dump(data, handle, indent=1, allow_nan=False)
-        handle.write("\n")
-
-
-def write_text(path: str | os.PathLike[str], text: str) -> None:
-    with atomic_open(path, "w", encoding="utf-8") as handle:
-        handle.write(text)
-
-
-def read_json(path: str | os.PathLike[str]) -> Any:
-    return json.loads(Path(path).read_text(encoding="utf-8"))
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,36 @@
+"""Every BLAS on one thread while a solve runs, so that every executor gives the same numbers."""
+
+from __future__ import annotations
+
+import contextlib
+
+_CASADI_BLAS_REGISTERED: list[bool] = []
+
+
+def single_threaded_blas() -> contextlib.AbstractContextManager[object]:
+    """A context with every BLAS (NumPy's, and the OpenBLAS that CasADi bundles for IPOPT and MUMPS) on one
+    thread.
+
+    A threaded BLAS sums in an order that depends on its thread count, and Dask workers pin it to one thread
+    where a plain process does not; the difference moves IPOPT's iterates and so the results, within the solver
+    tolerance. With one thread everywhere, every executor gives the same numbers, bitwise in practice
+    (parallelism comes from the executor's processes).
+    """
+    import threadpoolctl
+
+    if not _CASADI_BLAS_REGISTERED:
+        threadpoolctl.register(_casadi_openblas_controller())
+        _CASADI_BLAS_REGISTERED.append(True)
+    return threadpoolctl.threadpool_limits(limits=1)
+
+
+def _casadi_openblas_controller() -> type:
+    from threadpoolctl import OpenBLASController
+
+    class CasadiOpenBLAS(OpenBLASController):
+        """CasADi's bundled OpenBLAS, which threadpoolctl does not know by its file name."""
+
+        internal_api = "casadi_openblas"
+        filename_prefixes = ("libcasadi-tp-openblas",)
+
+    return CasadiOpenBLAS

@@ -1,0 +1,270 @@
+"""The one result record of a design: its objectives, per-joint quantities, margins and solver status as plain
+data (JSON types, SI units), and the one table row made from it (``ParetoSet.to_frame``, ``pareto.csv`` and the
+report's tables).
+
+A sweep's finished pieces (:class:`SweepPoint`) round-trip through JSON exactly (floats are written with
+``repr``), so that a run resumed from saved points gives the numbers of an uninterrupted one.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..model.impulse import optimal_velocity, phase_impulses, series_stiffness
+from .problem import OBJECTIVES
+from .solve import Design, DesignResult
+
+if TYPE_CHECKING:
+    from ..hardware.motors import Motor
+    from .problem import DesignProblem
+
+JOINT_COLUMNS = (
+    ("stator_diameter", "m"),
+    ("stack_length", "m"),
+    ("gear_ratio", "-"),
+    ("software_stiffness", "N*m/rad"),
+    ("reflected_inertia", "kg*m^2"),
+    ("peak_torque", "N*m"),
+    ("required_torque", "N*m"),
+    ("motor_mass", "kg"),
+)
+"""Per-joint columns of a design's table row: (record key, unit)."""
+
+
+def threshold_unit(sensing: str) -> str:
+    """The unit of a design's threshold: a force [N] for force sensing, a position error [m] otherwise."""
+    return "N" if sensing == "force" else "m"
+
+
+@dataclass(frozen=True)
+class PointFailure:
+    """A solve of a sweep that did not succeed: which objective was minimised under which bounds, and why.
+
+    objective: the minimised objective; epsilon: the bounds on the others [their units] (empty for an anchor's
+    first solve); status: the solver's return status; message: its explanation.
+    """
+
+    objective: str
+    epsilon: dict[str, float]
+    status: str
+    message: str
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "objective": self.objective,
+            "epsilon": dict(self.epsilon),
+            "status": self.status,
+            "message": self.message,
+        }
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> PointFailure:
+        return cls(str(data["objective"]), dict(data["epsilon"]), str(data["status"]), str(data["message"]))
+
+
+@dataclass(frozen=True)
+class SweepPoint:
+    """One finished piece of a Pareto sweep.
+
+    label: what was solved (``"anchor: actuator_mass"``, ``"epsilon: actuator_mass <= 0.1"``, ``"optimum"``);
+    result: the design found, or None if the solve failed; failures: the solves that failed on the way (a failed
+    point's own solve, or an anchor's lexicographic steps, whose anchor then is the one found so far).
+    """
+
+    label: str
+    result: DesignResult | None
+    failures: tuple[PointFailure, ...] = field(default=())
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "label": self.label,
+            "result": None if self.result is None else result_to_json(self.result),
+            "failures": [f.as_dict() for f in self.failures],
+        }
+
+    @classmethod
+    def from_json(cls, data: Mapping[str, Any]) -> SweepPoint:
+        result = data["result"]
+        return cls(
+            str(data["label"]),
+            None if result is None else result_from_json(result),
+            tuple(PointFailure.from_dict(f) for f in data["failures"]),
+        )
+
+
+_DESIGN_ARRAYS = (
+    "stator_diameter",
+    "stack_length",
+    "gear_ratio",
+    "software_stiffness",
+    "mechanical_stiffness",
+    "rotor_inertia",
+    "reflected_inertia",
+    "motor_peak_torque",
+    "peak_torque",
+    "motor_mass",
+)
+
+
+def result_to_json(result: DesignResult) -> dict[str, Any]:
+    """A :class:`DesignResult` as JSON types (the solver's multipliers are left out: sweeps start from points)."""
+    return {
+        "design": result.design.as_dict(),
+        "objectives": dict(result.objectives),
+        "numpy_objectives": dict(result.numpy_objectives),
+        "impulses": np.asarray(result.impulses, dtype=float).tolist(),
+        "required_torque": np.asarray(result.required_torque, dtype=float).tolist(),
+        "torque_margin": np.asarray(result.torque_margin, dtype=float).tolist(),
+        "status": result.status,
+        "success": bool(result.success),
+        "iterations": int(result.iterations),
+        "solve_time": float(result.solve_time),
+        "build_time": float(result.build_time),
+        "epsilon": {k: float(v) for k, v in result.epsilon.items()},
+        "x": np.asarray(result.x, dtype=float).tolist(),
+    }
+
+
+def result_from_json(data: Mapping[str, Any]) -> DesignResult:
+    """The :class:`DesignResult` written by :func:`result_to_json` (bitwise the same numbers)."""
+    saved = data["design"]
+    design = Design(
+        joint_names=tuple(saved["joint_names"]),
+        **{name: np.asarray(saved[name], dtype=float) for name in _DESIGN_ARRAYS},
+        threshold=float(saved["threshold"]),
+        approach_velocity=float(saved["approach_velocity"]),
+        sensing=str(saved["sensing"]),
+    )
+    return DesignResult(
+        design=design,
+        objectives=dict(data["objectives"]),
+        numpy_objectives=dict(data["numpy_objectives"]),
+        impulses=np.asarray(data["impulses"], dtype=float),
+        required_torque=np.asarray(data["required_torque"], dtype=float),
+        torque_margin=np.asarray(data["torque_margin"], dtype=float),
+        status=str(data["status"]),
+        success=bool(data["success"]),
+        iterations=int(data["iterations"]),
+        solve_time=float(data["solve_time"]),
+        build_time=float(data["build_time"]),
+        epsilon=dict(data["epsilon"]),
+        x=np.asarray(data["x"], dtype=float),
+    )
+
+
+def result_record(result: DesignResult, label: str) -> dict[str, Any]:
+    """A design and its solve as plain data: objectives, per-joint quantities and margins, solver status."""
+    design = result.design
+    joints = []
+    for i, name in enumerate(design.joint_names):
+        joints.append(
+            {
+                "joint": name,
+                "stator_diameter": float(design.stator_diameter[i]),
+                "stack_length": float(design.stack_length[i]),
+                "gear_ratio": float(design.gear_ratio[i]),
+                "rotor_inertia": float(design.rotor_inertia[i]),
+                "reflected_inertia": float(design.reflected_inertia[i]),
+                "motor_peak_torque": float(design.motor_peak_torque[i]),
+                "peak_torque": float(design.peak_torque[i]),
+                "required_torque": float(result.required_torque[i]),
+                # No requirement (a joint gravity does not load): a margin is meaningless, not a huge number.
+                "torque_margin": (
+                    float(result.torque_margin[i])
+                    if result.required_torque[i] > 1e-9 * design.peak_torque[i]
+                    else None
+                ),
+                "mechanical_stiffness": float(design.mechanical_stiffness[i]),
+                "software_stiffness": float(design.software_stiffness[i]),
+                "stiffness": float(
+                    series_stiffness(design.mechanical_stiffness[i], design.software_stiffness[i])
+                ),
+                "motor_mass": float(design.motor_mass[i]),
+            }
+        )
+    return {
+        "label": label,
+        "objectives": {k: float(v) for k, v in result.numpy_objectives.items()},
+        "casadi_objectives": {k: float(v) for k, v in result.objectives.items()},
+        "threshold": float(design.threshold),
+        "sensing": design.sensing,
+        "approach_velocity": float(design.approach_velocity),
+        "joints": joints,
+        "impulses": np.asarray(result.impulses, dtype=float).tolist(),
+        "solver": {
+            "status": result.status,
+            "iterations": int(result.iterations),
+            "solve_time": float(result.solve_time),
+            "build_time": float(result.build_time),
+            "epsilon": {k: float(v) for k, v in result.epsilon.items()},
+        },
+    }
+
+
+def design_record(
+    problem: DesignProblem,
+    result: DesignResult,
+    label: str,
+    catalogue: Mapping[str, Motor] | None = None,
+) -> dict[str, Any]:
+    """:func:`result_record` with what a report shows about the collisions: the impulse phases and the optimal
+    approach velocity per sample (from ``problem``'s samples), and each joint's nearest catalogue motor."""
+    from .evaluate import design_collision_parameters
+
+    record = result_record(result, label)
+    design = result.design
+    reaction = problem.technology.reaction
+    params, threshold = design_collision_parameters(problem, design)
+    phases = phase_impulses(
+        params.m_f, params.k, params.k_m, threshold, params.a, design.approach_velocity, reaction
+    )
+    v_star = optimal_velocity(params.m_f, params.k, threshold, reaction, params.k_m, params.a)
+    record["phases"] = {
+        "initial": np.broadcast_to(phases.initial, params.m_f.shape).tolist(),
+        "sensing": np.broadcast_to(phases.sensing, params.m_f.shape).tolist(),
+        "reaction": np.broadcast_to(phases.reaction, params.m_f.shape).tolist(),
+    }
+    record["optimal_velocity"] = np.asarray(v_star, dtype=float).tolist()
+    for i, joint in enumerate(record["joints"]):
+        joint["nearest_catalogue_motor"] = (
+            nearest_catalogue_motor(
+                catalogue, float(design.motor_peak_torque[i]), float(design.rotor_inertia[i])
+            )
+            if catalogue
+            else None
+        )
+    return record
+
+
+def nearest_catalogue_motor(catalogue: Mapping[str, Motor], peak_torque: float, rotor_inertia: float) -> str:
+    """The catalogue motor closest to a scaled motor (peak torque [N*m], rotor inertia [kg*m^2]) in (log peak
+    torque, log rotor inertia): the off-the-shelf part a designer would start from."""
+    best, best_distance = "", math.inf
+    for name, motor in catalogue.items():
+        distance = math.hypot(
+            math.log(motor.peak_torque / peak_torque), math.log(motor.rotor_inertia / rotor_inertia)
+        )
+        if distance < best_distance:
+            best, best_distance = name, distance
+    return best
+
+
+def record_row(record: Mapping[str, Any], index: int) -> dict[str, Any]:
+    """The table row of a design record, every column name with its unit: ``pareto.csv``, the report's table
+    and :meth:`ParetoSet.to_frame` are made of these."""
+    row: dict[str, Any] = {"point": index, "label": record["label"]}
+    for name, value in record["objectives"].items():
+        row[f"{name} [{OBJECTIVES[name][1]}]"] = value
+    for key, unit in JOINT_COLUMNS:
+        for joint in record["joints"]:
+            row[f"{key}[{joint['joint']}] [{unit}]"] = joint[key]
+    row[f"threshold [{threshold_unit(record['sensing'])}]"] = record["threshold"]
+    row["status"] = record["solver"]["status"]
+    row["iterations"] = record["solver"]["iterations"]
+    row["solve_time [s]"] = record["solver"]["solve_time"]
+    return row

@@ -1,0 +1,35 @@
+"""The names of a run's result files, and atomic JSON and text writes (the run folder uses them too)."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+from .._io import atomic_open
+from ..errors import CollisionReflexError
+
+DESIGNS = "designs.json"
+PARETO = "pareto.csv"
+REPORT = "report.html"
+
+
+class ResultsMissing(CollisionReflexError, FileNotFoundError):
+    """A folder has no saved results to report on."""
+
+
+def write_json(path: str | os.PathLike[str], data: Any) -> None:
+    """Write ``data`` as JSON, atomically (NaN refused: it is never a valid result)."""
+    with atomic_open(path, "w", encoding="utf-8") as handle:
+        json.dump(data, handle, indent=1, allow_nan=False)
+        handle.write("\n")
+
+
+def write_text(path: str | os.PathLike[str], text: str) -> None:
+    with atomic_open(path, "w", encoding="utf-8") as handle:
+        handle.write(text)
+
+
+def read_json(path: str | os.PathLike[str]) -> Any:
+    return json.loads(Path(path).read_text(encoding="utf-8"))

@@ -1,0 +1,42 @@
+"""An arm study's results as plain data (``designs.json``): the chosen design, the Pareto front as the optimiser
+decided it, and where each contact sample comes from."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from ..optimize.pareto import built_problem
+from ..optimize.results import design_record
+from .arm_setup import StudyProblems, sample_layout
+
+if TYPE_CHECKING:
+    from ..optimize import DesignResult, ParetoSet
+
+
+def arm_results(problems: StudyProblems, chosen: DesignResult, front: ParetoSet | None) -> dict[str, Any]:
+    """``samples``, ``chosen`` and ``pareto`` of an arm study's results.
+
+    The chosen design (the optimum of the study's objective) records ``dominated_by``: the index of a Pareto
+    design that dominates it, or None (a local optimum the sweep beat, or no front computed).
+    """
+    setup = problems.setup
+    # Every problem of a study shares its samples and technology: one of them evaluates every record.
+    problem = built_problem(problems, problems.objective)
+
+    def record(result: DesignResult, label: str) -> dict[str, Any]:
+        return design_record(problem, result, label, setup.catalogue)
+
+    pareto: dict[str, Any] = {"objectives": [], "points": [], "failed": [], "dominated": []}
+    chosen_record = record(chosen, "optimum")
+    chosen_record["dominated_by"] = None
+    if front is not None:
+        pareto = {
+            "objectives": list(front.objectives),
+            "points": [record(r, label) for r, label in zip(front.points, front.labels, strict=True)],
+            "failed": [failure.as_dict() for failure in front.failed],
+            "dominated": [
+                record(r, label) for r, label in zip(front.dominated, front.dominated_labels, strict=True)
+            ],
+        }
+        chosen_record["dominated_by"] = front.dominating(chosen.numpy_objectives)
+    return {"samples": sample_layout(setup), "chosen": chosen_record, "pareto": pareto}

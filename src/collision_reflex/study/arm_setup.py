@@ -1,0 +1,259 @@
+"""An arm study translated into the optimiser's inputs: robot, motors, design space, actuator technology,
+constraints and contact samples (:class:`ArmSetup`), every problem located in the study file; and the picklable
+problem builder (:class:`StudyProblems`) that rebuilds the design problems from the resolved study text in any
+process (the setup and the problems are built once per process).
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Hashable, Mapping
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import StudyFileError, StudyProblem
+from ..optimize.blas import single_threaded_blas
+from .load import LoadedStudy, parse_study
+from .prepare import check_motors, joint_actuators, per_joint_bounds
+from .robot import load_arm
+from .samples import configuration_samples, direction_samples
+from .schema import PER_JOINT_DESIGN_VARIABLES, ArmStudy
+
+if TYPE_CHECKING:
+    from ..arm.core import Arm
+    from ..hardware.motors import Motor
+    from ..optimize import ActuatorTechnology, Constraints, ContactSamples, DesignProblem, DesignSpace
+
+IPOPT_OPTIONS = {"ipopt.max_iter": 400}
+"""Options over the optimiser's defaults for study runs (a cap keeps a hopeless Pareto point from stalling a run)."""
+
+
+@dataclass(frozen=True)
+class ArmSetup:
+    """Everything an arm study's solves need, built once per process.
+
+    arm: the robot; catalogue: the motor catalogue by name; configurations: (n, nq) [rad]; directions:
+    (m, task_dim) unit vectors; samples: the optimiser's contact samples (every configuration with every
+    direction); space, technology, constraints: the optimiser's inputs.
+    """
+
+    study: ArmStudy
+    arm: Arm
+    catalogue: dict[str, Motor]
+    configurations: np.ndarray
+    directions: np.ndarray
+    samples: ContactSamples
+    space: DesignSpace
+    technology: ActuatorTechnology
+    constraints: Constraints
+
+
+def arm_setup(loaded: LoadedStudy) -> ArmSetup:
+    """Load the robot and motors and translate the study into the optimiser's inputs; every problem located."""
+    from ..optimize import ActuatorTechnology, Bounds, Constraints, ContactSamples, DesignSpace
+
+    study = loaded.study
+    assert isinstance(study, ArmStudy)
+    catalogue = check_motors(loaded)
+    arm = load_arm(loaded)
+    joints = list(arm.joint_names)
+    actuators = joint_actuators(study, joints)
+    _check_supported(loaded, study)
+    reference_spec = study.actuators.motor
+    reference = catalogue[reference_spec.reference]
+
+    def nominal(name: str, values: list[float]) -> list[Any]:
+        spec = getattr(study.design, name)
+        if spec is None:
+            return [Bounds.fixed(v, f"{name}[{j}]") for v, j in zip(values, joints, strict=True)]
+        return [
+            Bounds(lo, hi, f"{name}[{j}]")
+            for (lo, hi), j in zip(per_joint_bounds(spec, joints), joints, strict=True)
+        ]
+
+    diameters = [a.motor.stator_diameter or reference.stator_diameter for a in actuators]
+    stacks = [a.motor.stack_length or reference.stack_length for a in actuators]
+    scheme = study.sensing.scheme
+    threshold_spec = study.design.threshold if scheme == "force" else study.design.position_error
+    velocity_spec = study.design.approach_velocity
+    space = DesignSpace(
+        stator_diameter=nominal("stator_diameter", diameters),
+        stack_length=nominal("stack_length", stacks),
+        gear_ratio=nominal("gear_ratio", [a.gear_ratio for a in actuators]),
+        software_stiffness=nominal("software_stiffness", [a.software_stiffness for a in actuators]),
+        threshold=Bounds(*threshold_spec.bounds, "threshold") if threshold_spec else study.sensing.value,
+        approach_velocity=Bounds(*velocity_spec.bounds, "approach_velocity")
+        if velocity_spec
+        else study.approach_velocity,
+    )
+    technology = ActuatorTechnology(
+        reference_motor=reference,
+        mechanical_stiffness=[a.mechanical_stiffness for a in actuators],
+        scaling_law=reference_spec.scaling_law,
+        sensing=scheme,
+        reaction=study.reaction,
+        reflected_inertia_in=study.reflected_inertia_in,
+    )
+    constraints = Constraints(
+        payload=study.constraints.payload,
+        safety_factor=study.constraints.safety_factor,
+        torque_required=study.constraints.torque_required,
+        threshold_floor=study.constraints.threshold_floor,
+    )
+    configurations = configuration_samples(loaded, arm)
+    directions = direction_samples(loaded, arm)
+    samples = ContactSamples.grid(arm.kinematics(configurations), directions)
+    return ArmSetup(
+        study, arm, catalogue, configurations, directions, samples, space, technology, constraints
+    )
+
+
+def _check_supported(loaded: LoadedStudy, study: ArmStudy) -> None:
+    """Refuse, at their lines, the study features the arm optimiser does not model."""
+    problems: list[StudyProblem] = []
+    base = study.actuators.motor
+    for joint, override in study.actuators.joints.items():
+        motor = override.motor
+        if motor is not None and (motor.reference != base.reference or motor.scaling_law != base.scaling_law):
+            problems.append(
+                loaded.problem(
+                    ("actuators", "joints", joint, "motor"),
+                    "a different reference motor or law",
+                    "the same reference motor and scaling law for every joint (the optimiser scales one "
+                    "reference); override stator_diameter or stack_length only",
+                )
+            )
+        if override.gearbox is not None:
+            problems.append(_gearbox_problem(loaded, ("actuators", "joints", joint, "gearbox")))
+    if study.actuators.gearbox is not None:
+        problems.append(_gearbox_problem(loaded, ("actuators", "gearbox")))
+    if problems:
+        raise StudyFileError(loaded.source.file, problems)
+
+
+def _gearbox_problem(loaded: LoadedStudy, path: tuple[Any, ...]) -> StudyProblem:
+    return loaded.problem(
+        path,
+        "a gearbox in an arm study",
+        "null: the arm optimiser's actuator mass and inertia are the motor's (gear ratio only); "
+        "compare gearboxes in an actuator study (kind: actuator)",
+    )
+
+
+@functools.lru_cache(maxsize=4)
+def setup_from_text(resolved_text: str) -> ArmSetup:
+    """The setup of a resolved study, built once per process."""
+    with single_threaded_blas():  # the same arithmetic in every process (see single_threaded_blas)
+        return arm_setup(parse_study(resolved_text, "resolved study"))
+
+
+def objective_key(objective: Mapping[str, float] | Mapping[Any, float]) -> Hashable:
+    """A hashable form of a study's objective: its name alone when it is a single unweighted objective, else
+    sorted ``(name, weight)`` pairs."""
+    if len(objective) == 1 and next(iter(objective.values())) == 1.0:
+        return next(iter(objective))
+    return tuple(sorted((str(k), float(v)) for k, v in objective.items()))
+
+
+@dataclass(frozen=True)
+class StudyProblems:
+    """The design problems of a resolved study, as :func:`collision_reflex.optimize.pareto.pareto_front` builds
+    them: ``StudyProblems(text)(objective, bounded)``. Plain text inside, so it crosses process boundaries."""
+
+    resolved_text: str
+
+    def __call__(self, objective: Hashable, bounded: tuple[str, ...] = ()) -> DesignProblem:
+        from ..optimize import build_problem
+
+        setup = setup_from_text(self.resolved_text)
+        weighted: Any = objective if isinstance(objective, str) else dict(objective)  # type: ignore[call-overload]
+        return build_problem(
+            setup.arm, setup.samples, setup.space, setup.technology, weighted, setup.constraints, bounded
+        )
+
+    @property
+    def setup(self) -> ArmSetup:
+        return setup_from_text(self.resolved_text)
+
+    @property
+    def objective(self) -> Hashable:
+        """The study's own objective (for :func:`collision_reflex.optimize.pareto.built_problem`)."""
+        return objective_key(self.setup.study.objective)
+
+
+def sample_layout(setup: ArmSetup) -> dict[str, Any]:
+    """Where each sample comes from (for the report's surfaces): configuration index and direction per sample."""
+    return {
+        "configurations": setup.configurations.tolist(),
+        "directions": setup.directions.tolist(),
+        "config_index": setup.samples.config_index.tolist(),
+        "sample_directions": setup.samples.directions.tolist(),
+        "joint_names": list(setup.arm.joint_names),
+        "task_dim": int(setup.arm.task_dim),
+    }
+
+
+def checked_setup(loaded: LoadedStudy, resolved_text: str) -> ArmSetup:
+    """The setup of a study, with its problem built once: every input problem (robot, frames, samples on which
+    the arm cannot move, impossible bounds) is raised here, located in the study file, before a run writes
+    anything."""
+    from ..errors import InvalidParameter
+    from ..optimize.pareto import built_problem
+
+    setup = arm_setup(loaded)  # located errors for the robot, motors and names
+    unreachable = _torque_out_of_reach(loaded, setup)
+    if unreachable:
+        raise StudyFileError(loaded.source.file, unreachable)
+    try:
+        problems = StudyProblems(resolved_text)
+        built_problem(problems, problems.objective)
+    except InvalidParameter as error:
+        raise loaded.fail(_field_of(error.name), f"{error}", "inputs the design problem accepts") from None
+    return setup
+
+
+def _torque_out_of_reach(loaded: LoadedStudy, setup: ArmSetup) -> list[StudyProblem]:
+    """Given torque requirements no design within the bounds can meet: the largest motor at the largest gear
+    ratio (torque grows with motor size under every scaling law) short of the safety factor times the need."""
+    from ..hardware.motors import scaled_motor_quantities
+
+    required = setup.study.constraints.torque_required
+    if required is None:
+        return []
+    joints = list(setup.arm.joint_names)
+    n = len(joints)
+    reference = setup.technology.reference_motor
+    diameters = setup.space.per_joint("stator_diameter", n)
+    stacks = setup.space.per_joint("stack_length", n, reference.stack_length)
+    gears = setup.space.per_joint("gear_ratio", n)
+    factor = setup.study.constraints.safety_factor
+    problems = []
+    for i, joint in enumerate(joints):
+        motor = scaled_motor_quantities(
+            reference, diameters[i].upper, stacks[i].upper, setup.technology.scaling_law
+        )
+        reachable = gears[i].upper * float(motor.peak_torque)
+        if factor * required[i] > reachable * (1 + 1e-9):
+            problems.append(
+                loaded.problem(
+                    ("constraints", "torque_required", i),
+                    f"{required[i]:g} N*m for {joint} (x {factor:g} safety)",
+                    f"at most {reachable:.4g} N*m, the peak torque of the largest motor at the largest gear "
+                    "ratio; widen design.stator_diameter or design.gear_ratio, or lower the requirement",
+                )
+            )
+    return problems
+
+
+def _field_of(name: str) -> tuple[str, ...]:
+    """The study field an optimiser parameter comes from (for locating its errors)."""
+    root = name.split("[")[0].split(" ")[0]
+    if root in PER_JOINT_DESIGN_VARIABLES or root in ("threshold", "approach_velocity"):
+        return ("design", root)
+    if root in ("payload", "safety_factor", "torque_required", "threshold_floor"):
+        return ("constraints", root)
+    if root in ("sample", "directions", "config_index"):
+        return ("samples",)
+    return ()
