@@ -29,7 +29,7 @@ import numpy as np
 import pinocchio as pin
 
 from collision_reflex.model import impulse
-from collision_reflex.arm.core import Arm, JointParameters, collision_impulses, effective_parameters
+from collision_reflex.arm import Arm, JointParameters, collision_impulses, effective_parameters
 from collision_reflex.arm.directions import sphere_directions
 
 # Panda-like actuation: reflected inertia [kg m^2], torque limits (the URDF's) [N m], joint stiffness

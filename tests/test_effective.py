@@ -14,7 +14,7 @@ import pinocchio as pin
 import pytest
 
 from collision_reflex.model import impulse
-from collision_reflex.arm.core import Arm, JointParameters, collision_impulses, effective_parameters
+from collision_reflex.arm import Arm, JointParameters, collision_impulses, effective_parameters
 from collision_reflex.arm.directions import circle_directions, sphere_directions, unit_directions
 from collision_reflex.errors import InvalidParameter
 
