@@ -15,6 +15,7 @@ import numpy as np
 
 from .. import _validate
 from ..errors import InvalidParameter
+from ..model.sensing import sensing_scheme, threshold_force
 from .directions import normalised_directions
 from .joints import joint_array
 from .samples import ArmSamples, task_inverse_inertia
@@ -190,12 +191,6 @@ def effective_parameters(
 
 
 # ---------------------------------------------------------------------- impulses
-SENSING_SCHEMES: tuple[str, ...] = ("force", "position", "joint_torque")
-"""How contact is detected: ``"force"``, a force threshold at the contact [N]; ``"position"``, a tracking-error
-threshold [m] so that ``F_s = k e_th``; ``"joint_torque"``, per-joint torque thresholds (motor current seen
-through the transmission) given to :func:`effective_parameters` as ``joint_threshold``."""
-
-
 @dataclass(frozen=True)
 class CollisionImpulses:
     """Impulses of collisions along many directions, arrays of the shape of the effective parameters.
@@ -230,30 +225,30 @@ def collision_impulses(
     params: from :func:`effective_parameters`.
     v0: approach velocity [m/s], a scalar or broadcastable to ``params.shape``.
     threshold: ``F_s`` [N] for ``sensing="force"``, the tracking-error threshold [m] for ``"position"``;
-        unused for ``"joint_torque"`` (the thresholds were given to :func:`effective_parameters`).
-    sensing: one of :data:`SENSING_SCHEMES`.
+        unused for ``"current"`` (the joint-side threshold torques were given to :func:`effective_parameters`
+        as ``joint_threshold``, and the first joint to reach its threshold detects).
+    sensing: one of :data:`collision_reflex.model.sensing.SENSING_SCHEMES` (``"joint_torque"``: deprecated
+        spelling of ``"current"``).
     reaction: ``"at_rest"`` (the paper's) or ``"moving"``, see :func:`collision_reflex.phase_impulses`.
     """
     from ..model.impulse import optimal_velocity, phase_impulses
 
-    _validate.choice("sensing", sensing, SENSING_SCHEMES)
+    sensing = sensing_scheme(sensing)
     shape = params.shape
-    if sensing == "joint_torque":
+    if sensing == "current":
         if params.joint_threshold_force is None:
             raise InvalidParameter(
                 "sensing",
                 sensing,
                 "'force' or 'position' here",
-                "pass joint_threshold=... to effective_parameters for joint-torque sensing",
+                "pass joint_threshold=... to effective_parameters for motor-current sensing",
             )
         force = params.joint_threshold_force
     else:
         if threshold is None:
             raise InvalidParameter("threshold", None, "a force [N] or a position error [m]")
         _validate.positive("threshold", threshold)
-        force = np.asarray(threshold, dtype=float)
-        if sensing == "position":
-            force = params.k * force
+        force = threshold_force(sensing, np.asarray(threshold, dtype=float), params.k)
     _validate.positive("v0", v0)
     singular = params.singular
     any_singular = bool(np.any(singular))

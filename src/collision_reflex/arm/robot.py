@@ -277,9 +277,9 @@ class Arm:
 
     def sensing_options(self) -> dict[str, Any]:
         """The sensing of this arm's actuators as keyword arguments: ``{"sensing": "force", "threshold": F_s}``
-        for force thresholds at the contact, or ``{"sensing": "joint_torque", "joint_threshold": tau_s}`` [N m]
-        for the joint-side schemes (position error, motor current), where the first joint to reach its
-        threshold detects the contact."""
+        for force thresholds at the contact, or ``{"sensing": "current", "joint_threshold": tau_s}`` [N m]
+        for the joint-side schemes (motor current, and joint position errors, whose threshold is the joint
+        torque ``k e_th`` as well), where the first joint to reach its threshold detects the contact."""
         from ..hardware.actuators import ForceThreshold
 
         if not self.actuators:
@@ -302,7 +302,7 @@ class Arm:
             scheme.joint_threshold_torque(actuator)
             for scheme, actuator in zip(schemes, self.actuators, strict=True)
         ]
-        return {"sensing": "joint_torque", "joint_threshold": np.array(torques)}
+        return {"sensing": "current", "joint_threshold": np.array(torques)}
 
     def visual_model(self) -> Any:
         """Pinocchio visual ``GeometryModel`` of the URDF, meshes resolved through ``package_dirs``."""

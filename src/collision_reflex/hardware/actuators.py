@@ -24,6 +24,7 @@ from typing import Any, Protocol
 from .. import _validate
 from ..errors import InvalidParameter
 from ..model.impulse import series_stiffness
+from ..model.sensing import current_threshold_torque, threshold_force
 from .gearboxes import Gearbox
 from .motors import Motor
 
@@ -127,7 +128,7 @@ class PositionThreshold:
                 "a finite joint stiffness for a position-error threshold",
                 "a rigid joint never builds a position error; give mechanical or software stiffness",
             )
-        return stiffness * self.error
+        return float(threshold_force("position", self.error, stiffness))
 
     def contact_threshold(self, actuator: Actuator, lever: float) -> float:
         """Contact force at detection [N]: ``k e_th / L``."""
@@ -160,7 +161,7 @@ class CurrentThreshold:
         _validate.non_negative("CurrentThreshold.friction_torque", self.friction_torque)
 
     def joint_threshold_torque(self, actuator: Actuator, lever: float | None = None) -> float:
-        return actuator.gear_ratio * self.motor_torque + self.friction_torque
+        return float(current_threshold_torque(actuator.gear_ratio, self.motor_torque, self.friction_torque))
 
     def contact_threshold(self, actuator: Actuator, lever: float) -> float:
         """Contact force at detection [N]: ``(N tau_s + tau_friction) / L``."""

@@ -40,10 +40,11 @@ from ..errors import InvalidParameter
 from ..hardware.actuators import REFLECTED_INERTIA_PLACEMENTS
 from ..hardware.motors import Motor, scaled_motor_quantities
 from ..model.impulse import REACTION_MODES, phase_impulses, series_stiffness
+from ..model.sensing import sensing_scheme, threshold_force
 from .space import (
     GLOBAL_VARIABLES,
+    OPTIMIZED_SENSING_SCHEMES,
     PER_JOINT_VARIABLES,
-    SENSING_SCHEMES,
     Bounds,
     Constraints,
     ContactSamples,
@@ -91,7 +92,7 @@ class ActuatorTechnology:
 
     def __post_init__(self) -> None:
         _validate.positive("mechanical_stiffness", np.asarray(self.mechanical_stiffness, dtype=float))
-        _validate.choice("sensing", self.sensing, SENSING_SCHEMES)
+        object.__setattr__(self, "sensing", sensing_scheme(self.sensing, OPTIMIZED_SENSING_SCHEMES))
         _validate.choice("reaction", self.reaction, REACTION_MODES)
         _validate.choice("reflected_inertia_in", self.reflected_inertia_in, REFLECTED_INERTIA_PLACEMENTS)
 
@@ -589,7 +590,7 @@ def _sample_function(n_joints: int, sensing: str, reaction: str, reflected_inert
     # Effective parameters along u (MODEL.md §3), compliance forms.
     robot_mass = 1 / ca.sum1(w**2 / inertia)
     k = 1 / ca.sum1(w**2 / stiffness)
-    force_threshold = threshold_variable if sensing == "force" else k * threshold_variable
+    force_threshold = threshold_force(sensing, threshold_variable, k)
     acceleration = 1 / (compliance * robot_mass)  # a = F_a / m_r
     impulse = phase_impulses(finger_mass, k, k_mech, force_threshold, acceleration, velocity, reaction).total
     return ca.Function(

@@ -13,8 +13,8 @@ from ..errors import InvalidParameter
 
 PER_JOINT_VARIABLES = ("stator_diameter", "stack_length", "gear_ratio", "software_stiffness")
 GLOBAL_VARIABLES = ("threshold", "approach_velocity")
-SENSING_SCHEMES = ("force", "position")
-"""Sensing schemes the optimiser handles: a contact-force threshold ``F_s`` [N] or a contact-point
+OPTIMIZED_SENSING_SCHEMES: tuple[str, ...] = ("force", "position")
+"""The schemes of :data:`collision_reflex.model.sensing.SENSING_SCHEMES` the optimiser handles: a contact-force threshold ``F_s`` [N] or a contact-point
 position-error threshold ``e_th`` [m] with ``F_s = k(u) e_th``. A motor-current threshold makes the contact
 threshold a minimum over joints, which is evaluated but not optimised."""
 
