@@ -15,6 +15,7 @@ import numpy as np
 
 from .. import _validate
 from ..errors import InvalidParameter
+from ..model import effective as formulas
 from ..model.sensing import sensing_scheme, threshold_force
 from .directions import normalised_directions
 from .joints import joint_array
@@ -135,16 +136,16 @@ def effective_parameters(
     jac = samples.jacobian
     structure = samples.structure_mass_matrix(motor_mass)
     if finger_joint_inertia is not None:
-        structure = structure + np.diag(joint_array("finger_joint_inertia", finger_joint_inertia, nv))
-    jac_t = np.swapaxes(jac, 1, 2)
+        finger = joint_array("finger_joint_inertia", finger_joint_inertia, nv)
+        structure = np.asarray(formulas.finger_mass_matrix(structure, joint_finger_inertia=finger))
     # Task-space inverse inertias and compliances, once per configuration: G = J X^-1 J^T, stacked as
-    # (structure, actuators, stiffness, mechanical stiffness).
+    # (structure, actuators, stiffness, mechanical stiffness); the quantities along u are 1 / (u^T G u).
     task = np.stack(
         [
             task_inverse_inertia(structure, jac),
-            (jac / inertia) @ jac_t,
-            (jac / joint_k) @ jac_t,
-            (jac / joint_km) @ jac_t,
+            formulas.task_compliance(jac, inertia),
+            formulas.task_compliance(jac, joint_k),
+            formulas.task_compliance(jac, joint_km),
         ]
     )  # (4, n, task_dim, task_dim)
     scale = np.trace(task[0], axis1=1, axis2=2)
@@ -164,8 +165,8 @@ def effective_parameters(
         w_f, w_r, k, k_m = forms
         singular = w_f <= singular_tolerance * scale_s
         m_f = np.reciprocal(w_f, out=w_f)
-        load = _largest_moment(jac, 1 / tau_max, units, pair_index)  # 1 / F_a
-        a = w_r / load  # F_a / m_r
+        load = _reaction_compliance(jac, tau_max, units, pair_index)  # 1 / F_a
+        a = formulas.reaction_acceleration(w_r, load)
         m_r = np.reciprocal(w_r, out=w_r)
         F_a = np.reciprocal(load, out=load)
         if stiffness_form == "paper":
@@ -175,7 +176,7 @@ def effective_parameters(
         np.reciprocal(k_m, out=k_m)
         joint_force = None
         if tau_s is not None:
-            joint_force = _largest_moment(jac, 1 / tau_s, units, pair_index)
+            joint_force = _reaction_compliance(jac, tau_s, units, pair_index)
             np.reciprocal(joint_force, out=joint_force)
     if np.any(singular):
         for value in (m_f, m_r, k, k_m, F_a, joint_force):
@@ -279,22 +280,21 @@ def collision_impulses(
     )
 
 
-def _largest_moment(
-    jac: np.ndarray, weight: np.ndarray, units: np.ndarray, index: np.ndarray | None
+def _reaction_compliance(
+    jac: np.ndarray, torque: np.ndarray, units: np.ndarray, index: np.ndarray | None
 ) -> np.ndarray:
-    """``max_i weight_i |(J^T u)_i|`` for the grid (n, d) or for paired samples (n_samples,)."""
-    scaled = jac * weight
+    """``max_i |(J^T u)_i| / torque_i`` [1/N] (:func:`collision_reflex.model.effective.reaction_compliance`) for
+    the grid (n, d) or for paired samples (n_samples,)."""
     if index is not None:
-        return np.max(np.abs(np.einsum("sta,st->sa", scaled[index], units)), axis=-1)
+        return formulas.reaction_compliance(np.einsum("sta,st->sa", jac[index], units), torque)
     n, nv, d = jac.shape[0], jac.shape[2], units.shape[0]
     out = np.empty((n, d))
     # Blocks of configurations small enough to stay in cache (about 1 MB of moments each).
     step = max(1, 2**17 // (nv * d))
-    directions_t = np.ascontiguousarray(units.T)
+    directions_t, torque_column = np.ascontiguousarray(units.T), torque[:, None]
     for start in range(0, n, step):
-        block = np.swapaxes(scaled[start : start + step], 1, 2) @ directions_t  # (block, nv, d)
-        np.abs(block, out=block)
-        np.max(block, axis=1, out=out[start : start + step])
+        moments = np.swapaxes(jac[start : start + step], 1, 2) @ directions_t  # (block, nv, d)
+        out[start : start + step] = formulas.reaction_compliance(moments, torque_column, joint_axis=-2)
     return out
 
 

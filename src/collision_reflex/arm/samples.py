@@ -9,6 +9,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import InvalidParameter
+from ..model import effective
+from ..model.effective import finger_mass_matrix
 from .joints import joint_array
 
 
@@ -114,19 +116,14 @@ class ArmSamples:
                 "None for samples without motor terms",
                 "compute the samples with Arm.kinematics(q, motor_terms=True)",
             )
-        return self.mass_matrix + np.einsum("i,sijk->sjk", masses, self.motor_mass_influence)
+        return np.asarray(finger_mass_matrix(self.mass_matrix, self.motor_mass_influence, masses))
 
 
 def task_inverse_inertia(mass_matrix: np.ndarray, jacobian: np.ndarray) -> np.ndarray:
     """``J M^-1 J^T`` for stacked mass matrices (n, nv, nv) [kg m^2] and Jacobians (n, m, nv) [m/rad],
     (n, m, m) [1/kg]: the inverse of the task-space (operational-space) inertia, the ellipsoid of gyration."""
-    return jacobian @ _solve_spd(mass_matrix, np.swapaxes(jacobian, -1, -2))
-
-
-def _solve_spd(matrix: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-    """Solve stacked symmetric positive-definite systems."""
     try:
-        return np.linalg.solve(matrix, rhs)
+        return np.asarray(effective.task_inverse_inertia(jacobian, mass_matrix))
     except np.linalg.LinAlgError:
         raise InvalidParameter(
             "mass_matrix",
