@@ -88,7 +88,7 @@ def effective_parameters(
     torque_limit: largest output torque per joint [N m], > 0, ``inf`` allowed.
     config_index: (n_samples,) configuration of each paired sample; None for the grid.
     motor_mass: motor mass per joint [kg], added to the structure as ``sum_i m_i A_i``; None for none.
-    finger_joint_inertia: joint-space inertia per joint [kg m^2] that acts rigidly on the link side during the
+    finger_joint_inertia: joint-space inertia per joint [kg m^2], >= 0, that acts rigidly on the link side during the
         impact, added to the finger's mass matrix as ``diag(...)``: the reflected rotor inertia of a stiff
         transmission whose compliance sits at the contact (the paper's geared A8). None for none (the paper's
         arm model, reflected inertia in the robot mass only).
@@ -136,7 +136,7 @@ def effective_parameters(
     jac = samples.jacobian
     structure = samples.structure_mass_matrix(motor_mass)
     if finger_joint_inertia is not None:
-        finger = joint_array("finger_joint_inertia", finger_joint_inertia, nv)
+        finger = joint_array("finger_joint_inertia", finger_joint_inertia, nv, allow_zero=True)
         structure = np.asarray(formulas.finger_mass_matrix(structure, joint_finger_inertia=finger))
     # Task-space inverse inertias and compliances, once per configuration: G = J X^-1 J^T, stacked as
     # (structure, actuators, stiffness, mechanical stiffness); the quantities along u are 1 / (u^T G u).

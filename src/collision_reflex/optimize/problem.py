@@ -39,6 +39,7 @@ from .. import _validate
 from ..errors import InvalidParameter
 from ..hardware.actuators import REFLECTED_INERTIA_PLACEMENTS
 from ..hardware.motors import Motor, scaled_motor_quantities
+from ..model import effective as formulas
 from ..model.impulse import REACTION_MODES, phase_impulses, series_stiffness
 from ..model.sensing import sensing_scheme, threshold_force
 from .space import (
@@ -158,8 +159,9 @@ class DesignProblem:
     ``nlp`` is CasADi's ``{"x", "f", "g", "p"}``; ``lbx``/``ubx``/``x0``/``lbg``/``ubg`` its bounds and start;
     ``constraint_labels[i]`` names constraint ``g[i]``; ``objective_scale`` the value each objective is divided
     by in the NLP; ``evaluate`` a CasADi function of ``x`` giving ``impulses`` (1 x n_samples), ``actuator_mass``,
-    ``approach_velocity``, ``thresholds`` (1 x n_samples), ``required_torque`` and ``peak_torque`` (n_joints);
-    use :meth:`exact_point` first so that the auxiliary variables hold their exact values.
+    ``approach_velocity``, ``thresholds`` (1 x n_samples), ``required_torque`` and ``peak_torque`` (n_joints),
+    and ``parameters`` (5 x n_samples: ``m_f, m_r, k, k_m, a``, see :meth:`sample_parameters`); use
+    :meth:`exact_point` first so that the auxiliary variables hold their exact values.
     """
 
     nlp: dict[str, Any]
@@ -210,6 +212,16 @@ class DesignProblem:
             x[self.epigraph_index] = impulses.max() / self.objective_scale["worst_case_impulse"]
         return x
 
+    def sample_parameters(self, x: np.ndarray) -> dict[str, np.ndarray]:
+        """The effective 1D parameters of every sample as the NLP evaluates them at the design in ``x``
+        (auxiliaries at their exact values): ``m_f``, ``m_r`` [kg], ``k``, ``k_m`` [N/m], ``a`` [m/s^2] and the
+        contact-force threshold ``F_s`` [N], arrays of shape (n_samples,)."""
+        evaluated = self.evaluate(self.exact_point(x))
+        rows = np.asarray(evaluated[6])
+        out = dict(zip(("m_f", "m_r", "k", "k_m", "a"), rows, strict=True))
+        out["F_s"] = np.asarray(evaluated[3]).ravel()
+        return out
+
     def impulse_function(self) -> Any:
         """The collision impulse of every sample as a CasADi function of the design variables alone.
 
@@ -229,14 +241,14 @@ class DesignProblem:
         loaded = loaded_joints(self.samples)
         impulses = []
         for s_index, config in enumerate(self.samples.config_index):
-            structure = ca.DM(kin.mass_matrix[config]) + ca.diag(finger_inertia)
-            for i in range(n):
-                structure += motor_mass[i] * ca.DM(kin.motor_mass_influence[config, i])
-            y = ca.solve(structure, ca.DM(w[s_index]))
-            direction = y / ca.dot(ca.DM(w[s_index]), y)
-            ratios = [abs(w[s_index, i]) / peak_torque[i] for i in range(n) if loaded[s_index, i]]
-            compliance = ca.mmax(ca.vertcat(*ratios))
-            impulse, _, _ = self._sample_function(
+            influence = [ca.DM(kin.motor_mass_influence[config, i]) for i in range(n)]
+            structure = formulas.finger_mass_matrix(
+                ca.DM(kin.mass_matrix[config]), influence, motor_mass, finger_inertia
+            )
+            direction = formulas.finger_mass_direction(ca.DM(w[s_index]), structure)
+            joints = np.flatnonzero(loaded[s_index]).tolist()
+            compliance = formulas.reaction_compliance(ca.DM(w[s_index, joints]), peak_torque[joints])
+            impulse, *_ = self._sample_function(
                 design_column, direction, compliance, ca.DM(self._sample_data[:, s_index])
             )
             impulses.append(impulse)
@@ -350,7 +362,9 @@ def build_problem(
         np.tile(direction_scale, (n_joints, 1))
     )
     compliance = ca.exp(ca.transpose(x[compliance_index]))
-    impulses, thresholds, normalisation = per_sample(design_column, directions, compliance, ca.DM(data))
+    impulses, thresholds, normalisation, parameters = per_sample(
+        design_column, directions, compliance, ca.DM(data)
+    )
     actuator_mass = ca.sum1(motor_mass)
     mass_bounds = [np.asarray(joint_numbers(bound)[0]).ravel() for bound in (lbx, ubx)]
     torque_demands = _binding_torque_demands(samples, constraints, joint_names, *mass_bounds)
@@ -365,9 +379,18 @@ def build_problem(
             thresholds,
             required_torque(motor_mass),
             peak_torque,
+            parameters,
         ],
         ["x"],
-        ["impulses", "actuator_mass", "approach_velocity", "thresholds", "required_torque", "peak_torque"],
+        [
+            "impulses",
+            "actuator_mass",
+            "approach_velocity",
+            "thresholds",
+            "required_torque",
+            "peak_torque",
+            "parameters",
+        ],
     )
     x0[direction_index] = (start_directions / direction_scale[:, None]).ravel()
     x0[compliance_index] = np.log(reaction_compliance(samples, start_torque))
@@ -503,7 +526,7 @@ def _design_quantities(
         technology.reference_motor, values["stator_diameter"], values["stack_length"], technology.scaling_law
     )
     gear = values["gear_ratio"]
-    reflected = gear**2 * motor.rotor_inertia  # N^2 J_m
+    reflected = formulas.reflected_inertia(gear, motor.rotor_inertia)
     design_column = ca.vertcat(
         motor.mass,
         reflected,
@@ -511,7 +534,7 @@ def _design_quantities(
         values["threshold"],
         values["approach_velocity"],
     )
-    finger_inertia = reflected if technology.reflected_inertia_in == "finger" else 0 * gear
+    finger_inertia = formulas.finger_inertia(reflected, technology.reflected_inertia_in)
     return values, design_column, motor.mass, gear * motor.peak_torque, finger_inertia
 
 
@@ -566,8 +589,8 @@ def _sample_function(n_joints: int, sensing: str, reaction: str, reflected_inert
     Inputs: the design column (motor masses, reflected inertias, joint stiffnesses (n each), threshold,
     approach velocity), the finger-mass direction ``x`` (n, with ``w^T x = 1``), the reaction compliance ``c``
     (``1/F_a`` [1/N]) and the sample's data (``w = J^T u`` (n), ``M_bb0`` (n*n), motor-mass influence matrices
-    (n*n*n), effective mechanical stiffness). Outputs: the impulse [N*s], the contact-force threshold [N] and
-    ``w^T x``.
+    (n*n*n), effective mechanical stiffness). Outputs: the impulse [N*s], the contact-force threshold [N],
+    ``w^T x`` and the effective parameters ``(m_f, m_r, k, k_m, a)`` of :mod:`collision_reflex.model.effective`.
     """
     n = n_joints
     design = ca.SX.sym("design", 3 * n + 2)
@@ -578,25 +601,28 @@ def _sample_function(n_joints: int, sensing: str, reaction: str, reflected_inert
     threshold_variable, velocity = design[3 * n], design[3 * n + 1]
     w = data[:n]
     offset = n + n * n
-    # x^T M_f x with M_f = M_bb0 + sum_i m_i A_i (+ diag(N^2 J_m)), each term a quadratic form in x.
-    finger_mass = ca.bilin(ca.reshape(data[n:offset], n, n), direction, direction)
-    for i in range(n):
-        influence = ca.reshape(data[offset + i * n * n : offset + (i + 1) * n * n], n, n)
-        finger_mass += mass[i] * ca.bilin(influence, direction, direction)
-    if reflected_inertia_in == "finger":
-        finger_mass += ca.dot(inertia, direction**2)
+    influence = [ca.reshape(data[offset + i * n * n : offset + (i + 1) * n * n], n, n) for i in range(n)]
+    finger_matrix = formulas.finger_mass_matrix(
+        ca.reshape(data[n:offset], n, n),
+        influence,
+        mass,
+        inertia if reflected_inertia_in == "finger" else None,
+    )
+    # x^T M_f x: the finger mass at the optimal x (the NLP's constraint w^T x = 1 and its minimisation).
+    finger_mass = formulas.finger_mass(direction, finger_matrix)
     k_mech = data[-1]
 
-    # Effective parameters along u (MODEL.md §3), compliance forms.
-    robot_mass = 1 / ca.sum1(w**2 / inertia)
-    k = 1 / ca.sum1(w**2 / stiffness)
+    # Effective parameters along u (MODEL.md §3), compliance forms; w^T is the Jacobian along u.
+    robot_compliance = formulas.task_compliance(ca.transpose(w), inertia)
+    k = 1 / formulas.task_compliance(ca.transpose(w), stiffness)
     force_threshold = threshold_force(sensing, threshold_variable, k)
-    acceleration = 1 / (compliance * robot_mass)  # a = F_a / m_r
+    acceleration = formulas.reaction_acceleration(robot_compliance, compliance)
     impulse = phase_impulses(finger_mass, k, k_mech, force_threshold, acceleration, velocity, reaction).total
+    parameters = ca.vertcat(finger_mass, 1 / robot_compliance, k, k_mech, acceleration)
     return ca.Function(
         "sample_impulse",
         [design, direction, compliance, data],
-        [impulse, force_threshold, ca.dot(w, direction)],
+        [impulse, force_threshold, ca.dot(w, direction), parameters],
     )
 
 
@@ -618,14 +644,16 @@ def _sample_data(samples: ContactSamples, k_mech: np.ndarray) -> np.ndarray:
     influence = (
         kin.motor_mass_influence[samples.config_index].transpose(0, 1, 3, 2).reshape(n_samples, n * n * n)
     )
-    k_mech_effective = 1 / np.sum(w**2 / k_mech, axis=1)
+    k_mech_effective = 1 / formulas.task_compliance(w[:, None, :], k_mech)[:, 0, 0]
     return np.column_stack([w, structure, influence, k_mech_effective]).T
 
 
 def reaction_compliance(samples: ContactSamples, peak_torque: np.ndarray) -> np.ndarray:
     """``1 / F_a = max_i |w_i| / tau_i`` per sample [1/N]: the inverse of the largest contact force the joints
     can push back with before the first saturates (MODEL.md §3)."""
-    return np.max(np.abs(samples.joint_moment_arms) / np.asarray(peak_torque, dtype=float), axis=1)
+    return np.asarray(
+        formulas.reaction_compliance(samples.joint_moment_arms, np.asarray(peak_torque, dtype=float))
+    )
 
 
 def finger_mass_directions(
@@ -636,12 +664,10 @@ def finger_mass_directions(
     reflected inertia acts on the finger, ``diag(N^2 J_m)`` [kg m^2]."""
     kin = samples.kinematics
     index = samples.config_index
-    structure = kin.mass_matrix[index] + np.einsum("i,sijk->sjk", motor_mass, kin.motor_mass_influence[index])
-    if finger_joint_inertia is not None:
-        structure = structure + np.diag(finger_joint_inertia)
-    w = samples.joint_moment_arms
-    y = np.linalg.solve(structure, w[..., None])[..., 0]
-    return y / np.einsum("sj,sj->s", w, y)[:, None]
+    structure = formulas.finger_mass_matrix(
+        kin.mass_matrix[index], kin.motor_mass_influence[index], motor_mass, finger_joint_inertia
+    )
+    return np.asarray(formulas.finger_mass_direction(samples.joint_moment_arms, structure))
 
 
 def loaded_joints(samples: ContactSamples) -> np.ndarray:
