@@ -23,6 +23,7 @@ from typing import Any, Protocol
 
 from .. import _validate
 from ..errors import InvalidParameter
+from ..model import effective
 from ..model.impulse import series_stiffness
 from ..model.sensing import current_threshold_torque, threshold_force
 from .gearboxes import Gearbox
@@ -245,7 +246,7 @@ class Actuator:
     @property
     def rotor_reflected_inertia(self) -> float:
         """Rotor inertia seen at the joint, ``N**2 J_m`` [kg m^2]."""
-        return self.gear_ratio**2 * self.motor.rotor_inertia
+        return float(effective.reflected_inertia(self.gear_ratio, self.motor.rotor_inertia))
 
     @property
     def reflected_inertia(self) -> float:
