@@ -116,15 +116,7 @@ def effective_parameters(
     if not (np.isfinite(singular_tolerance) and 0 < singular_tolerance < 1):
         raise InvalidParameter("singular_tolerance", singular_tolerance, "a number in (0, 1)")
     units = normalised_directions(directions, task_dim)
-    paired = config_index is not None
-    if paired:
-        index = np.asarray(config_index, dtype=int).ravel()
-        if index.shape != (units.shape[0],):
-            raise InvalidParameter(
-                "config_index", index.shape, f"one index per direction, ({units.shape[0]},)"
-            )
-        if index.size and (index.min() < 0 or index.max() >= samples.count):
-            raise InvalidParameter("config_index", index, f"indices in [0, {samples.count})")
+    pair_index = None if config_index is None else _checked_index(config_index, units, samples.count)
     if stiffness_form == "paper" and task_dim != nv:
         raise InvalidParameter(
             "stiffness_form",
@@ -148,16 +140,9 @@ def effective_parameters(
             formulas.task_compliance(jac, joint_km),
         ]
     )  # (4, n, task_dim, task_dim)
+    forms = _quadratic_forms(task, units, pair_index)
     scale = np.trace(task[0], axis1=1, axis2=2)
-    pair_index = index if paired else None
-    if paired:
-        forms = np.einsum("sa,qsab,sb->qs", units, task[:, index], units)
-        scale_s = scale[index]
-    else:
-        # u^T G u for every G and u in one product: (4 n, task_dim^2) x (task_dim^2, d).
-        outer = np.einsum("da,db->dab", units, units).reshape(units.shape[0], -1)
-        forms = (task.reshape(-1, task_dim * task_dim) @ outer.T).reshape(4, samples.count, -1)
-        scale_s = scale[:, None]
+    scale_s = scale[:, None] if pair_index is None else scale[pair_index]
 
     # Reciprocals in place: a zero compliance (an infinite joint stiffness or torque) gives inf; the 0/0 and
     # negative rounding of singular directions are overwritten with their limits below.
@@ -278,6 +263,27 @@ def collision_impulses(
         v_star=np.broadcast_to(v_star, shape),
         singular=singular,
     )
+
+
+def _checked_index(config_index: Any, units: np.ndarray, count: int) -> np.ndarray:
+    """The configuration index of paired samples, one per direction, each in ``[0, count)``."""
+    index = np.asarray(config_index, dtype=int).ravel()
+    if index.shape != (units.shape[0],):
+        raise InvalidParameter("config_index", index.shape, f"one index per direction, ({units.shape[0]},)")
+    if index.size and (index.min() < 0 or index.max() >= count):
+        raise InvalidParameter("config_index", index, f"indices in [0, {count})")
+    return index
+
+
+def _quadratic_forms(task: np.ndarray, units: np.ndarray, index: np.ndarray | None) -> np.ndarray:
+    """``u^T G u`` of stacked task matrices ``task`` (q, n, m, m) for the grid of every configuration with every
+    direction (q, n, d), or for paired samples (q, n_samples)."""
+    if index is not None:
+        return np.einsum("sa,qsab,sb->qs", units, task[:, index], units)
+    # Every G with every u in one product: (q n, m^2) x (m^2, d).
+    q, n, m = task.shape[0], task.shape[1], task.shape[-1]
+    outer = np.einsum("da,db->dab", units, units).reshape(units.shape[0], -1)
+    return (task.reshape(-1, m * m) @ outer.T).reshape(q, n, -1)
 
 
 def _reaction_compliance(

@@ -75,7 +75,8 @@ class ActuatorTechnology:
     scaling_law: motor scaling law name (see :data:`collision_reflex.hardware.motors.SCALING_LAWS`).
     mechanical_stiffness: joint mechanical stiffness [N m/rad], one value or one per joint, finite > 0: it is
         the only spring left in the reaction phase.
-    sensing: ``"force"`` (contact-force threshold) or ``"position"`` (contact position-error threshold).
+    sensing: ``"force"`` (contact-force threshold) or ``"position"`` (contact position-error threshold), see
+        :data:`collision_reflex.optimize.space.OPTIMIZED_SENSING_SCHEMES`.
     reaction: reaction-phase model, ``"at_rest"`` (the paper's) or ``"moving"``.
     reflected_inertia_in: where the reflected rotor inertia ``N^2 J_m`` acts. ``"robot"`` (default, the paper's
         arm model): behind the joint springs, in the robot mass ``m_r`` of the reaction phase only.
@@ -292,7 +293,7 @@ def build_problem(
 
     Parameters
     ----------
-    arm: the :class:`collision_reflex.arm.core.Arm` (joint names; ``samples.kinematics`` must come from it).
+    arm: the :class:`collision_reflex.arm.Arm` (joint names; ``samples.kinematics`` must come from it).
     samples: contact cases: configurations (with their Pinocchio data) and directions.
     space: bounds of the design variables.
     technology: reference motor, scaling law, mechanical stiffness, sensing scheme, reaction model.
