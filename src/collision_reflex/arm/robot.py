@@ -20,7 +20,7 @@ import numpy as np
 from ..errors import FrameNotFound, InvalidParameter, UrdfError
 from .effective import EffectiveParameters, effective_parameters
 from .joints import JointParameters, joint_array
-from .kinematic_tree import forward_kinematics, joint_kinematics, plane_basis, skew, support_mask
+from .kinematic_tree import joint_kinematics
 from .robots import (
     ROBOT_DEFAULTS,
     captured_stderr,
@@ -30,7 +30,7 @@ from .robots import (
     parser_reason,
     with_locked_joints,
 )
-from .samples import ArmSamples
+from .samples import ArmSamples, ContactKinematics
 
 # Joints whose limits are missing or meaningless (URDF "continuous", or lower >= upper) are sampled on a full
 # turn; limits beyond this magnitude are treated as missing.
@@ -120,26 +120,12 @@ class Arm:
         self._source_model = model
         self.model = model.copy()
         self.model.armature = params.reflected_inertia.copy()
+        self._contact_kinematics = ContactKinematics.of_model(
+            model, self._joints, self._contact_joint, self._contact_local
+        )
         # Kinematics use a structure-only model (no armature), so ArmSamples.mass_matrix is M_bb0.
-        self._structure = model.copy()
-        self._structure.armature = np.zeros(model.nv)
-        # A frame at the contact point itself, so that Pinocchio's frame Jacobian is the contact Jacobian.
-        self._contact_frame_id = self._structure.addFrame(
-            pin.Frame(
-                "collision_reflex_contact_point",
-                self._contact_joint,
-                pin.SE3(np.eye(3), self._contact_local),
-                pin.FrameType.OP_FRAME,
-            )
-        )
-        self._data = self._structure.createData()
-        self._gravity = np.asarray(self._structure.gravity.linear, dtype=float).copy()
-        # Masks of the joints (velocity indices) that move the contact point and each motor's parent link.
-        supports = [set(self._structure.supports[j]) for j in range(self._structure.njoints)]
-        self._motor_masks = np.array(
-            [support_mask(self._structure, supports[jk.parent]) for jk in self._joints]
-        )
-        self.plane = plane_basis(self._structure, self._joints)
+        self._structure = self._contact_kinematics.model
+        self.plane = self._contact_kinematics.plane
         self.reference_configuration: np.ndarray = np.array(pin.neutral(model))
         """A configuration to start from [rad, m]: the robot's reference pose when known, else neutral."""
         self._pin = pin
@@ -433,47 +419,7 @@ class Arm:
         only what the effective collision parameters need (``q``, ``mass_matrix``, ``jacobian``; the other
         fields are None).
         """
-        q = self._checked_q(q)
-        pin, model, data = self._pin, self._structure, self._data
-        n, nv = q.shape[0], self.nv
-        mass = np.empty((n, nv, nv))
-        contact_jacobian = np.empty((n, 6, nv))
-        crba, frame_jacobian = pin.crba, pin.computeFrameJacobian
-        frame, aligned = self._contact_frame_id, pin.LOCAL_WORLD_ALIGNED
-        for s, qs in enumerate(q):
-            mass[s] = crba(model, data, qs)
-            contact_jacobian[s] = frame_jacobian(model, data, qs, frame, aligned)
-        jacobian3 = np.ascontiguousarray(contact_jacobian[:, :3])
-        jacobian = jacobian3 if self.plane is None else np.einsum("tp,stj->spj", self.plane, jacobian3)
-        if not full:
-            return ArmSamples(q=q, mass_matrix=mass, jacobian=jacobian)
-
-        spatial = np.empty((n, 6, nv))
-        gravity = np.empty((n, nv))
-        joint_jacobians, generalized_gravity = pin.computeJointJacobians, pin.computeGeneralizedGravity
-        for s, qs in enumerate(q):
-            spatial[s] = joint_jacobians(model, data, qs)  # world frame, every joint
-            gravity[s] = generalized_gravity(model, data, qs)
-        rotations, origins, motor_points = forward_kinematics(self._joints, q)
-        linear, angular = spatial[:, :3], spatial[:, 3:]
-        contact_joint = self._contact_joint - 1
-        contact = origins[contact_joint] + rotations[contact_joint] @ self._contact_local
-        # Motor i sits at joint i's origin on the parent link: it moves with the parent link's point there.
-        points = np.stack(motor_points, axis=1)  # (n, motor i, 3)
-        motor_jac = self._motor_masks[None, :, None, :] * (
-            linear[:, None] - skew(points) @ angular[:, None]
-        )  # (n, motor i, 3, nv)
-        return ArmSamples(
-            q=q,
-            mass_matrix=mass,
-            jacobian=jacobian,
-            gravity=gravity,
-            motor_mass_influence=np.swapaxes(motor_jac, -1, -2) @ motor_jac,
-            motor_gravity=-np.einsum("sitj,t->sij", motor_jac, self._gravity),
-            contact_gravity=-np.einsum("stj,t->sj", jacobian3, self._gravity),
-            contact_position=contact,
-            joint_positions=np.stack(origins, axis=1),
-        )
+        return self._contact_kinematics.samples(self._checked_q(q), full)
 
     def effective_parameters(
         self, samples: ArmSamples, directions: Any, **options: Any

@@ -12,6 +12,7 @@ from ..errors import InvalidParameter
 from ..model import effective
 from ..model.effective import finger_mass_matrix
 from .joints import joint_array
+from .kinematic_tree import JointKinematics, forward_kinematics, plane_basis, skew, support_mask
 
 
 @dataclass(frozen=True)
@@ -117,6 +118,111 @@ class ArmSamples:
                 "compute the samples with Arm.kinematics(q, motor_terms=True)",
             )
         return np.asarray(finger_mass_matrix(self.mass_matrix, self.motor_mass_influence, masses))
+
+
+@dataclass(frozen=True)
+class ContactKinematics:
+    """What the batched kinematics of an arm needs: its structure-only Pinocchio model (no armature), with a
+    frame at the contact point, and the joint tree.
+
+    model, data: the structure model and its data.
+    contact_frame_id: the frame at the contact point.
+    contact_joint: the model joint that carries the contact point; contact_local: the point in that joint's
+        frame [m].
+    joints: the joint tree (:func:`collision_reflex.arm.kinematic_tree.joint_kinematics`).
+    motor_masks: (nv motors, nv) masks of the joints that move each motor's parent link.
+    gravity: gravity acceleration of the model [m/s^2], (3,).
+    plane: (3, 2) basis of a planar arm's plane, None for a spatial arm.
+    """
+
+    model: Any
+    data: Any
+    contact_frame_id: int
+    contact_joint: int
+    contact_local: np.ndarray
+    joints: list[JointKinematics]
+    motor_masks: np.ndarray
+    gravity: np.ndarray
+    plane: np.ndarray | None
+
+    @classmethod
+    def of_model(
+        cls, model: Any, joints: list[JointKinematics], contact_joint: int, contact_local: np.ndarray
+    ) -> ContactKinematics:
+        """From a fixed-base ``pinocchio.Model`` (copied), its joint tree and the contact point, ``contact_local``
+        [m] in the frame of joint ``contact_joint``."""
+        import pinocchio as pin
+
+        structure = model.copy()
+        structure.armature = np.zeros(model.nv)
+        # A frame at the contact point itself, so that Pinocchio's frame Jacobian is the contact Jacobian.
+        frame_id = structure.addFrame(
+            pin.Frame(
+                "collision_reflex_contact_point",
+                contact_joint,
+                pin.SE3(np.eye(3), contact_local),
+                pin.FrameType.OP_FRAME,
+            )
+        )
+        supports = [set(structure.supports[j]) for j in range(structure.njoints)]
+        return cls(
+            model=structure,
+            data=structure.createData(),
+            contact_frame_id=int(frame_id),
+            contact_joint=contact_joint,
+            contact_local=contact_local,
+            joints=joints,
+            motor_masks=np.array([support_mask(structure, supports[jk.parent]) for jk in joints]),
+            gravity=np.asarray(structure.gravity.linear, dtype=float).copy(),
+            plane=plane_basis(structure, joints),
+        )
+
+    def samples(self, q: np.ndarray, full: bool = True) -> ArmSamples:
+        """:class:`ArmSamples` at checked configurations ``q`` (n, nq) [rad, m], see
+        :meth:`collision_reflex.arm.Arm.kinematics`."""
+        import pinocchio as pin
+
+        model, data = self.model, self.data
+
+        n, nv = q.shape[0], self.model.nv
+        mass = np.empty((n, nv, nv))
+        contact_jacobian = np.empty((n, 6, nv))
+        crba, frame_jacobian = pin.crba, pin.computeFrameJacobian
+        frame, aligned = self.contact_frame_id, pin.LOCAL_WORLD_ALIGNED
+        for s, qs in enumerate(q):
+            mass[s] = crba(model, data, qs)
+            contact_jacobian[s] = frame_jacobian(model, data, qs, frame, aligned)
+        jacobian3 = np.ascontiguousarray(contact_jacobian[:, :3])
+        jacobian = jacobian3 if self.plane is None else np.einsum("tp,stj->spj", self.plane, jacobian3)
+        if not full:
+            return ArmSamples(q=q, mass_matrix=mass, jacobian=jacobian)
+
+        spatial = np.empty((n, 6, nv))
+        gravity = np.empty((n, nv))
+        joint_jacobians, generalized_gravity = pin.computeJointJacobians, pin.computeGeneralizedGravity
+        for s, qs in enumerate(q):
+            spatial[s] = joint_jacobians(model, data, qs)  # world frame, every joint
+            gravity[s] = generalized_gravity(model, data, qs)
+        rotations, origins, motor_points = forward_kinematics(self.joints, q)
+        linear, angular = spatial[:, :3], spatial[:, 3:]
+        contact_joint = self.contact_joint - 1
+        contact = origins[contact_joint] + rotations[contact_joint] @ self.contact_local
+        # Motor i sits at joint i's origin on the parent link: it moves with the parent link's point there.
+        points = np.stack(motor_points, axis=1)  # (n, motor i, 3)
+        motor_jac = self.motor_masks[None, :, None, :] * (
+            linear[:, None] - skew(points) @ angular[:, None]
+        )  # (n, motor i, 3, nv)
+        return ArmSamples(
+            q=q,
+            mass_matrix=mass,
+            jacobian=jacobian,
+            gravity=gravity,
+            motor_mass_influence=np.swapaxes(motor_jac, -1, -2) @ motor_jac,
+            motor_gravity=-np.einsum("sitj,t->sij", motor_jac, self.gravity),
+            contact_gravity=-np.einsum("stj,t->sj", jacobian3, self.gravity),
+            contact_position=contact,
+            joint_positions=np.stack(origins, axis=1),
+        )
 
 
 def task_inverse_inertia(mass_matrix: np.ndarray, jacobian: np.ndarray) -> np.ndarray:
