@@ -315,7 +315,7 @@ class Actuator:
         _validate.non_negative("robot_mass", robot_mass)
         _validate.choice("reflected_inertia_in", reflected_inertia_in, REFLECTED_INERTIA_PLACEMENTS)
         reflected_mass = self.reflected_inertia / lever**2
-        m_f = finger_mass + (reflected_mass if reflected_inertia_in == "finger" else 0.0)
+        m_f = finger_mass + effective.finger_inertia(reflected_mass, reflected_inertia_in)
         if m_f <= 0:
             raise InvalidParameter(
                 "finger_mass",
