@@ -1,6 +1,6 @@
 """Effective 1D collision parameters of an arm along a contact direction ``u`` (MODEL.md §3), written once.
 
-The formulas are plain arithmetic on the helpers of :mod:`collision_reflex._backend`, so they serve the NumPy
+The formulas are plain arithmetic on the functions of :mod:`collision_reflex._backend`, so they serve the NumPy
 path (:func:`collision_reflex.arm.effective_parameters`, batched over configurations and directions) and the
 CasADi problem (:mod:`collision_reflex.optimize.problem`, symbolic in the design) alike.
 
