@@ -314,16 +314,7 @@ def build_problem(
     if len(joint_names) != n_joints:
         raise InvalidParameter("arm", len(joint_names), f"{n_joints} joint names to match the samples")
 
-    layout = _Layout()
-    reference = technology.reference_motor
-    defaults = {"stack_length": reference.stack_length}
-    for name in PER_JOINT_VARIABLES:
-        layout.add(name, space.per_joint(name, n_joints, defaults.get(name)))
-    for name in GLOBAL_VARIABLES:
-        bounds = space.global_bounds(name)
-        if name == "threshold" and technology.sensing == "force":
-            bounds = _with_noise_floor(bounds, constraints.threshold_floor)
-        layout.add(name, [bounds])
+    layout = _design_layout(space, technology, constraints, n_joints)
 
     # Variables: design (log values) | epigraph t (if needed) | g = log(1/F_a) (n_samples) |
     # finger-mass directions x (n_joints * n_samples).
@@ -370,42 +361,28 @@ def build_problem(
     mass_bounds = [np.asarray(joint_numbers(bound)[0]).ravel() for bound in (lbx, ubx)]
     torque_demands = _binding_torque_demands(samples, constraints, joint_names, *mass_bounds)
     required_torque = _required_torque_function(torque_demands, n_joints)
-    evaluate = ca.Function(
-        "evaluate",
-        [x],
-        [
-            impulses,
-            actuator_mass,
-            values["approach_velocity"],
-            thresholds,
-            required_torque(motor_mass),
-            peak_torque,
-            parameters,
-        ],
-        ["x"],
-        [
-            "impulses",
-            "actuator_mass",
-            "approach_velocity",
-            "thresholds",
-            "required_torque",
-            "peak_torque",
-            "parameters",
-        ],
+    evaluate = _evaluate_function(
+        x,
+        {
+            "impulses": impulses,
+            "actuator_mass": actuator_mass,
+            "approach_velocity": values["approach_velocity"],
+            "thresholds": thresholds,
+            "required_torque": required_torque(motor_mass),
+            "peak_torque": peak_torque,
+            "parameters": parameters,
+        },
     )
     x0[direction_index] = (start_directions / direction_scale[:, None]).ravel()
     x0[compliance_index] = np.log(reaction_compliance(samples, start_torque))
     start_impulses = np.asarray(evaluate(x0)[0]).ravel()
     _check_finite(start_impulses, "impulse at the start point", samples)
+    velocity_start = layout.values(x0[:n_design])["approach_velocity"][0]
     scale = {
         "worst_case_impulse": float(start_impulses.max()),
         "mean_impulse": float(start_impulses.mean()),
         "actuator_mass": float(start_mass.sum()),
-        "approach_velocity": float(
-            np.exp(x0[layout.slices["approach_velocity"][0]])
-            if layout.slices["approach_velocity"][0] is not None
-            else layout.bounds["approach_velocity"][0].lower
-        ),
+        "approach_velocity": float(velocity_start),
     }
     expressions: dict[str, Any] = {
         "mean_impulse": ca.sum2(impulses) / n_samples,
@@ -413,17 +390,8 @@ def build_problem(
         "approach_velocity": values["approach_velocity"],
     }
 
-    g_parts: list[Any] = []
-    lbg_parts: list[np.ndarray] = []
-    ubg_parts: list[np.ndarray] = []
-    labels: list[str] = []
-
-    def add(expression: Any, lower: float, upper: float, names: list[str]) -> None:
-        g_parts.append(expression)
-        lbg_parts.append(np.full(len(names), lower))
-        ubg_parts.append(np.full(len(names), upper))
-        labels.extend(names)
-
+    g = _ConstraintList()
+    add = g.add
     if epigraph_index is not None:
         t = x[epigraph_index] * scale["worst_case_impulse"]
         x0[epigraph_index] = 1.0
@@ -436,42 +404,21 @@ def build_problem(
         )
         expressions["worst_case_impulse"] = t
 
-    # g_s + log tau_i >= log|w_si| for every loaded (sample, joint), i.e. 1/F_a >= |w_si| / tau_i.
-    loaded = loaded_joints(samples)
-    pair_sample, pair_joint = np.nonzero(loaded)
-    log_arm = np.log(np.abs(samples.joint_moment_arms[pair_sample, pair_joint]))
-    add(
-        x[compliance_index][pair_sample.tolist()] + ca.log(peak_torque)[pair_joint.tolist()] - log_arm,
-        0.0,
-        np.inf,
-        [
-            f"reaction capacity of sample {s} within the torque of {joint_names[j]}"
-            for s, j in zip(pair_sample, pair_joint, strict=True)
-        ],
+    _add_model_constraints(
+        g,
+        x[compliance_index],
+        peak_torque,
+        normalisation,
+        thresholds,
+        motor_mass,
+        start_mass,
+        required_torque,
+        torque_demands,
+        samples,
+        technology,
+        constraints,
+        joint_names,
     )
-
-    add(ca.transpose(normalisation), 1.0, 1.0, [f"w^T x = 1 at sample {s}" for s in range(n_samples)])
-
-    # Torque: peak output torque covers the requirement in every sampled configuration, as linear constraints
-    # scaled by the requirement at the start; only demands that can be the largest somewhere in the box of
-    # motor masses allowed by the bounds can bind, the others are dropped (exactly).
-    torque_scale = np.maximum(np.asarray(required_torque(start_mass)).ravel(), 1e-3)
-    for j, (bases, slopes, demand_labels) in enumerate(torque_demands):
-        demand = ca.DM(bases) + ca.mtimes(ca.DM(slopes), motor_mass)
-        add(
-            (peak_torque[j] - demand) / torque_scale[j],
-            0.0,
-            np.inf,
-            [f"peak torque of {joint_names[j]} >= {label}" for label in demand_labels],
-        )
-
-    if technology.sensing == "position" and constraints.threshold_floor > 0:
-        add(
-            ca.transpose(thresholds) / constraints.threshold_floor,
-            1.0,
-            np.inf,
-            [f"contact threshold of sample {s} >= noise floor" for s in range(n_samples)],
-        )
 
     for k, name in enumerate(bounded):
         add(
@@ -485,15 +432,15 @@ def build_problem(
         weight * OBJECTIVES[name][0] * expressions[name] / scale[name] for name, weight in weights.items()
     )
     f += TIE_BREAK_WEIGHT * expressions["mean_impulse"] / scale["mean_impulse"]
-    nlp = {"x": x, "f": f, "g": ca.vertcat(*g_parts), "p": p}
+    nlp = {"x": x, "f": f, "g": ca.vertcat(*g.parts), "p": p}
     return DesignProblem(
         nlp=nlp,
         x0=x0,
         lbx=lbx,
         ubx=ubx,
-        lbg=np.concatenate(lbg_parts),
-        ubg=np.concatenate(ubg_parts),
-        constraint_labels=labels,
+        lbg=np.concatenate(g.lower),
+        ubg=np.concatenate(g.upper),
+        constraint_labels=g.labels,
         objective=weights,
         bounded_objectives=bounded,
         objective_scale=scale,
@@ -514,6 +461,102 @@ def build_problem(
         _sample_function=sample_function,
         _sample_data=data,
     )
+
+
+def _evaluate_function(x: Any, outputs: dict[str, Any]) -> Any:
+    """CasADi function of the NLP's ``x`` giving the named ``outputs`` (see :class:`DesignProblem`)."""
+    return ca.Function("evaluate", [x], list(outputs.values()), ["x"], list(outputs))
+
+
+def _design_layout(
+    space: DesignSpace, technology: ActuatorTechnology, constraints: Constraints, n_joints: int
+) -> _Layout:
+    """The design variables with their bounds: per joint, then global; with force sensing the noise floor
+    bounds the threshold from below."""
+    layout = _Layout()
+    defaults = {"stack_length": technology.reference_motor.stack_length}
+    for name in PER_JOINT_VARIABLES:
+        layout.add(name, space.per_joint(name, n_joints, defaults.get(name)))
+    for name in GLOBAL_VARIABLES:
+        bounds = space.global_bounds(name)
+        if name == "threshold" and technology.sensing == "force":
+            bounds = _with_noise_floor(bounds, constraints.threshold_floor)
+        layout.add(name, [bounds])
+    return layout
+
+
+@dataclass
+class _ConstraintList:
+    """The NLP's constraints ``lower <= g <= upper`` as they are added, each row with a label."""
+
+    parts: list[Any] = field(default_factory=list)
+    lower: list[np.ndarray] = field(default_factory=list)
+    upper: list[np.ndarray] = field(default_factory=list)
+    labels: list[str] = field(default_factory=list)
+
+    def add(self, expression: Any, lower: float, upper: float, names: list[str]) -> None:
+        self.parts.append(expression)
+        self.lower.append(np.full(len(names), lower))
+        self.upper.append(np.full(len(names), upper))
+        self.labels.extend(names)
+
+
+def _add_model_constraints(
+    g: _ConstraintList,
+    log_compliance: Any,
+    peak_torque: Any,
+    normalisation: Any,
+    thresholds: Any,
+    motor_mass: Any,
+    start_mass: np.ndarray,
+    required_torque: Any,
+    torque_demands: list[tuple[np.ndarray, np.ndarray, list[str]]],
+    samples: ContactSamples,
+    technology: ActuatorTechnology,
+    constraints: Constraints,
+    joint_names: tuple[str, ...],
+) -> None:
+    """The constraints of the model itself: reaction capacities within the joint torques, ``w^T x = 1`` for the
+    finger-mass directions, the torque requirement and the sensing noise floor (symbolic arguments: the log
+    reaction compliances (n_samples), peak torques and motor masses (n_joints), per-sample ``w^T x`` and
+    contact thresholds)."""
+    n_samples = samples.size
+    # g_s + log tau_i >= log|w_si| for every loaded (sample, joint), i.e. 1/F_a >= |w_si| / tau_i.
+    loaded = loaded_joints(samples)
+    pair_sample, pair_joint = np.nonzero(loaded)
+    log_arm = np.log(np.abs(samples.joint_moment_arms[pair_sample, pair_joint]))
+    g.add(
+        log_compliance[pair_sample.tolist()] + ca.log(peak_torque)[pair_joint.tolist()] - log_arm,
+        0.0,
+        np.inf,
+        [
+            f"reaction capacity of sample {s} within the torque of {joint_names[j]}"
+            for s, j in zip(pair_sample, pair_joint, strict=True)
+        ],
+    )
+
+    g.add(ca.transpose(normalisation), 1.0, 1.0, [f"w^T x = 1 at sample {s}" for s in range(n_samples)])
+
+    # Torque: peak output torque covers the requirement in every sampled configuration, as linear constraints
+    # scaled by the requirement at the start; only demands that can be the largest somewhere in the box of
+    # motor masses allowed by the bounds can bind, the others are dropped (exactly).
+    torque_scale = np.maximum(np.asarray(required_torque(start_mass)).ravel(), 1e-3)
+    for j, (bases, slopes, demand_labels) in enumerate(torque_demands):
+        demand = ca.DM(bases) + ca.mtimes(ca.DM(slopes), motor_mass)
+        g.add(
+            (peak_torque[j] - demand) / torque_scale[j],
+            0.0,
+            np.inf,
+            [f"peak torque of {joint_names[j]} >= {label}" for label in demand_labels],
+        )
+
+    if technology.sensing == "position" and constraints.threshold_floor > 0:
+        g.add(
+            ca.transpose(thresholds) / constraints.threshold_floor,
+            1.0,
+            np.inf,
+            [f"contact threshold of sample {s} >= noise floor" for s in range(n_samples)],
+        )
 
 
 def _design_quantities(
