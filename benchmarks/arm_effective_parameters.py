@@ -28,9 +28,9 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 import numpy as np
 import pinocchio as pin
 
-from collision_reflex.model import impulse
 from collision_reflex.arm.core import Arm, JointParameters, collision_impulses, effective_parameters
 from collision_reflex.arm.directions import sphere_directions
+from collision_reflex.model import impulse
 
 # Panda-like actuation: reflected inertia [kg m^2], torque limits (the URDF's) [N m], joint stiffness
 # [N m/rad]; a 5 N force threshold and 0.25 m/s approach.
