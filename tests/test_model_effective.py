@@ -71,10 +71,11 @@ def test_task_forms_match_explicit_matrices(system):
 def test_reaction_force_is_set_by_the_first_joint_to_saturate():
     w = np.array([[0.5, -0.2, 0.1], [0.0, 0.3, -0.6]])
     torque = np.array([10.0, 2.0, 3.0])
-    compliance = effective.reaction_compliance(w, torque)
+    compliance = effective.reaction_compliance(effective.torque_fractions(w, torque))
     # Contact forces at which each joint saturates: tau_i / |w_i|; F_a is the smallest.
     np.testing.assert_allclose(1 / compliance, [10.0, 5.0], rtol=1e-14)
-    np.testing.assert_allclose(effective.reaction_compliance(w.T, torque[:, None], joint_axis=-2), compliance)
+    transposed = effective.torque_fractions(w.T, torque[:, None])
+    np.testing.assert_allclose(effective.reaction_compliance(transposed, joint_axis=-2), compliance)
     robot = np.array([0.25, 0.5])  # 1 / m_r [1/kg]
     np.testing.assert_allclose(effective.reaction_acceleration(robot, compliance), [10.0 / 4, 5.0 / 2])
 
@@ -109,7 +110,8 @@ def test_casadi_backend_gives_the_numpy_values(system):
     compliance = effective.task_compliance(ca.DM(w[:1]), m)
     value = float(ca.Function("c", [m], [compliance])(inertia))
     assert value == pytest.approx(float(np.sum(w[0] ** 2 / inertia)), rel=1e-12)
-    torque = ca.Function("r", [m], [effective.reaction_compliance(ca.DM(w[0]), m)])
+    fractions = effective.torque_fractions(ca.DM(w[0]), m)
+    torque = ca.Function("r", [m], [effective.reaction_compliance(fractions)])
     assert float(torque(inertia)) == pytest.approx(float(np.max(np.abs(w[0]) / inertia)), rel=1e-14)
 
 

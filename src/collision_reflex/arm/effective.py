@@ -291,16 +291,18 @@ def _reaction_compliance(
 ) -> np.ndarray:
     """``max_i |(J^T u)_i| / torque_i`` [1/N] (:func:`collision_reflex.model.effective.reaction_compliance`) for
     the grid (n, d) or for paired samples (n_samples,)."""
+    # The torque fractions are linear in J^T u: scale the Jacobian's joint columns once, not every moment.
+    scaled = formulas.torque_fractions(jac, torque)
     if index is not None:
-        return formulas.reaction_compliance(np.einsum("sta,st->sa", jac[index], units), torque)
+        return formulas.reaction_compliance(np.einsum("sta,st->sa", scaled[index], units))
     n, nv, d = jac.shape[0], jac.shape[2], units.shape[0]
     out = np.empty((n, d))
-    # Blocks of configurations small enough to stay in cache (about 1 MB of moments each).
-    step = max(1, 2**17 // (nv * d))
-    directions_t, torque_column = np.ascontiguousarray(units.T), torque[:, None]
+    # Blocks of configurations small enough to stay in cache (about 256 kB of fractions each).
+    step = max(1, 2**15 // (nv * d))
+    directions_t = np.ascontiguousarray(units.T)
     for start in range(0, n, step):
-        moments = np.swapaxes(jac[start : start + step], 1, 2) @ directions_t  # (block, nv, d)
-        out[start : start + step] = formulas.reaction_compliance(moments, torque_column, joint_axis=-2)
+        fractions = np.swapaxes(scaled[start : start + step], 1, 2) @ directions_t  # (block, nv, d)
+        out[start : start + step] = formulas.reaction_compliance(fractions, joint_axis=-2)
     return out
 
 

@@ -91,20 +91,29 @@ def task_compliance(jacobian: Any, joint_values: Any) -> Any:
     return matmul(divide_columns(jacobian, joint_values), transpose(jacobian))
 
 
-def reaction_compliance(moment_arms: Any, torque_limit: Any, joint_axis: int = -1) -> Any:
-    """``1 / F_a = max_i |w_i| / tau_i`` [1/N]: the inverse of the largest contact force the joints can push back
-    with along ``-u`` before the first one saturates.
+def torque_fractions(moment_arms: Any, torque_limit: Any) -> Any:
+    """``w_i / tau_i`` [1/N]: the fraction of each joint's torque a unit contact force along ``u`` takes.
 
     Parameters
     ----------
-    moment_arms: ``w = J^T u`` [m/rad], joints on the last axis (NumPy) or a CasADi vector.
-    torque_limit: largest output torque per joint ``tau_i`` [N m] (or any joint torque threshold: then this is
-        the inverse of the contact force at which the first joint reaches it), broadcast against
-        ``moment_arms``.
-    joint_axis: the axis of ``moment_arms`` that holds the joints (NumPy; -2 lets a batch keep its directions
-        on the last, contiguous axis).
+    moment_arms: ``w = J^T u`` [m/rad], joints on the last axis (NumPy) or a CasADi vector. The map is linear,
+        so applied to the Jacobian ``J`` (joints on its last axis) it gives ``J diag(1/tau)``, whose product with
+        ``u`` is the fractions along ``u``.
+    torque_limit: largest output torque per joint ``tau_i`` [N m] (or a joint torque threshold), broadcast
+        against ``moment_arms``.
     """
-    return largest(absolute(moment_arms) / torque_limit, joint_axis)
+    return moment_arms / torque_limit
+
+
+def reaction_compliance(fractions: Any, joint_axis: int = -1) -> Any:
+    """``1 / F_a = max_i |w_i| / tau_i`` [1/N] from the :func:`torque_fractions`: the inverse of the largest
+    contact force the joints can push back with along ``-u`` before the first one saturates (with threshold
+    torques instead of limits: the inverse of the contact force at which the first joint reaches its threshold).
+
+    ``joint_axis`` is the axis of ``fractions`` that holds the joints (NumPy; -2 lets a batch keep its
+    directions on the last, contiguous axis).
+    """
+    return largest(absolute(fractions), joint_axis)
 
 
 def reaction_acceleration(robot_compliance: Any, reaction_compliance_: Any) -> Any:

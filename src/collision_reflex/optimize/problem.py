@@ -248,7 +248,8 @@ class DesignProblem:
             )
             direction = formulas.finger_mass_direction(ca.DM(w[s_index]), structure)
             joints = np.flatnonzero(loaded[s_index]).tolist()
-            compliance = formulas.reaction_compliance(ca.DM(w[s_index, joints]), peak_torque[joints])
+            fractions = formulas.torque_fractions(ca.DM(w[s_index, joints]), peak_torque[joints])
+            compliance = formulas.reaction_compliance(fractions)
             impulse, *_ = self._sample_function(
                 design_column, direction, compliance, ca.DM(self._sample_data[:, s_index])
             )
@@ -696,7 +697,9 @@ def reaction_compliance(samples: ContactSamples, peak_torque: np.ndarray) -> np.
     """``1 / F_a = max_i |w_i| / tau_i`` per sample [1/N]: the inverse of the largest contact force the joints
     can push back with before the first saturates (MODEL.md §3)."""
     return np.asarray(
-        formulas.reaction_compliance(samples.joint_moment_arms, np.asarray(peak_torque, dtype=float))
+        formulas.reaction_compliance(
+            formulas.torque_fractions(samples.joint_moment_arms, np.asarray(peak_torque, dtype=float))
+        )
     )
 
 
