@@ -8,7 +8,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from collision_reflex.arm.core import Arm, JointParameters
+from collision_reflex.arm import Arm, JointParameters
 from collision_reflex.errors import FrameNotFound, InvalidParameter, UrdfError
 
 DESIGNS = Path(__file__).resolve().parents[1] / "designs"

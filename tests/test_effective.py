@@ -13,10 +13,10 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from collision_reflex.arm.core import Arm, JointParameters, collision_impulses, effective_parameters
+from collision_reflex.arm import Arm, JointParameters, collision_impulses, effective_parameters
 from collision_reflex.arm.directions import circle_directions, sphere_directions, unit_directions
 from collision_reflex.errors import InvalidParameter
-from collision_reflex.model import impulse
+from collision_reflex.model import impulse, sensing
 
 TWO_LINK = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
 
@@ -206,18 +206,27 @@ def test_impulses_go_through_the_1d_model(panda, panda_samples):
     np.testing.assert_allclose(position.threshold, 0.01 * params.k, rtol=1e-14)
 
 
-def test_joint_torque_threshold_is_the_first_joint_to_trip(panda, panda_samples):
+def test_current_threshold_is_the_first_joint_to_trip(panda, panda_samples):
     u = sphere_directions(6)
     tau_s = np.full(7, 2.0)
     params = effective_parameters(panda_samples, u, **PANDA_JOINTS, joint_threshold=tau_s)
     moments = np.abs(np.einsum("std,kt->skd", panda_samples.jacobian, u))
     np.testing.assert_allclose(params.joint_threshold_force, 2.0 / moments.max(axis=-1), rtol=1e-14)
-    result = collision_impulses(params, 0.2, sensing="joint_torque")
+    result = collision_impulses(params, 0.2, sensing="current")
     np.testing.assert_allclose(result.threshold, params.joint_threshold_force)
     with pytest.raises(InvalidParameter, match="joint_threshold"):
-        collision_impulses(
-            effective_parameters(panda_samples, u, **PANDA_JOINTS), 0.2, sensing="joint_torque"
-        )
+        collision_impulses(effective_parameters(panda_samples, u, **PANDA_JOINTS), 0.2, sensing="current")
+
+
+def test_joint_torque_is_a_deprecated_spelling_of_current(panda_samples, monkeypatch):
+    monkeypatch.setattr(sensing, "_warned", set())
+    params = effective_parameters(panda_samples, sphere_directions(4), **PANDA_JOINTS, joint_threshold=2.0)
+    with pytest.warns(DeprecationWarning, match="'current'"):
+        old = collision_impulses(params, 0.2, sensing="joint_torque")
+    new = collision_impulses(params, 0.2, sensing="current")
+    np.testing.assert_array_equal(old.total, new.total)
+    with pytest.raises(InvalidParameter, match="sensing"):
+        collision_impulses(params, 0.2, threshold=1.0, sensing="torque")
 
 
 @pytest.mark.parametrize(

@@ -13,7 +13,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from collision_reflex.arm.core import Arm, effective_parameters
+from collision_reflex.arm import Arm, effective_parameters
 from collision_reflex.arm.directions import circle_directions, sphere_directions
 from collision_reflex.arm.metrics import (
     dynamic_manipulability_ellipsoid,

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from collision_reflex.arm.core import Arm, JointParameters
+from collision_reflex.arm import Arm, JointParameters
 from collision_reflex.arm.surfaces import reflex_surface
 from collision_reflex.errors import InvalidParameter
 

@@ -2,16 +2,11 @@
 direction, transparency metrics and collision reflex surfaces.
 """
 
-from .core import (
-    Arm,
-    ArmSamples,
-    CollisionImpulses,
-    EffectiveParameters,
-    JointParameters,
-    collision_impulses,
-    effective_parameters,
-)
 from .directions import circle_directions, sphere_directions, unit_directions
+from .effective import CollisionImpulses, EffectiveParameters, collision_impulses, effective_parameters
+from .joints import JointParameters
+from .robot import Arm
+from .samples import ArmSamples
 
 __all__ = [
     "Arm",

@@ -84,6 +84,17 @@ def unit_directions(spec: Any, task_dim: int, plane: np.ndarray | None = None) -
     return np.array(vectors)
 
 
+def normalised_directions(directions: Any, task_dim: int) -> np.ndarray:
+    """Direction vectors (d, task_dim) checked (non-zero, finite) and scaled to unit length."""
+    units = np.atleast_2d(np.asarray(directions, dtype=float))
+    if units.ndim != 2 or units.shape[1] != task_dim:
+        raise InvalidParameter("directions", units.shape, f"unit vectors of shape (d, {task_dim})")
+    norms = np.linalg.norm(units, axis=1)
+    if not np.all(np.isfinite(norms) & (norms > 0)):
+        raise InvalidParameter("directions", directions, "non-zero finite vectors")
+    return units / norms[:, None]
+
+
 def _vector(item: Any, task_dim: int, plane: np.ndarray | None) -> np.ndarray:
     if isinstance(item, str):
         text = item.strip().lower()

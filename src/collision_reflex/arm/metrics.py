@@ -21,8 +21,10 @@ from typing import Any
 import numpy as np
 
 from ..errors import FrameNotFound, InvalidParameter
-from .core import ArmSamples, _joint_array, _unit_directions, task_inverse_inertia
+from .directions import normalised_directions
+from .joints import joint_array
 from .robots import ROBOT_DEFAULTS, example_robot
+from .samples import ArmSamples, task_inverse_inertia
 
 
 @dataclass(frozen=True)
@@ -45,7 +47,7 @@ class Ellipsoid:
 
     def along(self, directions: Any) -> np.ndarray:
         """The quadratic form ``u^T A u`` for unit directions (d, m), (n, d)."""
-        units = _unit_directions(directions, self.matrix.shape[-1])
+        units = normalised_directions(directions, self.matrix.shape[-1])
         return np.einsum("da,nab,db->nd", units, self.matrix, units)
 
 
@@ -58,7 +60,7 @@ def full_mass_matrix(
     mass = samples.structure_mass_matrix(motor_mass)
     if reflected_inertia is None:
         return mass
-    armature = _joint_array("reflected_inertia", reflected_inertia, samples.nv, allow_zero=True)
+    armature = joint_array("reflected_inertia", reflected_inertia, samples.nv, allow_zero=True)
     return mass + np.diag(armature)
 
 
@@ -170,7 +172,7 @@ def impact_mitigation_factor(
         raise InvalidParameter("q", q.shape, f"a finite configuration of shape ({model.nq},)")
     free = model.copy()
     free.armature = np.concatenate(
-        [np.zeros(6), _joint_array("reflected_inertia", reflected_inertia, model.nv - 6, allow_zero=True)]
+        [np.zeros(6), joint_array("reflected_inertia", reflected_inertia, model.nv - 6, allow_zero=True)]
     )
     data = free.createData()
     mass = pin.crba(free, data, q)

@@ -14,8 +14,9 @@ from typing import Any
 import numpy as np
 
 from ..errors import InvalidParameter
-from .core import Arm, CollisionImpulses, EffectiveParameters, collision_impulses
 from .directions import unit_directions
+from .effective import CollisionImpulses, EffectiveParameters, collision_impulses
+from .robot import Arm
 
 DEFAULT_DIRECTION_COUNT = {2: 360, 3: 2000}
 """Directions swept by default: one per degree on the circle, 2000 Fibonacci points on the sphere."""
@@ -98,16 +99,16 @@ def reflex_surface(
     q: (nq,) configuration.
     v0: approach velocity [m/s], > 0.
     threshold: the sensing threshold, a force [N] (``sensing="force"``) or a position error [m]
-        (``"position"``); joint torques [N m] for ``"joint_torque"`` go in ``joint_threshold``. When neither
+        (``"position"``); joint-side threshold torques [N m] for ``"current"`` go in ``joint_threshold``. When neither
         ``threshold``, ``sensing`` nor ``joint_threshold`` is given, the arm's actuators' sensing schemes are used
-        (:meth:`collision_reflex.arm.core.Arm.sensing_options`).
+        (:meth:`collision_reflex.arm.Arm.sensing_options`).
     directions: a count, names or vectors (see :func:`collision_reflex.arm.directions.unit_directions`); default
         :data:`DEFAULT_DIRECTION_COUNT` evenly spread.
-    sensing, reaction: see :func:`collision_reflex.arm.core.collision_impulses`.
+    sensing, reaction: see :func:`collision_reflex.arm.collision_impulses`.
     task_stiffness: Cartesian controller stiffness [N/m] in series with the joints, see
-        :func:`collision_reflex.arm.core.effective_parameters`.
+        :func:`collision_reflex.arm.effective_parameters`.
     stiffness_form: ``"compliance"`` or ``"paper"``.
-    joint_threshold: joint torque thresholds [N m] for ``sensing="joint_torque"``.
+    joint_threshold: joint-side threshold torques [N m] for ``sensing="current"``.
     """
     configuration = np.asarray(q, dtype=float)
     if configuration.shape != (arm.nq,):
@@ -119,7 +120,7 @@ def reflex_surface(
         sensing = detection["sensing"]
         threshold = detection.get("threshold")
         joint_threshold = detection.get("joint_threshold")
-    sensing = sensing or ("joint_torque" if joint_threshold is not None else "force")
+    sensing = sensing or ("current" if joint_threshold is not None else "force")
     samples = arm.kinematics(configuration[None])
     params = arm.effective_parameters(
         samples,

@@ -44,8 +44,14 @@ import numpy as np
 
 from .. import _validate
 from ..errors import FitFailed
-from ..model.impulse import REACTION_MODES, PhaseImpulses, phase_impulses, series_stiffness
-from .sensor import SensorModel, model_samples, pulse_duration
+from ..model.impulse import (
+    REACTION_MODES,
+    PhaseImpulses,
+    impact_pulse_duration,
+    phase_impulses,
+    series_stiffness,
+)
+from .sensor import SensorModel, model_samples
 from .traces import Trace
 from .window import ContactWindow
 
@@ -183,7 +189,7 @@ def fit_one_shot(
 
     def residuals(x: np.ndarray) -> np.ndarray:
         m_f, k_s, F_s, a, t0 = unpack(x)
-        k = 1.0 / (1.0 / k_m + 1.0 / k_s)
+        k = series_stiffness(k_m, k_s)
         model = model_samples(times, m_f, k, k_m, F_s, a, v0, t0, sensor, reaction)
         return (model + x[5] * sigma - force) / sigma
 
@@ -211,7 +217,7 @@ def fit_one_shot(
     # time, and the solver stops anywhere on that plateau. The data may want the pulse to spill a little
     # into the previous or the next sample: try both ends of the plateau.
     m_f, _, _, _, t0 = unpack(best.x)
-    width = float(pulse_duration(m_f, k_m))
+    width = float(impact_pulse_duration(m_f, k_m))
     if width < period:
         centre = t0 + width / 2
         j = int(np.argmin(np.abs(times - centre)))

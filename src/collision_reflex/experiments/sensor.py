@@ -21,15 +21,13 @@ Gauss-Legendre quadrature (the ramp and the reaction are polynomials of degree 1
 from __future__ import annotations
 
 import functools
-import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
 from .. import _validate
 from ..errors import InvalidParameter
-from ..model.impulse import collision_times, force_profile
+from ..model.impulse import collision_times, force_profile, impact_pulse_duration
 
 # 8 Gauss-Legendre nodes integrate the pulse's sine over a quarter period to ~1e-13 relative and the ramp
 # and the reaction's parabola exactly.
@@ -99,15 +97,9 @@ def _butterworth(order: int, cutoff: float) -> tuple[np.ndarray, np.ndarray]:
     return b, a
 
 
-def pulse_duration(m_f: Any, k_m: Any) -> Any:
-    """Duration of the model's impact pulse [s], the compression quarter-period ``pi/2 sqrt(m_f/k_m)``.
-
-    Parameters
-    ----------
-    m_f: finger mass [kg].
-    k_m: mechanical (sensor) stiffness [N/m].
-    """
-    return math.pi / 2 * np.sqrt(np.asarray(m_f, dtype=float) / k_m)
+pulse_duration = impact_pulse_duration
+"""The impact pulse's duration [s], kept under this name for existing callers: it is
+:func:`collision_reflex.model.impulse.impact_pulse_duration`."""
 
 
 def model_samples(
@@ -142,7 +134,7 @@ def model_samples(
     half = sensor.period / 2
     shifted = np.asarray(times, dtype=float) - impact_time
     lower, upper = shifted - half, shifted + half
-    pulse_end = float(pulse_duration(m_f, k_m))
+    pulse_end = float(impact_pulse_duration(m_f, k_m))
     breakpoints = np.array([0.0, pulse_end, float(t1), float(t2)])
     means = np.zeros(shifted.shape)
     in_contact = (upper > 0.0) & (lower < float(t2))

@@ -23,7 +23,9 @@ from typing import Any, Protocol
 
 from .. import _validate
 from ..errors import InvalidParameter
+from ..model import effective
 from ..model.impulse import series_stiffness
+from ..model.sensing import current_threshold_torque, threshold_force
 from .gearboxes import Gearbox
 from .motors import Motor
 
@@ -127,7 +129,7 @@ class PositionThreshold:
                 "a finite joint stiffness for a position-error threshold",
                 "a rigid joint never builds a position error; give mechanical or software stiffness",
             )
-        return stiffness * self.error
+        return float(threshold_force("position", self.error, stiffness))
 
     def contact_threshold(self, actuator: Actuator, lever: float) -> float:
         """Contact force at detection [N]: ``k e_th / L``."""
@@ -160,7 +162,7 @@ class CurrentThreshold:
         _validate.non_negative("CurrentThreshold.friction_torque", self.friction_torque)
 
     def joint_threshold_torque(self, actuator: Actuator, lever: float | None = None) -> float:
-        return actuator.gear_ratio * self.motor_torque + self.friction_torque
+        return float(current_threshold_torque(actuator.gear_ratio, self.motor_torque, self.friction_torque))
 
     def contact_threshold(self, actuator: Actuator, lever: float) -> float:
         """Contact force at detection [N]: ``(N tau_s + tau_friction) / L``."""
@@ -244,7 +246,7 @@ class Actuator:
     @property
     def rotor_reflected_inertia(self) -> float:
         """Rotor inertia seen at the joint, ``N**2 J_m`` [kg m^2]."""
-        return self.gear_ratio**2 * self.motor.rotor_inertia
+        return float(effective.reflected_inertia(self.gear_ratio, self.motor.rotor_inertia))
 
     @property
     def reflected_inertia(self) -> float:
@@ -313,7 +315,7 @@ class Actuator:
         _validate.non_negative("robot_mass", robot_mass)
         _validate.choice("reflected_inertia_in", reflected_inertia_in, REFLECTED_INERTIA_PLACEMENTS)
         reflected_mass = self.reflected_inertia / lever**2
-        m_f = finger_mass + (reflected_mass if reflected_inertia_in == "finger" else 0.0)
+        m_f = finger_mass + effective.finger_inertia(reflected_mass, reflected_inertia_in)
         if m_f <= 0:
             raise InvalidParameter(
                 "finger_mass",

@@ -33,7 +33,13 @@ import numpy as np
 from .. import _validate
 from .._io import atomic_open
 from ..errors import InvalidParameter
-from ..model.impulse import REACTION_MODES, minimum_impulse, optimal_velocity, phase_impulses
+from ..model.impulse import (
+    REACTION_MODES,
+    minimum_impulse,
+    optimal_velocity,
+    phase_impulses,
+    series_stiffness,
+)
 from .actuators import (
     REFLECTED_INERTIA_PLACEMENTS,
     Actuator,
@@ -368,7 +374,7 @@ def stiffness_sweep(
     motor = motor if motor is not None else reference_motor()
     middle = float(np.sqrt(stiffnesses[0] * stiffnesses[-1]))
     if position_error is None:
-        position_error = threshold / (1 / (1 / middle + 1 / software_stiffness))
+        position_error = threshold / series_stiffness(middle, software_stiffness)
     _validate.positive("position_error", position_error)
 
     def impulse(k_m: float, sensing: Any) -> tuple[float, float]:

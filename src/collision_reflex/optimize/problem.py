@@ -39,11 +39,13 @@ from .. import _validate
 from ..errors import InvalidParameter
 from ..hardware.actuators import REFLECTED_INERTIA_PLACEMENTS
 from ..hardware.motors import Motor, scaled_motor_quantities
+from ..model import effective as formulas
 from ..model.impulse import REACTION_MODES, phase_impulses, series_stiffness
+from ..model.sensing import sensing_scheme, threshold_force
 from .space import (
     GLOBAL_VARIABLES,
+    OPTIMIZED_SENSING_SCHEMES,
     PER_JOINT_VARIABLES,
-    SENSING_SCHEMES,
     Bounds,
     Constraints,
     ContactSamples,
@@ -73,7 +75,8 @@ class ActuatorTechnology:
     scaling_law: motor scaling law name (see :data:`collision_reflex.hardware.motors.SCALING_LAWS`).
     mechanical_stiffness: joint mechanical stiffness [N m/rad], one value or one per joint, finite > 0: it is
         the only spring left in the reaction phase.
-    sensing: ``"force"`` (contact-force threshold) or ``"position"`` (contact position-error threshold).
+    sensing: ``"force"`` (contact-force threshold) or ``"position"`` (contact position-error threshold), see
+        :data:`collision_reflex.optimize.space.OPTIMIZED_SENSING_SCHEMES`.
     reaction: reaction-phase model, ``"at_rest"`` (the paper's) or ``"moving"``.
     reflected_inertia_in: where the reflected rotor inertia ``N^2 J_m`` acts. ``"robot"`` (default, the paper's
         arm model): behind the joint springs, in the robot mass ``m_r`` of the reaction phase only.
@@ -91,7 +94,7 @@ class ActuatorTechnology:
 
     def __post_init__(self) -> None:
         _validate.positive("mechanical_stiffness", np.asarray(self.mechanical_stiffness, dtype=float))
-        _validate.choice("sensing", self.sensing, SENSING_SCHEMES)
+        object.__setattr__(self, "sensing", sensing_scheme(self.sensing, OPTIMIZED_SENSING_SCHEMES))
         _validate.choice("reaction", self.reaction, REACTION_MODES)
         _validate.choice("reflected_inertia_in", self.reflected_inertia_in, REFLECTED_INERTIA_PLACEMENTS)
 
@@ -157,8 +160,9 @@ class DesignProblem:
     ``nlp`` is CasADi's ``{"x", "f", "g", "p"}``; ``lbx``/``ubx``/``x0``/``lbg``/``ubg`` its bounds and start;
     ``constraint_labels[i]`` names constraint ``g[i]``; ``objective_scale`` the value each objective is divided
     by in the NLP; ``evaluate`` a CasADi function of ``x`` giving ``impulses`` (1 x n_samples), ``actuator_mass``,
-    ``approach_velocity``, ``thresholds`` (1 x n_samples), ``required_torque`` and ``peak_torque`` (n_joints);
-    use :meth:`exact_point` first so that the auxiliary variables hold their exact values.
+    ``approach_velocity``, ``thresholds`` (1 x n_samples), ``required_torque`` and ``peak_torque`` (n_joints),
+    and ``parameters`` (5 x n_samples: ``m_f, m_r, k, k_m, a``, see :meth:`sample_parameters`); use
+    :meth:`exact_point` first so that the auxiliary variables hold their exact values.
     """
 
     nlp: dict[str, Any]
@@ -197,8 +201,7 @@ class DesignProblem:
     def exact_point(self, x: np.ndarray) -> np.ndarray:
         """``x`` with the auxiliary variables (finger-mass directions, reaction compliances and the epigraph
         ``t``) set to their exact values for the design in ``x``, so that evaluating there gives the model's
-        values to machine precision.
-        """
+        values to machine precision."""
         x = np.array(x, dtype=float)
         masses, torques, finger = (np.asarray(v).ravel() for v in self._joint_numbers(x))
         x[self.direction_index] = (
@@ -209,6 +212,16 @@ class DesignProblem:
             impulses = np.asarray(self.evaluate(x)[0]).ravel()
             x[self.epigraph_index] = impulses.max() / self.objective_scale["worst_case_impulse"]
         return x
+
+    def sample_parameters(self, x: np.ndarray) -> dict[str, np.ndarray]:
+        """The effective 1D parameters of every sample as the NLP evaluates them at the design in ``x``
+        (auxiliaries at their exact values): ``m_f``, ``m_r`` [kg], ``k``, ``k_m`` [N/m], ``a`` [m/s^2] and the
+        contact-force threshold ``F_s`` [N], arrays of shape (n_samples,)."""
+        evaluated = self.evaluate(self.exact_point(x))
+        rows = np.asarray(evaluated[6])
+        out = dict(zip(("m_f", "m_r", "k", "k_m", "a"), rows, strict=True))
+        out["F_s"] = np.asarray(evaluated[3]).ravel()
+        return out
 
     def impulse_function(self) -> Any:
         """The collision impulse of every sample as a CasADi function of the design variables alone.
@@ -229,14 +242,15 @@ class DesignProblem:
         loaded = loaded_joints(self.samples)
         impulses = []
         for s_index, config in enumerate(self.samples.config_index):
-            structure = ca.DM(kin.mass_matrix[config]) + ca.diag(finger_inertia)
-            for i in range(n):
-                structure += motor_mass[i] * ca.DM(kin.motor_mass_influence[config, i])
-            y = ca.solve(structure, ca.DM(w[s_index]))
-            direction = y / ca.dot(ca.DM(w[s_index]), y)
-            ratios = [abs(w[s_index, i]) / peak_torque[i] for i in range(n) if loaded[s_index, i]]
-            compliance = ca.mmax(ca.vertcat(*ratios))
-            impulse, _, _ = self._sample_function(
+            influence = [ca.DM(kin.motor_mass_influence[config, i]) for i in range(n)]
+            structure = formulas.finger_mass_matrix(
+                ca.DM(kin.mass_matrix[config]), influence, motor_mass, finger_inertia
+            )
+            direction = formulas.finger_mass_direction(ca.DM(w[s_index]), structure)
+            joints = np.flatnonzero(loaded[s_index]).tolist()
+            fractions = formulas.torque_fractions(ca.DM(w[s_index, joints]), peak_torque[joints])
+            compliance = formulas.reaction_compliance(fractions)
+            impulse, *_ = self._sample_function(
                 design_column, direction, compliance, ca.DM(self._sample_data[:, s_index])
             )
             impulses.append(impulse)
@@ -280,7 +294,7 @@ def build_problem(
 
     Parameters
     ----------
-    arm: the :class:`collision_reflex.arm.core.Arm` (joint names; ``samples.kinematics`` must come from it).
+    arm: the :class:`collision_reflex.arm.Arm` (joint names; ``samples.kinematics`` must come from it).
     samples: contact cases: configurations (with their Pinocchio data) and directions.
     space: bounds of the design variables.
     technology: reference motor, scaling law, mechanical stiffness, sensing scheme, reaction model.
@@ -301,16 +315,7 @@ def build_problem(
     if len(joint_names) != n_joints:
         raise InvalidParameter("arm", len(joint_names), f"{n_joints} joint names to match the samples")
 
-    layout = _Layout()
-    reference = technology.reference_motor
-    defaults = {"stack_length": reference.stack_length}
-    for name in PER_JOINT_VARIABLES:
-        layout.add(name, space.per_joint(name, n_joints, defaults.get(name)))
-    for name in GLOBAL_VARIABLES:
-        bounds = space.global_bounds(name)
-        if name == "threshold" and technology.sensing == "force":
-            bounds = _with_noise_floor(bounds, constraints.threshold_floor)
-        layout.add(name, [bounds])
+    layout = _design_layout(space, technology, constraints, n_joints)
 
     # Variables: design (log values) | epigraph t (if needed) | g = log(1/F_a) (n_samples) |
     # finger-mass directions x (n_joints * n_samples).
@@ -350,38 +355,35 @@ def build_problem(
         np.tile(direction_scale, (n_joints, 1))
     )
     compliance = ca.exp(ca.transpose(x[compliance_index]))
-    impulses, thresholds, normalisation = per_sample(design_column, directions, compliance, ca.DM(data))
+    impulses, thresholds, normalisation, parameters = per_sample(
+        design_column, directions, compliance, ca.DM(data)
+    )
     actuator_mass = ca.sum1(motor_mass)
     mass_bounds = [np.asarray(joint_numbers(bound)[0]).ravel() for bound in (lbx, ubx)]
     torque_demands = _binding_torque_demands(samples, constraints, joint_names, *mass_bounds)
     required_torque = _required_torque_function(torque_demands, n_joints)
-    evaluate = ca.Function(
-        "evaluate",
-        [x],
-        [
-            impulses,
-            actuator_mass,
-            values["approach_velocity"],
-            thresholds,
-            required_torque(motor_mass),
-            peak_torque,
-        ],
-        ["x"],
-        ["impulses", "actuator_mass", "approach_velocity", "thresholds", "required_torque", "peak_torque"],
+    evaluate = _evaluate_function(
+        x,
+        {
+            "impulses": impulses,
+            "actuator_mass": actuator_mass,
+            "approach_velocity": values["approach_velocity"],
+            "thresholds": thresholds,
+            "required_torque": required_torque(motor_mass),
+            "peak_torque": peak_torque,
+            "parameters": parameters,
+        },
     )
     x0[direction_index] = (start_directions / direction_scale[:, None]).ravel()
     x0[compliance_index] = np.log(reaction_compliance(samples, start_torque))
     start_impulses = np.asarray(evaluate(x0)[0]).ravel()
     _check_finite(start_impulses, "impulse at the start point", samples)
+    velocity_start = layout.values(x0[:n_design])["approach_velocity"][0]
     scale = {
         "worst_case_impulse": float(start_impulses.max()),
         "mean_impulse": float(start_impulses.mean()),
         "actuator_mass": float(start_mass.sum()),
-        "approach_velocity": float(
-            np.exp(x0[layout.slices["approach_velocity"][0]])
-            if layout.slices["approach_velocity"][0] is not None
-            else layout.bounds["approach_velocity"][0].lower
-        ),
+        "approach_velocity": float(velocity_start),
     }
     expressions: dict[str, Any] = {
         "mean_impulse": ca.sum2(impulses) / n_samples,
@@ -389,17 +391,8 @@ def build_problem(
         "approach_velocity": values["approach_velocity"],
     }
 
-    g_parts: list[Any] = []
-    lbg_parts: list[np.ndarray] = []
-    ubg_parts: list[np.ndarray] = []
-    labels: list[str] = []
-
-    def add(expression: Any, lower: float, upper: float, names: list[str]) -> None:
-        g_parts.append(expression)
-        lbg_parts.append(np.full(len(names), lower))
-        ubg_parts.append(np.full(len(names), upper))
-        labels.extend(names)
-
+    g = _ConstraintList()
+    add = g.add
     if epigraph_index is not None:
         t = x[epigraph_index] * scale["worst_case_impulse"]
         x0[epigraph_index] = 1.0
@@ -412,42 +405,21 @@ def build_problem(
         )
         expressions["worst_case_impulse"] = t
 
-    # g_s + log tau_i >= log|w_si| for every loaded (sample, joint), i.e. 1/F_a >= |w_si| / tau_i.
-    loaded = loaded_joints(samples)
-    pair_sample, pair_joint = np.nonzero(loaded)
-    log_arm = np.log(np.abs(samples.joint_moment_arms[pair_sample, pair_joint]))
-    add(
-        x[compliance_index][pair_sample.tolist()] + ca.log(peak_torque)[pair_joint.tolist()] - log_arm,
-        0.0,
-        np.inf,
-        [
-            f"reaction capacity of sample {s} within the torque of {joint_names[j]}"
-            for s, j in zip(pair_sample, pair_joint, strict=True)
-        ],
+    _add_model_constraints(
+        g,
+        x[compliance_index],
+        peak_torque,
+        normalisation,
+        thresholds,
+        motor_mass,
+        start_mass,
+        required_torque,
+        torque_demands,
+        samples,
+        technology,
+        constraints,
+        joint_names,
     )
-
-    add(ca.transpose(normalisation), 1.0, 1.0, [f"w^T x = 1 at sample {s}" for s in range(n_samples)])
-
-    # Torque: peak output torque covers the requirement in every sampled configuration, as linear constraints
-    # scaled by the requirement at the start; only demands that can be the largest somewhere in the box of
-    # motor masses allowed by the bounds can bind, the others are dropped (exactly).
-    torque_scale = np.maximum(np.asarray(required_torque(start_mass)).ravel(), 1e-3)
-    for j, (bases, slopes, demand_labels) in enumerate(torque_demands):
-        demand = ca.DM(bases) + ca.mtimes(ca.DM(slopes), motor_mass)
-        add(
-            (peak_torque[j] - demand) / torque_scale[j],
-            0.0,
-            np.inf,
-            [f"peak torque of {joint_names[j]} >= {label}" for label in demand_labels],
-        )
-
-    if technology.sensing == "position" and constraints.threshold_floor > 0:
-        add(
-            ca.transpose(thresholds) / constraints.threshold_floor,
-            1.0,
-            np.inf,
-            [f"contact threshold of sample {s} >= noise floor" for s in range(n_samples)],
-        )
 
     for k, name in enumerate(bounded):
         add(
@@ -461,15 +433,15 @@ def build_problem(
         weight * OBJECTIVES[name][0] * expressions[name] / scale[name] for name, weight in weights.items()
     )
     f += TIE_BREAK_WEIGHT * expressions["mean_impulse"] / scale["mean_impulse"]
-    nlp = {"x": x, "f": f, "g": ca.vertcat(*g_parts), "p": p}
+    nlp = {"x": x, "f": f, "g": ca.vertcat(*g.parts), "p": p}
     return DesignProblem(
         nlp=nlp,
         x0=x0,
         lbx=lbx,
         ubx=ubx,
-        lbg=np.concatenate(lbg_parts),
-        ubg=np.concatenate(ubg_parts),
-        constraint_labels=labels,
+        lbg=np.concatenate(g.lower),
+        ubg=np.concatenate(g.upper),
+        constraint_labels=g.labels,
         objective=weights,
         bounded_objectives=bounded,
         objective_scale=scale,
@@ -492,19 +464,114 @@ def build_problem(
     )
 
 
+def _evaluate_function(x: Any, outputs: dict[str, Any]) -> Any:
+    """CasADi function of the NLP's ``x`` giving the named ``outputs`` (see :class:`DesignProblem`)."""
+    return ca.Function("evaluate", [x], list(outputs.values()), ["x"], list(outputs))
+
+
+def _design_layout(
+    space: DesignSpace, technology: ActuatorTechnology, constraints: Constraints, n_joints: int
+) -> _Layout:
+    """The design variables with their bounds: per joint, then global; with force sensing the noise floor
+    bounds the threshold from below."""
+    layout = _Layout()
+    defaults = {"stack_length": technology.reference_motor.stack_length}
+    for name in PER_JOINT_VARIABLES:
+        layout.add(name, space.per_joint(name, n_joints, defaults.get(name)))
+    for name in GLOBAL_VARIABLES:
+        bounds = space.global_bounds(name)
+        if name == "threshold" and technology.sensing == "force":
+            bounds = _with_noise_floor(bounds, constraints.threshold_floor)
+        layout.add(name, [bounds])
+    return layout
+
+
+@dataclass
+class _ConstraintList:
+    """The NLP's constraints ``lower <= g <= upper`` as they are added, each row with a label."""
+
+    parts: list[Any] = field(default_factory=list)
+    lower: list[np.ndarray] = field(default_factory=list)
+    upper: list[np.ndarray] = field(default_factory=list)
+    labels: list[str] = field(default_factory=list)
+
+    def add(self, expression: Any, lower: float, upper: float, names: list[str]) -> None:
+        self.parts.append(expression)
+        self.lower.append(np.full(len(names), lower))
+        self.upper.append(np.full(len(names), upper))
+        self.labels.extend(names)
+
+
+def _add_model_constraints(
+    g: _ConstraintList,
+    log_compliance: Any,
+    peak_torque: Any,
+    normalisation: Any,
+    thresholds: Any,
+    motor_mass: Any,
+    start_mass: np.ndarray,
+    required_torque: Any,
+    torque_demands: list[tuple[np.ndarray, np.ndarray, list[str]]],
+    samples: ContactSamples,
+    technology: ActuatorTechnology,
+    constraints: Constraints,
+    joint_names: tuple[str, ...],
+) -> None:
+    """The constraints of the model itself: reaction capacities within the joint torques, ``w^T x = 1`` for the
+    finger-mass directions, the torque requirement and the sensing noise floor (symbolic arguments: the log
+    reaction compliances (n_samples), peak torques and motor masses (n_joints), per-sample ``w^T x`` and
+    contact thresholds)."""
+    n_samples = samples.size
+    # g_s + log tau_i >= log|w_si| for every loaded (sample, joint), i.e. 1/F_a >= |w_si| / tau_i.
+    loaded = loaded_joints(samples)
+    pair_sample, pair_joint = np.nonzero(loaded)
+    log_arm = np.log(np.abs(samples.joint_moment_arms[pair_sample, pair_joint]))
+    g.add(
+        log_compliance[pair_sample.tolist()] + ca.log(peak_torque)[pair_joint.tolist()] - log_arm,
+        0.0,
+        np.inf,
+        [
+            f"reaction capacity of sample {s} within the torque of {joint_names[j]}"
+            for s, j in zip(pair_sample, pair_joint, strict=True)
+        ],
+    )
+
+    g.add(ca.transpose(normalisation), 1.0, 1.0, [f"w^T x = 1 at sample {s}" for s in range(n_samples)])
+
+    # Torque: peak output torque covers the requirement in every sampled configuration, as linear constraints
+    # scaled by the requirement at the start; only demands that can be the largest somewhere in the box of
+    # motor masses allowed by the bounds can bind, the others are dropped (exactly).
+    torque_scale = np.maximum(np.asarray(required_torque(start_mass)).ravel(), 1e-3)
+    for j, (bases, slopes, demand_labels) in enumerate(torque_demands):
+        demand = ca.DM(bases) + ca.mtimes(ca.DM(slopes), motor_mass)
+        g.add(
+            (peak_torque[j] - demand) / torque_scale[j],
+            0.0,
+            np.inf,
+            [f"peak torque of {joint_names[j]} >= {label}" for label in demand_labels],
+        )
+
+    if technology.sensing == "position" and constraints.threshold_floor > 0:
+        g.add(
+            ca.transpose(thresholds) / constraints.threshold_floor,
+            1.0,
+            np.inf,
+            [f"contact threshold of sample {s} >= noise floor" for s in range(n_samples)],
+        )
+
+
 def _design_quantities(
     layout: _Layout, z: Any, technology: ActuatorTechnology, k_mech: np.ndarray
 ) -> tuple[dict[str, Any], Any, Any, Any, Any]:
     """Symbolic joint quantities of the design variables ``z`` (log values): the variables themselves, the
     per-sample function's design column, motor masses [kg], peak output torques [N m] and the reflected inertia
-    acting on the finger [kg m^2] (zero unless ``reflected_inertia_in == "finger"``).
-    """
+    acting on the finger [kg m^2] (zero unless ``reflected_inertia_in == "finger"``)."""
     values = layout.expressions(z)
     motor = scaled_motor_quantities(
         technology.reference_motor, values["stator_diameter"], values["stack_length"], technology.scaling_law
     )
     gear = values["gear_ratio"]
-    reflected = gear**2 * motor.rotor_inertia  # N^2 J_m
+    reflected = formulas.reflected_inertia(gear, motor.rotor_inertia)
     design_column = ca.vertcat(
         motor.mass,
         reflected,
@@ -512,7 +579,7 @@ def _design_quantities(
         values["threshold"],
         values["approach_velocity"],
     )
-    finger_inertia = reflected if technology.reflected_inertia_in == "finger" else 0 * gear
+    finger_inertia = formulas.finger_inertia(reflected, technology.reflected_inertia_in)
     return values, design_column, motor.mass, gear * motor.peak_torque, finger_inertia
 
 
@@ -535,8 +602,7 @@ def _feasible_gear_start(
     joint_names: tuple[str, ...],
 ) -> None:
     """Move the start's free gear ratios up to where the peak torque covers the requirement (with 10 % to
-    spare), within their bounds: IPOPT converges much faster from a torque-feasible start.
-    """
+    spare), within their bounds: IPOPT converges much faster from a torque-feasible start."""
     masses, torques, _ = (np.asarray(v).ravel() for v in joint_numbers(x0))
     rows, _ = _torque_requirement_rows(samples, constraints, joint_names)
     required = np.max([base + per_motor @ masses for base, per_motor in rows], axis=0)
@@ -568,8 +634,8 @@ def _sample_function(n_joints: int, sensing: str, reaction: str, reflected_inert
     Inputs: the design column (motor masses, reflected inertias, joint stiffnesses (n each), threshold,
     approach velocity), the finger-mass direction ``x`` (n, with ``w^T x = 1``), the reaction compliance ``c``
     (``1/F_a`` [1/N]) and the sample's data (``w = J^T u`` (n), ``M_bb0`` (n*n), motor-mass influence matrices
-    (n*n*n), effective mechanical stiffness). Outputs: the impulse [N*s], the contact-force threshold [N] and
-    ``w^T x``.
+    (n*n*n), effective mechanical stiffness). Outputs: the impulse [N*s], the contact-force threshold [N],
+    ``w^T x`` and the effective parameters ``(m_f, m_r, k, k_m, a)`` of :mod:`collision_reflex.model.effective`.
     """
     n = n_joints
     design = ca.SX.sym("design", 3 * n + 2)
@@ -580,25 +646,28 @@ def _sample_function(n_joints: int, sensing: str, reaction: str, reflected_inert
     threshold_variable, velocity = design[3 * n], design[3 * n + 1]
     w = data[:n]
     offset = n + n * n
-    # x^T M_f x with M_f = M_bb0 + sum_i m_i A_i (+ diag(N^2 J_m)), each term a quadratic form in x.
-    finger_mass = ca.bilin(ca.reshape(data[n:offset], n, n), direction, direction)
-    for i in range(n):
-        influence = ca.reshape(data[offset + i * n * n : offset + (i + 1) * n * n], n, n)
-        finger_mass += mass[i] * ca.bilin(influence, direction, direction)
-    if reflected_inertia_in == "finger":
-        finger_mass += ca.dot(inertia, direction**2)
+    influence = [ca.reshape(data[offset + i * n * n : offset + (i + 1) * n * n], n, n) for i in range(n)]
+    finger_matrix = formulas.finger_mass_matrix(
+        ca.reshape(data[n:offset], n, n),
+        influence,
+        mass,
+        inertia if reflected_inertia_in == "finger" else None,
+    )
+    # x^T M_f x: the finger mass at the optimal x (the NLP's constraint w^T x = 1 and its minimisation).
+    finger_mass = formulas.finger_mass(direction, finger_matrix)
     k_mech = data[-1]
 
-    # Effective parameters along u (MODEL.md §3), compliance forms.
-    robot_mass = 1 / ca.sum1(w**2 / inertia)
-    k = 1 / ca.sum1(w**2 / stiffness)
-    force_threshold = threshold_variable if sensing == "force" else k * threshold_variable
-    acceleration = 1 / (compliance * robot_mass)  # a = F_a / m_r
+    # Effective parameters along u (MODEL.md §3), compliance forms; w^T is the Jacobian along u.
+    robot_compliance = formulas.task_compliance(ca.transpose(w), inertia)
+    k = 1 / formulas.task_compliance(ca.transpose(w), stiffness)
+    force_threshold = threshold_force(sensing, threshold_variable, k)
+    acceleration = formulas.reaction_acceleration(robot_compliance, compliance)
     impulse = phase_impulses(finger_mass, k, k_mech, force_threshold, acceleration, velocity, reaction).total
+    parameters = ca.vertcat(finger_mass, 1 / robot_compliance, k, k_mech, acceleration)
     return ca.Function(
         "sample_impulse",
         [design, direction, compliance, data],
-        [impulse, force_threshold, ca.dot(w, direction)],
+        [impulse, force_threshold, ca.dot(w, direction), parameters],
     )
 
 
@@ -620,15 +689,18 @@ def _sample_data(samples: ContactSamples, k_mech: np.ndarray) -> np.ndarray:
     influence = (
         kin.motor_mass_influence[samples.config_index].transpose(0, 1, 3, 2).reshape(n_samples, n * n * n)
     )
-    k_mech_effective = 1 / np.sum(w**2 / k_mech, axis=1)
+    k_mech_effective = 1 / formulas.task_compliance(w[:, None, :], k_mech)[:, 0, 0]
     return np.column_stack([w, structure, influence, k_mech_effective]).T
 
 
 def reaction_compliance(samples: ContactSamples, peak_torque: np.ndarray) -> np.ndarray:
     """``1 / F_a = max_i |w_i| / tau_i`` per sample [1/N]: the inverse of the largest contact force the joints
-    can push back with before the first saturates (MODEL.md §3).
-    """
-    return np.max(np.abs(samples.joint_moment_arms) / np.asarray(peak_torque, dtype=float), axis=1)
+    can push back with before the first saturates (MODEL.md §3)."""
+    return np.asarray(
+        formulas.reaction_compliance(
+            formulas.torque_fractions(samples.joint_moment_arms, np.asarray(peak_torque, dtype=float))
+        )
+    )
 
 
 def finger_mass_directions(
@@ -636,22 +708,18 @@ def finger_mass_directions(
 ) -> np.ndarray:
     """The minimiser ``x_s = M_f^-1 w_s / (w_s^T M_f^-1 w_s)`` of ``x^T M_f x`` with ``w_s^T x = 1`` for every
     sample, (n_samples, n_joints): ``M_f`` the structure mass matrix with motor masses ``m`` [kg] and, when the
-    reflected inertia acts on the finger, ``diag(N^2 J_m)`` [kg m^2].
-    """
+    reflected inertia acts on the finger, ``diag(N^2 J_m)`` [kg m^2]."""
     kin = samples.kinematics
     index = samples.config_index
-    structure = kin.mass_matrix[index] + np.einsum("i,sijk->sjk", motor_mass, kin.motor_mass_influence[index])
-    if finger_joint_inertia is not None:
-        structure = structure + np.diag(finger_joint_inertia)
-    w = samples.joint_moment_arms
-    y = np.linalg.solve(structure, w[..., None])[..., 0]
-    return y / np.einsum("sj,sj->s", w, y)[:, None]
+    structure = formulas.finger_mass_matrix(
+        kin.mass_matrix[index], kin.motor_mass_influence[index], motor_mass, finger_joint_inertia
+    )
+    return np.asarray(formulas.finger_mass_direction(samples.joint_moment_arms, structure))
 
 
 def loaded_joints(samples: ContactSamples) -> np.ndarray:
     """(n_samples, n_joints) True where a contact force along the sample's direction loads the joint, so its
-    torque limit bounds the reaction force; ``|w_i|`` below 1e-12 of the largest counts as unloaded.
-    """
+    torque limit bounds the reaction force; ``|w_i|`` below 1e-12 of the largest counts as unloaded."""
     w = np.abs(samples.joint_moment_arms)
     return w > 1e-12 * np.maximum(w.max(axis=1, keepdims=True), 1e-300)
 
@@ -712,8 +780,7 @@ def _binding_torque_demands(
 
 def _required_torque_function(demands: list[tuple[np.ndarray, np.ndarray, list[str]]], n_joints: int) -> Any:
     """CasADi function: motor masses [kg] -> required peak torque per joint [N m], the largest binding demand
-    (safety factor included), for reporting.
-    """
+    (safety factor included), for reporting."""
     masses = ca.MX.sym("motor_mass", n_joints)
     required = [ca.mmax(ca.DM(bases) + ca.mtimes(ca.DM(slopes), masses)) for bases, slopes, _ in demands]
     return ca.Function("required_torque", [masses], [ca.vertcat(*required)])

@@ -276,6 +276,7 @@ def _result(
 def design_at(problem: DesignProblem, x: np.ndarray) -> Design:
     """The design (and its derived actuator quantities) at NLP point ``x``."""
     from ..hardware.motors import scaled_motor_quantities
+    from ..model import effective
 
     values = problem.layout.values(np.asarray(x, dtype=float))
     technology = problem.technology
@@ -291,7 +292,7 @@ def design_at(problem: DesignProblem, x: np.ndarray) -> Design:
         software_stiffness=values["software_stiffness"],
         mechanical_stiffness=technology.joint_mechanical_stiffness(problem.n_joints),
         rotor_inertia=np.asarray(motor.rotor_inertia, dtype=float),
-        reflected_inertia=gear**2 * np.asarray(motor.rotor_inertia, dtype=float),
+        reflected_inertia=effective.reflected_inertia(gear, np.asarray(motor.rotor_inertia, dtype=float)),
         motor_peak_torque=np.asarray(motor.peak_torque, dtype=float),
         peak_torque=gear * np.asarray(motor.peak_torque, dtype=float),
         motor_mass=np.asarray(motor.mass, dtype=float),

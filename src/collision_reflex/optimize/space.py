@@ -13,10 +13,11 @@ from ..errors import InvalidParameter
 
 PER_JOINT_VARIABLES = ("stator_diameter", "stack_length", "gear_ratio", "software_stiffness")
 GLOBAL_VARIABLES = ("threshold", "approach_velocity")
-SENSING_SCHEMES = ("force", "position")
-"""Sensing schemes the optimiser handles: a contact-force threshold ``F_s`` [N] or a contact-point
-position-error threshold ``e_th`` [m] with ``F_s = k(u) e_th``. A motor-current threshold makes the contact
-threshold a minimum over joints, which is evaluated but not optimised."""
+OPTIMIZED_SENSING_SCHEMES: tuple[str, ...] = ("force", "position")
+"""The schemes of :data:`collision_reflex.model.sensing.SENSING_SCHEMES` the optimiser handles: a
+contact-force threshold ``F_s`` [N] or a contact-point position-error threshold ``e_th`` [m] with
+``F_s = k(u) e_th``. A motor-current threshold (``"current"``) makes the contact threshold a minimum over joints,
+which is evaluated but not optimised."""
 
 
 @dataclass(frozen=True)
@@ -147,7 +148,7 @@ class ContactSamples:
     """Contact cases the design is evaluated on: sample ``s`` is configuration ``config_index[s]`` of
     ``kinematics`` hit along unit direction ``directions[s]`` (world-aligned, ``task_dim`` components).
 
-    kinematics: :class:`collision_reflex.arm.core.ArmSamples` of the configurations.
+    kinematics: :class:`collision_reflex.arm.ArmSamples` of the configurations.
     directions: (n_samples, task_dim) unit vectors.
     config_index: (n_samples,) index into the configurations.
     """

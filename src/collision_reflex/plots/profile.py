@@ -9,7 +9,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..model.impulse import collision_times, force_profile, phase_impulses
+from ..model.impulse import (
+    collision_times,
+    force_profile,
+    impact_pulse_duration,
+    phase_impulses,
+    sensing_force,
+)
 from . import new_figure, save_figure
 
 
@@ -30,7 +36,7 @@ def plot_force_profile(
     """
     t1, t2 = collision_times(m_f, k, k_m, F_s, a, v0, reaction, v_r)
     phases = phase_impulses(m_f, k, k_m, F_s, a, v0, reaction, v_r)
-    t_impact = np.pi / 2 * np.sqrt(m_f / k_m)
+    t_impact = impact_pulse_duration(m_f, k_m)
     # Dense sampling in each phase so the (often very short) impact pulse is resolved too.
     t = np.unique(
         np.concatenate(
@@ -48,7 +54,7 @@ def plot_force_profile(
     fig, ax = new_figure(figsize=(7, 3.6))
     ax.plot(t, force, color="black", lw=1.4, label="F(t)")
     # Stack the shading so each area is its phase's impulse: the impact pulse sits on top of the sensing ramp.
-    ramp = np.where((t >= 0) & (t < t1), k * v0 * t, 0.0)
+    ramp = np.where((t >= 0) & (t < t1), sensing_force(t, k, v0), 0.0)
     in_sensing = (t >= 0) & (t <= t1)
     in_impact = (t >= 0) & (t <= t_impact)
     in_reaction = (t >= t1) & (t <= t2)

@@ -1,0 +1,446 @@
+"""The :class:`Arm`: a fixed-base URDF robot with a contact point and per-joint actuation, loaded through
+Pinocchio, with its configurations and its batched kinematics (:class:`ArmSamples`).
+
+Conventions (SI throughout): the contact Jacobian is the translational Jacobian of the contact point in
+world-aligned axes; a planar arm (all joint axes parallel) is described in the plane perpendicular to its axes
+(``task_dim == 2``), any other arm in 3D. ``model.armature`` carries the reflected rotor inertia ``N^2 J_m``; the
+structure mass matrix of :class:`ArmSamples` excludes it, and excludes the motor masses, whose effect is given
+separately and linearly (``M_bb(q; m) = M_bb0(q) + sum_i m_i A_i(q)``).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import FrameNotFound, InvalidParameter, UrdfError
+from .effective import EffectiveParameters, effective_parameters
+from .joints import JointParameters, joint_array
+from .kinematic_tree import joint_kinematics
+from .robots import (
+    ROBOT_DEFAULTS,
+    captured_stderr,
+    configuration_by_name,
+    example_robot,
+    load_urdf,
+    parser_reason,
+    with_locked_joints,
+)
+from .samples import ArmSamples, ContactKinematics
+
+# Joints whose limits are missing or meaningless (URDF "continuous", or lower >= upper) are sampled on a full
+# turn; limits beyond this magnitude are treated as missing.
+_UNBOUNDED_LIMIT = 1e3
+
+
+class Arm:
+    """A fixed-base robot arm from a URDF, with a contact point and per-joint actuation.
+
+    Parameters
+    ----------
+    model: a fixed-base ``pinocchio.Model`` whose joints all have one degree of freedom (revolute or
+        prismatic). It is copied; the copy's ``armature`` is set to the reflected inertia.
+    contact_frame: name of the frame that makes contact.
+    contact_offset: contact point in that frame's coordinates [m], default its origin.
+    actuators: one actuator per joint, or one for all joints (anything with ``reflected_inertia``,
+        ``peak_torque``, ``stiffness``, ``mechanical_stiffness`` and ``mass``); or a :class:`JointParameters`.
+        Default: the model's armature and URDF effort limits, rigid joints and no motor masses.
+    name: a name for messages and figures.
+    urdf_path: the URDF the model came from (for :meth:`visual_model`).
+    package_dirs: directories that resolve the URDF's ``package://`` mesh references.
+    """
+
+    def __init__(
+        self,
+        model: Any,
+        contact_frame: str,
+        contact_offset: Any = None,
+        actuators: Any = None,
+        name: str = "",
+        urdf_path: str | os.PathLike[str] | None = None,
+        package_dirs: Sequence[str | os.PathLike[str]] | None = None,
+    ) -> None:
+        import pinocchio as pin
+
+        self.name = name or str(model.name)
+        self.urdf_path = None if urdf_path is None else Path(urdf_path)
+        self.package_dirs = tuple(str(p) for p in package_dirs or ())
+        self._joints = joint_kinematics(model, self.name)
+        self.joint_names: tuple[str, ...] = tuple(model.names[i] for i in range(1, model.njoints))
+        if not model.existFrame(contact_frame):
+            raise FrameNotFound(contact_frame, [f.name for f in model.frames], "frame", self.name)
+        self.contact_frame = contact_frame
+        offset = np.zeros(3) if contact_offset is None else np.asarray(contact_offset, dtype=float)
+        if offset.shape != (3,) or not np.all(np.isfinite(offset)):
+            raise InvalidParameter("contact_offset", contact_offset, "three finite coordinates [m]")
+        self.contact_offset = offset
+        frame = model.frames[model.getFrameId(contact_frame)]
+        self._contact_joint = int(frame.parentJoint)
+        if self._contact_joint == 0:
+            raise InvalidParameter(
+                "contact_frame",
+                contact_frame,
+                "a frame moved by at least one joint",
+                "it is fixed to the base",
+            )
+        # The contact point in its parent joint's frame.
+        self._contact_local = np.asarray(frame.placement.act(offset), dtype=float)
+
+        effort = np.asarray(model.effortLimit, dtype=float)
+        # URDFs often leave effort at 0 (unknown); Pinocchio reports "no limit" as the largest double.
+        unknown = (effort <= 0) | (effort > 1e300) | ~np.isfinite(effort)
+        self.urdf_torque_limit: np.ndarray = np.where(unknown, np.nan, effort)
+        """The URDF's effort limit per joint [N m], ``nan`` where it gives none."""
+        if isinstance(actuators, JointParameters):
+            params = actuators
+        elif actuators is not None:
+            params = JointParameters.from_actuators(actuators, model.nv)
+        else:
+            params = JointParameters(
+                reflected_inertia=np.asarray(model.armature, dtype=float),
+                torque_limit=self.urdf_torque_limit,
+                stiffness=np.full(model.nv, np.inf),
+                mechanical_stiffness=np.full(model.nv, np.inf),
+                motor_mass=np.zeros(model.nv),
+            )
+        if params.size != model.nv:
+            raise InvalidParameter("actuators", params.size, f"{model.nv} joints' parameters")
+        self.joint_parameters = params
+        if actuators is None or isinstance(actuators, JointParameters):
+            self.actuators: tuple[Any, ...] | None = None
+        else:
+            self.actuators = (
+                tuple(actuators) if isinstance(actuators, list | tuple) else (actuators,) * model.nv
+            )
+
+        self._source_model = model
+        self.model = model.copy()
+        self.model.armature = params.reflected_inertia.copy()
+        self._contact_kinematics = ContactKinematics.of_model(
+            model, self._joints, self._contact_joint, self._contact_local
+        )
+        # Kinematics use a structure-only model (no armature), so ArmSamples.mass_matrix is M_bb0.
+        self._structure = self._contact_kinematics.model
+        self.plane = self._contact_kinematics.plane
+        self.reference_configuration: np.ndarray = np.array(pin.neutral(model))
+        """A configuration to start from [rad, m]: the robot's reference pose when known, else neutral."""
+        self._pin = pin
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def from_urdf(
+        cls,
+        path: str | os.PathLike[str],
+        contact_frame: str,
+        package_dirs: Sequence[str | os.PathLike[str]] | None = None,
+        contact_offset: Any = None,
+        actuators: Any = None,
+        locked_joints: Sequence[str] = (),
+        name: str = "",
+    ) -> Arm:
+        """Load an arm from a URDF file.
+
+        Parameters
+        ----------
+        path: the URDF file.
+        contact_frame: name of the contact frame (a link or a fixed joint of the URDF).
+        package_dirs: directories that resolve ``package://`` mesh references; only needed for
+            :meth:`visual_model`.
+        contact_offset: contact point in the contact frame [m].
+        actuators: see :class:`Arm`.
+        locked_joints: names of joints to lock at zero (``pinocchio.buildReducedModel``), e.g. gripper fingers.
+        """
+        model = load_urdf(path)
+        model = with_locked_joints(model, locked_joints, str(path))
+        return cls(
+            model, contact_frame, contact_offset, actuators, name or Path(path).stem, path, package_dirs
+        )
+
+    @classmethod
+    def from_example_robot_data(
+        cls,
+        name: str,
+        contact_frame: str | None = None,
+        contact_offset: Any = None,
+        actuators: Any = None,
+        locked_joints: Sequence[str] | None = None,
+    ) -> Arm:
+        """Load a robot of the ``example-robot-data`` package by name (``"ur5"``, ``"panda"``,
+        ``"double_pendulum"``, ...).
+
+        Defaults per robot: Panda contacts at ``panda_hand_tcp`` with its two finger joints locked; UR robots at
+        ``tool0``; the double pendulum at its second link's tip (0.2 m along the link); legged robots (``solo12``,
+        ``a1``) at the front-left foot with the base fixed to the world. Other robots need ``contact_frame``.
+        ``locked_joints`` replaces the default list of locked joints (``()`` locks none).
+        """
+        full_model, urdf, q0 = example_robot(name)
+        model = full_model
+        defaults = ROBOT_DEFAULTS.get(name, {})
+        if contact_frame is None:
+            if "contact_frame" not in defaults:
+                raise InvalidParameter(
+                    "contact_frame",
+                    None,
+                    f"a frame name for {name!r} (no default is known)",
+                    "frames: " + ", ".join(f.name for f in model.frames),
+                )
+            contact_frame = defaults["contact_frame"]
+            if contact_offset is None:
+                contact_offset = defaults.get("contact_offset")
+        if model.njoints > 1 and model.joints[1].nq == 7:  # free-flyer root: fix the base to the world
+            model = load_urdf(urdf)
+        to_lock = defaults.get("locked_joints", ()) if locked_joints is None else tuple(locked_joints)
+        model = with_locked_joints(model, to_lock, name)
+        # The robots' URDFs name their meshes package://example-robot-data/robots/...: the package directory
+        # is two levels above the "robots" directory.
+        share = Path(urdf).resolve()
+        while share.name != "robots" and share != share.parent:
+            share = share.parent
+        arm = cls(model, contact_frame, contact_offset, actuators, name, urdf, [share.parent.parent])
+        arm.reference_configuration = configuration_by_name(full_model, q0, model)
+        return arm
+
+    def with_actuators(self, actuators: Any) -> Arm:
+        """The same arm and contact point with other actuators (see :class:`Arm`)."""
+        arm = Arm(
+            self._source_model,
+            self.contact_frame,
+            self.contact_offset,
+            actuators,
+            self.name,
+            self.urdf_path,
+            self.package_dirs,
+        )
+        arm.reference_configuration = self.reference_configuration.copy()
+        return arm
+
+    def with_scaled_motors(
+        self,
+        stator_diameter: float,
+        torque_required: Any = None,
+        *,
+        reference: Any = None,
+        law: str = "haddadin",
+        mechanical_stiffness: Any = np.inf,
+        software_stiffness: Any = np.inf,
+        sensing: Any = None,
+    ) -> Arm:
+        """The same arm with a scaled motor at every joint, geared to meet a torque requirement (the paper's
+        sweep of ``tab:motor_params``): ``N_i = max(1, tau_req,i / tau_p(r))``.
+
+        Parameters
+        ----------
+        stator_diameter: stator outer diameter of every motor [m] (the paper's ``r_m``).
+        torque_required: output torque per joint [N m] (scalar or (nv,)); default the URDF effort limits
+            (:attr:`urdf_torque_limit`).
+        reference: the motor scaled from; default the Omni+ OPN-060-013-A (``motors.reference_motor``).
+        law: scaling law name (``motors.SCALING_LAWS``).
+        mechanical_stiffness, software_stiffness: joint springs [N m/rad] (scalar or (nv,)).
+        sensing: a sensing scheme of :mod:`collision_reflex.hardware.actuators` for every joint; default a 3 N force
+            threshold.
+        """
+        from ..hardware.actuators import Actuator, ForceThreshold, gear_ratio_for
+        from ..hardware.motors import reference_motor
+
+        required = self.urdf_torque_limit if torque_required is None else torque_required
+        required = joint_array("torque_required", required, self.nv)
+        motor = (reference if reference is not None else reference_motor()).scaled(
+            stator_diameter=stator_diameter, law=law
+        )
+        ratios = np.atleast_1d(gear_ratio_for(required, motor.peak_torque))
+        k_mech = joint_array("mechanical_stiffness", mechanical_stiffness, self.nv, allow_inf=True)
+        k_soft = joint_array("software_stiffness", software_stiffness, self.nv, allow_inf=True)
+        scheme = ForceThreshold() if sensing is None else sensing
+        actuators = [
+            Actuator(motor, float(ratios[i]), float(k_mech[i]), float(k_soft[i]), scheme)
+            for i in range(self.nv)
+        ]
+        return self.with_actuators(actuators)
+
+    def sensing_options(self) -> dict[str, Any]:
+        """The sensing of this arm's actuators as keyword arguments: ``{"sensing": "force", "threshold": F_s}``
+        for force thresholds at the contact, or ``{"sensing": "current", "joint_threshold": tau_s}`` [N m]
+        for the joint-side schemes (motor current, and joint position errors, whose threshold is the joint
+        torque ``k e_th`` as well), where the first joint to reach its threshold detects the contact."""
+        from ..hardware.actuators import ForceThreshold
+
+        if not self.actuators:
+            raise InvalidParameter(
+                "actuators", None, "Actuator objects with sensing schemes", "give the threshold explicitly"
+            )
+        schemes = [actuator.sensing for actuator in self.actuators]
+        if all(isinstance(scheme, ForceThreshold) for scheme in schemes):
+            forces = {float(scheme.force) for scheme in schemes}
+            if len(forces) > 1:
+                raise InvalidParameter(
+                    "actuators", sorted(forces), "one contact-force threshold for the whole arm"
+                )
+            return {"sensing": "force", "threshold": forces.pop()}
+        if any(isinstance(scheme, ForceThreshold) for scheme in schemes):
+            raise InvalidParameter(
+                "actuators", [type(s).__name__ for s in schemes], "force thresholds at every joint or at none"
+            )
+        torques = [
+            scheme.joint_threshold_torque(actuator)
+            for scheme, actuator in zip(schemes, self.actuators, strict=True)
+        ]
+        return {"sensing": "current", "joint_threshold": np.array(torques)}
+
+    def visual_model(self) -> Any:
+        """Pinocchio visual ``GeometryModel`` of the URDF, meshes resolved through ``package_dirs``."""
+        if self.urdf_path is None:
+            raise InvalidParameter("urdf_path", None, "an arm loaded from a URDF file")
+        pin = self._pin
+        failure: Exception | None = None
+        with captured_stderr() as captured:
+            try:
+                geometry = pin.buildGeomFromUrdf(
+                    self._structure,
+                    str(self.urdf_path),
+                    pin.GeometryType.VISUAL,
+                    package_dirs=list(self.package_dirs) or None,
+                )
+            except (ValueError, RuntimeError) as error:
+                failure = error
+        if failure is not None:
+            raise UrdfError(self.urdf_path, parser_reason(failure, captured.text))
+        return geometry
+
+    # ------------------------------------------------------------------ properties
+    @property
+    def nq(self) -> int:
+        return int(self._structure.nq)
+
+    @property
+    def nv(self) -> int:
+        return int(self._structure.nv)
+
+    @property
+    def task_dim(self) -> int:
+        """2 for a planar arm (all joint axes parallel), 3 otherwise."""
+        return 3 if self.plane is None else 2
+
+    @property
+    def reflected_inertia(self) -> np.ndarray:
+        """``N^2 J_m`` per joint [kg m^2] (``model.armature``)."""
+        return self.joint_parameters.reflected_inertia
+
+    @property
+    def torque_limit(self) -> np.ndarray:
+        """Largest output torque per joint [N m] (``nan`` where unknown)."""
+        return self.joint_parameters.torque_limit
+
+    def __repr__(self) -> str:
+        return (
+            f"Arm({self.name!r}, {self.nv} joints, contact {self.contact_frame!r}"
+            f"{' + ' + str(self.contact_offset.tolist()) if np.any(self.contact_offset) else ''}, "
+            f"{'planar' if self.plane is not None else 'spatial'})"
+        )
+
+    # ------------------------------------------------------------------ configurations
+    def joint_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper limit per joint [rad or m], (nv,) each; a full turn where the URDF gives none."""
+        lower = np.empty(self.nv)
+        upper = np.empty(self.nv)
+        low_q = np.asarray(self._structure.lowerPositionLimit, dtype=float)
+        high_q = np.asarray(self._structure.upperPositionLimit, dtype=float)
+        for v, joint in enumerate(self._joints):
+            lo, hi = (low_q[joint.idx_q], high_q[joint.idx_q]) if joint.nq == 1 else (np.nan, np.nan)
+            bounded = (
+                np.isfinite(lo) and np.isfinite(hi) and lo < hi and max(abs(lo), abs(hi)) < _UNBOUNDED_LIMIT
+            )
+            if bounded:
+                lower[v], upper[v] = lo, hi
+            elif joint.revolute:
+                lower[v], upper[v] = -np.pi, np.pi
+            else:
+                raise InvalidParameter(
+                    "joint limits",
+                    (lo, hi),
+                    f"finite limits for prismatic joint {self.joint_names[v]!r}",
+                    "add <limit lower=... upper=...> to the URDF",
+                )
+        return lower, upper
+
+    def configuration(self, angles: Any) -> np.ndarray:
+        """Configurations (..., nq) from joint coordinates (..., nv) [rad or m] (unbounded revolute joints are
+        stored by Pinocchio as cosine and sine)."""
+        angles = np.asarray(angles, dtype=float)
+        if angles.shape[-1:] != (self.nv,):
+            raise InvalidParameter("angles", angles.shape, f"a last axis of {self.nv} joint coordinates")
+        q = np.empty((*angles.shape[:-1], self.nq))
+        for v, joint in enumerate(self._joints):
+            if joint.nq == 1:
+                q[..., joint.idx_q] = angles[..., v]
+            else:
+                q[..., joint.idx_q] = np.cos(angles[..., v])
+                q[..., joint.idx_q + 1] = np.sin(angles[..., v])
+        return q
+
+    def joint_coordinates(self, q: Any) -> np.ndarray:
+        """Joint angles or displacements (..., nv) of configurations (..., nq) [rad or m]."""
+        q = self._checked_q(q)
+        out = np.empty((q.shape[0], self.nv))
+        for v, joint in enumerate(self._joints):
+            if joint.nq == 1:
+                out[:, v] = q[:, joint.idx_q]
+            else:
+                out[:, v] = np.arctan2(q[:, joint.idx_q + 1], q[:, joint.idx_q])
+        return out
+
+    def sample_configurations(self, count: int, rng: np.random.Generator) -> np.ndarray:
+        """``count`` configurations drawn uniformly within the joint limits, shape (count, nq).
+
+        Parameters
+        ----------
+        count: number of configurations, >= 1.
+        rng: the random generator (``numpy.random.default_rng(seed)``), for reproducible samples.
+        """
+        if not isinstance(rng, np.random.Generator):
+            raise InvalidParameter(
+                "rng", rng, "a numpy.random.Generator", "use numpy.random.default_rng(seed)"
+            )
+        if int(count) != count or count < 1:
+            raise InvalidParameter("count", count, "an integer >= 1")
+        lower, upper = self.joint_limits()
+        return self.configuration(rng.uniform(lower, upper, size=(int(count), self.nv)))
+
+    # ------------------------------------------------------------------ kinematics
+    def kinematics(self, q: Any, *, full: bool = True) -> ArmSamples:
+        """Mass matrix, contact Jacobian, gravity and motor-mass terms at configurations ``q`` (n, nq).
+
+        Pinocchio evaluates the mass matrix (CRBA) and the contact Jacobian once per configuration, and with
+        ``full`` also the joint Jacobians and the gravity torques, from which the motor-point Jacobians, the
+        motor-mass terms and the positions are assembled for all configurations at once. ``full=False`` returns
+        only what the effective collision parameters need (``q``, ``mass_matrix``, ``jacobian``; the other
+        fields are None).
+        """
+        return self._contact_kinematics.samples(self._checked_q(q), full)
+
+    def effective_parameters(
+        self, samples: ArmSamples, directions: Any, **options: Any
+    ) -> EffectiveParameters:
+        """:func:`effective_parameters` with this arm's joint parameters (motor masses included); keyword
+        ``options`` are passed on and may override any of them."""
+        params = self.joint_parameters
+        kwargs: dict[str, Any] = {
+            "reflected_inertia": params.reflected_inertia,
+            "stiffness": params.stiffness,
+            "mechanical_stiffness": params.mechanical_stiffness,
+            "torque_limit": params.torque_limit,
+            "motor_mass": params.motor_mass if np.any(params.motor_mass > 0) else None,
+        }
+        kwargs.update(options)
+        return effective_parameters(samples, directions, **kwargs)
+
+    def _checked_q(self, q: Any) -> np.ndarray:
+        q = np.atleast_2d(np.asarray(q, dtype=float))
+        if q.ndim != 2 or q.shape[1] != self.nq:
+            raise InvalidParameter("q", q.shape, f"configurations of shape (n, {self.nq})")
+        if not np.all(np.isfinite(q)):
+            raise InvalidParameter("q", q, "finite joint coordinates")
+        return q

@@ -1,0 +1,76 @@
+"""Sensing schemes: how contact is detected, and the threshold each scheme gives (MODEL.md "Sensing schemes").
+
+One vocabulary for the whole package:
+
+- ``"force"``: a contact-force threshold ``F_s`` [N] (a force sensor or an external-force observer);
+- ``"position"``: a position-error threshold ``e_th`` [m] (or [rad] at a joint), so ``F_s = k e_th`` grows with
+  the stiffness ``k`` the error builds up against;
+- ``"current"``: a motor-current (torque) threshold on the motor side of the transmission, so the joint-side
+  threshold torque is ``N tau_s`` (plus any joint friction); at a contact the first joint to reach its
+  threshold detects.
+
+The formulas are plain arithmetic, so they take floats, NumPy arrays and CasADi expressions alike.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+from .. import _validate
+
+SENSING_SCHEMES: tuple[str, ...] = ("force", "position", "current")
+"""The sensing schemes, see the module docstring."""
+
+DEPRECATED_SCHEMES: dict[str, str] = {"joint_torque": "current"}
+"""Old spellings still accepted (with a ``DeprecationWarning``, once per spelling) and their new names."""
+
+_warned: set[str] = set()
+
+
+def sensing_scheme(name: str, allowed: tuple[str, ...] = SENSING_SCHEMES) -> str:
+    """The scheme called ``name``, checked against ``allowed``; a deprecated spelling is mapped to its new
+    name with a warning (once per process and spelling)."""
+    if name in DEPRECATED_SCHEMES:
+        new = DEPRECATED_SCHEMES[name]
+        if name not in _warned:
+            _warned.add(name)
+            warnings.warn(
+                f"the sensing scheme {name!r} is deprecated; call it {new!r}",
+                DeprecationWarning,
+                stacklevel=3,
+            )
+        name = new
+    _validate.choice("sensing", name, allowed)
+    return name
+
+
+def threshold_force(sensing: str, threshold: Any, stiffness: Any) -> Any:
+    """Force (or torque) at detection for the ``"force"`` and ``"position"`` schemes.
+
+    Parameters
+    ----------
+    sensing: ``"force"`` or ``"position"``.
+    threshold: ``F_s`` [N] for ``"force"``; the position-error threshold ``e_th`` [m] (or [rad]) for
+        ``"position"``.
+    stiffness: the stiffness the position error builds up against, ``k`` [N/m] (or [N m/rad]); unused for
+        ``"force"``.
+
+    Returns
+    -------
+    ``F_s`` [N] (or the joint torque [N m] for joint units): ``threshold`` itself, or ``k e_th``.
+    """
+    _validate.choice("sensing", sensing, ("force", "position"))
+    return threshold if sensing == "force" else stiffness * threshold
+
+
+def current_threshold_torque(gear_ratio: Any, motor_torque: Any, friction_torque: Any = 0.0) -> Any:
+    """Joint-side threshold torque of a motor-current threshold [N m]: ``N tau_s + tau_friction``.
+
+    Parameters
+    ----------
+    gear_ratio: transmission ratio ``N`` [-].
+    motor_torque: motor-side threshold torque ``tau_s`` [N m] (current times torque constant).
+    friction_torque: joint-side friction the motor overcomes before the contact loads it [N m].
+    """
+    return gear_ratio * motor_torque + friction_torque
