@@ -28,7 +28,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 import numpy as np
 import pinocchio as pin
 
-from collision_reflex.arm.core import Arm, JointParameters, collision_impulses, effective_parameters
+from collision_reflex.arm import Arm, JointParameters, collision_impulses, effective_parameters
 from collision_reflex.arm.directions import sphere_directions
 from collision_reflex.model import impulse
 

@@ -24,7 +24,7 @@ import time
 import numpy as np
 
 import collision_reflex as cr
-from collision_reflex.arm.core import Arm
+from collision_reflex.arm import Arm
 from collision_reflex.optimize import hypervolume, pareto
 from collision_reflex.optimize.nsga import nsga2_front
 

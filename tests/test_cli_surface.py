@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from collision_reflex.arm.core import Arm
+from collision_reflex.arm import Arm
 from collision_reflex.arm.surfaces import reflex_surface
 from collision_reflex.cli import main
 from collision_reflex.hardware.actuators import ForceThreshold

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import collision_reflex as cr
-from collision_reflex.arm.core import Arm
+from collision_reflex.arm import Arm
 from collision_reflex.optimize import hypervolume
 from collision_reflex.optimize.evaluate import evaluate_design
 from collision_reflex.optimize.problem import TIE_BREAK_WEIGHT

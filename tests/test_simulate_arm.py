@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import collision_reflex as cr
-from collision_reflex.arm.core import Arm
+from collision_reflex.arm import Arm
 from collision_reflex.errors import InvalidParameter
 from collision_reflex.simulate.arm import simulate_arm_collision
 

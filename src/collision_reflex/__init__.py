@@ -7,7 +7,7 @@ URDF arms, and optimises actuator designs against it.
 """
 
 from . import experiments
-from .arm.core import (
+from .arm import (
     Arm,
     ArmSamples,
     CollisionImpulses,

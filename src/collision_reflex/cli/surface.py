@@ -123,7 +123,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``crx surface`` with parsed ``args``; return the exit status."""
-    from ..arm.core import Arm
+    from ..arm import Arm
     from ..arm.surfaces import reflex_surface
     from ..errors import InvalidParameter
     from ..plots import check_figure_path

@@ -19,10 +19,10 @@ if TYPE_CHECKING:
 
 
 def design_collision_parameters(problem: DesignProblem, design: Design) -> tuple[Any, np.ndarray]:
-    """Effective 1D parameters (:class:`collision_reflex.arm.core.EffectiveParameters`) of ``design`` at each of the
+    """Effective 1D parameters (:class:`collision_reflex.arm.EffectiveParameters`) of ``design`` at each of the
     problem's samples, and the contact-force threshold [N] per sample.
     """
-    from ..arm.core import effective_parameters
+    from ..arm import effective_parameters
 
     samples = problem.samples
     params = effective_parameters(

@@ -274,7 +274,7 @@ def _closed_form(
     arm: Any, joints: _Joints, approach_velocity: float, threshold: float, reaction: str
 ) -> _ClosedForm:
     """Issue 4's effective parameters at ``q0`` along ``u`` through :mod:`collision_reflex.model.impulse`."""
-    from ..arm.core import effective_parameters
+    from ..arm import effective_parameters
 
     u = joints.u
     samples = arm.kinematics(joints.q0[None])

@@ -22,7 +22,7 @@ from .samples import configuration_samples, direction_samples
 from .schema import PER_JOINT_DESIGN_VARIABLES, ArmStudy
 
 if TYPE_CHECKING:
-    from ..arm.core import Arm
+    from ..arm import Arm
     from ..hardware.motors import Motor
     from ..optimize import ActuatorTechnology, Constraints, ContactSamples, DesignProblem, DesignSpace
 

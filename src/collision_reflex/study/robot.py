@@ -22,7 +22,7 @@ def example_robot_names() -> list[str]:
 
 
 def load_arm(loaded: LoadedStudy) -> Any:
-    """The :class:`collision_reflex.arm.core.Arm` of an arm study, checked against the study.
+    """The :class:`collision_reflex.arm.Arm` of an arm study, checked against the study.
 
     Raises
     ------
@@ -33,7 +33,7 @@ def load_arm(loaded: LoadedStudy) -> Any:
     if not isinstance(study, ArmStudy):
         raise TypeError("load_arm needs an arm study")
     spec = study.robot
-    from ..arm.core import Arm
+    from ..arm import Arm
 
     offset = list(spec.contact_offset)
     locked = list(spec.locked_joints)
