@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from typing import Any, Protocol
 
 from .. import _validate
+from .._compat import renamed_keywords
 from ..errors import InvalidParameter
 from ..model import effective
 from ..model.impulse import series_stiffness
@@ -285,11 +286,12 @@ class Actuator:
         """Motor mass plus gearbox mass [kg]."""
         return self.motor.mass + (self.gearbox.mass if self.gearbox is not None else 0.0)
 
+    @renamed_keywords(finger_mass="m_f", robot_mass="m_r")
     def contact_parameters(
         self,
         lever: float,
-        finger_mass: float = 0.0,
-        robot_mass: float = 0.0,
+        m_f: float = 0.0,
+        m_r: float = 0.0,
         reflected_inertia_in: str = "robot",
     ) -> CollisionParameters:
         """The 1D collision parameters of a rotary joint acting on a contact point at ``lever``.
@@ -299,31 +301,33 @@ class Actuator:
         accelerates away; ``reflected_inertia_in`` says whether it also reaches the contact in the impact:
 
         - ``"robot"`` (the arm model's placement): the compliance sits between the rotor and the finger, so the
-          finger mass is only ``finger_mass``;
+          finger mass is only ``m_f``;
         - ``"finger"``: a rigid transmission with the compliance at the contact (like the paper's geared A8,
           whose fitted finger mass was 20 kg), so ``N**2 J_m / L**2`` is added to the finger mass too.
+
+        The old keywords ``finger_mass`` and ``robot_mass`` still work, with a ``DeprecationWarning``.
 
         Parameters
         ----------
         lever: distance from the joint axis to the contact point, perpendicular to the motion [m].
-        finger_mass: sprung (link) mass at the contact [kg].
-        robot_mass: unsprung mass at the contact besides the reflected inertia [kg].
+        m_f: sprung (link) mass at the contact [kg].
+        m_r: unsprung mass at the contact besides the reflected inertia [kg].
         reflected_inertia_in: ``"robot"`` or ``"finger"``.
         """
         _validate.positive("lever", lever)
-        _validate.non_negative("finger_mass", finger_mass)
-        _validate.non_negative("robot_mass", robot_mass)
+        _validate.non_negative("m_f", m_f)
+        _validate.non_negative("m_r", m_r)
         _validate.choice("reflected_inertia_in", reflected_inertia_in, REFLECTED_INERTIA_PLACEMENTS)
         reflected_mass = self.reflected_inertia / lever**2
-        m_f = finger_mass + effective.finger_inertia(reflected_mass, reflected_inertia_in)
-        if m_f <= 0:
+        finger = m_f + effective.finger_inertia(reflected_mass, reflected_inertia_in)
+        if finger <= 0:
             raise InvalidParameter(
-                "finger_mass",
-                finger_mass,
+                "m_f",
+                m_f,
                 "a number > 0 when the reflected inertia is not in the finger",
                 "give the link's sprung mass at the contact",
             )
-        m_r = robot_mass + reflected_mass
+        robot = m_r + reflected_mass
         k_m = self.mechanical_stiffness / lever**2
         if math.isinf(k_m):
             raise InvalidParameter(
@@ -335,11 +339,11 @@ class Actuator:
         k = self.stiffness / lever**2
         F_a = self.peak_torque / lever
         return CollisionParameters(
-            m_f=m_f,
-            m_r=m_r,
+            m_f=finger,
+            m_r=robot,
             k=k,
             k_m=k_m,
             F_s=float(self.sensing.contact_threshold(self, lever)),
-            a=F_a / m_r,
+            a=F_a / robot,
             F_a=F_a,
         )
