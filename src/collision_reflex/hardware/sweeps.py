@@ -318,26 +318,26 @@ def _sweep_grid(scaling: _MotorScaling, diameters: np.ndarray, velocities: np.nd
     """Evaluate the impulse over the grid, its per-diameter optimum and the refined overall optimum."""
     actuators = [scaling.actuator(float(d)) for d in diameters]
     contacts = [scaling.contact(actuator) for actuator in actuators]
-    args: dict[str, np.ndarray] = {
-        key: np.array([c.impulse_arguments()[key] for c in contacts])
-        for key in ("m_f", "k", "k_m", "F_s", "a")
-    }
-    column = {key: value[:, None] for key, value in args.items()}
-    impulse = phase_impulses(**column, v0=velocities[None, :]).total
-    v_star = optimal_velocity(args["m_f"], args["k"], args["F_s"])
-    i_star = minimum_impulse(**args)
+    m_f, k, k_m, F_s, a = (
+        np.array([getattr(c, key) for c in contacts]) for key in ("m_f", "k", "k_m", "F_s", "a")
+    )
+    impulse = phase_impulses(
+        m_f[:, None], k[:, None], k_m[:, None], F_s[:, None], a[:, None], velocities[None, :]
+    )
+    v_star = optimal_velocity(m_f, k, F_s)
+    i_star = minimum_impulse(m_f, k, k_m, F_s, a)
 
     best_diameter, best_impulse = _refine_minimum(diameters, i_star, scaling.minimum_impulse)
     best = scaling.contact(scaling.actuator(best_diameter))
     return RadiusVelocitySweep(
         diameters=diameters,
         velocities=velocities,
-        impulse=np.asarray(impulse, dtype=float),
+        impulse=np.asarray(impulse.total, dtype=float),
         gear_ratio=np.array([actuator.gear_ratio for actuator in actuators]),
         reflected_inertia=np.array([actuator.reflected_inertia for actuator in actuators]),
-        m_f=args["m_f"],
+        m_f=m_f,
         m_r=np.array([c.m_r for c in contacts]),
-        F_s=args["F_s"],
+        F_s=F_s,
         optimal_velocity=np.asarray(v_star, dtype=float),
         minimum_impulse=np.asarray(i_star, dtype=float),
         best_diameter=best_diameter,
