@@ -74,7 +74,9 @@ class SensingScheme(Protocol):
         """Contact force at detection [N] for a contact at ``lever`` [m]."""
         ...
 
-    def describe(self) -> str: ...
+    def describe(self) -> str:
+        """One line naming the scheme and its threshold, with units."""
+        ...
 
 
 @dataclass(frozen=True)
@@ -104,6 +106,7 @@ class ForceThreshold:
         return float(self.force) * lever
 
     def describe(self) -> str:
+        """One line naming the scheme and its threshold [N]."""
         return f"force threshold F_s = {self.force:g} N"
 
 
@@ -122,6 +125,7 @@ class PositionThreshold:
         _validate.positive("PositionThreshold.error", self.error)
 
     def joint_threshold_torque(self, actuator: Actuator, lever: float | None = None) -> float:
+        """Joint torque at detection [N m]: ``k e_th`` with the series joint stiffness ``k`` (``lever`` unused)."""
         stiffness = actuator.stiffness
         if math.isinf(stiffness):
             raise InvalidParameter(
@@ -138,6 +142,7 @@ class PositionThreshold:
         return self.joint_threshold_torque(actuator) / lever
 
     def describe(self) -> str:
+        """One line naming the scheme and its threshold [rad]."""
         return f"position-error threshold e_th = {self.error:g} rad"
 
 
@@ -163,6 +168,7 @@ class CurrentThreshold:
         _validate.non_negative("CurrentThreshold.friction_torque", self.friction_torque)
 
     def joint_threshold_torque(self, actuator: Actuator, lever: float | None = None) -> float:
+        """Joint torque at detection [N m]: ``N tau_s`` plus the friction torque (``lever`` unused)."""
         return float(current_threshold_torque(actuator.gear_ratio, self.motor_torque, self.friction_torque))
 
     def contact_threshold(self, actuator: Actuator, lever: float) -> float:
@@ -171,6 +177,7 @@ class CurrentThreshold:
         return self.joint_threshold_torque(actuator) / lever
 
     def describe(self) -> str:
+        """One line naming the scheme and its thresholds [N m]."""
         text = f"motor-current threshold tau_s = {self.motor_torque:g} N m (motor side)"
         return text + (f" + friction {self.friction_torque:g} N m" if self.friction_torque else "")
 
