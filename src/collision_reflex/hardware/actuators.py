@@ -21,6 +21,9 @@ import numbers
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
+import numpy as np
+from numpy.typing import ArrayLike
+
 from .. import _validate
 from .._compat import renamed_keywords
 from ..errors import InvalidParameter
@@ -45,7 +48,7 @@ REFLECTED_INERTIA_PLACEMENTS: tuple[str, ...] = ("finger", "robot")
 """Where the reflected inertia ``N**2 J_m`` sits in the 1D model (see :meth:`Actuator.contact_parameters`)."""
 
 
-def gear_ratio_for(torque_required: Any, peak_torque: Any) -> Any:
+def gear_ratio_for(torque_required: ArrayLike, peak_torque: ArrayLike) -> float | np.ndarray:
     """The smallest gear ratio that meets a torque requirement: ``N = max(1, tau_req / tau_p)``.
 
     Parameters
@@ -55,8 +58,6 @@ def gear_ratio_for(torque_required: Any, peak_torque: Any) -> Any:
 
     Floats and NumPy arrays (broadcast); the paper's sweep rule (``tab:motor_params``).
     """
-    import numpy as np
-
     _validate.positive("torque_required", torque_required)
     _validate.positive("peak_torque", peak_torque)
     ratio = np.maximum(1.0, np.asarray(torque_required, dtype=float) / np.asarray(peak_torque, dtype=float))

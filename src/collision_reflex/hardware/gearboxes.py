@@ -18,7 +18,8 @@ from __future__ import annotations
 import math
 import numbers
 from dataclasses import dataclass
-from typing import Any
+
+import numpy as np
 
 from .. import _validate
 from ..errors import InvalidParameter
@@ -34,8 +35,8 @@ class GearboxScaling:
     diameter: float
     stages: float
 
-    def factor(self, length_ratio: Any, diameter_ratio: Any, stages_ratio: Any) -> Any:
-        """Scale factor ``(l/l0)**p (r/r0)**e (a/a0)**s`` for the given ratios to the reference (floats or arrays)."""
+    def factor(self, length_ratio: float, diameter_ratio: float, stages_ratio: float) -> float:
+        """Scale factor ``(l/l0)**p (r/r0)**e (a/a0)**s`` for the given ratios to the reference [-]."""
         return length_ratio**self.length * diameter_ratio**self.diameter * stages_ratio**self.stages
 
 
@@ -102,7 +103,7 @@ class Gearbox:
             _validate.positive(f"Gearbox.{field}", value)
             object.__setattr__(self, field, float(value))
 
-    def reflected_inertia(self, gear_ratio: Any) -> Any:
+    def reflected_inertia(self, gear_ratio: float | np.ndarray) -> float | np.ndarray:
         """Gearbox inertia seen at the output [kg m^2]: ``N**2 inertia`` (ball screw: ``inertia``)."""
         _validate.positive("gear_ratio", gear_ratio)
         return self.inertia if self.kind == "ball_screw" else gear_ratio**2 * self.inertia

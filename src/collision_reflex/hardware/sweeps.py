@@ -28,7 +28,7 @@ import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -54,6 +54,9 @@ from .actuators import (
 )
 from .gearboxes import Gearbox
 from .motors import DEFAULT_SCALING_LAW, Motor, reference_motor, scaling_law
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = [
     "SWEEP_DEFAULTS",
@@ -139,7 +142,7 @@ class RadiusVelocitySweep:
     robot_mass = _deprecated_field("robot_mass", "m_r")
     threshold = _deprecated_field("threshold", "F_s")
 
-    def table(self) -> Any:
+    def table(self) -> pd.DataFrame:
         """The grid as a long pandas DataFrame, one row per (diameter, velocity), SI units in the headers."""
         import pandas as pd
 
@@ -386,7 +389,7 @@ class StiffnessSweep:
     assumptions: dict[str, Any] = field(default_factory=dict)
     """Every setting used, including the assumptions the paper does not state."""
 
-    def table(self) -> Any:
+    def table(self) -> pd.DataFrame:
         """One row per stiffness, SI units in the headers (pandas DataFrame)."""
         import pandas as pd
 
@@ -482,7 +485,7 @@ def stiffness_sweep(
     )
 
 
-def _write_csv(path: str | os.PathLike[str], table: Any, assumptions: dict[str, Any]) -> Path:
+def _write_csv(path: str | os.PathLike[str], table: pd.DataFrame, assumptions: dict[str, Any]) -> Path:
     """Write ``table`` (a pandas DataFrame) to a ``.csv`` path atomically, ``assumptions`` as ``#`` lines."""
     if Path(path).suffix.lower() != ".csv":
         raise InvalidParameter("CSV file", str(path), "a name ending in .csv")
