@@ -9,7 +9,12 @@ import numpy as np
 import pytest
 
 import collision_reflex as cr
-from collision_reflex.hardware.sweeps import RadiusVelocitySweep, radius_velocity_sweep, stiffness_sweep
+from collision_reflex.hardware.sweeps import (
+    SWEEP_DEFAULTS,
+    RadiusVelocitySweep,
+    radius_velocity_sweep,
+    stiffness_sweep,
+)
 
 LEVER, FINGER = 0.1143, 0.1  # the documented defaults
 
@@ -155,6 +160,16 @@ def test_old_radius_velocity_keywords_warn_and_agree():
     fields["robot_mass"] = fields.pop("m_r")
     with pytest.warns(DeprecationWarning, match="'robot_mass' is deprecated; call it 'm_r'"):
         assert RadiusVelocitySweep(**fields).m_r is new.m_r
+
+
+def test_old_default_keys_warn_and_read_the_renamed_value():
+    assert (
+        SWEEP_DEFAULTS["F_s"] == 3.0 and SWEEP_DEFAULTS["m_f"] == 0.1
+    )  # fig:motor_scale_modeling, tab:one_shot
+    with pytest.warns(DeprecationWarning, match=r"SWEEP_DEFAULTS\['threshold'\] is deprecated; read 'F_s'"):
+        assert SWEEP_DEFAULTS["threshold"] == 3.0
+    with pytest.raises(KeyError):
+        SWEEP_DEFAULTS["velocity"]
 
 
 def test_old_stiffness_sweep_keywords_warn_and_agree():

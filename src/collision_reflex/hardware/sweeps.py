@@ -66,18 +66,6 @@ __all__ = [
     "stiffness_sweep",
 ]
 
-SWEEP_DEFAULTS: dict[str, Any] = {
-    "torque_required": 1.3,  # N m, tab:motor_params (the reference motor's peak torque)
-    "k_m": 1000.0,  # N/m at the contact, fig:motor_scale_modeling
-    "k_s": 100.0,  # N/m at the contact, fig:motor_scale_modeling
-    "F_s": 3.0,  # N, fig:motor_scale_modeling
-    "lever": 0.1143,  # m: ASSUMPTION, the paper's 1D experiment's characteristic length
-    "m_f": 0.1,  # kg: ASSUMPTION, the paper's U8 fit in tab:one_shot
-    "m_r": 0.0,  # kg: ASSUMPTION, no unsprung mass besides the reflected inertia
-    "reflected_inertia_in": "finger",  # ASSUMPTION, see the module docstring
-    "law": DEFAULT_SCALING_LAW,
-}
-
 # Old keyword spellings of the sweeps (contact-level quantities now use the paper's symbols).
 _RENAMED_CONTACT_KEYWORDS = {
     "mechanical_stiffness": "k_m",
@@ -86,6 +74,35 @@ _RENAMED_CONTACT_KEYWORDS = {
     "finger_mass": "m_f",
     "robot_mass": "m_r",
 }
+
+
+class _SweepDefaults(dict[str, Any]):
+    """The defaults by name; an old key still reads its value, with a ``DeprecationWarning``."""
+
+    def __missing__(self, key: str) -> Any:
+        if key not in _RENAMED_CONTACT_KEYWORDS:
+            raise KeyError(key)
+        new = _RENAMED_CONTACT_KEYWORDS[key]
+        warnings.warn(
+            f"SWEEP_DEFAULTS[{key!r}] is deprecated; read {new!r}", DeprecationWarning, stacklevel=2
+        )
+        return self[new]
+
+
+SWEEP_DEFAULTS: dict[str, Any] = _SweepDefaults(
+    {
+        "torque_required": 1.3,  # N m, tab:motor_params (the reference motor's peak torque)
+        "k_m": 1000.0,  # N/m at the contact, fig:motor_scale_modeling
+        "k_s": 100.0,  # N/m at the contact, fig:motor_scale_modeling
+        "F_s": 3.0,  # N, fig:motor_scale_modeling
+        "lever": 0.1143,  # m: ASSUMPTION, the paper's 1D experiment's characteristic length
+        "m_f": 0.1,  # kg: ASSUMPTION, the paper's U8 fit in tab:one_shot
+        "m_r": 0.0,  # kg: ASSUMPTION, no unsprung mass besides the reflected inertia
+        "reflected_inertia_in": "finger",  # ASSUMPTION, see the module docstring
+        "law": DEFAULT_SCALING_LAW,
+    }
+)
+"""The sweeps' default settings (contact-level ones in the paper's symbols, SI units); old keys still read."""
 
 
 def _deprecated_field(old: str, new: str) -> property:
