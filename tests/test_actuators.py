@@ -58,7 +58,7 @@ def test_gear_ratio_below_one_rejected(gear):
 def test_contact_parameters_map_through_the_lever():
     lever = 0.2
     actuator = cr.Actuator(MOTOR, 4.0, mechanical_stiffness=80.0, software_stiffness=40.0)
-    robot = actuator.contact_parameters(lever, finger_mass=0.1)
+    robot = actuator.contact_parameters(lever, m_f=0.1)
     reflected = 16 * 2e-5 / 0.04  # N^2 J_m / L^2
     assert robot.m_f == pytest.approx(0.1, rel=1e-15)
     assert robot.m_r == pytest.approx(reflected, rel=1e-15)
@@ -67,7 +67,7 @@ def test_contact_parameters_map_through_the_lever():
     assert robot.F_a == pytest.approx(4 * 1.5 / 0.2, rel=1e-15)
     assert robot.a == pytest.approx(robot.F_a / reflected, rel=1e-15)
     assert robot.F_s == 3.0
-    finger = actuator.contact_parameters(lever, finger_mass=0.1, reflected_inertia_in="finger")
+    finger = actuator.contact_parameters(lever, m_f=0.1, reflected_inertia_in="finger")
     assert finger.m_f == pytest.approx(0.1 + reflected, rel=1e-15)
     assert finger.m_r == robot.m_r
 
@@ -88,12 +88,12 @@ def test_sensing_thresholds():
 def test_contact_parameters_refuse_impossible_setups():
     rigid = cr.Actuator(MOTOR, sensing=cr.PositionThreshold(0.01))
     with pytest.raises(cr.InvalidParameter, match="mechanical_stiffness"):
-        rigid.contact_parameters(0.1, finger_mass=0.1)  # rigid joint on a rigid constraint: infinite force
+        rigid.contact_parameters(0.1, m_f=0.1)  # rigid joint on a rigid constraint: infinite force
     with pytest.raises(cr.InvalidParameter, match="stiffness"):
         rigid.sensing.joint_threshold_torque(rigid)  # a rigid joint never builds a position error
     soft = cr.Actuator(MOTOR, mechanical_stiffness=10.0)
-    with pytest.raises(cr.InvalidParameter, match="finger_mass"):
-        soft.contact_parameters(0.1, finger_mass=0.0)  # nothing hits the constraint in the impact phase
+    with pytest.raises(cr.InvalidParameter, match="m_f"):
+        soft.contact_parameters(0.1, m_f=0.0)  # nothing hits the constraint in the impact phase
     assert soft.contact_parameters(0.1, 0.0, reflected_inertia_in="finger").m_f == pytest.approx(2e-5 / 0.01)
 
 
@@ -109,3 +109,15 @@ def test_current_threshold_grows_with_gear_ratio():
     )
     assert direct.F_s == pytest.approx(3.0, rel=1e-14)
     assert geared.F_s == pytest.approx(27.0, rel=1e-14)
+
+
+def test_contact_parameters_old_keywords_warn_and_agree():
+    actuator = cr.Actuator(MOTOR, 4.0, mechanical_stiffness=80.0, software_stiffness=40.0)
+    new = actuator.contact_parameters(0.2, m_f=0.1, m_r=0.3)
+    with pytest.warns(DeprecationWarning, match="deprecated; call it 'm_[fr]'") as record:
+        old = actuator.contact_parameters(0.2, finger_mass=0.1, robot_mass=0.3)
+    assert len(record) == 2  # one warning per old keyword
+    assert old == new
+    assert new.m_r == pytest.approx(0.3 + 16 * 2e-5 / 0.04, rel=1e-15)  # the robot mass is not dropped
+    with pytest.raises(TypeError, match="both"):
+        actuator.contact_parameters(0.2, m_f=0.1, finger_mass=0.1)

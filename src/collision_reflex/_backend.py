@@ -50,8 +50,10 @@ def largest(x: Any, axis: int = -1) -> Any:
 
 
 def dot(a: Any, b: Any, keepdims: bool = False) -> Any:
-    """Inner product over the last axis (NumPy, batched and broadcast; ``keepdims`` keeps that axis, of length
-    1) or of two CasADi vectors."""
+    """Inner product over the last axis (NumPy, batched and broadcast) or of two CasADi vectors.
+
+    ``keepdims`` keeps that axis (NumPy), of length 1.
+    """
     if is_symbolic(a, b):
         return _ca.dot(a, b)
     product = np.einsum("...i,...i->...", a, b)
@@ -96,16 +98,20 @@ def diagonal_matrix(values: Any) -> Any:
 
 
 def divide_columns(matrix: Any, values: Any) -> Any:
-    """``matrix diag(values)^-1``: column ``i`` divided by ``values[i]`` (NumPy: ``values`` broadcast on the last
-    axis)."""
+    """``matrix diag(values)^-1``: column ``i`` divided by ``values[i]``.
+
+    NumPy: ``values`` broadcast on the last axis.
+    """
     if is_symbolic(matrix, values):
         return _ca.mtimes(matrix, _ca.diag(1 / values))
     return matrix / values
 
 
 def weighted_sum(weights: Any, matrices: Any) -> Any:
-    """``sum_i weights[i] matrices[..., i, :, :]``: NumPy (stacks broadcast), or CasADi with ``matrices`` a
-    sequence of matrices."""
+    """``sum_i weights[i] matrices[..., i, :, :]``: NumPy (stacks broadcast) or CasADi.
+
+    With CasADi, ``matrices`` is a sequence of matrices.
+    """
     if is_symbolic(weights) or (len(matrices) and is_symbolic(matrices[0])):
         total = 0
         for i, matrix in enumerate(matrices):

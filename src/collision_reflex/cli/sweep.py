@@ -23,7 +23,7 @@ _PLACEMENT_HELP = (
 def _common(parser: argparse.ArgumentParser) -> None:
     options.add_catalogue(parser)
     parser.add_argument("--motor", default=REFERENCE_MOTOR_NAME, help="catalogue motor (default %(default)s)")
-    options.THRESHOLD.add(parser, SWEEP_DEFAULTS["threshold"])
+    options.THRESHOLD.add(parser, SWEEP_DEFAULTS["F_s"])
     options.LEVER.add(
         parser,
         SWEEP_DEFAULTS["lever"],
@@ -31,13 +31,13 @@ def _common(parser: argparse.ArgumentParser) -> None:
     )
     options.FINGER_MASS.add(
         parser,
-        SWEEP_DEFAULTS["finger_mass"],
+        SWEEP_DEFAULTS["m_f"],
         bound="non-negative",
         note="the link's, besides any reflected inertia; the paper does not state it: the default is its U8 "
         "fit (tab:one_shot)",
     )
     options.ROBOT_MASS.add(
-        parser, SWEEP_DEFAULTS["robot_mass"], bound="non-negative", note="besides the reflected inertia"
+        parser, SWEEP_DEFAULTS["m_r"], bound="non-negative", note="besides the reflected inertia"
     )
     parser.add_argument(
         "--reflected-inertia-in",
@@ -81,8 +81,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     options.STACK_LENGTH.add(radius, shown="the motor's own")
     options.TORQUE_REQUIRED.add(radius, SWEEP_DEFAULTS["torque_required"])
-    options.MECH_STIFFNESS.add(radius, SWEEP_DEFAULTS["mechanical_stiffness"], aliases=["--k-m"])
-    options.SOFT_STIFFNESS.add(radius, SWEEP_DEFAULTS["software_stiffness"], aliases=["--k-s"])
+    options.MECH_STIFFNESS.add(radius, SWEEP_DEFAULTS["k_m"], aliases=["--k-m"])
+    options.SOFT_STIFFNESS.add(radius, SWEEP_DEFAULTS["k_s"], aliases=["--k-s"])
     options.add_plot(radius, "radius_velocity.png", what="the heat map")
     options.add_csv(radius, "radius_velocity.csv", what="the grid")
     radius.set_defaults(run=run_radius_velocity)
@@ -122,7 +122,8 @@ def _check_outputs(args: argparse.Namespace) -> None:
         raise InvalidParameter("--csv", args.csv, "a file name ending in .csv")
 
 
-def _print_assumptions(assumptions: dict) -> None:
+def _print_assumptions(assumptions: dict[str, object]) -> None:
+    """Print every setting of a sweep, one ``key: value`` line each."""
     print("settings and assumptions:")
     for key, value in assumptions.items():
         print(f"  {key}: {value}")
@@ -141,12 +142,12 @@ def run_radius_velocity(args: argparse.Namespace) -> int:
         reference=get_motor(args.motor, args.catalogue),
         law=args.law,
         torque_required=args.torque,
-        mechanical_stiffness=args.k_m,
-        software_stiffness=args.k_s,
-        threshold=args.F_s,
+        k_m=args.k_m,
+        k_s=args.k_s,
+        F_s=args.F_s,
         lever=args.lever,
-        finger_mass=args.m_f,
-        robot_mass=args.m_r,
+        m_f=args.m_f,
+        m_r=args.m_r,
         reflected_inertia_in=args.reflected_inertia_in,
         stack_length=args.stack_length,
     )
@@ -157,7 +158,7 @@ def run_radius_velocity(args: argparse.Namespace) -> int:
     for i in range(0, sweep.diameters.size, step):
         print(
             f"{sweep.diameters[i] * 1e3:>14.4g}{sweep.gear_ratio[i]:>9.4g}{sweep.reflected_inertia[i]:>12.4g}"
-            f"{sweep.finger_mass[i]:>11.4g}{sweep.optimal_velocity[i]:>10.4g}{sweep.minimum_impulse[i]:>11.4g}"
+            f"{sweep.m_f[i]:>11.4g}{sweep.optimal_velocity[i]:>10.4g}{sweep.minimum_impulse[i]:>11.4g}"
         )
     print()
     print(
@@ -177,15 +178,15 @@ def run_stiffness(args: argparse.Namespace) -> int:
     _check_outputs(args)
     sweep = stiffness_sweep(
         args.k_m_values,
-        velocity=args.v0,
-        threshold=args.F_s,
-        position_error=args.e_th,
-        software_stiffness=args.k_s,
+        v0=args.v0,
+        F_s=args.F_s,
+        e_th=args.e_th,
+        k_s=args.k_s,
         motor=get_motor(args.motor, args.catalogue),
         gear_ratio=args.gear_ratio,
         lever=args.lever,
-        finger_mass=args.m_f,
-        robot_mass=args.m_r,
+        m_f=args.m_f,
+        m_r=args.m_r,
         reflected_inertia_in=args.reflected_inertia_in,
         reaction=args.reaction,
     )

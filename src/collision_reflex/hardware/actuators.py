@@ -21,7 +21,11 @@ import numbers
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
+import numpy as np
+from numpy.typing import ArrayLike
+
 from .. import _validate
+from .._compat import renamed_keywords
 from ..errors import InvalidParameter
 from ..model import effective
 from ..model.impulse import series_stiffness
@@ -44,7 +48,7 @@ REFLECTED_INERTIA_PLACEMENTS: tuple[str, ...] = ("finger", "robot")
 """Where the reflected inertia ``N**2 J_m`` sits in the 1D model (see :meth:`Actuator.contact_parameters`)."""
 
 
-def gear_ratio_for(torque_required: Any, peak_torque: Any) -> Any:
+def gear_ratio_for(torque_required: ArrayLike, peak_torque: ArrayLike) -> float | np.ndarray:
     """The smallest gear ratio that meets a torque requirement: ``N = max(1, tau_req / tau_p)``.
 
     Parameters
@@ -54,8 +58,6 @@ def gear_ratio_for(torque_required: Any, peak_torque: Any) -> Any:
 
     Floats and NumPy arrays (broadcast); the paper's sweep rule (``tab:motor_params``).
     """
-    import numpy as np
-
     _validate.positive("torque_required", torque_required)
     _validate.positive("peak_torque", peak_torque)
     ratio = np.maximum(1.0, np.asarray(torque_required, dtype=float) / np.asarray(peak_torque, dtype=float))
@@ -73,7 +75,9 @@ class SensingScheme(Protocol):
         """Contact force at detection [N] for a contact at ``lever`` [m]."""
         ...
 
-    def describe(self) -> str: ...
+    def describe(self) -> str:
+        """One line naming the scheme and its threshold, with units."""
+        ...
 
 
 @dataclass(frozen=True)
@@ -103,6 +107,7 @@ class ForceThreshold:
         return float(self.force) * lever
 
     def describe(self) -> str:
+        """One line naming the scheme and its threshold [N]."""
         return f"force threshold F_s = {self.force:g} N"
 
 
@@ -121,6 +126,7 @@ class PositionThreshold:
         _validate.positive("PositionThreshold.error", self.error)
 
     def joint_threshold_torque(self, actuator: Actuator, lever: float | None = None) -> float:
+        """Joint torque at detection [N m]: ``k e_th`` with the series joint stiffness ``k`` (``lever`` unused)."""
         stiffness = actuator.stiffness
         if math.isinf(stiffness):
             raise InvalidParameter(
@@ -137,6 +143,7 @@ class PositionThreshold:
         return self.joint_threshold_torque(actuator) / lever
 
     def describe(self) -> str:
+        """One line naming the scheme and its threshold [rad]."""
         return f"position-error threshold e_th = {self.error:g} rad"
 
 
@@ -162,6 +169,7 @@ class CurrentThreshold:
         _validate.non_negative("CurrentThreshold.friction_torque", self.friction_torque)
 
     def joint_threshold_torque(self, actuator: Actuator, lever: float | None = None) -> float:
+        """Joint torque at detection [N m]: ``N tau_s`` plus the friction torque (``lever`` unused)."""
         return float(current_threshold_torque(actuator.gear_ratio, self.motor_torque, self.friction_torque))
 
     def contact_threshold(self, actuator: Actuator, lever: float) -> float:
@@ -170,6 +178,7 @@ class CurrentThreshold:
         return self.joint_threshold_torque(actuator) / lever
 
     def describe(self) -> str:
+        """One line naming the scheme and its thresholds [N m]."""
         text = f"motor-current threshold tau_s = {self.motor_torque:g} N m (motor side)"
         return text + (f" + friction {self.friction_torque:g} N m" if self.friction_torque else "")
 
@@ -285,11 +294,12 @@ class Actuator:
         """Motor mass plus gearbox mass [kg]."""
         return self.motor.mass + (self.gearbox.mass if self.gearbox is not None else 0.0)
 
+    @renamed_keywords(finger_mass="m_f", robot_mass="m_r")
     def contact_parameters(
         self,
         lever: float,
-        finger_mass: float = 0.0,
-        robot_mass: float = 0.0,
+        m_f: float = 0.0,
+        m_r: float = 0.0,
         reflected_inertia_in: str = "robot",
     ) -> CollisionParameters:
         """The 1D collision parameters of a rotary joint acting on a contact point at ``lever``.
@@ -299,31 +309,33 @@ class Actuator:
         accelerates away; ``reflected_inertia_in`` says whether it also reaches the contact in the impact:
 
         - ``"robot"`` (the arm model's placement): the compliance sits between the rotor and the finger, so the
-          finger mass is only ``finger_mass``;
+          finger mass is only ``m_f``;
         - ``"finger"``: a rigid transmission with the compliance at the contact (like the paper's geared A8,
           whose fitted finger mass was 20 kg), so ``N**2 J_m / L**2`` is added to the finger mass too.
+
+        The old keywords ``finger_mass`` and ``robot_mass`` still work, with a ``DeprecationWarning``.
 
         Parameters
         ----------
         lever: distance from the joint axis to the contact point, perpendicular to the motion [m].
-        finger_mass: sprung (link) mass at the contact [kg].
-        robot_mass: unsprung mass at the contact besides the reflected inertia [kg].
+        m_f: sprung (link) mass at the contact [kg].
+        m_r: unsprung mass at the contact besides the reflected inertia [kg].
         reflected_inertia_in: ``"robot"`` or ``"finger"``.
         """
         _validate.positive("lever", lever)
-        _validate.non_negative("finger_mass", finger_mass)
-        _validate.non_negative("robot_mass", robot_mass)
+        _validate.non_negative("m_f", m_f)
+        _validate.non_negative("m_r", m_r)
         _validate.choice("reflected_inertia_in", reflected_inertia_in, REFLECTED_INERTIA_PLACEMENTS)
         reflected_mass = self.reflected_inertia / lever**2
-        m_f = finger_mass + effective.finger_inertia(reflected_mass, reflected_inertia_in)
-        if m_f <= 0:
+        finger = m_f + effective.finger_inertia(reflected_mass, reflected_inertia_in)
+        if finger <= 0:
             raise InvalidParameter(
-                "finger_mass",
-                finger_mass,
+                "m_f",
+                m_f,
                 "a number > 0 when the reflected inertia is not in the finger",
                 "give the link's sprung mass at the contact",
             )
-        m_r = robot_mass + reflected_mass
+        robot = m_r + reflected_mass
         k_m = self.mechanical_stiffness / lever**2
         if math.isinf(k_m):
             raise InvalidParameter(
@@ -335,11 +347,11 @@ class Actuator:
         k = self.stiffness / lever**2
         F_a = self.peak_torque / lever
         return CollisionParameters(
-            m_f=m_f,
-            m_r=m_r,
+            m_f=finger,
+            m_r=robot,
             k=k,
             k_m=k_m,
             F_s=float(self.sensing.contact_threshold(self, lever)),
-            a=F_a / m_r,
+            a=F_a / robot,
             F_a=F_a,
         )

@@ -1,7 +1,7 @@
-"""Gearboxes and their scaling laws (Saerens et al. 2019, as tabulated in ``tab:scaling_laws`` of "Reacting to
-Contact: Transparency and Collision Reflex in Actuation").
+"""Gearboxes and their scaling laws.
 
-A scaling law says how a quantity changes with the gearbox's outer diameter ``r``, length ``l`` and number of
+The laws are Saerens et al. 2019's, as tabulated in ``tab:scaling_laws`` of "Reacting to Contact: Transparency
+and Collision Reflex in Actuation". A scaling law says how a quantity changes with the gearbox's outer diameter ``r``, length ``l`` and number of
 stages ``a``, relative to a reference gearbox: ``q = q0 (l/l0)**p (r/r0)**e (a/a0)**s``. So a gearbox is
 described by a real one (its own mass, inertia and rated torque at its size, with a source), and
 :meth:`Gearbox.scaled` moves it to another size. No reference values are built in: gearbox data vary too much
@@ -18,7 +18,8 @@ from __future__ import annotations
 import math
 import numbers
 from dataclasses import dataclass
-from typing import Any
+
+import numpy as np
 
 from .. import _validate
 from ..errors import InvalidParameter
@@ -34,7 +35,8 @@ class GearboxScaling:
     diameter: float
     stages: float
 
-    def factor(self, length_ratio: Any, diameter_ratio: Any, stages_ratio: Any) -> Any:
+    def factor(self, length_ratio: float, diameter_ratio: float, stages_ratio: float) -> float:
+        """Scale factor ``(l/l0)**p (r/r0)**e (a/a0)**s`` for the given ratios to the reference [-]."""
         return length_ratio**self.length * diameter_ratio**self.diameter * stages_ratio**self.stages
 
 
@@ -101,7 +103,7 @@ class Gearbox:
             _validate.positive(f"Gearbox.{field}", value)
             object.__setattr__(self, field, float(value))
 
-    def reflected_inertia(self, gear_ratio: Any) -> Any:
+    def reflected_inertia(self, gear_ratio: float | np.ndarray) -> float | np.ndarray:
         """Gearbox inertia seen at the output [kg m^2]: ``N**2 inertia`` (ball screw: ``inertia``)."""
         _validate.positive("gear_ratio", gear_ratio)
         return self.inertia if self.kind == "ball_screw" else gear_ratio**2 * self.inertia
@@ -109,7 +111,7 @@ class Gearbox:
     def scaled(
         self, diameter: float | None = None, length: float | None = None, stages: int | None = None
     ) -> Gearbox:
-        """This gearbox moved to another diameter [m], length [m] and/or number of stages by its scaling law."""
+        """Return this gearbox moved to another diameter [m], length [m] and/or number of stages by its law."""
         new_diameter = self.diameter if diameter is None else diameter
         new_length = self.length if length is None else length
         new_stages = self.stages if stages is None else stages

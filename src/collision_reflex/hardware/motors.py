@@ -163,7 +163,7 @@ class Motor:
         stack_length: float | None = None,
         law: str | ScalingLaw = DEFAULT_SCALING_LAW,
     ) -> Motor:
-        """This motor scaled to a new stator diameter [m] and/or stack length [m] under ``law``.
+        """Return this motor scaled to a new stator diameter [m] and/or stack length [m] under ``law``.
 
         An omitted dimension keeps this motor's value.
         """

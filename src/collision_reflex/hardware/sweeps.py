@@ -24,13 +24,17 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .. import _validate
+from .._compat import renamed_keywords
 from .._io import atomic_open
 from ..errors import InvalidParameter
 from ..model.impulse import (
@@ -51,6 +55,9 @@ from .actuators import (
 from .gearboxes import Gearbox
 from .motors import DEFAULT_SCALING_LAW, Motor, reference_motor, scaling_law
 
+if TYPE_CHECKING:
+    import pandas as pd
+
 __all__ = [
     "SWEEP_DEFAULTS",
     "RadiusVelocitySweep",
@@ -59,17 +66,57 @@ __all__ = [
     "stiffness_sweep",
 ]
 
-SWEEP_DEFAULTS: dict[str, Any] = {
-    "torque_required": 1.3,  # N m, tab:motor_params (the reference motor's peak torque)
-    "mechanical_stiffness": 1000.0,  # N/m at the contact, fig:motor_scale_modeling
-    "software_stiffness": 100.0,  # N/m at the contact, fig:motor_scale_modeling
-    "threshold": 3.0,  # N, fig:motor_scale_modeling
-    "lever": 0.1143,  # m: ASSUMPTION, the paper's 1D experiment's characteristic length
-    "finger_mass": 0.1,  # kg: ASSUMPTION, the paper's U8 fit in tab:one_shot
-    "robot_mass": 0.0,  # kg: ASSUMPTION, no unsprung mass besides the reflected inertia
-    "reflected_inertia_in": "finger",  # ASSUMPTION, see the module docstring
-    "law": DEFAULT_SCALING_LAW,
+# Old keyword spellings of the sweeps (contact-level quantities now use the paper's symbols).
+_RENAMED_CONTACT_KEYWORDS = {
+    "mechanical_stiffness": "k_m",
+    "software_stiffness": "k_s",
+    "threshold": "F_s",
+    "finger_mass": "m_f",
+    "robot_mass": "m_r",
 }
+
+
+class _SweepDefaults(dict[str, Any]):
+    """The defaults by name; an old key still reads its value, with a ``DeprecationWarning``."""
+
+    def __missing__(self, key: str) -> Any:
+        if key not in _RENAMED_CONTACT_KEYWORDS:
+            raise KeyError(key)
+        new = _RENAMED_CONTACT_KEYWORDS[key]
+        warnings.warn(
+            f"SWEEP_DEFAULTS[{key!r}] is deprecated; read {new!r}", DeprecationWarning, stacklevel=2
+        )
+        return self[new]
+
+
+SWEEP_DEFAULTS: dict[str, Any] = _SweepDefaults(
+    {
+        "torque_required": 1.3,  # N m, tab:motor_params (the reference motor's peak torque)
+        "k_m": 1000.0,  # N/m at the contact, fig:motor_scale_modeling
+        "k_s": 100.0,  # N/m at the contact, fig:motor_scale_modeling
+        "F_s": 3.0,  # N, fig:motor_scale_modeling
+        "lever": 0.1143,  # m: ASSUMPTION, the paper's 1D experiment's characteristic length
+        "m_f": 0.1,  # kg: ASSUMPTION, the paper's U8 fit in tab:one_shot
+        "m_r": 0.0,  # kg: ASSUMPTION, no unsprung mass besides the reflected inertia
+        "reflected_inertia_in": "finger",  # ASSUMPTION, see the module docstring
+        "law": DEFAULT_SCALING_LAW,
+    }
+)
+"""The sweeps' default settings (contact-level ones in the paper's symbols, SI units); old keys still read."""
+
+
+def _deprecated_field(old: str, new: str) -> property:
+    """A read-only attribute ``old`` that warns (``DeprecationWarning``) and returns the field ``new``."""
+
+    def read(self: object) -> Any:
+        warnings.warn(
+            f"{type(self).__name__}.{old} is deprecated; read {type(self).__name__}.{new}",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return getattr(self, new)
+
+    return property(read, doc=f"Deprecated spelling of :attr:`{new}`.")
 
 
 @dataclass(frozen=True)
@@ -89,12 +136,12 @@ class RadiusVelocitySweep:
     """``N = max(1, tau_req / tau_p(r))``."""
     reflected_inertia: np.ndarray
     """``N**2 J_m`` [kg m^2]."""
-    finger_mass: np.ndarray
-    """``m_f`` at the contact [kg]."""
-    robot_mass: np.ndarray
-    """``m_r`` at the contact [kg]."""
-    threshold: np.ndarray
-    """``F_s`` at the contact [N]."""
+    m_f: np.ndarray
+    """Finger (sprung) mass at the contact [kg]."""
+    m_r: np.ndarray
+    """Robot (unsprung) mass at the contact [kg]."""
+    F_s: np.ndarray
+    """Force threshold at the contact [N]."""
     optimal_velocity: np.ndarray
     """``v*`` per diameter [m/s] (``eq:v_star``)."""
     minimum_impulse: np.ndarray
@@ -108,7 +155,11 @@ class RadiusVelocitySweep:
     assumptions: dict[str, Any] = field(default_factory=dict)
     """Every setting used, including the assumptions the paper does not state."""
 
-    def table(self) -> Any:
+    finger_mass = _deprecated_field("finger_mass", "m_f")
+    robot_mass = _deprecated_field("robot_mass", "m_r")
+    threshold = _deprecated_field("threshold", "F_s")
+
+    def table(self) -> pd.DataFrame:
         """The grid as a long pandas DataFrame, one row per (diameter, velocity), SI units in the headers."""
         import pandas as pd
 
@@ -119,8 +170,8 @@ class RadiusVelocitySweep:
                 "velocity_m_per_s": np.tile(self.velocities, self.diameters.size),
                 "gear_ratio": np.repeat(self.gear_ratio, n_v),
                 "reflected_inertia_kg_m2": np.repeat(self.reflected_inertia, n_v),
-                "finger_mass_kg": np.repeat(self.finger_mass, n_v),
-                "robot_mass_kg": np.repeat(self.robot_mass, n_v),
+                "finger_mass_kg": np.repeat(self.m_f, n_v),
+                "robot_mass_kg": np.repeat(self.m_r, n_v),
                 "impulse_N_s": self.impulse.ravel(),
             }
         )
@@ -130,13 +181,19 @@ class RadiusVelocitySweep:
         return _write_csv(path, self.table(), self.assumptions)
 
 
+# The old field spellings keep working as keywords (with a warning); `dataclasses.replace` needs the new ones.
+RadiusVelocitySweep.__init__ = renamed_keywords(  # type: ignore[method-assign]
+    finger_mass="m_f", robot_mass="m_r", threshold="F_s"
+)(RadiusVelocitySweep.__init__)
+
+
 def _contact_actuator(
     motor: Motor,
     gear: float,
     k_m: float,
     k_s: float,
     lever: float,
-    sensing: Any,
+    sensing: ForceThreshold | PositionThreshold,
     gearbox: Gearbox | None = None,
 ) -> Actuator:
     """An actuator whose joint stiffnesses are the contact stiffnesses [N/m] moved to the joint (``k L**2``)."""
@@ -151,19 +208,78 @@ def _contact_actuator(
     )
 
 
+@dataclass(frozen=True)
+class _MotorScaling:
+    """The settings of a radius-velocity sweep that turn a stator diameter [m] into a contact."""
+
+    reference: Motor
+    law: str
+    stack_length: float | None
+    torque_required: float
+    k_m: float
+    k_s: float
+    F_s: float
+    lever: float
+    m_f: float
+    m_r: float
+    reflected_inertia_in: str
+    gearbox: Gearbox | None
+
+    def actuator(self, diameter: float) -> Actuator:
+        """The reference motor scaled to ``diameter`` [m], geared to meet the torque requirement."""
+        motor = self.reference.scaled(diameter, self.stack_length, self.law)
+        gear = float(gear_ratio_for(self.torque_required, motor.peak_torque))
+        box = self.gearbox.scaled(diameter=diameter) if self.gearbox is not None and gear > 1 else None
+        return _contact_actuator(motor, gear, self.k_m, self.k_s, self.lever, ForceThreshold(self.F_s), box)
+
+    def contact(self, actuator: Actuator) -> CollisionParameters:
+        """The 1D collision parameters of ``actuator`` at the sweep's lever."""
+        return actuator.contact_parameters(self.lever, self.m_f, self.m_r, self.reflected_inertia_in)
+
+    def minimum_impulse(self, diameter: float) -> float:
+        """The impulse at the optimal velocity [N s] of the motor of stator ``diameter`` [m]."""
+        return float(minimum_impulse(**self.contact(self.actuator(diameter)).impulse_arguments()))
+
+    def assumptions(self) -> dict[str, Any]:
+        """Every setting, labelled with its unit and whether the paper states it."""
+        return {
+            "reference motor": self.reference.name,
+            "scaling law": self.law,
+            "stack length [m]": (
+                self.stack_length if self.stack_length is not None else self.reference.stack_length
+            ),
+            "torque requirement [N m]": self.torque_required,
+            "mechanical stiffness k_m at the contact [N/m]": self.k_m,
+            "software stiffness k_s at the contact [N/m]": self.k_s,
+            "force threshold F_s [N]": self.F_s,
+            "lever L [m] (assumed: the paper's 1D experiment length)": self.lever,
+            "finger mass [kg] (assumed: the paper's U8 fit, tab:one_shot)": self.m_f,
+            "extra robot mass [kg] (assumed)": self.m_r,
+            "reflected inertia in (assumed, see docs)": self.reflected_inertia_in,
+            "gearbox inertia": (
+                "ignored, as in the paper"
+                if self.gearbox is None
+                else f"{self.gearbox.kind} gearbox scaled to each geared motor's diameter, "
+                f"from: {self.gearbox.source}"
+            ),
+            "reaction": "at_rest (the paper's)",
+        }
+
+
+@renamed_keywords(**_RENAMED_CONTACT_KEYWORDS)
 def radius_velocity_sweep(
-    diameters: Any,
-    velocities: Any,
+    diameters: ArrayLike,
+    velocities: ArrayLike,
     *,
     reference: Motor | None = None,
     law: str = SWEEP_DEFAULTS["law"],
     torque_required: float = SWEEP_DEFAULTS["torque_required"],
-    mechanical_stiffness: float = SWEEP_DEFAULTS["mechanical_stiffness"],
-    software_stiffness: float = SWEEP_DEFAULTS["software_stiffness"],
-    threshold: float = SWEEP_DEFAULTS["threshold"],
+    k_m: float = SWEEP_DEFAULTS["k_m"],
+    k_s: float = SWEEP_DEFAULTS["k_s"],
+    F_s: float = SWEEP_DEFAULTS["F_s"],
     lever: float = SWEEP_DEFAULTS["lever"],
-    finger_mass: float = SWEEP_DEFAULTS["finger_mass"],
-    robot_mass: float = SWEEP_DEFAULTS["robot_mass"],
+    m_f: float = SWEEP_DEFAULTS["m_f"],
+    m_r: float = SWEEP_DEFAULTS["m_r"],
     reflected_inertia_in: str = SWEEP_DEFAULTS["reflected_inertia_in"],
     stack_length: float | None = None,
     gearbox: Gearbox | None = None,
@@ -172,6 +288,8 @@ def radius_velocity_sweep(
 
     Each diameter gets the reference motor scaled by ``law`` at ``stack_length`` and the gear ratio
     ``N = max(1, tau_req / tau_p(r))``; the actuator drives a contact at ``lever`` through a rotary joint.
+    The old keywords ``mechanical_stiffness``, ``software_stiffness``, ``threshold``, ``finger_mass`` and
+    ``robot_mass`` still work, with a ``DeprecationWarning``.
 
     Parameters
     ----------
@@ -180,108 +298,78 @@ def radius_velocity_sweep(
     reference: motor scaled from (default the Omni+ OPN-060-013-A).
     law: motor scaling law name.
     torque_required: output torque the joint must reach [N m].
-    mechanical_stiffness: ``k_m`` at the contact [N/m].
-    software_stiffness: ``k_s`` at the contact [N/m].
-    threshold: force threshold ``F_s`` at the contact [N].
+    k_m: mechanical stiffness at the contact [N/m].
+    k_s: software stiffness at the contact [N/m].
+    F_s: force threshold at the contact [N].
     lever: distance from the joint axis to the contact [m].
-    finger_mass: link (sprung) mass at the contact [kg].
-    robot_mass: unsprung mass at the contact besides the reflected inertia [kg].
+    m_f: link (sprung) mass at the contact [kg].
+    m_r: unsprung mass at the contact besides the reflected inertia [kg].
     reflected_inertia_in: ``"finger"`` or ``"robot"``, see :meth:`Actuator.contact_parameters`.
     stack_length: motor stack length [m], default the reference's.
     gearbox: a real gearbox to add to every geared motor (``N > 1``), scaled to the motor's stator diameter at
         its own length and stages; its reflected inertia then counts (the paper ignores it, the default).
         Direct-drive motors get none.
     """
-    reference = reference if reference is not None else reference_motor()
     diameters = _grid("diameters", diameters)
     velocities = _grid("velocities", velocities)
     law_name = scaling_law(law).name
-    for name, value in (
-        ("torque_required", torque_required),
-        ("mechanical_stiffness", mechanical_stiffness),
-        ("software_stiffness", software_stiffness),
-        ("threshold", threshold),
-        ("lever", lever),
-    ):
+    for name, value in (("torque_required", torque_required), ("k_m", k_m), ("k_s", k_s), ("F_s", F_s)):
         _validate.positive(name, value)
+    _validate.positive("lever", lever)
     _validate.choice("reflected_inertia_in", reflected_inertia_in, REFLECTED_INERTIA_PLACEMENTS)
-
-    def parameters_at(diameter: float) -> tuple[CollisionParameters, float, float]:
-        motor = reference.scaled(diameter, stack_length, law_name)
-        gear = float(gear_ratio_for(torque_required, motor.peak_torque))
-        geared_box = gearbox.scaled(diameter=diameter) if gearbox is not None and gear > 1 else None
-        actuator = _contact_actuator(
-            motor,
-            gear,
-            mechanical_stiffness,
-            software_stiffness,
-            lever,
-            ForceThreshold(threshold),
-            geared_box,
-        )
-        contact = actuator.contact_parameters(lever, finger_mass, robot_mass, reflected_inertia_in)
-        return contact, gear, actuator.reflected_inertia
-
-    per_diameter = [parameters_at(float(d)) for d in diameters]
-    args: dict[str, Any] = {
-        key: np.array([p[0].impulse_arguments()[key] for p in per_diameter])
-        for key in ("m_f", "k", "k_m", "F_s", "a")
-    }
-    robot_masses = np.array([p[0].m_r for p in per_diameter])
-    gears = np.array([p[1] for p in per_diameter])
-    reflected = np.array([p[2] for p in per_diameter])
-    column: dict[str, Any] = {key: value[:, None] for key, value in args.items()}
-    impulse = phase_impulses(**column, v0=velocities[None, :]).total
-    v_star = optimal_velocity(args["m_f"], args["k"], args["F_s"])
-    i_star = minimum_impulse(**args)
-
-    best_diameter, best_impulse = _refine_minimum(
-        diameters, i_star, lambda d: _min_impulse(parameters_at(d)[0].impulse_arguments())
+    scaling = _MotorScaling(
+        reference=reference if reference is not None else reference_motor(),
+        law=law_name,
+        stack_length=stack_length,
+        torque_required=torque_required,
+        k_m=k_m,
+        k_s=k_s,
+        F_s=F_s,
+        lever=lever,
+        m_f=m_f,
+        m_r=m_r,
+        reflected_inertia_in=reflected_inertia_in,
+        gearbox=gearbox,
     )
-    best_args = parameters_at(best_diameter)[0].impulse_arguments()
-    best_velocity = float(optimal_velocity(best_args["m_f"], best_args["k"], best_args["F_s"]))
-    assumptions = {
-        "reference motor": reference.name,
-        "scaling law": law_name,
-        "stack length [m]": stack_length if stack_length is not None else reference.stack_length,
-        "torque requirement [N m]": torque_required,
-        "mechanical stiffness k_m at the contact [N/m]": mechanical_stiffness,
-        "software stiffness k_s at the contact [N/m]": software_stiffness,
-        "force threshold F_s [N]": threshold,
-        "lever L [m] (assumed: the paper's 1D experiment length)": lever,
-        "finger mass [kg] (assumed: the paper's U8 fit, tab:one_shot)": finger_mass,
-        "extra robot mass [kg] (assumed)": robot_mass,
-        "reflected inertia in (assumed, see docs)": reflected_inertia_in,
-        "gearbox inertia": (
-            "ignored, as in the paper"
-            if gearbox is None
-            else f"{gearbox.kind} gearbox scaled to each geared motor's diameter, from: {gearbox.source}"
-        ),
-        "reaction": "at_rest (the paper's)",
-    }
+    return _sweep_grid(scaling, diameters, velocities)
+
+
+def _sweep_grid(scaling: _MotorScaling, diameters: np.ndarray, velocities: np.ndarray) -> RadiusVelocitySweep:
+    """Evaluate the impulse over the grid, its per-diameter optimum and the refined overall optimum."""
+    actuators = [scaling.actuator(float(d)) for d in diameters]
+    contacts = [scaling.contact(actuator) for actuator in actuators]
+    m_f, k, k_m, F_s, a = (
+        np.array([getattr(c, key) for c in contacts]) for key in ("m_f", "k", "k_m", "F_s", "a")
+    )
+    impulse = phase_impulses(
+        m_f[:, None], k[:, None], k_m[:, None], F_s[:, None], a[:, None], velocities[None, :]
+    )
+    v_star = optimal_velocity(m_f, k, F_s)
+    i_star = minimum_impulse(m_f, k, k_m, F_s, a)
+
+    best_diameter, best_impulse = _refine_minimum(diameters, i_star, scaling.minimum_impulse)
+    best = scaling.contact(scaling.actuator(best_diameter))
     return RadiusVelocitySweep(
         diameters=diameters,
         velocities=velocities,
-        impulse=np.asarray(impulse, dtype=float),
-        gear_ratio=gears,
-        reflected_inertia=reflected,
-        finger_mass=args["m_f"],
-        robot_mass=robot_masses,
-        threshold=args["F_s"],
+        impulse=np.asarray(impulse.total, dtype=float),
+        gear_ratio=np.array([actuator.gear_ratio for actuator in actuators]),
+        reflected_inertia=np.array([actuator.reflected_inertia for actuator in actuators]),
+        m_f=m_f,
+        m_r=np.array([c.m_r for c in contacts]),
+        F_s=F_s,
         optimal_velocity=np.asarray(v_star, dtype=float),
         minimum_impulse=np.asarray(i_star, dtype=float),
         best_diameter=best_diameter,
-        best_velocity=best_velocity,
+        best_velocity=float(optimal_velocity(best.m_f, best.k, best.F_s)),
         best_impulse=best_impulse,
-        assumptions=assumptions,
+        assumptions=scaling.assumptions(),
     )
 
 
-def _min_impulse(args: dict[str, Any]) -> float:
-    return float(minimum_impulse(**args))
-
-
-def _refine_minimum(grid: np.ndarray, values: np.ndarray, function: Any) -> tuple[float, float]:
+def _refine_minimum(
+    grid: np.ndarray, values: np.ndarray, function: Callable[[float], float]
+) -> tuple[float, float]:
     """Minimise ``function`` between the grid neighbours of the best grid point (log scale, bounded Brent)."""
     from scipy.optimize import minimize_scalar
 
@@ -316,8 +404,9 @@ class StiffnessSweep:
     position_threshold: np.ndarray
     """``F_s = k e_th`` of the position-threshold scheme [N]."""
     assumptions: dict[str, Any] = field(default_factory=dict)
+    """Every setting used, including the assumptions the paper does not state."""
 
-    def table(self) -> Any:
+    def table(self) -> pd.DataFrame:
         """One row per stiffness, SI units in the headers (pandas DataFrame)."""
         import pandas as pd
 
@@ -336,66 +425,70 @@ class StiffnessSweep:
         return _write_csv(path, self.table(), self.assumptions)
 
 
+@renamed_keywords(velocity="v0", position_error="e_th", **_RENAMED_CONTACT_KEYWORDS)
 def stiffness_sweep(
-    stiffnesses: Any,
+    stiffnesses: ArrayLike,
     *,
-    velocity: float = 0.1,
-    threshold: float = SWEEP_DEFAULTS["threshold"],
-    position_error: float | None = None,
-    software_stiffness: float = math.inf,
+    v0: float = 0.1,
+    F_s: float = SWEEP_DEFAULTS["F_s"],
+    e_th: float | None = None,
+    k_s: float = math.inf,
     motor: Motor | None = None,
     gear_ratio: float = 1.0,
     lever: float = SWEEP_DEFAULTS["lever"],
-    finger_mass: float = SWEEP_DEFAULTS["finger_mass"],
-    robot_mass: float = SWEEP_DEFAULTS["robot_mass"],
+    m_f: float = SWEEP_DEFAULTS["m_f"],
+    m_r: float = SWEEP_DEFAULTS["m_r"],
     reflected_inertia_in: str = SWEEP_DEFAULTS["reflected_inertia_in"],
     reaction: str = "at_rest",
 ) -> StiffnessSweep:
     """Impulse over mechanical stiffness for two sensing schemes (``fig:stiff-sensing-impulse``).
 
+    The old keywords ``velocity``, ``threshold``, ``position_error``, ``software_stiffness``, ``finger_mass``
+    and ``robot_mass`` still work, with a ``DeprecationWarning``.
+
     Parameters
     ----------
     stiffnesses: mechanical stiffnesses ``k_m`` at the contact [N/m], > 0 (1D array).
-    velocity: approach velocity [m/s].
-    threshold: force threshold ``F_s`` [N] of the force-threshold scheme.
-    position_error: position-error threshold at the contact [m]; default ``threshold / k`` at the geometric
-        middle of the swept stiffnesses, so that both schemes detect at the same force there.
-    software_stiffness: ``k_s`` at the contact [N/m]; default ``inf`` (rigid), so that the swept stiffness is
-        the whole joint's, as the paper's figure varies a single stiffness.
+    v0: approach velocity [m/s].
+    F_s: force threshold [N] of the force-threshold scheme.
+    e_th: position-error threshold at the contact [m]; default ``F_s / k`` at the geometric middle of the swept
+        stiffnesses, so that both schemes detect at the same force there.
+    k_s: software stiffness at the contact [N/m]; default ``inf`` (rigid), so that the swept stiffness is the
+        whole joint's, as the paper's figure varies a single stiffness.
     motor: the motor (default the Omni+ reference), with ``gear_ratio``.
-    lever, finger_mass, robot_mass, reflected_inertia_in: as :func:`radius_velocity_sweep`.
+    lever, m_f, m_r, reflected_inertia_in: as :func:`radius_velocity_sweep`.
     reaction: reaction model of :func:`collision_reflex.phase_impulses`.
     """
     stiffnesses = _grid("stiffnesses", stiffnesses)
-    for name, value in (("velocity", velocity), ("threshold", threshold), ("lever", lever)):
+    for name, value in (("v0", v0), ("F_s", F_s), ("lever", lever)):
         _validate.positive(name, value)
-    _validate.positive("software_stiffness", software_stiffness, allow_inf=True)
+    _validate.positive("k_s", k_s, allow_inf=True)
     _validate.choice("reaction", reaction, REACTION_MODES)
     motor = motor if motor is not None else reference_motor()
     middle = float(np.sqrt(stiffnesses[0] * stiffnesses[-1]))
-    if position_error is None:
-        position_error = threshold / series_stiffness(middle, software_stiffness)
-    _validate.positive("position_error", position_error)
+    if e_th is None:
+        e_th = F_s / series_stiffness(middle, k_s)
+    _validate.positive("e_th", e_th)
 
-    def impulse(k_m: float, sensing: Any) -> tuple[float, float]:
-        actuator = _contact_actuator(motor, gear_ratio, k_m, software_stiffness, lever, sensing)
-        contact = actuator.contact_parameters(lever, finger_mass, robot_mass, reflected_inertia_in)
-        total = phase_impulses(**contact.impulse_arguments(), v0=velocity, reaction=reaction).total
+    def impulse(k_m: float, sensing: ForceThreshold | PositionThreshold) -> tuple[float, float]:
+        actuator = _contact_actuator(motor, gear_ratio, k_m, k_s, lever, sensing)
+        contact = actuator.contact_parameters(lever, m_f, m_r, reflected_inertia_in)
+        total = phase_impulses(**contact.impulse_arguments(), v0=v0, reaction=reaction).total
         return float(total), contact.F_s
 
     # The joint position error is the contact error over the lever (small angles).
-    force = [impulse(float(k), ForceThreshold(threshold)) for k in stiffnesses]
-    position = [impulse(float(k), PositionThreshold(position_error / lever)) for k in stiffnesses]
+    force = [impulse(float(k), ForceThreshold(F_s)) for k in stiffnesses]
+    position = [impulse(float(k), PositionThreshold(e_th / lever)) for k in stiffnesses]
     assumptions = {
         "motor": motor.name,
         "gear ratio": gear_ratio,
-        "approach velocity [m/s]": velocity,
-        "force threshold F_s [N]": threshold,
-        "position-error threshold e_th at the contact [m]": position_error,
-        "software stiffness k_s at the contact [N/m]": software_stiffness,
+        "approach velocity [m/s]": v0,
+        "force threshold F_s [N]": F_s,
+        "position-error threshold e_th at the contact [m]": e_th,
+        "software stiffness k_s at the contact [N/m]": k_s,
         "lever L [m] (assumed: the paper's 1D experiment length)": lever,
-        "finger mass [kg] (assumed: the paper's U8 fit, tab:one_shot)": finger_mass,
-        "extra robot mass [kg] (assumed)": robot_mass,
+        "finger mass [kg] (assumed: the paper's U8 fit, tab:one_shot)": m_f,
+        "extra robot mass [kg] (assumed)": m_r,
         "reflected inertia in (assumed, see docs)": reflected_inertia_in,
         "reaction": reaction,
     }
@@ -409,7 +502,8 @@ def stiffness_sweep(
     )
 
 
-def _write_csv(path: str | os.PathLike[str], table: Any, assumptions: dict[str, Any]) -> Path:
+def _write_csv(path: str | os.PathLike[str], table: pd.DataFrame, assumptions: dict[str, Any]) -> Path:
+    """Write ``table`` (a pandas DataFrame) to a ``.csv`` path atomically, ``assumptions`` as ``#`` lines."""
     if Path(path).suffix.lower() != ".csv":
         raise InvalidParameter("CSV file", str(path), "a name ending in .csv")
     with atomic_open(path, "w", newline="") as handle:
@@ -419,7 +513,7 @@ def _write_csv(path: str | os.PathLike[str], table: Any, assumptions: dict[str, 
     return Path(path)
 
 
-def _grid(name: str, values: Any) -> np.ndarray:
+def _grid(name: str, values: ArrayLike) -> np.ndarray:
     """A sorted 1D float array of positive finite values, or InvalidParameter."""
     _validate.positive(name, values)
     array = np.atleast_1d(np.asarray(values, dtype=float))

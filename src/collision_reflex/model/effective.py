@@ -47,9 +47,11 @@ def reflected_inertia(gear_ratio: Any, rotor_inertia: Any) -> Any:
 
 
 def finger_inertia(joint_reflected_inertia: Any, reflected_inertia_in: str) -> Any:
-    """The part of the reflected inertia [kg m^2] that acts rigidly on the link side during the impact:
-    all of it for ``reflected_inertia_in == "finger"`` (a stiff transmission with the compliance at the contact),
-    none (zeros) for ``"robot"`` (the paper's arm model, reflected inertia behind the joint springs)."""
+    """The part of the reflected inertia [kg m^2] that acts rigidly on the link side during the impact.
+
+    All of it for ``reflected_inertia_in == "finger"`` (a stiff transmission with the compliance at the
+    contact), none (zeros) for ``"robot"`` (the paper's arm model, reflected inertia behind the joint springs).
+    """
     return joint_reflected_inertia if reflected_inertia_in == "finger" else 0 * joint_reflected_inertia
 
 
@@ -79,15 +81,20 @@ def finger_mass_matrix(
 
 
 def task_inverse_inertia(jacobian: Any, mass_matrix: Any) -> Any:
-    """``J M^-1 J^T`` [1/kg]: the inverse task-space inertia (the ellipsoid of gyration) of a joint-space mass
-    matrix ``M`` [kg m^2] (..., nv, nv) seen through the contact Jacobian ``J`` [m/rad] (..., m, nv)."""
+    """``J M^-1 J^T`` [1/kg]: the inverse task-space inertia (the ellipsoid of gyration).
+
+    It is that of a joint-space mass matrix ``M`` [kg m^2] (..., nv, nv) seen through the contact Jacobian
+    ``J`` [m/rad] (..., m, nv).
+    """
     return matmul(jacobian, solve(mass_matrix, transpose(jacobian)))
 
 
 def task_compliance(jacobian: Any, joint_values: Any) -> Any:
-    """``J X^-1 J^T`` for a diagonal joint-space ``X = diag(joint_values)``: a task compliance [m/N] from joint
-    stiffnesses [N m/rad], or an inverse task inertia [1/kg] from joint inertias [kg m^2]. Infinite joint values
-    contribute nothing."""
+    """``J X^-1 J^T`` for a diagonal joint-space ``X = diag(joint_values)``.
+
+    A task compliance [m/N] from joint stiffnesses [N m/rad], or an inverse task inertia [1/kg] from joint
+    inertias [kg m^2]. Infinite joint values contribute nothing.
+    """
     return matmul(divide_columns(jacobian, joint_values), transpose(jacobian))
 
 
@@ -106,9 +113,11 @@ def torque_fractions(moment_arms: Any, torque_limit: Any) -> Any:
 
 
 def reaction_compliance(fractions: Any, joint_axis: int = -1) -> Any:
-    """``1 / F_a = max_i |w_i| / tau_i`` [1/N] from the :func:`torque_fractions`: the inverse of the largest
-    contact force the joints can push back with along ``-u`` before the first one saturates (with threshold
-    torques instead of limits: the inverse of the contact force at which the first joint reaches its threshold).
+    """``1 / F_a = max_i |w_i| / tau_i`` [1/N] from the :func:`torque_fractions`.
+
+    The inverse of the largest contact force the joints can push back with along ``-u`` before the first one
+    saturates (with threshold torques instead of limits: the inverse of the contact force at which the first
+    joint reaches its threshold).
 
     ``joint_axis`` is the axis of ``fractions`` that holds the joints (NumPy; -2 lets a batch keep its
     directions on the last, contiguous axis).
@@ -122,8 +131,9 @@ def reaction_acceleration(robot_compliance: Any, reaction_compliance_: Any) -> A
 
 
 def finger_mass_direction(moment_arms: Any, mass_matrix: Any) -> Any:
-    """``x = M_f^-1 w / (w^T M_f^-1 w)``: the minimiser of ``x^T M_f x`` subject to ``w^T x = 1``, where the
-    minimum is the finger mass (see :func:`finger_mass`).
+    """``x = M_f^-1 w / (w^T M_f^-1 w)``: the minimiser of ``x^T M_f x`` subject to ``w^T x = 1``.
+
+    The minimum is the finger mass (see :func:`finger_mass`).
 
     Parameters
     ----------
@@ -135,8 +145,9 @@ def finger_mass_direction(moment_arms: Any, mass_matrix: Any) -> Any:
 
 
 def finger_mass(direction: Any, mass_matrix: Any) -> Any:
-    """Effective finger mass ``m_f = x^T M_f x`` [kg] at the direction ``x`` of :func:`finger_mass_direction`,
-    where it equals ``1 / (w^T M_f^-1 w)``; at any other ``x`` with ``w^T x = 1`` it is larger, which lets an
+    """Effective finger mass ``m_f = x^T M_f x`` [kg] at the direction ``x`` of :func:`finger_mass_direction`.
+
+    There it equals ``1 / (w^T M_f^-1 w)``; at any other ``x`` with ``w^T x = 1`` it is larger, which lets an
     optimiser treat ``x`` as a variable instead of inverting ``M_f`` symbolically.
 
     Parameters

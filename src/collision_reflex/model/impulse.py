@@ -101,8 +101,9 @@ def total_impulse(
 def collision_times(
     m_f: Any, k: Any, k_m: Any, F_s: Any, a: Any, v0: Any, reaction: str = "at_rest", v_r: Any = None
 ) -> tuple[Any, Any]:
-    """Detection time ``t1`` and end of contact ``t2`` [s], impact at ``t = 0``; arguments as
-    :func:`phase_impulses`.
+    """Detection time ``t1`` and end of contact ``t2`` [s], impact at ``t = 0``.
+
+    Arguments as :func:`phase_impulses`.
     """
     m_f, k, k_m, F_s, a, v0, v_r = _checked(m_f, k, k_m, F_s, a, v0, reaction, v_r)
     t1 = F_s / (k * v0)  # eq:t1def
@@ -195,23 +196,28 @@ def force_profile(
 
 
 def impact_pulse_duration(m_f: Any, k_m: Any) -> Any:
-    """Duration of the impact pulse [s]: the compression quarter-period ``pi / (2 w)`` of the finger mass
-    ``m_f`` [kg] on the mechanical spring ``k_m`` [N/m], ``w = sqrt(k_m / m_f)``.
+    """Duration of the impact pulse [s]: the compression quarter-period ``pi / (2 w)``.
+
+    That of the finger mass ``m_f`` [kg] on the mechanical spring ``k_m`` [N/m], ``w = sqrt(k_m / m_f)``.
     """
     return np.pi / (2 * sqrt(k_m / m_f))
 
 
 def sensing_force(t: Any, k: Any, v0: Any) -> Any:
-    """Contact force of the sensing ramp at time ``t`` [s] after impact [N]: the velocity-controlled robot
-    compresses the lumped spring ``k`` [N/m] at ``v0`` [m/s], ``F = k v0 t`` (valid until detection, ``t1``).
+    """Contact force of the sensing ramp at time ``t`` [s] after impact [N].
+
+    The velocity-controlled robot compresses the lumped spring ``k`` [N/m] at ``v0`` [m/s], ``F = k v0 t``
+    (valid until detection, ``t1``).
     """
     return k * v0 * t
 
 
 def reaction_duration(F_s: Any, k_m: Any, a: Any, v_r: Any = 0.0) -> Any:
-    """Duration ``t2 - t1`` of the reaction phase [s]: from detection at ``F_s`` [N] until the mechanical
-    spring ``k_m`` [N/m] is unloaded, the robot mass accelerating away at ``a`` [m/s^2] from a velocity ``v_r``
-    [m/s] toward the constraint (0: the paper's robot at rest, ``sqrt(2 F_s / (a k_m))``).
+    """Duration ``t2 - t1`` of the reaction phase [s].
+
+    From detection at ``F_s`` [N] until the mechanical spring ``k_m`` [N/m] is unloaded, the robot mass
+    accelerating away at ``a`` [m/s^2] from a velocity ``v_r`` [m/s] toward the constraint (0: the paper's
+    robot at rest, ``sqrt(2 F_s / (a k_m))``).
     """
     duration, _ = _reaction_phase(F_s, k_m, a, v_r)
     return duration

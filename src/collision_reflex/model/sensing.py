@@ -29,8 +29,10 @@ _warned: set[str] = set()
 
 
 def sensing_scheme(name: str, allowed: tuple[str, ...] = SENSING_SCHEMES) -> str:
-    """The scheme called ``name``, checked against ``allowed``; a deprecated spelling is mapped to its new
-    name with a warning (once per process and spelling)."""
+    """The scheme called ``name``, checked against ``allowed``.
+
+    A deprecated spelling is mapped to its new name with a warning (once per process and spelling).
+    """
     if name in DEPRECATED_SCHEMES:
         new = DEPRECATED_SCHEMES[name]
         if name not in _warned:

@@ -32,12 +32,10 @@ def plot_radius_velocity(sweep: RadiusVelocitySweep, path: str | os.PathLike[str
     mesh = ax.pcolormesh(
         diameters_mm, sweep.velocities, impulse, norm=norm, cmap="viridis", shading="gouraud"
     )
-    if True:  # contour lines label the heat map's levels
-        levels = np.geomspace(float(np.min(impulse)) * 1.05, float(np.max(impulse)), 9)
-        lines = ax.contour(
-            diameters_mm, sweep.velocities, impulse, levels=levels, colors="white", linewidths=0.6
-        )
-        ax.clabel(lines, fmt="%.3g", fontsize=7)
+    # Contour lines label the heat map's levels.
+    levels = np.geomspace(float(np.min(impulse)) * 1.05, float(np.max(impulse)), 9)
+    lines = ax.contour(diameters_mm, sweep.velocities, impulse, levels=levels, colors="white", linewidths=0.6)
+    ax.clabel(lines, fmt="%.3g", fontsize=7)
     ax.plot(diameters_mm, sweep.optimal_velocity, color="white", ls="--", lw=1.0, label="v*(r) (eq:v_star)")
     geared = sweep.gear_ratio > 1
     if np.any(geared) and not np.all(geared):

@@ -74,7 +74,7 @@ def sensing_scheme(sensing: SensingSpec, lever: float) -> Any:
 def _contact(actuator: Any, candidate: ActuatorCandidate, study: ActuatorStudy) -> Any:
     """The candidate's collision parameters at the contact, with the object hit in series."""
     params = actuator.contact_parameters(
-        study.load.lever, study.load.finger_mass, reflected_inertia_in=candidate.reflected_inertia_in
+        study.load.lever, m_f=study.load.finger_mass, reflected_inertia_in=candidate.reflected_inertia_in
     )
     if study.load.contact_stiffness is None:
         return params
