@@ -59,8 +59,9 @@ def _actuator(
 
 
 def sensing_scheme(sensing: SensingSpec, lever: float) -> Any:
-    """The actuator model's sensing scheme for a study's sensing; a contact position error ``e`` [m] is the
-    joint error ``e / L`` [rad].
+    """The actuator model's sensing scheme for a study's sensing.
+
+    A contact position error ``e`` [m] is the joint error ``e / L`` [rad] at the lever ``L`` [m].
     """
     from ..hardware.actuators import CurrentThreshold, ForceThreshold, PositionThreshold
 
@@ -86,8 +87,10 @@ def _contact(actuator: Any, candidate: ActuatorCandidate, study: ActuatorStudy) 
 
 
 def evaluate_actuator_study(loaded: LoadedStudy) -> dict[str, Any]:
-    """Every candidate's 1D collision: parameters at the contact, impulse and phases at the study's approach
-    velocity and over its velocity range, optimal velocity and minimum impulse. Plain data (SI units).
+    """Every candidate's 1D collision, as plain data (SI units).
+
+    Parameters at the contact, impulse and phases at the study's approach velocity and over its velocity range,
+    optimal velocity and minimum impulse.
     """
     study = loaded.study
     assert isinstance(study, ActuatorStudy)
