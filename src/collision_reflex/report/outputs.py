@@ -1,6 +1,7 @@
 """A run's result files from its results (plain data): ``designs.json``, ``pareto.csv``, figures (PNG and SVG),
 ``report.html`` and optionally ``report.pdf``. :func:`render_report` redoes the figures and the report from a
-folder's saved ``designs.json`` alone."""
+folder's saved ``designs.json`` alone.
+"""
 
 from __future__ import annotations
 
@@ -21,7 +22,8 @@ def objective_unit(name: str) -> str:
 
 def pareto_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
     """The rows of ``pareto.csv``: one per Pareto design (arm studies; the chosen design if there is no front)
-    or per candidate actuator (actuator studies)."""
+    or per candidate actuator (actuator studies).
+    """
     from ..optimize.results import record_row
 
     if results["kind"] == "actuator":
@@ -73,7 +75,8 @@ def render_report(
     folder: str | os.PathLike[str], results: dict[str, Any] | None = None, figures: bool = True
 ) -> Path:
     """(Re)draw the figures and write ``report.html`` (and ``report.pdf`` if the study asks) from the results
-    saved in ``folder``."""
+    saved in ``folder``.
+    """
     from .figures import draw_figures
     from .html import render_html
 

@@ -151,7 +151,8 @@ def setup_from_text(resolved_text: str) -> ArmSetup:
 
 def objective_key(objective: Mapping[str, float] | Mapping[Any, float]) -> Hashable:
     """A hashable form of a study's objective: its name alone when it is a single unweighted objective, else
-    sorted ``(name, weight)`` pairs."""
+    sorted ``(name, weight)`` pairs.
+    """
     if len(objective) == 1 and next(iter(objective.values())) == 1.0:
         return next(iter(objective))
     return tuple(sorted((str(k), float(v)) for k, v in objective.items()))
@@ -160,7 +161,8 @@ def objective_key(objective: Mapping[str, float] | Mapping[Any, float]) -> Hasha
 @dataclass(frozen=True)
 class StudyProblems:
     """The design problems of a resolved study, as :func:`collision_reflex.optimize.pareto.pareto_front` builds
-    them: ``StudyProblems(text)(objective, bounded)``. Plain text inside, so it crosses process boundaries."""
+    them: ``StudyProblems(text)(objective, bounded)``. Plain text inside, so it crosses process boundaries.
+    """
 
     resolved_text: str
 
@@ -198,7 +200,8 @@ def sample_layout(setup: ArmSetup) -> dict[str, Any]:
 def checked_setup(loaded: LoadedStudy, resolved_text: str) -> ArmSetup:
     """The setup of a study, with its problem built once: every input problem (robot, frames, samples on which
     the arm cannot move, impossible bounds) is raised here, located in the study file, before a run writes
-    anything."""
+    anything.
+    """
     from ..errors import InvalidParameter
     from ..optimize.pareto import built_problem
 
@@ -216,7 +219,8 @@ def checked_setup(loaded: LoadedStudy, resolved_text: str) -> ArmSetup:
 
 def _torque_out_of_reach(loaded: LoadedStudy, setup: ArmSetup) -> list[StudyProblem]:
     """Given torque requirements no design within the bounds can meet: the largest motor at the largest gear
-    ratio (torque grows with motor size under every scaling law) short of the safety factor times the need."""
+    ratio (torque grows with motor size under every scaling law) short of the safety factor times the need.
+    """
     from ..hardware.motors import scaled_motor_quantities
 
     required = setup.study.constraints.torque_required

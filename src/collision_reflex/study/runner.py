@@ -48,7 +48,8 @@ class RunResult:
 
 def smoke_study(data: dict[str, Any]) -> dict[str, Any]:
     """A resolved study shrunk for a quick run: a few configurations, directions, Pareto points and
-    velocities. The shrunk study is what the run records as its resolved study."""
+    velocities. The shrunk study is what the run records as its resolved study.
+    """
     data = {**data}
     if data.get("kind") == "actuator":
         data["velocities"] = {**data["velocities"], "count": min(data["velocities"]["count"], 12)}
@@ -170,7 +171,8 @@ def _dump(data: dict[str, Any]) -> str:
 
 def _prepare(loaded: LoadedStudy, text: str) -> None:
     """Check everything a run needs; problems are located in ``loaded`` (the file as written), while the
-    problem is built from ``text`` (the resolved study that runs)."""
+    problem is built from ``text`` (the resolved study that runs).
+    """
     if isinstance(loaded.study, ArmStudy):
         from .arm_setup import checked_setup
 
@@ -233,7 +235,8 @@ def _run_arm(
     window: int,
 ) -> tuple[dict[str, Any], tuple[int, int]]:
     """The study's optimum, and its Pareto front by the optimiser's one sweep; each piece saved as it
-    finishes and found again when the run resumes."""
+    finishes and found again when the run resumes.
+    """
     from ..errors import SolverFailed, StudyRunFailed
     from ..optimize.pareto import pareto_front, single_optimum
     from .arm_setup import IPOPT_OPTIONS, StudyProblems
