@@ -1,5 +1,7 @@
-"""An arm study's results as plain data (``designs.json``): the chosen design, the Pareto front as the optimiser
-decided it, and where each contact sample comes from.
+"""An arm study's results as plain data (``designs.json``).
+
+The record holds the chosen design, the Pareto front as the optimiser decided it, and where each contact
+sample comes from.
 """
 
 from __future__ import annotations

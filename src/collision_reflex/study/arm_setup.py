@@ -1,7 +1,9 @@
-"""An arm study translated into the optimiser's inputs: robot, motors, design space, actuator technology,
-constraints and contact samples (:class:`ArmSetup`), every problem located in the study file; and the picklable
-problem builder (:class:`StudyProblems`) that rebuilds the design problems from the resolved study text in any
-process (the setup and the problems are built once per process).
+"""An arm study translated into the optimiser's inputs, and a picklable builder of its design problems.
+
+:class:`ArmSetup` holds the robot, motors, design space, actuator technology, constraints and contact samples,
+every problem located in the study file. The picklable problem builder (:class:`StudyProblems`) rebuilds the
+design problems from the resolved study text in any process (the setup and the problems are built once per
+process).
 """
 
 from __future__ import annotations
@@ -150,8 +152,9 @@ def setup_from_text(resolved_text: str) -> ArmSetup:
 
 
 def objective_key(objective: Mapping[str, float] | Mapping[Any, float]) -> Hashable:
-    """A hashable form of a study's objective: its name alone when it is a single unweighted objective, else
-    sorted ``(name, weight)`` pairs.
+    """A hashable form of a study's objective.
+
+    Its name alone when it is a single unweighted objective, else sorted ``(name, weight)`` pairs.
     """
     if len(objective) == 1 and next(iter(objective.values())) == 1.0:
         return next(iter(objective))
@@ -160,8 +163,10 @@ def objective_key(objective: Mapping[str, float] | Mapping[Any, float]) -> Hasha
 
 @dataclass(frozen=True)
 class StudyProblems:
-    """The design problems of a resolved study, as :func:`collision_reflex.optimize.pareto.pareto_front` builds
-    them: ``StudyProblems(text)(objective, bounded)``. Plain text inside, so it crosses process boundaries.
+    """The design problems of a resolved study, built from its text in any process.
+
+    Called as :func:`collision_reflex.optimize.pareto.pareto_front` builds them:
+    ``StudyProblems(text)(objective, bounded)``. Plain text inside, so it crosses process boundaries.
     """
 
     resolved_text: str
@@ -198,9 +203,10 @@ def sample_layout(setup: ArmSetup) -> dict[str, Any]:
 
 
 def checked_setup(loaded: LoadedStudy, resolved_text: str) -> ArmSetup:
-    """The setup of a study, with its problem built once: every input problem (robot, frames, samples on which
-    the arm cannot move, impossible bounds) is raised here, located in the study file, before a run writes
-    anything.
+    """The setup of a study, with its problem built once.
+
+    Every input problem (robot, frames, samples on which the arm cannot move, impossible bounds) is raised
+    here, located in the study file, before a run writes anything.
     """
     from ..errors import InvalidParameter
     from ..optimize.pareto import built_problem
@@ -218,8 +224,10 @@ def checked_setup(loaded: LoadedStudy, resolved_text: str) -> ArmSetup:
 
 
 def _torque_out_of_reach(loaded: LoadedStudy, setup: ArmSetup) -> list[StudyProblem]:
-    """Given torque requirements no design within the bounds can meet: the largest motor at the largest gear
-    ratio (torque grows with motor size under every scaling law) short of the safety factor times the need.
+    """The torque requirements no design within the bounds can meet.
+
+    A requirement is unmet when the largest motor at the largest gear ratio (torque grows with motor size
+    under every scaling law) is short of the safety factor times the need.
     """
     from ..hardware.motors import scaled_motor_quantities
 

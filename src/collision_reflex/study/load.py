@@ -67,8 +67,9 @@ def load_study(path: str | os.PathLike[str]) -> LoadedStudy:
 def parse_study(
     text: str, file: str = "<string>", directory: str | os.PathLike[str] | None = None
 ) -> LoadedStudy:
-    """Validate study text (as :func:`load_study`); relative paths resolve against ``directory`` (default: the
-    working directory).
+    """Validate study text (as :func:`load_study`).
+
+    Relative paths resolve against ``directory`` (default: the working directory).
     """
     return _validated(parse_study_source(text, file, Path(directory) if directory is not None else None))
 

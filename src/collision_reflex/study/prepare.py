@@ -1,5 +1,7 @@
-"""From a validated study to the objects a run needs: motors from the catalogue, the arm, the samples, and the
-actuator of every joint. Every failure is located in the study file.
+"""From a validated study to the objects a run needs.
+
+Motors from the catalogue, the arm, the samples, and the actuator of every joint. Every failure is located in
+the study file.
 """
 
 from __future__ import annotations
@@ -85,8 +87,9 @@ def gearbox_for(spec: GearboxSpec | None) -> Any:
 
 @dataclass(frozen=True)
 class JointActuatorValues:
-    """The nominal actuator of one joint of an arm study (SI units): the study's defaults with the joint's
-    overrides applied.
+    """The nominal actuator of one joint of an arm study (SI units).
+
+    The study's defaults with the joint's overrides applied.
     """
 
     joint: str
@@ -155,8 +158,10 @@ def per_joint_bounds(spec: Any, joint_names: list[str]) -> list[tuple[float, flo
 
 
 def describe_study(loaded: LoadedStudy, load_robot: bool = True) -> str:
-    """A one-line summary of a study; with ``load_robot`` the motors and (arm studies) the robot are loaded and
-    checked, raising :class:`StudyFileError` at the offending line.
+    """A one-line summary of a study.
+
+    With ``load_robot`` the motors and (arm studies) the robot are loaded and checked, raising
+    :class:`StudyFileError` at the offending line.
     """
     study = loaded.study
     if isinstance(study, ActuatorStudy):

@@ -147,8 +147,10 @@ class ActuatorsSpec(_Model):
 
 
 class SensingSpec(_Model):
-    """How contact is detected (MODEL.md §2): a contact-force threshold, a position-error threshold (``F_s = k e``)
-    or a motor-current threshold (joint-side threshold torque ``N tau_s``).
+    """How contact is detected (MODEL.md §2).
+
+    A contact-force threshold, a position-error threshold (``F_s = k e``) or a motor-current threshold
+    (joint-side threshold torque ``N tau_s``).
     """
 
     scheme: Literal["force", "position", "current"]
@@ -206,8 +208,10 @@ class ConfigurationSamples(_Model):
 
 
 class DirectionSamples(_Model):
-    """Exactly one of ``circle`` (n directions in the plane: the arm's plane, or the world x-y plane), ``sphere``
-    (n directions spread evenly over the sphere), ``named`` or ``list`` (vectors, normalised).
+    """The contact directions: exactly one of ``circle``, ``sphere``, ``named`` or ``list``.
+
+    ``circle``: n directions in the plane (the arm's plane, or the world x-y plane); ``sphere``: n directions
+    spread evenly over the sphere; ``named`` or ``list``: vectors, normalised.
     """
 
     circle: PositiveInt | None = None
@@ -309,8 +313,10 @@ PER_JOINT_DESIGN_VARIABLES = ("stator_diameter", "stack_length", "gear_ratio", "
 
 
 class DesignSpec(_Model):
-    """Design variables the optimiser may change; any not listed keeps the value of its section
-    (``actuators``, ``sensing``, ``approach_velocity``). Per-joint variables take ``joints: {name: {...}}``.
+    """Design variables the optimiser may change.
+
+    Any not listed keeps the value of its section (``actuators``, ``sensing``, ``approach_velocity``).
+    Per-joint variables take ``joints: {name: {...}}``.
     """
 
     stator_diameter: StatorDiameterVariable | None = None  # type: ignore[valid-type]
@@ -461,8 +467,9 @@ class VelocityRange(_Model):
 
 
 class ActuatorStudy(_Model):
-    """Single-joint actuators compared in a 1D collision at a lever (the paper's direct-drive U8 against the
-    geared A8, for example).
+    """Single-joint actuators compared in a 1D collision at a lever.
+
+    For example the paper's direct-drive U8 against the geared A8.
     """
 
     kind: Literal["actuator"]

@@ -46,8 +46,9 @@ class StudySource:
         return self.positions.get(path, (1, 1))
 
     def resolve_path(self, path: Sequence[Any]) -> PathKey:
-        """``path`` with the components that do not exist in the file dropped (validators insert the names of
-        union branches or wrapper functions into error locations).
+        """``path`` with the components that do not exist in the file dropped.
+
+        Validators insert the names of union branches or wrapper functions into error locations.
         """
         kept: list[Any] = []
         node = self.data
@@ -76,8 +77,9 @@ def _looks_internal(key: Any) -> bool:
 
 
 def format_path(path: Sequence[Any]) -> str:
-    """``("actuators", "joints", "j2", "gear_ratio")`` -> ``"actuators.joints.j2.gear_ratio"``; list indices as
-    ``[i]``.
+    """A location path as dotted text, list indices as ``[i]``.
+
+    ``("actuators", "joints", "j2", "gear_ratio")`` -> ``"actuators.joints.j2.gear_ratio"``.
     """
     text = ""
     for key in path:
@@ -89,7 +91,9 @@ def format_path(path: Sequence[Any]) -> str:
 
 
 def read_study_source(path: str | os.PathLike[str]) -> StudySource:
-    """Read a study file. A missing or unreadable file, or YAML that does not parse, raises
+    """Read a study file.
+
+    A missing or unreadable file, or YAML that does not parse, raises
     :class:`~collision_reflex.errors.StudyFileError` with the line.
     """
     name = str(path)
@@ -187,8 +191,9 @@ def _index_children(
 
 
 def _constructed_key(key_node: yaml.Node, raw: Any) -> Any:
-    """The key as the safe loader constructs it (``1`` for ``1``, ``True`` for ``yes``...), so that paths from
-    the data and from the node tree agree.
+    """The key as the safe loader constructs it (``1`` for ``1``, ``True`` for ``yes``...).
+
+    So that paths from the data and from the node tree agree.
     """
     if not isinstance(key_node, yaml.ScalarNode):
         return raw

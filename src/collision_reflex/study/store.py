@@ -1,5 +1,4 @@
-"""A run's output folder: atomic files, a manifest that ties the folder to one study, and finished work kept
-for resuming.
+"""A run's output folder: atomic files, a manifest that ties it to one study, finished work kept for resuming.
 
 Layout::
 
