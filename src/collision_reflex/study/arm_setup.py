@@ -172,6 +172,7 @@ class StudyProblems:
     resolved_text: str
 
     def __call__(self, objective: Hashable, bounded: tuple[str, ...] = ()) -> DesignProblem:
+        """The design problem for ``objective`` (an :func:`objective_key`); ``bounded`` may be bounded per solve."""
         from ..optimize import build_problem
 
         setup = setup_from_text(self.resolved_text)
@@ -182,6 +183,7 @@ class StudyProblems:
 
     @property
     def setup(self) -> ArmSetup:
+        """The study's setup, rebuilt from the resolved text (once per process)."""
         return setup_from_text(self.resolved_text)
 
     @property

@@ -52,6 +52,7 @@ class LoadedStudy:
         return (self.directory / relative).resolve()
 
     def problem(self, path: Sequence[Any], found: str, expected: str) -> StudyProblem:
+        """A problem at ``path``, located at its line in the study file."""
         return self.source.problem(path, found, expected)
 
     def fail(self, path: Sequence[Any], found: str, expected: str) -> StudyFileError:

@@ -45,6 +45,7 @@ class RunResult:
 
     @property
     def report(self) -> Path:
+        """The run's HTML report."""
         return self.folder / "report.html"
 
 

@@ -183,11 +183,15 @@ class SensingSpec(_Model):
 
 
 class RandomConfigurations(_Model):
+    """Configurations drawn at random within the joint limits."""
+
     count: PositiveInt = Field(description="number of configurations drawn uniformly within joint limits")
     seed: int = Field(0, strict=True, description="seed of the numpy Generator")
 
 
 class TrajectorySpec(_Model):
+    """Configurations read from a trajectory file (joint positions [rad])."""
+
     file: str = Field(description="CSV of joint positions [rad], one row per time step, one column per joint")
     every: PositiveInt = Field(1, description="use every n-th row")
 
@@ -229,6 +233,8 @@ class DirectionSamples(_Model):
 
 
 class SamplesSpec(_Model):
+    """The contact samples: arm configurations crossed with contact directions."""
+
     configurations: ConfigurationSamples
     directions: DirectionSamples
 
@@ -332,6 +338,8 @@ class DesignSpec(_Model):
 
 
 class ConstraintsSpec(_Model):
+    """Design constraints: payload [kg], torque safety factor, threshold noise floor [N], torques [N m]."""
+
     payload: Mass = Field(0.0, ge=0, description="mass carried at the contact point [kg]")
     safety_factor: Ratio = Field(1.0, ge=1, description="peak torque >= safety_factor x required torque")
     threshold_floor: Force = Field(0.0, ge=0, description="sensing noise floor [N]")
@@ -341,6 +349,8 @@ class ConstraintsSpec(_Model):
 
 
 class ParetoSpec(_Model):
+    """The Pareto front to trace: two or three objectives, the number of points, the anchors' start points."""
+
     objectives: list[ObjectiveName] = Field(min_length=2, max_length=3)
     points: Annotated[int, Field(ge=2, le=400, strict=True)] = 20
     anchor_starts: Annotated[
@@ -362,11 +372,15 @@ class ParetoSpec(_Model):
 
 
 class OutputsSpec(_Model):
+    """Which files a run writes besides the results: figure formats and the PDF report."""
+
     figures: list[Literal["png", "svg"]] = Field(default_factory=lambda: ["png", "svg"])  # type: ignore[arg-type]
     pdf: bool = Field(False, description="also write report.pdf (needs Chromium)")
 
 
 class ExecutionSpec(_Model):
+    """Where the independent work runs: in-process, a local process pool, or a Dask cluster."""
+
     executor: Literal["serial", "processes", "dask"] = "serial"
     workers: PositiveInt = 2
     scheduler: str | None = Field(None, description="Dask scheduler address, e.g. tcp://host:8786")
@@ -455,6 +469,8 @@ class LoadSpec(_Model):
 
 
 class VelocityRange(_Model):
+    """Approach velocities [m/s]: ``count`` values from ``min`` to ``max``, evenly spaced in log scale."""
+
     min: Velocity = Field(gt=0)
     max: Velocity = Field(gt=0)
     count: Annotated[int, Field(ge=2, le=10000, strict=True)] = 50
