@@ -11,7 +11,7 @@ from __future__ import annotations
 import functools
 from collections.abc import Hashable, Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
 
@@ -192,7 +192,23 @@ class StudyProblems:
         return objective_key(self.setup.study.objective)
 
 
-def sample_layout(setup: ArmSetup) -> dict[str, Any]:
+class SampleLayout(TypedDict):
+    """Where each contact sample comes from, as plain data (``designs.json``: ``samples``).
+
+    ``configurations`` are joint positions [rad] (one row per configuration), ``directions`` unit contact
+    directions; sample ``i`` is configuration ``config_index[i]`` hit along ``sample_directions[i]``.
+    ``task_dim`` is the task-space dimension (2 for a planar arm, 3 otherwise).
+    """
+
+    configurations: list[list[float]]
+    directions: list[list[float]]
+    config_index: list[int]
+    sample_directions: list[list[float]]
+    joint_names: list[str]
+    task_dim: int
+
+
+def sample_layout(setup: ArmSetup) -> SampleLayout:
     """Where each sample comes from (for the report's surfaces): configuration index and direction per sample."""
     return {
         "configurations": setup.configurations.tolist(),

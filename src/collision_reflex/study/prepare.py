@@ -7,13 +7,17 @@ the study file.
 from __future__ import annotations
 
 import difflib
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import StudyFileError, StudyProblem
 from .load import LoadedStudy
 from .schema import PER_JOINT_DESIGN_VARIABLES, ActuatorStudy, ArmStudy, GearboxSpec, MotorSpec
+
+if TYPE_CHECKING:
+    from ..hardware.gearboxes import Gearbox
+    from ..hardware.motors import Motor
 
 
 def _motor_specs(study: ArmStudy | ActuatorStudy) -> Iterator[tuple[tuple[Any, ...], MotorSpec]]:
@@ -27,7 +31,7 @@ def _motor_specs(study: ArmStudy | ActuatorStudy) -> Iterator[tuple[tuple[Any, .
             yield ("actuators", name, "motor"), candidate.motor
 
 
-def check_motors(loaded: LoadedStudy, catalogue: dict[str, Any] | None = None) -> dict[str, Any]:
+def check_motors(loaded: LoadedStudy, catalogue: dict[str, Motor] | None = None) -> dict[str, Motor]:
     """The motor catalogue, after checking that every motor the study names is in it."""
     from ..hardware.motors import load_catalogue
 
@@ -57,7 +61,7 @@ def _written_as_mapping(loaded: LoadedStudy, path: tuple[Any, ...]) -> bool:
     return isinstance(node, dict)
 
 
-def motor_for(spec: MotorSpec, catalogue: dict[str, Any]) -> Any:
+def motor_for(spec: MotorSpec, catalogue: Mapping[str, Motor]) -> Motor:
     """The :class:`collision_reflex.hardware.motors.Motor` a spec describes: the catalogue motor, scaled if asked."""
     motor = catalogue[spec.reference]
     if spec.stator_diameter is None and spec.stack_length is None:
@@ -67,7 +71,7 @@ def motor_for(spec: MotorSpec, catalogue: dict[str, Any]) -> Any:
     )
 
 
-def gearbox_for(spec: GearboxSpec | None) -> Any:
+def gearbox_for(spec: GearboxSpec | None) -> Gearbox | None:
     """The :class:`collision_reflex.hardware.actuators.Gearbox` of a spec (``None`` for direct drive)."""
     if spec is None:
         return None

@@ -7,11 +7,14 @@ the study file that names them.
 from __future__ import annotations
 
 import difflib
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import FrameNotFound, InvalidParameter, StudyFileError, StudyProblem, UrdfError
 from .load import LoadedStudy
 from .schema import PER_JOINT_DESIGN_VARIABLES, ArmStudy
+
+if TYPE_CHECKING:
+    from ..arm import Arm
 
 
 def example_robot_names() -> list[str]:
@@ -21,7 +24,7 @@ def example_robot_names() -> list[str]:
     return sorted(ROBOTS)
 
 
-def load_arm(loaded: LoadedStudy) -> Any:
+def load_arm(loaded: LoadedStudy) -> Arm:
     """The :class:`collision_reflex.arm.Arm` of an arm study, checked against the study.
 
     Raises
@@ -100,7 +103,7 @@ def load_arm(loaded: LoadedStudy) -> Any:
     return arm
 
 
-def check_against_arm(loaded: LoadedStudy, arm: Any) -> list[StudyProblem]:
+def check_against_arm(loaded: LoadedStudy, arm: Arm) -> list[StudyProblem]:
     """Every joint name and size in the study, checked against ``arm``."""
     study = loaded.study
     assert isinstance(study, ArmStudy)
