@@ -31,7 +31,7 @@ def _unique_svg_ids(name: str) -> Iterator[None]:
         yield
 
 
-def _draw(directory: Path, name: str, formats: list[str], draw: Callable[[Path], Any]) -> str:
+def _draw(directory: Path, name: str, formats: list[str], draw: Callable[[Path], Path]) -> str:
     directory.mkdir(parents=True, exist_ok=True)
     with _unique_svg_ids(name):
         svg_path = draw(directory / f"{name}.svg")

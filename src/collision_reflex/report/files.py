@@ -19,7 +19,7 @@ class ResultsMissing(CollisionReflexError, FileNotFoundError):
     """A folder has no saved results to report on."""
 
 
-def write_json(path: str | os.PathLike[str], data: Any) -> None:
+def write_json(path: str | os.PathLike[str], data: object) -> None:
     """Write ``data`` as JSON, atomically (NaN refused: it is never a valid result)."""
     with atomic_open(path, "w", encoding="utf-8") as handle:
         json.dump(data, handle, indent=1, allow_nan=False)

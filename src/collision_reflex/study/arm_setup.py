@@ -22,6 +22,7 @@ from .prepare import check_motors, joint_actuators, per_joint_bounds
 from .robot import load_arm
 from .samples import configuration_samples, direction_samples
 from .schema import PER_JOINT_DESIGN_VARIABLES, ArmStudy
+from .source import PathKey
 
 if TYPE_CHECKING:
     from ..arm import Arm
@@ -135,7 +136,7 @@ def _check_supported(loaded: LoadedStudy, study: ArmStudy) -> None:
         raise StudyFileError(loaded.source.file, problems)
 
 
-def _gearbox_problem(loaded: LoadedStudy, path: tuple[Any, ...]) -> StudyProblem:
+def _gearbox_problem(loaded: LoadedStudy, path: PathKey) -> StudyProblem:
     return loaded.problem(
         path,
         "a gearbox in an arm study",

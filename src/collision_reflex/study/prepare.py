@@ -14,13 +14,14 @@ from typing import TYPE_CHECKING, Any
 from ..errors import StudyFileError, StudyProblem
 from .load import LoadedStudy
 from .schema import PER_JOINT_DESIGN_VARIABLES, ActuatorStudy, ArmStudy, GearboxSpec, MotorSpec
+from .source import PathKey
 
 if TYPE_CHECKING:
     from ..hardware.gearboxes import Gearbox
     from ..hardware.motors import Motor
 
 
-def _motor_specs(study: ArmStudy | ActuatorStudy) -> Iterator[tuple[tuple[Any, ...], MotorSpec]]:
+def _motor_specs(study: ArmStudy | ActuatorStudy) -> Iterator[tuple[PathKey, MotorSpec]]:
     if isinstance(study, ArmStudy):
         yield ("actuators", "motor"), study.actuators.motor
         for joint, override in study.actuators.joints.items():
@@ -54,7 +55,7 @@ def check_motors(loaded: LoadedStudy, catalogue: dict[str, Motor] | None = None)
     return catalogue
 
 
-def _written_as_mapping(loaded: LoadedStudy, path: tuple[Any, ...]) -> bool:
+def _written_as_mapping(loaded: LoadedStudy, path: PathKey) -> bool:
     node: Any = loaded.source.data
     for key in path:
         node = node.get(key) if isinstance(node, dict) else None

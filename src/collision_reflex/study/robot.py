@@ -7,11 +7,12 @@ the study file that names them.
 from __future__ import annotations
 
 import difflib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from ..errors import FrameNotFound, InvalidParameter, StudyFileError, StudyProblem, UrdfError
 from .load import LoadedStudy
 from .schema import PER_JOINT_DESIGN_VARIABLES, ArmStudy
+from .source import PathKey
 
 if TYPE_CHECKING:
     from ..arm import Arm
@@ -74,7 +75,7 @@ def load_arm(loaded: LoadedStudy) -> Arm:
             )
     except FrameNotFound as error:
         if error.kind == "joint" and error.name in locked:
-            where: tuple[Any, ...] = ("robot", "locked_joints", locked.index(error.name))
+            where: PathKey = ("robot", "locked_joints", locked.index(error.name))
         else:
             where = ("robot", "contact_frame")
         close = difflib.get_close_matches(error.name, error.available, n=1)
@@ -110,7 +111,7 @@ def check_against_arm(loaded: LoadedStudy, arm: Arm) -> list[StudyProblem]:
     joints = list(arm.joint_names)
     problems: list[StudyProblem] = []
 
-    def check_joint(path: tuple[Any, ...], name: str) -> None:
+    def check_joint(path: PathKey, name: str) -> None:
         if name not in joints:
             close = difflib.get_close_matches(name, joints, n=1)
             problems.append(
