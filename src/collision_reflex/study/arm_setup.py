@@ -173,7 +173,10 @@ class StudyProblems:
     resolved_text: str
 
     def __call__(self, objective: Hashable, bounded: tuple[str, ...] = ()) -> DesignProblem:
-        """The design problem for ``objective`` (an :func:`objective_key`); ``bounded`` may be bounded per solve."""
+        """The design problem for ``objective`` (an :func:`objective_key`).
+
+        The objectives named in ``bounded`` can be bounded per solve (epsilon-constraint Pareto sweeps).
+        """
         from ..optimize import build_problem
 
         setup = setup_from_text(self.resolved_text)
