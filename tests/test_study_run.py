@@ -470,3 +470,31 @@ def test_a_study_asks_for_multi_start_anchors(tmp_path, monkeypatch):
     # Two anchors, each started twice, then one lexicographic step each and two points from one start.
     assert sorted(starts) == [1, 1, 1, 1, 1, 2, 2]
     assert results["pareto"]["points"][0]["label"] == "anchor: worst_case_impulse"
+
+
+@pytest.mark.parametrize("name", ARM_STUDIES, ids=ARM_STUDIES)
+def test_saved_arm_results_have_the_declared_record_types(runs, name):
+    # The TypedDicts are what the report reads; a key written but not declared (or declared, never written)
+    # means the declaration and designs.json have drifted apart.
+    from typing import get_type_hints
+
+    from collision_reflex.study.arm_results import ArmResults, ParetoRecord
+    from collision_reflex.study.arm_setup import SampleLayout
+
+    results = json.loads((runs[name] / "designs.json").read_text())
+    for record, declared in (
+        (results, ArmResults),
+        (results["pareto"], ParetoRecord),
+        (results["samples"], SampleLayout),
+    ):
+        assert set(get_type_hints(declared)) <= set(record), declared.__name__
+    assert set(results["pareto"]) == set(get_type_hints(ParetoRecord))
+    assert set(results["samples"]) == set(get_type_hints(SampleLayout))
+    samples = results["samples"]
+    n_samples = len(samples["config_index"])
+    assert n_samples == len(samples["sample_directions"]) >= 1
+    assert all(
+        isinstance(i, int) and 0 <= i < len(samples["configurations"]) for i in samples["config_index"]
+    )
+    assert all(len(d) == samples["task_dim"] for d in samples["sample_directions"])
+    assert all(len(q) == len(samples["joint_names"]) for q in samples["configurations"])

@@ -74,6 +74,7 @@ from .model.impulse import (
     total_impulse,
     velocity_coefficients,
 )
+from .model.sensing import SENSING_SCHEMES, current_threshold_torque, threshold_force
 from .optimize import (
     OBJECTIVES,
     ActuatorTechnology,
@@ -86,10 +87,16 @@ from .optimize import (
     DesignSpace,
     ParetoSet,
     build_problem,
+    hypervolume,
     pareto_front,
     solve,
 )
+from .optimize.results import result_from_json, result_to_json
+from .report import render_report
 from .simulate import (
+    DETECTION_KINDS,
+    DRIVES,
+    SWEEP_PARAMETERS,
     ArmCollision,
     CollisionSetup,
     Detection,
@@ -107,11 +114,15 @@ from .study.runner import run_study
 __version__ = "0.1.0"
 
 __all__ = [
+    "DETECTION_KINDS",
+    "DRIVES",
     "GEARBOX_KINDS",
     "OBJECTIVES",
     "REACTION_MODES",
     "REFLECTED_INERTIA_PLACEMENTS",
     "SCALING_LAWS",
+    "SENSING_SCHEMES",
+    "SWEEP_PARAMETERS",
     "Actuator",
     "ActuatorTechnology",
     "Arm",
@@ -164,6 +175,7 @@ __all__ = [
     "collision_times",
     "contact_damping_for_restitution",
     "contact_restitution",
+    "current_threshold_torque",
     "dynamic_manipulability_ellipsoid",
     "effective_mass",
     "effective_parameters",
@@ -172,6 +184,7 @@ __all__ = [
     "force_profile",
     "gear_ratio_for",
     "generalized_inertia_ellipsoid",
+    "hypervolume",
     "impact_mitigation_factor",
     "load_catalogue",
     "load_study",
@@ -181,6 +194,9 @@ __all__ = [
     "phase_impulses",
     "reference_motor",
     "reflex_surface",
+    "render_report",
+    "result_from_json",
+    "result_to_json",
     "run_study",
     "scaled_motor_quantities",
     "scaling_law",
@@ -191,6 +207,7 @@ __all__ = [
     "solve",
     "sphere_directions",
     "study_json_schema",
+    "threshold_force",
     "total_impulse",
     "unit_directions",
     "velocity_coefficients",

@@ -1,5 +1,7 @@
-"""The report's figures, drawn from saved results into ``figures/`` (PNG and/or SVG files) and returned as SVG
-text for inlining in the HTML report.
+"""The report's figures, drawn from saved results and returned as SVG text for the HTML report.
+
+Each figure is drawn into ``figures/`` (PNG and/or SVG files) and its SVG text is returned for inlining in the
+HTML report.
 """
 
 from __future__ import annotations
@@ -18,7 +20,9 @@ from .outputs import objective_unit
 
 @contextlib.contextmanager
 def _unique_svg_ids(name: str) -> Iterator[None]:
-    """Matplotlib names SVG elements by hashes salted with ``svg.hashsalt``; a salt per figure keeps ids unique
+    """Salt Matplotlib's SVG ids with the figure's name, so inlined figures do not share ids.
+
+    Matplotlib names SVG elements by hashes salted with ``svg.hashsalt``; a salt per figure keeps ids unique
     when several figures are inlined in one HTML page (and identical between runs).
     """
     import matplotlib
@@ -27,7 +31,7 @@ def _unique_svg_ids(name: str) -> Iterator[None]:
         yield
 
 
-def _draw(directory: Path, name: str, formats: list[str], draw: Callable[[Path], Any]) -> str:
+def _draw(directory: Path, name: str, formats: list[str], draw: Callable[[Path], Path]) -> str:
     directory.mkdir(parents=True, exist_ok=True)
     with _unique_svg_ids(name):
         svg_path = draw(directory / f"{name}.svg")

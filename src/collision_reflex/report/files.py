@@ -19,7 +19,7 @@ class ResultsMissing(CollisionReflexError, FileNotFoundError):
     """A folder has no saved results to report on."""
 
 
-def write_json(path: str | os.PathLike[str], data: Any) -> None:
+def write_json(path: str | os.PathLike[str], data: object) -> None:
     """Write ``data`` as JSON, atomically (NaN refused: it is never a valid result)."""
     with atomic_open(path, "w", encoding="utf-8") as handle:
         json.dump(data, handle, indent=1, allow_nan=False)
@@ -27,9 +27,11 @@ def write_json(path: str | os.PathLike[str], data: Any) -> None:
 
 
 def write_text(path: str | os.PathLike[str], text: str) -> None:
+    """Write ``text`` as UTF-8, atomically."""
     with atomic_open(path, "w", encoding="utf-8") as handle:
         handle.write(text)
 
 
 def read_json(path: str | os.PathLike[str]) -> Any:
+    """Read a JSON file (UTF-8)."""
     return json.loads(Path(path).read_text(encoding="utf-8"))

@@ -29,7 +29,7 @@ UNITS = {
 }
 
 
-def number(value: Any, digits: int = 4) -> str:
+def number(value: object, digits: int = 4) -> str:
     """A number with ``digits`` significant digits (the precision every table of the report uses)."""
     if value is None:
         return "–"

@@ -1,6 +1,9 @@
-"""A run's result files from its results (plain data): ``designs.json``, ``pareto.csv``, figures (PNG and SVG),
-``report.html`` and optionally ``report.pdf``. :func:`render_report` redoes the figures and the report from a
-folder's saved ``designs.json`` alone."""
+"""A run's result files, written from its results (plain data).
+
+The files are ``designs.json``, ``pareto.csv``, figures (PNG and SVG), ``report.html`` and optionally
+``report.pdf``. :func:`render_report` redoes the figures and the report from a folder's saved ``designs.json``
+alone.
+"""
 
 from __future__ import annotations
 
@@ -20,8 +23,11 @@ def objective_unit(name: str) -> str:
 
 
 def pareto_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
-    """The rows of ``pareto.csv``: one per Pareto design (arm studies; the chosen design if there is no front)
-    or per candidate actuator (actuator studies)."""
+    """The rows of ``pareto.csv``.
+
+    One row per Pareto design (arm studies; the chosen design if there is no front) or per candidate actuator
+    (actuator studies).
+    """
     from ..optimize.results import record_row
 
     if results["kind"] == "actuator":
@@ -72,8 +78,10 @@ def _write_csv(path: Path, rows: list[dict[str, Any]]) -> None:
 def render_report(
     folder: str | os.PathLike[str], results: dict[str, Any] | None = None, figures: bool = True
 ) -> Path:
-    """(Re)draw the figures and write ``report.html`` (and ``report.pdf`` if the study asks) from the results
-    saved in ``folder``."""
+    """Redraw the figures and rewrite the report from the results saved in ``folder``.
+
+    Writes ``report.html`` (and ``report.pdf`` if the study asks).
+    """
     from .figures import draw_figures
     from .html import render_html
 

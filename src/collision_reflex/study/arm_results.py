@@ -1,19 +1,43 @@
-"""An arm study's results as plain data (``designs.json``): the chosen design, the Pareto front as the optimiser
-decided it, and where each contact sample comes from."""
+"""An arm study's results as plain data (``designs.json``).
+
+The record holds the chosen design, the Pareto front as the optimiser decided it, and where each contact
+sample comes from.
+"""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypedDict
 
 from ..optimize.pareto import built_problem
 from ..optimize.results import design_record
-from .arm_setup import StudyProblems, sample_layout
+from .arm_setup import SampleLayout, StudyProblems, sample_layout
 
 if TYPE_CHECKING:
     from ..optimize import DesignResult, ParetoSet
 
 
-def arm_results(problems: StudyProblems, chosen: DesignResult, front: ParetoSet | None) -> dict[str, Any]:
+class ParetoRecord(TypedDict):
+    """The Pareto front as plain data: objective names, designs on the front, failed points, dominated designs.
+
+    Each design is a :func:`collision_reflex.optimize.results.design_record`; each failure a
+    :meth:`collision_reflex.optimize.results.PointFailure.as_dict`.
+    """
+
+    objectives: list[str]
+    points: list[dict[str, Any]]
+    failed: list[dict[str, Any]]
+    dominated: list[dict[str, Any]]
+
+
+class ArmResults(TypedDict):
+    """An arm study's own part of ``designs.json``: the samples, the chosen design and the Pareto front."""
+
+    samples: SampleLayout
+    chosen: dict[str, Any]
+    pareto: ParetoRecord
+
+
+def arm_results(problems: StudyProblems, chosen: DesignResult, front: ParetoSet | None) -> ArmResults:
     """``samples``, ``chosen`` and ``pareto`` of an arm study's results.
 
     The chosen design (the optimum of the study's objective) records ``dominated_by``: the index of a Pareto
@@ -26,7 +50,7 @@ def arm_results(problems: StudyProblems, chosen: DesignResult, front: ParetoSet 
     def record(result: DesignResult, label: str) -> dict[str, Any]:
         return design_record(problem, result, label, setup.catalogue)
 
-    pareto: dict[str, Any] = {"objectives": [], "points": [], "failed": [], "dominated": []}
+    pareto: ParetoRecord = {"objectives": [], "points": [], "failed": [], "dominated": []}
     chosen_record = record(chosen, "optimum")
     chosen_record["dominated_by"] = None
     if front is not None:

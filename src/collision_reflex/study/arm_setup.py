@@ -1,7 +1,9 @@
-"""An arm study translated into the optimiser's inputs: robot, motors, design space, actuator technology,
-constraints and contact samples (:class:`ArmSetup`), every problem located in the study file; and the picklable
-problem builder (:class:`StudyProblems`) that rebuilds the design problems from the resolved study text in any
-process (the setup and the problems are built once per process).
+"""An arm study translated into the optimiser's inputs, and a picklable builder of its design problems.
+
+:class:`ArmSetup` holds the robot, motors, design space, actuator technology, constraints and contact samples,
+every problem located in the study file. The picklable problem builder (:class:`StudyProblems`) rebuilds the
+design problems from the resolved study text in any process (the setup and the problems are built once per
+process).
 """
 
 from __future__ import annotations
@@ -9,7 +11,7 @@ from __future__ import annotations
 import functools
 from collections.abc import Hashable, Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
 
@@ -20,6 +22,7 @@ from .prepare import check_motors, joint_actuators, per_joint_bounds
 from .robot import load_arm
 from .samples import configuration_samples, direction_samples
 from .schema import PER_JOINT_DESIGN_VARIABLES, ArmStudy
+from .source import PathKey
 
 if TYPE_CHECKING:
     from ..arm import Arm
@@ -133,7 +136,7 @@ def _check_supported(loaded: LoadedStudy, study: ArmStudy) -> None:
         raise StudyFileError(loaded.source.file, problems)
 
 
-def _gearbox_problem(loaded: LoadedStudy, path: tuple[Any, ...]) -> StudyProblem:
+def _gearbox_problem(loaded: LoadedStudy, path: PathKey) -> StudyProblem:
     return loaded.problem(
         path,
         "a gearbox in an arm study",
@@ -150,8 +153,10 @@ def setup_from_text(resolved_text: str) -> ArmSetup:
 
 
 def objective_key(objective: Mapping[str, float] | Mapping[Any, float]) -> Hashable:
-    """A hashable form of a study's objective: its name alone when it is a single unweighted objective, else
-    sorted ``(name, weight)`` pairs."""
+    """A hashable form of a study's objective.
+
+    Its name alone when it is a single unweighted objective, else sorted ``(name, weight)`` pairs.
+    """
     if len(objective) == 1 and next(iter(objective.values())) == 1.0:
         return next(iter(objective))
     return tuple(sorted((str(k), float(v)) for k, v in objective.items()))
@@ -159,12 +164,19 @@ def objective_key(objective: Mapping[str, float] | Mapping[Any, float]) -> Hasha
 
 @dataclass(frozen=True)
 class StudyProblems:
-    """The design problems of a resolved study, as :func:`collision_reflex.optimize.pareto.pareto_front` builds
-    them: ``StudyProblems(text)(objective, bounded)``. Plain text inside, so it crosses process boundaries."""
+    """The design problems of a resolved study, built from its text in any process.
+
+    Called as :func:`collision_reflex.optimize.pareto.pareto_front` builds them:
+    ``StudyProblems(text)(objective, bounded)``. Plain text inside, so it crosses process boundaries.
+    """
 
     resolved_text: str
 
     def __call__(self, objective: Hashable, bounded: tuple[str, ...] = ()) -> DesignProblem:
+        """The design problem for ``objective`` (an :func:`objective_key`).
+
+        The objectives named in ``bounded`` can be bounded per solve (epsilon-constraint Pareto sweeps).
+        """
         from ..optimize import build_problem
 
         setup = setup_from_text(self.resolved_text)
@@ -175,6 +187,7 @@ class StudyProblems:
 
     @property
     def setup(self) -> ArmSetup:
+        """The study's setup, rebuilt from the resolved text (once per process)."""
         return setup_from_text(self.resolved_text)
 
     @property
@@ -183,7 +196,23 @@ class StudyProblems:
         return objective_key(self.setup.study.objective)
 
 
-def sample_layout(setup: ArmSetup) -> dict[str, Any]:
+class SampleLayout(TypedDict):
+    """Where each contact sample comes from, as plain data (``designs.json``: ``samples``).
+
+    ``configurations`` are joint positions [rad] (one row per configuration), ``directions`` unit contact
+    directions; sample ``i`` is configuration ``config_index[i]`` hit along ``sample_directions[i]``.
+    ``task_dim`` is the task-space dimension (2 for a planar arm, 3 otherwise).
+    """
+
+    configurations: list[list[float]]
+    directions: list[list[float]]
+    config_index: list[int]
+    sample_directions: list[list[float]]
+    joint_names: list[str]
+    task_dim: int
+
+
+def sample_layout(setup: ArmSetup) -> SampleLayout:
     """Where each sample comes from (for the report's surfaces): configuration index and direction per sample."""
     return {
         "configurations": setup.configurations.tolist(),
@@ -196,9 +225,11 @@ def sample_layout(setup: ArmSetup) -> dict[str, Any]:
 
 
 def checked_setup(loaded: LoadedStudy, resolved_text: str) -> ArmSetup:
-    """The setup of a study, with its problem built once: every input problem (robot, frames, samples on which
-    the arm cannot move, impossible bounds) is raised here, located in the study file, before a run writes
-    anything."""
+    """The setup of a study, with its problem built once.
+
+    Every input problem (robot, frames, samples on which the arm cannot move, impossible bounds) is raised
+    here, located in the study file, before a run writes anything.
+    """
     from ..errors import InvalidParameter
     from ..optimize.pareto import built_problem
 
@@ -215,8 +246,11 @@ def checked_setup(loaded: LoadedStudy, resolved_text: str) -> ArmSetup:
 
 
 def _torque_out_of_reach(loaded: LoadedStudy, setup: ArmSetup) -> list[StudyProblem]:
-    """Given torque requirements no design within the bounds can meet: the largest motor at the largest gear
-    ratio (torque grows with motor size under every scaling law) short of the safety factor times the need."""
+    """The torque requirements no design within the bounds can meet.
+
+    A requirement is unmet when the largest motor at the largest gear ratio (torque grows with motor size
+    under every scaling law) is short of the safety factor times the need.
+    """
     from ..hardware.motors import scaled_motor_quantities
 
     required = setup.study.constraints.torque_required

@@ -1,5 +1,7 @@
-"""Executors for a study's independent work (Pareto points, sample chunks): in-process, a local process pool, or a
-Dask distributed cluster. All are :class:`concurrent.futures.Executor`; nothing here schedules work itself.
+"""Executors for a study's independent work (Pareto points, sample chunks).
+
+In-process, a local process pool, or a Dask distributed cluster. All are :class:`concurrent.futures.Executor`;
+nothing here schedules work itself.
 """
 
 from __future__ import annotations

@@ -1,5 +1,6 @@
-"""The JSON Schema of study files, for editors that complete and check YAML (e.g. through yaml-language-server's
-``# yaml-language-server: $schema=study.schema.json``).
+"""The JSON Schema of study files, for editors that complete and check YAML.
+
+For example through yaml-language-server's ``# yaml-language-server: $schema=study.schema.json``.
 """
 
 from __future__ import annotations

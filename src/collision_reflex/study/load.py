@@ -12,7 +12,7 @@ import json
 import os
 import types
 import typing
-from collections.abc import Sequence
+from collections.abc import Hashable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -51,10 +51,11 @@ class LoadedStudy:
         """A path named in the study, resolved against the study file's directory."""
         return (self.directory / relative).resolve()
 
-    def problem(self, path: Sequence[Any], found: str, expected: str) -> StudyProblem:
+    def problem(self, path: Sequence[Hashable], found: str, expected: str) -> StudyProblem:
+        """A problem at ``path``, located at its line in the study file."""
         return self.source.problem(path, found, expected)
 
-    def fail(self, path: Sequence[Any], found: str, expected: str) -> StudyFileError:
+    def fail(self, path: Sequence[Hashable], found: str, expected: str) -> StudyFileError:
         """A :class:`StudyFileError` with one problem at ``path`` (to raise)."""
         return StudyFileError(self.source.file, [self.problem(path, found, expected)])
 
@@ -67,8 +68,9 @@ def load_study(path: str | os.PathLike[str]) -> LoadedStudy:
 def parse_study(
     text: str, file: str = "<string>", directory: str | os.PathLike[str] | None = None
 ) -> LoadedStudy:
-    """Validate study text (as :func:`load_study`); relative paths resolve against ``directory`` (default: the
-    working directory).
+    """Validate study text (as :func:`load_study`).
+
+    Relative paths resolve against ``directory`` (default: the working directory).
     """
     return _validated(parse_study_source(text, file, Path(directory) if directory is not None else None))
 
@@ -140,7 +142,7 @@ def _found(value: Any) -> str:
     return text if len(text) <= _FOUND_LIMIT else text[: _FOUND_LIMIT - 3] + "..."
 
 
-def _allowed_keys(model: type[BaseModel], path: Sequence[Any]) -> list[str]:
+def _allowed_keys(model: type[BaseModel], path: Sequence[Hashable]) -> list[str]:
     """Field names of the model at ``path`` below ``model`` (empty if it cannot be told)."""
     target: Any = model
     for key in path:

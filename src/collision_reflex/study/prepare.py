@@ -1,20 +1,27 @@
-"""From a validated study to the objects a run needs: motors from the catalogue, the arm, the samples, and the
-actuator of every joint. Every failure is located in the study file.
+"""From a validated study to the objects a run needs.
+
+Motors from the catalogue, the arm, the samples, and the actuator of every joint. Every failure is located in
+the study file.
 """
 
 from __future__ import annotations
 
 import difflib
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import StudyFileError, StudyProblem
 from .load import LoadedStudy
 from .schema import PER_JOINT_DESIGN_VARIABLES, ActuatorStudy, ArmStudy, GearboxSpec, MotorSpec
+from .source import PathKey
+
+if TYPE_CHECKING:
+    from ..hardware.gearboxes import Gearbox
+    from ..hardware.motors import Motor
 
 
-def _motor_specs(study: ArmStudy | ActuatorStudy) -> Iterator[tuple[tuple[Any, ...], MotorSpec]]:
+def _motor_specs(study: ArmStudy | ActuatorStudy) -> Iterator[tuple[PathKey, MotorSpec]]:
     if isinstance(study, ArmStudy):
         yield ("actuators", "motor"), study.actuators.motor
         for joint, override in study.actuators.joints.items():
@@ -25,7 +32,7 @@ def _motor_specs(study: ArmStudy | ActuatorStudy) -> Iterator[tuple[tuple[Any, .
             yield ("actuators", name, "motor"), candidate.motor
 
 
-def check_motors(loaded: LoadedStudy, catalogue: dict[str, Any] | None = None) -> dict[str, Any]:
+def check_motors(loaded: LoadedStudy, catalogue: dict[str, Motor] | None = None) -> dict[str, Motor]:
     """The motor catalogue, after checking that every motor the study names is in it."""
     from ..hardware.motors import load_catalogue
 
@@ -48,14 +55,14 @@ def check_motors(loaded: LoadedStudy, catalogue: dict[str, Any] | None = None) -
     return catalogue
 
 
-def _written_as_mapping(loaded: LoadedStudy, path: tuple[Any, ...]) -> bool:
+def _written_as_mapping(loaded: LoadedStudy, path: PathKey) -> bool:
     node: Any = loaded.source.data
     for key in path:
         node = node.get(key) if isinstance(node, dict) else None
     return isinstance(node, dict)
 
 
-def motor_for(spec: MotorSpec, catalogue: dict[str, Any]) -> Any:
+def motor_for(spec: MotorSpec, catalogue: Mapping[str, Motor]) -> Motor:
     """The :class:`collision_reflex.hardware.motors.Motor` a spec describes: the catalogue motor, scaled if asked."""
     motor = catalogue[spec.reference]
     if spec.stator_diameter is None and spec.stack_length is None:
@@ -65,7 +72,7 @@ def motor_for(spec: MotorSpec, catalogue: dict[str, Any]) -> Any:
     )
 
 
-def gearbox_for(spec: GearboxSpec | None) -> Any:
+def gearbox_for(spec: GearboxSpec | None) -> Gearbox | None:
     """The :class:`collision_reflex.hardware.actuators.Gearbox` of a spec (``None`` for direct drive)."""
     if spec is None:
         return None
@@ -85,8 +92,9 @@ def gearbox_for(spec: GearboxSpec | None) -> Any:
 
 @dataclass(frozen=True)
 class JointActuatorValues:
-    """The nominal actuator of one joint of an arm study (SI units): the study's defaults with the joint's
-    overrides applied.
+    """The nominal actuator of one joint of an arm study (SI units).
+
+    The study's defaults with the joint's overrides applied.
     """
 
     joint: str
@@ -155,8 +163,10 @@ def per_joint_bounds(spec: Any, joint_names: list[str]) -> list[tuple[float, flo
 
 
 def describe_study(loaded: LoadedStudy, load_robot: bool = True) -> str:
-    """A one-line summary of a study; with ``load_robot`` the motors and (arm studies) the robot are loaded and
-    checked, raising :class:`StudyFileError` at the offending line.
+    """A one-line summary of a study.
+
+    With ``load_robot`` the motors and (arm studies) the robot are loaded and checked, raising
+    :class:`StudyFileError` at the offending line.
     """
     study = loaded.study
     if isinstance(study, ActuatorStudy):

@@ -10,14 +10,17 @@ from __future__ import annotations
 
 import functools
 import math
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 from pydantic import BeforeValidator, WithJsonSchema
 from pydantic_core import PydanticCustomError
 
+if TYPE_CHECKING:
+    import pint
+
 
 @functools.cache
-def unit_registry() -> Any:
+def unit_registry() -> pint.UnitRegistry:
     """The pint registry used for every study file (built once: it takes a while)."""
     import pint
 
@@ -51,7 +54,7 @@ def to_si(value: Any, unit: str, what: str, example: str) -> float:
 def _parse(text: str, unit: str, what: str, expected: str) -> float:
     registry = unit_registry()
     try:
-        quantity = registry.Quantity(text.strip())
+        quantity: pint.Quantity = registry.Quantity(text.strip())
         target = registry.Quantity(1.0, unit)
     except Exception:  # pint's parser raises many kinds of errors on arbitrary text; any is "not a quantity"
         raise PydanticCustomError("quantity", "{expected}", {"expected": expected}) from None

@@ -7,11 +7,15 @@ the study file that names them.
 from __future__ import annotations
 
 import difflib
-from typing import Any
+from typing import TYPE_CHECKING
 
 from ..errors import FrameNotFound, InvalidParameter, StudyFileError, StudyProblem, UrdfError
 from .load import LoadedStudy
 from .schema import PER_JOINT_DESIGN_VARIABLES, ArmStudy
+from .source import PathKey
+
+if TYPE_CHECKING:
+    from ..arm import Arm
 
 
 def example_robot_names() -> list[str]:
@@ -21,7 +25,7 @@ def example_robot_names() -> list[str]:
     return sorted(ROBOTS)
 
 
-def load_arm(loaded: LoadedStudy) -> Any:
+def load_arm(loaded: LoadedStudy) -> Arm:
     """The :class:`collision_reflex.arm.Arm` of an arm study, checked against the study.
 
     Raises
@@ -71,7 +75,7 @@ def load_arm(loaded: LoadedStudy) -> Any:
             )
     except FrameNotFound as error:
         if error.kind == "joint" and error.name in locked:
-            where: tuple[Any, ...] = ("robot", "locked_joints", locked.index(error.name))
+            where: PathKey = ("robot", "locked_joints", locked.index(error.name))
         else:
             where = ("robot", "contact_frame")
         close = difflib.get_close_matches(error.name, error.available, n=1)
@@ -100,14 +104,14 @@ def load_arm(loaded: LoadedStudy) -> Any:
     return arm
 
 
-def check_against_arm(loaded: LoadedStudy, arm: Any) -> list[StudyProblem]:
+def check_against_arm(loaded: LoadedStudy, arm: Arm) -> list[StudyProblem]:
     """Every joint name and size in the study, checked against ``arm``."""
     study = loaded.study
     assert isinstance(study, ArmStudy)
     joints = list(arm.joint_names)
     problems: list[StudyProblem] = []
 
-    def check_joint(path: tuple[Any, ...], name: str) -> None:
+    def check_joint(path: PathKey, name: str) -> None:
         if name not in joints:
             close = difflib.get_close_matches(name, joints, n=1)
             problems.append(

@@ -1,5 +1,7 @@
-"""Running a study end to end: validate everything first, then do the independent work through an executor,
-keep each finished piece, and write the results and the report.
+"""Running a study end to end.
+
+Validate everything first, then do the independent work through an executor, keep each finished piece, and
+write the results and the report.
 
 A run restarted with the same command finds its finished pieces in ``OUT/points`` and does only the rest; the
 same study (and seed) gives the same numbers whatever the executor, because every piece of work is a pure
@@ -43,12 +45,16 @@ class RunResult:
 
     @property
     def report(self) -> Path:
+        """The run's HTML report."""
         return self.folder / "report.html"
 
 
 def smoke_study(data: dict[str, Any]) -> dict[str, Any]:
-    """A resolved study shrunk for a quick run: a few configurations, directions, Pareto points and
-    velocities. The shrunk study is what the run records as its resolved study."""
+    """A resolved study shrunk for a quick run.
+
+    A few configurations, directions, Pareto points and velocities. The shrunk study is what the run records
+    as its resolved study.
+    """
     data = {**data}
     if data.get("kind") == "actuator":
         data["velocities"] = {**data["velocities"], "count": min(data["velocities"]["count"], 12)}
@@ -169,8 +175,11 @@ def _dump(data: dict[str, Any]) -> str:
 
 
 def _prepare(loaded: LoadedStudy, text: str) -> None:
-    """Check everything a run needs; problems are located in ``loaded`` (the file as written), while the
-    problem is built from ``text`` (the resolved study that runs)."""
+    """Check everything a run needs.
+
+    Problems are located in ``loaded`` (the file as written), while the problem is built from ``text`` (the
+    resolved study that runs).
+    """
     if isinstance(loaded.study, ArmStudy):
         from .arm_setup import checked_setup
 
@@ -232,8 +241,10 @@ def _run_arm(
     progress: _Progress,
     window: int,
 ) -> tuple[dict[str, Any], tuple[int, int]]:
-    """The study's optimum, and its Pareto front by the optimiser's one sweep; each piece saved as it
-    finishes and found again when the run resumes."""
+    """The study's optimum, and its Pareto front by the optimiser's one sweep.
+
+    Each piece is saved as it finishes and found again when the run resumes.
+    """
     from ..errors import SolverFailed, StudyRunFailed
     from ..optimize.pareto import pareto_front, single_optimum
     from .arm_setup import IPOPT_OPTIONS, StudyProblems

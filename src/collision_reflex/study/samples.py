@@ -7,7 +7,7 @@ seed, so a study's numbers depend only on its file.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -16,8 +16,11 @@ from ..errors import InvalidParameter
 from .load import LoadedStudy
 from .schema import ArmStudy, ConfigurationSamples, DirectionSamples
 
+if TYPE_CHECKING:
+    from ..arm import Arm
 
-def direction_samples(loaded: LoadedStudy, arm: Any) -> np.ndarray:
+
+def direction_samples(loaded: LoadedStudy, arm: Arm) -> np.ndarray:
     """The contact directions of an arm study, unit vectors (n, task_dim) in the arm's task coordinates.
 
     ``circle: n`` spreads n directions evenly over the arm's plane (planar arms) or the world x-y plane;
@@ -44,7 +47,7 @@ def direction_samples(loaded: LoadedStudy, arm: Any) -> np.ndarray:
     return np.array(out)
 
 
-def configuration_samples(loaded: LoadedStudy, arm: Any) -> np.ndarray:
+def configuration_samples(loaded: LoadedStudy, arm: Arm) -> np.ndarray:
     """The configurations of an arm study [rad], shape (n, nq).
 
     Random configurations come from ``arm.sample_configurations`` with ``numpy.random.default_rng(seed)``; a
@@ -63,7 +66,7 @@ def configuration_samples(loaded: LoadedStudy, arm: Any) -> np.ndarray:
     return _trajectory(loaded, arm, spec.trajectory.file, spec.trajectory.every)
 
 
-def _trajectory(loaded: LoadedStudy, arm: Any, file: str, every: int) -> np.ndarray:
+def _trajectory(loaded: LoadedStudy, arm: Arm, file: str, every: int) -> np.ndarray:
     import pandas as pd
 
     where = ("samples", "configurations", "trajectory", "file")

@@ -147,8 +147,10 @@ class ActuatorsSpec(_Model):
 
 
 class SensingSpec(_Model):
-    """How contact is detected (MODEL.md §2): a contact-force threshold, a position-error threshold (``F_s = k e``)
-    or a motor-current threshold (joint-side threshold torque ``N tau_s``).
+    """How contact is detected (MODEL.md §2).
+
+    A contact-force threshold, a position-error threshold (``F_s = k e``) or a motor-current threshold
+    (joint-side threshold torque ``N tau_s``).
     """
 
     scheme: Literal["force", "position", "current"]
@@ -181,11 +183,15 @@ class SensingSpec(_Model):
 
 
 class RandomConfigurations(_Model):
+    """Configurations drawn at random within the joint limits."""
+
     count: PositiveInt = Field(description="number of configurations drawn uniformly within joint limits")
     seed: int = Field(0, strict=True, description="seed of the numpy Generator")
 
 
 class TrajectorySpec(_Model):
+    """Configurations read from a trajectory file (joint positions [rad])."""
+
     file: str = Field(description="CSV of joint positions [rad], one row per time step, one column per joint")
     every: PositiveInt = Field(1, description="use every n-th row")
 
@@ -206,8 +212,10 @@ class ConfigurationSamples(_Model):
 
 
 class DirectionSamples(_Model):
-    """Exactly one of ``circle`` (n directions in the plane: the arm's plane, or the world x-y plane), ``sphere``
-    (n directions spread evenly over the sphere), ``named`` or ``list`` (vectors, normalised).
+    """The contact directions: exactly one of ``circle``, ``sphere``, ``named`` or ``list``.
+
+    ``circle``: n directions in the plane (the arm's plane, or the world x-y plane); ``sphere``: n directions
+    spread evenly over the sphere; ``named`` or ``list``: vectors, normalised.
     """
 
     circle: PositiveInt | None = None
@@ -225,6 +233,8 @@ class DirectionSamples(_Model):
 
 
 class SamplesSpec(_Model):
+    """The contact samples: arm configurations crossed with contact directions."""
+
     configurations: ConfigurationSamples
     directions: DirectionSamples
 
@@ -309,8 +319,10 @@ PER_JOINT_DESIGN_VARIABLES = ("stator_diameter", "stack_length", "gear_ratio", "
 
 
 class DesignSpec(_Model):
-    """Design variables the optimiser may change; any not listed keeps the value of its section
-    (``actuators``, ``sensing``, ``approach_velocity``). Per-joint variables take ``joints: {name: {...}}``.
+    """Design variables the optimiser may change.
+
+    Any not listed keeps the value of its section (``actuators``, ``sensing``, ``approach_velocity``).
+    Per-joint variables take ``joints: {name: {...}}``.
     """
 
     stator_diameter: StatorDiameterVariable | None = None  # type: ignore[valid-type]
@@ -326,6 +338,8 @@ class DesignSpec(_Model):
 
 
 class ConstraintsSpec(_Model):
+    """Design constraints: payload [kg], torque safety factor, threshold noise floor [N], torques [N m]."""
+
     payload: Mass = Field(0.0, ge=0, description="mass carried at the contact point [kg]")
     safety_factor: Ratio = Field(1.0, ge=1, description="peak torque >= safety_factor x required torque")
     threshold_floor: Force = Field(0.0, ge=0, description="sensing noise floor [N]")
@@ -335,6 +349,8 @@ class ConstraintsSpec(_Model):
 
 
 class ParetoSpec(_Model):
+    """The Pareto front to trace: two or three objectives, the number of points, the anchors' start points."""
+
     objectives: list[ObjectiveName] = Field(min_length=2, max_length=3)
     points: Annotated[int, Field(ge=2, le=400, strict=True)] = 20
     anchor_starts: Annotated[
@@ -356,11 +372,15 @@ class ParetoSpec(_Model):
 
 
 class OutputsSpec(_Model):
+    """Which files a run writes besides the results: figure formats and the PDF report."""
+
     figures: list[Literal["png", "svg"]] = Field(default_factory=lambda: ["png", "svg"])  # type: ignore[arg-type]
     pdf: bool = Field(False, description="also write report.pdf (needs Chromium)")
 
 
 class ExecutionSpec(_Model):
+    """Where the independent work runs: in-process, a local process pool, or a Dask cluster."""
+
     executor: Literal["serial", "processes", "dask"] = "serial"
     workers: PositiveInt = 2
     scheduler: str | None = Field(None, description="Dask scheduler address, e.g. tcp://host:8786")
@@ -449,6 +469,8 @@ class LoadSpec(_Model):
 
 
 class VelocityRange(_Model):
+    """Approach velocities [m/s]: ``count`` values from ``min`` to ``max``, evenly spaced in log scale."""
+
     min: Velocity = Field(gt=0)
     max: Velocity = Field(gt=0)
     count: Annotated[int, Field(ge=2, le=10000, strict=True)] = 50
@@ -461,8 +483,9 @@ class VelocityRange(_Model):
 
 
 class ActuatorStudy(_Model):
-    """Single-joint actuators compared in a 1D collision at a lever (the paper's direct-drive U8 against the
-    geared A8, for example).
+    """Single-joint actuators compared in a 1D collision at a lever.
+
+    For example the paper's direct-drive U8 against the geared A8.
     """
 
     kind: Literal["actuator"]

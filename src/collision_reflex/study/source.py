@@ -7,7 +7,7 @@ from it. :class:`StudySource` keeps both and maps a field path (keys and list in
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Hashable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -16,7 +16,8 @@ import yaml
 
 from ..errors import StudyFileError, StudyProblem
 
-PathKey = tuple[Any, ...]
+PathKey = tuple[Hashable, ...]
+"""A field path in a study: mapping keys (as YAML constructs them) and list indices."""
 
 
 @dataclass(frozen=True)
@@ -38,18 +39,19 @@ class StudySource:
     positions: dict[PathKey, tuple[int, int]] = field(repr=False)
     duplicate_keys: tuple[PathKey, ...] = ()
 
-    def locate(self, path: Sequence[Any]) -> tuple[int, int]:
+    def locate(self, path: Sequence[Hashable]) -> tuple[int, int]:
         """Line and column of ``path``, or of its nearest ancestor that exists in the file."""
         path = tuple(path)
         while path and path not in self.positions:
             path = path[:-1]
         return self.positions.get(path, (1, 1))
 
-    def resolve_path(self, path: Sequence[Any]) -> PathKey:
-        """``path`` with the components that do not exist in the file dropped (validators insert the names of
-        union branches or wrapper functions into error locations).
+    def resolve_path(self, path: Sequence[Hashable]) -> PathKey:
+        """``path`` with the components that do not exist in the file dropped.
+
+        Validators insert the names of union branches or wrapper functions into error locations.
         """
-        kept: list[Any] = []
+        kept: list[Hashable] = []
         node = self.data
         for key in path:
             if isinstance(node, dict) and key in node:
@@ -64,20 +66,21 @@ class StudySource:
             # else: an internal location component (union branch, validator name); skip it
         return tuple(kept)
 
-    def problem(self, path: Sequence[Any], found: str, expected: str) -> StudyProblem:
+    def problem(self, path: Sequence[Hashable], found: str, expected: str) -> StudyProblem:
         """A :class:`StudyProblem` at ``path`` (a path in the file's data)."""
         line, column = self.locate(path)
         return StudyProblem(self.file, line, column, format_path(path), found, expected)
 
 
-def _looks_internal(key: Any) -> bool:
+def _looks_internal(key: Hashable) -> bool:
     text = str(key)
     return "[" in text or ("-" in text and not text.startswith(("+", "-")))
 
 
-def format_path(path: Sequence[Any]) -> str:
-    """``("actuators", "joints", "j2", "gear_ratio")`` -> ``"actuators.joints.j2.gear_ratio"``; list indices as
-    ``[i]``.
+def format_path(path: Sequence[Hashable]) -> str:
+    """A location path as dotted text, list indices as ``[i]``.
+
+    ``("actuators", "joints", "j2", "gear_ratio")`` -> ``"actuators.joints.j2.gear_ratio"``.
     """
     text = ""
     for key in path:
@@ -89,7 +92,9 @@ def format_path(path: Sequence[Any]) -> str:
 
 
 def read_study_source(path: str | os.PathLike[str]) -> StudySource:
-    """Read a study file. A missing or unreadable file, or YAML that does not parse, raises
+    """Read a study file.
+
+    A missing or unreadable file, or YAML that does not parse, raises
     :class:`~collision_reflex.errors.StudyFileError` with the line.
     """
     name = str(path)
@@ -187,8 +192,9 @@ def _index_children(
 
 
 def _constructed_key(key_node: yaml.Node, raw: Any) -> Any:
-    """The key as the safe loader constructs it (``1`` for ``1``, ``True`` for ``yes``...), so that paths from
-    the data and from the node tree agree.
+    """The key as the safe loader constructs it (``1`` for ``1``, ``True`` for ``yes``...).
+
+    So that paths from the data and from the node tree agree.
     """
     if not isinstance(key_node, yaml.ScalarNode):
         return raw

@@ -1,5 +1,4 @@
-"""A run's output folder: atomic files, a manifest that ties the folder to one study, and finished work kept
-for resuming.
+"""A run's output folder: atomic files, a manifest that ties it to one study, finished work kept for resuming.
 
 Layout::
 
@@ -49,10 +48,12 @@ class RunFolder:
 
     @property
     def points(self) -> Path:
+        """The folder of finished pieces of work."""
         return self.path / "points"
 
     @property
     def figures(self) -> Path:
+        """The folder of the report's figures."""
         return self.path / "figures"
 
     def claim(self, fingerprint: str, resolved_yaml: str, details: dict[str, Any]) -> bool:
@@ -94,9 +95,11 @@ class RunFolder:
             return None  # unreadable: do the work again
 
     def save(self, name: str, record: dict[str, Any]) -> None:
+        """Keep a finished piece of work under ``name`` (atomically)."""
         write_json(self.points / f"{name}.json", record)
 
     def update_manifest(self, **fields: Any) -> None:
+        """Set ``fields`` in the run manifest, keeping the others."""
         manifest = self.path / MANIFEST
         data = read_json(manifest) if manifest.exists() else {}
         data.update(fields)
