@@ -141,13 +141,13 @@ def trapezoidal_motion(
     starts = np.array([start for start, _ in segments] + [np.inf])
     owner = np.searchsorted(starts, t, side="right") - 1
     q[:] = via_points[0]
-    for index, (start, move) in enumerate(segments):
+    for index, (start, segment) in enumerate(segments):
         here = owner == index
-        if move is None:
+        if segment is None:
             q[here] = position
             continue
-        q[here], qd[here], qdd[here] = move.evaluate(t[here] - start)
-        position = move.end
+        q[here], qd[here], qdd[here] = segment.evaluate(t[here] - start)
+        position = segment.end
     q[t >= clock] = position
     qd[t >= clock] = 0.0
     qdd[t >= clock] = 0.0
