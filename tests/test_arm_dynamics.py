@@ -59,9 +59,7 @@ def _closed_form_torques(
     h = length1 * first2 * sin2
     coriolis = np.column_stack([-h * (2 * qd[:, 0] * qd[:, 1] + qd[:, 1] ** 2), h * qd[:, 0] ** 2])
     cos1, cos12 = np.cos(q[:, 0]), np.cos(q[:, 0] + q[:, 1])
-    gravity = GRAVITY * np.column_stack(
-        [(first1 + mass2 * length1) * cos1 + first2 * cos12, first2 * cos12]
-    )
+    gravity = GRAVITY * np.column_stack([(first1 + mass2 * length1) * cos1 + first2 * cos12, first2 * cos12])
     inertial = np.column_stack([m11 * qdd[:, 0] + m12 * qdd[:, 1], m12 * qdd[:, 0] + inertia2 * qdd[:, 1]])
     return inertial + coriolis + gravity
 
@@ -198,7 +196,9 @@ def test_statistics_accept_casadi(two_link_vertical):
     numeric_peak, numeric_rms = (float(v) for v in functions(value))
     exact = torques.demand([0.5, 0.25], [0.0, 0.005])[:, 1]
     assert numeric_peak == pytest.approx(np.max(np.abs(exact)), rel=1e-13)
-    assert numeric_rms == pytest.approx(np.sqrt(backend.quadratic_form(torques.rms_form(1), value)), rel=1e-12)
+    assert numeric_rms == pytest.approx(
+        np.sqrt(backend.quadratic_form(torques.rms_form(1), value)), rel=1e-12
+    )
 
 
 def test_joint_side_torque_is_affine_in_reflected_inertia():

@@ -61,7 +61,7 @@ class TrajectoryError(TraceError):
         return (type(self), (self.source, self.reason, self.line))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Payload:
     """A rigid payload held with its centre of mass at the arm's contact point.
 
@@ -91,7 +91,7 @@ class Payload:
         object.__setattr__(self, "inertia", inertia)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class DutyCycle:
     """Joint motion over one cycle, with the payload carried.
 
@@ -201,7 +201,7 @@ class DutyCycle:
             if bad.size:
                 raise TrajectoryError(
                     source,
-                    f"missing or non-numeric {what} ({values[bad[0], 0]!r}) at sample {int(bad[0])}",
+                    f"missing or non-numeric {what} ({float(values[bad[0], 0])!r}) at sample {int(bad[0])}",
                     line(int(bad[0])),
                 )
         _check_times(t, source, lines)
@@ -369,7 +369,9 @@ def _check_times(t: np.ndarray, source: str, lines: np.ndarray | None = None) ->
     index = int(bad[0]) if bad.size else int(late[0])
     where = int(lines[index]) if lines is not None else None
     if bad.size:
-        raise TrajectoryError(source, f"missing or non-numeric time ({t[index]!r}) at sample {index}", where)
+        raise TrajectoryError(
+            source, f"missing or non-numeric time ({float(t[index])!r}) at sample {index}", where
+        )
     raise TrajectoryError(
         source,
         f"time does not increase at sample {index}: t = {t[index]:.9g} s follows t = {t[index - 1]:.9g} s; "
