@@ -25,7 +25,7 @@ from .. import _backend as backend
 from ..errors import InvalidParameter
 from .duty_cycle import DutyCycle, Payload
 from .joints import joint_array
-from .kinematic_tree import forward_kinematics, joint_kinematics, skew, support_mask
+from .kinematic_tree import forward_kinematics, joint_kinematics, support_mask
 
 
 @dataclass(frozen=True)
@@ -96,8 +96,8 @@ def cycle_torques(arm: Any, cycle: DutyCycle) -> CycleTorques:
 
     One Pinocchio pass per sample: RNEA of the links and the payload, and the joint Jacobians with their time
     derivative, from which the torques of a unit mass at every motor are assembled for all samples at once:
-    ``tau_unit[i] = J_i^T (J_i qdd + dJ_i/dt qd - g)``, ``J_i`` the translational Jacobian of motor ``i``'s
-    point. The rotors are not included (see :func:`joint_side_torque`).
+    ``tau_unit[i] = J_i^T (a_i - g)``, ``J_i`` the translational Jacobian of motor ``i``'s point and
+    ``a_i = J_i qdd + dJ_i/dt qd`` its acceleration. The rotors are not included (see :func:`joint_side_torque`).
 
     Parameters
     ----------
@@ -127,27 +127,29 @@ def cycle_torques(arm: Any, cycle: DutyCycle) -> CycleTorques:
 
     joints = joint_kinematics(model, arm.name)
     supports = [set(model.supports[joint.parent]) for joint in joints]
-    masks = np.array([support_mask(model, joints_above) for joints_above in supports])[None, :, None, :]
+    masks = np.array([support_mask(model, joints_above) for joints_above in supports])  # (motor i, nv)
     _, _, motor_points = forward_kinematics(joints, q)
-    points = skew(np.stack(motor_points, axis=1))  # (n, motor i, 3, 3)
-    # Motor i's point moves with its parent link: v = J_i qd with J_i = lin - [p_i]x ang (world frame).
-    jac = masks * (spatial[:, None, :3] - points @ spatial[:, None, 3:])  # (n, i, 3, nv)
-    velocity = jac @ qd[:, None, :, None]  # (n, i, 3, 1)
-    jac_rate = masks * (
-        spatial_rate[:, None, :3]
-        - points @ spatial_rate[:, None, 3:]
-        - skew(velocity[..., 0]) @ spatial[:, None, 3:]
-    )
-    gravity = np.asarray(model.gravity.linear, dtype=float)
-    acceleration = jac @ qdd[:, None, :, None] + jac_rate @ qd[:, None, :, None]
-    unit = np.swapaxes(jac, -1, -2) @ (acceleration - gravity[:, None])  # (n, i, nv, 1)
+    points = np.stack(motor_points, axis=2)  # (n, 3, motor i), world frame
+    # Motor i moves with its parent link, driven by the joints of masks[i]: the link's spatial velocity and
+    # acceleration (world frame, at the world origin), then its point p_i's velocity v = v_o + w x p and
+    # classical acceleration a = a_o + dw/dt x p + w x v. Stacked matrix products (n, ., motor i) throughout.
+    masked_qd = masks.T * qd[:, :, None]  # (n, nv, i)
+    twist = spatial @ masked_qd
+    accel = spatial @ (masks.T * qdd[:, :, None]) + spatial_rate @ masked_qd
+    omega = twist[:, 3:]
+    velocity = twist[:, :3] + np.cross(omega, points, axis=1)
+    acceleration = accel[:, :3] + np.cross(accel[:, 3:], points, axis=1) + np.cross(omega, velocity, axis=1)
+    force = acceleration - np.asarray(model.gravity.linear, dtype=float)[:, None]  # per kg, (n, 3, i)
+    # tau_unit[i] = J_i^T f with J_i = masks[i] (lin - [p_i]x ang): lin^T f + ang^T (p_i x f).
+    linear, angular = np.swapaxes(spatial[:, :3], 1, 2), np.swapaxes(spatial[:, 3:], 1, 2)
+    unit = masks.T * (linear @ force + angular @ np.cross(points, force, axis=1))  # (n, nv, i)
     return CycleTorques(
         joint_names=tuple(arm.joint_names),
         t=cycle.t,
         qd=qd,
         qdd=qdd,
         structure=structure,
-        per_motor_mass=np.ascontiguousarray(np.moveaxis(unit[..., 0], 1, 0)),
+        per_motor_mass=np.ascontiguousarray(np.transpose(unit, (2, 0, 1))),
     )
 
 
