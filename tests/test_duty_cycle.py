@@ -160,6 +160,14 @@ def test_sampling_too_coarse(tmp_path):
     assert COARSE_TOLERANCE == 0.1
 
 
+def test_error_survives_pickling(tmp_path):
+    import pickle
+
+    error = _failure(tmp_path, _csv(GOOD_T[:3], GOOD_Q[:3]))
+    copy = pickle.loads(pickle.dumps(error))
+    assert str(copy) == str(error) and copy.line == error.line
+
+
 def test_unreadable_and_empty_files(tmp_path):
     with pytest.raises(TrajectoryError, match="cannot read"):
         DutyCycle.from_csv(tmp_path / "absent.csv", NAMES)

@@ -402,6 +402,7 @@ def _check_resolution(
             f"sampling too coarse for the derivatives of joint {names[joint]!r} between samples {sample} and "
             f"{sample + 1} (t = {t[sample]:.9g} s and {t[sample + 1]:.9g} s): a quintic and a cubic spline "
             f"through the samples differ there by {relative[worst]:.0%} of the joint's peak acceleration (at most {COARSE_TOLERANCE:.0%}); "
-            "sample the motion more finely",
+            "sample the motion more finely (or, if the positions are noisy, filter them first: the spline "
+            "interpolates every sample)",
             line(sample + 1),
         )
