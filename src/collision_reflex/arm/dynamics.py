@@ -17,7 +17,7 @@ For the optimiser the demand of joint ``j`` is affine in ``x = [1, m_0, ..., m_{
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -26,6 +26,9 @@ from ..errors import InvalidParameter
 from .duty_cycle import DutyCycle, Payload
 from .joints import joint_array
 from .kinematic_tree import forward_kinematics, joint_kinematics, support_mask
+
+if TYPE_CHECKING:
+    from .robot import Arm
 
 
 @dataclass(frozen=True)
@@ -91,7 +94,7 @@ class CycleTorques:
         return basis.T @ (weights[:, None] * basis)
 
 
-def cycle_torques(arm: Any, cycle: DutyCycle) -> CycleTorques:
+def cycle_torques(arm: Arm, cycle: DutyCycle) -> CycleTorques:
     """Joint torques of an :class:`~collision_reflex.arm.Arm` over a duty cycle.
 
     One Pinocchio pass per sample: RNEA of the links and the payload, and the joint Jacobians with their time
