@@ -1,0 +1,408 @@
+"""The motion an arm must make (:class:`DutyCycle`) and what it carries (:class:`Payload`).
+
+A duty cycle is joint positions, velocities and accelerations over time, with the payload held at the contact
+point. It comes from sampled positions (arrays or a CSV file), whose derivatives are those of an interpolating
+quintic spline, or from via configurations and joint limits (:mod:`collision_reflex.arm.motion_profiles`).
+
+Derivatives of sampled positions: a quintic (``k = 5``) interpolating B-spline, SciPy's
+``make_interp_spline`` with not-a-knot ends. The torques depend on the accelerations, and a quintic's second
+derivative is twice continuously differentiable with an error of order ``h^4`` in the step ``h`` (a cubic
+spline's acceleration is only piecewise linear, with an error of order ``h^2``). The spline interpolates: a
+noisy recording should be filtered before it is given. Samples too coarse for the spline are refused: where
+the accelerations of the quintic and of a cubic spline through the same samples differ, at the midpoints
+between samples, by more than :data:`COARSE_TOLERANCE` of the joint's largest acceleration, the motion between
+samples is not determined by them (for a sine that happens below about 10 samples per period).
+
+CSV layout: optional leading ``#`` comment lines, then a header with a time column (``time`` or ``t``) and one
+column per joint, named by the joint, each with its unit in brackets (``time [s]``, ``shoulder [deg]``,
+``slide [mm]``; a column without one is in s, rad or m), then one row per sample. Other columns are ignored.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import InvalidParameter, TraceError
+from ..experiments.traces import _HEADER as HEADER_PATTERN
+from ..experiments.traces import unit_factor
+from .motion_profiles import trapezoidal_motion
+
+SPLINE_ORDER = 5
+"""Order of the interpolating spline differentiated for velocities and accelerations (quintic)."""
+MIN_SAMPLES = SPLINE_ORDER + 1
+"""Fewest samples an interpolating spline of :data:`SPLINE_ORDER` needs."""
+COARSE_TOLERANCE = 0.1
+"""Largest relative disagreement between the quintic's and a cubic's accelerations between samples."""
+_TIME_NAMES = ("time", "t")
+
+
+class TrajectoryError(TraceError):
+    """A position trajectory (CSV file or arrays) cannot be used as a duty cycle.
+
+    Attributes
+    ----------
+    source: the file (``""`` for arrays).
+    line: the file line (1-based), or ``None`` for arrays (the reason then names the sample) or when the
+        problem is not one line.
+    reason: what is wrong and what to do.
+    """
+
+    def __init__(self, source: str, reason: str, line: int | None = None) -> None:
+        super().__init__(source or "trajectory", "", reason, line)
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (type(self), (self.source, self.reason, self.line))
+
+
+@dataclass(frozen=True, eq=False)
+class Payload:
+    """A rigid payload held with its centre of mass at the arm's contact point.
+
+    Attributes
+    ----------
+    mass: payload mass [kg], > 0.
+    inertia: (3, 3) rotational inertia about its centre of mass, in the axes of the contact frame [kg m^2];
+        symmetric positive semi-definite. Default zero (a point mass).
+    """
+
+    mass: float
+    inertia: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
+
+    def __post_init__(self) -> None:
+        mass = float(self.mass)
+        if not (np.isfinite(mass) and mass > 0):
+            raise InvalidParameter("mass", self.mass, "a finite payload mass > 0 [kg]")
+        inertia = np.asarray(self.inertia, dtype=float)
+        if inertia.shape != (3, 3) or not np.all(np.isfinite(inertia)):
+            raise InvalidParameter("inertia", self.inertia, "a finite 3x3 matrix [kg m^2]")
+        scale = max(float(np.max(np.abs(inertia))), 1e-300)
+        if not np.allclose(inertia, inertia.T, rtol=0, atol=1e-12 * scale):
+            raise InvalidParameter("inertia", inertia.tolist(), "a symmetric matrix [kg m^2]")
+        if np.min(np.linalg.eigvalsh(inertia)) < -1e-12 * scale:
+            raise InvalidParameter("inertia", inertia.tolist(), "a positive semi-definite matrix [kg m^2]")
+        object.__setattr__(self, "mass", mass)
+        object.__setattr__(self, "inertia", inertia)
+
+
+@dataclass(frozen=True, eq=False)
+class DutyCycle:
+    """Joint motion over one cycle, with the payload carried.
+
+    Attributes
+    ----------
+    joint_names: one name per joint, in the column order of the arrays.
+    t: (n,) strictly increasing sample times [s].
+    q: (n, nv) joint positions [rad or m].
+    qd: (n, nv) joint velocities [rad/s or m/s].
+    qdd: (n, nv) joint accelerations [rad/s^2 or m/s^2].
+    payload: what the arm holds at its contact point, or None.
+    """
+
+    joint_names: tuple[str, ...]
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    payload: Payload | None = None
+
+    def __post_init__(self) -> None:
+        names = tuple(str(name) for name in self.joint_names)
+        if not names or len(set(names)) != len(names):
+            raise InvalidParameter("joint_names", self.joint_names, "distinct joint names, at least one")
+        object.__setattr__(self, "joint_names", names)
+        t = np.asarray(self.t, dtype=float)
+        if t.ndim != 1 or t.size < 2:
+            raise InvalidParameter("t", t.shape, "a 1-D array of at least 2 times [s]")
+        _check_times(t, "")
+        object.__setattr__(self, "t", t)
+        for name in ("q", "qd", "qdd"):
+            values = np.asarray(getattr(self, name), dtype=float)
+            if values.shape != (t.size, len(names)):
+                raise InvalidParameter(name, values.shape, f"an array of shape ({t.size}, {len(names)})")
+            bad = np.flatnonzero(~np.all(np.isfinite(values), axis=1))
+            if bad.size:
+                raise InvalidParameter(name, values, "finite values", f"sample {int(bad[0])} is not")
+            object.__setattr__(self, name, values)
+        if self.payload is not None and not isinstance(self.payload, Payload):
+            raise InvalidParameter("payload", self.payload, "a Payload or None")
+
+    @property
+    def duration(self) -> float:
+        """Length of the cycle [s]."""
+        return float(self.t[-1] - self.t[0])
+
+    def columns(self, joint_names: Sequence[str]) -> np.ndarray:
+        """Indices of ``joint_names`` (e.g. an arm's joints, in its order) among this cycle's joints."""
+        missing = [name for name in joint_names if name not in self.joint_names]
+        if missing:
+            raise InvalidParameter(
+                "joint_names",
+                missing,
+                "joints of the duty cycle: " + ", ".join(self.joint_names),
+                "the duty cycle must give every joint of the arm",
+            )
+        return np.array([self.joint_names.index(name) for name in joint_names], dtype=int)
+
+    # ------------------------------------------------------------------ constructors
+    @classmethod
+    def from_positions(
+        cls,
+        t: Any,
+        q: Any,
+        joint_names: Sequence[str],
+        payload: Payload | None = None,
+        *,
+        source: str = "",
+        lines: np.ndarray | None = None,
+    ) -> DutyCycle:
+        """A duty cycle from sampled positions; velocities and accelerations of a quintic spline through them.
+
+        Parameters
+        ----------
+        t: (n,) strictly increasing times [s], n >= :data:`MIN_SAMPLES`.
+        q: (n, nv) joint positions [rad or m].
+        joint_names: the joints of the columns of ``q``.
+        payload: the payload carried, if any.
+        source, lines: the file and the file line of each sample, for error messages.
+
+        Raises
+        ------
+        TrajectoryError: NaN, non-increasing times, too few samples, or samples too coarse for the spline;
+            located at the file line (or sample index).
+        """
+        from scipy.interpolate import make_interp_spline
+
+        t = np.asarray(t, dtype=float)
+        q = np.asarray(q, dtype=float)
+        names = tuple(joint_names)
+        if t.ndim != 1 or q.shape != (t.size, len(names)):
+            raise InvalidParameter(
+                "q", q.shape, f"an array of shape ({t.size}, {len(names)}) for t {t.shape}"
+            )
+
+        def line(index: int) -> int | None:
+            return int(lines[index]) if lines is not None else None
+
+        if t.size < MIN_SAMPLES:
+            raise TrajectoryError(
+                source,
+                f"too few samples for the derivatives: {t.size}, need at least {MIN_SAMPLES} "
+                f"(an interpolating spline of order {SPLINE_ORDER})",
+            )
+        for what, values in (("time", t[:, None]), *((name, q[:, [j]]) for j, name in enumerate(names))):
+            bad = np.flatnonzero(~np.isfinite(values[:, 0]))
+            if bad.size:
+                raise TrajectoryError(
+                    source,
+                    f"missing or non-numeric {what} ({float(values[bad[0], 0])!r}) at sample {int(bad[0])}",
+                    line(int(bad[0])),
+                )
+        _check_times(t, source, lines)
+        quintic = make_interp_spline(t, q, k=SPLINE_ORDER)
+        velocity, acceleration = quintic.derivative(1), quintic.derivative(2)
+        _check_resolution(t, q, acceleration, names, source, line)
+        return cls(names, t, q, velocity(t), acceleration(t), payload)
+
+    @classmethod
+    def from_csv(
+        cls,
+        path: str | os.PathLike[str],
+        joint_names: Sequence[str],
+        payload: Payload | None = None,
+        *,
+        prismatic: Sequence[str] = (),
+    ) -> DutyCycle:
+        """Read a trajectory file (layout in the module docstring) and differentiate it.
+
+        Parameters
+        ----------
+        path: the CSV file.
+        joint_names: the joints to read, each a column of the file.
+        payload: the payload carried, if any.
+        prismatic: the joints among ``joint_names`` whose positions are lengths (default m); the others are
+            angles (default rad).
+
+        Raises
+        ------
+        TrajectoryError: the file cannot be read, a joint or the time column is missing, a unit is not of the
+            column's kind, a value is NaN, the times do not increase, there are too few samples or they are too
+            coarse; located at the file line.
+        """
+        source = str(path)
+        header_line, table = _read_table(path)
+        columns = {HEADER_PATTERN.match(str(c)).group("name"): str(c) for c in table.columns}  # type: ignore[union-attr]
+        lowered = {name.lower(): column for name, column in columns.items()}
+        time_column = next((lowered[n] for n in _TIME_NAMES if n in lowered), None)
+        if time_column is None:
+            raise TrajectoryError(
+                source, f"no time column among {list(columns.values())}; name one 'time [s]'", header_line
+            )
+        missing = [name for name in joint_names if name not in columns]
+        if missing:
+            raise TrajectoryError(
+                source,
+                f"no column for joint(s) {', '.join(missing)}; the header names {list(columns.values())}, "
+                "and needs one column per joint: " + ", ".join(joint_names),
+                header_line,
+            )
+        import pandas as pd
+
+        def numbers(column: str, default_unit: str, what: str) -> np.ndarray:
+            match = HEADER_PATTERN.match(column)
+            unit = (match.group("unit") if match else None) or default_unit
+            try:
+                scale = unit_factor(unit, default_unit, what, source)
+            except TraceError as error:
+                raise TrajectoryError(source, error.reason, header_line) from None
+            return pd.to_numeric(table[column], errors="coerce").to_numpy(dtype=float) * scale
+
+        t = numbers(time_column, "s", "time")
+        q = np.column_stack(
+            [
+                numbers(columns[name], "m" if name in prismatic else "rad", f"joint {name!r}")
+                for name in joint_names
+            ]
+        )
+        lines = np.arange(t.size) + header_line + 1
+        return cls.from_positions(t, q, joint_names, payload, source=source, lines=lines)
+
+    @classmethod
+    def through_via_points(
+        cls,
+        via_points: Any,
+        joint_names: Sequence[str],
+        max_velocity: Any,
+        max_acceleration: Any,
+        *,
+        rate: float = 1000.0,
+        dwell: Any = 0.0,
+        payload: Payload | None = None,
+    ) -> DutyCycle:
+        """A motion through via configurations: synchronised trapezoids (see :mod:`.motion_profiles`).
+
+        Parameters
+        ----------
+        via_points: (k, nv) joint configurations to pass through, at rest at each [rad or m], k >= 2.
+        joint_names: the joints of the columns.
+        max_velocity: joint speed limits [rad/s or m/s], scalar or (nv,), > 0.
+        max_acceleration: joint acceleration limits [rad/s^2 or m/s^2], scalar or (nv,), > 0.
+        rate: sampling rate [Hz], > 0; the phase switching times are sampled as well.
+        dwell: time at rest at each via point [s], scalar or (k,), >= 0 (the first before moving, the last
+            after arriving).
+        payload: the payload carried, if any.
+
+        Returns
+        -------
+        The cycle, with analytic velocities and accelerations; it starts and ends at rest.
+        """
+        names = tuple(joint_names)
+        points = np.asarray(via_points, dtype=float)
+        if points.ndim != 2 or points.shape[0] < 2 or points.shape[1] != len(names):
+            raise InvalidParameter(
+                "via_points", points.shape, f"an array of shape (k >= 2, {len(names)}) [rad or m]"
+            )
+        if not np.all(np.isfinite(points)):
+            raise InvalidParameter("via_points", points, "finite joint positions [rad or m]")
+        limits = {}
+        for name, value in (("max_velocity", max_velocity), ("max_acceleration", max_acceleration)):
+            array = np.broadcast_to(np.asarray(value, dtype=float), (len(names),)).copy()
+            if not np.all(np.isfinite(array) & (array > 0)):
+                raise InvalidParameter(name, value, "finite limits > 0, one per joint or one for all")
+            limits[name] = array
+        rate = float(rate)
+        if not (np.isfinite(rate) and rate > 0):
+            raise InvalidParameter("rate", rate, "a finite sampling rate > 0 [Hz]")
+        rest = np.broadcast_to(np.asarray(dwell, dtype=float), (points.shape[0],)).copy()
+        if not np.all(np.isfinite(rest) & (rest >= 0)):
+            raise InvalidParameter("dwell", dwell, "finite times >= 0 [s], one per via point or one for all")
+        t, q, qd, qdd = trapezoidal_motion(
+            points, limits["max_velocity"], limits["max_acceleration"], rate, rest
+        )
+        return cls(names, t, q, qd, qdd, payload)
+
+
+def _read_table(path: str | os.PathLike[str]) -> tuple[int, Any]:
+    """The header's file line (1-based) and the table of strings below it."""
+    import pandas as pd
+
+    source = str(path)
+    try:
+        text = Path(path).read_text()
+    except (OSError, UnicodeDecodeError) as error:
+        raise TrajectoryError(source, f"cannot read the file ({error})") from None
+    lines = text.splitlines()
+    header = 0
+    while header < len(lines) and (lines[header].startswith("#") or not lines[header].strip()):
+        header += 1
+    if header >= len(lines):
+        raise TrajectoryError(source, "no header line and no samples")
+    try:
+        table = pd.read_csv(
+            io.StringIO("\n".join(lines[header:])),
+            skip_blank_lines=False,
+            dtype=str,
+            keep_default_na=False,
+            skipinitialspace=True,
+        )
+    except (pd.errors.ParserError, pd.errors.EmptyDataError) as error:
+        raise TrajectoryError(source, f"not a CSV table ({error})".replace("\n", " "), header + 1) from None
+    # Trailing blank lines end the file; blank lines inside the data are reported as missing values.
+    blank = (table == "").all(axis=1).to_numpy()
+    last = len(blank) - int(np.argmin(blank[::-1])) if not blank.all() else 0
+    return header + 1, table.iloc[:last]
+
+
+def _check_times(t: np.ndarray, source: str, lines: np.ndarray | None = None) -> None:
+    """Refuse NaN and non-increasing (or repeated) times, at the offending sample."""
+    bad = np.flatnonzero(~np.isfinite(t))
+    steps = np.diff(t)
+    late = np.flatnonzero(steps <= 0) + 1
+    if not bad.size and not late.size:
+        return
+    index = int(bad[0]) if bad.size else int(late[0])
+    where = int(lines[index]) if lines is not None else None
+    if bad.size:
+        raise TrajectoryError(
+            source, f"missing or non-numeric time ({float(t[index])!r}) at sample {index}", where
+        )
+    raise TrajectoryError(
+        source,
+        f"time does not increase at sample {index}: t = {t[index]:.9g} s follows t = {t[index - 1]:.9g} s; "
+        "samples must be in strictly increasing time order, each time once",
+        where,
+    )
+
+
+def _check_resolution(
+    t: np.ndarray, q: np.ndarray, acceleration: Any, names: tuple[str, ...], source: str, line: Any
+) -> None:
+    """Refuse samples too coarse for the spline (criterion in the module docstring)."""
+    from scipy.interpolate import make_interp_spline
+
+    midpoints = 0.5 * (t[1:] + t[:-1])
+    quintic = acceleration(midpoints)
+    cubic = make_interp_spline(t, q, k=3).derivative(2)(midpoints)
+    scale = np.max(np.abs(acceleration(t)), axis=0)
+    disagreement = np.abs(quintic - cubic)
+    moving = scale > 0
+    relative = np.zeros_like(disagreement)
+    relative[:, moving] = disagreement[:, moving] / scale[moving]
+    worst = np.unravel_index(int(np.argmax(relative)), relative.shape)
+    if relative[worst] > COARSE_TOLERANCE:
+        sample, joint = int(worst[0]), int(worst[1])
+        raise TrajectoryError(
+            source,
+            f"sampling too coarse for the derivatives of joint {names[joint]!r} between samples {sample} and "
+            f"{sample + 1} (t = {t[sample]:.9g} s and {t[sample + 1]:.9g} s): a quintic and a cubic spline "
+            f"through the samples differ there by {relative[worst]:.0%} of the joint's peak acceleration (at most {COARSE_TOLERANCE:.0%}); "
+            "sample the motion more finely (or, if the positions are noisy, filter them first: the spline "
+            "interpolates every sample)",
+            line(sample + 1),
+        )
