@@ -31,12 +31,15 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn
 
 import numpy as np
 
 from .._io import atomic_open
 from ..errors import TraceError
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 MIN_SAMPLES = 20
 """Fewest samples a trace may have: enough for a noise floor and a contact of a few samples."""
@@ -201,48 +204,18 @@ def read_traces(
     ------
     TraceError: the file cannot be read, or has no time or force column.
     """
-    import pandas as pd
-
     source = str(path)
     try:
-        text = Path(path).read_text()
+        lines = Path(path).read_text().splitlines()
     except (OSError, UnicodeDecodeError) as error:
         raise TraceError(source, "", f"cannot read the file ({error})") from None
-    lines = text.splitlines()
-    metadata: dict[str, str] = {}
-    header_line = 0
-    while header_line < len(lines) and (lines[header_line].startswith("#") or not lines[header_line].strip()):
-        key, sep, value = lines[header_line].lstrip("#").partition(":")
-        if sep:
-            metadata[_normalise(key)] = value.strip()
-        header_line += 1
+    metadata, header_line = _leading_metadata(lines)
     if header_line >= len(lines):
         raise TraceError(source, "", "no header line and no samples")
-    try:
-        table = pd.read_csv(
-            io.StringIO("\n".join(lines[header_line:])),
-            skip_blank_lines=False,
-            dtype=str,
-            keep_default_na=False,
-            skipinitialspace=True,
-        )
-    except (pd.errors.ParserError, pd.errors.EmptyDataError) as error:
-        raise TraceError(
-            source, "", f"not a CSV table ({error})".replace("\n", " "), header_line + 1
-        ) from None
-    # Drop trailing blank lines, keep blank lines inside the data (they are reported as missing values).
-    blank = (table == "").all(axis=1).to_numpy()
-    last = len(blank) - int(np.argmin(blank[::-1])) if not blank.all() else 0
-    table = table.iloc[:last]
+    table = _read_table(lines, header_line, source)
     file_lines = np.arange(len(table)) + header_line + 2  # header is line header_line + 1
-
     columns = {_HEADER.match(str(c)).group("name").lower(): str(c) for c in table.columns}  # type: ignore[union-attr]
-    time_column = _find(columns, _TIME_NAMES, "time", source)
-    force_column = _find(columns, _FORCE_NAMES, "force", source)
-    time_scale = _column_factor(time_column, time_unit, "time", source)
-    force_scale = _column_factor(force_column, force_unit, "force", source)
-    time = pd.to_numeric(table[time_column], errors="coerce").to_numpy(dtype=float) * time_scale
-    force = pd.to_numeric(table[force_column], errors="coerce").to_numpy(dtype=float) * force_scale
+    time, force = _samples(table, columns, time_unit, force_unit, source)
 
     default_system = system if system is not None else Path(path).resolve().parent.name
     file_meta = {
@@ -270,21 +243,7 @@ def read_traces(
     traces = []
     for name in dict.fromkeys(trial_names):  # file order, each once
         rows = np.flatnonzero(trial_names == name)
-        meta = dict(file_meta)
-        for key, unit in _META_COLUMNS.items():
-            if key not in columns:
-                continue
-            values = table[columns[key]].to_numpy(dtype=str)[rows]
-            if np.any(values != values[0]):
-                raise TraceError(
-                    source, name, f"the {key!r} column changes within the trial", int(file_lines[rows[0]])
-                )
-            target = "k_m" if key == "sensor stiffness" else key
-            if unit is None:
-                meta[target] = values[0]
-            else:
-                scale = _column_factor(columns[key], unit, key, source)
-                meta[target] = to_si(values[0], unit, key, source, int(file_lines[rows[0]])) * scale
+        meta = {**file_meta, **_trial_columns(table, columns, rows, file_lines, str(name), source)}
         traces.append(
             Trace(
                 time[rows],
@@ -297,6 +256,82 @@ def read_traces(
             )
         )
     return traces
+
+
+def _leading_metadata(lines: list[str]) -> tuple[dict[str, str], int]:
+    """The ``# key: value`` metadata before the header, and the header's index in ``lines``."""
+    metadata: dict[str, str] = {}
+    header_line = 0
+    while header_line < len(lines) and (lines[header_line].startswith("#") or not lines[header_line].strip()):
+        key, sep, value = lines[header_line].lstrip("#").partition(":")
+        if sep:
+            metadata[_normalise(key)] = value.strip()
+        header_line += 1
+    return metadata, header_line
+
+
+def _read_table(lines: list[str], header_line: int, source: str) -> pd.DataFrame:
+    """The CSV table from the header on, as text, without trailing blank lines."""
+    import pandas as pd
+
+    try:
+        table = pd.read_csv(
+            io.StringIO("\n".join(lines[header_line:])),
+            skip_blank_lines=False,
+            dtype=str,
+            keep_default_na=False,
+            skipinitialspace=True,
+        )
+    except (pd.errors.ParserError, pd.errors.EmptyDataError) as error:
+        raise TraceError(
+            source, "", f"not a CSV table ({error})".replace("\n", " "), header_line + 1
+        ) from None
+    # Drop trailing blank lines, keep blank lines inside the data (they are reported as missing values).
+    blank = (table == "").all(axis=1).to_numpy()
+    last = len(blank) - int(np.argmin(blank[::-1])) if not blank.all() else 0
+    return table.iloc[:last]
+
+
+def _samples(
+    table: pd.DataFrame, columns: Mapping[str, str], time_unit: str, force_unit: str, source: str
+) -> tuple[np.ndarray, np.ndarray]:
+    """Time [s] and force [N] columns in SI; a non-numeric cell becomes NaN (reported by the check)."""
+    import pandas as pd
+
+    time_column = _find(columns, _TIME_NAMES, "time", source)
+    force_column = _find(columns, _FORCE_NAMES, "force", source)
+    time_scale = _column_factor(time_column, time_unit, "time", source)
+    force_scale = _column_factor(force_column, force_unit, "force", source)
+    time = pd.to_numeric(table[time_column], errors="coerce").to_numpy(dtype=float) * time_scale
+    force = pd.to_numeric(table[force_column], errors="coerce").to_numpy(dtype=float) * force_scale
+    return time, force
+
+
+def _trial_columns(
+    table: pd.DataFrame,
+    columns: Mapping[str, str],
+    rows: np.ndarray,
+    file_lines: np.ndarray,
+    name: str,
+    source: str,
+) -> dict[str, Any]:
+    """One trial's metadata from the per-trial columns (``velocity``, ``system``, ``sensor stiffness``)."""
+    meta: dict[str, Any] = {}
+    for key, unit in _META_COLUMNS.items():
+        if key not in columns:
+            continue
+        values = table[columns[key]].to_numpy(dtype=str)[rows]
+        if np.any(values != values[0]):
+            raise TraceError(
+                source, name, f"the {key!r} column changes within the trial", int(file_lines[rows[0]])
+            )
+        target = "k_m" if key == "sensor stiffness" else key
+        if unit is None:
+            meta[target] = values[0]
+        else:
+            scale = _column_factor(columns[key], unit, key, source)
+            meta[target] = to_si(values[0], unit, key, source, int(file_lines[rows[0]])) * scale
+    return meta
 
 
 def write_trace(path: str | os.PathLike[str], trace: Trace, time_unit: str = "ms", digits: int = 6) -> Path:
