@@ -8,7 +8,7 @@ give (the paper's section "Collision Reflex in Higher Dimensions", ``eq:eff_mf``
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -108,11 +108,9 @@ def effective_parameters(
     """
     _validate.choice("stiffness_form", stiffness_form, STIFFNESS_FORMS)
     nv, task_dim = samples.nv, samples.task_dim
-    inertia = joint_array("reflected_inertia", reflected_inertia, nv)
-    joint_k = joint_array("stiffness", stiffness, nv, allow_inf=True)
-    joint_km = joint_array("mechanical_stiffness", mechanical_stiffness, nv, allow_inf=True)
-    tau_max = joint_array("torque_limit", torque_limit, nv, allow_inf=True)
-    tau_s = None if joint_threshold is None else joint_array("joint_threshold", joint_threshold, nv)
+    inertia, joint_k, joint_km, tau_max, tau_s = _joint_arrays(
+        nv, reflected_inertia, stiffness, mechanical_stiffness, torque_limit, joint_threshold
+    )
     if not (np.isfinite(singular_tolerance) and 0 < singular_tolerance < 1):
         raise InvalidParameter("singular_tolerance", singular_tolerance, "a number in (0, 1)")
     units = normalised_directions(directions, task_dim)
@@ -126,20 +124,7 @@ def effective_parameters(
         )
 
     jac = samples.jacobian
-    structure = samples.structure_mass_matrix(motor_mass)
-    if finger_joint_inertia is not None:
-        finger = joint_array("finger_joint_inertia", finger_joint_inertia, nv, allow_zero=True)
-        structure = np.asarray(formulas.finger_mass_matrix(structure, joint_finger_inertia=finger))
-    # Task-space inverse inertias and compliances, once per configuration: G = J X^-1 J^T, stacked as
-    # (structure, actuators, stiffness, mechanical stiffness); the quantities along u are 1 / (u^T G u).
-    task = np.stack(
-        [
-            task_inverse_inertia(structure, jac),
-            formulas.task_compliance(jac, inertia),
-            formulas.task_compliance(jac, joint_k),
-            formulas.task_compliance(jac, joint_km),
-        ]
-    )  # (4, n, task_dim, task_dim)
+    task = _task_matrices(samples, inertia, joint_k, joint_km, motor_mass, finger_joint_inertia)
     forms = _quadratic_forms(task, units, pair_index)
     scale = np.trace(task[0], axis1=1, axis2=2)
     scale_s = scale[:, None] if pair_index is None else scale[pair_index]
@@ -163,17 +148,75 @@ def effective_parameters(
         if tau_s is not None:
             joint_force = _reaction_compliance(jac, tau_s, units, pair_index)
             np.reciprocal(joint_force, out=joint_force)
+    return _with_limits(EffectiveParameters(m_f, m_r, k, k_m, F_a, a, singular, joint_force), task_stiffness)
+
+
+def _joint_arrays(
+    nv: int,
+    reflected_inertia: Any,
+    stiffness: Any,
+    mechanical_stiffness: Any,
+    torque_limit: Any,
+    joint_threshold: Any,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
+    """The per-joint arguments of :func:`effective_parameters` as validated (nv,) arrays (threshold optional)."""
+    return (
+        joint_array("reflected_inertia", reflected_inertia, nv),
+        joint_array("stiffness", stiffness, nv, allow_inf=True),
+        joint_array("mechanical_stiffness", mechanical_stiffness, nv, allow_inf=True),
+        joint_array("torque_limit", torque_limit, nv, allow_inf=True),
+        None if joint_threshold is None else joint_array("joint_threshold", joint_threshold, nv),
+    )
+
+
+def _task_matrices(
+    samples: ArmSamples,
+    inertia: np.ndarray,
+    joint_k: np.ndarray,
+    joint_km: np.ndarray,
+    motor_mass: Any,
+    finger_joint_inertia: Any,
+) -> np.ndarray:
+    """Task-space inverse inertias and compliances ``G = J X^-1 J^T``, once per configuration.
+
+    Stacked as (structure, actuators, stiffness, mechanical stiffness), shape (4, n, task_dim, task_dim); the
+    quantities along ``u`` are ``1 / (u^T G u)``. ``inertia`` [kg m^2] and the stiffnesses [N m/rad] are per
+    joint; ``motor_mass`` [kg] and ``finger_joint_inertia`` [kg m^2] as in :func:`effective_parameters`.
+    """
+    jac = samples.jacobian
+    structure = samples.structure_mass_matrix(motor_mass)
+    if finger_joint_inertia is not None:
+        finger = joint_array("finger_joint_inertia", finger_joint_inertia, samples.nv, allow_zero=True)
+        structure = np.asarray(formulas.finger_mass_matrix(structure, joint_finger_inertia=finger))
+    return np.stack(
+        [
+            task_inverse_inertia(structure, jac),
+            formulas.task_compliance(jac, inertia),
+            formulas.task_compliance(jac, joint_k),
+            formulas.task_compliance(jac, joint_km),
+        ]
+    )
+
+
+def _with_limits(params: EffectiveParameters, task_stiffness: Any) -> EffectiveParameters:
+    """``params`` with their limits along singular directions, and a task-space spring [N/m] in series with ``k``.
+
+    Singular directions get ``inf`` masses, stiffnesses and forces and ``a = 0`` (in place: the arrays are
+    fresh); ``task_stiffness`` (None for none) adds its compliance to ``k`` off the singular directions.
+    """
+    singular = params.singular
     if np.any(singular):
-        for value in (m_f, m_r, k, k_m, F_a, joint_force):
+        for value in (params.m_f, params.m_r, params.k, params.k_m, params.F_a, params.joint_threshold_force):
             if value is not None:
                 value[singular] = np.inf
-        a[singular] = 0.0
-    if task_stiffness is not None:
-        from ..model.impulse import series_stiffness
+        params.a[singular] = 0.0
+    if task_stiffness is None:
+        return params
+    from ..model.impulse import series_stiffness
 
-        _validate.positive("task_stiffness", task_stiffness)
-        k = np.where(singular, np.inf, series_stiffness(k, task_stiffness))
-    return EffectiveParameters(m_f, m_r, k, k_m, F_a, a, singular, joint_force)
+    _validate.positive("task_stiffness", task_stiffness)
+    k = np.where(singular, np.inf, series_stiffness(params.k, task_stiffness))
+    return replace(params, k=k)
 
 
 # ---------------------------------------------------------------------- impulses
