@@ -289,7 +289,7 @@ def _print_summary(arm: Arm, surface: ReflexSurface) -> None:
     smallest, largest = surface.extremes()
     print(
         f"{arm!r}: {surface.directions.shape[0]} directions, v0 = {surface.v0:g} m/s, "
-        f"gear ratios {np.round([a.gear_ratio for a in arm.actuators], 2).tolist()}"
+        f"gear ratios {np.round([a.gear_ratio for a in arm.actuators or ()], 2).tolist()}"
     )
     print(f"smallest impulse {impulse.min():.4g} N*s along {np.round(smallest, 3).tolist()}")
     if np.all(finite):

@@ -252,7 +252,7 @@ def read_traces(
                 source=source,
                 lines=file_lines[rows],
                 metadata=others,
-                **meta,  # type: ignore[arg-type]
+                **meta,
             )
         )
     return traces
