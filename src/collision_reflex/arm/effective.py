@@ -1,5 +1,6 @@
-"""Effective 1D collision parameters of an arm along many directions at once, and the collision impulses they
-give (the paper's section "Collision Reflex in Higher Dimensions", ``eq:eff_mf`` to ``eq:eff_a``; MODEL.md §3).
+"""Effective 1D collision parameters of an arm along many directions at once, and their collision impulses.
+
+The paper's section "Collision Reflex in Higher Dimensions", ``eq:eff_mf`` to ``eq:eff_a``; MODEL.md §3.
 
 :func:`effective_parameters` maps :class:`ArmSamples` and unit directions ``u`` to ``m_f``, ``m_r``, ``k``,
 ``k_m``, ``F_a`` and ``a``; :func:`collision_impulses` applies the 1D model of
@@ -29,8 +30,9 @@ STIFFNESS_FORMS: tuple[str, ...] = ("compliance", "paper")
 
 @dataclass(frozen=True)
 class EffectiveParameters:
-    """The 1D collision parameters along each direction, arrays of one shape: (n_configurations,
-    n_directions) for a grid, (n_samples,) for paired samples.
+    """The 1D collision parameters along each direction, arrays of one shape.
+
+    The shape is (n_configurations, n_directions) for a grid, (n_samples,) for paired samples.
 
     m_f: effective finger (structure) mass ``1 / (u^T J M_bb^-1 J^T u)`` (``eq:eff_mf``) [kg].
     m_r: effective robot (actuator) mass ``1 / (u^T J M_jj^-1 J^T u)`` [kg].
@@ -55,6 +57,7 @@ class EffectiveParameters:
 
     @property
     def shape(self) -> tuple[int, ...]:
+        """The arrays' shape: (n_configurations, n_directions) or (n_samples,)."""
         return tuple(self.m_f.shape)
 
 
@@ -159,7 +162,7 @@ def _joint_arrays(
     torque_limit: Any,
     joint_threshold: Any,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
-    """The per-joint arguments of :func:`effective_parameters` as validated (nv,) arrays (threshold optional)."""
+    """Validated (nv,) arrays of the per-joint arguments of :func:`effective_parameters`; threshold may be None."""
     return (
         joint_array("reflected_inertia", reflected_inertia, nv),
         joint_array("stiffness", stiffness, nv, allow_inf=True),
@@ -199,7 +202,7 @@ def _task_matrices(
 
 
 def _with_limits(params: EffectiveParameters, task_stiffness: Any) -> EffectiveParameters:
-    """``params`` with their limits along singular directions, and a task-space spring [N/m] in series with ``k``.
+    """``params`` with their singular limits, and a task-space spring [N/m] in series with ``k``.
 
     Singular directions get ``inf`` masses, stiffnesses and forces and ``a = 0`` (in place: the arrays are
     fresh); ``task_stiffness`` (None for none) adds its compliance to ``k`` off the singular directions.
@@ -283,8 +286,10 @@ def collision_impulses(
     any_singular = bool(np.any(singular))
 
     def stand_in(value: Any) -> Any:
-        """Finite stand-ins along singular directions (their results are replaced below), so that the 1D
-        model sees only valid numbers; scalars pass as they are."""
+        """Finite stand-ins along singular directions (their results are replaced below).
+
+        So the 1D model sees only valid numbers; scalars pass as they are.
+        """
         value = np.asarray(value, dtype=float)
         return np.where(singular, 1.0, value) if any_singular and value.ndim else value
 
@@ -319,8 +324,10 @@ def _checked_index(config_index: Any, units: np.ndarray, count: int) -> np.ndarr
 
 
 def _quadratic_forms(task: np.ndarray, units: np.ndarray, index: np.ndarray | None) -> np.ndarray:
-    """``u^T G u`` of stacked task matrices ``task`` (q, n, m, m) for the grid of every configuration with every
-    direction (q, n, d), or for paired samples (q, n_samples)."""
+    """``u^T G u`` of stacked task matrices ``task`` (q, n, m, m).
+
+    For the grid of every configuration with every direction (q, n, d), or for paired samples (q, n_samples).
+    """
     if index is not None:
         return np.einsum("sa,qsab,sb->qs", units, task[:, index], units)
     # Every G with every u in one product: (q n, m^2) x (m^2, d).
@@ -332,8 +339,10 @@ def _quadratic_forms(task: np.ndarray, units: np.ndarray, index: np.ndarray | No
 def _reaction_compliance(
     jac: np.ndarray, torque: np.ndarray, units: np.ndarray, index: np.ndarray | None
 ) -> np.ndarray:
-    """``max_i |(J^T u)_i| / torque_i`` [1/N] (:func:`collision_reflex.model.effective.reaction_compliance`) for
-    the grid (n, d) or for paired samples (n_samples,)."""
+    """``max_i |(J^T u)_i| / torque_i`` [1/N], for the grid (n, d) or for paired samples (n_samples,).
+
+    As :func:`collision_reflex.model.effective.reaction_compliance`.
+    """
     # The torque fractions are linear in J^T u: scale the Jacobian's joint columns once, not every moment.
     scaled = formulas.torque_fractions(jac, torque)
     if index is not None:
@@ -352,8 +361,11 @@ def _reaction_compliance(
 def _paper_stiffness(
     jac: np.ndarray, joint_k: np.ndarray, units: np.ndarray, index: np.ndarray | None
 ) -> np.ndarray:
-    """``u^T J^-T K J^-1 u`` (``eq:eff_k``) for square Jacobians, through the SVD so that a singular Jacobian
-    gives ``inf`` along its singular direction and the finite limit perpendicular to it."""
+    """``u^T J^-T K J^-1 u`` (``eq:eff_k``) for square Jacobians [N/m].
+
+    Through the SVD, so that a singular Jacobian gives ``inf`` along its singular direction and the finite
+    limit perpendicular to it.
+    """
     if not np.all(np.isfinite(joint_k)):
         raise InvalidParameter("stiffness", joint_k, "finite joint stiffnesses for stiffness_form='paper'")
     left, sigma, right_t = np.linalg.svd(jac)

@@ -29,8 +29,9 @@ from .samples import ArmSamples, task_inverse_inertia
 
 @dataclass(frozen=True)
 class Ellipsoid:
-    """Stacked ellipsoids ``{x : x^T A^-1 x <= 1}`` given by symmetric positive semi-definite matrices ``A``
-    (n, m, m); the semi-axes are the square roots of the eigenvalues of ``A``.
+    """Stacked ellipsoids ``{x : x^T A^-1 x <= 1}`` of symmetric positive semi-definite matrices ``A``.
+
+    ``A`` is (n, m, m); the semi-axes are the square roots of the eigenvalues of ``A``.
     """
 
     matrix: np.ndarray
@@ -54,8 +55,9 @@ class Ellipsoid:
 def full_mass_matrix(
     samples: ArmSamples, reflected_inertia: Any = None, motor_mass: Any = None
 ) -> np.ndarray:
-    """``M = M_bb(q; m) + diag(N^2 J_m)`` (n, nv, nv): structure, motor masses [kg] and reflected rotor
-    inertia [kg m^2] (each default zero).
+    """``M = M_bb(q; m) + diag(N^2 J_m)`` (n, nv, nv).
+
+    Structure, motor masses [kg] and reflected rotor inertia [kg m^2] (each default zero).
     """
     mass = samples.structure_mass_matrix(motor_mass)
     if reflected_inertia is None:
@@ -97,8 +99,9 @@ def generalized_inertia_ellipsoid(
 def dynamic_manipulability_ellipsoid(
     samples: ArmSamples, reflected_inertia: Any = None, motor_mass: Any = None
 ) -> Ellipsoid:
-    """``Lambda_d = J (M^T M)^-1 J^T`` [(m/s^2)^2 per (N m)^2]: the task accelerations reachable with joint
-    torques of unit norm lie in this ellipsoid.
+    """``Lambda_d = J (M^T M)^-1 J^T`` [(m/s^2)^2 per (N m)^2].
+
+    The task accelerations reachable with joint torques of unit norm lie in this ellipsoid.
     """
     mass = full_mass_matrix(samples, reflected_inertia, motor_mass)
     return Ellipsoid(task_inverse_inertia(np.swapaxes(mass, 1, 2) @ mass, samples.jacobian))
@@ -107,8 +110,9 @@ def dynamic_manipulability_ellipsoid(
 def effective_mass(
     samples: ArmSamples, directions: Any, reflected_inertia: Any = None, motor_mass: Any = None
 ) -> np.ndarray:
-    """Effective mass ``(u^T J M^-1 J^T u)^-1`` [kg] of the whole arm (rotor inertia included) along each
-    direction, (n, d); ``inf`` along singular directions.
+    """Effective mass ``(u^T J M^-1 J^T u)^-1`` [kg] of the whole arm along each direction, (n, d).
+
+    Rotor inertia included; ``inf`` along singular directions.
     """
     gyration = ellipsoid_of_gyration(samples, reflected_inertia, motor_mass)
     inverse = gyration.along(directions)

@@ -1,5 +1,6 @@
-"""The :class:`Arm`: a fixed-base URDF robot with a contact point and per-joint actuation, loaded through
-Pinocchio, with its configurations and its batched kinematics (:class:`ArmSamples`).
+"""The :class:`Arm`: a fixed-base URDF robot with a contact point and per-joint actuation.
+
+Loaded through Pinocchio, with its configurations and its batched kinematics (:class:`ArmSamples`).
 
 Conventions (SI throughout): the contact Jacobian is the translational Jacobian of the contact point in
 world-aligned axes; a planar arm (all joint axes parallel) is described in the plane perpendicular to its axes
@@ -169,8 +170,9 @@ class Arm:
         actuators: Any = None,
         locked_joints: Sequence[str] | None = None,
     ) -> Arm:
-        """Load a robot of the ``example-robot-data`` package by name (``"ur5"``, ``"panda"``,
-        ``"double_pendulum"``, ...).
+        """Load a robot of the ``example-robot-data`` package by name.
+
+        Names such as ``"ur5"``, ``"panda"``, ``"double_pendulum"``, ...
 
         Defaults per robot: Panda contacts at ``panda_hand_tcp`` with its two finger joints locked; UR robots at
         ``tool0``; the double pendulum at its second link's tip (0.2 m along the link); legged robots (``solo12``,
@@ -229,8 +231,9 @@ class Arm:
         software_stiffness: Any = np.inf,
         sensing: Any = None,
     ) -> Arm:
-        """The same arm with a scaled motor at every joint, geared to meet a torque requirement (the paper's
-        sweep of ``tab:motor_params``): ``N_i = max(1, tau_req,i / tau_p(r))``.
+        """The same arm with a scaled motor at every joint, geared to meet a torque requirement.
+
+        The paper's sweep of ``tab:motor_params``: ``N_i = max(1, tau_req,i / tau_p(r))``.
 
         Parameters
         ----------
@@ -262,10 +265,13 @@ class Arm:
         return self.with_actuators(actuators)
 
     def sensing_options(self) -> dict[str, Any]:
-        """The sensing of this arm's actuators as keyword arguments: ``{"sensing": "force", "threshold": F_s}``
-        for force thresholds at the contact, or ``{"sensing": "current", "joint_threshold": tau_s}`` [N m]
-        for the joint-side schemes (motor current, and joint position errors, whose threshold is the joint
-        torque ``k e_th`` as well), where the first joint to reach its threshold detects the contact."""
+        """The sensing of this arm's actuators as keyword arguments.
+
+        ``{"sensing": "force", "threshold": F_s}`` [N] for force thresholds at the contact, or
+        ``{"sensing": "current", "joint_threshold": tau_s}`` [N m] for the joint-side schemes (motor current,
+        and joint position errors, whose threshold is the joint torque ``k e_th`` as well), where the first
+        joint to reach its threshold detects the contact.
+        """
         from ..hardware.actuators import ForceThreshold
 
         if not self.actuators:
@@ -313,10 +319,12 @@ class Arm:
     # ------------------------------------------------------------------ properties
     @property
     def nq(self) -> int:
+        """Size of a configuration vector (a continuous joint counts twice: cosine and sine)."""
         return int(self._structure.nq)
 
     @property
     def nv(self) -> int:
+        """Number of joints (degrees of freedom)."""
         return int(self._structure.nv)
 
     @property
@@ -367,8 +375,10 @@ class Arm:
         return lower, upper
 
     def configuration(self, angles: Any) -> np.ndarray:
-        """Configurations (..., nq) from joint coordinates (..., nv) [rad or m] (unbounded revolute joints are
-        stored by Pinocchio as cosine and sine)."""
+        """Configurations (..., nq) from joint coordinates (..., nv) [rad or m].
+
+        Unbounded revolute joints are stored by Pinocchio as cosine and sine.
+        """
         angles = np.asarray(angles, dtype=float)
         if angles.shape[-1:] != (self.nv,):
             raise InvalidParameter("angles", angles.shape, f"a last axis of {self.nv} joint coordinates")
@@ -424,8 +434,10 @@ class Arm:
     def effective_parameters(
         self, samples: ArmSamples, directions: Any, **options: Any
     ) -> EffectiveParameters:
-        """:func:`effective_parameters` with this arm's joint parameters (motor masses included); keyword
-        ``options`` are passed on and may override any of them."""
+        """:func:`effective_parameters` with this arm's joint parameters (motor masses included).
+
+        Keyword ``options`` are passed on and may override any of them.
+        """
         params = self.joint_parameters
         kwargs: dict[str, Any] = {
             "reflected_inertia": params.reflected_inertia,

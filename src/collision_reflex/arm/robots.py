@@ -1,5 +1,7 @@
-"""Loading robot models: URDF files through Pinocchio (with the parser's own reasons for failures) and the
-robots of ``example-robot-data`` (with sensible contact points and locked joints).
+"""Loading robot models: URDF files through Pinocchio and the robots of ``example-robot-data``.
+
+URDF failures carry the parser's own reasons; the stock robots get sensible contact points and locked
+joints.
 """
 
 from __future__ import annotations
@@ -56,16 +58,18 @@ def _cachedexample_robot(name: str) -> tuple[Any, str, np.ndarray]:
 
 
 def example_robot(name: str) -> tuple[Any, str, np.ndarray]:
-    """The Pinocchio model (a copy), URDF path and reference configuration of an example-robot-data robot;
-    loading parses meshes and is slow, so it happens once per name.
+    """The Pinocchio model (a copy), URDF path and reference configuration of an example-robot-data robot.
+
+    Loading parses meshes and is slow, so it happens once per name.
     """
     model, urdf, q0 = _cachedexample_robot(name)
     return model.copy(), urdf, q0.copy()
 
 
 def configuration_by_name(source: Any, q_source: np.ndarray, target: Any) -> np.ndarray:
-    """A configuration of ``target`` taking each joint's coordinates from ``q_source`` of ``source`` (same joint
-    names), neutral for joints ``source`` does not have.
+    """A configuration of ``target`` taking each joint's coordinates from ``q_source`` of ``source``.
+
+    Joints are matched by name; joints ``source`` does not have are neutral.
     """
     import pinocchio as pin
 
@@ -128,8 +132,9 @@ class _Captured:
 
 @contextlib.contextmanager
 def captured_stderr() -> Iterator[_Captured]:
-    """Capture what C++ code writes to the process's stderr (file descriptor 2) while the block runs; the text
-    is in the yielded object's ``text`` once the block has ended.
+    """Capture what C++ code writes to the process's stderr (file descriptor 2) while the block runs.
+
+    The text is in the yielded object's ``text`` once the block has ended.
     """
     captured = _Captured()
     sys.stderr.flush()

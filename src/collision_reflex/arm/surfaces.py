@@ -58,11 +58,13 @@ class ReflexSurface:
 
     @property
     def task_dim(self) -> int:
+        """Dimension of the directions: 2 for a planar arm, 3 otherwise."""
         return int(self.directions.shape[1])
 
     def points(self, scale: float = 1.0, cap: float | None = None) -> np.ndarray:
-        """Surface points ``scale * min(I(u), cap) * u`` relative to the contact point, (d, task_dim)
-        [m per N s times ``scale``]; ``cap`` [N s] bounds the infinite values of singular directions.
+        """Surface points ``scale * min(I(u), cap) * u`` relative to the contact point, (d, task_dim).
+
+        In [m per N s times ``scale``]; ``cap`` [N s] bounds the infinite values of singular directions.
         """
         radius = self.impulse if cap is None else np.minimum(self.impulse, cap)
         return scale * radius[:, None] * self.directions

@@ -117,7 +117,10 @@ def _add_actuation_options(parser: argparse.ArgumentParser) -> None:
 
 
 def _add_sweep_options(parser: argparse.ArgumentParser) -> None:
-    """The stiffness form, the directions swept and the planar grid's rows (second joint angles, motor sizes, velocities)."""
+    """The stiffness form, the directions swept and the planar grid's rows.
+
+    The rows: second joint angles, motor sizes, approach velocities.
+    """
     add = parser.add_argument
     add(
         "--stiffness-form",
@@ -202,7 +205,7 @@ def _check_torque(arm: Arm, torque: list[float] | None) -> None:
 
 
 def _actuated(arm: Arm, args: argparse.Namespace, stator_diameter: float) -> Arm:
-    """``arm`` with scaled motors of ``stator_diameter`` [m] and the springs and force threshold of ``args``."""
+    """``arm`` with scaled motors of ``stator_diameter`` [m], and the springs and threshold of ``args``."""
     from ..hardware.actuators import ForceThreshold
 
     return arm.with_scaled_motors(

@@ -99,8 +99,9 @@ class ExperimentResults:
         return pd.DataFrame(rows)
 
     def one_shot_summary(self) -> Any:
-        """Mean and standard deviation of each fitted parameter over the trials of each system, as the
-        paper's ``tab:one_shot`` (a pandas DataFrame, one row per system and parameter).
+        """Mean and standard deviation of each fitted parameter over the trials of each system.
+
+        As the paper's ``tab:one_shot`` (a pandas DataFrame, one row per system and parameter).
         """
         import pandas as pd
 

@@ -198,7 +198,9 @@ def fit_one_shot(
 
 @dataclass(frozen=True)
 class _Residuals:
-    """The weighted residuals of the one-shot fit, over ``x = (log m_f, log k_s, log F_s, log a, shift, offset)``.
+    """The weighted residuals of the one-shot fit [noise sigmas], a function of the fit's vector ``x``.
+
+    ``x = (log m_f, log k_s, log F_s, log a, shift, offset)``, in kg, N/m, N and m/s^2 under the logarithms.
 
     ``shift`` moves the impact time from ``impact_guess`` [s] in samples; ``offset`` is the floor's offset in
     noise ``sigma`` [N]. ``times`` [s] and ``force`` [N] are the whole trace, floor subtracted.
@@ -373,7 +375,10 @@ def _software_stiffness(k: float, k_m: float) -> float:
 
 
 def _filter_delay(sensor: SensorModel) -> float:
-    """Group delay of the sensor's filter at zero frequency [samples]: the centroid of its impulse response."""
+    """Group delay of the sensor's filter at zero frequency [samples].
+
+    The centroid of its impulse response.
+    """
     if sensor.bandwidth is None:
         return 0.0
     impulse = np.zeros(int(50 * sensor.sampling_rate / sensor.bandwidth) + 50)

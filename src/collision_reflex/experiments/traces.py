@@ -104,7 +104,10 @@ class Trace:
         raise TraceError(self.source, self.name, reason, None if index is None else self.line_of(index))
 
     def check(self) -> None:
-        """Raise :class:`TraceError` if the samples cannot be analysed: too short, NaNs, time not increasing."""
+        """Raise :class:`TraceError` if the samples cannot be analysed.
+
+        That is: too short, NaNs, or time not increasing.
+        """
         n = self.time.size
         if n < MIN_SAMPLES:
             self.fail(f"too short: {n} samples, need at least {MIN_SAMPLES}")
