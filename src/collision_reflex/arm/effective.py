@@ -162,7 +162,7 @@ def _joint_arrays(
     torque_limit: Any,
     joint_threshold: Any,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
-    """Validated (nv,) arrays of the per-joint arguments of :func:`effective_parameters`, threshold or None."""
+    """Validated (nv,) arrays of per-joint arguments of :func:`effective_parameters`; threshold or None."""
     return (
         joint_array("reflected_inertia", reflected_inertia, nv),
         joint_array("stiffness", stiffness, nv, allow_inf=True),
