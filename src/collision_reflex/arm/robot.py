@@ -17,10 +17,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from ..errors import FrameNotFound, InvalidParameter, UrdfError
+from .actuation import joint_parameters, scaled_actuators, sensing_options
+from .configurations import ConfigurationSpace
 from .effective import EffectiveParameters, effective_parameters
-from .joints import JointParameters, joint_array
+from .joints import JointParameters
 from .kinematic_tree import joint_kinematics
 from .robots import (
     ROBOT_DEFAULTS,
@@ -32,10 +35,6 @@ from .robots import (
     with_locked_joints,
 )
 from .samples import ArmSamples, ContactKinematics
-
-# Joints whose limits are missing or meaningless (URDF "continuous", or lower >= upper) are sampled on a full
-# turn; limits beyond this magnitude are treated as missing.
-_UNBOUNDED_LIMIT = 1e3
 
 
 class Arm:
@@ -96,20 +95,7 @@ class Arm:
         unknown = (effort <= 0) | (effort > 1e300) | ~np.isfinite(effort)
         self.urdf_torque_limit: np.ndarray = np.where(unknown, np.nan, effort)
         """The URDF's effort limit per joint [N m], ``nan`` where it gives none."""
-        if isinstance(actuators, JointParameters):
-            params = actuators
-        elif actuators is not None:
-            params = JointParameters.from_actuators(actuators, model.nv)
-        else:
-            params = JointParameters(
-                reflected_inertia=np.asarray(model.armature, dtype=float),
-                torque_limit=self.urdf_torque_limit,
-                stiffness=np.full(model.nv, np.inf),
-                mechanical_stiffness=np.full(model.nv, np.inf),
-                motor_mass=np.zeros(model.nv),
-            )
-        if params.size != model.nv:
-            raise InvalidParameter("actuators", params.size, f"{model.nv} joints' parameters")
+        params = joint_parameters(actuators, model.nv, model.armature, self.urdf_torque_limit)
         self.joint_parameters = params
         if actuators is None or isinstance(actuators, JointParameters):
             self.actuators: tuple[Any, ...] | None = None
@@ -127,6 +113,13 @@ class Arm:
         # Kinematics use a structure-only model (no armature), so ArmSamples.mass_matrix is M_bb0.
         self._structure = self._contact_kinematics.model
         self.plane = self._contact_kinematics.plane
+        self.configuration_space = ConfigurationSpace(
+            tuple(self._joints),
+            self.joint_names,
+            np.asarray(self._structure.lowerPositionLimit, dtype=float),
+            np.asarray(self._structure.upperPositionLimit, dtype=float),
+        )
+        """The joints as coordinates: limits, and the map to and from configurations."""
         self.reference_configuration: np.ndarray = np.array(pin.neutral(model))
         """A configuration to start from [rad, m]: the robot's reference pose when known, else neutral."""
         self._pin = pin
@@ -246,22 +239,17 @@ class Arm:
         sensing: a sensing scheme of :mod:`collision_reflex.hardware.actuators` for every joint; default a 3 N force
             threshold.
         """
-        from ..hardware.actuators import Actuator, ForceThreshold, gear_ratio_for
-        from ..hardware.motors import reference_motor
-
         required = self.urdf_torque_limit if torque_required is None else torque_required
-        required = joint_array("torque_required", required, self.nv)
-        motor = (reference if reference is not None else reference_motor()).scaled(
-            stator_diameter=stator_diameter, law=law
+        actuators = scaled_actuators(
+            stator_diameter,
+            required,
+            self.nv,
+            reference=reference,
+            law=law,
+            mechanical_stiffness=mechanical_stiffness,
+            software_stiffness=software_stiffness,
+            sensing=sensing,
         )
-        ratios = np.atleast_1d(gear_ratio_for(required, motor.peak_torque))
-        k_mech = joint_array("mechanical_stiffness", mechanical_stiffness, self.nv, allow_inf=True)
-        k_soft = joint_array("software_stiffness", software_stiffness, self.nv, allow_inf=True)
-        scheme = ForceThreshold() if sensing is None else sensing
-        actuators = [
-            Actuator(motor, float(ratios[i]), float(k_mech[i]), float(k_soft[i]), scheme)
-            for i in range(self.nv)
-        ]
         return self.with_actuators(actuators)
 
     def sensing_options(self) -> dict[str, Any]:
@@ -272,29 +260,7 @@ class Arm:
         and joint position errors, whose threshold is the joint torque ``k e_th`` as well), where the first
         joint to reach its threshold detects the contact.
         """
-        from ..hardware.actuators import ForceThreshold
-
-        if not self.actuators:
-            raise InvalidParameter(
-                "actuators", None, "Actuator objects with sensing schemes", "give the threshold explicitly"
-            )
-        schemes = [actuator.sensing for actuator in self.actuators]
-        if all(isinstance(scheme, ForceThreshold) for scheme in schemes):
-            forces = {float(scheme.force) for scheme in schemes}
-            if len(forces) > 1:
-                raise InvalidParameter(
-                    "actuators", sorted(forces), "one contact-force threshold for the whole arm"
-                )
-            return {"sensing": "force", "threshold": forces.pop()}
-        if any(isinstance(scheme, ForceThreshold) for scheme in schemes):
-            raise InvalidParameter(
-                "actuators", [type(s).__name__ for s in schemes], "force thresholds at every joint or at none"
-            )
-        torques = [
-            scheme.joint_threshold_torque(actuator)
-            for scheme, actuator in zip(schemes, self.actuators, strict=True)
-        ]
-        return {"sensing": "current", "joint_threshold": np.array(torques)}
+        return sensing_options(self.actuators)
 
     def visual_model(self) -> Any:
         """Pinocchio visual ``GeometryModel`` of the URDF, meshes resolved through ``package_dirs``."""
@@ -352,55 +318,18 @@ class Arm:
     # ------------------------------------------------------------------ configurations
     def joint_limits(self) -> tuple[np.ndarray, np.ndarray]:
         """Lower and upper limit per joint [rad or m], (nv,) each; a full turn where the URDF gives none."""
-        lower = np.empty(self.nv)
-        upper = np.empty(self.nv)
-        low_q = np.asarray(self._structure.lowerPositionLimit, dtype=float)
-        high_q = np.asarray(self._structure.upperPositionLimit, dtype=float)
-        for v, joint in enumerate(self._joints):
-            lo, hi = (low_q[joint.idx_q], high_q[joint.idx_q]) if joint.nq == 1 else (np.nan, np.nan)
-            bounded = (
-                np.isfinite(lo) and np.isfinite(hi) and lo < hi and max(abs(lo), abs(hi)) < _UNBOUNDED_LIMIT
-            )
-            if bounded:
-                lower[v], upper[v] = lo, hi
-            elif joint.revolute:
-                lower[v], upper[v] = -np.pi, np.pi
-            else:
-                raise InvalidParameter(
-                    "joint limits",
-                    (lo, hi),
-                    f"finite limits for prismatic joint {self.joint_names[v]!r}",
-                    "add <limit lower=... upper=...> to the URDF",
-                )
-        return lower, upper
+        return self.configuration_space.joint_limits()
 
-    def configuration(self, angles: Any) -> np.ndarray:
+    def configuration(self, angles: npt.ArrayLike) -> np.ndarray:
         """Configurations (..., nq) from joint coordinates (..., nv) [rad or m].
 
         Unbounded revolute joints are stored by Pinocchio as cosine and sine.
         """
-        angles = np.asarray(angles, dtype=float)
-        if angles.shape[-1:] != (self.nv,):
-            raise InvalidParameter("angles", angles.shape, f"a last axis of {self.nv} joint coordinates")
-        q = np.empty((*angles.shape[:-1], self.nq))
-        for v, joint in enumerate(self._joints):
-            if joint.nq == 1:
-                q[..., joint.idx_q] = angles[..., v]
-            else:
-                q[..., joint.idx_q] = np.cos(angles[..., v])
-                q[..., joint.idx_q + 1] = np.sin(angles[..., v])
-        return q
+        return self.configuration_space.configuration(angles)
 
-    def joint_coordinates(self, q: Any) -> np.ndarray:
+    def joint_coordinates(self, q: npt.ArrayLike) -> np.ndarray:
         """Joint angles or displacements (..., nv) of configurations (..., nq) [rad or m]."""
-        q = self._checked_q(q)
-        out = np.empty((q.shape[0], self.nv))
-        for v, joint in enumerate(self._joints):
-            if joint.nq == 1:
-                out[:, v] = q[:, joint.idx_q]
-            else:
-                out[:, v] = np.arctan2(q[:, joint.idx_q + 1], q[:, joint.idx_q])
-        return out
+        return self.configuration_space.joint_coordinates(q)
 
     def sample_configurations(self, count: int, rng: np.random.Generator) -> np.ndarray:
         """``count`` configurations drawn uniformly within the joint limits, shape (count, nq).
@@ -410,14 +339,7 @@ class Arm:
         count: number of configurations, >= 1.
         rng: the random generator (``numpy.random.default_rng(seed)``), for reproducible samples.
         """
-        if not isinstance(rng, np.random.Generator):
-            raise InvalidParameter(
-                "rng", rng, "a numpy.random.Generator", "use numpy.random.default_rng(seed)"
-            )
-        if int(count) != count or count < 1:
-            raise InvalidParameter("count", count, "an integer >= 1")
-        lower, upper = self.joint_limits()
-        return self.configuration(rng.uniform(lower, upper, size=(int(count), self.nv)))
+        return self.configuration_space.sample(count, rng)
 
     # ------------------------------------------------------------------ kinematics
     def kinematics(self, q: Any, *, full: bool = True) -> ArmSamples:
@@ -429,7 +351,7 @@ class Arm:
         only what the effective collision parameters need (``q``, ``mass_matrix``, ``jacobian``; the other
         fields are None).
         """
-        return self._contact_kinematics.samples(self._checked_q(q), full)
+        return self._contact_kinematics.samples(self.configuration_space.checked(q), full)
 
     def effective_parameters(
         self, samples: ArmSamples, directions: Any, **options: Any
@@ -448,11 +370,3 @@ class Arm:
         }
         kwargs.update(options)
         return effective_parameters(samples, directions, **kwargs)
-
-    def _checked_q(self, q: Any) -> np.ndarray:
-        q = np.atleast_2d(np.asarray(q, dtype=float))
-        if q.ndim != 2 or q.shape[1] != self.nq:
-            raise InvalidParameter("q", q.shape, f"configurations of shape (n, {self.nq})")
-        if not np.all(np.isfinite(q)):
-            raise InvalidParameter("q", q, "finite joint coordinates")
-        return q
