@@ -25,15 +25,7 @@ from .configurations import ConfigurationSpace
 from .effective import EffectiveParameters, effective_parameters
 from .joints import JointParameters
 from .kinematic_tree import joint_kinematics
-from .robots import (
-    ROBOT_DEFAULTS,
-    captured_stderr,
-    configuration_by_name,
-    example_robot,
-    load_urdf,
-    parser_reason,
-    with_locked_joints,
-)
+from .robots import captured_stderr, load_urdf, loaded_example_robot, parser_reason, with_locked_joints
 from .samples import ArmSamples, ContactKinematics
 
 
@@ -172,31 +164,17 @@ class Arm:
         ``a1``) at the front-left foot with the base fixed to the world. Other robots need ``contact_frame``.
         ``locked_joints`` replaces the default list of locked joints (``()`` locks none).
         """
-        full_model, urdf, q0 = example_robot(name)
-        model = full_model
-        defaults = ROBOT_DEFAULTS.get(name, {})
-        if contact_frame is None:
-            if "contact_frame" not in defaults:
-                raise InvalidParameter(
-                    "contact_frame",
-                    None,
-                    f"a frame name for {name!r} (no default is known)",
-                    "frames: " + ", ".join(f.name for f in model.frames),
-                )
-            contact_frame = defaults["contact_frame"]
-            if contact_offset is None:
-                contact_offset = defaults.get("contact_offset")
-        if model.njoints > 1 and model.joints[1].nq == 7:  # free-flyer root: fix the base to the world
-            model = load_urdf(urdf)
-        to_lock = defaults.get("locked_joints", ()) if locked_joints is None else tuple(locked_joints)
-        model = with_locked_joints(model, to_lock, name)
-        # The robots' URDFs name their meshes package://example-robot-data/robots/...: the package directory
-        # is two levels above the "robots" directory.
-        share = Path(urdf).resolve()
-        while share.name != "robots" and share != share.parent:
-            share = share.parent
-        arm = cls(model, contact_frame, contact_offset, actuators, name, urdf, [share.parent.parent])
-        arm.reference_configuration = configuration_by_name(full_model, q0, model)
+        robot = loaded_example_robot(name, contact_frame, contact_offset, locked_joints)
+        arm = cls(
+            robot.model,
+            robot.contact_frame,
+            robot.contact_offset,
+            actuators,
+            name,
+            robot.urdf,
+            [robot.package_dir],
+        )
+        arm.reference_configuration = robot.reference_configuration
         return arm
 
     def with_actuators(self, actuators: Any) -> Arm:
