@@ -13,6 +13,7 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from .. import _validate
 from ..errors import InvalidParameter
@@ -63,18 +64,18 @@ class EffectiveParameters:
 
 def effective_parameters(
     samples: ArmSamples,
-    directions: Any,
-    reflected_inertia: Any,
-    stiffness: Any,
-    mechanical_stiffness: Any,
-    torque_limit: Any,
+    directions: npt.ArrayLike,
+    reflected_inertia: npt.ArrayLike,
+    stiffness: npt.ArrayLike,
+    mechanical_stiffness: npt.ArrayLike,
+    torque_limit: npt.ArrayLike,
     *,
-    config_index: Any = None,
-    motor_mass: Any = None,
-    finger_joint_inertia: Any = None,
+    config_index: npt.ArrayLike | None = None,
+    motor_mass: npt.ArrayLike | None = None,
+    finger_joint_inertia: npt.ArrayLike | None = None,
     stiffness_form: str = "compliance",
-    joint_threshold: Any = None,
-    task_stiffness: Any = None,
+    joint_threshold: npt.ArrayLike | None = None,
+    task_stiffness: npt.ArrayLike | None = None,
     singular_tolerance: float = 1e-12,
 ) -> EffectiveParameters:
     """Effective 1D collision parameters for many configurations and directions at once (MODEL.md §3).
@@ -245,8 +246,8 @@ class CollisionImpulses:
 
 def collision_impulses(
     params: EffectiveParameters,
-    v0: Any,
-    threshold: Any = None,
+    v0: npt.ArrayLike,
+    threshold: npt.ArrayLike | None = None,
     sensing: str = "force",
     reaction: str = "at_rest",
 ) -> CollisionImpulses:

@@ -14,7 +14,7 @@ from __future__ import annotations
 import os
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
@@ -27,6 +27,10 @@ from .joints import JointParameters
 from .kinematic_tree import joint_kinematics
 from .robots import captured_stderr, load_urdf, loaded_example_robot, parser_reason, with_locked_joints
 from .samples import ArmSamples, ContactKinematics
+
+if TYPE_CHECKING:
+    from ..hardware.actuators import CurrentThreshold, ForceThreshold, PositionThreshold
+    from ..hardware.motors import Motor
 
 
 class Arm:
@@ -50,7 +54,7 @@ class Arm:
         self,
         model: Any,
         contact_frame: str,
-        contact_offset: Any = None,
+        contact_offset: npt.ArrayLike | None = None,
         actuators: Any = None,
         name: str = "",
         urdf_path: str | os.PathLike[str] | None = None,
@@ -123,7 +127,7 @@ class Arm:
         path: str | os.PathLike[str],
         contact_frame: str,
         package_dirs: Sequence[str | os.PathLike[str]] | None = None,
-        contact_offset: Any = None,
+        contact_offset: npt.ArrayLike | None = None,
         actuators: Any = None,
         locked_joints: Sequence[str] = (),
         name: str = "",
@@ -151,7 +155,7 @@ class Arm:
         cls,
         name: str,
         contact_frame: str | None = None,
-        contact_offset: Any = None,
+        contact_offset: npt.ArrayLike | None = None,
         actuators: Any = None,
         locked_joints: Sequence[str] | None = None,
     ) -> Arm:
@@ -194,13 +198,13 @@ class Arm:
     def with_scaled_motors(
         self,
         stator_diameter: float,
-        torque_required: Any = None,
+        torque_required: npt.ArrayLike | None = None,
         *,
-        reference: Any = None,
+        reference: Motor | None = None,
         law: str = "haddadin",
-        mechanical_stiffness: Any = np.inf,
-        software_stiffness: Any = np.inf,
-        sensing: Any = None,
+        mechanical_stiffness: npt.ArrayLike = np.inf,
+        software_stiffness: npt.ArrayLike = np.inf,
+        sensing: ForceThreshold | PositionThreshold | CurrentThreshold | None = None,
     ) -> Arm:
         """The same arm with a scaled motor at every joint, geared to meet a torque requirement.
 
@@ -320,7 +324,7 @@ class Arm:
         return self.configuration_space.sample(count, rng)
 
     # ------------------------------------------------------------------ kinematics
-    def kinematics(self, q: Any, *, full: bool = True) -> ArmSamples:
+    def kinematics(self, q: npt.ArrayLike, *, full: bool = True) -> ArmSamples:
         """Mass matrix, contact Jacobian, gravity and motor-mass terms at configurations ``q`` (n, nq).
 
         Pinocchio evaluates the mass matrix (CRBA) and the contact Jacobian once per configuration, and with
@@ -332,7 +336,7 @@ class Arm:
         return self._contact_kinematics.samples(self.configuration_space.checked(q), full)
 
     def effective_parameters(
-        self, samples: ArmSamples, directions: Any, **options: Any
+        self, samples: ArmSamples, directions: npt.ArrayLike, **options: Any
     ) -> EffectiveParameters:
         """:func:`effective_parameters` with this arm's joint parameters (motor masses included).
 

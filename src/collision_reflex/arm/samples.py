@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from ..errors import InvalidParameter
 from ..model import effective
@@ -107,7 +108,7 @@ class ArmSamples:
                 picked[name] = None
         return ArmSamples(**picked)
 
-    def structure_mass_matrix(self, motor_mass: Any = None) -> np.ndarray:
+    def structure_mass_matrix(self, motor_mass: npt.ArrayLike | None = None) -> np.ndarray:
         """``M_bb(q; m) = M_bb0(q) + sum_i m_i A_i(q)`` [kg m^2], (n, nv, nv); ``motor_mass`` [kg], (nv,)."""
         if motor_mass is None:
             return self.mass_matrix

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from ..errors import InvalidParameter
 from .directions import unit_directions
@@ -82,16 +83,16 @@ class ReflexSurface:
 
 def reflex_surface(
     arm: Arm,
-    q: Any,
+    q: npt.ArrayLike,
     v0: float,
-    threshold: Any = None,
+    threshold: npt.ArrayLike | None = None,
     *,
     directions: Any = None,
     sensing: str | None = None,
     reaction: str = "at_rest",
-    task_stiffness: Any = None,
+    task_stiffness: npt.ArrayLike | None = None,
     stiffness_form: str = "compliance",
-    joint_threshold: Any = None,
+    joint_threshold: npt.ArrayLike | None = None,
 ) -> ReflexSurface:
     """The collision-reflex surface of ``arm`` at configuration ``q``.
 
