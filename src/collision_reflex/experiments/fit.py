@@ -150,7 +150,7 @@ def fit_one_shot(
 
     Parameters
     ----------
-    trace: the trace; its ``velocity`` (pre-impact, [m/s]) must be known. Its own ``k_m``, if set, wins
+    trace: the trace; its ``v0`` (pre-impact velocity [m/s]) must be known. Its own ``k_m``, if set, wins
         over the argument.
     window: its contact window (noise floor and extent), from :func:`find_contact`.
     k_m: mechanical (sensor) stiffness [N/m], not fitted (see the module docstring).
@@ -163,9 +163,9 @@ def fit_one_shot(
     FitFailed: the least-squares solver did not converge.
     """
     _validate.choice("reaction", reaction, REACTION_MODES)
-    if trace.velocity is None:
+    if trace.v0 is None:
         trace.fail("no pre-impact velocity: give it as '# velocity: ...' in the file or with --velocity")
-    v0 = float(trace.velocity)
+    v0 = float(trace.v0)
     k_m = float(trace.k_m if trace.k_m is not None else k_m)
     _validate.positive("k_m", k_m)
     sensor = _sensor_for(trace, bandwidth)

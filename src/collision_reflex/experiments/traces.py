@@ -28,6 +28,7 @@ import io
 import math
 import os
 import re
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,6 +36,7 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 import numpy as np
 
+from .._compat import renamed_keywords
 from .._io import atomic_open
 from ..errors import TraceError
 
@@ -47,6 +49,7 @@ MIN_SAMPLES = 20
 _TIME_NAMES = ("time", "t")
 _FORCE_NAMES = ("force", "fz", "f")
 _META_COLUMNS = {"velocity": "m/s", "system": None, "sensor stiffness": "N/m"}
+_META_TARGETS = {"velocity": "v0", "sensor stiffness": "k_m"}  # metadata key -> Trace field
 _HEADER = re.compile(r"^\s*(?P<name>[^\[\(]*?)\s*(?:[\[\(]\s*(?P<unit>[^\]\)]*?)\s*[\]\)])?\s*$")
 
 
@@ -58,7 +61,7 @@ class Trace:
     ----------
     time: sample times [s], shape (n,).
     force: contact force [N], shape (n,); positive in compression.
-    velocity: pre-impact velocity [m/s], or ``None`` if unknown (then the impulse is measured but the model
+    v0: pre-impact velocity [m/s], or ``None`` if unknown (then the impulse is measured but the model
         is not fitted).
     system: name of the system tested; trials of one system are aggregated together.
     name: the trial's name.
@@ -70,7 +73,7 @@ class Trace:
 
     time: np.ndarray
     force: np.ndarray
-    velocity: float | None = None
+    v0: float | None = None
     system: str = ""
     name: str = ""
     source: str = ""
@@ -85,10 +88,16 @@ class Trace:
             self.fail(f"time and force must be 1-D of one length, got shapes {time.shape} and {force.shape}")
         object.__setattr__(self, "time", time)
         object.__setattr__(self, "force", force)
-        for name in ("velocity", "k_m"):
+        for name in ("v0", "k_m"):
             value = getattr(self, name)
             if value is not None and not (math.isfinite(value) and value > 0):
                 self.fail(f"{name} = {value!r} is invalid: expected a finite number > 0")
+
+    @property
+    def velocity(self) -> float | None:
+        """Deprecated spelling of :attr:`v0`, the pre-impact velocity [m/s]."""
+        warnings.warn("Trace.velocity is deprecated; call it Trace.v0", DeprecationWarning, stacklevel=2)
+        return self.v0
 
     @property
     def label(self) -> str:
@@ -128,6 +137,10 @@ class Trace:
                 "samples must be in increasing time order",
                 i,
             )
+
+
+# The old spelling keeps working (with a warning); `dataclasses.replace` needs the new one.
+Trace.__init__ = renamed_keywords(velocity="v0")(Trace.__init__)  # type: ignore[method-assign]
 
 
 @functools.lru_cache(maxsize=1)
@@ -179,12 +192,13 @@ def unit_factor(unit: str, default_unit: str, what: str, source: str = "") -> fl
         ) from None
 
 
+@renamed_keywords(velocity="v0")
 def read_traces(
     path: str | os.PathLike[str],
     *,
     time_unit: str = "s",
     force_unit: str = "N",
-    velocity: float | None = None,
+    v0: float | None = None,
     system: str | None = None,
     k_m: float | None = None,
 ) -> list[Trace]:
@@ -194,7 +208,7 @@ def read_traces(
     ----------
     path: the CSV file.
     time_unit, force_unit: units of the time and force columns when their headers name none.
-    velocity: pre-impact velocity [m/s] for trials whose metadata gives none.
+    v0: pre-impact velocity [m/s] for trials whose metadata gives none (``velocity``: deprecated spelling).
     system: system name for trials whose metadata gives none (default: the file's parent folder's name).
     k_m: sensor stiffness [N/m] for trials whose metadata gives none.
 
@@ -222,7 +236,7 @@ def read_traces(
 
     default_system = system if system is not None else Path(path).resolve().parent.name
     file_meta = {
-        "velocity": _meta_value(metadata, "velocity", "m/s", velocity, source),
+        "v0": _meta_value(metadata, "velocity", "m/s", v0, source),
         "k_m": _meta_value(metadata, "sensor stiffness", "N/m", k_m, source),
         "system": metadata.get("system", default_system),
     }
@@ -328,7 +342,7 @@ def _trial_columns(
             raise TraceError(
                 source, name, f"the {key!r} column changes within the trial", int(file_lines[rows[0]])
             )
-        target = "k_m" if key == "sensor stiffness" else key
+        target = _META_TARGETS.get(key, key)
         if unit is None:
             meta[target] = values[0]
         else:
@@ -343,8 +357,8 @@ def write_trace(path: str | os.PathLike[str], trace: Trace, time_unit: str = "ms
     lines = []
     if trace.name:
         lines.append(f"# trial: {trace.name}")
-    if trace.velocity is not None:
-        lines.append(f"# velocity: {trace.velocity:.9g} m/s")
+    if trace.v0 is not None:
+        lines.append(f"# velocity: {trace.v0:.9g} m/s")
     if trace.system:
         lines.append(f"# system: {trace.system}")
     if trace.k_m is not None:
