@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -273,3 +274,26 @@ def test_example_robots_load_with_default_contacts(name, nv, task_dim, frame):
     assert (arm.nv, arm.task_dim, arm.contact_frame) == (nv, task_dim, frame)
     samples = arm.kinematics(arm.sample_configurations(2, np.random.default_rng(1)))
     assert np.all(np.isfinite(samples.jacobian)) and np.any(samples.jacobian != 0)
+
+
+def test_sensing_options_need_one_kind_of_threshold(two_link):
+    """Force thresholds must agree and cannot be mixed with joint-side schemes; joint-side ones give torques."""
+    from collision_reflex.hardware.actuators import CurrentThreshold, ForceThreshold
+
+    with pytest.raises(InvalidParameter, match="give the threshold explicitly"):
+        two_link.sensing_options()  # URDF defaults: no actuator objects
+    forced = two_link.with_scaled_motors(0.060, 1.3, sensing=ForceThreshold(4.0))
+    assert forced.sensing_options() == {"sensing": "force", "threshold": 4.0}
+    uneven = forced.with_actuators(
+        [forced.actuators[0], replace(forced.actuators[1], sensing=ForceThreshold(5.0))]
+    )
+    with pytest.raises(InvalidParameter, match="one contact-force threshold"):
+        uneven.sensing_options()
+    current = two_link.with_scaled_motors(0.060, 1.3, sensing=CurrentThreshold(0.01))
+    mixed = current.with_actuators([forced.actuators[0], current.actuators[1]])
+    with pytest.raises(InvalidParameter, match="force thresholds at every joint or at none"):
+        mixed.sensing_options()
+    options = current.sensing_options()
+    assert options["sensing"] == "current"
+    expected = [a.gear_ratio * 0.01 for a in current.actuators]  # N tau_s per joint [N m]
+    np.testing.assert_allclose(options["joint_threshold"], expected, rtol=1e-12)  # one product: rounding

@@ -108,3 +108,15 @@ def test_nshot_fit_below_v_star_only_flags_a_bound():
     fit = fit_velocity_law(velocity, 0.002 / velocity + 0.1)
     assert fit.at_bound == ("A",)
     assert fit.v_star == np.inf
+
+
+@pytest.mark.parametrize("k_s", [1e3, 2e7, 5e9])
+def test_software_stiffness_inverts_series_stiffness(k_s):
+    """The fit's k_s from k and k_m is the inverse of series_stiffness, from soft to stiffer than the sensor."""
+    from collision_reflex.experiments.fit import _software_stiffness
+
+    k_m = 2e7
+    k = cr.series_stiffness(k_m, k_s)
+    # Two divisions and a subtraction of 1/k - 1/k_m; cancellation grows as k_s/k_m, so the bound is relative
+    # to that ratio (a wrong inverse, e.g. k itself, is off by k_s/k = 1 + k_s/k_m >= 1.00005).
+    assert _software_stiffness(k, k_m) == pytest.approx(k_s, rel=1e-12 * (1 + k_s / k_m))

@@ -47,7 +47,7 @@ def test_units_in_headers_and_metadata_are_converted(tmp_path):
     (read,) = read_traces(path)
     np.testing.assert_allclose(read.time, trace.time, rtol=1e-8, atol=1e-15)
     np.testing.assert_allclose(read.force, trace.force, rtol=1e-8, atol=1e-12)
-    assert (read.velocity, read.system, read.k_m) == (pytest.approx(0.08), "U8 stiff", pytest.approx(2e7))
+    assert (read.v0, read.system, read.k_m) == (pytest.approx(0.08), "U8 stiff", pytest.approx(2e7))
     assert read.metadata == {"operator": "someone"}
     assert read.lines[0] == 6  # the first sample is on the file's sixth line
 
@@ -71,7 +71,7 @@ def test_units_given_by_the_caller_and_many_trials_per_file(tmp_path):
     pd.concat(rows).to_csv(path, index=False)
     traces = read_traces(path, time_unit="ms")
     assert [t.name for t in traces] == ["slow", "fast"]
-    assert [t.velocity for t in traces] == [pytest.approx(0.05), pytest.approx(0.12)]
+    assert [t.v0 for t in traces] == [pytest.approx(0.05), pytest.approx(0.12)]
     assert traces[0].time[1] == pytest.approx(1 / RATE)
 
 
@@ -79,25 +79,21 @@ def _write_bad_traces(folder: Path) -> dict[str, str]:
     """One good trial and one of each kind of bad trace; returns file name -> expected reason."""
     good = _trace(seed=2)
     write_trace(folder / "good.csv", good)
-    write_trace(folder / "short.csv", cr.experiments.Trace(good.time[:12], good.force[:12], velocity=0.08))
+    write_trace(folder / "short.csv", cr.experiments.Trace(good.time[:12], good.force[:12], v0=0.08))
     quiet = _trace(seed=3)
-    write_trace(
-        folder / "no_contact.csv", cr.experiments.Trace(quiet.time[:60], quiet.force[:60], velocity=0.08)
-    )
+    write_trace(folder / "no_contact.csv", cr.experiments.Trace(quiet.time[:60], quiet.force[:60], v0=0.08))
     clipped = _trace(seed=4, noise=0.05)
     clipped_sensor = SensorModel(RATE, 1000.0, full_scale=2.5)  # saturates below F_s = 3.03 N
     clipped = synthetic_trace(PAPER_SYSTEMS["U8 stiff"], 0.08, clipped_sensor, np.random.default_rng(4))
     write_trace(folder / "clipped.csv", clipped)
     backwards = good.time.copy()
     backwards[100], backwards[101] = backwards[101], backwards[100]
-    write_trace(folder / "time.csv", cr.experiments.Trace(backwards, good.force, velocity=0.08))
+    write_trace(folder / "time.csv", cr.experiments.Trace(backwards, good.force, v0=0.08))
     holes = good.force.copy()
     holes[50] = np.nan
-    write_trace(folder / "nan.csv", cr.experiments.Trace(good.time, holes, velocity=0.08))
+    write_trace(folder / "nan.csv", cr.experiments.Trace(good.time, holes, v0=0.08))
     cut = _trace(seed=5)
-    write_trace(
-        folder / "unfinished.csv", cr.experiments.Trace(cut.time[:150], cut.force[:150], velocity=0.08)
-    )
+    write_trace(folder / "unfinished.csv", cr.experiments.Trace(cut.time[:150], cut.force[:150], v0=0.08))
     (folder / "columns.csv").write_text("seconds,newtons\n0,1\n")
     (folder / "unit.csv").write_text((folder / "good.csv").read_text().replace("time [ms]", "time [kg]"))
     (folder / "text.csv").write_text(
@@ -201,3 +197,21 @@ def test_help_names_units():
     )
     for unit in ("[N/m]", "[Hz]", "[m/s]"):
         assert unit in done.stdout
+
+
+def test_velocity_is_a_deprecated_spelling_of_v0(tmp_path):
+    """Trace, read_traces and analyse_files take the old `velocity` keyword with a warning, as `v0`."""
+    with pytest.warns(DeprecationWarning, match="'velocity' is deprecated"):
+        trace = cr.experiments.Trace(np.arange(3.0), np.zeros(3), velocity=0.08)
+    assert trace.v0 == 0.08
+    with pytest.warns(DeprecationWarning, match="Trace.v0"):
+        assert trace.velocity == 0.08
+    path = write_trace(tmp_path / "plain.csv", cr.experiments.Trace(np.arange(3.0), np.zeros(3)))
+    with pytest.warns(DeprecationWarning, match="'velocity' is deprecated"):
+        (read,) = read_traces(path, velocity=0.3)
+    assert read.v0 == pytest.approx(0.3)
+    with pytest.raises(TypeError, match="both 'velocity' and 'v0'"):
+        read_traces(path, velocity=0.3, v0=0.3)
+    with pytest.warns(DeprecationWarning, match="'velocity' is deprecated"):
+        results = analyse_files([path], velocity=0.3)
+    assert results.rejected[0].reason.startswith("too short")

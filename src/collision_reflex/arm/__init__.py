@@ -1,5 +1,7 @@
-"""Arms through Pinocchio: loading URDFs and stock robots, contact samples, effective parameters along a
-direction, transparency metrics and collision reflex surfaces.
+"""Arms through Pinocchio: loading, contact samples, effective parameters, metrics and reflex surfaces.
+
+Loading covers URDFs and stock robots; effective parameters are along a direction; the metrics are
+transparency metrics, and the surfaces collision reflex surfaces.
 """
 
 from .directions import circle_directions, sphere_directions, unit_directions

@@ -31,8 +31,9 @@ def circle_directions(count: int, start: float = 0.0) -> np.ndarray:
 
 
 def sphere_directions(count: int) -> np.ndarray:
-    """``count`` nearly uniform unit vectors on the sphere, (count, 3): the Fibonacci (golden-angle) lattice,
-    deterministic, with equal-area bands in ``z``.
+    """``count`` nearly uniform unit vectors on the sphere, (count, 3).
+
+    The Fibonacci (golden-angle) lattice: deterministic, with equal-area bands in ``z``.
     """
     count = _count(count)
     index = np.arange(count) + 0.5

@@ -1,5 +1,6 @@
-"""Effective 1D collision parameters of an arm along many directions at once, and the collision impulses they
-give (the paper's section "Collision Reflex in Higher Dimensions", ``eq:eff_mf`` to ``eq:eff_a``; MODEL.md §3).
+"""Effective 1D collision parameters of an arm along many directions at once, and their collision impulses.
+
+The paper's section "Collision Reflex in Higher Dimensions", ``eq:eff_mf`` to ``eq:eff_a``; MODEL.md §3.
 
 :func:`effective_parameters` maps :class:`ArmSamples` and unit directions ``u`` to ``m_f``, ``m_r``, ``k``,
 ``k_m``, ``F_a`` and ``a``; :func:`collision_impulses` applies the 1D model of
@@ -8,10 +9,11 @@ give (the paper's section "Collision Reflex in Higher Dimensions", ``eq:eff_mf``
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from .. import _validate
 from ..errors import InvalidParameter
@@ -29,8 +31,9 @@ STIFFNESS_FORMS: tuple[str, ...] = ("compliance", "paper")
 
 @dataclass(frozen=True)
 class EffectiveParameters:
-    """The 1D collision parameters along each direction, arrays of one shape: (n_configurations,
-    n_directions) for a grid, (n_samples,) for paired samples.
+    """The 1D collision parameters along each direction, arrays of one shape.
+
+    The shape is (n_configurations, n_directions) for a grid, (n_samples,) for paired samples.
 
     m_f: effective finger (structure) mass ``1 / (u^T J M_bb^-1 J^T u)`` (``eq:eff_mf``) [kg].
     m_r: effective robot (actuator) mass ``1 / (u^T J M_jj^-1 J^T u)`` [kg].
@@ -55,23 +58,24 @@ class EffectiveParameters:
 
     @property
     def shape(self) -> tuple[int, ...]:
+        """The arrays' shape: (n_configurations, n_directions) or (n_samples,)."""
         return tuple(self.m_f.shape)
 
 
 def effective_parameters(
     samples: ArmSamples,
-    directions: Any,
-    reflected_inertia: Any,
-    stiffness: Any,
-    mechanical_stiffness: Any,
-    torque_limit: Any,
+    directions: npt.ArrayLike,
+    reflected_inertia: npt.ArrayLike,
+    stiffness: npt.ArrayLike,
+    mechanical_stiffness: npt.ArrayLike,
+    torque_limit: npt.ArrayLike,
     *,
-    config_index: Any = None,
-    motor_mass: Any = None,
-    finger_joint_inertia: Any = None,
+    config_index: npt.ArrayLike | None = None,
+    motor_mass: npt.ArrayLike | None = None,
+    finger_joint_inertia: npt.ArrayLike | None = None,
     stiffness_form: str = "compliance",
-    joint_threshold: Any = None,
-    task_stiffness: Any = None,
+    joint_threshold: npt.ArrayLike | None = None,
+    task_stiffness: npt.ArrayLike | None = None,
     singular_tolerance: float = 1e-12,
 ) -> EffectiveParameters:
     """Effective 1D collision parameters for many configurations and directions at once (MODEL.md §3).
@@ -108,11 +112,9 @@ def effective_parameters(
     """
     _validate.choice("stiffness_form", stiffness_form, STIFFNESS_FORMS)
     nv, task_dim = samples.nv, samples.task_dim
-    inertia = joint_array("reflected_inertia", reflected_inertia, nv)
-    joint_k = joint_array("stiffness", stiffness, nv, allow_inf=True)
-    joint_km = joint_array("mechanical_stiffness", mechanical_stiffness, nv, allow_inf=True)
-    tau_max = joint_array("torque_limit", torque_limit, nv, allow_inf=True)
-    tau_s = None if joint_threshold is None else joint_array("joint_threshold", joint_threshold, nv)
+    inertia, joint_k, joint_km, tau_max, tau_s = _joint_arrays(
+        nv, reflected_inertia, stiffness, mechanical_stiffness, torque_limit, joint_threshold
+    )
     if not (np.isfinite(singular_tolerance) and 0 < singular_tolerance < 1):
         raise InvalidParameter("singular_tolerance", singular_tolerance, "a number in (0, 1)")
     units = normalised_directions(directions, task_dim)
@@ -126,20 +128,7 @@ def effective_parameters(
         )
 
     jac = samples.jacobian
-    structure = samples.structure_mass_matrix(motor_mass)
-    if finger_joint_inertia is not None:
-        finger = joint_array("finger_joint_inertia", finger_joint_inertia, nv, allow_zero=True)
-        structure = np.asarray(formulas.finger_mass_matrix(structure, joint_finger_inertia=finger))
-    # Task-space inverse inertias and compliances, once per configuration: G = J X^-1 J^T, stacked as
-    # (structure, actuators, stiffness, mechanical stiffness); the quantities along u are 1 / (u^T G u).
-    task = np.stack(
-        [
-            task_inverse_inertia(structure, jac),
-            formulas.task_compliance(jac, inertia),
-            formulas.task_compliance(jac, joint_k),
-            formulas.task_compliance(jac, joint_km),
-        ]
-    )  # (4, n, task_dim, task_dim)
+    task = _task_matrices(samples, inertia, joint_k, joint_km, motor_mass, finger_joint_inertia)
     forms = _quadratic_forms(task, units, pair_index)
     scale = np.trace(task[0], axis1=1, axis2=2)
     scale_s = scale[:, None] if pair_index is None else scale[pair_index]
@@ -163,17 +152,75 @@ def effective_parameters(
         if tau_s is not None:
             joint_force = _reaction_compliance(jac, tau_s, units, pair_index)
             np.reciprocal(joint_force, out=joint_force)
+    return _with_limits(EffectiveParameters(m_f, m_r, k, k_m, F_a, a, singular, joint_force), task_stiffness)
+
+
+def _joint_arrays(
+    nv: int,
+    reflected_inertia: Any,
+    stiffness: Any,
+    mechanical_stiffness: Any,
+    torque_limit: Any,
+    joint_threshold: Any,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
+    """Validated (nv,) arrays of per-joint arguments of :func:`effective_parameters`; threshold or None."""
+    return (
+        joint_array("reflected_inertia", reflected_inertia, nv),
+        joint_array("stiffness", stiffness, nv, allow_inf=True),
+        joint_array("mechanical_stiffness", mechanical_stiffness, nv, allow_inf=True),
+        joint_array("torque_limit", torque_limit, nv, allow_inf=True),
+        None if joint_threshold is None else joint_array("joint_threshold", joint_threshold, nv),
+    )
+
+
+def _task_matrices(
+    samples: ArmSamples,
+    inertia: np.ndarray,
+    joint_k: np.ndarray,
+    joint_km: np.ndarray,
+    motor_mass: Any,
+    finger_joint_inertia: Any,
+) -> np.ndarray:
+    """Task-space inverse inertias and compliances ``G = J X^-1 J^T``, once per configuration.
+
+    Stacked as (structure, actuators, stiffness, mechanical stiffness), shape (4, n, task_dim, task_dim); the
+    quantities along ``u`` are ``1 / (u^T G u)``. ``inertia`` [kg m^2] and the stiffnesses [N m/rad] are per
+    joint; ``motor_mass`` [kg] and ``finger_joint_inertia`` [kg m^2] as in :func:`effective_parameters`.
+    """
+    jac = samples.jacobian
+    structure = samples.structure_mass_matrix(motor_mass)
+    if finger_joint_inertia is not None:
+        finger = joint_array("finger_joint_inertia", finger_joint_inertia, samples.nv, allow_zero=True)
+        structure = np.asarray(formulas.finger_mass_matrix(structure, joint_finger_inertia=finger))
+    return np.stack(
+        [
+            task_inverse_inertia(structure, jac),
+            formulas.task_compliance(jac, inertia),
+            formulas.task_compliance(jac, joint_k),
+            formulas.task_compliance(jac, joint_km),
+        ]
+    )
+
+
+def _with_limits(params: EffectiveParameters, task_stiffness: Any) -> EffectiveParameters:
+    """``params`` with their singular limits, and a task-space spring [N/m] in series with ``k``.
+
+    Singular directions get ``inf`` masses, stiffnesses and forces and ``a = 0`` (in place: the arrays are
+    fresh); ``task_stiffness`` (None for none) adds its compliance to ``k`` off the singular directions.
+    """
+    singular = params.singular
     if np.any(singular):
-        for value in (m_f, m_r, k, k_m, F_a, joint_force):
+        for value in (params.m_f, params.m_r, params.k, params.k_m, params.F_a, params.joint_threshold_force):
             if value is not None:
                 value[singular] = np.inf
-        a[singular] = 0.0
-    if task_stiffness is not None:
-        from ..model.impulse import series_stiffness
+        params.a[singular] = 0.0
+    if task_stiffness is None:
+        return params
+    from ..model.impulse import series_stiffness
 
-        _validate.positive("task_stiffness", task_stiffness)
-        k = np.where(singular, np.inf, series_stiffness(k, task_stiffness))
-    return EffectiveParameters(m_f, m_r, k, k_m, F_a, a, singular, joint_force)
+    _validate.positive("task_stiffness", task_stiffness)
+    k = np.where(singular, np.inf, series_stiffness(params.k, task_stiffness))
+    return replace(params, k=k)
 
 
 # ---------------------------------------------------------------------- impulses
@@ -199,8 +246,8 @@ class CollisionImpulses:
 
 def collision_impulses(
     params: EffectiveParameters,
-    v0: Any,
-    threshold: Any = None,
+    v0: npt.ArrayLike,
+    threshold: npt.ArrayLike | None = None,
     sensing: str = "force",
     reaction: str = "at_rest",
 ) -> CollisionImpulses:
@@ -240,8 +287,10 @@ def collision_impulses(
     any_singular = bool(np.any(singular))
 
     def stand_in(value: Any) -> Any:
-        """Finite stand-ins along singular directions (their results are replaced below), so that the 1D
-        model sees only valid numbers; scalars pass as they are."""
+        """Finite stand-ins along singular directions (their results are replaced below).
+
+        So the 1D model sees only valid numbers; scalars pass as they are.
+        """
         value = np.asarray(value, dtype=float)
         return np.where(singular, 1.0, value) if any_singular and value.ndim else value
 
@@ -276,8 +325,10 @@ def _checked_index(config_index: Any, units: np.ndarray, count: int) -> np.ndarr
 
 
 def _quadratic_forms(task: np.ndarray, units: np.ndarray, index: np.ndarray | None) -> np.ndarray:
-    """``u^T G u`` of stacked task matrices ``task`` (q, n, m, m) for the grid of every configuration with every
-    direction (q, n, d), or for paired samples (q, n_samples)."""
+    """``u^T G u`` of stacked task matrices ``task`` (q, n, m, m).
+
+    For the grid of every configuration with every direction (q, n, d), or for paired samples (q, n_samples).
+    """
     if index is not None:
         return np.einsum("sa,qsab,sb->qs", units, task[:, index], units)
     # Every G with every u in one product: (q n, m^2) x (m^2, d).
@@ -289,8 +340,10 @@ def _quadratic_forms(task: np.ndarray, units: np.ndarray, index: np.ndarray | No
 def _reaction_compliance(
     jac: np.ndarray, torque: np.ndarray, units: np.ndarray, index: np.ndarray | None
 ) -> np.ndarray:
-    """``max_i |(J^T u)_i| / torque_i`` [1/N] (:func:`collision_reflex.model.effective.reaction_compliance`) for
-    the grid (n, d) or for paired samples (n_samples,)."""
+    """``max_i |(J^T u)_i| / torque_i`` [1/N], for the grid (n, d) or for paired samples (n_samples,).
+
+    As :func:`collision_reflex.model.effective.reaction_compliance`.
+    """
     # The torque fractions are linear in J^T u: scale the Jacobian's joint columns once, not every moment.
     scaled = formulas.torque_fractions(jac, torque)
     if index is not None:
@@ -309,8 +362,11 @@ def _reaction_compliance(
 def _paper_stiffness(
     jac: np.ndarray, joint_k: np.ndarray, units: np.ndarray, index: np.ndarray | None
 ) -> np.ndarray:
-    """``u^T J^-T K J^-1 u`` (``eq:eff_k``) for square Jacobians, through the SVD so that a singular Jacobian
-    gives ``inf`` along its singular direction and the finite limit perpendicular to it."""
+    """``u^T J^-T K J^-1 u`` (``eq:eff_k``) for square Jacobians [N/m].
+
+    Through the SVD, so that a singular Jacobian gives ``inf`` along its singular direction and the finite
+    limit perpendicular to it.
+    """
     if not np.all(np.isfinite(joint_k)):
         raise InvalidParameter("stiffness", joint_k, "finite joint stiffnesses for stiffness_form='paper'")
     left, sigma, right_t = np.linalg.svd(jac)

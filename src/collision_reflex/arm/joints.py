@@ -1,5 +1,7 @@
-"""Per-joint actuation of an arm (reflected inertia, torque limit, stiffnesses, motor mass) and the checks of
-per-joint input arrays."""
+"""Per-joint actuation of an arm and the checks of per-joint input arrays.
+
+The actuation: reflected inertia, torque limit, stiffnesses, motor mass.
+"""
 
 from __future__ import annotations
 
@@ -47,6 +49,7 @@ class JointParameters:
 
     @property
     def size(self) -> int:
+        """Number of joints."""
         return int(self.reflected_inertia.size)
 
     @classmethod

@@ -1,5 +1,8 @@
-"""The joint tree of a fixed-base Pinocchio model with 1-DoF joints: joint descriptions, the plane of a planar
-arm, and forward kinematics batched over configurations (SI: rad, m)."""
+"""The joint tree of a fixed-base Pinocchio model with 1-DoF joints.
+
+Joint descriptions, the plane of a planar arm, and forward kinematics batched over configurations (SI: rad,
+m).
+"""
 
 from __future__ import annotations
 
@@ -25,10 +28,12 @@ class JointKinematics:
 
     @property
     def rotation_skew(self) -> np.ndarray:
+        """``R_p K``: the placement rotation times the skew matrix of the axis (Rodrigues' ``sin`` term)."""
         return self.rotation @ skew(self.axis)
 
     @property
     def rotation_skew2(self) -> np.ndarray:
+        """``R_p K^2``: the placement rotation times the squared skew matrix (Rodrigues' ``1 - cos`` term)."""
         cross = skew(self.axis)
         return self.rotation @ cross @ cross
 
@@ -94,8 +99,11 @@ def joint_kinematics(model: Any, robot: str) -> list[JointKinematics]:
 
 
 def plane_basis(model: Any, joints: list[JointKinematics]) -> np.ndarray | None:
-    """(3, 2) world basis of the plane of motion when every revolute axis is parallel (and every prismatic
-    axis perpendicular to them) in all configurations; None for a spatial arm."""
+    """(3, 2) world basis of the plane of motion of a planar arm; None for a spatial arm.
+
+    An arm is planar when every revolute axis is parallel (and every prismatic axis perpendicular to them) in
+    all configurations.
+    """
     import pinocchio as pin
 
     data = model.createData()
@@ -128,6 +136,7 @@ def plane_basis(model: Any, joints: list[JointKinematics]) -> np.ndarray | None:
 
 
 def random_configuration(model: Any, joints: list[JointKinematics], rng: np.random.Generator) -> np.ndarray:
+    """A random configuration (nq,) of ``model`` [rad, m], drawn with ``rng``."""
     import pinocchio as pin
 
     q = pin.neutral(model)
@@ -143,9 +152,11 @@ def random_configuration(model: Any, joints: list[JointKinematics], rng: np.rand
 def forward_kinematics(
     joints: list[JointKinematics], q: np.ndarray
 ) -> tuple[list[np.ndarray], list[np.ndarray], list[np.ndarray]]:
-    """Joint frames for all configurations at once, one array per joint: rotations (n, 3, 3) and origins
-    (n, 3) of the joint frames, and the parent-side points of the joint origins (n, 3), where the motors
-    sit [m]."""
+    """Joint frames for all configurations at once, one array per joint.
+
+    Rotations (n, 3, 3) and origins (n, 3) [m] of the joint frames, and the parent-side points of the joint
+    origins (n, 3), where the motors sit [m].
+    """
     n = q.shape[0]
     rotations: list[np.ndarray] = []
     origins: list[np.ndarray] = []

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from ..errors import FrameNotFound, InvalidParameter
 from .directions import normalised_directions
@@ -29,8 +30,9 @@ from .samples import ArmSamples, task_inverse_inertia
 
 @dataclass(frozen=True)
 class Ellipsoid:
-    """Stacked ellipsoids ``{x : x^T A^-1 x <= 1}`` given by symmetric positive semi-definite matrices ``A``
-    (n, m, m); the semi-axes are the square roots of the eigenvalues of ``A``.
+    """Stacked ellipsoids ``{x : x^T A^-1 x <= 1}`` of symmetric positive semi-definite matrices ``A``.
+
+    ``A`` is (n, m, m); the semi-axes are the square roots of the eigenvalues of ``A``.
     """
 
     matrix: np.ndarray
@@ -45,17 +47,20 @@ class Ellipsoid:
         """(n, m, m) unit principal directions, one per column, in the order of :attr:`semi_axes`."""
         return np.linalg.eigh(self.matrix)[1]
 
-    def along(self, directions: Any) -> np.ndarray:
+    def along(self, directions: npt.ArrayLike) -> np.ndarray:
         """The quadratic form ``u^T A u`` for unit directions (d, m), (n, d)."""
         units = normalised_directions(directions, self.matrix.shape[-1])
         return np.einsum("da,nab,db->nd", units, self.matrix, units)
 
 
 def full_mass_matrix(
-    samples: ArmSamples, reflected_inertia: Any = None, motor_mass: Any = None
+    samples: ArmSamples,
+    reflected_inertia: npt.ArrayLike | None = None,
+    motor_mass: npt.ArrayLike | None = None,
 ) -> np.ndarray:
-    """``M = M_bb(q; m) + diag(N^2 J_m)`` (n, nv, nv): structure, motor masses [kg] and reflected rotor
-    inertia [kg m^2] (each default zero).
+    """``M = M_bb(q; m) + diag(N^2 J_m)`` (n, nv, nv).
+
+    Structure, motor masses [kg] and reflected rotor inertia [kg m^2] (each default zero).
     """
     mass = samples.structure_mass_matrix(motor_mass)
     if reflected_inertia is None:
@@ -65,7 +70,9 @@ def full_mass_matrix(
 
 
 def ellipsoid_of_gyration(
-    samples: ArmSamples, reflected_inertia: Any = None, motor_mass: Any = None
+    samples: ArmSamples,
+    reflected_inertia: npt.ArrayLike | None = None,
+    motor_mass: npt.ArrayLike | None = None,
 ) -> Ellipsoid:
     """``Lambda_0^-1 = J M^-1 J^T`` [1/kg]: defined at every configuration, singular ones included."""
     return Ellipsoid(
@@ -74,7 +81,9 @@ def ellipsoid_of_gyration(
 
 
 def generalized_inertia_ellipsoid(
-    samples: ArmSamples, reflected_inertia: Any = None, motor_mass: Any = None
+    samples: ArmSamples,
+    reflected_inertia: npt.ArrayLike | None = None,
+    motor_mass: npt.ArrayLike | None = None,
 ) -> Ellipsoid:
     """``Lambda_0 = (J M^-1 J^T)^-1`` [kg] (equal to ``J^-T M J^-1`` for a square Jacobian).
 
@@ -95,20 +104,27 @@ def generalized_inertia_ellipsoid(
 
 
 def dynamic_manipulability_ellipsoid(
-    samples: ArmSamples, reflected_inertia: Any = None, motor_mass: Any = None
+    samples: ArmSamples,
+    reflected_inertia: npt.ArrayLike | None = None,
+    motor_mass: npt.ArrayLike | None = None,
 ) -> Ellipsoid:
-    """``Lambda_d = J (M^T M)^-1 J^T`` [(m/s^2)^2 per (N m)^2]: the task accelerations reachable with joint
-    torques of unit norm lie in this ellipsoid.
+    """``Lambda_d = J (M^T M)^-1 J^T`` [(m/s^2)^2 per (N m)^2].
+
+    The task accelerations reachable with joint torques of unit norm lie in this ellipsoid.
     """
     mass = full_mass_matrix(samples, reflected_inertia, motor_mass)
     return Ellipsoid(task_inverse_inertia(np.swapaxes(mass, 1, 2) @ mass, samples.jacobian))
 
 
 def effective_mass(
-    samples: ArmSamples, directions: Any, reflected_inertia: Any = None, motor_mass: Any = None
+    samples: ArmSamples,
+    directions: npt.ArrayLike,
+    reflected_inertia: npt.ArrayLike | None = None,
+    motor_mass: npt.ArrayLike | None = None,
 ) -> np.ndarray:
-    """Effective mass ``(u^T J M^-1 J^T u)^-1`` [kg] of the whole arm (rotor inertia included) along each
-    direction, (n, d); ``inf`` along singular directions.
+    """Effective mass ``(u^T J M^-1 J^T u)^-1`` [kg] of the whole arm along each direction, (n, d).
+
+    Rotor inertia included; ``inf`` along singular directions.
     """
     gyration = ellipsoid_of_gyration(samples, reflected_inertia, motor_mass)
     inverse = gyration.along(directions)
@@ -141,8 +157,8 @@ class ImpactMitigation:
 
 def impact_mitigation_factor(
     robot: str | Any,
-    reflected_inertia: Any,
-    q: Any = None,
+    reflected_inertia: npt.ArrayLike,
+    q: npt.ArrayLike | None = None,
     contact_frame: str | None = None,
 ) -> ImpactMitigation:
     """Impact mitigation factor of a floating-base robot at a contact frame.

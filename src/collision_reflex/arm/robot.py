@@ -1,5 +1,6 @@
-"""The :class:`Arm`: a fixed-base URDF robot with a contact point and per-joint actuation, loaded through
-Pinocchio, with its configurations and its batched kinematics (:class:`ArmSamples`).
+"""The :class:`Arm`: a fixed-base URDF robot with a contact point and per-joint actuation.
+
+Loaded through Pinocchio, with its configurations and its batched kinematics (:class:`ArmSamples`).
 
 Conventions (SI throughout): the contact Jacobian is the translational Jacobian of the contact point in
 world-aligned axes; a planar arm (all joint axes parallel) is described in the plane perpendicular to its axes
@@ -13,28 +14,23 @@ from __future__ import annotations
 import os
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import numpy.typing as npt
 
 from ..errors import FrameNotFound, InvalidParameter, UrdfError
+from .actuation import joint_parameters, scaled_actuators, sensing_options
+from .configurations import ConfigurationSpace
 from .effective import EffectiveParameters, effective_parameters
-from .joints import JointParameters, joint_array
+from .joints import JointParameters
 from .kinematic_tree import joint_kinematics
-from .robots import (
-    ROBOT_DEFAULTS,
-    captured_stderr,
-    configuration_by_name,
-    example_robot,
-    load_urdf,
-    parser_reason,
-    with_locked_joints,
-)
+from .robots import captured_stderr, load_urdf, loaded_example_robot, parser_reason, with_locked_joints
 from .samples import ArmSamples, ContactKinematics
 
-# Joints whose limits are missing or meaningless (URDF "continuous", or lower >= upper) are sampled on a full
-# turn; limits beyond this magnitude are treated as missing.
-_UNBOUNDED_LIMIT = 1e3
+if TYPE_CHECKING:
+    from ..hardware.actuators import CurrentThreshold, ForceThreshold, PositionThreshold
+    from ..hardware.motors import Motor
 
 
 class Arm:
@@ -58,7 +54,7 @@ class Arm:
         self,
         model: Any,
         contact_frame: str,
-        contact_offset: Any = None,
+        contact_offset: npt.ArrayLike | None = None,
         actuators: Any = None,
         name: str = "",
         urdf_path: str | os.PathLike[str] | None = None,
@@ -95,20 +91,7 @@ class Arm:
         unknown = (effort <= 0) | (effort > 1e300) | ~np.isfinite(effort)
         self.urdf_torque_limit: np.ndarray = np.where(unknown, np.nan, effort)
         """The URDF's effort limit per joint [N m], ``nan`` where it gives none."""
-        if isinstance(actuators, JointParameters):
-            params = actuators
-        elif actuators is not None:
-            params = JointParameters.from_actuators(actuators, model.nv)
-        else:
-            params = JointParameters(
-                reflected_inertia=np.asarray(model.armature, dtype=float),
-                torque_limit=self.urdf_torque_limit,
-                stiffness=np.full(model.nv, np.inf),
-                mechanical_stiffness=np.full(model.nv, np.inf),
-                motor_mass=np.zeros(model.nv),
-            )
-        if params.size != model.nv:
-            raise InvalidParameter("actuators", params.size, f"{model.nv} joints' parameters")
+        params = joint_parameters(actuators, model.nv, model.armature, self.urdf_torque_limit)
         self.joint_parameters = params
         if actuators is None or isinstance(actuators, JointParameters):
             self.actuators: tuple[Any, ...] | None = None
@@ -126,6 +109,13 @@ class Arm:
         # Kinematics use a structure-only model (no armature), so ArmSamples.mass_matrix is M_bb0.
         self._structure = self._contact_kinematics.model
         self.plane = self._contact_kinematics.plane
+        self.configuration_space = ConfigurationSpace(
+            tuple(self._joints),
+            self.joint_names,
+            np.asarray(self._structure.lowerPositionLimit, dtype=float),
+            np.asarray(self._structure.upperPositionLimit, dtype=float),
+        )
+        """The joints as coordinates: limits, and the map to and from configurations."""
         self.reference_configuration: np.ndarray = np.array(pin.neutral(model))
         """A configuration to start from [rad, m]: the robot's reference pose when known, else neutral."""
         self._pin = pin
@@ -137,7 +127,7 @@ class Arm:
         path: str | os.PathLike[str],
         contact_frame: str,
         package_dirs: Sequence[str | os.PathLike[str]] | None = None,
-        contact_offset: Any = None,
+        contact_offset: npt.ArrayLike | None = None,
         actuators: Any = None,
         locked_joints: Sequence[str] = (),
         name: str = "",
@@ -165,43 +155,30 @@ class Arm:
         cls,
         name: str,
         contact_frame: str | None = None,
-        contact_offset: Any = None,
+        contact_offset: npt.ArrayLike | None = None,
         actuators: Any = None,
         locked_joints: Sequence[str] | None = None,
     ) -> Arm:
-        """Load a robot of the ``example-robot-data`` package by name (``"ur5"``, ``"panda"``,
-        ``"double_pendulum"``, ...).
+        """Load a robot of the ``example-robot-data`` package by name.
+
+        Names such as ``"ur5"``, ``"panda"``, ``"double_pendulum"``, ...
 
         Defaults per robot: Panda contacts at ``panda_hand_tcp`` with its two finger joints locked; UR robots at
         ``tool0``; the double pendulum at its second link's tip (0.2 m along the link); legged robots (``solo12``,
         ``a1``) at the front-left foot with the base fixed to the world. Other robots need ``contact_frame``.
         ``locked_joints`` replaces the default list of locked joints (``()`` locks none).
         """
-        full_model, urdf, q0 = example_robot(name)
-        model = full_model
-        defaults = ROBOT_DEFAULTS.get(name, {})
-        if contact_frame is None:
-            if "contact_frame" not in defaults:
-                raise InvalidParameter(
-                    "contact_frame",
-                    None,
-                    f"a frame name for {name!r} (no default is known)",
-                    "frames: " + ", ".join(f.name for f in model.frames),
-                )
-            contact_frame = defaults["contact_frame"]
-            if contact_offset is None:
-                contact_offset = defaults.get("contact_offset")
-        if model.njoints > 1 and model.joints[1].nq == 7:  # free-flyer root: fix the base to the world
-            model = load_urdf(urdf)
-        to_lock = defaults.get("locked_joints", ()) if locked_joints is None else tuple(locked_joints)
-        model = with_locked_joints(model, to_lock, name)
-        # The robots' URDFs name their meshes package://example-robot-data/robots/...: the package directory
-        # is two levels above the "robots" directory.
-        share = Path(urdf).resolve()
-        while share.name != "robots" and share != share.parent:
-            share = share.parent
-        arm = cls(model, contact_frame, contact_offset, actuators, name, urdf, [share.parent.parent])
-        arm.reference_configuration = configuration_by_name(full_model, q0, model)
+        robot = loaded_example_robot(name, contact_frame, contact_offset, locked_joints)
+        arm = cls(
+            robot.model,
+            robot.contact_frame,
+            robot.contact_offset,
+            actuators,
+            name,
+            robot.urdf,
+            [robot.package_dir],
+        )
+        arm.reference_configuration = robot.reference_configuration
         return arm
 
     def with_actuators(self, actuators: Any) -> Arm:
@@ -221,16 +198,17 @@ class Arm:
     def with_scaled_motors(
         self,
         stator_diameter: float,
-        torque_required: Any = None,
+        torque_required: npt.ArrayLike | None = None,
         *,
-        reference: Any = None,
+        reference: Motor | None = None,
         law: str = "haddadin",
-        mechanical_stiffness: Any = np.inf,
-        software_stiffness: Any = np.inf,
-        sensing: Any = None,
+        mechanical_stiffness: npt.ArrayLike = np.inf,
+        software_stiffness: npt.ArrayLike = np.inf,
+        sensing: ForceThreshold | PositionThreshold | CurrentThreshold | None = None,
     ) -> Arm:
-        """The same arm with a scaled motor at every joint, geared to meet a torque requirement (the paper's
-        sweep of ``tab:motor_params``): ``N_i = max(1, tau_req,i / tau_p(r))``.
+        """The same arm with a scaled motor at every joint, geared to meet a torque requirement.
+
+        The paper's sweep of ``tab:motor_params``: ``N_i = max(1, tau_req,i / tau_p(r))``.
 
         Parameters
         ----------
@@ -243,52 +221,28 @@ class Arm:
         sensing: a sensing scheme of :mod:`collision_reflex.hardware.actuators` for every joint; default a 3 N force
             threshold.
         """
-        from ..hardware.actuators import Actuator, ForceThreshold, gear_ratio_for
-        from ..hardware.motors import reference_motor
-
         required = self.urdf_torque_limit if torque_required is None else torque_required
-        required = joint_array("torque_required", required, self.nv)
-        motor = (reference if reference is not None else reference_motor()).scaled(
-            stator_diameter=stator_diameter, law=law
+        actuators = scaled_actuators(
+            stator_diameter,
+            required,
+            self.nv,
+            reference=reference,
+            law=law,
+            mechanical_stiffness=mechanical_stiffness,
+            software_stiffness=software_stiffness,
+            sensing=sensing,
         )
-        ratios = np.atleast_1d(gear_ratio_for(required, motor.peak_torque))
-        k_mech = joint_array("mechanical_stiffness", mechanical_stiffness, self.nv, allow_inf=True)
-        k_soft = joint_array("software_stiffness", software_stiffness, self.nv, allow_inf=True)
-        scheme = ForceThreshold() if sensing is None else sensing
-        actuators = [
-            Actuator(motor, float(ratios[i]), float(k_mech[i]), float(k_soft[i]), scheme)
-            for i in range(self.nv)
-        ]
         return self.with_actuators(actuators)
 
     def sensing_options(self) -> dict[str, Any]:
-        """The sensing of this arm's actuators as keyword arguments: ``{"sensing": "force", "threshold": F_s}``
-        for force thresholds at the contact, or ``{"sensing": "current", "joint_threshold": tau_s}`` [N m]
-        for the joint-side schemes (motor current, and joint position errors, whose threshold is the joint
-        torque ``k e_th`` as well), where the first joint to reach its threshold detects the contact."""
-        from ..hardware.actuators import ForceThreshold
+        """The sensing of this arm's actuators as keyword arguments.
 
-        if not self.actuators:
-            raise InvalidParameter(
-                "actuators", None, "Actuator objects with sensing schemes", "give the threshold explicitly"
-            )
-        schemes = [actuator.sensing for actuator in self.actuators]
-        if all(isinstance(scheme, ForceThreshold) for scheme in schemes):
-            forces = {float(scheme.force) for scheme in schemes}
-            if len(forces) > 1:
-                raise InvalidParameter(
-                    "actuators", sorted(forces), "one contact-force threshold for the whole arm"
-                )
-            return {"sensing": "force", "threshold": forces.pop()}
-        if any(isinstance(scheme, ForceThreshold) for scheme in schemes):
-            raise InvalidParameter(
-                "actuators", [type(s).__name__ for s in schemes], "force thresholds at every joint or at none"
-            )
-        torques = [
-            scheme.joint_threshold_torque(actuator)
-            for scheme, actuator in zip(schemes, self.actuators, strict=True)
-        ]
-        return {"sensing": "current", "joint_threshold": np.array(torques)}
+        ``{"sensing": "force", "threshold": F_s}`` [N] for force thresholds at the contact, or
+        ``{"sensing": "current", "joint_threshold": tau_s}`` [N m] for the joint-side schemes (motor current,
+        and joint position errors, whose threshold is the joint torque ``k e_th`` as well), where the first
+        joint to reach its threshold detects the contact.
+        """
+        return sensing_options(self.actuators)
 
     def visual_model(self) -> Any:
         """Pinocchio visual ``GeometryModel`` of the URDF, meshes resolved through ``package_dirs``."""
@@ -313,10 +267,12 @@ class Arm:
     # ------------------------------------------------------------------ properties
     @property
     def nq(self) -> int:
+        """Size of a configuration vector (a continuous joint counts twice: cosine and sine)."""
         return int(self._structure.nq)
 
     @property
     def nv(self) -> int:
+        """Number of joints (degrees of freedom)."""
         return int(self._structure.nv)
 
     @property
@@ -344,53 +300,18 @@ class Arm:
     # ------------------------------------------------------------------ configurations
     def joint_limits(self) -> tuple[np.ndarray, np.ndarray]:
         """Lower and upper limit per joint [rad or m], (nv,) each; a full turn where the URDF gives none."""
-        lower = np.empty(self.nv)
-        upper = np.empty(self.nv)
-        low_q = np.asarray(self._structure.lowerPositionLimit, dtype=float)
-        high_q = np.asarray(self._structure.upperPositionLimit, dtype=float)
-        for v, joint in enumerate(self._joints):
-            lo, hi = (low_q[joint.idx_q], high_q[joint.idx_q]) if joint.nq == 1 else (np.nan, np.nan)
-            bounded = (
-                np.isfinite(lo) and np.isfinite(hi) and lo < hi and max(abs(lo), abs(hi)) < _UNBOUNDED_LIMIT
-            )
-            if bounded:
-                lower[v], upper[v] = lo, hi
-            elif joint.revolute:
-                lower[v], upper[v] = -np.pi, np.pi
-            else:
-                raise InvalidParameter(
-                    "joint limits",
-                    (lo, hi),
-                    f"finite limits for prismatic joint {self.joint_names[v]!r}",
-                    "add <limit lower=... upper=...> to the URDF",
-                )
-        return lower, upper
+        return self.configuration_space.joint_limits()
 
-    def configuration(self, angles: Any) -> np.ndarray:
-        """Configurations (..., nq) from joint coordinates (..., nv) [rad or m] (unbounded revolute joints are
-        stored by Pinocchio as cosine and sine)."""
-        angles = np.asarray(angles, dtype=float)
-        if angles.shape[-1:] != (self.nv,):
-            raise InvalidParameter("angles", angles.shape, f"a last axis of {self.nv} joint coordinates")
-        q = np.empty((*angles.shape[:-1], self.nq))
-        for v, joint in enumerate(self._joints):
-            if joint.nq == 1:
-                q[..., joint.idx_q] = angles[..., v]
-            else:
-                q[..., joint.idx_q] = np.cos(angles[..., v])
-                q[..., joint.idx_q + 1] = np.sin(angles[..., v])
-        return q
+    def configuration(self, angles: npt.ArrayLike) -> np.ndarray:
+        """Configurations (..., nq) from joint coordinates (..., nv) [rad or m].
 
-    def joint_coordinates(self, q: Any) -> np.ndarray:
+        Unbounded revolute joints are stored by Pinocchio as cosine and sine.
+        """
+        return self.configuration_space.configuration(angles)
+
+    def joint_coordinates(self, q: npt.ArrayLike) -> np.ndarray:
         """Joint angles or displacements (..., nv) of configurations (..., nq) [rad or m]."""
-        q = self._checked_q(q)
-        out = np.empty((q.shape[0], self.nv))
-        for v, joint in enumerate(self._joints):
-            if joint.nq == 1:
-                out[:, v] = q[:, joint.idx_q]
-            else:
-                out[:, v] = np.arctan2(q[:, joint.idx_q + 1], q[:, joint.idx_q])
-        return out
+        return self.configuration_space.joint_coordinates(q)
 
     def sample_configurations(self, count: int, rng: np.random.Generator) -> np.ndarray:
         """``count`` configurations drawn uniformly within the joint limits, shape (count, nq).
@@ -400,17 +321,10 @@ class Arm:
         count: number of configurations, >= 1.
         rng: the random generator (``numpy.random.default_rng(seed)``), for reproducible samples.
         """
-        if not isinstance(rng, np.random.Generator):
-            raise InvalidParameter(
-                "rng", rng, "a numpy.random.Generator", "use numpy.random.default_rng(seed)"
-            )
-        if int(count) != count or count < 1:
-            raise InvalidParameter("count", count, "an integer >= 1")
-        lower, upper = self.joint_limits()
-        return self.configuration(rng.uniform(lower, upper, size=(int(count), self.nv)))
+        return self.configuration_space.sample(count, rng)
 
     # ------------------------------------------------------------------ kinematics
-    def kinematics(self, q: Any, *, full: bool = True) -> ArmSamples:
+    def kinematics(self, q: npt.ArrayLike, *, full: bool = True) -> ArmSamples:
         """Mass matrix, contact Jacobian, gravity and motor-mass terms at configurations ``q`` (n, nq).
 
         Pinocchio evaluates the mass matrix (CRBA) and the contact Jacobian once per configuration, and with
@@ -419,13 +333,15 @@ class Arm:
         only what the effective collision parameters need (``q``, ``mass_matrix``, ``jacobian``; the other
         fields are None).
         """
-        return self._contact_kinematics.samples(self._checked_q(q), full)
+        return self._contact_kinematics.samples(self.configuration_space.checked(q), full)
 
     def effective_parameters(
-        self, samples: ArmSamples, directions: Any, **options: Any
+        self, samples: ArmSamples, directions: npt.ArrayLike, **options: Any
     ) -> EffectiveParameters:
-        """:func:`effective_parameters` with this arm's joint parameters (motor masses included); keyword
-        ``options`` are passed on and may override any of them."""
+        """:func:`effective_parameters` with this arm's joint parameters (motor masses included).
+
+        Keyword ``options`` are passed on and may override any of them.
+        """
         params = self.joint_parameters
         kwargs: dict[str, Any] = {
             "reflected_inertia": params.reflected_inertia,
@@ -436,11 +352,3 @@ class Arm:
         }
         kwargs.update(options)
         return effective_parameters(samples, directions, **kwargs)
-
-    def _checked_q(self, q: Any) -> np.ndarray:
-        q = np.atleast_2d(np.asarray(q, dtype=float))
-        if q.ndim != 2 or q.shape[1] != self.nq:
-            raise InvalidParameter("q", q.shape, f"configurations of shape (n, {self.nq})")
-        if not np.all(np.isfinite(q)):
-            raise InvalidParameter("q", q, "finite joint coordinates")
-        return q

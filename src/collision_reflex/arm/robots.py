@@ -1,5 +1,7 @@
-"""Loading robot models: URDF files through Pinocchio (with the parser's own reasons for failures) and the
-robots of ``example-robot-data`` (with sensible contact points and locked joints).
+"""Loading robot models: URDF files through Pinocchio and the robots of ``example-robot-data``.
+
+URDF failures carry the parser's own reasons; the stock robots get sensible contact points and locked
+joints.
 """
 
 from __future__ import annotations
@@ -11,6 +13,7 @@ import sys
 import tempfile
 import xml.etree.ElementTree as ElementTree
 from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -55,17 +58,82 @@ def _cachedexample_robot(name: str) -> tuple[Any, str, np.ndarray]:
     return robot.model, str(robot.urdf), np.array(robot.q0, dtype=float)
 
 
+@dataclass(frozen=True)
+class ExampleRobot:
+    """An example-robot-data robot made ready for :class:`~collision_reflex.arm.Arm`.
+
+    Attributes
+    ----------
+    model: its fixed-base Pinocchio model, the locked joints removed.
+    contact_frame: the frame that makes contact.
+    contact_offset: the contact point in that frame [m], or None for its origin.
+    urdf: the robot's URDF file.
+    package_dir: the directory that resolves its ``package://`` mesh references.
+    reference_configuration: the robot's reference pose in ``model``'s coordinates [rad, m], (nq,).
+    """
+
+    model: Any
+    contact_frame: str
+    contact_offset: Any
+    urdf: str
+    package_dir: Path
+    reference_configuration: np.ndarray
+
+
+def loaded_example_robot(
+    name: str, contact_frame: str | None, contact_offset: Any, locked_joints: Sequence[str] | None
+) -> ExampleRobot:
+    """Load ``name`` with the defaults of :data:`ROBOT_DEFAULTS` for what the caller leaves None.
+
+    The contact offset [m] defaults with the frame only; ``locked_joints`` replaces the default list (``()``
+    locks none); a floating base is fixed to the world.
+    """
+    full_model, urdf, q0 = example_robot(name)
+    model = full_model
+    defaults = ROBOT_DEFAULTS.get(name, {})
+    if contact_frame is None:
+        if "contact_frame" not in defaults:
+            raise InvalidParameter(
+                "contact_frame",
+                None,
+                f"a frame name for {name!r} (no default is known)",
+                "frames: " + ", ".join(f.name for f in model.frames),
+            )
+        contact_frame = defaults["contact_frame"]
+        if contact_offset is None:
+            contact_offset = defaults.get("contact_offset")
+    if model.njoints > 1 and model.joints[1].nq == 7:  # free-flyer root: fix the base to the world
+        model = load_urdf(urdf)
+    to_lock = defaults.get("locked_joints", ()) if locked_joints is None else tuple(locked_joints)
+    model = with_locked_joints(model, to_lock, name)
+    # The robots' URDFs name their meshes package://example-robot-data/robots/...: the package directory
+    # is two levels above the "robots" directory.
+    share = Path(urdf).resolve()
+    while share.name != "robots" and share != share.parent:
+        share = share.parent
+    return ExampleRobot(
+        model,
+        contact_frame,
+        contact_offset,
+        urdf,
+        share.parent.parent,
+        configuration_by_name(full_model, q0, model),
+    )
+
+
 def example_robot(name: str) -> tuple[Any, str, np.ndarray]:
-    """The Pinocchio model (a copy), URDF path and reference configuration of an example-robot-data robot;
-    loading parses meshes and is slow, so it happens once per name.
+    """The Pinocchio model (a copy), URDF path and reference configuration of an example-robot-data robot.
+
+    Loading parses meshes and is slow, so it happens once per name.
     """
     model, urdf, q0 = _cachedexample_robot(name)
     return model.copy(), urdf, q0.copy()
 
 
 def configuration_by_name(source: Any, q_source: np.ndarray, target: Any) -> np.ndarray:
-    """A configuration of ``target`` taking each joint's coordinates from ``q_source`` of ``source`` (same joint
-    names), neutral for joints ``source`` does not have.
+    """A configuration of ``target`` taking each joint's coordinates from ``q_source`` of ``source``.
+
+    Joints are matched by name; joints ``source`` does not have are neutral.
     """
     import pinocchio as pin
 
@@ -128,8 +196,9 @@ class _Captured:
 
 @contextlib.contextmanager
 def captured_stderr() -> Iterator[_Captured]:
-    """Capture what C++ code writes to the process's stderr (file descriptor 2) while the block runs; the text
-    is in the yielded object's ``text`` once the block has ended.
+    """Capture what C++ code writes to the process's stderr (file descriptor 2) while the block runs.
+
+    The text is in the yielded object's ``text`` once the block has ended.
     """
     captured = _Captured()
     sys.stderr.flush()

@@ -1,5 +1,7 @@
-"""Configuration-dependent quantities of an arm stacked over configurations (:class:`ArmSamples`), and the
-task-space inverse inertia they give."""
+"""Configuration-dependent quantities of an arm stacked over configurations, and their task inverse inertia.
+
+The stack is :class:`ArmSamples`; the task-space inverse inertia is ``J M^-1 J^T``.
+"""
 
 from __future__ import annotations
 
@@ -7,6 +9,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from ..errors import InvalidParameter
 from ..model import effective
@@ -84,10 +87,12 @@ class ArmSamples:
 
     @property
     def nv(self) -> int:
+        """Number of joints."""
         return int(self.mass_matrix.shape[-1])
 
     @property
     def task_dim(self) -> int:
+        """Dimension of the contact space: 2 for a planar arm, 3 otherwise."""
         return int(self.jacobian.shape[1])
 
     def take(self, index: Any) -> ArmSamples:
@@ -103,7 +108,7 @@ class ArmSamples:
                 picked[name] = None
         return ArmSamples(**picked)
 
-    def structure_mass_matrix(self, motor_mass: Any = None) -> np.ndarray:
+    def structure_mass_matrix(self, motor_mass: npt.ArrayLike | None = None) -> np.ndarray:
         """``M_bb(q; m) = M_bb0(q) + sum_i m_i A_i(q)`` [kg m^2], (n, nv, nv); ``motor_mass`` [kg], (nv,)."""
         if motor_mass is None:
             return self.mass_matrix
@@ -122,8 +127,9 @@ class ArmSamples:
 
 @dataclass(frozen=True)
 class ContactKinematics:
-    """What the batched kinematics of an arm needs: its structure-only Pinocchio model (no armature), with a
-    frame at the contact point, and the joint tree.
+    """What the batched kinematics of an arm needs.
+
+    Its structure-only Pinocchio model (no armature), with a frame at the contact point, and the joint tree.
 
     model, data: the structure model and its data.
     contact_frame_id: the frame at the contact point.
@@ -149,8 +155,10 @@ class ContactKinematics:
     def of_model(
         cls, model: Any, joints: list[JointKinematics], contact_joint: int, contact_local: np.ndarray
     ) -> ContactKinematics:
-        """From a fixed-base ``pinocchio.Model`` (copied), its joint tree and the contact point, ``contact_local``
-        [m] in the frame of joint ``contact_joint``."""
+        """From a fixed-base ``pinocchio.Model`` (copied), its joint tree and the contact point.
+
+        The contact point is ``contact_local`` [m] in the frame of joint ``contact_joint``.
+        """
         import pinocchio as pin
 
         structure = model.copy()
@@ -178,8 +186,10 @@ class ContactKinematics:
         )
 
     def samples(self, q: np.ndarray, full: bool = True) -> ArmSamples:
-        """:class:`ArmSamples` at checked configurations ``q`` (n, nq) [rad, m], see
-        :meth:`collision_reflex.arm.Arm.kinematics`."""
+        """:class:`ArmSamples` at checked configurations ``q`` (n, nq) [rad, m].
+
+        See :meth:`collision_reflex.arm.Arm.kinematics`.
+        """
         import pinocchio as pin
 
         model, data = self.model, self.data
@@ -226,8 +236,11 @@ class ContactKinematics:
 
 
 def task_inverse_inertia(mass_matrix: np.ndarray, jacobian: np.ndarray) -> np.ndarray:
-    """``J M^-1 J^T`` for stacked mass matrices (n, nv, nv) [kg m^2] and Jacobians (n, m, nv) [m/rad],
-    (n, m, m) [1/kg]: the inverse of the task-space (operational-space) inertia, the ellipsoid of gyration."""
+    """``J M^-1 J^T`` (n, m, m) [1/kg] for stacked mass matrices and Jacobians.
+
+    Mass matrices (n, nv, nv) [kg m^2], Jacobians (n, m, nv) [m/rad]. The result is the inverse of the
+    task-space (operational-space) inertia, the ellipsoid of gyration.
+    """
     try:
         return np.asarray(effective.task_inverse_inertia(jacobian, mass_matrix))
     except np.linalg.LinAlgError:

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from ..errors import InvalidParameter
 from .directions import unit_directions
@@ -58,11 +59,13 @@ class ReflexSurface:
 
     @property
     def task_dim(self) -> int:
+        """Dimension of the directions: 2 for a planar arm, 3 otherwise."""
         return int(self.directions.shape[1])
 
     def points(self, scale: float = 1.0, cap: float | None = None) -> np.ndarray:
-        """Surface points ``scale * min(I(u), cap) * u`` relative to the contact point, (d, task_dim)
-        [m per N s times ``scale``]; ``cap`` [N s] bounds the infinite values of singular directions.
+        """Surface points ``scale * min(I(u), cap) * u`` relative to the contact point, (d, task_dim).
+
+        In [m per N s times ``scale``]; ``cap`` [N s] bounds the infinite values of singular directions.
         """
         radius = self.impulse if cap is None else np.minimum(self.impulse, cap)
         return scale * radius[:, None] * self.directions
@@ -80,16 +83,16 @@ class ReflexSurface:
 
 def reflex_surface(
     arm: Arm,
-    q: Any,
+    q: npt.ArrayLike,
     v0: float,
-    threshold: Any = None,
+    threshold: npt.ArrayLike | None = None,
     *,
     directions: Any = None,
     sensing: str | None = None,
     reaction: str = "at_rest",
-    task_stiffness: Any = None,
+    task_stiffness: npt.ArrayLike | None = None,
     stiffness_form: str = "compliance",
-    joint_threshold: Any = None,
+    joint_threshold: npt.ArrayLike | None = None,
 ) -> ReflexSurface:
     """The collision-reflex surface of ``arm`` at configuration ``q``.
 

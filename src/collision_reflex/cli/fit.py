@@ -65,7 +65,7 @@ def run(args: argparse.Namespace) -> int:
         args.traces,
         time_unit=args.time_unit,
         force_unit=args.force_unit,
-        velocity=args.v0,
+        v0=args.v0,
         system=args.system,
         k_m=args.k_m,
         bandwidth=args.bandwidth,
@@ -94,7 +94,7 @@ def _print_trials(results: ExperimentResults) -> None:
         f"{'m_f [kg]':>11}{'k_s [N/m]':>11}{'F_s [N]':>9}{'a [m/s^2]':>11}"
     )
     for t in results.trials:
-        v0 = f"{t.trace.velocity:>10.4g}" if t.trace.velocity is not None else f"{'-':>10}"
+        v0 = f"{t.trace.v0:>10.4g}" if t.trace.v0 is not None else f"{'-':>10}"
         line = (
             f"{t.trace.system[:11]:<12}{t.trace.label[:21]:<22}{v0}{t.impulse.value:>12.5g}"
             f"{t.impulse.uncertainty:>10.2g}{t.impulse.trapezoid:>12.5g}"
@@ -157,6 +157,6 @@ def _write_outputs(out: Path, results: ExperimentResults, figures: bool) -> None
         stem = re.sub(r"[^A-Za-z0-9_.-]+", "_", f"{trial.trace.system}_{trial.trace.label}".strip("_"))
         plot_trace_fit(out / "traces" / f"{stem}.png", trial)
     written = [f"{len(results.trials)} trace figures in {out / 'traces'}"]
-    if any(t.trace.velocity is not None for t in results.trials):
+    if any(t.trace.v0 is not None for t in results.trials):
         written.append(str(plot_impulse_velocity(out / "impulse_velocity.png", results)))
     print("wrote " + ", ".join(written))

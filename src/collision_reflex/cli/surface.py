@@ -5,11 +5,16 @@ from __future__ import annotations
 import argparse
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from . import options
 from .options import Alias
+
+if TYPE_CHECKING:
+    from ..arm import Arm
+    from ..arm.surfaces import ReflexSurface
 
 # Defaults of the paper's two-link example (fig:two_link; fig:motor_scale_modeling for stiffness and threshold):
 # Omni+ motors of 60 mm stator diameter geared to the URDF's torque limits, q2 = 45 deg, v0 = 0.5 m/s, a 3 N
@@ -45,6 +50,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
             f"Default arm: {_DEFAULT_URDF} (relative to the current directory), contact frame 'tip'."
         ),
     )
+    _add_arm_options(parser)
+    _add_actuation_options(parser)
+    _add_sweep_options(parser)
+    options.add_plot(parser, "reflex_surface.png", aliases=["--output", "-o"])
+    options.add_csv(parser, what="the baseline surface, one row per direction,", aliases=["--table"])
+    parser.set_defaults(run=run)
+
+
+def _add_arm_options(parser: argparse.ArgumentParser) -> None:
+    """The arm: its URDF or robot, contact frame and offset, packages, locked joints and configuration."""
     add = parser.add_argument
     source = parser.add_mutually_exclusive_group()
     source.add_argument(
@@ -86,6 +101,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="joint angles [deg] (prismatic joints [m]); default q1 = 0, q2 = 45 for a planar arm, the robot's "
         "reference pose otherwise",
     )
+
+
+def _add_actuation_options(parser: argparse.ArgumentParser) -> None:
+    """The motors, joint springs, controller stiffness, threshold and approach velocity of the baseline."""
     options.STATOR_DIAMETER.add(parser, _DEFAULTS["stator_diameter"], aliases=[Alias("--motor-size", "mm")])
     options.TORQUE_REQUIRED.add(
         parser, nargs="+", note="one value or one per joint", shown="the URDF effort limits"
@@ -95,6 +114,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     options.TASK_STIFFNESS.add(parser, _DEFAULTS["task_stiffness"])
     options.THRESHOLD.add(parser, _DEFAULTS["F_s"])
     options.APPROACH_VELOCITY.add(parser, _DEFAULTS["v0"])
+
+
+def _add_sweep_options(parser: argparse.ArgumentParser) -> None:
+    """The stiffness form, the directions swept and the planar grid's rows.
+
+    The rows: second joint angles, motor sizes, approach velocities.
+    """
+    add = parser.add_argument
     add(
         "--stiffness-form",
         choices=("compliance", "paper"),
@@ -116,36 +143,18 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         aliases=[Alias("--motor-sizes", "mm")],
     )
     options.APPROACH_VELOCITIES.add(parser, _DEFAULTS["velocities"], note="the grid's third row")
-    options.add_plot(parser, "reflex_surface.png", aliases=["--output", "-o"])
-    options.add_csv(parser, what="the baseline surface, one row per direction,", aliases=["--table"])
-    parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
     """Run ``crx surface`` with parsed ``args``; return the exit status."""
-    from ..arm import Arm
     from ..arm.surfaces import reflex_surface
     from ..errors import InvalidParameter
     from ..plots import check_figure_path
 
     check_figure_path(args.plot)
-    if args.robot is not None:
-        arm = Arm.from_example_robot_data(args.robot, args.frame, args.offset, locked_joints=args.lock)
-    else:
-        path = args.urdf if args.urdf is not None else _DEFAULT_URDF
-        arm = Arm.from_urdf(
-            path, args.frame or "tip", args.package_dir, args.offset, locked_joints=args.lock or ()
-        )
+    arm = _load_arm(args)
     q = _configuration(arm, args.q)
-    if args.torque is None and np.any(np.isnan(arm.urdf_torque_limit)):
-        raise InvalidParameter(
-            "--torque",
-            None,
-            f"a torque requirement [N m] for the joints of {arm.name}",
-            "its URDF gives no effort limits; pass --torque T (one value or one per joint)",
-        )
-    if args.torque is not None and len(args.torque) not in (1, arm.nv):
-        raise InvalidParameter("--torque", args.torque, f"one value or {arm.nv} values [N m]")
+    _check_torque(arm, args.torque)
     settings = {
         "task_stiffness": args.task_stiffness,
         "stiffness_form": args.stiffness_form,
@@ -154,64 +163,115 @@ def run(args: argparse.Namespace) -> int:
     if args.directions is not None and args.directions < 3:
         raise InvalidParameter("--directions", args.directions, "at least 3")
 
-    def actuated(stator_diameter: float) -> Arm:
-        from ..hardware.actuators import ForceThreshold
-
-        return arm.with_scaled_motors(
-            stator_diameter,
-            args.torque if args.torque is None or len(args.torque) > 1 else args.torque[0],
-            mechanical_stiffness=args.mechanical_stiffness,
-            software_stiffness=args.software_stiffness,
-            sensing=ForceThreshold(args.F_s),
-        )
-
-    base_arm = actuated(args.stator_diameter)
+    base_arm = _actuated(arm, args, args.stator_diameter)
     baseline = reflex_surface(base_arm, q, args.v0, **settings)
     _print_summary(base_arm, baseline)
     if args.csv is not None:
         _write_table(args.csv, baseline)
         print(f"wrote {args.csv}")
-
     if arm.task_dim == 2:
-        from ..plots.surface import SurfaceRow, plot_planar_grid
-
-        if arm.nv < 2:
-            raise InvalidParameter("arm", arm.name, "at least two joints for the grid's second-joint row")
-        angle_row = []
-        for angle in args.q2_values:
-            varied = q.copy()
-            varied[_SECOND_JOINT] = math.radians(angle)
-            angle_row.append(reflex_surface(base_arm, varied, args.v0, **settings))
-        motor_row = [reflex_surface(actuated(d), q, args.v0, **settings) for d in args.stator_diameters]
-        velocity_row = [reflex_surface(base_arm, q, v, **settings) for v in args.velocities]
-        rows = [
-            SurfaceRow("second joint angle", angle_row, [f"q2 = {a:g}°" for a in args.q2_values]),
-            SurfaceRow("motor size", motor_row, [f"r_m = {d * 1e3:g} mm" for d in args.stator_diameters]),
-            SurfaceRow("approach velocity", velocity_row, [f"v0 = {v:g} m/s" for v in args.velocities]),
-        ]
-        title = (
-            f"{arm.name}: q2 = {math.degrees(q[_SECOND_JOINT]):g}°, r_m = {args.stator_diameter * 1e3:g} mm, "
-            f"v0 = {args.v0:g} m/s unless stated; F_s = {args.F_s:g} N"
-        )
-        written = plot_planar_grid(args.plot, rows, title)
+        written = _plot_planar_grid(arm, base_arm, q, args, settings)
     else:
-        from ..arm.directions import COORDINATE_PLANES, plane_directions
-        from ..plots.surface import plot_spatial_surface
-
-        count = args.directions or 360
-        sections = {
-            name: reflex_surface(
-                base_arm, q, args.v0, **{**settings, "directions": plane_directions(name, count)}
-            )
-            for name in COORDINATE_PLANES
-        }
-        title = f"{arm.name} at q = {np.round(np.degrees(q), 1).tolist()} deg, r_m = {args.stator_diameter * 1e3:g} mm, v0 = {args.v0:g} m/s"
-        written = plot_spatial_surface(args.plot, baseline, sections, title)
+        written = _plot_spatial(base_arm, baseline, q, args, settings)
     print(f"wrote {written}")
     return 0
 
 
-def _configuration(arm, degrees: list[float] | None) -> np.ndarray:
+def _load_arm(args: argparse.Namespace) -> Arm:
+    """The arm named by ``--robot``, else read from ``--urdf`` (default the paper's two-link URDF)."""
+    from ..arm import Arm
+
+    if args.robot is not None:
+        return Arm.from_example_robot_data(args.robot, args.frame, args.offset, locked_joints=args.lock)
+    path = args.urdf if args.urdf is not None else _DEFAULT_URDF
+    return Arm.from_urdf(
+        path, args.frame or "tip", args.package_dir, args.offset, locked_joints=args.lock or ()
+    )
+
+
+def _check_torque(arm: Arm, torque: list[float] | None) -> None:
+    """Raise :class:`InvalidParameter` unless a torque requirement [N m] is known for every joint."""
+    from ..errors import InvalidParameter
+
+    if torque is None and np.any(np.isnan(arm.urdf_torque_limit)):
+        raise InvalidParameter(
+            "--torque",
+            None,
+            f"a torque requirement [N m] for the joints of {arm.name}",
+            "its URDF gives no effort limits; pass --torque T (one value or one per joint)",
+        )
+    if torque is not None and len(torque) not in (1, arm.nv):
+        raise InvalidParameter("--torque", torque, f"one value or {arm.nv} values [N m]")
+
+
+def _actuated(arm: Arm, args: argparse.Namespace, stator_diameter: float) -> Arm:
+    """``arm`` with scaled motors of ``stator_diameter`` [m], and the springs and threshold of ``args``."""
+    from ..hardware.actuators import ForceThreshold
+
+    return arm.with_scaled_motors(
+        stator_diameter,
+        args.torque if args.torque is None or len(args.torque) > 1 else args.torque[0],
+        mechanical_stiffness=args.mechanical_stiffness,
+        software_stiffness=args.software_stiffness,
+        sensing=ForceThreshold(args.F_s),
+    )
+
+
+def _plot_planar_grid(
+    arm: Arm, base_arm: Arm, q: np.ndarray, args: argparse.Namespace, settings: dict[str, Any]
+) -> Path:
+    """The paper's grid for a planar arm: rows over the second joint angle, the motor size and ``v0``."""
+    from ..arm.surfaces import reflex_surface
+    from ..errors import InvalidParameter
+    from ..plots.surface import SurfaceRow, plot_planar_grid
+
+    if arm.nv < 2:
+        raise InvalidParameter("arm", arm.name, "at least two joints for the grid's second-joint row")
+    angle_row = []
+    for angle in args.q2_values:
+        varied = q.copy()
+        varied[_SECOND_JOINT] = math.radians(angle)
+        angle_row.append(reflex_surface(base_arm, varied, args.v0, **settings))
+    motor_row = [
+        reflex_surface(_actuated(arm, args, d), q, args.v0, **settings) for d in args.stator_diameters
+    ]
+    velocity_row = [reflex_surface(base_arm, q, v, **settings) for v in args.velocities]
+    rows = [
+        SurfaceRow("second joint angle", angle_row, [f"q2 = {a:g}°" for a in args.q2_values]),
+        SurfaceRow("motor size", motor_row, [f"r_m = {d * 1e3:g} mm" for d in args.stator_diameters]),
+        SurfaceRow("approach velocity", velocity_row, [f"v0 = {v:g} m/s" for v in args.velocities]),
+    ]
+    title = (
+        f"{arm.name}: q2 = {math.degrees(q[_SECOND_JOINT]):g}°, r_m = {args.stator_diameter * 1e3:g} mm, "
+        f"v0 = {args.v0:g} m/s unless stated; F_s = {args.F_s:g} N"
+    )
+    return plot_planar_grid(args.plot, rows, title)
+
+
+def _plot_spatial(
+    base_arm: Arm, baseline: ReflexSurface, q: np.ndarray, args: argparse.Namespace, settings: dict[str, Any]
+) -> Path:
+    """A spatial arm's 3D surface with its sections in the x-y, x-z and y-z planes."""
+    from ..arm.directions import COORDINATE_PLANES, plane_directions
+    from ..arm.surfaces import reflex_surface
+    from ..plots.surface import plot_spatial_surface
+
+    count = args.directions or 360
+    sections = {
+        name: reflex_surface(
+            base_arm, q, args.v0, **{**settings, "directions": plane_directions(name, count)}
+        )
+        for name in COORDINATE_PLANES
+    }
+    title = (
+        f"{base_arm.name} at q = {np.round(np.degrees(q), 1).tolist()} deg, "
+        f"r_m = {args.stator_diameter * 1e3:g} mm, v0 = {args.v0:g} m/s"
+    )
+    return plot_spatial_surface(args.plot, baseline, sections, title)
+
+
+def _configuration(arm: Arm, degrees: list[float] | None) -> np.ndarray:
+    """The configuration of ``degrees`` [deg] (prismatic joints [m]), else the default pose (see ``--q``)."""
     from ..errors import InvalidParameter
 
     if degrees is None:
@@ -225,13 +285,14 @@ def _configuration(arm, degrees: list[float] | None) -> np.ndarray:
     return arm.configuration(np.radians(degrees))
 
 
-def _print_summary(arm, surface) -> None:
+def _print_summary(arm: Arm, surface: ReflexSurface) -> None:
+    """Print the arm, the extreme impulses [N s] and their directions, and the range of v* [m/s]."""
     impulse = surface.impulse
     finite = np.isfinite(impulse)
     smallest, largest = surface.extremes()
     print(
         f"{arm!r}: {surface.directions.shape[0]} directions, v0 = {surface.v0:g} m/s, "
-        f"gear ratios {np.round([a.gear_ratio for a in arm.actuators], 2).tolist()}"
+        f"gear ratios {np.round([a.gear_ratio for a in arm.actuators or ()], 2).tolist()}"
     )
     print(f"smallest impulse {impulse.min():.4g} N*s along {np.round(smallest, 3).tolist()}")
     if np.all(finite):
@@ -247,7 +308,8 @@ def _print_summary(arm, surface) -> None:
     )
 
 
-def _write_table(path: str, surface) -> None:
+def _write_table(path: str, surface: ReflexSurface) -> None:
+    """Write ``surface`` as CSV, one row per direction: effective parameters and impulses in SI."""
     import csv
 
     from .._io import atomic_open

@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from .._compat import renamed_keywords
 from ..errors import CollisionReflexError, TraceError
 from .fit import PAPER_SENSOR_STIFFNESS, PARAMETER_UNITS, PARAMETERS, OneShotFit, fit_one_shot
 from .nshot import VelocityLawFit, fit_velocity_law
@@ -77,7 +78,7 @@ class ExperimentResults:
                 "system": t.trace.system,
                 "trial": t.trace.label,
                 "source": t.trace.source,
-                "velocity [m/s]": t.trace.velocity,
+                "velocity [m/s]": t.trace.v0,
                 "impulse [N*s]": t.impulse.value,
                 "impulse trapezoid [N*s]": t.impulse.trapezoid,
                 "impulse stderr [N*s]": t.impulse.uncertainty,
@@ -99,8 +100,9 @@ class ExperimentResults:
         return pd.DataFrame(rows)
 
     def one_shot_summary(self) -> Any:
-        """Mean and standard deviation of each fitted parameter over the trials of each system, as the
-        paper's ``tab:one_shot`` (a pandas DataFrame, one row per system and parameter).
+        """Mean and standard deviation of each fitted parameter over the trials of each system.
+
+        As the paper's ``tab:one_shot`` (a pandas DataFrame, one row per system and parameter).
         """
         import pandas as pd
 
@@ -123,9 +125,9 @@ class ExperimentResults:
 
     def velocity_law(self, system: str) -> VelocityLawFit:
         """The n-shot fit ``I(v) = A v + B/v + C`` over the measured impulses of ``system``'s trials."""
-        chosen = [t for t in self.trials if t.trace.system == system and t.trace.velocity is not None]
+        chosen = [t for t in self.trials if t.trace.system == system and t.trace.v0 is not None]
         return fit_velocity_law(
-            np.array([t.trace.velocity for t in chosen], dtype=float),
+            np.array([t.trace.v0 for t in chosen], dtype=float),
             np.array([t.impulse.value for t in chosen]),
             np.array([t.impulse.uncertainty for t in chosen]),
         )
@@ -189,7 +191,7 @@ def analyse_trace(
     n_sigma: float = 5.0,
     reaction: str = "at_rest",
 ) -> TrialResult:
-    """Contact window, impulse and (when ``trace.velocity`` is known) one-shot fit of one trace.
+    """Contact window, impulse and (when ``trace.v0`` is known) one-shot fit of one trace.
 
     Parameters
     ----------
@@ -205,7 +207,7 @@ def analyse_trace(
     """
     window = find_contact(trace, n_sigma)
     impulse = measure_impulse(trace, window)
-    if trace.velocity is None:
+    if trace.v0 is None:
         return TrialResult(trace, window, impulse, None, "no pre-impact velocity: impulse only")
     try:
         fit = fit_one_shot(trace, window, k_m=k_m, bandwidth=bandwidth, reaction=reaction)
@@ -225,18 +227,20 @@ def analyse_traces(traces: Iterable[Trace], **options: Any) -> ExperimentResults
     return ExperimentResults(tuple(done), tuple(rejected))
 
 
+@renamed_keywords(velocity="v0")
 def analyse_files(
     paths: Sequence[str | os.PathLike[str]],
     *,
     time_unit: str = "s",
     force_unit: str = "N",
-    velocity: float | None = None,
+    v0: float | None = None,
     system: str | None = None,
     **options: Any,
 ) -> ExperimentResults:
     """Read every file (a folder: its ``*.csv`` files, sorted) and analyse every trial.
 
-    ``time_unit``, ``force_unit``, ``velocity`` and ``system`` are passed to :func:`read_traces`;
+    ``time_unit``, ``force_unit``, ``v0`` (pre-impact velocity [m/s]; ``velocity``: deprecated spelling) and
+    ``system`` are passed to :func:`read_traces`;
     the other options (``k_m``, ``bandwidth``, ``n_sigma``, ``reaction``) to :func:`analyse_trace`.
     An unreadable file is rejected as a whole; the other files are still processed.
     """
@@ -249,7 +253,7 @@ def analyse_files(
                     path,
                     time_unit=time_unit,
                     force_unit=force_unit,
-                    velocity=velocity,
+                    v0=v0,
                     system=system,
                     k_m=options.get("k_m"),
                 )

@@ -150,7 +150,7 @@ def fit_one_shot(
 
     Parameters
     ----------
-    trace: the trace; its ``velocity`` (pre-impact, [m/s]) must be known. Its own ``k_m``, if set, wins
+    trace: the trace; its ``v0`` (pre-impact velocity [m/s]) must be known. Its own ``k_m``, if set, wins
         over the argument.
     window: its contact window (noise floor and extent), from :func:`find_contact`.
     k_m: mechanical (sensor) stiffness [N/m], not fitted (see the module docstring).
@@ -162,85 +162,131 @@ def fit_one_shot(
     TraceError: no pre-impact velocity, or irregular sampling.
     FitFailed: the least-squares solver did not converge.
     """
-    from scipy.optimize import least_squares
-
     _validate.choice("reaction", reaction, REACTION_MODES)
-    if trace.velocity is None:
+    if trace.v0 is None:
         trace.fail("no pre-impact velocity: give it as '# velocity: ...' in the file or with --velocity")
-    v0 = float(trace.velocity)
+    v0 = float(trace.v0)
     k_m = float(trace.k_m if trace.k_m is not None else k_m)
     _validate.positive("k_m", k_m)
     sensor = _sensor_for(trace, bandwidth)
-    period = sensor.period
-
-    # The whole trace is fitted: the pre- and post-contact samples pin down the floor level (a free offset,
-    # so its uncertainty reaches the parameters') and the impact time.
-    times = trace.time
-    force = trace.force - window.floor.level
-    # Weight by the noise; a noiseless synthetic trace gets unit weights.
-    sigma = window.floor.sigma if window.floor.sigma > 0 else 1.0
     start = _initial_guess(trace, window, sensor, k_m, v0)
-    delay = 0.0 if bandwidth is None else sensor.sampling_rate / bandwidth  # filter delay, in samples
-    t_span = 3.0 + 2.0 * delay
-
-    def unpack(x: np.ndarray) -> tuple[float, float, float, float, float]:
-        m_f, k_s, F_s, a = np.exp(x[:4])
-        return m_f, k_s, F_s, a, start["impact_time"] + x[4] * period
-
-    def residuals(x: np.ndarray) -> np.ndarray:
-        m_f, k_s, F_s, a, t0 = unpack(x)
-        k = series_stiffness(k_m, k_s)
-        model = model_samples(times, m_f, k, k_m, F_s, a, v0, t0, sensor, reaction)
-        return (model + x[5] * sigma - force) / sigma
-
+    # The whole trace is fitted: the pre- and post-contact samples pin down the floor level (a free offset,
+    # so its uncertainty reaches the parameters') and the impact time. Weight by the noise; a noiseless
+    # synthetic trace gets unit weights.
+    problem = _Residuals(
+        times=trace.time,
+        force=trace.force - window.floor.level,
+        sigma=window.floor.sigma if window.floor.sigma > 0 else 1.0,
+        k_m=k_m,
+        v0=v0,
+        sensor=sensor,
+        reaction=reaction,
+        impact_guess=start["impact_time"],
+    )
     x0 = np.array([math.log(start[name]) for name in PARAMETERS] + [0.0, 0.0])
+    delay = 0.0 if bandwidth is None else sensor.sampling_rate / bandwidth  # filter delay, in samples
     wide = math.log(1e3)  # parameters are searched within three decades of the initial guess
     offset = 10.0  # the floor's level is known from the pre-impact samples to far better than 10 sigma
-    half_range = np.array([wide, wide, wide, wide, t_span, offset])
+    half_range = np.array([wide, wide, wide, wide, 3.0 + 2.0 * delay, offset])
     bounds = (x0 - half_range, x0 + half_range)
 
-    def shifted(x: np.ndarray, shift: float) -> np.ndarray:
-        """``x`` with the impact time moved by ``shift`` samples."""
-        moved = x.copy()
-        moved[4] += shift
-        return moved
-
-    def solve(x_start: np.ndarray) -> Any:
-        x_start = np.clip(x_start, bounds[0], bounds[1])
-        return least_squares(residuals, x_start, bounds=bounds, method="trf", max_nfev=200)
-
-    # Scan the impact time (the other parameters at their guesses) and refine from the best phase.
-    shifts = np.linspace(-1.5, 1.5, 61)  # the centroid guess is good to a fraction of a sample
-    scan = [float(np.sum(residuals(shifted(x0, shift)) ** 2)) for shift in shifts]
-    best = solve(shifted(x0, float(shifts[int(np.argmin(scan))])))
-    # A pulse shorter than a sample that lies inside one sampling interval leaves the cost flat in the impact
-    # time, and the solver stops anywhere on that plateau. The data may want the pulse to spill a little
-    # into the previous or the next sample: try both ends of the plateau.
-    m_f, _, _, _, t0 = unpack(best.x)
-    width = float(impact_pulse_duration(m_f, k_m))
-    if width < period:
-        centre = t0 + width / 2
-        j = int(np.argmin(np.abs(times - centre)))
-        for edge_time in (times[j] - period / 2 - 0.1 * width, times[j] + period / 2 - 0.9 * width):
-            x_edge = best.x.copy()
-            x_edge[4] = (edge_time - start["impact_time"]) / period
-            found = solve(x_edge)
-            if found.cost < best.cost:
-                best = found
+    best = _plateau_ends(problem, _scanned_solve(problem, x0, bounds), bounds)
     if not best.success:
         raise FitFailed(f"one-shot fit of {trace.source or trace.label}", best.message)
+    return _fit_record(problem, best)
 
-    n, p = times.size, x0.size
+
+@dataclass(frozen=True)
+class _Residuals:
+    """The weighted residuals of the one-shot fit [noise sigmas], a function of the fit's vector ``x``.
+
+    ``x = (log m_f, log k_s, log F_s, log a, shift, offset)``, in kg, N/m, N and m/s^2 under the logarithms.
+
+    ``shift`` moves the impact time from ``impact_guess`` [s] in samples; ``offset`` is the floor's offset in
+    noise ``sigma`` [N]. ``times`` [s] and ``force`` [N] are the whole trace, floor subtracted.
+    """
+
+    times: np.ndarray
+    force: np.ndarray
+    sigma: float
+    k_m: float
+    v0: float
+    sensor: SensorModel
+    reaction: str
+    impact_guess: float
+
+    def unpack(self, x: np.ndarray) -> tuple[float, float, float, float, float]:
+        """``(m_f, k_s, F_s, a, impact_time)`` in kg, N/m, N, m/s^2 and s."""
+        m_f, k_s, F_s, a = np.exp(x[:4])
+        return m_f, k_s, F_s, a, self.impact_guess + x[4] * self.sensor.period
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        m_f, k_s, F_s, a, t0 = self.unpack(x)
+        k = series_stiffness(self.k_m, k_s)
+        model = model_samples(self.times, m_f, k, self.k_m, F_s, a, self.v0, t0, self.sensor, self.reaction)
+        return (model + x[5] * self.sigma - self.force) / self.sigma
+
+
+def _solve(problem: _Residuals, x_start: np.ndarray, bounds: tuple[np.ndarray, np.ndarray]) -> Any:
+    """One bounded least-squares run from ``x_start`` (clipped into the bounds)."""
+    from scipy.optimize import least_squares
+
+    x_start = np.clip(x_start, bounds[0], bounds[1])
+    return least_squares(problem, x_start, bounds=bounds, method="trf", max_nfev=200)
+
+
+def _shifted(x: np.ndarray, shift: float) -> np.ndarray:
+    """``x`` with the impact time moved by ``shift`` samples."""
+    moved = x.copy()
+    moved[4] += shift
+    return moved
+
+
+def _scanned_solve(problem: _Residuals, x0: np.ndarray, bounds: tuple[np.ndarray, np.ndarray]) -> Any:
+    """Scan the impact time (the other parameters at their guesses) and refine from the best phase."""
+    shifts = np.linspace(-1.5, 1.5, 61)  # the centroid guess is good to a fraction of a sample
+    scan = [float(np.sum(problem(_shifted(x0, shift)) ** 2)) for shift in shifts]
+    return _solve(problem, _shifted(x0, float(shifts[int(np.argmin(scan))])), bounds)
+
+
+def _plateau_ends(problem: _Residuals, best: Any, bounds: tuple[np.ndarray, np.ndarray]) -> Any:
+    """The better of ``best`` and fits started at both ends of a sub-sample pulse's plateau.
+
+    A pulse shorter than a sample that lies inside one sampling interval leaves the cost flat in the impact
+    time, and the solver stops anywhere on that plateau. The data may want the pulse to spill a little into
+    the previous or the next sample: try both ends of the plateau.
+    """
+    period = problem.sensor.period
+    m_f, _, _, _, t0 = problem.unpack(best.x)
+    width = float(impact_pulse_duration(m_f, problem.k_m))
+    if width >= period:
+        return best
+    centre = t0 + width / 2
+    j = int(np.argmin(np.abs(problem.times - centre)))
+    for edge_time in (
+        problem.times[j] - period / 2 - 0.1 * width,
+        problem.times[j] + period / 2 - 0.9 * width,
+    ):
+        x_edge = best.x.copy()
+        x_edge[4] = (edge_time - problem.impact_guess) / period
+        found = _solve(problem, x_edge, bounds)
+        if found.cost < best.cost:
+            best = found
+    return best
+
+
+def _fit_record(problem: _Residuals, best: Any) -> OneShotFit:
+    """The fit's record: values at the optimum, uncertainties from the Jacobian (module docstring)."""
+    n, p = problem.times.size, best.x.size
     residual_variance = 2 * best.cost / max(n - p, 1)
     jac = best.jac
     covariance = np.linalg.pinv(jac.T @ jac) * residual_variance
-    m_f, k_s, F_s, a, t0 = unpack(best.x)
+    m_f, k_s, F_s, a, t0 = problem.unpack(best.x)
     log_stderr = np.sqrt(np.clip(np.diag(covariance), 0.0, None))
     stderr = {
         name: value * s for name, value, s in zip(PARAMETERS, (m_f, k_s, F_s, a), log_stderr, strict=False)
     }
-    stderr["impact_time"] = float(log_stderr[4] * period)
-    phase_stderr = _phase_stderr(best.x, covariance, k_m, v0, reaction)
+    stderr["impact_time"] = float(log_stderr[4] * problem.sensor.period)
     return OneShotFit(
         m_f=m_f,
         k_s=k_s,
@@ -248,13 +294,13 @@ def fit_one_shot(
         a=a,
         impact_time=t0,
         stderr=stderr,
-        k_m=k_m,
-        v0=v0,
-        sensor=sensor,
-        reaction=reaction,
-        residual_rms=float(np.sqrt(2 * best.cost / n)) * sigma,
+        k_m=problem.k_m,
+        v0=problem.v0,
+        sensor=problem.sensor,
+        reaction=problem.reaction,
+        residual_rms=float(np.sqrt(2 * best.cost / n)) * problem.sigma,
         samples=n,
-        phase_stderr=phase_stderr,
+        phase_stderr=_phase_stderr(best.x, covariance, problem.k_m, problem.v0, problem.reaction),
     )
 
 
@@ -309,7 +355,7 @@ def _initial_guess(
     impact_time = centroid - _filter_delay(sensor) * period
     t1 = max(float(time[top]) - impact_time, period)
     k = min(F_s / (t1 * v0), 0.5 * k_m)
-    k_s = 1.0 / (1.0 / k - 1.0 / k_m)
+    k_s = _software_stiffness(k, k_m)
     duration = max(float(time[last] - time[top]), period)
     a = 2 * F_s / (k_m * duration**2)
     ramp_area = k * v0 * (float(time[pulse_end] - time[first]) + period) ** 2 / 2
@@ -319,8 +365,20 @@ def _initial_guess(
     return {"m_f": m_f, "k_s": k_s, "F_s": F_s, "a": a, "impact_time": impact_time}
 
 
+def _software_stiffness(k: float, k_m: float) -> float:
+    """The software stiffness [N/m] that in series with ``k_m`` [N/m] gives ``k`` [N/m] (``k < k_m``).
+
+    The inverse of :func:`~collision_reflex.model.impulse.series_stiffness`: compliances add there, so here
+    ``1/k_s = 1/k - 1/k_m``.
+    """
+    return 1.0 / (1.0 / k - 1.0 / k_m)
+
+
 def _filter_delay(sensor: SensorModel) -> float:
-    """Group delay of the sensor's filter at zero frequency [samples]: the centroid of its impulse response."""
+    """Group delay of the sensor's filter at zero frequency [samples].
+
+    The centroid of its impulse response.
+    """
     if sensor.bandwidth is None:
         return 0.0
     impulse = np.zeros(int(50 * sensor.sampling_rate / sensor.bandwidth) + 50)

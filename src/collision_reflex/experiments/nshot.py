@@ -1,5 +1,6 @@
-"""The n-shot fit: impulse against pre-impact velocity, ``I(v) = A v + B / v + C`` (paper,
-"Effect of Actuator Selection"; ``fig:1d_experiment_nshot``).
+"""The n-shot fit: impulse against pre-impact velocity, ``I(v) = A v + B / v + C``.
+
+The paper's "Effect of Actuator Selection"; ``fig:1d_experiment_nshot``.
 
 The model predicts ``A = m_f``, ``B = F_s^2 / (2 k)`` and ``C = I3`` (:func:`collision_reflex.velocity_coefficients`)
 and the optimal approach velocity ``v* = sqrt(B / A)``, which equals ``F_s / sqrt(2 k m_f)`` (``eq:v_star``).

@@ -108,7 +108,7 @@ def synthetic_trace(
     return Trace(
         time,
         force,
-        velocity=v0,
+        v0=v0,
         system=system,
         name=name,
         k_m=truth.k_m,

@@ -28,15 +28,20 @@ import io
 import math
 import os
 import re
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn
 
 import numpy as np
 
+from .._compat import renamed_keywords
 from .._io import atomic_open
 from ..errors import TraceError
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 MIN_SAMPLES = 20
 """Fewest samples a trace may have: enough for a noise floor and a contact of a few samples."""
@@ -44,6 +49,7 @@ MIN_SAMPLES = 20
 _TIME_NAMES = ("time", "t")
 _FORCE_NAMES = ("force", "fz", "f")
 _META_COLUMNS = {"velocity": "m/s", "system": None, "sensor stiffness": "N/m"}
+_META_TARGETS = {"velocity": "v0", "sensor stiffness": "k_m"}  # metadata key -> Trace field
 _HEADER = re.compile(r"^\s*(?P<name>[^\[\(]*?)\s*(?:[\[\(]\s*(?P<unit>[^\]\)]*?)\s*[\]\)])?\s*$")
 
 
@@ -55,7 +61,7 @@ class Trace:
     ----------
     time: sample times [s], shape (n,).
     force: contact force [N], shape (n,); positive in compression.
-    velocity: pre-impact velocity [m/s], or ``None`` if unknown (then the impulse is measured but the model
+    v0: pre-impact velocity [m/s], or ``None`` if unknown (then the impulse is measured but the model
         is not fitted).
     system: name of the system tested; trials of one system are aggregated together.
     name: the trial's name.
@@ -67,7 +73,7 @@ class Trace:
 
     time: np.ndarray
     force: np.ndarray
-    velocity: float | None = None
+    v0: float | None = None
     system: str = ""
     name: str = ""
     source: str = ""
@@ -82,10 +88,16 @@ class Trace:
             self.fail(f"time and force must be 1-D of one length, got shapes {time.shape} and {force.shape}")
         object.__setattr__(self, "time", time)
         object.__setattr__(self, "force", force)
-        for name in ("velocity", "k_m"):
+        for name in ("v0", "k_m"):
             value = getattr(self, name)
             if value is not None and not (math.isfinite(value) and value > 0):
                 self.fail(f"{name} = {value!r} is invalid: expected a finite number > 0")
+
+    @property
+    def velocity(self) -> float | None:
+        """Deprecated spelling of :attr:`v0`, the pre-impact velocity [m/s]."""
+        warnings.warn("Trace.velocity is deprecated; call it Trace.v0", DeprecationWarning, stacklevel=2)
+        return self.v0
 
     @property
     def label(self) -> str:
@@ -101,7 +113,10 @@ class Trace:
         raise TraceError(self.source, self.name, reason, None if index is None else self.line_of(index))
 
     def check(self) -> None:
-        """Raise :class:`TraceError` if the samples cannot be analysed: too short, NaNs, time not increasing."""
+        """Raise :class:`TraceError` if the samples cannot be analysed.
+
+        That is: too short, NaNs, or time not increasing.
+        """
         n = self.time.size
         if n < MIN_SAMPLES:
             self.fail(f"too short: {n} samples, need at least {MIN_SAMPLES}")
@@ -122,6 +137,10 @@ class Trace:
                 "samples must be in increasing time order",
                 i,
             )
+
+
+# The old spelling keeps working (with a warning); `dataclasses.replace` needs the new one.
+Trace.__init__ = renamed_keywords(velocity="v0")(Trace.__init__)  # type: ignore[method-assign]
 
 
 @functools.lru_cache(maxsize=1)
@@ -173,12 +192,13 @@ def unit_factor(unit: str, default_unit: str, what: str, source: str = "") -> fl
         ) from None
 
 
+@renamed_keywords(velocity="v0")
 def read_traces(
     path: str | os.PathLike[str],
     *,
     time_unit: str = "s",
     force_unit: str = "N",
-    velocity: float | None = None,
+    v0: float | None = None,
     system: str | None = None,
     k_m: float | None = None,
 ) -> list[Trace]:
@@ -188,7 +208,7 @@ def read_traces(
     ----------
     path: the CSV file.
     time_unit, force_unit: units of the time and force columns when their headers name none.
-    velocity: pre-impact velocity [m/s] for trials whose metadata gives none.
+    v0: pre-impact velocity [m/s] for trials whose metadata gives none (``velocity``: deprecated spelling).
     system: system name for trials whose metadata gives none (default: the file's parent folder's name).
     k_m: sensor stiffness [N/m] for trials whose metadata gives none.
 
@@ -201,52 +221,22 @@ def read_traces(
     ------
     TraceError: the file cannot be read, or has no time or force column.
     """
-    import pandas as pd
-
     source = str(path)
     try:
-        text = Path(path).read_text()
+        lines = Path(path).read_text().splitlines()
     except (OSError, UnicodeDecodeError) as error:
         raise TraceError(source, "", f"cannot read the file ({error})") from None
-    lines = text.splitlines()
-    metadata: dict[str, str] = {}
-    header_line = 0
-    while header_line < len(lines) and (lines[header_line].startswith("#") or not lines[header_line].strip()):
-        key, sep, value = lines[header_line].lstrip("#").partition(":")
-        if sep:
-            metadata[_normalise(key)] = value.strip()
-        header_line += 1
+    metadata, header_line = _leading_metadata(lines)
     if header_line >= len(lines):
         raise TraceError(source, "", "no header line and no samples")
-    try:
-        table = pd.read_csv(
-            io.StringIO("\n".join(lines[header_line:])),
-            skip_blank_lines=False,
-            dtype=str,
-            keep_default_na=False,
-            skipinitialspace=True,
-        )
-    except (pd.errors.ParserError, pd.errors.EmptyDataError) as error:
-        raise TraceError(
-            source, "", f"not a CSV table ({error})".replace("\n", " "), header_line + 1
-        ) from None
-    # Drop trailing blank lines, keep blank lines inside the data (they are reported as missing values).
-    blank = (table == "").all(axis=1).to_numpy()
-    last = len(blank) - int(np.argmin(blank[::-1])) if not blank.all() else 0
-    table = table.iloc[:last]
+    table = _read_table(lines, header_line, source)
     file_lines = np.arange(len(table)) + header_line + 2  # header is line header_line + 1
-
     columns = {_HEADER.match(str(c)).group("name").lower(): str(c) for c in table.columns}  # type: ignore[union-attr]
-    time_column = _find(columns, _TIME_NAMES, "time", source)
-    force_column = _find(columns, _FORCE_NAMES, "force", source)
-    time_scale = _column_factor(time_column, time_unit, "time", source)
-    force_scale = _column_factor(force_column, force_unit, "force", source)
-    time = pd.to_numeric(table[time_column], errors="coerce").to_numpy(dtype=float) * time_scale
-    force = pd.to_numeric(table[force_column], errors="coerce").to_numpy(dtype=float) * force_scale
+    time, force = _samples(table, columns, time_unit, force_unit, source)
 
     default_system = system if system is not None else Path(path).resolve().parent.name
     file_meta = {
-        "velocity": _meta_value(metadata, "velocity", "m/s", velocity, source),
+        "v0": _meta_value(metadata, "velocity", "m/s", v0, source),
         "k_m": _meta_value(metadata, "sensor stiffness", "N/m", k_m, source),
         "system": metadata.get("system", default_system),
     }
@@ -270,21 +260,7 @@ def read_traces(
     traces = []
     for name in dict.fromkeys(trial_names):  # file order, each once
         rows = np.flatnonzero(trial_names == name)
-        meta = dict(file_meta)
-        for key, unit in _META_COLUMNS.items():
-            if key not in columns:
-                continue
-            values = table[columns[key]].to_numpy(dtype=str)[rows]
-            if np.any(values != values[0]):
-                raise TraceError(
-                    source, name, f"the {key!r} column changes within the trial", int(file_lines[rows[0]])
-                )
-            target = "k_m" if key == "sensor stiffness" else key
-            if unit is None:
-                meta[target] = values[0]
-            else:
-                scale = _column_factor(columns[key], unit, key, source)
-                meta[target] = to_si(values[0], unit, key, source, int(file_lines[rows[0]])) * scale
+        meta = {**file_meta, **_trial_columns(table, columns, rows, file_lines, str(name), source)}
         traces.append(
             Trace(
                 time[rows],
@@ -293,10 +269,86 @@ def read_traces(
                 source=source,
                 lines=file_lines[rows],
                 metadata=others,
-                **meta,  # type: ignore[arg-type]
+                **meta,
             )
         )
     return traces
+
+
+def _leading_metadata(lines: list[str]) -> tuple[dict[str, str], int]:
+    """The ``# key: value`` metadata before the header, and the header's index in ``lines``."""
+    metadata: dict[str, str] = {}
+    header_line = 0
+    while header_line < len(lines) and (lines[header_line].startswith("#") or not lines[header_line].strip()):
+        key, sep, value = lines[header_line].lstrip("#").partition(":")
+        if sep:
+            metadata[_normalise(key)] = value.strip()
+        header_line += 1
+    return metadata, header_line
+
+
+def _read_table(lines: list[str], header_line: int, source: str) -> pd.DataFrame:
+    """The CSV table from the header on, as text, without trailing blank lines."""
+    import pandas as pd
+
+    try:
+        table = pd.read_csv(
+            io.StringIO("\n".join(lines[header_line:])),
+            skip_blank_lines=False,
+            dtype=str,
+            keep_default_na=False,
+            skipinitialspace=True,
+        )
+    except (pd.errors.ParserError, pd.errors.EmptyDataError) as error:
+        raise TraceError(
+            source, "", f"not a CSV table ({error})".replace("\n", " "), header_line + 1
+        ) from None
+    # Drop trailing blank lines, keep blank lines inside the data (they are reported as missing values).
+    blank = (table == "").all(axis=1).to_numpy()
+    last = len(blank) - int(np.argmin(blank[::-1])) if not blank.all() else 0
+    return table.iloc[:last]
+
+
+def _samples(
+    table: pd.DataFrame, columns: Mapping[str, str], time_unit: str, force_unit: str, source: str
+) -> tuple[np.ndarray, np.ndarray]:
+    """Time [s] and force [N] columns in SI; a non-numeric cell becomes NaN (reported by the check)."""
+    import pandas as pd
+
+    time_column = _find(columns, _TIME_NAMES, "time", source)
+    force_column = _find(columns, _FORCE_NAMES, "force", source)
+    time_scale = _column_factor(time_column, time_unit, "time", source)
+    force_scale = _column_factor(force_column, force_unit, "force", source)
+    time = pd.to_numeric(table[time_column], errors="coerce").to_numpy(dtype=float) * time_scale
+    force = pd.to_numeric(table[force_column], errors="coerce").to_numpy(dtype=float) * force_scale
+    return time, force
+
+
+def _trial_columns(
+    table: pd.DataFrame,
+    columns: Mapping[str, str],
+    rows: np.ndarray,
+    file_lines: np.ndarray,
+    name: str,
+    source: str,
+) -> dict[str, Any]:
+    """One trial's metadata from the per-trial columns (``velocity``, ``system``, ``sensor stiffness``)."""
+    meta: dict[str, Any] = {}
+    for key, unit in _META_COLUMNS.items():
+        if key not in columns:
+            continue
+        values = table[columns[key]].to_numpy(dtype=str)[rows]
+        if np.any(values != values[0]):
+            raise TraceError(
+                source, name, f"the {key!r} column changes within the trial", int(file_lines[rows[0]])
+            )
+        target = _META_TARGETS.get(key, key)
+        if unit is None:
+            meta[target] = values[0]
+        else:
+            scale = _column_factor(columns[key], unit, key, source)
+            meta[target] = to_si(values[0], unit, key, source, int(file_lines[rows[0]])) * scale
+    return meta
 
 
 def write_trace(path: str | os.PathLike[str], trace: Trace, time_unit: str = "ms", digits: int = 6) -> Path:
@@ -305,8 +357,8 @@ def write_trace(path: str | os.PathLike[str], trace: Trace, time_unit: str = "ms
     lines = []
     if trace.name:
         lines.append(f"# trial: {trace.name}")
-    if trace.velocity is not None:
-        lines.append(f"# velocity: {trace.velocity:.9g} m/s")
+    if trace.v0 is not None:
+        lines.append(f"# velocity: {trace.v0:.9g} m/s")
     if trace.system:
         lines.append(f"# system: {trace.system}")
     if trace.k_m is not None:

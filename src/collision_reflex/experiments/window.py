@@ -70,6 +70,7 @@ class ContactWindow:
 
     @property
     def slice(self) -> slice:
+        """The contact's samples, ``start:stop``."""
         return slice(self.start, self.stop)
 
 

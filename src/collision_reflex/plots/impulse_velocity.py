@@ -33,11 +33,11 @@ def plot_impulse_velocity(
     fig, ax = new_figure(figsize=(6, 4))
     colours = iter(["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink"])
     for system in results.systems:
-        trials = [t for t in results.trials if t.trace.system == system and t.trace.velocity is not None]
+        trials = [t for t in results.trials if t.trace.system == system and t.trace.v0 is not None]
         if not trials:
             continue
         colour = next(colours, "black")
-        v = np.array([t.trace.velocity for t in trials], dtype=float)
+        v = np.array([t.trace.v0 for t in trials], dtype=float)
         impulse = np.array([t.impulse.value for t in trials])
         error = np.array([t.impulse.uncertainty for t in trials])
         ax.errorbar(v * 1e3, impulse, yerr=error, fmt="o", ms=4, color=colour, label=system or "trials")

@@ -1,5 +1,6 @@
-"""Force-time profile of one collision with its three phases shaded (the paper's
-``fig:collision_reflex_plot``, top).
+"""Force-time profile of one collision with its three phases shaded.
+
+The paper's ``fig:collision_reflex_plot``, top.
 """
 
 from __future__ import annotations
