@@ -7,10 +7,12 @@ runs IPOPT and returns a :class:`DesignResult`; :func:`pareto_front` sweeps obje
 row of a design.
 """
 
+from .constraints import Constraints
 from .pareto import ParetoSet, hypervolume, pareto_front
 from .problem import OBJECTIVES, ActuatorTechnology, DesignProblem, build_problem
+from .samples import ContactSamples
 from .solve import Design, DesignResult, design_at, solve
-from .space import Bounds, Constraints, ContactSamples, DesignSpace
+from .space import Bounds, DesignSpace
 
 __all__ = [
     "OBJECTIVES",

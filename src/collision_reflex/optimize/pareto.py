@@ -45,7 +45,8 @@ DOMINANCE_TOLERANCE = 1e-9
 
 class ProblemBuilder(Protocol):
     """``build(objective, bounded_objectives) -> DesignProblem``. Hashable (the problems are cached per process
-    by builder); picklable (a module-level function, or a frozen dataclass) to run through a process pool."""
+    by builder); picklable (a module-level function, or a frozen dataclass) to run through a process pool.
+    """
 
     def __call__(self, objective: Any, bounded: tuple[str, ...], /) -> DesignProblem: ...
 
@@ -93,7 +94,8 @@ class ParetoSet:
 
     def to_frame(self) -> pd.DataFrame:
         """One row per design (:func:`collision_reflex.optimize.results.record_row`): objectives, per-joint
-        design and solver status, every column with its unit."""
+        design and solver status, every column with its unit.
+        """
         import pandas as pd
 
         return pd.DataFrame([record_row(record, i) for i, record in enumerate(self.records())])
@@ -123,7 +125,8 @@ class ParetoSet:
 
     def plot(self, path: str | os.PathLike[str], chosen: Sequence[float] | None = None) -> Any:
         """Draw the front (2 objectives: a line plot; 3: a scatter coloured by the third); ``chosen``: a design's
-        objective values to mark."""
+        objective values to mark.
+        """
         from ..plots.design_front import plot_design_front
 
         units = [OBJECTIVES[name][1] for name in self.objectives]
@@ -333,7 +336,8 @@ time (a Dask worker with several threads, for instance); parallelism comes from 
 @functools.lru_cache(maxsize=16)
 def built_problem(build: Hashable, objective: Hashable, bounded: tuple[str, ...] = ()) -> DesignProblem:
     """``build(objective, bounded)``, built once per process and builder (later pieces reuse its solvers; the
-    results do not depend on which piece came first)."""
+    results do not depend on which piece came first).
+    """
     problem: DesignProblem = build(objective, bounded)  # type: ignore[operator]
     return problem
 
@@ -363,7 +367,8 @@ def solve_anchor(
 ) -> SweepPoint:
     """A Pareto anchor: ``objective`` minimised (from ``starts`` start points), then (lexicographically) each
     other objective with it held at its optimum, so that the anchor is not dominated. A lexicographic step the
-    solver cannot do keeps the anchor found so far and is recorded among the failures."""
+    solver cannot do keeps the anchor found so far and is recorded among the failures.
+    """
     label = f"anchor: {objective}"
     try:
         result = solve(
@@ -397,7 +402,8 @@ def solve_point(
     ipopt_options: dict[str, Any] | None,
 ) -> SweepPoint:
     """One epsilon-constraint point: the first objective minimised with the others bounded by ``epsilon``
-    [their units], started from ``start`` (a point of the NLP's variables)."""
+    [their units], started from ``start`` (a point of the NLP's variables).
+    """
     label = "epsilon: " + ", ".join(_bound_text(k, v) for k, v in epsilon.items())
     problem = built_problem(build, objectives[0], objectives[1:])
     try:
@@ -414,7 +420,8 @@ def solve_alone(
     build: ProblemBuilder, objective: Hashable, ipopt_options: dict[str, Any] | None
 ) -> SweepPoint:
     """A single-objective optimum (``objective``: a name, or what ``build`` takes for a weighted one) as a
-    piece run like the sweep's."""
+    piece run like the sweep's.
+    """
     try:
         result = solve(built_problem(build, objective), ipopt_options=ipopt_options)
     except SolverFailed as error:
@@ -468,7 +475,8 @@ def _minimised(values: np.ndarray, names: Sequence[str]) -> np.ndarray:
 
 def _dominance(values: np.ndarray, tolerance: float) -> np.ndarray:
     """(n, n) booleans of minimised ``values`` (n, m): ``[i, j]`` if point i dominates point j (no worse in any
-    column and better in one, by more than ``tolerance`` of the column's largest magnitude)."""
+    column and better in one, by more than ``tolerance`` of the column's largest magnitude).
+    """
     scale = np.maximum(np.abs(values).max(axis=0), 1e-300)
     diff = (values[:, None, :] - values[None, :, :]) / scale  # [i, j] < 0: i is better than j
     return np.all(diff <= tolerance, axis=2) & np.any(diff < -tolerance, axis=2)

@@ -213,7 +213,8 @@ def design_record(
     catalogue: Mapping[str, Motor] | None = None,
 ) -> dict[str, Any]:
     """:func:`result_record` with what a report shows about the collisions: the impulse phases and the optimal
-    approach velocity per sample (from ``problem``'s samples), and each joint's nearest catalogue motor."""
+    approach velocity per sample (from ``problem``'s samples), and each joint's nearest catalogue motor.
+    """
     from .evaluate import design_collision_parameters
 
     record = result_record(result, label)
@@ -243,7 +244,8 @@ def design_record(
 
 def nearest_catalogue_motor(catalogue: Mapping[str, Motor], peak_torque: float, rotor_inertia: float) -> str:
     """The catalogue motor closest to a scaled motor (peak torque [N*m], rotor inertia [kg*m^2]) in (log peak
-    torque, log rotor inertia): the off-the-shelf part a designer would start from."""
+    torque, log rotor inertia): the off-the-shelf part a designer would start from.
+    """
     best, best_distance = "", math.inf
     for name, motor in catalogue.items():
         distance = math.hypot(
@@ -256,7 +258,8 @@ def nearest_catalogue_motor(catalogue: Mapping[str, Motor], peak_torque: float, 
 
 def record_row(record: Mapping[str, Any], index: int) -> dict[str, Any]:
     """The table row of a design record, every column name with its unit: ``pareto.csv``, the report's table
-    and :meth:`ParetoSet.to_frame` are made of these."""
+    and :meth:`ParetoSet.to_frame` are made of these.
+    """
     row: dict[str, Any] = {"point": index, "label": record["label"]}
     for name, value in record["objectives"].items():
         row[f"{name} [{OBJECTIVES[name][1]}]"] = value
