@@ -250,11 +250,11 @@ def test_kinematics_without_the_motor_terms_are_a_clear_error(arm):
     # Arm.kinematics(q, full=False) leaves the gravity and motor-mass terms out; the problem needs them.
     q = arm.sample_configurations(1, np.random.default_rng(0))
     partial = cr.ContactSamples.grid(arm.kinematics(q, full=False), np.array([[1.0, 0.0]]))
-    with pytest.raises(cr.InvalidParameter, match="gravity = None .* full kinematics"):
+    with pytest.raises(cr.InvalidParameter, match=r"gravity = None .* full kinematics"):
         cr.build_problem(arm, partial, FREE_SPACE, _technology())
     # A given torque requirement needs no gravity terms, but the finger mass needs the motor-mass influence.
     given = cr.Constraints(torque_required=[1.0, 1.0])
-    with pytest.raises(cr.InvalidParameter, match="motor_mass_influence = None .* full kinematics"):
+    with pytest.raises(cr.InvalidParameter, match=r"motor_mass_influence = None .* full kinematics"):
         cr.build_problem(arm, partial, FREE_SPACE, _technology(), constraints=given)
 
 
