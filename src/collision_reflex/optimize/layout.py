@@ -119,6 +119,10 @@ class DesignQuantities(NamedTuple):
     peak_torque: ca.MX
     finger_inertia: ca.MX
 
+    def joint_function(self, x: ca.MX) -> ca.Function:
+        """CasADi function of ``x``: motor masses [kg], peak torques [N m], finger inertias [kg m^2] (n_joints)."""
+        return ca.Function("joint_numbers", [x], [self.motor_mass, self.peak_torque, self.finger_inertia])
+
 
 def design_quantities(
     layout: DesignLayout, z: ca.MX, technology: ActuatorTechnology, k_mech: np.ndarray

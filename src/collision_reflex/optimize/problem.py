@@ -31,7 +31,7 @@ import math
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import casadi as ca
 import numpy as np
@@ -48,7 +48,7 @@ from .constraints import (
     required_torque_function,
     torque_requirement_rows,
 )
-from .layout import DesignLayout, design_layout, design_quantities
+from .layout import DesignLayout, DesignQuantities, design_layout, design_quantities
 from .samples import (
     ContactSamples,
     check_finite,
@@ -242,10 +242,7 @@ def build_problem(
     """
     started = time.perf_counter()
     constraints = constraints or Constraints()
-    weights = _objective_weights(objective)
-    for name in bounded_objectives:
-        _validate.choice("bounded objective", name, tuple(OBJECTIVES))
-    bounded = tuple(bounded_objectives)
+    weights, bounded = _objective_weights(objective), _bounded_objectives(bounded_objectives)
     joint_names = _joint_names(arm, samples)
     n_joints = len(joint_names)
     layout = design_layout(space, technology, constraints, n_joints)
@@ -256,76 +253,40 @@ def build_problem(
     x = ca.MX.sym("x", direction_index.stop)
     p = ca.MX.sym("p", len(bounded))
 
-    k_mech = technology.joint_mechanical_stiffness(n_joints)
-    design = design_quantities(layout, x[:n_design], technology, k_mech)
-    joint_numbers = ca.Function(
-        "joint_numbers", [x], [design.motor_mass, design.peak_torque, design.finger_inertia]
+    design = design_quantities(
+        layout, x[:n_design], technology, technology.joint_mechanical_stiffness(n_joints)
     )
+    joint_numbers = design.joint_function(x)
     lbx, ubx, x0 = _bounds_and_start(x.shape[0], layout, joint_numbers, samples, constraints, joint_names)
     lbx[compliance_index], ubx[compliance_index] = _compliance_bounds(samples, joint_numbers, lbx, ubx)
 
-    data = sample_data(samples, k_mech)
-    per_sample = sample_function(
-        n_joints, technology.sensing, technology.reaction, technology.reflected_inertia_in
-    )
     start_mass, start_torque, start_finger = (np.asarray(v).ravel() for v in joint_numbers(x0))
-    # x_s is scaled per sample by its size at the start: across samples it spans orders of magnitude.
-    start_directions = finger_mass_directions(samples, start_mass, start_finger)
-    direction_scale = np.maximum(np.abs(start_directions).max(axis=1), 1e-300)
-    directions = ca.reshape(x[direction_index], n_joints, n_samples) * ca.DM(
-        np.tile(direction_scale, (n_joints, 1))
+    per_sample = _sample_terms(
+        x[direction_index], x[compliance_index], design, samples, technology, start_mass, start_finger
     )
-    compliance = ca.exp(ca.transpose(x[compliance_index]))
-    impulses, thresholds, normalisation, parameters = per_sample.map(n_samples)(
-        design.design_column, directions, compliance, ca.DM(data)
-    )
-    actuator_mass = ca.sum1(design.motor_mass)
-    mass_bounds = [np.asarray(joint_numbers(bound)[0]).ravel() for bound in (lbx, ubx)]
-    torque_demands = binding_torque_demands(samples, constraints, joint_names, *mass_bounds)
+    impulses, actuator_mass = per_sample.impulses, ca.sum1(design.motor_mass)
+    mass_range = [np.asarray(joint_numbers(bound)[0]).ravel() for bound in (lbx, ubx)]
+    torque_demands = binding_torque_demands(samples, constraints, joint_names, *mass_range)
     required_torque = required_torque_function(torque_demands, n_joints)
-    evaluate = _evaluate_function(
-        x,
-        {
-            "impulses": impulses,
-            "actuator_mass": actuator_mass,
-            "approach_velocity": design.values["approach_velocity"],
-            "thresholds": thresholds,
-            "required_torque": required_torque(design.motor_mass),
-            "peak_torque": design.peak_torque,
-            "parameters": parameters,
-        },
-    )
-    x0[direction_index] = (start_directions / direction_scale[:, None]).ravel()
+    evaluate = _evaluate_function(x, design, per_sample, actuator_mass, required_torque)
+    # Start point: auxiliaries at their exact values for the start design.
+    x0[direction_index] = (per_sample.start_directions / per_sample.direction_scale[:, None]).ravel()
     x0[compliance_index] = np.log(reaction_compliance(samples, start_torque))
     start_impulses = np.asarray(evaluate(x0)[0]).ravel()
     check_finite(start_impulses, "impulse at the start point", samples)
-    scale = {
-        "worst_case_impulse": float(start_impulses.max()),
-        "mean_impulse": float(start_impulses.mean()),
-        "actuator_mass": float(start_mass.sum()),
-        "approach_velocity": float(layout.values(x0[:n_design])["approach_velocity"][0]),
-    }
-    expressions: dict[str, ca.MX] = {
-        "mean_impulse": ca.sum2(impulses) / n_samples,
-        "actuator_mass": actuator_mass,
-        "approach_velocity": design.values["approach_velocity"],
-    }
+    velocity = layout.values(x0[:n_design])["approach_velocity"][0]
+    scale = _objective_scale(start_impulses, start_mass, velocity)
+    expressions = _objective_terms(impulses, actuator_mass, design.values["approach_velocity"])
 
     g = ConstraintList()
     if epigraph_index is not None:
         expressions["worst_case_impulse"] = _add_epigraph(g, x, epigraph_index, impulses, scale, x0, lbx)
     torque_scale = np.maximum(np.asarray(required_torque(start_mass)).ravel(), 1e-3)
-    terms = ModelTerms(x[compliance_index], design.peak_torque, normalisation, thresholds, design.motor_mass)
+    terms = _model_terms(x[compliance_index], design, per_sample)
     add_model_constraints(
         g, terms, torque_scale, torque_demands, samples, technology, constraints, joint_names
     )
-    for k, name in enumerate(bounded):
-        g.add(
-            OBJECTIVES[name][0] * expressions[name] / scale[name] - p[k],
-            -np.inf,
-            0.0,
-            [f"{name} within its bound"],
-        )
+    _add_objective_bounds(g, bounded, expressions, scale, p)
 
     nlp = {"x": x, "f": _objective_expression(weights, expressions, scale), "g": ca.vertcat(*g.parts), "p": p}
     return DesignProblem(
@@ -350,12 +311,84 @@ def build_problem(
         epigraph_index=epigraph_index,
         compliance_index=compliance_index,
         direction_index=direction_index,
-        direction_scale=direction_scale,
+        direction_scale=per_sample.direction_scale,
         build_time=time.perf_counter() - started,
         _joint_numbers=joint_numbers,
-        _sample_function=per_sample,
-        _sample_data=data,
+        _sample_function=per_sample.function,
+        _sample_data=per_sample.data,
     )
+
+
+class _SampleTerms(NamedTuple):
+    """The per-sample part of the NLP (see :func:`_sample_terms`)."""
+
+    function: ca.Function
+    data: np.ndarray
+    start_directions: np.ndarray
+    direction_scale: np.ndarray
+    impulses: ca.MX
+    thresholds: ca.MX
+    normalisation: ca.MX
+    parameters: ca.MX
+
+
+def _sample_terms(
+    scaled_directions: ca.MX,
+    log_compliance: ca.MX,
+    design: DesignQuantities,
+    samples: ContactSamples,
+    technology: ActuatorTechnology,
+    start_mass: np.ndarray,
+    start_finger: np.ndarray,
+) -> _SampleTerms:
+    """The per-sample function mapped over all samples, on the NLP's auxiliaries of every sample.
+
+    ``scaled_directions`` are the finger-mass directions ``x_s`` (n_joints * n_samples) divided by their size
+    at the start (motor masses ``start_mass`` [kg], finger inertias ``start_finger`` [kg m^2]): across samples
+    they span orders of magnitude. ``log_compliance`` is ``log(1/F_a)`` per sample.
+    """
+    n_joints, n_samples = start_mass.size, samples.size
+    data = sample_data(samples, technology.joint_mechanical_stiffness(n_joints))
+    function = sample_function(
+        n_joints, technology.sensing, technology.reaction, technology.reflected_inertia_in
+    )
+    start_directions = finger_mass_directions(samples, start_mass, start_finger)
+    direction_scale = np.maximum(np.abs(start_directions).max(axis=1), 1e-300)
+    directions = ca.reshape(scaled_directions, n_joints, n_samples) * ca.DM(
+        np.tile(direction_scale, (n_joints, 1))
+    )
+    compliance = ca.exp(ca.transpose(log_compliance))
+    outputs = function.map(n_samples)(design.design_column, directions, compliance, ca.DM(data))
+    return _SampleTerms(function, data, start_directions, direction_scale, *outputs)
+
+
+def _model_terms(log_compliance: ca.MX, design: DesignQuantities, per_sample: _SampleTerms) -> ModelTerms:
+    """The symbolic quantities the model's constraints bound, ``log_compliance`` the ``log(1/F_a)`` of ``x``."""
+    return ModelTerms(
+        log_compliance, design.peak_torque, per_sample.normalisation, per_sample.thresholds, design.motor_mass
+    )
+
+
+def _objective_terms(impulses: ca.MX, actuator_mass: ca.MX, approach_velocity: ca.MX) -> dict[str, ca.MX]:
+    """The objectives as expressions, but the worst case (an epigraph variable, see :func:`_add_epigraph`).
+
+    From the impulses [N*s] (1 x n_samples), the motors' total mass [kg] and the approach velocity [m/s].
+    """
+    return {
+        "mean_impulse": ca.sum2(impulses) / impulses.shape[1],
+        "actuator_mass": actuator_mass,
+        "approach_velocity": approach_velocity,
+    }
+
+
+def _objective_scale(start_impulses: np.ndarray, start_mass: np.ndarray, velocity: float) -> dict[str, float]:
+    """Each objective's value at the start (impulses [N*s], motor masses [kg], approach velocity [m/s])."""
+    return {
+        "worst_case_impulse": float(start_impulses.max()),
+        "mean_impulse": float(start_impulses.mean()),
+        "actuator_mass": float(start_mass.sum()),
+        "approach_velocity": float(velocity),
+    }
 
 
 def _joint_names(arm: Arm, samples: ContactSamples) -> tuple[str, ...]:
@@ -456,6 +489,23 @@ def _add_epigraph(
     return t
 
 
+def _add_objective_bounds(
+    g: ConstraintList,
+    bounded: Sequence[str],
+    expressions: Mapping[str, ca.MX],
+    scale: Mapping[str, float],
+    p: ca.MX,
+) -> None:
+    """Add ``f_k <= eps_k`` for each bounded objective, ``eps_k`` the NLP parameter ``p[k]`` (scaled units)."""
+    for k, name in enumerate(bounded):
+        g.add(
+            OBJECTIVES[name][0] * expressions[name] / scale[name] - p[k],
+            -np.inf,
+            0.0,
+            [f"{name} within its bound"],
+        )
+
+
 def _objective_expression(
     weights: Mapping[str, float], expressions: Mapping[str, ca.MX], scale: Mapping[str, float]
 ) -> ca.MX:
@@ -477,6 +527,28 @@ def _objective_weights(objective: str | Mapping[str, float]) -> dict[str, float]
     return weights
 
 
-def _evaluate_function(x: ca.MX, outputs: dict[str, ca.MX]) -> ca.Function:
-    """CasADi function of the NLP's ``x`` giving the named ``outputs`` (see :class:`DesignProblem`)."""
+def _bounded_objectives(names: Sequence[str]) -> tuple[str, ...]:
+    """The objectives that may be bounded per solve, names checked."""
+    for name in names:
+        _validate.choice("bounded objective", name, tuple(OBJECTIVES))
+    return tuple(names)
+
+
+def _evaluate_function(
+    x: ca.MX,
+    design: DesignQuantities,
+    per_sample: _SampleTerms,
+    actuator_mass: ca.MX,
+    required_torque: ca.Function,
+) -> ca.Function:
+    """CasADi function of the NLP's ``x`` giving the quantities :class:`DesignProblem` reports, by name."""
+    outputs = {
+        "impulses": per_sample.impulses,
+        "actuator_mass": actuator_mass,
+        "approach_velocity": design.values["approach_velocity"],
+        "thresholds": per_sample.thresholds,
+        "required_torque": required_torque(design.motor_mass),
+        "peak_torque": design.peak_torque,
+        "parameters": per_sample.parameters,
+    }
     return ca.Function("evaluate", [x], list(outputs.values()), ["x"], list(outputs))
