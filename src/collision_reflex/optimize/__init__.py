@@ -1,8 +1,9 @@
-"""Actuator design optimisation: CasADi + IPOPT over motor size, gear ratio, stiffness, threshold and approach
-velocity for a URDF arm, and Pareto sets by epsilon-constraint sweeps.
+"""Actuator design optimisation for a URDF arm, and Pareto sets by epsilon-constraint sweeps.
 
-Build and solve are separate: :func:`build_problem` returns an inspectable :class:`DesignProblem`, :func:`solve`
-runs IPOPT and returns a :class:`DesignResult`; :func:`pareto_front` sweeps objectives into a
+CasADi + IPOPT choose motor size, gear ratio, stiffness, threshold and approach velocity.
+
+Build and solve are separate: :func:`build_problem` returns an inspectable :class:`DesignProblem`,
+:func:`solve` runs IPOPT and returns a :class:`DesignResult`; :func:`pareto_front` sweeps objectives into a
 :class:`ParetoSet` (in-process or through any executor); :mod:`.results` makes the one result record and table
 row of a design.
 """

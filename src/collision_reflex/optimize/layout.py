@@ -120,7 +120,10 @@ class DesignQuantities(NamedTuple):
     finger_inertia: ca.MX
 
     def joint_function(self, x: ca.MX) -> ca.Function:
-        """CasADi function of ``x``: motor masses [kg], peak torques [N m], finger inertias [kg m^2] (n_joints)."""
+        """CasADi function of ``x`` giving the joint numbers.
+
+        Outputs (n_joints each): motor masses [kg], peak torques [N m], finger inertias [kg m^2].
+        """
         return ca.Function("joint_numbers", [x], [self.motor_mass, self.peak_torque, self.finger_inertia])
 
 

@@ -132,8 +132,8 @@ class DesignProblem:
     def exact_point(self, x: np.ndarray) -> np.ndarray:
         """Give ``x`` with the auxiliary variables set to their exact values for the design in ``x``.
 
-        The auxiliaries are the finger-mass directions, reaction compliances and the epigraph ``t``; evaluating
-        at the result gives the model's values to machine precision.
+        The auxiliaries are the finger-mass directions, reaction compliances and the epigraph ``t``;
+        evaluating at the result gives the model's values to machine precision.
         """
         x = np.array(x, dtype=float)
         masses, torques, finger = (np.asarray(v).ravel() for v in self._joint_numbers(x))
@@ -363,7 +363,7 @@ def _sample_terms(
 
 
 def _model_terms(log_compliance: ca.MX, design: DesignQuantities, per_sample: _SampleTerms) -> ModelTerms:
-    """The symbolic quantities the model's constraints bound, ``log_compliance`` the ``log(1/F_a)`` of ``x``."""
+    """The symbolic quantities the model's constraints bound; ``log_compliance``: ``log(1/F_a)`` in ``x``."""
     return ModelTerms(
         log_compliance, design.peak_torque, per_sample.normalisation, per_sample.thresholds, design.motor_mass
     )
@@ -405,8 +405,8 @@ def _variable_slices(
 ) -> tuple[int | None, slice, slice]:
     """Where the auxiliaries sit in ``x``: the epigraph ``t``, ``g = log(1/F_a)`` and the directions ``x_s``.
 
-    The layout is: design (log values) | epigraph ``t`` (if needed) | ``g`` (n_samples) | finger-mass directions
-    (n_joints * n_samples).
+    The layout is: design (log values) | epigraph ``t`` (if needed) | ``g`` (n_samples) | finger-mass
+    directions (n_joints * n_samples).
     """
     epigraph_index = n_design if with_epigraph else None
     compliance_start = n_design + (epigraph_index is not None)
@@ -496,7 +496,7 @@ def _add_objective_bounds(
     scale: Mapping[str, float],
     p: ca.MX,
 ) -> None:
-    """Add ``f_k <= eps_k`` for each bounded objective, ``eps_k`` the NLP parameter ``p[k]`` (scaled units)."""
+    """Add ``f_k <= eps_k`` for each bounded objective, ``eps_k`` the NLP parameter ``p[k]`` (scaled)."""
     for k, name in enumerate(bounded):
         g.add(
             OBJECTIVES[name][0] * expressions[name] / scale[name] - p[k],

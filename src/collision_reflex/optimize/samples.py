@@ -1,9 +1,10 @@
 """The contact samples a design is evaluated on, and the numeric and symbolic per-sample data of the NLP.
 
 Sample ``s`` is a configuration with its Pinocchio data hit along a unit direction ``u``. Per sample the NLP
-needs ``w = J^T u``, the structure mass matrix ``M_bb0`` and the motor-mass influence matrices (numeric, packed
-into one data column), and one SX function that maps the symbolic design column and the sample's auxiliaries
-to the effective parameters of MODEL.md §3 and the 1D impulse of :mod:`collision_reflex.model.impulse`.
+needs ``w = J^T u``, the structure mass matrix ``M_bb0`` and the motor-mass influence matrices (numeric,
+packed into one data column), and one SX function that maps the symbolic design column and the sample's
+auxiliaries to the effective parameters of MODEL.md §3 and the 1D impulse of
+:mod:`collision_reflex.model.impulse`.
 """
 
 from __future__ import annotations
@@ -179,8 +180,8 @@ def sample_function(n_joints: int, sensing: str, reaction: str, reflected_inerti
 def sample_data(samples: ContactSamples, k_mech: np.ndarray) -> np.ndarray:
     """Numeric data column per sample (see :func:`sample_function`), shape (rows, n_samples).
 
-    ``k_mech`` is the joint mechanical stiffness [N m/rad] per joint; the column holds its effective value along
-    ``u`` [N/m].
+    ``k_mech`` is the joint mechanical stiffness [N m/rad] per joint; the column holds its effective value
+    along ``u`` [N/m].
     """
     kin = samples.kinematics
     w = samples.joint_moment_arms
@@ -205,7 +206,7 @@ def sample_data(samples: ContactSamples, k_mech: np.ndarray) -> np.ndarray:
 
 
 def check_finite(values: np.ndarray, what: str, samples: ContactSamples) -> None:
-    """Raise :class:`InvalidParameter` naming the first sample where ``values`` (one per sample) is not finite."""
+    """Raise :class:`InvalidParameter` at the first sample where ``values`` (one per sample) is not finite."""
     if not np.all(np.isfinite(values)):
         bad = int(np.flatnonzero(~np.isfinite(values))[0])
         raise InvalidParameter(

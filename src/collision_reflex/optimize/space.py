@@ -40,10 +40,12 @@ class Bounds:
 
     @classmethod
     def fixed(cls, value: float, name: str = "variable") -> Bounds:
+        """Bounds that fix the variable at ``value`` [its SI unit]."""
         return cls(value, value, name)
 
     @property
     def is_fixed(self) -> bool:
+        """Whether the bounds fix the variable (``lower == upper``)."""
         return self.lower == self.upper
 
     @property
@@ -106,4 +108,5 @@ class DesignSpace:
         return bounds
 
     def global_bounds(self, name: str) -> Bounds:
+        """The bounds of global variable ``name`` (``threshold`` or ``approach_velocity``)."""
         return as_bounds(getattr(self, name), name)

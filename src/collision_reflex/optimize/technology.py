@@ -1,4 +1,8 @@
-"""The fixed actuation choices a design varies within: reference motor, scaling law, stiffness, sensing, reaction."""
+"""The fixed actuation choices a design varies within.
+
+They are the reference motor, the scaling law, the mechanical stiffness, the sensing scheme and the reaction
+model.
+"""
 
 from __future__ import annotations
 
