@@ -22,7 +22,7 @@ import time
 from collections.abc import Callable, Hashable, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Executor, Future, wait
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any, ParamSpec, Protocol
 
 import numpy as np
 
@@ -32,12 +32,14 @@ from .blas import single_threaded_blas
 from .problem import OBJECTIVES, DesignProblem
 from .results import PointFailure, SweepPoint, record_row, result_record
 from .serial import SerialExecutor
-from .solve import DesignResult, solve
+from .solve import DesignResult, IpoptOptions, solve
 
 if TYPE_CHECKING:
     from pathlib import Path
 
     import pandas as pd
+
+_P = ParamSpec("_P")
 
 ANCHOR_SLACK = 1e-6
 """Relative slack on the first objective when the second is minimised at an anchor (lexicographic step): small
@@ -151,7 +153,7 @@ def pareto_front(
     build: ProblemBuilder,
     objectives: Sequence[str] = ("worst_case_impulse", "actuator_mass"),
     points: int = 20,
-    ipopt_options: dict[str, Any] | None = None,
+    ipopt_options: IpoptOptions | None = None,
     progress: Callable[[int, int], None] | None = None,
     anchor_starts: int = 1,
     *,
@@ -251,7 +253,7 @@ def pareto_front(
 def single_optimum(
     build: ProblemBuilder,
     objective: Hashable,
-    ipopt_options: dict[str, Any] | None = None,
+    ipopt_options: IpoptOptions | None = None,
     progress: Callable[[int, int], None] | None = None,
     *,
     executor: Executor | None = None,
@@ -297,7 +299,7 @@ class _Sweep:
             self.progress(self.done, self.total)
 
     def run(
-        self, tasks: dict[str, tuple[Callable[..., SweepPoint], tuple[Any, ...]]]
+        self, tasks: Mapping[str, tuple[Callable[..., SweepPoint], tuple[object, ...]]]
     ) -> dict[str, SweepPoint]:
         """Every task's :class:`SweepPoint`, in the order of ``tasks``."""
         out: dict[str, SweepPoint] = {}
@@ -358,11 +360,11 @@ def built_problem(build: Hashable, objective: Hashable, bounded: tuple[str, ...]
     return problem
 
 
-def _one_at_a_time(function: Callable[..., SweepPoint]) -> Callable[..., SweepPoint]:
+def _one_at_a_time(function: Callable[_P, SweepPoint]) -> Callable[_P, SweepPoint]:
     """Run a piece under the solver lock with single-threaded BLAS (the same numbers in every process)."""
 
     @functools.wraps(function)
-    def locked(*args: Any, **kwargs: Any) -> SweepPoint:
+    def locked(*args: _P.args, **kwargs: _P.kwargs) -> SweepPoint:
         with _SOLVER_LOCK, single_threaded_blas():
             return function(*args, **kwargs)
 
@@ -378,7 +380,7 @@ def solve_anchor(
     build: ProblemBuilder,
     objective: str,
     objectives: tuple[str, ...],
-    ipopt_options: dict[str, Any] | None,
+    ipopt_options: IpoptOptions | None,
     starts: int = 1,
 ) -> SweepPoint:
     """A Pareto anchor: ``objective`` minimised, then each other objective with it held at its optimum.
@@ -417,7 +419,7 @@ def solve_point(
     objectives: tuple[str, ...],
     epsilon: dict[str, float],
     start: np.ndarray,
-    ipopt_options: dict[str, Any] | None,
+    ipopt_options: IpoptOptions | None,
 ) -> SweepPoint:
     """One epsilon-constraint point: the first objective minimised with the others bounded by ``epsilon``.
 
@@ -435,9 +437,7 @@ def solve_point(
 
 
 @_one_at_a_time
-def solve_alone(
-    build: ProblemBuilder, objective: Hashable, ipopt_options: dict[str, Any] | None
-) -> SweepPoint:
+def solve_alone(build: ProblemBuilder, objective: Hashable, ipopt_options: IpoptOptions | None) -> SweepPoint:
     """A single-objective optimum as a piece run like the sweep's.
 
     ``objective``: a name, or what ``build`` takes for a weighted one.
