@@ -12,7 +12,7 @@ import collision_reflex as cr
 from collision_reflex.arm import Arm
 from collision_reflex.optimize import hypervolume
 from collision_reflex.optimize.evaluate import evaluate_design
-from collision_reflex.optimize.problem import TIE_BREAK_WEIGHT
+from collision_reflex.optimize.objectives import TIE_BREAK_WEIGHT
 from collision_reflex.optimize.solve import design_at
 
 TWO_LINK = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"

@@ -9,11 +9,13 @@ row of a design.
 """
 
 from .constraints import Constraints
+from .objectives import OBJECTIVES
 from .pareto import ParetoSet, hypervolume, pareto_front
-from .problem import OBJECTIVES, ActuatorTechnology, DesignProblem, build_problem
+from .problem import DesignProblem, build_problem
 from .samples import ContactSamples
 from .solve import Design, DesignResult, design_at, solve
 from .space import Bounds, DesignSpace
+from .technology import ActuatorTechnology
 
 __all__ = [
     "OBJECTIVES",

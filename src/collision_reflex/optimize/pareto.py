@@ -29,7 +29,8 @@ import numpy as np
 from .. import _validate
 from ..errors import InvalidParameter, SolverFailed
 from .blas import single_threaded_blas
-from .problem import OBJECTIVES, DesignProblem
+from .objectives import OBJECTIVES
+from .problem import DesignProblem
 from .results import PointFailure, SweepPoint, record_row, result_record
 from .serial import SerialExecutor
 from .solve import DesignResult, IpoptOptions, solve

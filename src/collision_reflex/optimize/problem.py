@@ -20,8 +20,8 @@ Structure (see the README's "Design optimisation" section):
   ``w_s^T x_s = 1`` and uses ``x_s^T M_f x_s``: minimising over the design and ``x`` together is exact, and
   avoids both a symbolic inverse and a badly conditioned bilinear equality.
 - The worst case is an epigraph ``t >= I_s``.
-- Objectives can be bounded (``f_k <= eps_k``) through NLP parameters, so one solver serves a whole
-  epsilon-constraint Pareto sweep.
+- Objectives (:mod:`.objectives`) can be bounded (``f_k <= eps_k``) through NLP parameters, so one solver serves
+  a whole epsilon-constraint Pareto sweep.
 - The constraint rows (:mod:`.constraints`) each carry a label.
 """
 
@@ -36,7 +36,6 @@ from typing import TYPE_CHECKING, NamedTuple
 import casadi as ca
 import numpy as np
 
-from .. import _validate
 from ..errors import InvalidParameter
 from ..model import effective as formulas
 from .constraints import (
@@ -49,6 +48,17 @@ from .constraints import (
     torque_requirement_rows,
 )
 from .layout import DesignLayout, DesignQuantities, design_layout, design_quantities
+from .objectives import (
+    OBJECTIVES,
+    TIE_BREAK_WEIGHT,
+    add_epigraph,
+    add_objective_bounds,
+    checked_bounded_objectives,
+    objective_expression,
+    objective_scale,
+    objective_terms,
+    objective_weights,
+)
 from .samples import (
     ContactSamples,
     check_finite,
@@ -66,21 +76,6 @@ if TYPE_CHECKING:
     from ..arm.robot import Arm
 
 __all__ = ["OBJECTIVES", "TIE_BREAK_WEIGHT", "ActuatorTechnology", "DesignProblem", "build_problem"]
-
-TIE_BREAK_WEIGHT = 1e-3
-"""Weight of the (start-normalised) mean impulse added to every objective.
-
-A worst case leaves the samples that do not bind it, and the joints that do not affect it, undetermined; this
-small pull toward a lower mean picks a definite design among the equals and pins the per-sample auxiliary
-variables, at a cost of about this relative amount in the main objective."""
-
-OBJECTIVES: dict[str, tuple[int, str, str]] = {
-    # name: (sense: +1 minimise / -1 maximise, unit, description)
-    "worst_case_impulse": (1, "N*s", "largest collision impulse over the samples"),
-    "mean_impulse": (1, "N*s", "mean over the samples of the collision impulse"),
-    "actuator_mass": (1, "kg", "total mass of the motors"),
-    "approach_velocity": (-1, "m/s", "approach velocity (maximised: shorter cycle time)"),
-}
 
 
 @dataclass
@@ -242,7 +237,7 @@ def build_problem(
     """
     started = time.perf_counter()
     constraints = constraints or Constraints()
-    weights, bounded = _objective_weights(objective), _bounded_objectives(bounded_objectives)
+    weights, bounded = objective_weights(objective), checked_bounded_objectives(bounded_objectives)
     joint_names = _joint_names(arm, samples)
     n_joints = len(joint_names)
     layout = design_layout(space, technology, constraints, n_joints)
@@ -275,20 +270,20 @@ def build_problem(
     start_impulses = np.asarray(evaluate(x0)[0]).ravel()
     check_finite(start_impulses, "impulse at the start point", samples)
     velocity = layout.values(x0[:n_design])["approach_velocity"][0]
-    scale = _objective_scale(start_impulses, start_mass, velocity)
-    expressions = _objective_terms(impulses, actuator_mass, design.values["approach_velocity"])
+    scale = objective_scale(start_impulses, start_mass, velocity)
+    expressions = objective_terms(impulses, actuator_mass, design.values["approach_velocity"])
 
     g = ConstraintList()
     if epigraph_index is not None:
-        expressions["worst_case_impulse"] = _add_epigraph(g, x, epigraph_index, impulses, scale, x0, lbx)
+        expressions["worst_case_impulse"] = add_epigraph(g, x, epigraph_index, impulses, scale, x0, lbx)
     torque_scale = np.maximum(np.asarray(required_torque(start_mass)).ravel(), 1e-3)
     terms = _model_terms(x[compliance_index], design, per_sample)
     add_model_constraints(
         g, terms, torque_scale, torque_demands, samples, technology, constraints, joint_names
     )
-    _add_objective_bounds(g, bounded, expressions, scale, p)
+    add_objective_bounds(g, bounded, expressions, scale, p)
 
-    nlp = {"x": x, "f": _objective_expression(weights, expressions, scale), "g": ca.vertcat(*g.parts), "p": p}
+    nlp = {"x": x, "f": objective_expression(weights, expressions, scale), "g": ca.vertcat(*g.parts), "p": p}
     return DesignProblem(
         nlp=nlp,
         x0=x0,
@@ -369,28 +364,6 @@ def _model_terms(log_compliance: ca.MX, design: DesignQuantities, per_sample: _S
     )
 
 
-def _objective_terms(impulses: ca.MX, actuator_mass: ca.MX, approach_velocity: ca.MX) -> dict[str, ca.MX]:
-    """The objectives as expressions, but the worst case (an epigraph variable, see :func:`_add_epigraph`).
-
-    From the impulses [N*s] (1 x n_samples), the motors' total mass [kg] and the approach velocity [m/s].
-    """
-    return {
-        "mean_impulse": ca.sum2(impulses) / impulses.shape[1],
-        "actuator_mass": actuator_mass,
-        "approach_velocity": approach_velocity,
-    }
-
-
-def _objective_scale(start_impulses: np.ndarray, start_mass: np.ndarray, velocity: float) -> dict[str, float]:
-    """Each objective's value at the start (impulses [N*s], motor masses [kg], approach velocity [m/s])."""
-    return {
-        "worst_case_impulse": float(start_impulses.max()),
-        "mean_impulse": float(start_impulses.mean()),
-        "actuator_mass": float(start_mass.sum()),
-        "approach_velocity": float(velocity),
-    }
-
-
 def _joint_names(arm: Arm, samples: ContactSamples) -> tuple[str, ...]:
     """The arm's joint names, checked against the samples' joint count (generic names if the arm has none)."""
     n_joints = samples.kinematics.mass_matrix.shape[1]
@@ -462,76 +435,6 @@ def _feasible_gear_start(
                 x0[index] + math.log(1.1 * required[joint] / torques[joint]),
                 math.log(layout.bounds["gear_ratio"][joint].upper),
             )
-
-
-def _add_epigraph(
-    g: ConstraintList,
-    x: ca.MX,
-    index: int,
-    impulses: ca.MX,
-    scale: Mapping[str, float],
-    x0: np.ndarray,
-    lbx: np.ndarray,
-) -> ca.MX:
-    """Add ``t >= I_s`` for every sample to ``g`` and give the worst-case bound ``t`` [N*s].
-
-    ``x[index]`` is ``t`` divided by the start's worst case; it starts at 1 and is bounded below by 0.
-    """
-    t = x[index] * scale["worst_case_impulse"]
-    x0[index] = 1.0
-    lbx[index] = 0.0
-    g.add(
-        ca.transpose(t - impulses) / scale["worst_case_impulse"],
-        0.0,
-        np.inf,
-        [f"worst-case bound >= impulse of sample {s}" for s in range(impulses.shape[1])],
-    )
-    return t
-
-
-def _add_objective_bounds(
-    g: ConstraintList,
-    bounded: Sequence[str],
-    expressions: Mapping[str, ca.MX],
-    scale: Mapping[str, float],
-    p: ca.MX,
-) -> None:
-    """Add ``f_k <= eps_k`` for each bounded objective, ``eps_k`` the NLP parameter ``p[k]`` (scaled)."""
-    for k, name in enumerate(bounded):
-        g.add(
-            OBJECTIVES[name][0] * expressions[name] / scale[name] - p[k],
-            -np.inf,
-            0.0,
-            [f"{name} within its bound"],
-        )
-
-
-def _objective_expression(
-    weights: Mapping[str, float], expressions: Mapping[str, ca.MX], scale: Mapping[str, float]
-) -> ca.MX:
-    """The NLP's objective: the weighted, start-normalised objectives plus the tie-break pull on the mean."""
-    f = sum(
-        weight * OBJECTIVES[name][0] * expressions[name] / scale[name] for name, weight in weights.items()
-    )
-    return f + TIE_BREAK_WEIGHT * expressions["mean_impulse"] / scale["mean_impulse"]
-
-
-def _objective_weights(objective: str | Mapping[str, float]) -> dict[str, float]:
-    """The objective as ``{name: weight}``, names and weights (> 0) checked."""
-    weights = {objective: 1.0} if isinstance(objective, str) else dict(objective)
-    if not weights:
-        raise InvalidParameter("objective", objective, "an objective name or a non-empty {name: weight}")
-    for name, weight in weights.items():
-        _validate.choice("objective", name, tuple(OBJECTIVES))
-        _validate.positive(f"weight of {name}", weight)
-    return weights
-
-
-def _bounded_objectives(names: Sequence[str]) -> tuple[str, ...]:
-    """The objectives that may be bounded per solve, names checked."""
-    for name in names:
-        _validate.choice("bounded objective", name, tuple(OBJECTIVES))
-    return tuple(names)
 
 
 def _evaluate_function(

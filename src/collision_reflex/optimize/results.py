@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..model.impulse import optimal_velocity, phase_impulses, series_stiffness
-from .problem import OBJECTIVES
+from .objectives import OBJECTIVES
 from .solve import Design, DesignResult
 
 if TYPE_CHECKING:

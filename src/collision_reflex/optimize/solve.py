@@ -13,7 +13,8 @@ import numpy as np
 
 from ..errors import InvalidParameter, SolverFailed
 from .evaluate import evaluate_design
-from .problem import OBJECTIVES, DesignProblem
+from .objectives import OBJECTIVES
+from .problem import DesignProblem
 
 IpoptOptions = Mapping[str, str | float]
 """Options of CasADi's ``nlpsol`` with IPOPT (``"ipopt.<option>"`` and CasADi's own): strings, numbers, flags."""
