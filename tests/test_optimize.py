@@ -12,7 +12,7 @@ import collision_reflex as cr
 from collision_reflex.arm import Arm
 from collision_reflex.optimize import hypervolume
 from collision_reflex.optimize.evaluate import evaluate_design
-from collision_reflex.optimize.problem import TIE_BREAK_WEIGHT
+from collision_reflex.optimize.objectives import TIE_BREAK_WEIGHT
 from collision_reflex.optimize.solve import design_at
 
 TWO_LINK = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
@@ -244,6 +244,18 @@ def test_bad_bounds_are_clear_errors(arm, space_change, message):
     space = cr.DesignSpace(**{**FREE_SPACE.__dict__, **space_change})
     with pytest.raises(cr.InvalidParameter, match=message):
         cr.build_problem(arm, _samples(arm, 1, 2), space, _technology())
+
+
+def test_kinematics_without_the_motor_terms_are_a_clear_error(arm):
+    # Arm.kinematics(q, full=False) leaves the gravity and motor-mass terms out; the problem needs them.
+    q = arm.sample_configurations(1, np.random.default_rng(0))
+    partial = cr.ContactSamples.grid(arm.kinematics(q, full=False), np.array([[1.0, 0.0]]))
+    with pytest.raises(cr.InvalidParameter, match=r"gravity = None .* full kinematics"):
+        cr.build_problem(arm, partial, FREE_SPACE, _technology())
+    # A given torque requirement needs no gravity terms, but the finger mass needs the motor-mass influence.
+    given = cr.Constraints(torque_required=[1.0, 1.0])
+    with pytest.raises(cr.InvalidParameter, match=r"motor_mass_influence = None .* full kinematics"):
+        cr.build_problem(arm, partial, FREE_SPACE, _technology(), constraints=given)
 
 
 def test_bad_objective_and_floor(arm):

@@ -1,16 +1,21 @@
-"""Actuator design optimisation: CasADi + IPOPT over motor size, gear ratio, stiffness, threshold and approach
-velocity for a URDF arm, and Pareto sets by epsilon-constraint sweeps.
+"""Actuator design optimisation for a URDF arm, and Pareto sets by epsilon-constraint sweeps.
 
-Build and solve are separate: :func:`build_problem` returns an inspectable :class:`DesignProblem`, :func:`solve`
-runs IPOPT and returns a :class:`DesignResult`; :func:`pareto_front` sweeps objectives into a
+CasADi + IPOPT choose motor size, gear ratio, stiffness, threshold and approach velocity.
+
+Build and solve are separate: :func:`build_problem` returns an inspectable :class:`DesignProblem`,
+:func:`solve` runs IPOPT and returns a :class:`DesignResult`; :func:`pareto_front` sweeps objectives into a
 :class:`ParetoSet` (in-process or through any executor); :mod:`.results` makes the one result record and table
 row of a design.
 """
 
+from .constraints import Constraints
+from .objectives import OBJECTIVES
 from .pareto import ParetoSet, hypervolume, pareto_front
-from .problem import OBJECTIVES, ActuatorTechnology, DesignProblem, build_problem
+from .problem import DesignProblem, build_problem
+from .samples import ContactSamples
 from .solve import Design, DesignResult, design_at, solve
-from .space import Bounds, Constraints, ContactSamples, DesignSpace
+from .space import Bounds, DesignSpace
+from .technology import ActuatorTechnology
 
 __all__ = [
     "OBJECTIVES",

@@ -8,13 +8,13 @@ _CASADI_BLAS_REGISTERED: list[bool] = []
 
 
 def single_threaded_blas() -> contextlib.AbstractContextManager[object]:
-    """A context with every BLAS (NumPy's, and the OpenBLAS that CasADi bundles for IPOPT and MUMPS) on one
-    thread.
+    """A context with every BLAS on one thread.
 
-    A threaded BLAS sums in an order that depends on its thread count, and Dask workers pin it to one thread
-    where a plain process does not; the difference moves IPOPT's iterates and so the results, within the solver
-    tolerance. With one thread everywhere, every executor gives the same numbers, bitwise in practice
-    (parallelism comes from the executor's processes).
+    That is NumPy's, and the OpenBLAS that CasADi bundles for IPOPT and MUMPS. A threaded BLAS sums in an
+    order that depends on its thread count, and Dask workers pin it to one thread where a plain process does
+    not; the difference moves IPOPT's iterates and so the results, within the solver tolerance. With one
+    thread everywhere, every executor gives the same numbers, bitwise in practice (parallelism comes from the
+    executor's processes).
     """
     import threadpoolctl
 

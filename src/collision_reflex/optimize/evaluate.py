@@ -7,20 +7,25 @@ then the 1D impulse once. Agreement of the two checks the reformulation as well 
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..model.impulse import series_stiffness, total_impulse
 
 if TYPE_CHECKING:
+    from ..arm.effective import EffectiveParameters
     from .problem import DesignProblem
     from .solve import Design
 
 
-def design_collision_parameters(problem: DesignProblem, design: Design) -> tuple[Any, np.ndarray]:
-    """Effective 1D parameters (:class:`collision_reflex.arm.EffectiveParameters`) of ``design`` at each of the
-    problem's samples, and the contact-force threshold [N] per sample.
+def design_collision_parameters(
+    problem: DesignProblem, design: Design
+) -> tuple[EffectiveParameters, np.ndarray]:
+    """Effective 1D parameters of ``design`` at each of the problem's samples, and their force thresholds.
+
+    The parameters are a :class:`collision_reflex.arm.EffectiveParameters`; the contact-force threshold [N] is
+    one per sample, shape (n_samples,).
     """
     from ..arm import effective_parameters
 

@@ -14,7 +14,8 @@ import numpy as np
 
 from ..errors import CollisionReflexError
 from .evaluate import evaluate_design
-from .problem import OBJECTIVES, DesignProblem
+from .objectives import OBJECTIVES
+from .problem import DesignProblem
 from .solve import design_at
 
 

@@ -1,5 +1,7 @@
-"""Pareto sets of actuator designs by epsilon-constraint sweeps with lexicographic anchors: the one sweep, for
-the library and for studies alike, in-process or through any :class:`concurrent.futures.Executor`.
+"""Pareto sets of actuator designs by epsilon-constraint sweeps with lexicographic anchors.
+
+This is the one sweep, for the library and for studies alike, in-process or through any
+:class:`concurrent.futures.Executor`.
 
 Warm-start policy (one for every caller): each anchor's lexicographic steps start from the anchor found so
 far; every epsilon point starts from the first objective's anchor (its point, not its multipliers). A point's
@@ -20,34 +22,46 @@ import time
 from collections.abc import Callable, Hashable, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Executor, Future, wait
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any, ParamSpec, Protocol
 
 import numpy as np
 
 from .. import _validate
 from ..errors import InvalidParameter, SolverFailed
 from .blas import single_threaded_blas
-from .problem import OBJECTIVES, DesignProblem
+from .objectives import OBJECTIVES
+from .problem import DesignProblem
 from .results import PointFailure, SweepPoint, record_row, result_record
 from .serial import SerialExecutor
-from .solve import DesignResult, solve
+from .solve import DesignResult, IpoptOptions, solve
 
 if TYPE_CHECKING:
+    from pathlib import Path
+
     import pandas as pd
+
+_P = ParamSpec("_P")
 
 ANCHOR_SLACK = 1e-6
 """Relative slack on the first objective when the second is minimised at an anchor (lexicographic step): small
 enough not to move the anchor visibly, large enough for IPOPT to find an interior point."""
 
 DOMINANCE_TOLERANCE = 1e-9
-"""Relative difference (to each objective's largest magnitude) below which two objective values count as equal."""
+"""Relative difference below which two objective values count as equal.
+
+Relative to each objective's largest magnitude."""
 
 
 class ProblemBuilder(Protocol):
-    """``build(objective, bounded_objectives) -> DesignProblem``. Hashable (the problems are cached per process
-    by builder); picklable (a module-level function, or a frozen dataclass) to run through a process pool."""
+    """``build(objective, bounded_objectives) -> DesignProblem``.
 
-    def __call__(self, objective: Any, bounded: tuple[str, ...], /) -> DesignProblem: ...
+    Hashable (the problems are cached per process by builder); picklable (a module-level function, or a frozen
+    dataclass) to run through a process pool.
+    """
+
+    def __call__(self, objective: Hashable, bounded: tuple[str, ...], /) -> DesignProblem:
+        """Build the problem minimising ``objective`` (a name, or a weighted one) with ``bounded`` bounded."""
+        ...
 
     def __hash__(self) -> int: ...
 
@@ -92,8 +106,10 @@ class ParetoSet:
         return [result_record(r, label) for r, label in zip(self.points, labels, strict=True)]
 
     def to_frame(self) -> pd.DataFrame:
-        """One row per design (:func:`collision_reflex.optimize.results.record_row`): objectives, per-joint
-        design and solver status, every column with its unit."""
+        """One row per design (:func:`collision_reflex.optimize.results.record_row`).
+
+        The columns are the objectives, the per-joint design and the solver status, each with its unit.
+        """
         import pandas as pd
 
         return pd.DataFrame([record_row(record, i) for i, record in enumerate(self.records())])
@@ -114,16 +130,20 @@ class ParetoSet:
         return int(np.argmax(beaten)) if beaten.any() else None
 
     def hypervolume(self, reference: Sequence[float]) -> float:
-        """Hypervolume dominated by the front up to ``reference`` (objective units; maximised objectives are
-        negated, as everything here is minimised).
+        """Hypervolume dominated by the front up to ``reference`` (objective units).
+
+        Maximised objectives are negated, as everything here is minimised.
         """
         return hypervolume(
             _minimised(self.values(), self.objectives), _minimised(np.array([reference]), self.objectives)[0]
         )
 
-    def plot(self, path: str | os.PathLike[str], chosen: Sequence[float] | None = None) -> Any:
-        """Draw the front (2 objectives: a line plot; 3: a scatter coloured by the third); ``chosen``: a design's
-        objective values to mark."""
+    def plot(self, path: str | os.PathLike[str], chosen: Sequence[float] | None = None) -> Path:
+        """Draw the front to ``path`` and give the path of the figure.
+
+        2 objectives: a line plot; 3: a scatter coloured by the third; ``chosen``: a design's objective values
+        to mark.
+        """
         from ..plots.design_front import plot_design_front
 
         units = [OBJECTIVES[name][1] for name in self.objectives]
@@ -134,7 +154,7 @@ def pareto_front(
     build: ProblemBuilder,
     objectives: Sequence[str] = ("worst_case_impulse", "actuator_mass"),
     points: int = 20,
-    ipopt_options: dict[str, Any] | None = None,
+    ipopt_options: IpoptOptions | None = None,
     progress: Callable[[int, int], None] | None = None,
     anchor_starts: int = 1,
     *,
@@ -234,16 +254,17 @@ def pareto_front(
 def single_optimum(
     build: ProblemBuilder,
     objective: Hashable,
-    ipopt_options: dict[str, Any] | None = None,
+    ipopt_options: IpoptOptions | None = None,
     progress: Callable[[int, int], None] | None = None,
     *,
     executor: Executor | None = None,
     finished: FinishedHook | None = None,
     save: SaveHook | None = None,
 ) -> tuple[DesignResult, bool]:
-    """The optimum of one objective (a name, or what ``build`` takes for a weighted one), run, saved and found
-    again like a piece of :func:`pareto_front` (its name: ``optimum``). Returns the result and whether it was
-    found finished.
+    """The optimum of one objective (a name, or what ``build`` takes for a weighted one).
+
+    It is run, saved and found again like a piece of :func:`pareto_front` (its name: ``optimum``). Returns the
+    result and whether it was found finished.
 
     Raises
     ------
@@ -279,7 +300,7 @@ class _Sweep:
             self.progress(self.done, self.total)
 
     def run(
-        self, tasks: dict[str, tuple[Callable[..., SweepPoint], tuple[Any, ...]]]
+        self, tasks: Mapping[str, tuple[Callable[..., SweepPoint], tuple[object, ...]]]
     ) -> dict[str, SweepPoint]:
         """Every task's :class:`SweepPoint`, in the order of ``tasks``."""
         out: dict[str, SweepPoint] = {}
@@ -332,17 +353,19 @@ time (a Dask worker with several threads, for instance); parallelism comes from 
 
 @functools.lru_cache(maxsize=16)
 def built_problem(build: Hashable, objective: Hashable, bounded: tuple[str, ...] = ()) -> DesignProblem:
-    """``build(objective, bounded)``, built once per process and builder (later pieces reuse its solvers; the
-    results do not depend on which piece came first)."""
+    """``build(objective, bounded)``, built once per process and builder.
+
+    Later pieces reuse its solvers; the results do not depend on which piece came first.
+    """
     problem: DesignProblem = build(objective, bounded)  # type: ignore[operator]
     return problem
 
 
-def _one_at_a_time(function: Callable[..., SweepPoint]) -> Callable[..., SweepPoint]:
+def _one_at_a_time(function: Callable[_P, SweepPoint]) -> Callable[_P, SweepPoint]:
     """Run a piece under the solver lock with single-threaded BLAS (the same numbers in every process)."""
 
     @functools.wraps(function)
-    def locked(*args: Any, **kwargs: Any) -> SweepPoint:
+    def locked(*args: _P.args, **kwargs: _P.kwargs) -> SweepPoint:
         with _SOLVER_LOCK, single_threaded_blas():
             return function(*args, **kwargs)
 
@@ -358,12 +381,15 @@ def solve_anchor(
     build: ProblemBuilder,
     objective: str,
     objectives: tuple[str, ...],
-    ipopt_options: dict[str, Any] | None,
+    ipopt_options: IpoptOptions | None,
     starts: int = 1,
 ) -> SweepPoint:
-    """A Pareto anchor: ``objective`` minimised (from ``starts`` start points), then (lexicographically) each
-    other objective with it held at its optimum, so that the anchor is not dominated. A lexicographic step the
-    solver cannot do keeps the anchor found so far and is recorded among the failures."""
+    """A Pareto anchor: ``objective`` minimised, then each other objective with it held at its optimum.
+
+    The first solve runs from ``starts`` start points; the lexicographic steps make the anchor non-dominated.
+    A lexicographic step the solver cannot do keeps the anchor found so far and is recorded among the
+    failures.
+    """
     label = f"anchor: {objective}"
     try:
         result = solve(
@@ -394,10 +420,12 @@ def solve_point(
     objectives: tuple[str, ...],
     epsilon: dict[str, float],
     start: np.ndarray,
-    ipopt_options: dict[str, Any] | None,
+    ipopt_options: IpoptOptions | None,
 ) -> SweepPoint:
-    """One epsilon-constraint point: the first objective minimised with the others bounded by ``epsilon``
-    [their units], started from ``start`` (a point of the NLP's variables)."""
+    """One epsilon-constraint point: the first objective minimised with the others bounded by ``epsilon``.
+
+    The bounds are in the objectives' units; the solve starts from ``start`` (a point of the NLP's variables).
+    """
     label = "epsilon: " + ", ".join(_bound_text(k, v) for k, v in epsilon.items())
     problem = built_problem(build, objectives[0], objectives[1:])
     try:
@@ -410,11 +438,11 @@ def solve_point(
 
 
 @_one_at_a_time
-def solve_alone(
-    build: ProblemBuilder, objective: Hashable, ipopt_options: dict[str, Any] | None
-) -> SweepPoint:
-    """A single-objective optimum (``objective``: a name, or what ``build`` takes for a weighted one) as a
-    piece run like the sweep's."""
+def solve_alone(build: ProblemBuilder, objective: Hashable, ipopt_options: IpoptOptions | None) -> SweepPoint:
+    """A single-objective optimum as a piece run like the sweep's.
+
+    ``objective``: a name, or what ``build`` takes for a weighted one.
+    """
     try:
         result = solve(built_problem(build, objective), ipopt_options=ipopt_options)
     except SolverFailed as error:
@@ -438,8 +466,10 @@ def anchor_bound(name: str, value: float) -> float:
 def epsilon_grid(
     anchors: Mapping[str, DesignResult], bounded: Sequence[str], count: int
 ) -> list[dict[str, float]]:
-    """Bounds on the bounded objectives spread between their values at the anchors, ordered so that each point
-    is near the previous one (a snake through the grid for three objectives).
+    """Bounds on the bounded objectives spread between their values at the anchors [their units].
+
+    The points are ordered so that each is near the previous one (a snake through the grid for three
+    objectives).
     """
     if count <= 0:
         return []
@@ -467,8 +497,11 @@ def _minimised(values: np.ndarray, names: Sequence[str]) -> np.ndarray:
 
 
 def _dominance(values: np.ndarray, tolerance: float) -> np.ndarray:
-    """(n, n) booleans of minimised ``values`` (n, m): ``[i, j]`` if point i dominates point j (no worse in any
-    column and better in one, by more than ``tolerance`` of the column's largest magnitude)."""
+    """(n, n) booleans of minimised ``values`` (n, m): ``[i, j]`` if point i dominates point j.
+
+    Point i dominates point j when it is no worse in any column and better in one, by more than ``tolerance``
+    of the column's largest magnitude.
+    """
     scale = np.maximum(np.abs(values).max(axis=0), 1e-300)
     diff = (values[:, None, :] - values[None, :, :]) / scale  # [i, j] < 0: i is better than j
     return np.all(diff <= tolerance, axis=2) & np.any(diff < -tolerance, axis=2)

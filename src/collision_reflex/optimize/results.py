@@ -1,6 +1,7 @@
-"""The one result record of a design: its objectives, per-joint quantities, margins and solver status as plain
-data (JSON types, SI units), and the one table row made from it (``ParetoSet.to_frame``, ``pareto.csv`` and the
-report's tables).
+"""The one result record of a design, and the one table row made from it.
+
+The record holds a design's objectives, per-joint quantities, margins and solver status as plain data (JSON
+types, SI units); the row is what ``ParetoSet.to_frame``, ``pareto.csv`` and the report's tables show.
 
 A sweep's finished pieces (:class:`SweepPoint`) round-trip through JSON exactly (floats are written with
 ``repr``), so that a run resumed from saved points gives the numbers of an uninterrupted one.
@@ -16,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..model.impulse import optimal_velocity, phase_impulses, series_stiffness
-from .problem import OBJECTIVES
+from .objectives import OBJECTIVES
 from .solve import Design, DesignResult
 
 if TYPE_CHECKING:
@@ -55,6 +56,7 @@ class PointFailure:
     message: str
 
     def as_dict(self) -> dict[str, Any]:
+        """The failure as JSON types."""
         return {
             "objective": self.objective,
             "epsilon": dict(self.epsilon),
@@ -64,6 +66,7 @@ class PointFailure:
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> PointFailure:
+        """The failure written by :meth:`as_dict`."""
         return cls(str(data["objective"]), dict(data["epsilon"]), str(data["status"]), str(data["message"]))
 
 
@@ -81,6 +84,7 @@ class SweepPoint:
     failures: tuple[PointFailure, ...] = field(default=())
 
     def to_json(self) -> dict[str, Any]:
+        """The piece as JSON types (floats round-trip exactly)."""
         return {
             "label": self.label,
             "result": None if self.result is None else result_to_json(self.result),
@@ -89,6 +93,7 @@ class SweepPoint:
 
     @classmethod
     def from_json(cls, data: Mapping[str, Any]) -> SweepPoint:
+        """The piece written by :meth:`to_json` (bitwise the same numbers)."""
         result = data["result"]
         return cls(
             str(data["label"]),
@@ -112,7 +117,10 @@ _DESIGN_ARRAYS = (
 
 
 def result_to_json(result: DesignResult) -> dict[str, Any]:
-    """A :class:`DesignResult` as JSON types (the solver's multipliers are left out: sweeps start from points)."""
+    """A :class:`DesignResult` as JSON types.
+
+    The solver's multipliers are left out: sweeps start from points.
+    """
     return {
         "design": result.design.as_dict(),
         "objectives": dict(result.objectives),
@@ -212,8 +220,11 @@ def design_record(
     label: str,
     catalogue: Mapping[str, Motor] | None = None,
 ) -> dict[str, Any]:
-    """:func:`result_record` with what a report shows about the collisions: the impulse phases and the optimal
-    approach velocity per sample (from ``problem``'s samples), and each joint's nearest catalogue motor."""
+    """:func:`result_record` with what a report shows about the collisions.
+
+    That is the impulse phases [N*s] and the optimal approach velocity [m/s] per sample (from ``problem``'s
+    samples), and each joint's nearest catalogue motor.
+    """
     from .evaluate import design_collision_parameters
 
     record = result_record(result, label)
@@ -242,8 +253,10 @@ def design_record(
 
 
 def nearest_catalogue_motor(catalogue: Mapping[str, Motor], peak_torque: float, rotor_inertia: float) -> str:
-    """The catalogue motor closest to a scaled motor (peak torque [N*m], rotor inertia [kg*m^2]) in (log peak
-    torque, log rotor inertia): the off-the-shelf part a designer would start from."""
+    """The catalogue motor closest to a scaled motor (peak torque [N*m], rotor inertia [kg*m^2]).
+
+    Closest in (log peak torque, log rotor inertia): the off-the-shelf part a designer would start from.
+    """
     best, best_distance = "", math.inf
     for name, motor in catalogue.items():
         distance = math.hypot(
@@ -255,8 +268,10 @@ def nearest_catalogue_motor(catalogue: Mapping[str, Motor], peak_torque: float, 
 
 
 def record_row(record: Mapping[str, Any], index: int) -> dict[str, Any]:
-    """The table row of a design record, every column name with its unit: ``pareto.csv``, the report's table
-    and :meth:`ParetoSet.to_frame` are made of these."""
+    """The table row of a design record, every column name with its unit.
+
+    ``pareto.csv``, the report's table and :meth:`ParetoSet.to_frame` are made of these.
+    """
     row: dict[str, Any] = {"point": index, "label": record["label"]}
     for name, value in record["objectives"].items():
         row[f"{name} [{OBJECTIVES[name][1]}]"] = value

@@ -13,9 +13,13 @@ import numpy as np
 
 from ..errors import InvalidParameter, SolverFailed
 from .evaluate import evaluate_design
-from .problem import OBJECTIVES, DesignProblem
+from .objectives import OBJECTIVES
+from .problem import DesignProblem
 
-DEFAULT_IPOPT_OPTIONS: dict[str, Any] = {
+IpoptOptions = Mapping[str, str | float]
+"""Options of CasADi's ``nlpsol`` with IPOPT (``"ipopt.<option>"`` and CasADi's own): strings, numbers, flags."""
+
+DEFAULT_IPOPT_OPTIONS: dict[str, str | float] = {
     # Expanding the MX graph (mapped per-sample functions) to SX once makes every derivative evaluation an
     # order of magnitude cheaper; the solver is built once per problem and reused across Pareto points.
     "expand": True,
@@ -30,7 +34,7 @@ DEFAULT_IPOPT_OPTIONS: dict[str, Any] = {
     "ipopt.mu_init": 1e-2,
     "ipopt.linear_solver": "mumps",
 }
-WARM_START_OPTIONS: dict[str, Any] = {
+WARM_START_OPTIONS: dict[str, str | float] = {
     # Start from a neighbouring solution's primal and dual point, close to the central path.
     "ipopt.warm_start_init_point": "yes",
     "ipopt.warm_start_bound_push": 1e-6,
@@ -118,7 +122,7 @@ def solve(
     problem: DesignProblem,
     epsilon: Mapping[str, float] | None = None,
     x0: np.ndarray | DesignResult | None = None,
-    ipopt_options: Mapping[str, Any] | None = None,
+    ipopt_options: IpoptOptions | None = None,
     starts: int = 1,
     rng: np.random.Generator | None = None,
 ) -> DesignResult:
@@ -194,17 +198,17 @@ def _multi_start(
     problem: DesignProblem,
     epsilon: Mapping[str, float] | None,
     x0: np.ndarray | DesignResult | None,
-    ipopt_options: Mapping[str, Any] | None,
+    ipopt_options: IpoptOptions | None,
     starts: int,
     rng: np.random.Generator,
 ) -> DesignResult:
     """Best feasible result over the given (or default) start and ``starts - 1`` random ones."""
     n_design = problem.layout.size
-    points: list[Any] = [x0]
+    points: list[np.ndarray | DesignResult | None] = [x0]
     for _ in range(starts - 1):
-        point = problem.x0.copy()
-        point[:n_design] = rng.uniform(problem.lbx[:n_design], problem.ubx[:n_design])
-        points.append(problem.exact_point(point))
+        drawn = problem.x0.copy()
+        drawn[:n_design] = rng.uniform(problem.lbx[:n_design], problem.ubx[:n_design])
+        points.append(problem.exact_point(drawn))
     best: DesignResult | None = None
     best_value = np.inf
     failure: SolverFailed | None = None

@@ -1,13 +1,10 @@
-"""What the optimiser may change (design variables with bounds) and what it evaluates against (samples)."""
+"""What the optimiser may change: the design variables and their bounds."""
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
-from typing import Any
-
-import numpy as np
+from dataclasses import dataclass
 
 from ..errors import InvalidParameter
 
@@ -43,10 +40,12 @@ class Bounds:
 
     @classmethod
     def fixed(cls, value: float, name: str = "variable") -> Bounds:
+        """Bounds that fix the variable at ``value`` [its SI unit]."""
         return cls(value, value, name)
 
     @property
     def is_fixed(self) -> bool:
+        """Whether the bounds fix the variable (``lower == upper``)."""
         return self.lower == self.upper
 
     @property
@@ -109,83 +108,5 @@ class DesignSpace:
         return bounds
 
     def global_bounds(self, name: str) -> Bounds:
+        """The bounds of global variable ``name`` (``threshold`` or ``approach_velocity``)."""
         return as_bounds(getattr(self, name), name)
-
-
-@dataclass(frozen=True)
-class Constraints:
-    """Constraints of a design problem.
-
-    payload: mass carried at the contact point [kg], adds its gravity torques to the requirement.
-    safety_factor: peak output torque must be at least this times the required torque [-], >= 1.
-    torque_required: per-joint required torque [N m]; ``None`` derives it from Pinocchio gravity torques of the
-        structure, the motors and the payload over the sampled configurations.
-    threshold_floor: sensing noise floor [N]: the contact-force threshold may not go below it.
-    """
-
-    payload: float = 0.0
-    safety_factor: float = 1.0
-    torque_required: Sequence[float] | None = None
-    threshold_floor: float = 0.0
-
-    def __post_init__(self) -> None:
-        if not (math.isfinite(self.payload) and self.payload >= 0):
-            raise InvalidParameter("payload", self.payload, "a finite mass >= 0 [kg]")
-        if not (math.isfinite(self.safety_factor) and self.safety_factor >= 1):
-            raise InvalidParameter("safety_factor", self.safety_factor, "a finite number >= 1")
-        if not (math.isfinite(self.threshold_floor) and self.threshold_floor >= 0):
-            raise InvalidParameter("threshold_floor", self.threshold_floor, "a finite force >= 0 [N]")
-        if self.torque_required is not None:
-            required = np.asarray(self.torque_required, dtype=float)
-            if required.ndim != 1 or not np.all(np.isfinite(required) & (required >= 0)):
-                raise InvalidParameter(
-                    "torque_required", self.torque_required, "one torque >= 0 per joint [N m]"
-                )
-
-
-@dataclass(frozen=True)
-class ContactSamples:
-    """Contact cases the design is evaluated on: sample ``s`` is configuration ``config_index[s]`` of
-    ``kinematics`` hit along unit direction ``directions[s]`` (world-aligned, ``task_dim`` components).
-
-    kinematics: :class:`collision_reflex.arm.ArmSamples` of the configurations.
-    directions: (n_samples, task_dim) unit vectors.
-    config_index: (n_samples,) index into the configurations.
-    """
-
-    kinematics: Any
-    directions: np.ndarray
-    config_index: np.ndarray
-    labels: tuple[str, ...] = field(default=())
-
-    def __post_init__(self) -> None:
-        directions = np.atleast_2d(np.asarray(self.directions, dtype=float))
-        index = np.asarray(self.config_index, dtype=int).ravel()
-        task_dim = self.kinematics.jacobian.shape[1]
-        if directions.shape != (index.size, task_dim):
-            raise InvalidParameter("directions", directions.shape, f"shape ({index.size}, {task_dim})")
-        norms = np.linalg.norm(directions, axis=1)
-        if not np.all(np.isfinite(norms) & (norms > 0)):
-            raise InvalidParameter("directions", self.directions, "non-zero finite vectors")
-        if index.size == 0 or index.min() < 0 or index.max() >= self.kinematics.q.shape[0]:
-            raise InvalidParameter("config_index", index, f"indices in [0, {self.kinematics.q.shape[0]})")
-        object.__setattr__(self, "directions", directions / norms[:, None])
-        object.__setattr__(self, "config_index", index)
-
-    @classmethod
-    def grid(cls, kinematics: Any, directions: np.ndarray) -> ContactSamples:
-        """Every configuration of ``kinematics`` with every direction."""
-        directions = np.atleast_2d(np.asarray(directions, dtype=float))
-        n_config = kinematics.q.shape[0]
-        index = np.repeat(np.arange(n_config), directions.shape[0])
-        return cls(kinematics, np.tile(directions, (n_config, 1)), index)
-
-    @property
-    def size(self) -> int:
-        return int(self.config_index.size)
-
-    @property
-    def joint_moment_arms(self) -> np.ndarray:
-        """``w = J^T u`` per sample, (n_samples, nv): joint torque per unit contact force [m or N m/N]."""
-        jacobian = self.kinematics.jacobian[self.config_index]
-        return np.einsum("sdj,sd->sj", jacobian, self.directions)

@@ -1,0 +1,209 @@
+"""The constraints of a design problem: the user's requirements and the NLP's constraint rows.
+
+:class:`Constraints` holds what the caller asks for (torque requirement, sensing noise floor); the rest builds
+the NLP's ``lower <= g <= upper`` rows, each with a label: reaction capacities within the joint torques,
+``w^T x = 1`` for the finger-mass directions, the torque requirement and the noise floor.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import casadi as ca
+import numpy as np
+
+from ..errors import InvalidParameter
+from .samples import ContactSamples, kinematic_term, loaded_joints
+from .technology import ActuatorTechnology
+
+TorqueDemands = tuple[np.ndarray, np.ndarray, list[str]]
+"""One joint's affine torque demands ``b + S m`` [N m]: bases ``b`` (R,), slopes ``S`` (R, n) per motor mass
+[N m/kg] and one label per demand."""
+
+
+@dataclass(frozen=True)
+class Constraints:
+    """Constraints of a design problem.
+
+    payload: mass carried at the contact point [kg], adds its gravity torques to the requirement.
+    safety_factor: peak output torque must be at least this times the required torque [-], >= 1.
+    torque_required: per-joint required torque [N m]; ``None`` derives it from Pinocchio gravity torques of the
+        structure, the motors and the payload over the sampled configurations.
+    threshold_floor: sensing noise floor [N]: the contact-force threshold may not go below it.
+    """
+
+    payload: float = 0.0
+    safety_factor: float = 1.0
+    torque_required: Sequence[float] | None = None
+    threshold_floor: float = 0.0
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.payload) and self.payload >= 0):
+            raise InvalidParameter("payload", self.payload, "a finite mass >= 0 [kg]")
+        if not (math.isfinite(self.safety_factor) and self.safety_factor >= 1):
+            raise InvalidParameter("safety_factor", self.safety_factor, "a finite number >= 1")
+        if not (math.isfinite(self.threshold_floor) and self.threshold_floor >= 0):
+            raise InvalidParameter("threshold_floor", self.threshold_floor, "a finite force >= 0 [N]")
+        if self.torque_required is not None:
+            required = np.asarray(self.torque_required, dtype=float)
+            if required.ndim != 1 or not np.all(np.isfinite(required) & (required >= 0)):
+                raise InvalidParameter(
+                    "torque_required", self.torque_required, "one torque >= 0 per joint [N m]"
+                )
+
+
+@dataclass
+class ConstraintList:
+    """The NLP's constraints ``lower <= g <= upper`` as they are added, each row with a label."""
+
+    parts: list[ca.MX] = field(default_factory=list)
+    lower: list[np.ndarray] = field(default_factory=list)
+    upper: list[np.ndarray] = field(default_factory=list)
+    labels: list[str] = field(default_factory=list)
+
+    def add(self, expression: ca.MX, lower: float, upper: float, names: list[str]) -> None:
+        """Append the rows of ``expression`` with common bounds and one label per row."""
+        self.parts.append(expression)
+        self.lower.append(np.full(len(names), lower))
+        self.upper.append(np.full(len(names), upper))
+        self.labels.extend(names)
+
+
+@dataclass(frozen=True)
+class ModelTerms:
+    """The symbolic quantities the model's constraints bound (see :func:`add_model_constraints`).
+
+    log_compliance: log reaction compliances ``g_s = log(1/F_a)`` (n_samples).
+    peak_torque: peak output torques [N m] (n_joints).
+    normalisation: ``w_s^T x_s`` per sample (1 x n_samples).
+    thresholds: contact-force thresholds [N] (1 x n_samples).
+    motor_mass: motor masses [kg] (n_joints).
+    """
+
+    log_compliance: ca.MX
+    peak_torque: ca.MX
+    normalisation: ca.MX
+    thresholds: ca.MX
+    motor_mass: ca.MX
+
+
+def add_model_constraints(
+    g: ConstraintList,
+    terms: ModelTerms,
+    torque_scale: np.ndarray,
+    torque_demands: list[TorqueDemands],
+    samples: ContactSamples,
+    technology: ActuatorTechnology,
+    constraints: Constraints,
+    joint_names: tuple[str, ...],
+) -> None:
+    """Add the constraints of the model itself to ``g``.
+
+    They are: reaction capacities within the joint torques, ``w^T x = 1`` for the finger-mass directions, the
+    torque requirement (rows divided by ``torque_scale`` [N m], the requirement at the start) and the sensing
+    noise floor.
+    """
+    n_samples = samples.size
+    # g_s + log tau_i >= log|w_si| for every loaded (sample, joint), i.e. 1/F_a >= |w_si| / tau_i.
+    loaded = loaded_joints(samples)
+    pair_sample, pair_joint = np.nonzero(loaded)
+    log_arm = np.log(np.abs(samples.joint_moment_arms[pair_sample, pair_joint]))
+    g.add(
+        terms.log_compliance[pair_sample.tolist()] + ca.log(terms.peak_torque)[pair_joint.tolist()] - log_arm,
+        0.0,
+        np.inf,
+        [
+            f"reaction capacity of sample {s} within the torque of {joint_names[j]}"
+            for s, j in zip(pair_sample, pair_joint, strict=True)
+        ],
+    )
+
+    g.add(ca.transpose(terms.normalisation), 1.0, 1.0, [f"w^T x = 1 at sample {s}" for s in range(n_samples)])
+
+    # Torque: peak output torque covers the requirement in every sampled configuration, as linear constraints
+    # scaled by the requirement at the start; only demands that can be the largest somewhere in the box of
+    # motor masses allowed by the bounds can bind, the others are dropped (exactly).
+    for j, (bases, slopes, demand_labels) in enumerate(torque_demands):
+        demand = ca.DM(bases) + ca.mtimes(ca.DM(slopes), terms.motor_mass)
+        g.add(
+            (terms.peak_torque[j] - demand) / torque_scale[j],
+            0.0,
+            np.inf,
+            [f"peak torque of {joint_names[j]} >= {label}" for label in demand_labels],
+        )
+
+    if technology.sensing == "position" and constraints.threshold_floor > 0:
+        g.add(
+            ca.transpose(terms.thresholds) / constraints.threshold_floor,
+            1.0,
+            np.inf,
+            [f"contact threshold of sample {s} >= noise floor" for s in range(n_samples)],
+        )
+
+
+def torque_requirement_rows(
+    samples: ContactSamples, constraints: Constraints, joint_names: tuple[str, ...]
+) -> tuple[list[tuple[np.ndarray, np.ndarray]], list[str]]:
+    """Affine torque demands ``d0 + D m`` [N m] (``m``: motor masses [kg]) the peak torques must cover.
+
+    Given torques: one demand. Otherwise, per sampled configuration, plus and minus the gravity torque of the
+    structure, the motors (linear in their masses) and the payload at the contact point, all times the safety
+    factor.
+    """
+    n = len(joint_names)
+    factor = constraints.safety_factor
+    if constraints.torque_required is not None:
+        given = np.asarray(constraints.torque_required, dtype=float)
+        if given.shape != (n,):
+            raise InvalidParameter("torque_required", given.shape, f"{n} values, one per joint")
+        return [(factor * given, np.zeros((n, n)))], ["the given required torque"]
+    gravity, contact_gravity, motor_gravity = (
+        kinematic_term(samples, name) for name in ("gravity", "contact_gravity", "motor_gravity")
+    )
+    rows, labels = [], []
+    for c in np.unique(samples.config_index):
+        base = gravity[c] + constraints.payload * contact_gravity[c]
+        per_motor = motor_gravity[c].T  # (joint j, motor i)
+        for sign, word in ((1.0, "+"), (-1.0, "-")):
+            rows.append((sign * factor * base, sign * factor * per_motor))
+            labels.append(f"{word}gravity torque at configuration {c}")
+    return rows, labels
+
+
+def binding_torque_demands(
+    samples: ContactSamples,
+    constraints: Constraints,
+    joint_names: tuple[str, ...],
+    mass_low: np.ndarray,
+    mass_high: np.ndarray,
+) -> list[TorqueDemands]:
+    """Per joint, the torque demands ``b + S m`` [N m] that can bind: ``(b (R,), S (R, n), labels)``.
+
+    A demand whose largest value over the box of motor masses ``[mass_low, mass_high]`` [kg] is below another
+    demand's smallest value there never sets the requirement, so it is left out: an exact reduction (on arms,
+    from two rows per sampled configuration to a handful).
+    """
+    rows, labels = torque_requirement_rows(samples, constraints, joint_names)
+    demands = []
+    for j in range(len(joint_names)):
+        bases = np.array([base[j] for base, _ in rows])
+        slopes = np.array([per_motor[j] for _, per_motor in rows])
+        low = bases + np.minimum(slopes * mass_low, slopes * mass_high).sum(axis=1)
+        high = bases + np.maximum(slopes * mass_low, slopes * mass_high).sum(axis=1)
+        keep = high >= low.max() - 1e-12 * abs(low.max())
+        demands.append(
+            (bases[keep], slopes[keep], [label for label, k in zip(labels, keep, strict=True) if k])
+        )
+    return demands
+
+
+def required_torque_function(demands: list[TorqueDemands], n_joints: int) -> ca.Function:
+    """CasADi function: motor masses [kg] -> required peak torque per joint [N m].
+
+    The requirement is the largest binding demand (safety factor included), for reporting.
+    """
+    masses = ca.MX.sym("motor_mass", n_joints)
+    required = [ca.mmax(ca.DM(bases) + ca.mtimes(ca.DM(slopes), masses)) for bases, slopes, _ in demands]
+    return ca.Function("required_torque", [masses], [ca.vertcat(*required)])

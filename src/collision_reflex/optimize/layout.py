@@ -1,0 +1,153 @@
+"""The decision-variable layout: where each design variable lives in the NLP's ``x``, and what it gives.
+
+All design variables are positive and optimised as their logarithms: per joint the stator diameter (and
+optionally stack length) of a motor scaled from a reference motor, the gear ratio and the software stiffness;
+globally the sensing threshold and the approach velocity. A variable with equal bounds is fixed and takes no
+entry of ``x``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import NamedTuple
+
+import casadi as ca
+import numpy as np
+
+from ..errors import InvalidParameter
+from ..hardware.motors import scaled_motor_quantities
+from ..model import effective as formulas
+from ..model.impulse import series_stiffness
+from .constraints import Constraints
+from .space import GLOBAL_VARIABLES, PER_JOINT_VARIABLES, Bounds, DesignSpace
+from .technology import ActuatorTechnology
+
+
+@dataclass
+class DesignLayout:
+    """Where each design variable lives: a slice of the NLP's ``x`` (log values) or a fixed value."""
+
+    bounds: dict[str, list[Bounds]] = field(default_factory=dict)
+    slices: dict[str, list[int | None]] = field(default_factory=dict)
+    size: int = 0
+
+    def add(self, name: str, bounds: list[Bounds]) -> None:
+        """Append variable ``name`` with one bounds per entry; fixed entries take no place in ``x``."""
+        self.bounds[name] = bounds
+        indices: list[int | None] = []
+        for b in bounds:
+            if b.is_fixed:
+                indices.append(None)
+            else:
+                indices.append(self.size)
+                self.size += 1
+        self.slices[name] = indices
+
+    def expressions(self, x: ca.MX) -> dict[str, ca.MX]:
+        """Each variable as an MX column (exp of its log variable, or its fixed value)."""
+        out = {}
+        for name, bounds in self.bounds.items():
+            parts = [
+                ca.exp(x[i]) if i is not None else ca.MX(b.lower)
+                for i, b in zip(self.slices[name], bounds, strict=True)
+            ]
+            out[name] = ca.vertcat(*parts)
+        return out
+
+    def log_bounds(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Lower bounds, upper bounds and start (log-midpoint) of the free variables, in log space."""
+        lower, upper, start = (np.empty(self.size) for _ in range(3))
+        for name, bounds in self.bounds.items():
+            for i, b in zip(self.slices[name], bounds, strict=True):
+                if i is not None:
+                    lower[i], upper[i], start[i] = math.log(b.lower), math.log(b.upper), math.log(b.midpoint)
+        return lower, upper, start
+
+    def values(self, x: np.ndarray) -> dict[str, np.ndarray]:
+        """Numeric values [SI] of every variable at ``x``."""
+        return {
+            name: np.array(
+                [
+                    math.exp(x[i]) if i is not None else b.lower
+                    for i, b in zip(self.slices[name], bounds, strict=True)
+                ]
+            )
+            for name, bounds in self.bounds.items()
+        }
+
+
+def design_layout(
+    space: DesignSpace, technology: ActuatorTechnology, constraints: Constraints, n_joints: int
+) -> DesignLayout:
+    """The design variables with their bounds: per joint, then global.
+
+    With force sensing the noise floor bounds the threshold from below.
+    """
+    layout = DesignLayout()
+    defaults = {"stack_length": technology.reference_motor.stack_length}
+    for name in PER_JOINT_VARIABLES:
+        layout.add(name, space.per_joint(name, n_joints, defaults.get(name)))
+    for name in GLOBAL_VARIABLES:
+        bounds = space.global_bounds(name)
+        if name == "threshold" and technology.sensing == "force":
+            bounds = _with_noise_floor(bounds, constraints.threshold_floor)
+        layout.add(name, [bounds])
+    return layout
+
+
+def _with_noise_floor(bounds: Bounds, floor: float) -> Bounds:
+    """With force sensing the noise floor [N] is a lower bound on the threshold variable itself."""
+    if floor <= 0:
+        return bounds
+    if bounds.upper < floor:
+        raise InvalidParameter(
+            "threshold bounds",
+            (bounds.lower, bounds.upper),
+            f"an upper bound >= the sensing noise floor {floor} N",
+            "raise the threshold's upper bound or lower the floor",
+        )
+    return Bounds(max(bounds.lower, floor), bounds.upper, "threshold")
+
+
+class DesignQuantities(NamedTuple):
+    """Symbolic joint quantities of a design (see :func:`design_quantities`)."""
+
+    values: dict[str, ca.MX]
+    design_column: ca.MX
+    motor_mass: ca.MX
+    peak_torque: ca.MX
+    finger_inertia: ca.MX
+
+    def joint_function(self, x: ca.MX) -> ca.Function:
+        """CasADi function of ``x`` giving the joint numbers.
+
+        Outputs (n_joints each): motor masses [kg], peak torques [N m], finger inertias [kg m^2].
+        """
+        return ca.Function("joint_numbers", [x], [self.motor_mass, self.peak_torque, self.finger_inertia])
+
+
+def design_quantities(
+    layout: DesignLayout, z: ca.MX, technology: ActuatorTechnology, k_mech: np.ndarray
+) -> DesignQuantities:
+    """Symbolic joint quantities of the design variables ``z`` (log values).
+
+    Gives the variables themselves, the per-sample function's design column, motor masses [kg], peak output
+    torques [N m] and the reflected inertia acting on the finger [kg m^2] (zero unless
+    ``reflected_inertia_in == "finger"``); ``k_mech`` is the joint mechanical stiffness [N m/rad].
+    """
+    values = layout.expressions(z)
+    motor = scaled_motor_quantities(
+        technology.reference_motor, values["stator_diameter"], values["stack_length"], technology.scaling_law
+    )
+    gear = values["gear_ratio"]
+    reflected = formulas.reflected_inertia(gear, motor.rotor_inertia)
+    design_column = ca.vertcat(
+        motor.mass,
+        reflected,
+        series_stiffness(ca.DM(k_mech), values["software_stiffness"]),
+        values["threshold"],
+        values["approach_velocity"],
+    )
+    finger_inertia = formulas.finger_inertia(reflected, technology.reflected_inertia_in)
+    return DesignQuantities(values, design_column, motor.mass, gear * motor.peak_torque, finger_inertia)
