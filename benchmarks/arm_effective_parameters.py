@@ -3,7 +3,8 @@
 Prints three times for N configurations x D directions (default 10,000 x 64):
 
 1. a straightforward loop over every (q, u) pair: Pinocchio's mass matrix and frame Jacobian, then NumPy
-   (matrix inverses, the formulas of MODEL.md §3) and the 1D impulse per pair. Timed on a subset of the
+   (matrix inverses, the formulas of the paper's "Collision Reflex in Higher Dimensions") and the 1D impulse per
+   pair. Timed on a subset of the
    configurations and extrapolated linearly (each pair costs the same), as the output says;
 2. the batched path: ``Arm.kinematics(q, full=False)`` (Pinocchio's mass matrix and contact Jacobian once per
    configuration; the gravity and motor-mass terms, which only the optimiser needs, are timed separately for

@@ -1,4 +1,6 @@
-"""Effective collision parameters and impulses of arms (MODEL.md §3), against independent computations.
+"""Effective collision parameters and impulses of arms, against independent computations.
+
+The formulas are those of the paper's "Collision Reflex in Higher Dimensions".
 
 Tolerances: 1e-14 to 1e-12 where the same formula is evaluated in another order (rounding only); 1e-10 to 1e-9
 where a different algorithm computes the same quantity (LU solve against Pinocchio's ABA-based inverse, an

@@ -1,7 +1,7 @@
 """The design problem's numeric per-sample data and torque demands against direct computations.
 
-The references are written out here from their definitions (MODEL.md §3): the finger mass ``1 / (w^T M_f^-1 w)``
-by a linear solve, the reaction compliance ``max_i |w_i| / tau_i`` by a loop, the required torque as the largest
+The references are written out here from their definitions (the paper's "Collision Reflex in Higher Dimensions"): the finger
+mass ``1 / (w^T M_f^-1 w)`` by a linear solve, the reaction compliance ``max_i |w_i| / tau_i`` by a loop, the required torque as the largest
 ``|gravity torque|`` over the sampled configurations (Panda: the planar two-link arm has no gravity torques).
 Both sides are a few floating-point operations on the same arrays, so they agree to rounding: tolerance 1e-12
 relative (the sampled two-link mass matrices have condition numbers below 50). A missing motor mass, a dropped

@@ -140,7 +140,7 @@ def test_example_prints_what_the_readme_says(example, tmp_path, monkeypatch):
 
 
 def _closed_form(m_f, k, k_m, F_s, a, v0):
-    """The paper's impulse phases, written out here independently of the package (MODEL.md §1)."""
+    """The paper's impulse phases, written out independently of the package ("Proposed Collision Reflex Metric")."""
     return m_f * v0, F_s**2 / (2 * k * v0), math.sqrt(8 * F_s**3 / (9 * a * k_m))
 
 

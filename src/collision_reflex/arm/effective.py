@@ -1,6 +1,7 @@
 """Effective 1D collision parameters of an arm along many directions at once, and their collision impulses.
 
-The paper's section "Collision Reflex in Higher Dimensions", ``eq:eff_mf`` to ``eq:eff_a``; MODEL.md §3.
+The paper's section "Collision Reflex in Higher Dimensions", ``eq:eff_mf`` to ``eq:eff_a``; the README's
+"Model decisions".
 
 :func:`effective_parameters` maps :class:`ArmSamples` and unit directions ``u`` to ``m_f``, ``m_r``, ``k``,
 ``k_m``, ``F_a`` and ``a``; :func:`collision_impulses` applies the 1D model of
@@ -78,7 +79,9 @@ def effective_parameters(
     task_stiffness: npt.ArrayLike | None = None,
     singular_tolerance: float = 1e-12,
 ) -> EffectiveParameters:
-    """Effective 1D collision parameters for many configurations and directions at once (MODEL.md §3).
+    """Effective 1D collision parameters for many configurations and directions at once.
+
+    The formulas of the paper's "Collision Reflex in Higher Dimensions".
 
     Parameters
     ----------

@@ -1,4 +1,6 @@
-"""Effective 1D collision parameters of an arm along a contact direction ``u`` (MODEL.md §3), written once.
+"""Effective 1D collision parameters of an arm along a contact direction ``u``, written once.
+
+The formulas are those of the paper's "Collision Reflex in Higher Dimensions".
 
 The formulas are plain arithmetic on the functions of :mod:`collision_reflex._backend`, so they serve the NumPy
 path (:func:`collision_reflex.arm.effective_parameters`, batched over configurations and directions) and the

@@ -1,4 +1,7 @@
-"""Sensing schemes: how contact is detected, and the threshold each scheme gives (MODEL.md "Sensing schemes").
+"""Sensing schemes: how contact is detected, and the threshold each scheme gives.
+
+As in the paper's "Actuator Selection and the Collision Reflex" and its
+experiments.
 
 One vocabulary for the whole package:
 

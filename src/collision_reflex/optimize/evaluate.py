@@ -1,8 +1,8 @@
 """Evaluate a design on the problem's samples through the NumPy path, independently of the CasADi model.
 
 The CasADi model takes the maximum over joints of per-joint reaction impulses (its epigraph form); this path
-computes the reaction capacity as the minimum over joints, ``F_a = min_i tau_i / |w_i|`` (MODEL.md §3), and
-then the 1D impulse once. Agreement of the two checks the reformulation as well as the code.
+computes the reaction capacity as the minimum over joints, ``F_a = min_i tau_i / |w_i|`` (the paper's "Collision Reflex in Higher Dimensions"),
+and then the 1D impulse once. Agreement of the two checks the reformulation as well as the code.
 """
 
 from __future__ import annotations

@@ -5,8 +5,8 @@ Structure (see the README's "Design optimisation" section):
 - Design variables, all positive, are optimised as their logarithms (:mod:`.layout`): per joint the stator
   diameter (and optionally stack length) of a motor scaled from a reference motor, the gear ratio and the
   software stiffness; globally the sensing threshold and the approach velocity.
-- Per contact sample ``s`` (configuration, direction ``u``) the effective parameters of MODEL.md §3 are formed
-  from the numeric Pinocchio data (``M_bb0``, motor-mass influence matrices, ``w = J^T u``) and the symbolic
+- Per contact sample ``s`` (configuration, direction ``u``) the effective parameters of the paper's "Collision Reflex in Higher Dimensions"
+  are formed from the numeric Pinocchio data (``M_bb0``, motor-mass influence matrices, ``w = J^T u``) and the symbolic
   actuator quantities, and the 1D impulse of :mod:`collision_reflex.model.impulse` is applied. One SX function per
   sample (:mod:`.samples`) is mapped over all samples inside an MX NLP.
 - The reaction capacity ``F_a = min_i tau_i / |w_i|`` is a minimum over joints (non-smooth). Each sample gets a

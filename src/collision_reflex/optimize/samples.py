@@ -3,8 +3,8 @@
 Sample ``s`` is a configuration with its Pinocchio data hit along a unit direction ``u``. Per sample the NLP
 needs ``w = J^T u``, the structure mass matrix ``M_bb0`` and the motor-mass influence matrices (numeric,
 packed into one data column), and one SX function that maps the symbolic design column and the sample's
-auxiliaries to the effective parameters of MODEL.md §3 and the 1D impulse of
-:mod:`collision_reflex.model.impulse`.
+auxiliaries to the effective parameters of the paper's "Collision Reflex in Higher Dimensions" and the 1D
+impulse of :mod:`collision_reflex.model.impulse`.
 """
 
 from __future__ import annotations
@@ -106,7 +106,7 @@ def reaction_compliance(samples: ContactSamples, peak_torque: np.ndarray) -> np.
     """Give ``1 / F_a = max_i |w_i| / tau_i`` per sample [1/N] for peak joint torques ``tau`` [N m].
 
     It is the inverse of the largest contact force the joints can push back with before the first saturates
-    (MODEL.md §3).
+    (the paper's "Collision Reflex in Higher Dimensions").
     """
     return np.asarray(
         formulas.reaction_compliance(
@@ -163,7 +163,8 @@ def sample_function(n_joints: int, sensing: str, reaction: str, reflected_inerti
     finger_mass = formulas.finger_mass(direction, finger_matrix)
     k_mech = data[-1]
 
-    # Effective parameters along u (MODEL.md §3), compliance forms; w^T is the Jacobian along u.
+    # Effective parameters along u (the paper's "Collision Reflex in Higher Dimensions"), compliance forms;
+    # w^T is the Jacobian along u.
     robot_compliance = formulas.task_compliance(ca.transpose(w), inertia)
     k = 1 / formulas.task_compliance(ca.transpose(w), stiffness)
     force_threshold = threshold_force(sensing, threshold_variable, k)

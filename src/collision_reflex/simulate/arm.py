@@ -1,6 +1,6 @@
 """Time-domain collision of an arm with elastic joints against a compliant wall.
 
-It is compared with the arm-level closed form (MODEL.md §3, the paper's section "Collision Reflex in Higher
+It is compared with the arm-level closed form (the paper's section "Collision Reflex in Higher
 Dimensions").
 
 Each joint is a link side and a motor side coupled by the joint's mechanical spring ``k_m,i``::

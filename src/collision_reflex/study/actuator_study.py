@@ -1,8 +1,8 @@
 """Actuator studies: single-joint actuators compared in a 1D collision at a lever (no arm, no optimiser).
 
 Each candidate is a :class:`collision_reflex.hardware.actuators.Actuator`; its ``contact_parameters`` map it to the contact
-at the study's lever (MODEL.md §2: inertia ``J / L²``, stiffness ``k / L²``, torque ``τ / L``, the threshold by
-its sensing scheme). The object hit (``load.contact_stiffness``, e.g. a force sensor) is a spring in series with
+at the study's lever (the paper's "Actuator Selection and the Collision Reflex": inertia ``J / L²``, stiffness ``k / L²``,
+torque ``τ / L``, the threshold by its sensing scheme). The object hit (``load.contact_stiffness``, e.g. a force sensor) is a spring in series with
 the joint's, during sensing and reaction alike.
 """
 
