@@ -13,6 +13,7 @@ from scipy.integrate import solve_ivp
 
 from ..errors import SimulationError
 from ..model.impulse import collision_times
+from ..model.sensing import threshold_force
 from .dynamics import DEFL, ERR, IMP, LOSS, NSTATE, SURF, VF, VR, WORK, XF, HybridCollision
 from .result import SimulationResult
 from .setup import CollisionSetup, oscillation_period
@@ -41,9 +42,9 @@ def _reference_force(setup: CollisionSetup) -> float:
 
     It is the scale of the forces in the run.
     """
-    threshold = setup.detection.threshold
-    # same as model.sensing: a position threshold e_th trips at k e_th
-    return setup.lumped_stiffness * threshold if setup.detection.kind == "position" else threshold
+    if setup.detection.kind == "position":
+        return float(threshold_force("position", setup.detection.threshold, setup.lumped_stiffness))
+    return setup.detection.threshold
 
 
 def _default_duration(setup: CollisionSetup) -> float:

@@ -16,6 +16,7 @@ from .. import _validate
 from .._compat import renamed_keywords
 from ..errors import InvalidParameter
 from ..model.impulse import PhaseImpulses, impact_pulse_duration, phase_impulses, series_stiffness
+from ..model.sensing import threshold_force
 
 DRIVES: tuple[str, ...] = ("ideal", "impedance", "free")
 """Robot-side drive during the approach: see :mod:`collision_reflex.simulate`."""
@@ -183,7 +184,8 @@ class CollisionSetup:
         """
         threshold = self.detection.threshold
         if self.detection.kind == "position":
-            return self.lumped_stiffness * (threshold - self.play)  # same as model.sensing, after the play
+            # The play is taken up before the spring builds force.
+            return float(threshold_force("position", threshold - self.play, self.lumped_stiffness))
         if self.detection.kind == "current":
             v_r = self.detection_robot_velocity
             return threshold - self.coulomb_friction - self.viscous_friction * v_r
