@@ -116,7 +116,9 @@ def _quantity(text: str, unit: str) -> float:
         raise ValueError(f"{text!r} is not a quantity (a number and a unit, e.g. '60 mm')") from None
     # pint takes angles as dimensionless: "50 Hz" would pass as 50 rad/s, though it may mean 50 rev/s.
     if _radian_power(registry.Quantity(1, unit)) != _radian_power(quantity):
-        raise ValueError(f"{text!r} has no angle unit; give an angle per time, e.g. '3000 rpm' or '314 rad/s'")
+        raise ValueError(
+            f"{text!r} has no angle unit; give an angle per time, e.g. '3000 rpm' or '314 rad/s'"
+        )
     return converted
 
 
