@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import textwrap
 
 import pytest
@@ -41,6 +42,29 @@ def test_plain_exponent_numbers_are_si(tmp_path):
     assert motor.rotor_inertia == 1e-6
 
 
+@pytest.mark.parametrize(
+    "text, rad_per_s",
+    [
+        ("3000 rpm", 3000 * 2 * math.pi / 60),
+        ("314 rad/s", 314.0),
+        ("360 deg/s", 2 * math.pi),
+        ("314", 314.0),  # a plain number is SI: rad/s
+        ("2e3", 2000.0),
+    ],
+)
+def test_max_speed_read_with_units(tmp_path, text, rad_per_s):
+    entry = GOOD.replace("    source:", f"    max_speed: {text}\n    source:")
+    motor = cr.load_catalogue(_write(tmp_path, entry))["small"]
+    assert motor.max_speed == pytest.approx(rad_per_s, rel=1e-12)
+
+
+def test_max_speed_optional(tmp_path):
+    motor = cr.load_catalogue(_write(tmp_path, GOOD))["small"]
+    assert motor.max_speed is None
+    with pytest.raises(cr.InvalidParameter, match="no speed limit known for motor 'small'"):
+        motor.speed_limit()
+
+
 def test_packaged_catalogue_cites_sources():
     catalogue = cr.load_catalogue()
     assert "OPN-060-013-A" in catalogue
@@ -69,6 +93,24 @@ BAD = {
         7,
         "continuous_torque",
         "peak",
+    ),
+    "speed-wrong-unit": (
+        GOOD.replace("    source:", "    max_speed: 3000 kg\n    source:"),
+        9,
+        "motors.small.max_speed",
+        "cannot be converted to rad/s",
+    ),
+    "speed-without-angle": (
+        GOOD.replace("    source:", "    max_speed: 50 Hz\n    source:"),
+        9,
+        "motors.small.max_speed",
+        "no angle unit",
+    ),
+    "speed-negative": (
+        GOOD.replace("    source:", "    max_speed: -3000 rpm\n    source:"),
+        9,
+        "motors.small.max_speed",
+        "> 0",
     ),
     "bad-yaml": ("motors:\n  small: [1,\n", 3, "", "YAML"),
     "no-motors-key": ("engines: {}\n", 1, "motors", "missing"),

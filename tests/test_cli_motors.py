@@ -16,6 +16,30 @@ def test_motors_lists_catalogue(capsys):
     assert "OPN-060-013-A" in out and "assumption" in out
 
 
+def test_motors_list_shows_max_speed(tmp_path, capsys):
+    assert main(["motors"]) == 0
+    row = next(line for line in capsys.readouterr().out.splitlines() if line.startswith("OPN-060-013-A"))
+    assert row.split()[-2:] == ["492.6", "4704"]  # rad/s and rpm: 492.6 * 60 / (2 pi) = 4703.98
+    catalogue = tmp_path / "motors.yaml"
+    catalogue.write_text(
+        "motors:\n  bare:\n    stator_diameter: 30 mm\n    stack_length: 10 mm\n    rotor_inertia: 1e-6\n"
+        "    peak_torque: 0.4\n    continuous_torque: 0.2\n    mass: 0.08\n    source: a test entry\n"
+    )
+    assert main(["motors", "--catalogue", str(catalogue)]) == 0
+    row = next(line for line in capsys.readouterr().out.splitlines() if line.startswith("bare"))
+    assert row.split()[-2:] == ["unknown", "unknown"]
+
+
+def test_motors_scale_shows_scaled_max_speed(capsys):
+    assert main(["motors", "scale"]) == 0
+    out = capsys.readouterr().out
+    speed_row = next(line for line in out.splitlines() if line.startswith("Max. speed"))
+    # Constant surface speed: omega0 * 60 mm / r for r = 10, 60, 100 mm; printed to 4 significant figures,
+    # so within half a unit of the 4th figure (at most 0.5 / 2956 = 1.7e-4 relative for these values).
+    assert [float(x) for x in speed_row.split()[-3:]] == pytest.approx([2955.6, 492.6, 295.56], rel=2e-4)
+    assert "(r/r0)^-1" in out and "surface speed" in out
+
+
 def test_motors_scale_reproduces_tab_motor_params(capsys):
     assert main(["motors", "scale"]) == 0
     out = capsys.readouterr().out

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import collision_reflex as cr
+from collision_reflex.hardware.motors import SpeedScaling
 
 # tab:motor_params of "Reacting to Contact: Transparency and Collision Reflex in Actuation": the reference M2
 # scaled by the Haddadin law to 10 mm (M1) and 100 mm (M3), output torque held at 1.3 N m.
@@ -122,3 +123,62 @@ def test_motor_validates_its_fields():
         cr.Motor("x", 0.05, 0.01, 1e-5, 1.0, 2.0, 0.1)
     with pytest.raises(cr.InvalidParameter, match=r"Motor\.peak_torque"):
         cr.Motor("x", 0.05, 0.01, 1e-5, "1.0", 0.5, 0.1)  # type: ignore[arg-type]
+
+
+def _fast_motor(max_speed=300.0):
+    return cr.Motor("fast", 0.05, 0.02, 1e-5, 2.0, 1.0, 0.3, source="test", max_speed=max_speed)
+
+
+@pytest.mark.parametrize("name", LAW_EXPONENTS, ids=LAW_EXPONENTS.keys())
+def test_max_speed_keeps_the_rotor_surface_speed(name):
+    reference = _fast_motor()
+    # Twice the diameter, 1.5x the length: the tip speed omega * r stays 300 rad/s * 0.025 m = 7.5 m/s, so
+    # omega halves; the stack length does not enter.
+    scaled = reference.scaled(0.10, 0.03, law=name)
+    assert scaled.max_speed == pytest.approx(150.0, rel=1e-14)
+    assert scaled.max_speed * 0.10 / 2 == pytest.approx(300.0 * 0.05 / 2, rel=1e-14)
+    # At the reference size the reference's own speed comes back.
+    assert reference.scaled(0.05, 0.02, law=name).max_speed == pytest.approx(300.0, rel=1e-15)
+
+
+def test_speed_scaling_both_exponents_against_hand_and_casadi():
+    law = cr.ScalingLaw("test", 2.0, 4.0, 2.5, "test", speed=SpeedScaling(0.5, -1.5, "test law"))
+    reference = _fast_motor()
+    diameters, lengths = np.array([0.025, 0.05, 0.2]), np.array([0.08, 0.02, 0.005])
+    # omega = 300 (l/l0)^0.5 (r/r0)^-1.5: (4^0.5 0.5^-1.5, 1, 0.25^0.5 4^-1.5) = (5.657, 1, 0.0625) x 300
+    hand = 300.0 * np.array([2.0 * 2**1.5, 1.0, 0.5 / 8.0])
+    numeric = cr.scaled_motor_quantities(reference, diameters, lengths, law)
+    np.testing.assert_allclose(numeric.max_speed, hand, rtol=1e-14)
+    for sym_r, sym_l in ((ca.SX.sym("r", 3), ca.SX.sym("l", 3)), (ca.MX.sym("r", 3), ca.MX.sym("l", 3))):
+        symbolic = cr.scaled_motor_quantities(reference, sym_r, sym_l, law).max_speed
+        got = ca.Function("f", [sym_r, sym_l], [symbolic])(diameters, lengths)
+        np.testing.assert_allclose(np.asarray(got).ravel(), hand, rtol=1e-14)
+
+
+def test_unknown_max_speed_stays_unknown():
+    reference = _fast_motor(max_speed=None)
+    assert reference.scaled(0.1, 0.03).max_speed is None
+    assert cr.scaled_motor_quantities(reference, np.array([0.01, 0.1])).max_speed is None
+    assert cr.scaled_motor_quantities(reference, ca.SX.sym("r")).max_speed is None
+    with pytest.raises(cr.InvalidParameter, match="no speed limit known for motor 'fast'"):
+        reference.speed_limit()
+    assert _fast_motor().speed_limit() == 300.0
+
+
+def test_reference_max_speed_is_a_marked_estimate():
+    motor = cr.reference_motor()
+    # The catalogue's estimate: 10 m/s at the 40.6 mm rotor OD of tab:motor_params, rounded to 4 figures.
+    assert motor.max_speed == pytest.approx(10.0 / 0.0203, rel=1e-4)
+    assert "estimate" in motor.source.lower()
+    assert "surface speed" in cr.scaling_law("haddadin").speed.source
+
+
+def test_max_speed_and_speed_scaling_validated():
+    with pytest.raises(cr.InvalidParameter, match=r"Motor\.max_speed"):
+        _fast_motor(max_speed=-1.0)
+    with pytest.raises(cr.InvalidParameter, match=r"Motor\.max_speed"):
+        _fast_motor(max_speed="3000 rpm")  # type: ignore[arg-type]
+    with pytest.raises(cr.InvalidParameter, match="diameter_exponent"):
+        SpeedScaling(0.0, float("nan"), "x")
+    with pytest.raises(cr.InvalidParameter, match=r"ScalingLaw\.speed"):
+        cr.ScalingLaw("x", 2.0, 4.0, 2.5, speed=-1.0)  # type: ignore[arg-type]

@@ -3,14 +3,18 @@
 from __future__ import annotations
 
 import argparse
+import math
+from collections.abc import Sequence
 
 from ..hardware.actuators import Actuator, gear_ratio_for
 from ..hardware.motors import (
     DEFAULT_SCALING_LAW,
     REFERENCE_MOTOR_NAME,
     SCALING_LAWS,
+    Motor,
     get_motor,
     load_catalogue,
+    scaling_law,
 )
 from . import options
 
@@ -63,14 +67,14 @@ def run_list(args: argparse.Namespace) -> int:
     catalogue = load_catalogue(args.catalogue)
     header = (
         f"{'name':<18}{'stator OD [mm]':>15}{'stack [mm]':>11}{'J_m [kg m^2]':>14}"
-        f"{'tau_p [N m]':>12}{'tau_c [N m]':>12}{'mass [kg]':>10}"
+        f"{'tau_p [N m]':>12}{'tau_c [N m]':>12}{'mass [kg]':>10}{'max speed [rad/s]':>19}{'[rpm]':>8}"
     )
     print(header)
     for name, motor in catalogue.items():
         print(
             f"{name:<18}{motor.stator_diameter * 1e3:>15.4g}{motor.stack_length * 1e3:>11.4g}"
             f"{motor.rotor_inertia:>14.4g}{motor.peak_torque:>12.4g}{motor.continuous_torque:>12.4g}"
-            f"{motor.mass:>10.4g}"
+            f"{motor.mass:>10.4g}{_speed(motor, 1.0):>19}{_speed(motor, _RPM_PER_RAD_S):>8}"
         )
     print()
     for name, motor in catalogue.items():
@@ -78,18 +82,27 @@ def run_list(args: argparse.Namespace) -> int:
     return 0
 
 
+_RPM_PER_RAD_S = 60 / (2 * math.pi)
+
+
+def _speed(motor: Motor, factor: float) -> str:
+    """The motor's maximum speed times ``factor`` (4 significant figures), or "unknown"."""
+    return "unknown" if motor.max_speed is None else f"{motor.max_speed * factor:.4g}"
+
+
 def run_scale(args: argparse.Namespace) -> int:
     """Run ``crx motors scale`` (the reference scaled to each diameter); return the exit status."""
     reference = get_motor(args.motor, args.catalogue)
     motors = [reference.scaled(float(d), args.stack_length, args.law) for d in args.stator_diameters]
     actuators = [Actuator(m, float(gear_ratio_for(args.torque, m.peak_torque))) for m in motors]
-    rows = [
+    rows: list[tuple[str, str, Sequence[float | str]]] = [
         ("Stator OD (r_m)", "mm", [m.stator_diameter * 1e3 for m in motors]),
         ("Stack height (l)", "mm", [m.stack_length * 1e3 for m in motors]),
         ("Rotor inertia (J_m)", "kg m^2", [m.rotor_inertia for m in motors]),
         ("Cont. torque (tau_c)", "N m", [m.continuous_torque for m in motors]),
         ("Peak torque (tau_p)", "N m", [m.peak_torque for m in motors]),
         ("Mass", "kg", [m.mass for m in motors]),
+        ("Max. speed (omega_max)", "rad/s", [_speed(m, 1.0) for m in motors]),
         ("Gear ratio (N)", "-", [a.gear_ratio for a in actuators]),
         ("Inertia (N^2 J_m)", "kg m^2", [a.reflected_inertia for a in actuators]),
         ("Peak torque out (N tau_p)", "N m", [a.peak_torque for a in actuators]),
@@ -100,6 +113,14 @@ def run_scale(args: argparse.Namespace) -> int:
     )
     print(f"{'parameter':<27}{'unit':<8}" + "".join(f"{f'M{i + 1}':>12}" for i in range(len(motors))))
     for label, unit, values in rows:
-        print(f"{label:<27}{unit:<8}" + "".join(f"{v:>12.4g}" for v in values))
+        print(
+            f"{label:<27}{unit:<8}"
+            + "".join(f"{v:>12}" if isinstance(v, str) else f"{v:>12.4g}" for v in values)
+        )
     print(f"\nmass of {reference.name}: {reference.mass:g} kg ({reference.source})")
+    speed = scaling_law(args.law).speed
+    print(
+        f"maximum speed scaled as omega_max = omega0 (l/l0)^{speed.length_exponent:g} "
+        f"(r/r0)^{speed.diameter_exponent:g}: {speed.source}"
+    )
     return 0

@@ -23,6 +23,10 @@ _UNITS = {
     "continuous_torque": "N * m",
     "mass": "kg",
 }
+# Optional fields (None when omitted), same rules.
+_OPTIONAL_UNITS = {"max_speed": "rad/s"}
+_ALL_UNITS = {**_UNITS, **_OPTIONAL_UNITS}
+_FIELDS = ", ".join([*_UNITS, "source"]) + ", and optionally " + ", ".join(_OPTIONAL_UNITS)
 
 
 def packaged_catalogue_path() -> Path:
@@ -55,11 +59,14 @@ class _Entry(BaseModel):
     continuous_torque: float
     mass: float
     source: str
+    max_speed: float | None = None
 
-    @field_validator(*_UNITS, mode="before")
+    @field_validator(*_ALL_UNITS, mode="before")
     @classmethod
     def _to_si(cls, value: Any, info: Any) -> Any:
-        unit = _UNITS[info.field_name]
+        unit = _ALL_UNITS[info.field_name]
+        if value is None and info.field_name in _OPTIONAL_UNITS:
+            return None
         if isinstance(value, bool):
             raise ValueError("expected a number or a quantity with units, got a boolean")
         if isinstance(value, str):
@@ -71,9 +78,11 @@ class _Entry(BaseModel):
             return float(value)
         raise ValueError(f"expected a number (SI, {unit}) or a quantity string such as '60 mm'")
 
-    @field_validator(*_UNITS)
+    @field_validator(*_ALL_UNITS)
     @classmethod
-    def _positive(cls, value: float) -> float:
+    def _positive(cls, value: float | None) -> float | None:
+        if value is None:
+            return None
         if not (value > 0 and value < float("inf")):
             raise ValueError(f"expected a finite number > 0, got {value!r}")
         return value
@@ -99,11 +108,23 @@ def _quantity(text: str, unit: str) -> float:
 
     registry = _registry()
     try:
-        return float(registry.Quantity(text).to(unit).magnitude)
+        quantity = registry.Quantity(text)
+        converted = float(quantity.to(unit).magnitude)
     except pint.DimensionalityError:
         raise ValueError(f"{text!r} cannot be converted to {unit}") from None
     except Exception:
         raise ValueError(f"{text!r} is not a quantity (a number and a unit, e.g. '60 mm')") from None
+    # pint takes angles as dimensionless: "50 Hz" would pass as 50 rad/s, though it may mean 50 rev/s.
+    if _radian_power(registry.Quantity(1, unit)) != _radian_power(quantity):
+        raise ValueError(
+            f"{text!r} has no angle unit; give an angle per time, e.g. '3000 rpm' or '314 rad/s'"
+        )
+    return converted
+
+
+def _radian_power(quantity: Any) -> int:
+    """The power of the angle (radian) in ``quantity``'s unit: 1 for ``rpm`` and ``rad/s``, 0 for ``Hz``."""
+    return int(dict(quantity.to_root_units().unit_items()).get("radian", 0))
 
 
 def read_catalogue(path: Path) -> dict[str, dict[str, Any]]:
@@ -151,10 +172,10 @@ def read_catalogue(path: Path) -> dict[str, dict[str, Any]]:
             field = str(first["loc"][0]) if first["loc"] else ""
             if first["type"] == "missing":
                 line = _line(key_node)
-                reason = f"missing (an entry needs {', '.join([*_UNITS, 'source'])})"
+                reason = f"missing (an entry needs {_FIELDS})"
             elif first["type"] == "extra_forbidden":
                 line = _line(fields[field][0])
-                reason = "unknown field (allowed: " + ", ".join([*_UNITS, "source"]) + ")"
+                reason = f"unknown field (allowed: {_FIELDS})"
             else:
                 line = _line(fields[field][1]) if field in fields else _line(key_node)
                 reason = f"{first['msg']} (got {raw.get(field)!r})"

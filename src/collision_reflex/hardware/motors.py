@@ -1,9 +1,11 @@
 """Electric motors, their scaling laws, and the motor catalogue.
 
 A motor is described by its stator outer diameter ``r`` (the paper's ``r_m``), stack length ``l``, rotor
-inertia, peak and continuous torque and mass. Scaling a reference motor ``(r0, l0)`` to ``(r, l)`` multiplies
-every quantity by ``(l/l0) (r/r0)**e`` with the exponent ``e`` of a scaling law (Bhatia, Mason and Johnson,
-"Reacting to Contact: Transparency and Collision Reflex in Actuation", ``tab:scaling_laws``).
+inertia, peak and continuous torque, mass and (when known) maximum speed. Scaling a reference motor ``(r0, l0)``
+to ``(r, l)`` multiplies mass, inertia and torques by ``(l/l0) (r/r0)**e`` with the exponent ``e`` of a scaling
+law (Bhatia, Mason and Johnson, "Reacting to Contact: Transparency and Collision Reflex in Actuation",
+``tab:scaling_laws``), and the maximum speed by ``(l/l0)**a (r/r0)**b`` of the law's :class:`SpeedScaling`
+(default: constant rotor surface speed, ``omega_max ∝ 1/r``).
 
 The scaling arithmetic (:func:`scaled_motor_quantities`) works on floats, NumPy arrays and CasADi symbols, since
 the optimiser uses it with motor sizes as decision variables. The catalogue is YAML (plain SI numbers or
@@ -12,6 +14,7 @@ quantities with units such as ``"60 mm"``); the packaged one holds the paper's r
 
 from __future__ import annotations
 
+import math
 import numbers
 import os
 from dataclasses import dataclass
@@ -22,12 +25,14 @@ from .. import _validate
 from ..errors import InvalidParameter
 
 __all__ = [
+    "CONSTANT_SURFACE_SPEED",
     "DEFAULT_SCALING_LAW",
     "REFERENCE_MOTOR_NAME",
     "SCALING_LAWS",
     "Motor",
     "MotorQuantities",
     "ScalingLaw",
+    "SpeedScaling",
     "load_catalogue",
     "reference_motor",
     "scaled_motor_quantities",
@@ -36,10 +41,54 @@ __all__ = [
 
 
 @dataclass(frozen=True)
+class SpeedScaling:
+    """How a scaled motor's maximum speed changes with size: ``omega_max = omega0 (l/l0)**a (r/r0)**b``.
+
+    Parameters
+    ----------
+    length_exponent : float
+        ``a``, the exponent of the stack-length ratio ``l/l0``.
+    diameter_exponent : float
+        ``b``, the exponent of the stator-diameter ratio ``r/r0``.
+    source : str
+        The physics assumed and where it comes from, for reports.
+    """
+
+    length_exponent: float
+    diameter_exponent: float
+    source: str
+
+    def __post_init__(self) -> None:
+        for field in ("length_exponent", "diameter_exponent"):
+            value = getattr(self, field)
+            if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
+                raise InvalidParameter(f"SpeedScaling.{field}", value, "a finite number")
+
+
+CONSTANT_SURFACE_SPEED = SpeedScaling(
+    length_exponent=0.0,
+    diameter_exponent=-1.0,
+    source=(
+        "ASSUMPTION: constant rotor surface speed, omega_max = v_tip / r_rotor with the rotor diameter in "
+        "proportion to the stator diameter, so omega_max ∝ 1/r and independent of the stack length. The "
+        "centrifugal hoop stress of a rotating ring is rho v**2 (v = omega r; Timoshenko and Goodier, Theory "
+        "of Elasticity, rotating disks), so the magnet retention and laminations limit the peripheral "
+        "speed, not omega (Pyrhonen, Jokinen, Hrabovcova, Design of Rotating Electrical Machines, Wiley "
+        "2014, on peripheral-speed limits). Not chosen: a fixed drive voltage and current, omega_max ∝ "
+        "1/tau_p (the back-EMF constant grows with the torque constant), since a scaled motor's winding "
+        "is redesigned for its drive. The scaling laws of tab:scaling_laws say nothing of speed."
+    ),
+)
+"""The default :class:`SpeedScaling`: constant rotor surface (tip) speed, ``omega_max ∝ 1/r``."""
+
+
+@dataclass(frozen=True)
 class ScalingLaw:
     """Exponents ``e`` of the stator diameter in ``q = q0 (l/l0) (r/r0)**e`` for mass, rotor inertia, torque.
 
     Every law in ``tab:scaling_laws`` is linear in the stack length ``l``; only the diameter exponents differ.
+    The maximum speed scales by ``speed`` (a :class:`SpeedScaling`, default :data:`CONSTANT_SURFACE_SPEED`),
+    a stated assumption since ``tab:scaling_laws`` gives no speed.
     """
 
     name: str
@@ -47,10 +96,13 @@ class ScalingLaw:
     inertia_exponent: float
     torque_exponent: float
     source: str = ""
+    speed: SpeedScaling = CONSTANT_SURFACE_SPEED
 
     def __post_init__(self) -> None:
         for field in ("mass_exponent", "inertia_exponent", "torque_exponent"):
             _validate.non_negative(f"ScalingLaw.{field}", getattr(self, field))
+        if not isinstance(self.speed, SpeedScaling):
+            raise InvalidParameter("ScalingLaw.speed", self.speed, "a SpeedScaling")
 
     @property
     def inertia_torque_exponent(self) -> float:
@@ -116,6 +168,8 @@ class MotorQuantities(NamedTuple):
     """Continuous torque [N m]."""
     mass: Any
     """Motor mass [kg]."""
+    max_speed: Any = None
+    """Maximum speed [rad/s]; None when the reference motor's is not known."""
 
 
 @dataclass(frozen=True)
@@ -132,6 +186,8 @@ class Motor:
     continuous_torque: continuous torque ``tau_c`` [N m], at most the peak torque.
     mass: motor mass [kg].
     source: where the figures come from (datasheet, paper, scaling).
+    max_speed: maximum speed ``omega_max`` [rad/s], or None when not known (none is made up:
+        :meth:`speed_limit` then says so).
     """
 
     name: str
@@ -142,9 +198,11 @@ class Motor:
     continuous_torque: float
     mass: float
     source: str = ""
+    max_speed: float | None = None
 
     def __post_init__(self) -> None:
-        for field in _MOTOR_NUMBERS:
+        numbers_given = _MOTOR_NUMBERS if self.max_speed is None else (*_MOTOR_NUMBERS, "max_speed")
+        for field in numbers_given:
             value = getattr(self, field)
             if isinstance(value, bool) or not isinstance(value, numbers.Real):
                 raise InvalidParameter(f"Motor.{field}", value, "a number (SI units)")
@@ -156,6 +214,18 @@ class Motor:
                 self.continuous_torque,
                 f"at most the peak torque {self.peak_torque!r} N m",
             )
+
+    def speed_limit(self) -> float:
+        """Return the maximum speed [rad/s]; raise :class:`InvalidParameter` when it is not known."""
+        if self.max_speed is None:
+            raise InvalidParameter(
+                "Motor.max_speed",
+                None,
+                "a maximum speed in rad/s",
+                f"no speed limit known for motor {self.name!r}: give max_speed in its catalogue entry "
+                "(e.g. '3000 rpm')",
+            )
+        return self.max_speed
 
     def scaled(
         self,
@@ -180,6 +250,7 @@ class Motor:
             continuous_torque=float(quantities.continuous_torque),
             mass=float(quantities.mass),
             source=f"scaled from {self.name} by the {law.name} law ({law.source})",
+            max_speed=None if quantities.max_speed is None else float(quantities.max_speed),
         )
 
 
@@ -199,10 +270,11 @@ def scaled_motor_quantities(
     stack_length: Any = None,
     law: str | ScalingLaw = DEFAULT_SCALING_LAW,
 ) -> MotorQuantities:
-    """Rotor inertia, peak and continuous torque and mass of ``reference`` scaled to a new size.
+    """Rotor inertia, peak and continuous torque, mass and maximum speed of ``reference`` scaled to a new size.
 
-    ``q = q0 (l/l0) (r/r0)**e`` with ``e`` from ``law`` (``tab:scaling_laws``). Works on floats, NumPy arrays
-    (broadcast) and CasADi ``SX``/``MX`` symbols alike.
+    ``q = q0 (l/l0) (r/r0)**e`` with ``e`` from ``law`` (``tab:scaling_laws``), and ``omega_max = omega0
+    (l/l0)**a (r/r0)**b`` with ``a``, ``b`` from ``law.speed`` (:class:`SpeedScaling`); ``max_speed`` is None
+    when the reference's is. Works on floats, NumPy arrays (broadcast) and CasADi ``SX``/``MX`` symbols alike.
 
     Parameters
     ----------
@@ -227,6 +299,11 @@ def scaled_motor_quantities(
         peak_torque=scale(reference.peak_torque, law.torque_exponent),
         continuous_torque=scale(reference.continuous_torque, law.torque_exponent),
         mass=scale(reference.mass, law.mass_exponent),
+        max_speed=None
+        if reference.max_speed is None
+        else reference.max_speed
+        * length_ratio**law.speed.length_exponent
+        * diameter_ratio**law.speed.diameter_exponent,
     )
 
 
@@ -235,7 +312,8 @@ def load_catalogue(path: str | os.PathLike[str] | None = None) -> dict[str, Moto
 
     The file has a top-level ``motors`` mapping from name to entry; each entry gives ``stator_diameter``,
     ``stack_length``, ``rotor_inertia``, ``peak_torque``, ``continuous_torque``, ``mass`` (plain SI numbers or
-    strings with units, e.g. ``"60 mm"``, ``"1.3 N*m"``) and a ``source``. A missing or mistyped field raises
+    strings with units, e.g. ``"60 mm"``, ``"1.3 N*m"``), optionally ``max_speed`` (rad/s, or e.g. ``"3000
+    rpm"``; omitted means not known) and a ``source``. A missing or mistyped field raises
     :class:`~collision_reflex.errors.CatalogueError` naming the field, the file and the line.
     """
     from .catalogue import read_catalogue
