@@ -1,8 +1,10 @@
 """Arms through Pinocchio: loading URDFs and stock robots, contact samples, effective parameters along a
-direction, transparency metrics and collision reflex surfaces.
+direction, transparency metrics, collision reflex surfaces, and duty cycles with their joint torques.
 """
 
 from .directions import circle_directions, sphere_directions, unit_directions
+from .duty_cycle import DutyCycle, Payload
+from .dynamics import CycleTorques, cycle_torques, joint_side_torque
 from .effective import CollisionImpulses, EffectiveParameters, collision_impulses, effective_parameters
 from .joints import JointParameters
 from .robot import Arm
@@ -12,11 +14,16 @@ __all__ = [
     "Arm",
     "ArmSamples",
     "CollisionImpulses",
+    "CycleTorques",
+    "DutyCycle",
     "EffectiveParameters",
     "JointParameters",
+    "Payload",
     "circle_directions",
     "collision_impulses",
+    "cycle_torques",
     "effective_parameters",
+    "joint_side_torque",
     "sphere_directions",
     "unit_directions",
 ]
