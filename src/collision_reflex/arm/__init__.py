@@ -1,5 +1,7 @@
-"""Arms through Pinocchio: loading URDFs and stock robots, contact samples, effective parameters along a
-direction, transparency metrics, collision reflex surfaces, and duty cycles with their joint torques.
+"""Arms through Pinocchio, with their contact samples, duty cycles and joint torques.
+
+Loading URDFs and stock robots, contact samples, effective parameters along a direction, transparency
+metrics, collision reflex surfaces, duty cycles and the joint torques over them.
 """
 
 from .directions import circle_directions, sphere_directions, unit_directions
