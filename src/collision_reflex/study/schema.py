@@ -17,7 +17,16 @@ import builtins
 import re
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, WithJsonSchema, field_validator, model_validator
+from pydantic import (
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    WithJsonSchema,
+    field_validator,
+    model_validator,
+)
+from pydantic_core import PydanticCustomError
 
 from .quantities import (
     Angle,
@@ -31,6 +40,7 @@ from .quantities import (
     Torque,
     Velocity,
     quantity_type,
+    to_si,
 )
 
 OBJECTIVE_NAMES = ("worst_case_impulse", "mean_impulse", "actuator_mass", "approach_velocity")
@@ -242,12 +252,54 @@ class SamplesSpec(_Model):
 
 # --- duty cycle --------------------------------------------------------------------------------------------------
 
-JointSpeed = quantity_type("rad/s", "a joint speed (m/s for a prismatic joint)", "90 deg/s")
-JointAcceleration = quantity_type(
-    "rad/s^2", "a joint acceleration (m/s^2 for a prismatic joint)", "300 deg/s^2"
-)
-Duration = quantity_type("s", "a duration", "0.5 s")
 Rate = quantity_type("Hz", "a sampling rate", "500 Hz")
+
+
+def _quantities(unit: str, what: str, example: str, collection: type, minimum: str) -> Any:
+    """A quantity for every item (a number or a string with units), or a ``collection`` of them, in ``unit``.
+
+    ``collection`` is ``dict`` (by joint name) or ``list`` (one per item); ``minimum`` is ``"> 0"`` or
+    ``">= 0"``. One validator for both forms, so that a bad value gives one located problem.
+    """
+
+    def one(value: Any) -> float:
+        number = to_si(value, unit, what, example)
+        if not (number > 0 or (minimum == ">= 0" and number == 0)):
+            raise PydanticCustomError("quantity", "{expected}", {"expected": f"{what} {minimum} (found {number:g})"})
+        return number
+
+    def validate(value: Any) -> Any:
+        if isinstance(value, dict) and collection is dict:
+            return {str(key): one(item) for key, item in value.items()}
+        if isinstance(value, list) and collection is list:
+            return [one(item) for item in value]
+        return one(value)
+
+    bound = "exclusiveMinimum" if minimum == "> 0" else "minimum"
+    quantity = {"anyOf": [{"type": "number", bound: 0}, {"type": "string"}]}
+    many = (
+        {"type": "object", "additionalProperties": quantity}
+        if collection is dict
+        else {"type": "array", "items": quantity}
+    )
+    form = "a mapping by joint name naming every joint" if collection is dict else "a list, one per via point"
+    return Annotated[
+        float | collection[str, float] if collection is dict else float | list[float],  # type: ignore[index]
+        BeforeValidator(validate),
+        WithJsonSchema(
+            {
+                "anyOf": [quantity, many],
+                "description": f"{what} [{unit}] {minimum}, e.g. {example!r}: one for all, or {form}",
+            }
+        ),
+    ]
+
+
+JointSpeed = _quantities("rad/s", "a joint speed (m/s for a prismatic joint)", "90 deg/s", dict, "> 0")
+JointAcceleration = _quantities(
+    "rad/s^2", "a joint acceleration (m/s^2 for a prismatic joint)", "300 deg/s^2", dict, "> 0"
+)
+Dwell = _quantities("s", "a time at rest", "0.5 s", list, ">= 0")
 DEFAULT_DWELL = 0.0
 DEFAULT_RATE = 1000.0
 _VIA_ONLY = ("max_speed", "max_acceleration", "dwell", "rate")
@@ -290,16 +342,16 @@ class DutyCycleSpec(_Model):
     via: builtins.list[builtins.list[Angle]] | None = Field(
         None, min_length=2, description="via configurations [rad], one position per joint, at least 2"
     )
-    max_speed: JointSpeed | dict[str, JointSpeed] | None = Field(  # type: ignore[valid-type]
+    max_speed: JointSpeed | None = Field(  # type: ignore[valid-type]
         None, description="joint speed limit [rad/s] (via only): one for all joints or by joint name"
     )
-    max_acceleration: JointAcceleration | dict[str, JointAcceleration] | None = Field(  # type: ignore[valid-type]
+    max_acceleration: JointAcceleration | None = Field(  # type: ignore[valid-type]
         None, description="joint acceleration limit [rad/s^2] (via only): one for all joints or by joint name"
     )
-    dwell: Duration | builtins.list[Duration] | None = Field(  # type: ignore[valid-type]
+    dwell: Dwell | None = Field(  # type: ignore[valid-type]
         None, description=f"rest at each via point [s] (via only; default {DEFAULT_DWELL:g} s)"
     )
-    rate: Rate | None = Field(None, description=f"sampling rate [Hz] (via only; default {DEFAULT_RATE:g} Hz)")
+    rate: Rate | None = Field(None, gt=0, description=f"sampling rate [Hz] (via only; default {DEFAULT_RATE:g} Hz)")
     payload: PayloadSpec | None = Field(
         None, description="payload carried (default: constraints.payload as a point mass, if any)"
     )
@@ -315,20 +367,10 @@ class DutyCycleSpec(_Model):
         missing = [name for name in ("max_speed", "max_acceleration") if getattr(self, name) is None]
         if missing:
             raise ValueError(f"{' and '.join(missing)} for a motion through via points")
-        for name in ("max_speed", "max_acceleration"):
-            limits = getattr(self, name)
-            values = limits.values() if isinstance(limits, dict) else [limits]
-            if not all(value > 0 for value in values):
-                raise ValueError(f"{name}: limits > 0")
         dwell = self.dwell if self.dwell is not None else DEFAULT_DWELL
-        dwells = dwell if isinstance(dwell, builtins.list) else [dwell]
-        if not all(value >= 0 for value in dwells):
-            raise ValueError("dwell: times >= 0 [s]")
         if isinstance(dwell, builtins.list) and len(dwell) != len(self.via or []):
             raise ValueError(f"dwell: one time for all via points or one per via point ({len(self.via or [])})")
         rate = self.rate if self.rate is not None else DEFAULT_RATE
-        if not rate > 0:
-            raise ValueError("rate: a sampling rate > 0 [Hz]")
         # The defaults become explicit (the resolved study shows them).
         object.__setattr__(self, "dwell", dwell)
         object.__setattr__(self, "rate", rate)
