@@ -53,7 +53,9 @@ def _csv(rows: int = 60, *, time_unit: str = "s") -> str:
     """A smooth cycle (joint1 in deg, joint2 in rad) with a comment line and an extra column."""
     t = np.linspace(0.0, 2.0, rows)
     lines = ["# recorded cycle", f"time [{time_unit}], joint1 [deg], joint2, gripper [mm]"]
-    lines += [f"{ti:.12g}, {30 * math.sin(math.pi * ti):.12g}, {0.5 * math.cos(math.pi * ti):.12g}, 5" for ti in t]
+    lines += [
+        f"{ti:.12g}, {30 * math.sin(math.pi * ti):.12g}, {0.5 * math.cos(math.pi * ti):.12g}, 5" for ti in t
+    ]
     return "\n".join(lines) + "\n"
 
 
@@ -193,7 +195,7 @@ def _bad_csv(kind: str) -> tuple[str, int | None, str]:
     header = 2  # line 1 is a comment
     if kind == "missing-column":
         lines[1] = "time [s], joint1 [deg], gripper [mm]"
-        lines[2:] = [",".join(row.split(",")[:2] + ["5"]) for row in lines[2:]]
+        lines[2:] = [",".join([*row.split(",")[:2], "5"]) for row in lines[2:]]
         return "\n".join(lines), header, "joint2"
     if kind == "non-increasing":
         lines[16] = lines[14]
@@ -269,7 +271,12 @@ BAD_STUDIES = [
         2,
         ["symmetric"],
     ),
-    ("duty_cycle:\n  file: cycle.csv\n  payload: {mass: 1 kg}\n", "constraints: {payload: 2 kg}\n", None, ["once"]),
+    (
+        "duty_cycle:\n  file: cycle.csv\n  payload: {mass: 1 kg}\n",
+        "constraints: {payload: 2 kg}\n",
+        None,
+        ["once"],
+    ),
 ]
 
 
@@ -306,8 +313,18 @@ def test_bad_duty_cycle_sections_are_located(tmp_path, section, extra, offset, w
 
 ROBOT_BAD = [
     # (section, path of the problem, line within the section, words)
-    ("  via: [[0, 0, 0], [1, 1]]\n  max_speed: 1\n  max_acceleration: 1\n", "duty_cycle.via[0]", 1, ["3 joint"]),
-    ("  via: [[0, 0], [1, 4]]\n  max_speed: 1\n  max_acceleration: 1\n", "duty_cycle.via[1][1]", 1, ["limits"]),
+    (
+        "  via: [[0, 0, 0], [1, 1]]\n  max_speed: 1\n  max_acceleration: 1\n",
+        "duty_cycle.via[0]",
+        1,
+        ["3 joint"],
+    ),
+    (
+        "  via: [[0, 0], [1, 4]]\n  max_speed: 1\n  max_acceleration: 1\n",
+        "duty_cycle.via[1][1]",
+        1,
+        ["limits"],
+    ),
     (
         "  via: [[0, 0], [1, 1]]\n  max_speed: {joint1: 1, elbow: 1}\n  max_acceleration: 1\n",
         "duty_cycle.max_speed",

@@ -17,8 +17,8 @@ import numpy as np
 
 from ..errors import StudyFileError, StudyProblem
 from ..optimize.blas import single_threaded_blas
-from .load import LoadedStudy, parse_study
 from .duty import payload_of, study_duty_cycle
+from .load import LoadedStudy, parse_study
 from .prepare import check_motors, joint_actuators, per_joint_bounds
 from .robot import load_arm
 from .samples import configuration_samples, direction_samples

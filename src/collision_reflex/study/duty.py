@@ -150,7 +150,9 @@ def _per_joint(
     missing = [joint for joint in joints if joint not in value]
     for key in unknown:
         problems.append(
-            loaded.problem((*_SECTION, name, key), f"joint {key!r}, not a joint of the arm", ", ".join(joints))
+            loaded.problem(
+                (*_SECTION, name, key), f"joint {key!r}, not a joint of the arm", ", ".join(joints)
+            )
         )
     if missing:
         problems.append(

@@ -265,7 +265,9 @@ def _quantities(unit: str, what: str, example: str, collection: type, minimum: s
     def one(value: Any) -> float:
         number = to_si(value, unit, what, example)
         if not (number > 0 or (minimum == ">= 0" and number == 0)):
-            raise PydanticCustomError("quantity", "{expected}", {"expected": f"{what} {minimum} (found {number:g})"})
+            raise PydanticCustomError(
+                "quantity", "{expected}", {"expected": f"{what} {minimum} (found {number:g})"}
+            )
         return number
 
     def validate(value: Any) -> Any:
@@ -284,7 +286,7 @@ def _quantities(unit: str, what: str, example: str, collection: type, minimum: s
     )
     form = "a mapping by joint name naming every joint" if collection is dict else "a list, one per via point"
     return Annotated[
-        float | collection[str, float] if collection is dict else float | list[float],  # type: ignore[index]
+        (float | dict[str, float]) if collection is dict else (float | list[float]),
         BeforeValidator(validate),
         WithJsonSchema(
             {
@@ -351,7 +353,9 @@ class DutyCycleSpec(_Model):
     dwell: Dwell | None = Field(  # type: ignore[valid-type]
         None, description=f"rest at each via point [s] (via only; default {DEFAULT_DWELL:g} s)"
     )
-    rate: Rate | None = Field(None, gt=0, description=f"sampling rate [Hz] (via only; default {DEFAULT_RATE:g} Hz)")
+    rate: Rate | None = Field(  # type: ignore[valid-type]
+        None, gt=0, description=f"sampling rate [Hz] (via only; default {DEFAULT_RATE:g} Hz)"
+    )
     payload: PayloadSpec | None = Field(
         None, description="payload carried (default: constraints.payload as a point mass, if any)"
     )
@@ -362,14 +366,18 @@ class DutyCycleSpec(_Model):
         if self.file is not None:
             given = [name for name in _VIA_ONLY if getattr(self, name) is not None]
             if given:
-                raise ValueError(f"{', '.join(given)} only with via points (a trajectory file gives the motion)")
+                raise ValueError(
+                    f"{', '.join(given)} only with via points (a trajectory file gives the motion)"
+                )
             return self
         missing = [name for name in ("max_speed", "max_acceleration") if getattr(self, name) is None]
         if missing:
             raise ValueError(f"{' and '.join(missing)} for a motion through via points")
         dwell = self.dwell if self.dwell is not None else DEFAULT_DWELL
         if isinstance(dwell, builtins.list) and len(dwell) != len(self.via or []):
-            raise ValueError(f"dwell: one time for all via points or one per via point ({len(self.via or [])})")
+            raise ValueError(
+                f"dwell: one time for all via points or one per via point ({len(self.via or [])})"
+            )
         rate = self.rate if self.rate is not None else DEFAULT_RATE
         # The defaults become explicit (the resolved study shows them).
         object.__setattr__(self, "dwell", dwell)
@@ -555,7 +563,8 @@ class ArmStudy(_Model):
     )
     samples: SamplesSpec
     duty_cycle: DutyCycleSpec | None = Field(
-        None, description="the motion the arm must make; null: the torque requirement is static (gravity only)"
+        None,
+        description="the motion the arm must make; null: the torque requirement is static (gravity only)",
     )
     design: DesignSpec = Field(default_factory=DesignSpec)
     objective: Annotated[
