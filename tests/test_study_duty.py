@@ -356,3 +356,21 @@ def test_run_with_a_bad_trajectory_writes_nothing(tmp_path, capsys):
     err = capsys.readouterr().err
     assert f"{path}:{FILE_LINE}:" in err and f"cycle.csv:{csv_line}:" in err
     assert not out.exists()
+
+
+def test_example_trajectory_loads_with_the_minimum_jerk_peaks(tmp_path):
+    """studies/cycles/two_link_reach.csv: 60 deg minimum-jerk moves in 0.8 s, positions to 1e-6 deg."""
+    root = Path(__file__).resolve().parents[1]
+    base = BASE.replace(
+        "example_robot_data: double_pendulum",
+        f"urdf: {root / 'designs' / 'planar_two_link.urdf'}\n  contact_frame: tip",
+    )
+    section = f"duty_cycle:\n  file: {root / 'studies' / 'cycles' / 'two_link_reach.csv'}\n"
+    cycle = _cycle(_study(tmp_path, section, base=base))
+    assert cycle is not None and cycle.duration == 2.0 and cycle.t.size == 201
+    amplitude, move = math.radians(60), 0.8
+    # minimum jerk: peak speed 15/8 A/T at mid-move, peak acceleration 10 sqrt(3)/3 A/T^2
+    np.testing.assert_allclose(np.max(np.abs(cycle.qd), axis=0), 15 / 8 * amplitude / move, rtol=1e-5)
+    np.testing.assert_allclose(
+        np.max(np.abs(cycle.qdd), axis=0), 10 * math.sqrt(3) / 3 * amplitude / move**2, rtol=1e-3
+    )
