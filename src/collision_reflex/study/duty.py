@@ -99,7 +99,7 @@ def _through_via_points(
     joints = list(arm.joint_names)
     problems: list[StudyProblem] = []
     via = spec.via or []
-    lower, upper = arm.joint_limits()
+    lower, upper = _position_limits(arm)
     for index, point in enumerate(via):
         if len(point) != len(joints):
             problems.append(
@@ -138,6 +138,24 @@ def _through_via_points(
         )
     except InvalidParameter as error:  # pragma: no cover - the schema checks the same bounds first
         raise loaded.fail(_SECTION, str(error), "a motion through the via points") from None
+
+
+def _position_limits(arm: Arm) -> tuple[np.ndarray, np.ndarray]:
+    """The URDF's position limits per joint [rad or m]; infinite where it gives none.
+
+    As :meth:`~collision_reflex.arm.Arm.joint_limits` reads them, without its stand-in full turn for a revolute
+    joint without limits (continuous, or limits that are empty or huge): a via point may be anywhere there.
+    """
+    from ..arm.kinematic_tree import joint_kinematics
+
+    lower, upper = np.full(arm.nv, -np.inf), np.full(arm.nv, np.inf)
+    low, high = arm.model.lowerPositionLimit, arm.model.upperPositionLimit
+    real, _ = arm.joint_limits()
+    for v, joint in enumerate(joint_kinematics(arm.model, arm.name)):
+        lo, hi = (low[joint.idx_q], high[joint.idx_q]) if joint.nq == 1 else (np.nan, np.nan)
+        if lo == real[v] and lo < hi:  # joint_limits kept the URDF's limits
+            lower[v], upper[v] = lo, hi
+    return lower, upper
 
 
 def _per_joint(
