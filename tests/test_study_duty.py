@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 import textwrap
 from pathlib import Path
@@ -381,3 +382,15 @@ def test_example_trajectory_loads_with_the_minimum_jerk_peaks(tmp_path):
     np.testing.assert_allclose(
         np.max(np.abs(cycle.qdd), axis=0), 10 * math.sqrt(3) / 3 * amplitude / move**2, rtol=1e-3
     )
+
+
+def test_cli_schema_resolved_and_schema_only_summaries(tmp_path, capsys):
+    assert main(["schema"]) == 0
+    assert "DutyCycleSpec" in json.loads(capsys.readouterr().out)["$defs"]
+    path = _study(tmp_path, VIA)
+    assert main(["validate", "--resolved", str(path)]) == 0
+    resolved = yaml.safe_load(capsys.readouterr().out.split("\n", 1)[1])
+    assert resolved["duty_cycle"]["rate"] == 200.0 and resolved["duty_cycle"]["dwell"] == 0.25
+    assert resolved["duty_cycle"]["max_speed"] == {"joint1": pytest.approx(math.pi / 2), "joint2": 2.0}
+    assert main(["validate", "--schema-only", str(path)]) == 0
+    assert "duty cycle through 3 via points (not loaded)" in capsys.readouterr().out
