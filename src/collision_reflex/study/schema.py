@@ -489,7 +489,8 @@ class ConstraintsSpec(_Model):
     payload: Mass = Field(
         0.0,
         ge=0,
-        description="mass carried at the contact point [kg]; with a duty cycle, give it as duty_cycle.payload",
+        description="mass carried at the contact point [kg], a point mass (also over a duty cycle); or "
+        "duty_cycle.payload with its inertia, not both",
     )
     safety_factor: Ratio = Field(1.0, ge=1, description="peak torque >= safety_factor x required torque")
     threshold_floor: Force = Field(0.0, ge=0, description="sensing noise floor [N]")
