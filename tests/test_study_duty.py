@@ -14,9 +14,9 @@ import yaml
 from collision_reflex.arm.duty_cycle import DutyCycle, Payload
 from collision_reflex.cli import main
 from collision_reflex.errors import StudyFileError
-from collision_reflex.study import load_study, resolved_yaml, study_json_schema
+from collision_reflex.study import ArmStudy, load_study, resolved_yaml, study_json_schema
 from collision_reflex.study.arm_setup import arm_setup
-from collision_reflex.study.duty import STATIC_REQUIREMENT, study_duty_cycle
+from collision_reflex.study.duty import STATIC_REQUIREMENT, describe_duty_cycle, study_duty_cycle
 from collision_reflex.study.robot import load_arm
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -394,3 +394,13 @@ def test_cli_schema_resolved_and_schema_only_summaries(tmp_path, capsys):
     assert resolved["duty_cycle"]["max_speed"] == {"joint1": pytest.approx(math.pi / 2), "joint2": 2.0}
     assert main(["validate", "--schema-only", str(path)]) == 0
     assert "duty cycle through 3 via points (not loaded)" in capsys.readouterr().out
+
+
+def test_summary_gives_prismatic_speeds_in_metres_per_second(tmp_path):
+    study = load_study(_study(tmp_path, "")).study
+    assert isinstance(study, ArmStudy)
+    cycle = DutyCycle.through_via_points([[0, 0], [0.4, 1.0]], ("slide", "hinge"), [0.2, 3.0], 10.0)
+    text = describe_duty_cycle(cycle, study, prismatic=("slide",))
+    # synchronised: the slide (0.4 m at 0.2 m/s) sets the pace; the hinge cruises at 1.0 / 0.4 * 0.2 rad/s
+    hinge = 1.0 / 0.4 * 0.2
+    assert f"peak joint speed {hinge:.4g} rad/s (hinge) and 0.2 m/s (slide), no payload" in text

@@ -14,7 +14,7 @@ as ``constraints.payload`` (a mass), which a duty cycle then carries as a point 
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -70,20 +70,21 @@ def static_requirement(study: ArmStudy) -> str:
     return STATIC_REQUIREMENT
 
 
-def _from_file(loaded: LoadedStudy, arm: Arm, file: str, payload: Payload | None) -> DutyCycle:
+def prismatic_joints(arm: Arm) -> list[str]:
+    """The arm's prismatic joints (positions in m, speeds in m/s); the others are revolute."""
     from ..arm.kinematic_tree import joint_kinematics
 
+    kinds = joint_kinematics(arm.model, arm.name)
+    return [name for name, joint in zip(arm.joint_names, kinds, strict=True) if not joint.revolute]
+
+
+def _from_file(loaded: LoadedStudy, arm: Arm, file: str, payload: Payload | None) -> DutyCycle:
     where = (*_SECTION, "file")
     path = loaded.path(file)
     if not path.is_file():
         raise loaded.fail(where, f"{file!r} (no such file)", "a path relative to the study file's folder")
-    prismatic = [
-        name
-        for name, joint in zip(arm.joint_names, joint_kinematics(arm.model, arm.name), strict=True)
-        if not joint.revolute
-    ]
     try:
-        return DutyCycle.from_csv(path, arm.joint_names, payload, prismatic=prismatic)
+        return DutyCycle.from_csv(path, arm.joint_names, payload, prismatic=prismatic_joints(arm))
     except TrajectoryError as error:
         located = f"{file}:{error.line}" if error.line is not None else file
         raise loaded.fail(
@@ -183,14 +184,22 @@ def _per_joint(
     return np.array([float(value.get(joint, np.nan)) for joint in joints])
 
 
-def describe_duty_cycle(cycle: DutyCycle | None, study: ArmStudy) -> str:
-    """One line: the cycle's duration, samples, peak joint speed (and which joint), payload; or the static note."""
+def describe_duty_cycle(cycle: DutyCycle | None, study: ArmStudy, prismatic: Sequence[str] = ()) -> str:
+    """One line: the cycle's duration, samples, peak joint speed (and which joint), payload; or the static note.
+
+    The peak speed is the largest over the revolute joints [rad/s], and over the ``prismatic`` ones [m/s].
+    """
     if cycle is None:
         return static_requirement(study)
     speeds = np.max(np.abs(cycle.qd), axis=0)
-    fastest = int(np.argmax(speeds))
+    peaks = []
+    for unit, linear in (("rad/s", False), ("m/s", True)):
+        joints = [j for j, name in enumerate(cycle.joint_names) if (name in prismatic) == linear]
+        if joints:
+            fastest = max(joints, key=lambda j: speeds[j])
+            peaks.append(f"{speeds[fastest]:.4g} {unit} ({cycle.joint_names[fastest]})")
     payload = f", payload {cycle.payload.mass:g} kg" if cycle.payload is not None else ", no payload"
     return (
         f"duty cycle of {cycle.duration:.4g} s, {cycle.t.size} samples, peak joint speed "
-        f"{speeds[fastest]:.4g} rad/s ({cycle.joint_names[fastest]}){payload}"
+        f"{' and '.join(peaks)}{payload}"
     )

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from ..errors import StudyFileError, StudyProblem
-from .duty import describe_duty_cycle, static_requirement, study_duty_cycle
+from .duty import describe_duty_cycle, prismatic_joints, static_requirement, study_duty_cycle
 from .load import LoadedStudy
 from .schema import PER_JOINT_DESIGN_VARIABLES, ActuatorStudy, ArmStudy, GearboxSpec, MotorSpec
 from .source import PathKey
@@ -191,7 +191,7 @@ def describe_study(loaded: LoadedStudy, load_robot: bool = True) -> str:
         n_config = configuration_samples(loaded, arm).shape[0]
         n_dir = direction_samples(loaded, arm).shape[0]
         text += f" ({n_joints} joints: {', '.join(arm.joint_names)}), {n_config} configurations x {n_dir} directions"
-        cycle_summary = describe_duty_cycle(study_duty_cycle(loaded, arm), study)
+        cycle_summary = describe_duty_cycle(study_duty_cycle(loaded, arm), study, prismatic_joints(arm))
     else:
         cycle_summary = _duty_cycle_spec_summary(study)
     free = free_variables(study, n_joints or 1, list(arm.joint_names) if load_robot else None)
