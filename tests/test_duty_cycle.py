@@ -168,6 +168,14 @@ def test_error_survives_pickling(tmp_path):
     assert str(copy) == str(error) and copy.line == error.line
 
 
+def test_trajectory_error_is_one_class_in_errors_and_at_the_root():
+    import collision_reflex
+    from collision_reflex import errors
+
+    assert TrajectoryError is errors.TrajectoryError is collision_reflex.TrajectoryError
+    assert issubclass(TrajectoryError, errors.TraceError) and issubclass(TrajectoryError, ValueError)
+
+
 def test_unreadable_and_empty_files(tmp_path):
     with pytest.raises(TrajectoryError, match="cannot read"):
         DutyCycle.from_csv(tmp_path / "absent.csv", NAMES)

@@ -235,6 +235,24 @@ class TraceError(CollisionReflexError, ValueError):
         super().__init__(f"{where}: {reason}")
 
 
+class TrajectoryError(TraceError):
+    """A position trajectory (CSV file or arrays) cannot be used as a duty cycle.
+
+    Attributes
+    ----------
+    source: the file (``""`` for arrays).
+    line: the file line (1-based), or ``None`` for arrays (the reason then names the sample) or when the
+        problem is not one line.
+    reason: what is wrong and what to do.
+    """
+
+    def __init__(self, source: str, reason: str, line: int | None = None) -> None:
+        super().__init__(source or "trajectory", "", reason, line)
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (type(self), (self.source, self.reason, self.line))
+
+
 class FitFailed(CollisionReflexError):
     """A least-squares fit did not converge or its result is not usable.
 

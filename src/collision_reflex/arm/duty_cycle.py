@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InvalidParameter, TraceError
+from ..errors import InvalidParameter, TraceError, TrajectoryError
 from ..experiments.traces import _HEADER as HEADER_PATTERN
 from ..experiments.traces import unit_factor
 from .motion_profiles import trapezoidal_motion
@@ -41,24 +41,6 @@ MIN_SAMPLES = SPLINE_ORDER + 1
 COARSE_TOLERANCE = 0.1
 """Largest relative disagreement between the quintic's and a cubic's accelerations between samples."""
 _TIME_NAMES = ("time", "t")
-
-
-class TrajectoryError(TraceError):
-    """A position trajectory (CSV file or arrays) cannot be used as a duty cycle.
-
-    Attributes
-    ----------
-    source: the file (``""`` for arrays).
-    line: the file line (1-based), or ``None`` for arrays (the reason then names the sample) or when the
-        problem is not one line.
-    reason: what is wrong and what to do.
-    """
-
-    def __init__(self, source: str, reason: str, line: int | None = None) -> None:
-        super().__init__(source or "trajectory", "", reason, line)
-
-    def __reduce__(self) -> tuple[Any, ...]:
-        return (type(self), (self.source, self.reason, self.line))
 
 
 @dataclass(frozen=True, eq=False)

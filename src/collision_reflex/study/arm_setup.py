@@ -17,6 +17,7 @@ import numpy as np
 
 from ..errors import StudyFileError, StudyProblem
 from ..optimize.blas import single_threaded_blas
+from .duty import payload_of, study_duty_cycle
 from .load import LoadedStudy, parse_study
 from .prepare import check_motors, joint_actuators, per_joint_bounds
 from .robot import load_arm
@@ -25,7 +26,7 @@ from .schema import PER_JOINT_DESIGN_VARIABLES, ArmStudy
 from .source import PathKey
 
 if TYPE_CHECKING:
-    from ..arm import Arm
+    from ..arm import Arm, DutyCycle
     from ..hardware.motors import Motor
     from ..optimize import ActuatorTechnology, Constraints, ContactSamples, DesignProblem, DesignSpace
 
@@ -39,7 +40,8 @@ class ArmSetup:
 
     arm: the robot; catalogue: the motor catalogue by name; configurations: (n, nq) [rad]; directions:
     (m, task_dim) unit vectors; samples: the optimiser's contact samples (every configuration with every
-    direction); space, technology, constraints: the optimiser's inputs.
+    direction); space, technology, constraints: the optimiser's inputs; duty_cycle: the motion the arm must
+    make (with its payload), or ``None`` when the study gives none (:attr:`static_torque_requirement`).
     """
 
     study: ArmStudy
@@ -51,6 +53,12 @@ class ArmSetup:
     space: DesignSpace
     technology: ActuatorTechnology
     constraints: Constraints
+    duty_cycle: DutyCycle | None = None
+
+    @property
+    def static_torque_requirement(self) -> bool:
+        """True when the torque requirement is the static (gravity-only) one: the study gives no duty cycle."""
+        return self.duty_cycle is None
 
 
 def arm_setup(loaded: LoadedStudy) -> ArmSetup:
@@ -99,8 +107,9 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
         reaction=study.reaction,
         reflected_inertia_in=study.reflected_inertia_in,
     )
+    payload = payload_of(study)
     constraints = Constraints(
-        payload=study.constraints.payload,
+        payload=payload.mass if payload is not None else 0.0,  # the one payload (see .duty)
         safety_factor=study.constraints.safety_factor,
         torque_required=study.constraints.torque_required,
         threshold_floor=study.constraints.threshold_floor,
@@ -109,7 +118,16 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
     directions = direction_samples(loaded, arm)
     samples = ContactSamples.grid(arm.kinematics(configurations), directions)
     return ArmSetup(
-        study, arm, catalogue, configurations, directions, samples, space, technology, constraints
+        study,
+        arm,
+        catalogue,
+        configurations,
+        directions,
+        samples,
+        space,
+        technology,
+        constraints,
+        duty_cycle=study_duty_cycle(loaded, arm),
     )
 
 

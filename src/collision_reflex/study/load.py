@@ -258,6 +258,7 @@ def _arm_checks(loaded: LoadedStudy, study: ArmStudy) -> list[StudyProblem]:
                 _relative_hint(loaded),
             )
         )
+    problems += _duty_cycle_checks(loaded, study)
     lengths = {len(q) for q in study.samples.configurations.list or []}
     if len(lengths) > 1:
         problems.append(
@@ -274,6 +275,28 @@ def _arm_checks(loaded: LoadedStudy, study: ArmStudy) -> list[StudyProblem]:
                 ("samples", "directions", "list"),
                 "vectors of different sizes",
                 "every direction with the same number of components (2 for a planar arm, else 3)",
+            )
+        )
+    return problems
+
+
+def _duty_cycle_checks(loaded: LoadedStudy, study: ArmStudy) -> list[StudyProblem]:
+    """The trajectory file exists; the payload is given once (``duty_cycle.payload`` or ``constraints.payload``)."""
+    cycle = study.duty_cycle
+    if cycle is None:
+        return []
+    problems = []
+    if cycle.file is not None and not loaded.path(cycle.file).is_file():
+        problems.append(
+            loaded.problem(("duty_cycle", "file"), f"{cycle.file!r} (no such file)", _relative_hint(loaded))
+        )
+    if cycle.payload is not None and study.constraints.payload != 0:
+        problems.append(
+            loaded.problem(
+                ("constraints", "payload"),
+                f"a payload of {study.constraints.payload:g} kg here and another in duty_cycle.payload",
+                "the payload once: remove constraints.payload (duty_cycle.payload loads the static "
+                "requirement too)",
             )
         )
     return problems

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from ..errors import StudyFileError, StudyProblem
+from .duty import describe_duty_cycle, prismatic_joints, static_requirement, study_duty_cycle
 from .load import LoadedStudy
 from .schema import PER_JOINT_DESIGN_VARIABLES, ActuatorStudy, ArmStudy, GearboxSpec, MotorSpec
 from .source import PathKey
@@ -190,6 +191,9 @@ def describe_study(loaded: LoadedStudy, load_robot: bool = True) -> str:
         n_config = configuration_samples(loaded, arm).shape[0]
         n_dir = direction_samples(loaded, arm).shape[0]
         text += f" ({n_joints} joints: {', '.join(arm.joint_names)}), {n_config} configurations x {n_dir} directions"
+        cycle_summary = describe_duty_cycle(study_duty_cycle(loaded, arm), study, prismatic_joints(arm))
+    else:
+        cycle_summary = _duty_cycle_spec_summary(study)
     free = free_variables(study, n_joints or 1, list(arm.joint_names) if load_robot else None)
 
     def count(name: str, number: int) -> str:
@@ -204,4 +208,13 @@ def describe_study(loaded: LoadedStudy, load_robot: bool = True) -> str:
     )
     if study.pareto is not None:
         text += f"; Pareto front of {' vs '.join(study.pareto.objectives)} ({study.pareto.points} points)"
-    return text
+    return f"{text}; {cycle_summary}"
+
+
+def _duty_cycle_spec_summary(study: ArmStudy) -> str:
+    """What the study's duty cycle is, without the robot (its numbers need the arm)."""
+    spec = study.duty_cycle
+    if spec is None:
+        return static_requirement(study)
+    source = f"from {spec.file}" if spec.file is not None else f"through {len(spec.via or [])} via points"
+    return f"duty cycle {source} (not loaded)"

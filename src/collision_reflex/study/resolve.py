@@ -29,6 +29,9 @@ def resolved_study(loaded: LoadedStudy) -> dict[str, Any]:
         trajectory = data["samples"]["configurations"]["trajectory"]
         if trajectory is not None:
             trajectory["file"] = str(loaded.path(trajectory["file"]))
+        cycle = data["duty_cycle"]
+        if cycle is not None and cycle["file"] is not None:
+            cycle["file"] = str(loaded.path(cycle["file"]))
     return data
 
 

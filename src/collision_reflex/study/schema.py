@@ -17,7 +17,16 @@ import builtins
 import re
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, WithJsonSchema, field_validator, model_validator
+from pydantic import (
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    WithJsonSchema,
+    field_validator,
+    model_validator,
+)
+from pydantic_core import PydanticCustomError
 
 from .quantities import (
     Angle,
@@ -30,6 +39,8 @@ from .quantities import (
     RotaryStiffness,
     Torque,
     Velocity,
+    quantity_type,
+    to_si,
 )
 
 OBJECTIVE_NAMES = ("worst_case_impulse", "mean_impulse", "actuator_mass", "approach_velocity")
@@ -239,6 +250,141 @@ class SamplesSpec(_Model):
     directions: DirectionSamples
 
 
+# --- duty cycle --------------------------------------------------------------------------------------------------
+
+Rate = quantity_type("Hz", "a sampling rate", "500 Hz")
+
+
+def _quantities(unit: str, what: str, example: str, collection: type, minimum: str) -> Any:
+    """A quantity for every item (a number or a string with units), or a ``collection`` of them, in ``unit``.
+
+    ``collection`` is ``dict`` (by joint name) or ``list`` (one per item); ``minimum`` is ``"> 0"`` or
+    ``">= 0"``. One validator for both forms, so that a bad value gives one located problem.
+    """
+
+    def one(value: Any) -> float:
+        number = to_si(value, unit, what, example)
+        if not (number > 0 or (minimum == ">= 0" and number == 0)):
+            raise PydanticCustomError(
+                "quantity", "{expected}", {"expected": f"{what} {minimum} (found {number:g})"}
+            )
+        return number
+
+    def validate(value: Any) -> Any:
+        if isinstance(value, dict) and collection is dict:
+            return {str(key): one(item) for key, item in value.items()}
+        if isinstance(value, list) and collection is list:
+            return [one(item) for item in value]
+        return one(value)
+
+    bound = "exclusiveMinimum" if minimum == "> 0" else "minimum"
+    quantity = {"anyOf": [{"type": "number", bound: 0}, {"type": "string"}]}
+    many = (
+        {"type": "object", "additionalProperties": quantity}
+        if collection is dict
+        else {"type": "array", "items": quantity}
+    )
+    form = "a mapping by joint name naming every joint" if collection is dict else "a list, one per via point"
+    return Annotated[
+        (float | dict[str, float]) if collection is dict else (float | list[float]),
+        BeforeValidator(validate),
+        WithJsonSchema(
+            {
+                "anyOf": [quantity, many],
+                "description": f"{what} [{unit}] {minimum}, e.g. {example!r}: one for all, or {form}",
+            }
+        ),
+    ]
+
+
+JointSpeed = _quantities("rad/s", "a joint speed (m/s for a prismatic joint)", "90 deg/s", dict, "> 0")
+JointAcceleration = _quantities(
+    "rad/s^2", "a joint acceleration (m/s^2 for a prismatic joint)", "300 deg/s^2", dict, "> 0"
+)
+Dwell = _quantities("s", "a time at rest", "0.5 s", list, ">= 0")
+DEFAULT_DWELL = 0.0
+DEFAULT_RATE = 1000.0
+_VIA_ONLY = ("max_speed", "max_acceleration", "dwell", "rate")
+
+
+class PayloadSpec(_Model):
+    """The payload the arm carries over its duty cycle, its centre of mass at the contact point."""
+
+    mass: Mass = Field(gt=0, description="payload mass [kg]")
+    inertia: tuple[
+        tuple[Inertia, Inertia, Inertia], tuple[Inertia, Inertia, Inertia], tuple[Inertia, Inertia, Inertia]
+    ] = Field(
+        ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)),
+        description="3x3 inertia about the centre of mass, contact-frame axes [kg m^2]; default a point mass",
+    )
+
+    @model_validator(mode="after")
+    def _physical(self) -> PayloadSpec:
+        from ..arm.duty_cycle import Payload
+        from ..errors import InvalidParameter
+
+        try:
+            Payload(self.mass, self.inertia)  # type: ignore[arg-type]
+        except InvalidParameter as error:
+            raise ValueError(f"payload {error.name}: {error.allowed}") from None
+        return self
+
+
+class DutyCycleSpec(_Model):
+    """The motion the arm must make: a trajectory file, or a motion through via configurations.
+
+    ``file``: a CSV with a time column and one position column per joint (named by the joint, units in the
+    header, e.g. ``time [s]``, ``shoulder [deg]``), relative to the study file; columns of other names are
+    ignored. ``via``: configurations [rad] passed through at rest, joined by synchronised trapezoidal profiles
+    within ``max_speed`` and ``max_acceleration`` (one value for every joint, or a mapping by joint name), with
+    ``dwell`` at each via point and sampled at ``rate``.
+    """
+
+    file: str | None = Field(None, description="trajectory CSV, relative to the study file")
+    via: builtins.list[builtins.list[Angle]] | None = Field(
+        None, min_length=2, description="via configurations [rad], one position per joint, at least 2"
+    )
+    max_speed: JointSpeed | None = Field(  # type: ignore[valid-type]
+        None, description="joint speed limit [rad/s] (via only): one for all joints or by joint name"
+    )
+    max_acceleration: JointAcceleration | None = Field(  # type: ignore[valid-type]
+        None, description="joint acceleration limit [rad/s^2] (via only): one for all joints or by joint name"
+    )
+    dwell: Dwell | None = Field(  # type: ignore[valid-type]
+        None, description=f"rest at each via point [s] (via only; default {DEFAULT_DWELL:g} s)"
+    )
+    rate: Rate | None = Field(  # type: ignore[valid-type]
+        None, gt=0, description=f"sampling rate [Hz] (via only; default {DEFAULT_RATE:g} Hz)"
+    )
+    payload: PayloadSpec | None = Field(
+        None, description="payload carried (default: constraints.payload as a point mass, if any)"
+    )
+
+    @model_validator(mode="after")
+    def _one_source(self) -> DutyCycleSpec:
+        _exactly_one(self, ("file", "via"), "the duty cycle")
+        if self.file is not None:
+            given = [name for name in _VIA_ONLY if getattr(self, name) is not None]
+            if given:
+                raise ValueError(
+                    f"{', '.join(given)} only with via points (a trajectory file gives the motion)"
+                )
+            return self
+        missing = [name for name in ("max_speed", "max_acceleration") if getattr(self, name) is None]
+        if missing:
+            raise ValueError(f"{' and '.join(missing)} for a motion through via points")
+        dwell = self.dwell if self.dwell is not None else DEFAULT_DWELL
+        if isinstance(dwell, builtins.list) and len(dwell) != len(self.via or []):
+            raise ValueError(
+                f"dwell: one time for all via points or one per via point ({len(self.via or [])})"
+            )
+        rate = self.rate if self.rate is not None else DEFAULT_RATE
+        # The defaults become explicit (the resolved study shows them).
+        object.__setattr__(self, "dwell", dwell)
+        object.__setattr__(self, "rate", rate)
+        return self
+
+
 # --- design variables --------------------------------------------------------------------------------------------
 
 
@@ -340,7 +486,12 @@ class DesignSpec(_Model):
 class ConstraintsSpec(_Model):
     """Design constraints: payload [kg], torque safety factor, threshold noise floor [N], torques [N m]."""
 
-    payload: Mass = Field(0.0, ge=0, description="mass carried at the contact point [kg]")
+    payload: Mass = Field(
+        0.0,
+        ge=0,
+        description="mass carried at the contact point [kg], a point mass (also over a duty cycle); or "
+        "duty_cycle.payload with its inertia, not both",
+    )
     safety_factor: Ratio = Field(1.0, ge=1, description="peak torque >= safety_factor x required torque")
     threshold_floor: Force = Field(0.0, ge=0, description="sensing noise floor [N]")
     torque_required: list[Torque] | None = Field(
@@ -412,6 +563,10 @@ class ArmStudy(_Model):
         "(also rigidly in the finger mass: a stiff transmission with the compliance at the contact)",
     )
     samples: SamplesSpec
+    duty_cycle: DutyCycleSpec | None = Field(
+        None,
+        description="the motion the arm must make; null: the torque requirement is static (gravity only)",
+    )
     design: DesignSpec = Field(default_factory=DesignSpec)
     objective: Annotated[
         dict[ObjectiveName, Weight],
