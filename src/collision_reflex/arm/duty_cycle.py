@@ -20,7 +20,6 @@ column per joint, named by the joint, each with its unit in brackets (``time [s]
 
 from __future__ import annotations
 
-import io
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -29,8 +28,8 @@ from typing import Any
 
 import numpy as np
 
+from .._table import HEADER, TableProblem, read_table
 from ..errors import InvalidParameter, TraceError, TrajectoryError
-from ..experiments.traces import _HEADER as HEADER_PATTERN
 from ..experiments.traces import unit_factor
 from .motion_profiles import trapezoidal_motion
 
@@ -219,7 +218,7 @@ class DutyCycle:
         """
         source = str(path)
         header_line, table = _read_table(path)
-        columns = {HEADER_PATTERN.match(str(c)).group("name"): str(c) for c in table.columns}  # type: ignore[union-attr]
+        columns = {HEADER.match(str(c)).group("name"): str(c) for c in table.columns}  # type: ignore[union-attr]
         lowered = {name.lower(): column for name, column in columns.items()}
         time_column = next((lowered[n] for n in _TIME_NAMES if n in lowered), None)
         if time_column is None:
@@ -237,7 +236,7 @@ class DutyCycle:
         import pandas as pd
 
         def numbers(column: str, default_unit: str, what: str) -> np.ndarray:
-            match = HEADER_PATTERN.match(column)
+            match = HEADER.match(column)
             unit = (match.group("unit") if match else None) or default_unit
             try:
                 scale = unit_factor(unit, default_unit, what, source)
@@ -312,8 +311,6 @@ class DutyCycle:
 
 def _read_table(path: str | os.PathLike[str]) -> tuple[int, Any]:
     """The header's file line (1-based) and the table of strings below it."""
-    import pandas as pd
-
     source = str(path)
     try:
         text = Path(path).read_text()
@@ -326,19 +323,9 @@ def _read_table(path: str | os.PathLike[str]) -> tuple[int, Any]:
     if header >= len(lines):
         raise TrajectoryError(source, "no header line and no samples")
     try:
-        table = pd.read_csv(
-            io.StringIO("\n".join(lines[header:])),
-            skip_blank_lines=False,
-            dtype=str,
-            keep_default_na=False,
-            skipinitialspace=True,
-        )
-    except (pd.errors.ParserError, pd.errors.EmptyDataError) as error:
-        raise TrajectoryError(source, f"not a CSV table ({error})".replace("\n", " "), header + 1) from None
-    # Trailing blank lines end the file; blank lines inside the data are reported as missing values.
-    blank = (table == "").all(axis=1).to_numpy()
-    last = len(blank) - int(np.argmin(blank[::-1])) if not blank.all() else 0
-    return header + 1, table.iloc[:last]
+        return header + 1, read_table(lines, header)
+    except TableProblem as problem:
+        raise TrajectoryError(source, problem.reason, problem.line) from None
 
 
 def _check_times(t: np.ndarray, source: str, lines: np.ndarray | None = None) -> None:

@@ -23,8 +23,6 @@ Leading comment lines ``# key: value`` carry the trial's metadata; then a header
 
 from __future__ import annotations
 
-import functools
-import io
 import math
 import os
 import re
@@ -38,6 +36,8 @@ import numpy as np
 
 from .._compat import renamed_keywords
 from .._io import atomic_open
+from .._table import HEADER, TableProblem, read_table
+from .._units import unit_registry
 from ..errors import TraceError
 
 if TYPE_CHECKING:
@@ -50,7 +50,6 @@ _TIME_NAMES = ("time", "t")
 _FORCE_NAMES = ("force", "fz", "f")
 _META_COLUMNS = {"velocity": "m/s", "system": None, "sensor stiffness": "N/m"}
 _META_TARGETS = {"velocity": "v0", "sensor stiffness": "k_m"}  # metadata key -> Trace field
-_HEADER = re.compile(r"^\s*(?P<name>[^\[\(]*?)\s*(?:[\[\(]\s*(?P<unit>[^\]\)]*?)\s*[\]\)])?\s*$")
 
 
 @dataclass(frozen=True, eq=False)
@@ -143,13 +142,6 @@ class Trace:
 Trace.__init__ = renamed_keywords(velocity="v0")(Trace.__init__)  # type: ignore[method-assign]
 
 
-@functools.lru_cache(maxsize=1)
-def _registry() -> Any:
-    import pint
-
-    return pint.UnitRegistry()
-
-
 def to_si(
     value: str | float, default_unit: str, what: str, source: str = "", line: int | None = None
 ) -> float:
@@ -159,7 +151,7 @@ def to_si(
     """
     import pint
 
-    ureg = _registry()
+    ureg = unit_registry()
     try:
         quantity = ureg.Quantity(value) if isinstance(value, str) else ureg.Quantity(float(value))
         if quantity.dimensionless:  # a plain number is in the default unit
@@ -178,7 +170,7 @@ def unit_factor(unit: str, default_unit: str, what: str, source: str = "") -> fl
     """The factor converting values in ``unit`` to SI; ``unit`` must have ``default_unit``'s dimension."""
     import pint
 
-    ureg = _registry()
+    ureg = unit_registry()
     try:
         return float(
             ureg.Quantity(1.0, unit).to(ureg.Quantity(1.0, default_unit).to_base_units().units).magnitude
@@ -231,7 +223,7 @@ def read_traces(
         raise TraceError(source, "", "no header line and no samples")
     table = _read_table(lines, header_line, source)
     file_lines = np.arange(len(table)) + header_line + 2  # header is line header_line + 1
-    columns = {_HEADER.match(str(c)).group("name").lower(): str(c) for c in table.columns}  # type: ignore[union-attr]
+    columns = {HEADER.match(str(c)).group("name").lower(): str(c) for c in table.columns}  # type: ignore[union-attr]
     time, force = _samples(table, columns, time_unit, force_unit, source)
 
     default_system = system if system is not None else Path(path).resolve().parent.name
@@ -289,24 +281,10 @@ def _leading_metadata(lines: list[str]) -> tuple[dict[str, str], int]:
 
 def _read_table(lines: list[str], header_line: int, source: str) -> pd.DataFrame:
     """The CSV table from the header on, as text, without trailing blank lines."""
-    import pandas as pd
-
     try:
-        table = pd.read_csv(
-            io.StringIO("\n".join(lines[header_line:])),
-            skip_blank_lines=False,
-            dtype=str,
-            keep_default_na=False,
-            skipinitialspace=True,
-        )
-    except (pd.errors.ParserError, pd.errors.EmptyDataError) as error:
-        raise TraceError(
-            source, "", f"not a CSV table ({error})".replace("\n", " "), header_line + 1
-        ) from None
-    # Drop trailing blank lines, keep blank lines inside the data (they are reported as missing values).
-    blank = (table == "").all(axis=1).to_numpy()
-    last = len(blank) - int(np.argmin(blank[::-1])) if not blank.all() else 0
-    return table.iloc[:last]
+        return read_table(lines, header_line)
+    except TableProblem as problem:
+        raise TraceError(source, "", problem.reason, problem.line) from None
 
 
 def _samples(
@@ -392,7 +370,7 @@ def _find(columns: Mapping[str, str], names: tuple[str, ...], what: str, source:
 
 
 def _column_factor(column: str, default_unit: str, what: str, source: str) -> float:
-    match = _HEADER.match(column)
+    match = HEADER.match(column)
     unit = match.group("unit") if match else None
     return (
         unit_factor(unit, default_unit, what, source)

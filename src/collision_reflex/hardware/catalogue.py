@@ -5,13 +5,13 @@ Kept apart from :mod:`collision_reflex.hardware.motors` so that the scaling arit
 
 from __future__ import annotations
 
-import functools
 from pathlib import Path
 from typing import Any
 
 import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError, field_validator
 
+from .._units import unit_registry
 from ..errors import CatalogueError
 
 # Field -> the unit a plain number is taken in (SI), and the pint dimensionality a quantity string must have.
@@ -95,20 +95,13 @@ class _Entry(BaseModel):
         return value
 
 
-@functools.cache
-def _registry() -> Any:
-    import pint
-
-    return pint.UnitRegistry()
-
-
 def _quantity(text: str, unit: str) -> float:
     """``text`` (e.g. ``"60 mm"``) in ``unit``, or ValueError saying why not."""
     import pint
 
-    registry = _registry()
+    registry = unit_registry()
     try:
-        quantity = registry.Quantity(text)
+        quantity: Any = registry.Quantity(text)
         converted = float(quantity.to(unit).magnitude)
     except pint.DimensionalityError:
         raise ValueError(f"{text!r} cannot be converted to {unit}") from None

@@ -15,16 +15,10 @@ from typing import TYPE_CHECKING, Annotated, Any
 from pydantic import BeforeValidator, WithJsonSchema
 from pydantic_core import PydanticCustomError
 
+from .._units import unit_registry
+
 if TYPE_CHECKING:
     import pint
-
-
-@functools.cache
-def unit_registry() -> pint.UnitRegistry:
-    """The pint registry used for every study file (built once: it takes a while)."""
-    import pint
-
-    return pint.UnitRegistry()
 
 
 def to_si(value: Any, unit: str, what: str, example: str) -> float:

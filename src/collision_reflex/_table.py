@@ -1,0 +1,50 @@
+"""Text tables with units in their column headers (``time [s]``, ``shoulder [deg]``).
+
+The one CSV reader of force-time traces and joint trajectories.
+"""
+
+from __future__ import annotations
+
+import io
+import re
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+HEADER = re.compile(r"^\s*(?P<name>[^\[\(]*?)\s*(?:[\[\(]\s*(?P<unit>[^\]\)]*?)\s*[\]\)])?\s*$")
+"""A column header: a name and an optional unit in brackets or parentheses."""
+
+
+class TableProblem(Exception):
+    """The text is not a table; ``line`` is the 1-based line of the problem. Callers turn it into their error."""
+
+    def __init__(self, reason: str, line: int) -> None:
+        super().__init__(reason)
+        self.reason = reason
+        self.line = line
+
+
+def read_table(lines: list[str], header_line: int) -> pd.DataFrame:
+    """The CSV table from ``lines[header_line]`` (0-based: the header) on, every cell as text.
+
+    Trailing blank lines end the table; blank lines inside the data are kept (they are reported as missing
+    values by the caller's checks).
+    """
+    import pandas as pd
+
+    try:
+        table = pd.read_csv(
+            io.StringIO("\n".join(lines[header_line:])),
+            skip_blank_lines=False,
+            dtype=str,
+            keep_default_na=False,
+            skipinitialspace=True,
+        )
+    except (pd.errors.ParserError, pd.errors.EmptyDataError) as error:
+        raise TableProblem(f"not a CSV table ({error})".replace("\n", " "), header_line + 1) from None
+    blank = (table == "").all(axis=1).to_numpy()
+    last = len(blank) - int(np.argmin(blank[::-1])) if not blank.all() else 0
+    return table.iloc[:last]

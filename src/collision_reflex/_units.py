@@ -1,0 +1,20 @@
+"""The one pint unit registry of the package.
+
+Building a registry takes a while, and quantities from two registries cannot be combined.
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import pint
+
+
+@functools.cache
+def unit_registry() -> pint.UnitRegistry:
+    """The registry every unit string of the package is read with: study files, catalogues, traces."""
+    import pint
+
+    return pint.UnitRegistry()
