@@ -127,6 +127,7 @@ def test_approach_speed_sets_the_speed_margin_when_fastest():
         ({"max_speed": math.nan}, "max_speed"),
         ({"rms_torque": -0.1}, "rms_torque"),
         ({"peak_torque": "big"}, "peak_torque"),
+        ({"max_speed": [1.0, 2.0]}, "max_speed"),
     ],
 )
 def test_bad_joint_data_names_joint_and_field(kwargs, field):

@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from .._validate import non_negative, positive
 from ..errors import InvalidParameter
 from . import check_figure_path, new_figure, save_figure
 
@@ -78,13 +79,15 @@ class JointOperatingPoints:
                 f"{self.torque.size} samples",
                 f"as many samples as speed ({self.speed.size})",
             )
-        for name, allowed in (
-            ("peak_torque", "> 0"),
-            ("continuous_torque", "> 0"),
-            ("max_speed", "> 0"),
-            ("rms_torque", ">= 0"),
-        ):
-            object.__setattr__(self, name, self._limit(name, getattr(self, name), allowed))
+        for name in ("peak_torque", "continuous_torque", "max_speed", "rms_torque"):
+            value = getattr(self, name)
+            if value is None:
+                continue
+            if np.ndim(value) != 0:
+                raise InvalidParameter(f"{self.joint}: {name}", value, "a single number or None")
+            # A limit of zero is no motor; a zero RMS torque is an unloaded joint.
+            check = non_negative if name == "rms_torque" else positive
+            object.__setattr__(self, name, float(check(f"{self.joint}: {name}", value)))
 
     def _finite_array(self, name: str, value: Any) -> np.ndarray:
         """``value`` as a 1-D float array of finite numbers, else raise naming the joint and field."""
@@ -97,21 +100,6 @@ class JointOperatingPoints:
         if not np.all(np.isfinite(array)):
             raise InvalidParameter(f"{self.joint}: {name}", value, "finite numbers (no NaN or inf)")
         return array
-
-    def _limit(self, name: str, value: float | None, allowed: str) -> float | None:
-        """``value`` as a float if it is None or a finite number ``allowed``, else raise."""
-        if value is None:
-            return None
-        try:
-            number = float(value)
-        except (TypeError, ValueError):
-            raise InvalidParameter(
-                f"{self.joint}: {name}", value, f"a finite number {allowed} or None"
-            ) from None
-        ok = number > 0 if allowed == "> 0" else number >= 0
-        if not (math.isfinite(number) and ok):
-            raise InvalidParameter(f"{self.joint}: {name}", value, f"a finite number {allowed} or None")
-        return number
 
 
 def outside_envelope(
