@@ -1,0 +1,304 @@
+"""Torque–speed figure per joint: the duty cycle's motor operating points over the motor's envelope.
+
+The figure is drawn as motor sizing tools draw it: the magnitudes ``|speed|`` and ``|torque|`` in the first
+quadrant, because the envelope of a motor and drive is symmetric in the sign of torque and speed (it
+motors and brakes alike in both directions), so folding the four quadrants onto one shows every point
+against the same limits and doubles the resolution. Torques and speeds are motor-side (joint torque divided
+by the gear ratio, joint speed times the gear ratio). Speed is in rad/s on the bottom axis and in rpm on the
+top axis.
+
+The envelope is the rectangle the catalogue can state: the peak torque up to the maximum speed. The
+continuous (thermal) torque bounds the cycle's RMS torque, not single points, so it is drawn as a line and
+the RMS torque is compared with it.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .._validate import non_negative, positive
+from ..errors import InvalidParameter
+from . import check_figure_path, new_figure, save_figure
+
+RAD_PER_S_TO_RPM = 60.0 / (2.0 * math.pi)
+INSIDE_COLOUR = "tab:blue"
+APPROACH_COLOUR = "tab:green"
+WARNING_COLOUR = "tab:red"
+COLUMNS = 3
+
+
+@dataclass(frozen=True)
+class JointOperatingPoints:
+    """One joint's motor-side operating points and its motor's envelope.
+
+    Parameters
+    ----------
+    joint : str
+        The joint's name (the subplot's title).
+    speed : array_like
+        Motor speed at each sample of the duty cycle [rad/s], signed; may be empty (no duty cycle).
+    torque : array_like
+        Motor torque at each sample of the duty cycle [N*m], signed, motor-side (joint torque / gear
+        ratio); same length as ``speed``.
+    approach_speed : array_like, optional
+        Motor speeds of the approach to contact [rad/s], signed; may be empty.
+    peak_torque : float, optional
+        The motor's peak torque [N*m]; None when unknown (not drawn).
+    continuous_torque : float, optional
+        The motor's continuous (thermal) torque [N*m]; None when unknown (not drawn).
+    max_speed : float, optional
+        The motor's maximum speed [rad/s]; None when unknown (not drawn).
+    rms_torque : float, optional
+        The RMS motor torque over the cycle [N*m]; None when not computed.
+    """
+
+    joint: str
+    speed: np.ndarray
+    torque: np.ndarray
+    approach_speed: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    peak_torque: float | None = None
+    continuous_torque: float | None = None
+    max_speed: float | None = None
+    rms_torque: float | None = None
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.joint, str) or not self.joint:
+            raise InvalidParameter("joint", self.joint, "a non-empty joint name")
+        for name in ("speed", "torque", "approach_speed"):
+            object.__setattr__(self, name, self._finite_array(name, getattr(self, name)))
+        if self.speed.size != self.torque.size:
+            raise InvalidParameter(
+                f"{self.joint}: torque",
+                f"{self.torque.size} samples",
+                f"as many samples as speed ({self.speed.size})",
+            )
+        for name in ("peak_torque", "continuous_torque", "max_speed", "rms_torque"):
+            value = getattr(self, name)
+            if value is None:
+                continue
+            if np.ndim(value) != 0:
+                raise InvalidParameter(f"{self.joint}: {name}", value, "a single number or None")
+            # A limit of zero is no motor; a zero RMS torque is an unloaded joint.
+            check = non_negative if name == "rms_torque" else positive
+            object.__setattr__(self, name, float(check(f"{self.joint}: {name}", value)))
+
+    def _finite_array(self, name: str, value: Any) -> np.ndarray:
+        """``value`` as a 1-D float array of finite numbers, else raise naming the joint and field."""
+        try:
+            array = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            raise InvalidParameter(f"{self.joint}: {name}", value, "a 1-D array of numbers") from None
+        if array.ndim != 1:
+            raise InvalidParameter(f"{self.joint}: {name}", f"shape {array.shape}", "a 1-D array")
+        if not np.all(np.isfinite(array)):
+            raise InvalidParameter(f"{self.joint}: {name}", value, "finite numbers (no NaN or inf)")
+        return array
+
+
+def outside_envelope(
+    speed: np.ndarray, torque: np.ndarray, peak_torque: float | None, max_speed: float | None
+) -> np.ndarray:
+    """Which operating points lie outside the motor's envelope (a point on a limit is inside).
+
+    Parameters
+    ----------
+    speed : array_like
+        Motor speeds [rad/s], signed.
+    torque : array_like
+        Motor torques [N*m], signed, same length as ``speed``.
+    peak_torque : float or None
+        Peak torque [N*m]; None when unknown (no point is outside it).
+    max_speed : float or None
+        Maximum speed [rad/s]; None when unknown (no point is outside it).
+
+    Returns
+    -------
+    numpy.ndarray
+        Boolean mask, True where ``|torque| > peak_torque`` or ``|speed| > max_speed``.
+    """
+    speed = np.abs(np.asarray(speed, dtype=float))
+    torque = np.abs(np.asarray(torque, dtype=float))
+    outside = np.zeros(speed.shape, dtype=bool)
+    if peak_torque is not None:
+        outside |= torque > peak_torque
+    if max_speed is not None:
+        outside |= speed > max_speed
+    return outside
+
+
+def margins(point: JointOperatingPoints) -> dict[str, float | None]:
+    """Peak, RMS and speed margins as fractions (``limit / required - 1``), None when either is absent.
+
+    The speed margin covers the duty cycle's and the approach's speeds. A required value of zero with a
+    known limit has an infinite margin.
+    """
+    speeds = np.abs(np.concatenate([point.speed, point.approach_speed]))
+    required = {
+        "peak": float(np.max(np.abs(point.torque))) if point.torque.size else None,
+        "RMS": point.rms_torque,
+        "speed": float(np.max(speeds)) if speeds.size else None,
+    }
+    limits = {"peak": point.peak_torque, "RMS": point.continuous_torque, "speed": point.max_speed}
+    out: dict[str, float | None] = {}
+    for name, need in required.items():
+        limit = limits[name]
+        if need is None or limit is None:
+            out[name] = None
+        else:
+            out[name] = limit / need - 1 if need > 0 else math.inf
+    return out
+
+
+def plot_torque_speed(path: str | os.PathLike[str], joints: Sequence[JointOperatingPoints]) -> Path:
+    """Draw one torque–speed subplot per joint (a grid of up to 3 columns) and save it.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The figure file (.png, .svg or .pdf).
+    joints : sequence of JointOperatingPoints
+        One entry per joint, in the order drawn.
+
+    Returns
+    -------
+    pathlib.Path
+        The written file.
+    """
+    check_figure_path(path)
+    joints = list(joints)
+    if not joints:
+        raise InvalidParameter("joints", joints, "at least one joint's operating points")
+    for index, point in enumerate(joints):
+        if not isinstance(point, JointOperatingPoints):
+            raise InvalidParameter(f"joints[{index}]", point, "a JointOperatingPoints")
+    columns = min(COLUMNS, len(joints))
+    rows = math.ceil(len(joints) / columns)
+    fig, axes = new_figure(rows, columns, figsize=(4.6 * columns, 3.9 * rows), squeeze=False)
+    for ax, point in zip(axes.flat, joints, strict=False):
+        _draw_joint(ax, point)
+    for ax in list(axes.flat)[len(joints) :]:
+        ax.set_visible(False)
+    fig.suptitle(
+        "Motor operating points over the motor envelope (|speed|, |torque|, motor side)", fontsize=11
+    )
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def _draw_joint(ax: Any, point: JointOperatingPoints) -> None:
+    """One joint's subplot: envelope lines, cycle points, approach speeds, RMS torque; title with margins."""
+    speed, torque = np.abs(point.speed), np.abs(point.torque)
+    approach = np.abs(point.approach_speed)
+    # Room above the largest point or limit; a unit range when there is nothing to scale by.
+    x_top = 1.15 * max([*speed, *approach, point.max_speed or 0.0]) or 1.0
+    y_top = (
+        1.15
+        * max([*torque, point.peak_torque or 0.0, point.continuous_torque or 0.0, point.rms_torque or 0.0])
+        or 1.0
+    )
+    _draw_envelope(ax, point)
+    outside = outside_envelope(speed, torque, point.peak_torque, point.max_speed)
+    ax.plot(speed[~outside], torque[~outside], ".", ms=4, color=INSIDE_COLOUR, label="duty cycle")
+    if np.any(outside):
+        ax.plot(
+            speed[outside], torque[outside], ".", ms=6, color=WARNING_COLOUR, label="outside the envelope"
+        )
+    # The approach runs at constant speed: its torque is drawn at zero, on the speed axis (not clipped).
+    fast = outside_envelope(approach, np.zeros_like(approach), None, point.max_speed)
+    for selected, colour, label in (
+        (~fast, APPROACH_COLOUR, "approach"),
+        (fast, WARNING_COLOUR, "approach, too fast"),
+    ):
+        if np.any(selected):
+            ax.plot(
+                approach[selected],
+                np.zeros(int(np.sum(selected))),
+                "^",
+                ms=7,
+                color=colour,
+                clip_on=False,
+                label=label,
+            )
+    if point.rms_torque is not None:
+        too_hot = point.continuous_torque is not None and point.rms_torque > point.continuous_torque
+        ax.axhline(
+            point.rms_torque,
+            color=WARNING_COLOUR if too_hot else "black",
+            ls=":",
+            lw=1.2,
+            label=f"RMS torque {point.rms_torque:.3g} N·m",
+        )
+    ax.set_xlim(0.0, x_top)
+    ax.set_ylim(0.0, y_top)
+    ax.set_xlabel("motor speed |ω| [rad/s]")
+    ax.set_ylabel("motor torque |τ| = joint torque / N [N·m]", fontsize=8)
+    top = ax.secondary_xaxis("top", functions=(_to_rpm, _from_rpm))
+    top.set_xlabel("motor speed [rpm]", fontsize=8)
+    short = any(value is not None and value < 0 for value in margins(point).values())
+    ax.set_title(
+        f"{point.joint}\n{_margin_text(point)}", fontsize=9, color=WARNING_COLOUR if short else "black"
+    )
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=6.5, loc="best", framealpha=0.85)
+
+
+def _draw_envelope(ax: Any, point: JointOperatingPoints) -> None:
+    """Peak torque (up to the maximum speed), continuous torque and maximum speed; "unknown" in the legend."""
+    x_end = point.max_speed if point.max_speed is not None else 1.0
+    transform = ax.transData if point.max_speed is not None else ax.get_yaxis_transform()
+    for value, name, style in (
+        (point.peak_torque, "peak torque", "-"),
+        (point.continuous_torque, "continuous torque", "--"),
+    ):
+        if value is None:
+            ax.plot([], [], " ", label=f"{name}: unknown")
+        else:
+            ax.plot(
+                [0.0, x_end],
+                [value, value],
+                style,
+                color="dimgray",
+                lw=1.4,
+                transform=transform,
+                label=f"{name} {value:.3g} N·m",
+            )
+    if point.peak_torque is not None:
+        # The region the motor can reach, lightly shaded.
+        ax.fill_between([0.0, x_end], 0.0, point.peak_torque, color="0.92", transform=transform, zorder=0)
+    if point.max_speed is None:
+        ax.plot([], [], " ", label="max speed: unknown")
+    else:
+        ax.axvline(
+            point.max_speed,
+            color="dimgray",
+            lw=1.4,
+            label=f"max speed {point.max_speed:.3g} rad/s ({point.max_speed * RAD_PER_S_TO_RPM:.0f} rpm)",
+        )
+
+
+def _margin_text(point: JointOperatingPoints) -> str:
+    """``peak +35 %, RMS none, speed -4 %``: each margin in %, "none" where a limit or requirement is absent."""
+    parts = []
+    for name, value in margins(point).items():
+        if value is None:
+            parts.append(f"{name} none")
+        elif math.isinf(value):
+            parts.append(f"{name} unloaded")
+        else:
+            parts.append(f"{name} {100 * value:+.0f} %")
+    return "margins: " + ", ".join(parts)
+
+
+def _to_rpm(speed: np.ndarray) -> np.ndarray:
+    return speed * RAD_PER_S_TO_RPM
+
+
+def _from_rpm(rpm: np.ndarray) -> np.ndarray:
+    return rpm / RAD_PER_S_TO_RPM

@@ -1,0 +1,146 @@
+"""Torque–speed figure: files written, envelope classification against hand cases, margins, bad input."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from collision_reflex.errors import InvalidParameter
+from collision_reflex.plots.torque_speed import (
+    JointOperatingPoints,
+    margins,
+    outside_envelope,
+    plot_torque_speed,
+)
+
+PEAK = 2.0  # N*m
+MAX_SPEED = 300.0  # rad/s
+
+
+def _shoulder() -> JointOperatingPoints:
+    # A cycle inside the envelope except two points: one 10 % over the peak torque, one 10 % over max speed.
+    t = np.linspace(0.0, 1.0, 50)
+    speed = 250.0 * np.sin(2 * np.pi * t)
+    torque = 1.5 * np.cos(2 * np.pi * t)
+    speed = np.append(speed, [-100.0, 1.1 * MAX_SPEED])
+    torque = np.append(torque, [-1.1 * PEAK, 0.5])
+    return JointOperatingPoints(
+        joint="shoulder",
+        speed=speed,
+        torque=torque,
+        approach_speed=np.array([40.0, -60.0, 320.0]),
+        peak_torque=PEAK,
+        continuous_torque=1.0,
+        max_speed=MAX_SPEED,
+        rms_torque=1.06,
+    )
+
+
+def _wrist_unknown_limits() -> JointOperatingPoints:
+    return JointOperatingPoints(joint="wrist", speed=[10.0, -20.0], torque=[0.1, -0.3], continuous_torque=0.2)
+
+
+@pytest.mark.parametrize("suffix", [".png", ".svg"])
+def test_figure_is_written(tmp_path, suffix):
+    joints = [
+        _shoulder(),
+        _wrist_unknown_limits(),
+        JointOperatingPoints("elbow", [], [], approach_speed=[5.0]),
+    ]
+    target = plot_torque_speed(tmp_path / f"torque_speed{suffix}", joints)
+    assert target.exists() and target.stat().st_size > 1000
+    assert [p.name for p in tmp_path.iterdir()] == [target.name]  # the atomic save leaves no temporary file
+
+
+def test_svg_says_unknown_and_motor_side(tmp_path):
+    text = plot_torque_speed(tmp_path / "f.svg", [_wrist_unknown_limits()]).read_text(encoding="utf-8")
+    # Matplotlib's SVG keeps each text as a comment beside its glyph paths.
+    for label in (
+        "peak torque: unknown",
+        "max speed: unknown",
+        "continuous torque 0.2 N·m",
+        "joint torque / N",
+    ):
+        assert label in text
+    assert "margins: peak none, RMS none, speed none" in text
+    shoulder = plot_torque_speed(tmp_path / "g.svg", [_shoulder()]).read_text(encoding="utf-8")
+    # Peak: 2 / 2.2 - 1; RMS: 1 / 1.06 - 1; speed: 300 / 330 - 1; each rounded to whole %.
+    assert "margins: peak -9 %, RMS -6 %, speed -9 %" in shoulder
+    assert "max speed 300 rad/s (2865 rpm)" in shoulder
+
+
+def test_classification_at_one_percent_either_side_of_each_limit():
+    speed = np.array([0.0, 0.0, 0.99, 1.01, -1.01, 0.5]) * MAX_SPEED
+    torque = np.array([0.99, 1.01, 0.0, 0.0, 0.0, -1.01]) * PEAK
+    expected = [False, True, False, True, True, True]
+    assert outside_envelope(speed, torque, PEAK, MAX_SPEED).tolist() == expected
+    # A point exactly on a limit is inside.
+    assert not outside_envelope([MAX_SPEED], [PEAK], PEAK, MAX_SPEED).any()
+    # An unknown limit classifies nothing as outside it.
+    assert outside_envelope(speed, torque, None, MAX_SPEED).tolist() == [
+        False,
+        False,
+        False,
+        True,
+        True,
+        False,
+    ]
+    assert outside_envelope(speed, torque, PEAK, None).tolist() == [False, True, False, False, False, True]
+
+
+def test_classification_of_the_hand_made_cycle():
+    point = _shoulder()
+    outside = np.flatnonzero(outside_envelope(point.speed, point.torque, point.peak_torque, point.max_speed))
+    assert outside.tolist() == [50, 51]
+
+
+def test_margins_against_hand_values():
+    point = _shoulder()
+    found = margins(point)
+    assert found["peak"] == pytest.approx(1 / 1.1 - 1, rel=1e-12)
+    assert found["RMS"] == pytest.approx(1.0 / 1.06 - 1, rel=1e-12)
+    # The cycle's 1.1 x 300 rad/s is faster than the approach's 320 rad/s.
+    assert found["speed"] == pytest.approx(1 / 1.1 - 1, rel=1e-12)
+    wrist = margins(_wrist_unknown_limits())
+    assert wrist == {"peak": None, "RMS": None, "speed": None}
+    unloaded = margins(JointOperatingPoints("j", [0.0], [0.0], peak_torque=1.0))
+    assert unloaded["peak"] == math.inf
+
+
+def test_approach_speed_sets_the_speed_margin_when_fastest():
+    point = JointOperatingPoints("j", [100.0], [1.0], approach_speed=[-400.0], max_speed=MAX_SPEED)
+    assert margins(point)["speed"] == pytest.approx(MAX_SPEED / 400.0 - 1, rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field"),
+    [
+        ({"speed": [1.0, 2.0], "torque": [1.0]}, "torque"),
+        ({"speed": [1.0, math.nan], "torque": [1.0, 2.0]}, "speed"),
+        ({"speed": [1.0], "torque": [math.inf]}, "torque"),
+        ({"approach_speed": [math.nan]}, "approach_speed"),
+        ({"speed": [[1.0]], "torque": [[1.0]]}, "speed"),
+        ({"peak_torque": -1.0}, "peak_torque"),
+        ({"continuous_torque": 0.0}, "continuous_torque"),
+        ({"max_speed": math.nan}, "max_speed"),
+        ({"rms_torque": -0.1}, "rms_torque"),
+        ({"peak_torque": "big"}, "peak_torque"),
+        ({"max_speed": [1.0, 2.0]}, "max_speed"),
+    ],
+)
+def test_bad_joint_data_names_joint_and_field(kwargs, field):
+    arguments = {"speed": [1.0], "torque": [1.0], **kwargs}
+    with pytest.raises(InvalidParameter, match=f"elbow: {field}"):
+        JointOperatingPoints("elbow", **arguments)
+
+
+def test_no_joints_or_bad_path_raise(tmp_path):
+    with pytest.raises(InvalidParameter, match="joints"):
+        plot_torque_speed(tmp_path / "f.png", [])
+    with pytest.raises(InvalidParameter, match="figure file"):
+        plot_torque_speed(tmp_path / "f.txt", [_shoulder()])
+    with pytest.raises(InvalidParameter, match="joint"):
+        JointOperatingPoints("", [1.0], [1.0])
+    assert list(tmp_path.iterdir()) == []
