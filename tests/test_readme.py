@@ -230,3 +230,13 @@ def test_two_setup_commands():
     commands = "\n".join(_blocks("bash"))
     assert 'pip install -e ".[test]" && python3 -m pytest' in commands
     assert re.search(r"pip install -e \. && crx ", commands)
+
+
+def test_yaml_example_is_a_valid_study():
+    """The README's study example validates as written (its paths are relative to ``studies/``)."""
+    from collision_reflex.study import parse_study
+
+    (block,) = _blocks("yaml")[:1]
+    loaded = parse_study(block, "README.md", README.parent / "studies")
+    assert loaded.study.name == "two-link-paper"
+    assert loaded.study.duty_cycle is not None
