@@ -398,7 +398,9 @@ def test_study_sweep_is_the_library_sweep(runs, name):
     front = sweep.pareto_front(
         problems, spec["objectives"], spec["points"], IPOPT_OPTIONS, anchor_starts=spec["anchor_starts"]
     )
-    assert len(front.points) == len(saved["points"]) >= 2
+    assert len(front.points) == len(saved["points"]) >= 1
+    # Repeats of a point are merged (the smoke Panda front is one design): the sweep still solved several.
+    assert front.merged == saved["merged"] and len(front.points) + front.merged >= 2
     assert [f.as_dict() for f in front.failed] == saved["failed"]
     for ours, theirs in zip(front.records(), saved["points"], strict=True):
         assert ours["label"] == theirs["label"]
@@ -467,8 +469,9 @@ def test_a_study_asks_for_multi_start_anchors(tmp_path, monkeypatch):
     result = run_study(study, tmp_path / "out", quiet=True, smoke=True, executor="serial")
     results = json.loads((result.folder / "designs.json").read_text())
     assert results["resolved"]["pareto"]["anchor_starts"] == 2
-    # Two anchors, each started twice, then one lexicographic step each and two points from one start.
-    assert sorted(starts) == [1, 1, 1, 1, 1, 2, 2]
+    # Two anchors, each started twice, then one lexicographic step each and two points from one start; the
+    # study's optimum from OPTIMUM_STARTS starts.
+    assert sorted(starts) == sorted([1, 1, 1, 1, 2, 2, sweep.OPTIMUM_STARTS])
     assert results["pareto"]["points"][0]["label"] == "anchor: worst_case_impulse"
 
 
