@@ -501,3 +501,41 @@ def test_saved_arm_results_have_the_declared_record_types(runs, name):
     )
     assert all(len(d) == samples["task_dim"] for d in samples["sample_directions"])
     assert all(len(q) == len(samples["joint_names"]) for q in samples["configurations"])
+
+
+@pytest.mark.parametrize("name", ARM_STUDIES, ids=ARM_STUDIES)
+def test_the_recommended_design_is_not_dominated_and_the_verdict_says_it(runs, name):
+    from collision_reflex.optimize import OBJECTIVES
+
+    results = json.loads((runs[name] / "designs.json").read_text())
+    names = results["pareto"]["objectives"]
+    senses = [OBJECTIVES[n][0] for n in names]
+    recommended = results["recommended"]
+    for point in results["pareto"]["points"]:
+        assert not _dominates(point["objectives"], recommended["objectives"], names, senses), point["label"]
+    # At least as good in the study's objective as the single-objective solve, whatever was recommended (a
+    # weighted objective: dominance alone decides).
+    objective = next(iter(results["resolved"]["objective"]))
+    sense = OBJECTIVES[objective][0]
+    single = len(results["resolved"]["objective"]) == 1
+    if single and objective in names and recommended["source"] != "optimum":
+        merged_within = 1e-5 * abs(results["chosen"]["objectives"][objective])
+        assert sense * recommended["objectives"][objective] <= (
+            sense * results["chosen"]["objectives"][objective] + merged_within
+        )
+    verdict = results["verdict"]
+    assert verdict[0].startswith(f"Recommended design ({recommended['source']}): ")
+    assert all(j["joint"] in verdict[0] for j in recommended["joints"])
+    html = (runs[name] / "report.html").read_text()
+    for line in verdict:
+        assert line.replace("&", "&amp;") in html.replace("&#39;", "'"), line
+    assert html.index('id="verdict"') < html.index('id="chosen"')
+
+
+def test_crx_run_prints_the_verdict(tmp_path, capsys):
+    assert main(["run", str(TWO_LINK), "--out", str(tmp_path / "out"), "--smoke", "--executor", "serial"]) == 0
+    printed = capsys.readouterr().out
+    verdict = json.loads((tmp_path / "out" / "designs.json").read_text())["verdict"]
+    assert verdict and all(line in printed for line in verdict)
+    assert main(["run", str(TWO_LINK), "--out", str(tmp_path / "out"), "--smoke", "--quiet"]) == 0
+    assert "Recommended design" not in capsys.readouterr().out
