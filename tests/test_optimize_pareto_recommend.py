@@ -56,7 +56,9 @@ def test_a_front_point_better_in_the_studys_objective_is_recommended():
 
 
 def test_a_dominating_front_point_is_recommended_with_the_reason():
-    optimum = result(0.48604, 2.193)  # the Panda case of issue 12: both front points beat it on both objectives
+    optimum = result(
+        0.48604, 2.193
+    )  # the Panda case of issue 12: both front points beat it on both objectives
     points = front(result(0.48551, 0.391), result(0.48560, 0.380))
     found = recommend(optimum, points, "mean_impulse")  # not a front objective: dominance decides
     assert found.pareto_index in (0, 1) and "dominates the single-objective optimum" in found.reason

@@ -73,7 +73,9 @@ def test_active_bounds_and_constraints_per_joint():
         "software stiffness at its lower bound (50)",
         "sized by peak torque",
     ]
-    assert joint_limits(joint(diameter=0.14), BOUNDS, "static (gravity only)") == ["motor at its largest size"]
+    assert joint_limits(joint(diameter=0.14), BOUNDS, "static (gravity only)") == [
+        "motor at its largest size"
+    ]
     # Inside every bound, with margin: nothing active.
     assert joint_limits(joint(margin=2 * ACTIVE_TOLERANCE), BOUNDS, "static (gravity only)") == []
 
@@ -106,8 +108,10 @@ def test_spans_in_percent_of_the_best():
 def test_the_flat_front_sentence_fires_on_a_flat_front_only():
     flat = pareto([record(0.5000, 2.0), record(0.5005, 1.0), record(0.5011, 0.11)])  # 0.22 % vs 18x in mass
     lines = front_sentences(flat)
-    assert "Flat front: all designs within 0.22 % of the best worst case impulse: actuator mass is the only " \
+    assert (
+        "Flat front: all designs within 0.22 % of the best worst case impulse: actuator mass is the only "
         "real choice." in lines
+    )
     trade_off = pareto([record(0.40, 2.0), record(0.46, 1.0), record(0.60, 0.2)])  # 50 % vs 900 %
     lines = front_sentences(trade_off)
     assert lines[0] == "The front (3 designs) spans 50 % in worst case impulse, 900 % in actuator mass."
@@ -127,7 +131,11 @@ def test_the_lightest_design_within_5_percent_of_the_best_impulse():
     index, sentence = lightest_near_best(pareto(points))
     assert index == 2  # 0.418 <= 1.05 * 0.40 = 0.42; 0.43 is beyond
     assert "Pareto design 2, 0.8 kg at 0.418 N·s (4.5 % above the best)" in sentence
-    assert lightest_near_best({"objectives": ["worst_case_impulse", "approach_velocity"], "points": points}) is None
+    assert (
+        lightest_near_best({"objectives": ["worst_case_impulse", "approach_velocity"], "points": points})
+        is None
+    )
+    assert lightest_near_best(pareto(points[:1])) is None  # one design: nothing to choose
 
 
 def test_oversized_joints_are_warned_unless_their_motor_is_smallest():
@@ -135,6 +143,10 @@ def test_oversized_joints_are_warned_unless_their_motor_is_smallest():
     smallest = joint("elbow", diameter=0.03, margin=25.0)
     warnings = oversized_warnings(record(joints=[big, smallest]), BOUNDS)
     assert len(warnings) == 1 and warnings[0].startswith("Warning: shoulder delivers 3.5× its required peak")
+    # The smallest motor's excess is said as such, not warned about.
+    assert "peak torque 26× its requirement: even the smallest motor is more than it needs" in joint_limits(
+        smallest, BOUNDS, "static (gravity only)"
+    )
     assert oversized_warnings(record(joints=[joint(margin=1.9)]), BOUNDS) == []
 
 

@@ -533,7 +533,9 @@ def test_the_recommended_design_is_not_dominated_and_the_verdict_says_it(runs, n
 
 
 def test_crx_run_prints_the_verdict(tmp_path, capsys):
-    assert main(["run", str(TWO_LINK), "--out", str(tmp_path / "out"), "--smoke", "--executor", "serial"]) == 0
+    assert (
+        main(["run", str(TWO_LINK), "--out", str(tmp_path / "out"), "--smoke", "--executor", "serial"]) == 0
+    )
     printed = capsys.readouterr().out
     verdict = json.loads((tmp_path / "out" / "designs.json").read_text())["verdict"]
     assert verdict and all(line in printed for line in verdict)

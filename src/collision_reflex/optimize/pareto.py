@@ -619,7 +619,9 @@ def recommend(optimum: DesignResult, front: ParetoSet | None, objective: Hashabl
     mine = optimum.numpy_objectives
     if isinstance(objective, str) and objective in front.objectives:
         sense, unit = OBJECTIVES[objective][0], OBJECTIVES[objective][1]
-        best = min(range(len(front.points)), key=lambda i: sense * front.points[i].numpy_objectives[objective])
+        best = min(
+            range(len(front.points)), key=lambda i: sense * front.points[i].numpy_objectives[objective]
+        )
         theirs = front.points[best].numpy_objectives[objective]
         if sense * (mine[objective] - theirs) > MERGE_TOLERANCE * max(abs(theirs), abs(mine[objective])):
             return Recommendation(

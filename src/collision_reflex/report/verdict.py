@@ -51,8 +51,11 @@ def _percent(value: float) -> str:
 
 
 def bound_position(value: float, bounds: Sequence[float]) -> Position:
-    """Where ``value`` is in ``bounds`` ``[lower, upper]``: at a bound (within :data:`ACTIVE_TOLERANCE`, relative
-    to the bound), ``"fixed"`` (lower == upper: not a design choice), or None (inside)."""
+    """Where ``value`` is in ``bounds`` ``[lower, upper]``.
+
+    At a bound (``"lower"``, ``"upper"``: within :data:`ACTIVE_TOLERANCE`, relative to the bound), ``"fixed"``
+    (lower == upper: not a design choice), or None (inside).
+    """
     lower, upper = float(bounds[0]), float(bounds[1])
     if lower == upper:
         return "fixed"
@@ -64,12 +67,13 @@ def bound_position(value: float, bounds: Sequence[float]) -> Position:
 
 
 def motor_at_smallest_size(joint: Mapping[str, Any], bounds: Mapping[str, Any]) -> bool:
-    """Whether a joint's motor is at its smallest size: stator diameter and stack length each at their lower
-    bounds or fixed, and at least one of them a design variable."""
+    """Whether a joint's motor is at its smallest size.
+
+    Stator diameter and stack length each at their lower bounds or fixed, and at least one of them a design
+    variable.
+    """
     name = joint["joint"]
-    positions = [
-        bound_position(joint[key], bounds[key][name]) for key in ("stator_diameter", "stack_length")
-    ]
+    positions = [bound_position(joint[key], bounds[key][name]) for key in ("stator_diameter", "stack_length")]
     return all(p in ("lower", "fixed") for p in positions) and "lower" in positions
 
 
@@ -98,6 +102,11 @@ def joint_limits(joint: Mapping[str, Any], bounds: Mapping[str, Any], requiremen
         margin = joint.get(key)
         if margin is not None and margin < ACTIVE_TOLERANCE:
             phrases.append(f"sized by {constraint}")
+    margin = joint.get("torque_margin")
+    if margin is not None and margin > OVERSIZED_MARGIN and motor_at_smallest_size(joint, bounds):
+        phrases.append(
+            f"peak torque {_g(1 + margin, 3)}× its requirement: even the smallest motor is more than it needs"
+        )
     return phrases
 
 
@@ -118,10 +127,13 @@ def design_sentence(record: Mapping[str, Any]) -> str:
         motor = f"{_g(joint['stator_diameter'] * 1e3, 3)} mm × {_g(joint['stack_length'] * 1e3, 3)} mm motor"
         nearest = joint.get("nearest_catalogue_motor")
         joints.append(
-            f"{joint['joint']}: {motor}" + (f" (nearest catalogue motor {nearest})" if nearest else "")
+            f"{joint['joint']}: {motor}"
+            + (f" (nearest catalogue motor {nearest})" if nearest else "")
             + f" at N = {_g(joint['gear_ratio'])}"
         )
-    threshold = f"{_g(record['threshold'])} " + ("N" if record["sensing"] == "force" else "m (position error)")
+    threshold = f"{_g(record['threshold'])} " + (
+        "N" if record["sensing"] == "force" else "m (position error)"
+    )
     objectives = ", ".join(
         f"{_words(name)} {_g(record['objectives'][name])} {unit}"
         for name, unit in (("worst_case_impulse", "N·s"), ("mean_impulse", "N·s"), ("actuator_mass", "kg"))
@@ -134,8 +146,11 @@ def design_sentence(record: Mapping[str, Any]) -> str:
 
 
 def objective_spans(points: Sequence[Mapping[str, Any]], objectives: Sequence[str]) -> dict[str, float]:
-    """Each objective's span over ``points`` [%]: (largest - smallest) / |best|, best the value the front
-    optimises toward (the smallest, or the largest for a maximised objective)."""
+    """Each objective's span over ``points`` [%].
+
+    That is (largest - smallest) / |best|, best the value the front optimises toward (the smallest, or the
+    largest for a maximised objective).
+    """
     from ..optimize import OBJECTIVES
 
     spans = {}
@@ -147,8 +162,11 @@ def objective_spans(points: Sequence[Mapping[str, Any]], objectives: Sequence[st
 
 
 def front_sentences(pareto: Mapping[str, Any]) -> list[str]:
-    """The front's spans, and a plain sentence when it is flat (an objective spans < :data:`FLAT_SPAN`) or
-    degenerate (one point, every repeat merged)."""
+    """The front's spans, and a plain sentence when it is flat or degenerate.
+
+    Flat: an objective spans less than :data:`FLAT_SPAN`; degenerate: one point (every repeat merged), or every
+    objective flat.
+    """
     from ..optimize.pareto import MERGE_TOLERANCE
 
     points, names = pareto["points"], pareto["objectives"]
@@ -195,12 +213,12 @@ def front_sentences(pareto: Mapping[str, Any]) -> list[str]:
 def lightest_near_best(pareto: Mapping[str, Any], within: float = NEAR_BEST) -> tuple[int, str] | None:
     """The lightest front design within ``within`` (relative) of the best impulse, and its sentence.
 
-    None when the front does not trade an impulse objective against the actuator mass.
+    None when the front does not trade an impulse objective against the actuator mass, or is one design.
     """
     names = pareto["objectives"]
     impulse = next((n for n in IMPULSE_OBJECTIVES if n in names), None)
     points = pareto["points"]
-    if impulse is None or "actuator_mass" not in names or not points:
+    if impulse is None or "actuator_mass" not in names or len(points) < 2:
         return None
     best = min(p["objectives"][impulse] for p in points)
     near = [i for i, p in enumerate(points) if p["objectives"][impulse] <= best * (1 + within)]
@@ -225,8 +243,11 @@ def requirement_sentence(requirement: str) -> str:
 
 
 def oversized_warnings(record: Mapping[str, Any], bounds: Mapping[str, Any]) -> list[str]:
-    """A warning for each joint with a peak-torque margin above :data:`OVERSIZED_MARGIN` whose motor could be
-    smaller (not at its smallest size)."""
+    """A warning for each oversized joint.
+
+    Oversized: a peak-torque margin above :data:`OVERSIZED_MARGIN` while its motor could be smaller (not at its
+    smallest size).
+    """
     warnings = []
     for joint in record["joints"]:
         margin = joint.get("torque_margin")
@@ -253,7 +274,9 @@ def verdict(results: Mapping[str, Any]) -> list[str]:
         for joint in recommended["joints"]:
             phrases = joint_limits(joint, bounds, requirement)
             lines.append(
-                f"{joint['joint']}: " + (", ".join(phrases) if phrases else "no bound or constraint active") + "."
+                f"{joint['joint']}: "
+                + (", ".join(phrases) if phrases else "no bound or constraint active")
+                + "."
             )
         limits = design_limits(recommended, bounds)
         if limits:

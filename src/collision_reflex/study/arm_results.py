@@ -68,8 +68,8 @@ def design_bounds(setup: ArmSetup) -> dict[str, Any]:
         bounds = space.per_joint(name, len(joints), defaults.get(name))
         out[name] = {j: [b.lower, b.upper] for j, b in zip(joints, bounds, strict=True)}
     for name in GLOBAL_VARIABLES:
-        bounds = space.global_bounds(name)
-        out[name] = [bounds.lower, bounds.upper]
+        one = space.global_bounds(name)
+        out[name] = [one.lower, one.upper]
     return out
 
 

@@ -167,9 +167,7 @@ def run_study(
     write_outputs(folder.path, results, figures=figures)
     elapsed = time.perf_counter() - started
     folder.update_manifest(status="finished", elapsed=elapsed, computed=counts[0], reused=counts[1])
-    return RunResult(
-        folder.path, resumed, counts[0], counts[1], elapsed, tuple(results.get("verdict", ()))
-    )
+    return RunResult(folder.path, resumed, counts[0], counts[1], elapsed, tuple(results.get("verdict", ())))
 
 
 def _dump(data: dict[str, Any]) -> str:
