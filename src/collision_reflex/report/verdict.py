@@ -46,7 +46,9 @@ def _g(value: float, digits: int = 4) -> str:
 
 
 def _percent(value: float) -> str:
-    """A percentage to 3 significant digits, without exponents (``0.354``, ``12.3``, ``1,750``)."""
+    """A percentage to 3 significant digits, without exponents (``< 0.001``, ``0.354``, ``12.3``, ``1,750``)."""
+    if value < 1e-3:
+        return "< 0.001" if value > 0 else "0"
     return f"{value:,.0f}" if value >= 100 else f"{value:.3g}"
 
 
