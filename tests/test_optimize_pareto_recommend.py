@@ -101,3 +101,12 @@ def test_the_recommendation_is_never_dominated_brute_force(objective):
                 no_worse = all(theirs[n] <= found[n] for n in NAMES)
                 better = any(theirs[n] < found[n] * (1 - 1e-9) for n in NAMES)
                 assert not (no_worse and better), (impulse, mass, theirs)
+
+
+@pytest.mark.parametrize("starts", [0, 1.5, True])
+def test_single_optimum_refuses_a_bad_start_count_before_building(starts):
+    from collision_reflex.errors import InvalidParameter
+    from collision_reflex.optimize.pareto import single_optimum
+
+    with pytest.raises(InvalidParameter, match="starts"):
+        single_optimum(None, "worst_case_impulse", starts=starts)  # type: ignore[arg-type]
