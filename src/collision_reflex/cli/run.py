@@ -63,6 +63,8 @@ def run(args: argparse.Namespace) -> int:
         smoke=True if args.smoke else None,
     )
     if not args.quiet:
+        for line in result.verdict:
+            print(line)
         how = f"{result.computed} computed" + (
             f", {result.reused} reused from the interrupted run" if result.reused else ""
         )

@@ -51,6 +51,19 @@ DOMINANCE_TOLERANCE = 1e-9
 
 Relative to each objective's largest magnitude."""
 
+MERGE_TOLERANCE = 1e-5
+"""Relative difference below which two solved designs' objectives are equal: one point of the front, and no
+reason to prefer one design over the other.
+
+IPOPT stops at ``tol = 1e-8`` on its scaled optimality error, so one optimum reached from different starts or
+under different bounds repeats its objective values to about 1e-7 relative; a lexicographic anchor holds its
+first objective within :data:`ANCHOR_SLACK` (1e-6) of the optimum. Ten times the larger, 1e-5, merges such
+repeats and stays far below any difference a designer acts on."""
+
+OPTIMUM_STARTS = 4
+"""Start points of the single-objective solve by default: the given start and three seeded random ones (see
+:func:`collision_reflex.optimize.solve.solve`), against local optima of the non-convex worst case."""
+
 
 class ProblemBuilder(Protocol):
     """``build(objective, bounded_objectives) -> DesignProblem``.
@@ -94,6 +107,8 @@ class ParetoSet:
     dominated_labels: tuple[str, ...] = ()
     computed: int = 0
     reused: int = 0
+    merged: int = 0
+    """Solved points dropped as repeats of a reported point (objectives equal within :data:`MERGE_TOLERANCE`)."""
 
     def values(self, numpy_path: bool = True) -> np.ndarray:
         """(n_points, n_objectives) objective values in their units (NumPy path by default)."""
@@ -121,13 +136,22 @@ class ParetoSet:
         with atomic_open(path, "w", newline="") as handle:
             self.to_frame().to_csv(handle, index=False)
 
-    def dominating(self, objectives: Mapping[str, float]) -> int | None:
+    def dominating(
+        self, objectives: Mapping[str, float], tolerance: float = DOMINANCE_TOLERANCE
+    ) -> int | None:
         """Index of the first point that dominates a design with these objective values, or None."""
+        indices = self.all_dominating(objectives, tolerance)
+        return indices[0] if indices else None
+
+    def all_dominating(
+        self, objectives: Mapping[str, float], tolerance: float = DOMINANCE_TOLERANCE
+    ) -> list[int]:
+        """Indices of every point that dominates a design with these objective values (relative ``tolerance``)."""
         if not self.points:
-            return None
+            return []
         values = np.vstack([self.values(), [[objectives[name] for name in self.objectives]]])
-        beaten = _dominance(_minimised(values, self.objectives), DOMINANCE_TOLERANCE)[:-1, -1]
-        return int(np.argmax(beaten)) if beaten.any() else None
+        beaten = _dominance(_minimised(values, self.objectives), tolerance)[:-1, -1]
+        return [int(i) for i in np.flatnonzero(beaten)]
 
     def hypervolume(self, reference: Sequence[float]) -> float:
         """Hypervolume dominated by the front up to ``reference`` (objective units).
@@ -237,6 +261,7 @@ def pareto_front(
     pieces = [*anchors.values(), *sweep.run(point_tasks).values()]
     label = {id(p.result): p.label for p in pieces if p.result is not None}
     front, dominated = non_dominated([p.result for p in pieces if p.result is not None], names)
+    front, repeats = merge_repeats(front, names)
     return ParetoSet(
         names,
         tuple(front),
@@ -248,6 +273,7 @@ def pareto_front(
         dominated_labels=tuple(label[id(r)] for r in dominated),
         computed=sweep.computed,
         reused=sweep.reused,
+        merged=len(repeats),
     )
 
 
@@ -260,18 +286,23 @@ def single_optimum(
     executor: Executor | None = None,
     finished: FinishedHook | None = None,
     save: SaveHook | None = None,
+    starts: int = OPTIMUM_STARTS,
 ) -> tuple[DesignResult, bool]:
     """The optimum of one objective (a name, or what ``build`` takes for a weighted one).
 
-    It is run, saved and found again like a piece of :func:`pareto_front` (its name: ``optimum``). Returns the
-    result and whether it was found finished.
+    It is run, saved and found again like a piece of :func:`pareto_front` (its name: ``optimum``, or
+    ``optimum-<starts>-starts``). ``starts``: start points of the solve (multi-start, seeded: see
+    :func:`collision_reflex.optimize.solve.solve`). Returns the result and whether it was found finished.
 
     Raises
     ------
-    SolverFailed: the solve failed.
+    SolverFailed: every start failed.
     """
+    if not isinstance(starts, int) or isinstance(starts, bool) or starts < 1:
+        raise InvalidParameter("starts", starts, "an integer >= 1")
+    name = "optimum" if starts == 1 else f"optimum-{starts}-starts"
     pieces = _Sweep(executor or SerialExecutor(), 1, finished, save, progress, 1)
-    (point,) = pieces.run({"optimum": (solve_alone, (build, objective, ipopt_options))}).values()
+    (point,) = pieces.run({name: (solve_alone, (build, objective, ipopt_options, starts))}).values()
     if point.result is None:
         failure = point.failures[0]
         raise SolverFailed(failure.message, failure.status, {}, [])
@@ -438,13 +469,15 @@ def solve_point(
 
 
 @_one_at_a_time
-def solve_alone(build: ProblemBuilder, objective: Hashable, ipopt_options: IpoptOptions | None) -> SweepPoint:
+def solve_alone(
+    build: ProblemBuilder, objective: Hashable, ipopt_options: IpoptOptions | None, starts: int = 1
+) -> SweepPoint:
     """A single-objective optimum as a piece run like the sweep's.
 
-    ``objective``: a name, or what ``build`` takes for a weighted one.
+    ``objective``: a name, or what ``build`` takes for a weighted one; ``starts``: start points (multi-start).
     """
     try:
-        result = solve(built_problem(build, objective), ipopt_options=ipopt_options)
+        result = solve(built_problem(build, objective), ipopt_options=ipopt_options, starts=starts)
     except SolverFailed as error:
         return SweepPoint(
             "optimum", None, (PointFailure(str(objective), {}, error.status, str(error.args[0])),)
@@ -532,6 +565,97 @@ def non_dominated(
     dropped = _dominance(values, tolerance).any(axis=0) | earlier_duplicate
     keep = sorted(np.flatnonzero(~dropped).tolist(), key=lambda i: values[i, 0])
     return [results[i] for i in keep], [results[i] for i in np.flatnonzero(dropped).tolist()]
+
+
+def same_point(a: Mapping[str, float], b: Mapping[str, float], names: Sequence[str]) -> bool:
+    """Whether two designs' objective values agree within :data:`MERGE_TOLERANCE` (relative) in every objective."""
+    return all(
+        abs(a[name] - b[name]) <= MERGE_TOLERANCE * max(abs(a[name]), abs(b[name]), 1e-300) for name in names
+    )
+
+
+def merge_repeats(
+    results: Sequence[DesignResult], names: Sequence[str]
+) -> tuple[list[DesignResult], list[DesignResult]]:
+    """Drop the results that repeat an earlier one (:func:`same_point`): ``(kept, merged)``, order kept."""
+    kept: list[DesignResult] = []
+    merged: list[DesignResult] = []
+    for result in results:
+        repeat = any(same_point(result.numpy_objectives, k.numpy_objectives, names) for k in kept)
+        (merged if repeat else kept).append(result)
+    return kept, merged
+
+
+@dataclass(frozen=True)
+class Recommendation:
+    """The design a run recommends, and why.
+
+    result: the design; pareto_index: its index on the front, or None for the single-objective optimum;
+    reason: one sentence saying why it is this design and not another.
+    """
+
+    result: DesignResult
+    pareto_index: int | None
+    reason: str
+
+    @property
+    def source(self) -> str:
+        """``"optimum"`` or ``"Pareto design <i>"``."""
+        return "optimum" if self.pareto_index is None else f"Pareto design {self.pareto_index}"
+
+
+def recommend(optimum: DesignResult, front: ParetoSet | None, objective: Hashable) -> Recommendation:
+    """The best design of every solve a run made for ``objective``, never dominated by a point of ``front``.
+
+    ``objective``: the study's objective (a name, or a weighted one). When it is a name among the front's
+    objectives, a front point better in it than ``optimum`` (by more than :data:`MERGE_TOLERANCE`) wins; when a
+    front point dominates ``optimum`` (values within :data:`MERGE_TOLERANCE` counting as equal), the dominating
+    point with the best ``objective`` is recommended. A front
+    point equal to ``optimum`` within :data:`MERGE_TOLERANCE` is recommended as that point, so the
+    recommendation is on the front whenever the front holds it.
+    """
+    if front is None or not front.points:
+        return Recommendation(optimum, None, "the single-objective optimum (no Pareto front computed)")
+    mine = optimum.numpy_objectives
+    if isinstance(objective, str) and objective in front.objectives:
+        sense, unit = OBJECTIVES[objective][0], OBJECTIVES[objective][1]
+        best = min(
+            range(len(front.points)), key=lambda i: sense * front.points[i].numpy_objectives[objective]
+        )
+        theirs = front.points[best].numpy_objectives[objective]
+        if sense * (mine[objective] - theirs) > MERGE_TOLERANCE * max(abs(theirs), abs(mine[objective])):
+            return Recommendation(
+                front.points[best],
+                best,
+                f"Pareto design {best} has a better {objective.replace('_', ' ')} than the single-objective "
+                f"optimum ({theirs:.6g} vs {mine[objective]:.6g} {unit}): the optimum stopped at a local optimum",
+            )
+    for index, point in enumerate(front.points):
+        if same_point(point.numpy_objectives, mine, front.objectives):
+            return Recommendation(
+                point,
+                index,
+                f"the single-objective optimum, which is Pareto design {index} (equal within the solver "
+                f"tolerance, {MERGE_TOLERANCE:g} relative)",
+            )
+    beaten_by = front.all_dominating(mine, MERGE_TOLERANCE)
+    if beaten_by:
+        if isinstance(objective, str) and objective in front.objectives:
+            sense = OBJECTIVES[objective][0]
+            beaten_by.sort(key=lambda i: sense * front.points[i].numpy_objectives[objective])
+        index = beaten_by[0]
+        gaps = ", ".join(
+            f"{name.replace('_', ' ')} {front.points[index].numpy_objectives[name]:.6g} vs {mine[name]:.6g} "
+            f"{OBJECTIVES[name][1]}"
+            for name in front.objectives
+        )
+        return Recommendation(
+            front.points[index],
+            index,
+            f"Pareto design {index} dominates the single-objective optimum (within the solver tolerance, "
+            f"{MERGE_TOLERANCE:g} relative: {gaps})",
+        )
+    return Recommendation(optimum, None, "the single-objective optimum; no Pareto design dominates it")
 
 
 def hypervolume(points: np.ndarray, reference: np.ndarray) -> float:

@@ -17,10 +17,12 @@ def plot_design_front(
     units: Sequence[str],
     values: np.ndarray,
     chosen: Sequence[float] | None = None,
+    recommended: Sequence[float] | None = None,
 ) -> Path:
     """Draw a front of 2 objectives (line through the points) or 3 (scatter coloured by the third).
 
-    values: (n_points, len(names)) objective values in ``units``; chosen: the chosen design's values, marked.
+    values: (n_points, len(names)) objective values in ``units``; chosen: the chosen design's values (the
+    single-objective optimum as solved), marked; recommended: the recommended design's values, circled.
     """
     values = np.asarray(values, dtype=float)
     labels = [f"{name.replace('_', ' ')} [{unit}]" for name, unit in zip(names, units, strict=True)]
@@ -34,7 +36,18 @@ def plot_design_front(
     for index, (x, y) in enumerate(values[:, :2]):
         ax.annotate(str(index), (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
     if chosen is not None:
-        ax.plot([chosen[0]], [chosen[1]], "*", ms=12, color="tab:red", label="chosen design")
+        ax.plot([chosen[0]], [chosen[1]], "*", ms=12, color="tab:red", label="single-objective optimum")
+    if recommended is not None:
+        ax.plot(
+            [recommended[0]],
+            [recommended[1]],
+            "o",
+            ms=14,
+            mfc="none",
+            mew=1.8,
+            color="tab:green",
+            label="recommended design",
+        )
     ax.set_xlabel(labels[0])
     ax.set_ylabel(labels[1])
     ax.set_title(f"Pareto front: {values.shape[0]} designs", fontsize=10)

@@ -75,6 +75,9 @@ def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
                 [objective_unit(n) for n in names],
                 values,
                 [chosen["objectives"][n] for n in names[:2]],
+                [results["recommended"]["objectives"][n] for n in names[:2]]
+                if "recommended" in results
+                else None,
             ),
         )
     featured = {"chosen design": chosen}

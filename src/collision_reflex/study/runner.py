@@ -34,7 +34,8 @@ class RunResult:
     """Where a run wrote its results, and what it did.
 
     folder: the output folder; resumed: whether finished work was found and reused; computed: pieces of work
-    done in this run; reused: pieces found finished; elapsed: wall time [s].
+    done in this run; reused: pieces found finished; elapsed: wall time [s]; verdict: the sentences the report
+    opens with (arm studies; empty for actuator studies).
     """
 
     folder: Path
@@ -42,6 +43,7 @@ class RunResult:
     computed: int
     reused: int
     elapsed: float
+    verdict: tuple[str, ...] = ()
 
     @property
     def report(self) -> Path:
@@ -165,7 +167,7 @@ def run_study(
     write_outputs(folder.path, results, figures=figures)
     elapsed = time.perf_counter() - started
     folder.update_manifest(status="finished", elapsed=elapsed, computed=counts[0], reused=counts[1])
-    return RunResult(folder.path, resumed, counts[0], counts[1], elapsed)
+    return RunResult(folder.path, resumed, counts[0], counts[1], elapsed, tuple(results.get("verdict", ())))
 
 
 def _dump(data: dict[str, Any]) -> str:
@@ -241,12 +243,13 @@ def _run_arm(
     progress: _Progress,
     window: int,
 ) -> tuple[dict[str, Any], tuple[int, int]]:
-    """The study's optimum, and its Pareto front by the optimiser's one sweep.
+    """The study's optimum (multi-started), its Pareto front by the optimiser's one sweep, and the verdict.
 
     Each piece is saved as it finishes and found again when the run resumes.
     """
     from ..errors import SolverFailed, StudyRunFailed
-    from ..optimize.pareto import pareto_front, single_optimum
+    from ..optimize.pareto import OPTIMUM_STARTS, pareto_front, single_optimum
+    from ..report.verdict import verdict
     from .arm_setup import IPOPT_OPTIONS, StudyProblems
 
     problems = StudyProblems(text)
@@ -259,6 +262,7 @@ def _run_arm(
             executor=pool,
             finished=folder.finished,
             save=folder.save,
+            starts=OPTIMUM_STARTS,
         )
     except SolverFailed as error:
         raise StudyRunFailed(f"the optimum solve failed: {error.args[0]}", "optimum", error.status) from None
@@ -288,6 +292,7 @@ def _run_arm(
         "resolved": resolved_study(parse_study(text, "resolved study")),
         **arm_results(problems, optimum, front),
     }
+    results["verdict"] = verdict(results)
     return results, (computed, reused)
 
 

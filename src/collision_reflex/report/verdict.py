@@ -1,0 +1,304 @@
+"""The verdict an arm study's report opens with, as plain sentences decided from its results record.
+
+One place for the HTML report, ``designs.json`` (``verdict``) and ``crx run``'s closing print: the recommended
+design, the bounds and constraints that are active on each joint, how far each objective spans over the front
+(and a plain sentence when the front is flat or degenerate), the lightest design near the best impulse, the kind
+of torque requirement, and warnings about oversized joints. Every function reads plain data (the records of
+:func:`collision_reflex.optimize.results.design_record` and the results of
+:func:`collision_reflex.study.arm_results.arm_results`), so the verdict can be redone from a saved
+``designs.json``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any, Literal
+
+ACTIVE_TOLERANCE = 1e-3
+"""Relative distance below which a design variable is at its bound, and a margin below which its constraint
+is active (the solver's own tolerances are far smaller: a bound or constraint this close is what set the value)."""
+
+FLAT_SPAN = 1.0
+"""Span [%] of an objective over the front below which the front is flat in it: no design choice that matters."""
+
+NEAR_BEST = 0.05
+"""How far above the best impulse (relative) a design may be for "the lightest design within 5 % of the best"."""
+
+OVERSIZED_MARGIN = 2.0
+"""Peak-torque margin above which a joint is oversized (more than 3x its requirement) unless its motor is at its
+smallest size."""
+
+MARGINS = (("torque_margin", "peak torque"), ("rms_margin", "RMS torque"), ("speed_margin", "speed"))
+"""Per-joint margins of a design record (``peak / required - 1``) and the constraint each belongs to; a margin
+absent or ``None`` means the design has no such requirement."""
+
+IMPULSE_OBJECTIVES = ("worst_case_impulse", "mean_impulse")
+
+Position = Literal["lower", "upper", "fixed"] | None
+
+
+def _words(name: str) -> str:
+    return name.replace("_", " ")
+
+
+def _g(value: float, digits: int = 4) -> str:
+    return f"{value:.{digits}g}"
+
+
+def _percent(value: float) -> str:
+    """A percentage to 3 significant digits, without exponents (``< 0.001``, ``0.354``, ``12.3``, ``1,750``)."""
+    if value < 1e-3:
+        return "< 0.001" if value > 0 else "0"
+    return f"{value:,.0f}" if value >= 100 else f"{value:.3g}"
+
+
+def bound_position(value: float, bounds: Sequence[float]) -> Position:
+    """Where ``value`` is in ``bounds`` ``[lower, upper]``.
+
+    At a bound (``"lower"``, ``"upper"``: within :data:`ACTIVE_TOLERANCE`, relative to the bound), ``"fixed"``
+    (lower == upper: not a design choice), or None (inside).
+    """
+    lower, upper = float(bounds[0]), float(bounds[1])
+    if lower == upper:
+        return "fixed"
+    if abs(value - lower) <= ACTIVE_TOLERANCE * abs(lower):
+        return "lower"
+    if abs(value - upper) <= ACTIVE_TOLERANCE * abs(upper):
+        return "upper"
+    return None
+
+
+def motor_at_smallest_size(joint: Mapping[str, Any], bounds: Mapping[str, Any]) -> bool:
+    """Whether a joint's motor is at its smallest size.
+
+    Stator diameter and stack length each at their lower bounds or fixed, and at least one of them a design
+    variable.
+    """
+    name = joint["joint"]
+    positions = [bound_position(joint[key], bounds[key][name]) for key in ("stator_diameter", "stack_length")]
+    return all(p in ("lower", "fixed") for p in positions) and "lower" in positions
+
+
+def joint_limits(joint: Mapping[str, Any], bounds: Mapping[str, Any], requirement: str) -> list[str]:
+    """The bounds and constraints that are active on one joint of a design record, in words."""
+    name = joint["joint"]
+    size = {key: bound_position(joint[key], bounds[key][name]) for key in ("stator_diameter", "stack_length")}
+    phrases = []
+    if motor_at_smallest_size(joint, bounds):
+        phrases.append("motor at its smallest size")
+    elif all(p in ("upper", "fixed") for p in size.values()) and "upper" in size.values():
+        phrases.append("motor at its largest size")
+    else:
+        phrases += [f"{_words(key)} at its {p} bound" for key, p in size.items() if p in ("lower", "upper")]
+    for key in ("gear_ratio", "software_stiffness"):
+        position = bound_position(joint[key], bounds[key][name])
+        if position in ("lower", "upper"):
+            phrases.append(f"{_words(key)} at its {position} bound ({_g(joint[key])})")
+    if joint.get("torque_margin") is None:
+        phrases.append(
+            "no torque requirement: static gravity-only requirement is zero for this joint"
+            if requirement.startswith("static")
+            else "no torque requirement"
+        )
+    for key, constraint in MARGINS:
+        margin = joint.get(key)
+        if margin is not None and margin < ACTIVE_TOLERANCE:
+            phrases.append(f"sized by {constraint}")
+    margin = joint.get("torque_margin")
+    if margin is not None and margin > OVERSIZED_MARGIN and motor_at_smallest_size(joint, bounds):
+        phrases.append(
+            f"peak torque {_g(1 + margin, 3)}× its requirement: even the smallest motor is more than it needs"
+        )
+    return phrases
+
+
+def design_limits(record: Mapping[str, Any], bounds: Mapping[str, Any]) -> list[str]:
+    """The global design variables (threshold, approach velocity) of a record that are at a bound, in words."""
+    phrases = []
+    for key in ("threshold", "approach_velocity"):
+        position = bound_position(record[key], bounds[key])
+        if position in ("lower", "upper"):
+            phrases.append(f"{_words(key)} at its {position} bound ({_g(record[key])})")
+    return phrases
+
+
+def design_sentence(record: Mapping[str, Any]) -> str:
+    """A design in one sentence: per joint its motor size and gear ratio; the threshold and approach velocity."""
+    joints = []
+    for joint in record["joints"]:
+        motor = f"{_g(joint['stator_diameter'] * 1e3, 3)} mm × {_g(joint['stack_length'] * 1e3, 3)} mm motor"
+        nearest = joint.get("nearest_catalogue_motor")
+        joints.append(
+            f"{joint['joint']}: {motor}"
+            + (f" (nearest catalogue motor {nearest})" if nearest else "")
+            + f" at N = {_g(joint['gear_ratio'])}"
+        )
+    threshold = f"{_g(record['threshold'])} " + (
+        "N" if record["sensing"] == "force" else "m (position error)"
+    )
+    objectives = ", ".join(
+        f"{_words(name)} {_g(record['objectives'][name])} {unit}"
+        for name, unit in (("worst_case_impulse", "N·s"), ("mean_impulse", "N·s"), ("actuator_mass", "kg"))
+        if name in record["objectives"]
+    )
+    return (
+        "; ".join(joints)
+        + f"; threshold {threshold}, approach velocity {_g(record['approach_velocity'])} m/s ({objectives})."
+    )
+
+
+def objective_spans(points: Sequence[Mapping[str, Any]], objectives: Sequence[str]) -> dict[str, float]:
+    """Each objective's span over ``points`` [%].
+
+    That is (largest - smallest) / |best|, best the value the front optimises toward (the smallest, or the
+    largest for a maximised objective).
+    """
+    from ..optimize import OBJECTIVES
+
+    spans = {}
+    for name in objectives:
+        values = [float(p["objectives"][name]) for p in points]
+        best = min(values) if OBJECTIVES[name][0] > 0 else max(values)
+        spans[name] = 100 * (max(values) - min(values)) / max(abs(best), 1e-300)
+    return spans
+
+
+def front_sentences(pareto: Mapping[str, Any]) -> list[str]:
+    """The front's spans, and a plain sentence when it is flat or degenerate.
+
+    Flat: an objective spans less than :data:`FLAT_SPAN`; degenerate: one point (every repeat merged), or every
+    objective flat.
+    """
+    from ..optimize.pareto import MERGE_TOLERANCE
+
+    points, names = pareto["points"], pareto["objectives"]
+    if not points:
+        return []
+    merged = int(pareto.get("merged", 0))
+    lines = []
+    if merged:
+        lines.append(
+            f"{merged} solved point(s) repeated a reported design (objectives equal within {MERGE_TOLERANCE:g} "
+            "relative, the solver's tolerance) and were merged."
+        )
+    if len(points) == 1:
+        return [
+            *lines,
+            "Degenerate front: one design. The objectives "
+            + " and ".join(_words(n) for n in names)
+            + " do not trade off within these bounds; the recommended design is the only choice.",
+        ]
+    spans = objective_spans(points, names)
+    lines.insert(
+        0,
+        f"The front ({len(points)} designs) spans "
+        + ", ".join(f"{_percent(s)} % in {_words(n)}" for n, s in spans.items())
+        + ".",
+    )
+    flat = [n for n in names if spans[n] < FLAT_SPAN]
+    real = [n for n in names if spans[n] >= FLAT_SPAN]
+    if flat and not real:
+        lines.append(
+            f"Degenerate front: every design within {FLAT_SPAN:g} % in every objective; the designs are "
+            "practically one."
+        )
+    elif flat:
+        choice = " and ".join(_words(n) for n in real)
+        lines += [
+            f"Flat front: all designs within {_g(spans[n], 2)} % of the best {_words(n)}: {choice} "
+            + ("is the only real choice." if len(real) == 1 else "are the only real choices.")
+            for n in flat
+        ]
+    return lines
+
+
+def lightest_near_best(pareto: Mapping[str, Any], within: float = NEAR_BEST) -> tuple[int, str] | None:
+    """The lightest front design within ``within`` (relative) of the best impulse, and its sentence.
+
+    None when the front does not trade an impulse objective against the actuator mass, or is one design.
+    """
+    names = pareto["objectives"]
+    impulse = next((n for n in IMPULSE_OBJECTIVES if n in names), None)
+    points = pareto["points"]
+    if impulse is None or "actuator_mass" not in names or len(points) < 2:
+        return None
+    best = min(p["objectives"][impulse] for p in points)
+    near = [i for i, p in enumerate(points) if p["objectives"][impulse] <= best * (1 + within)]
+    index = min(near, key=lambda i: points[i]["objectives"]["actuator_mass"])
+    chosen = points[index]["objectives"]
+    above = 100 * (chosen[impulse] / best - 1)
+    return index, (
+        f"Lightest design within {_g(100 * within)} % of the best {_words(impulse)}: Pareto design {index}, "
+        f"{_g(chosen['actuator_mass'])} kg at {_g(chosen[impulse])} N·s ({_g(above, 2)} % above the best)."
+    )
+
+
+def requirement_sentence(requirement: str) -> str:
+    """What the torque requirement is, and what it leaves out."""
+    if requirement.startswith("static"):
+        return (
+            f"Torque requirement: {requirement}. The peak torque covers gravity (and the payload) over the "
+            "sampled configurations only: the motion's dynamics, RMS (thermal) torque and motor speed are not "
+            "checked; give the study a duty cycle to size for them."
+        )
+    return f"Torque requirement: {requirement}."
+
+
+def oversized_warnings(record: Mapping[str, Any], bounds: Mapping[str, Any]) -> list[str]:
+    """A warning for each oversized joint.
+
+    Oversized: a peak-torque margin above :data:`OVERSIZED_MARGIN` while its motor could be smaller (not at its
+    smallest size).
+    """
+    warnings = []
+    for joint in record["joints"]:
+        margin = joint.get("torque_margin")
+        if margin is not None and margin > OVERSIZED_MARGIN and not motor_at_smallest_size(joint, bounds):
+            warnings.append(
+                f"Warning: {joint['joint']} delivers {_g(1 + margin, 3)}× its required peak torque "
+                f"({_g(joint['peak_torque'])} vs {_g(joint['required_torque'])} N·m) with a motor above its "
+                "smallest size: nothing in the study sizes this actuator; check its requirement."
+            )
+    return warnings
+
+
+def verdict(results: Mapping[str, Any]) -> list[str]:
+    """The verdict of an arm study's results (:func:`collision_reflex.study.arm_results.arm_results`)."""
+    recommended = results.get("recommended") or {**results["chosen"], "source": "optimum", "reason": ""}
+    bounds = results.get("bounds")
+    requirement = str(results.get("requirement", "static (gravity only)"))
+    reason = str(recommended.get("reason", ""))
+    lines = [f"Recommended design ({recommended.get('source', 'optimum')}): {design_sentence(recommended)}"]
+    if reason:
+        lines.append(f"Why this design: {reason}.")
+    lines.append(requirement_sentence(requirement))
+    if bounds is not None:
+        for joint in recommended["joints"]:
+            phrases = joint_limits(joint, bounds, requirement)
+            lines.append(
+                f"{joint['joint']}: "
+                + (", ".join(phrases) if phrases else "no bound or constraint active")
+                + "."
+            )
+        limits = design_limits(recommended, bounds)
+        if limits:
+            lines.append("Sensing and approach: " + ", ".join(limits) + ".")
+    lines += front_sentences(results["pareto"])
+    near = lightest_near_best(results["pareto"])
+    if near is not None:
+        lines.append(near[1])
+    if bounds is not None:
+        lines += oversized_warnings(recommended, bounds)
+    return lines
+
+
+__all__ = [
+    "bound_position",
+    "design_sentence",
+    "front_sentences",
+    "joint_limits",
+    "lightest_near_best",
+    "objective_spans",
+    "oversized_warnings",
+    "verdict",
+]

@@ -1,0 +1,174 @@
+"""The verdict an arm report opens with, decided from hand-made records: active bounds and constraints per
+joint, the front's spans, flat and degenerate fronts, the lightest design near the best impulse, warnings."""
+
+from __future__ import annotations
+
+import pytest
+
+from collision_reflex.report.verdict import (
+    ACTIVE_TOLERANCE,
+    bound_position,
+    front_sentences,
+    joint_limits,
+    lightest_near_best,
+    objective_spans,
+    oversized_warnings,
+    verdict,
+)
+
+BOUNDS = {
+    "stator_diameter": {"shoulder": [0.03, 0.14], "elbow": [0.03, 0.14]},
+    "stack_length": {"shoulder": [0.0125, 0.0125], "elbow": [0.0125, 0.0125]},  # fixed
+    "gear_ratio": {"shoulder": [10.0, 160.0], "elbow": [10.0, 160.0]},
+    "software_stiffness": {"shoulder": [50.0, 3000.0], "elbow": [50.0, 3000.0]},
+    "threshold": [1.0, 20.0],
+    "approach_velocity": [0.05, 0.5],
+}
+
+
+def joint(name="shoulder", diameter=0.08, ratio=50.0, stiffness=500.0, margin=0.5, **extra):
+    peak = 10.0
+    return {
+        "joint": name,
+        "stator_diameter": diameter,
+        "stack_length": 0.0125,
+        "gear_ratio": ratio,
+        "software_stiffness": stiffness,
+        "peak_torque": peak,
+        "required_torque": None if margin is None else peak / (1 + margin),
+        "torque_margin": margin,
+        "nearest_catalogue_motor": "M-80",
+        **extra,
+    }
+
+
+def record(impulse=0.5, mass=1.0, joints=None, threshold=5.0, velocity=0.2):
+    return {
+        "label": "",
+        "objectives": {"worst_case_impulse": impulse, "mean_impulse": impulse / 2, "actuator_mass": mass},
+        "threshold": threshold,
+        "sensing": "force",
+        "approach_velocity": velocity,
+        "joints": joints or [joint(), joint("elbow")],
+    }
+
+
+def pareto(points, merged=0):
+    return {"objectives": ["worst_case_impulse", "actuator_mass"], "points": points, "merged": merged}
+
+
+def test_bound_position_within_the_relative_tolerance():
+    assert bound_position(10.0 * (1 + 0.5 * ACTIVE_TOLERANCE), [10.0, 160.0]) == "lower"
+    assert bound_position(10.0 * (1 + 2 * ACTIVE_TOLERANCE), [10.0, 160.0]) is None
+    assert bound_position(160.0 * (1 - 0.5 * ACTIVE_TOLERANCE), [10.0, 160.0]) == "upper"
+    assert bound_position(0.0125, [0.0125, 0.0125]) == "fixed"
+
+
+def test_active_bounds_and_constraints_per_joint():
+    at_bounds = joint(diameter=0.03, ratio=160.0, stiffness=50.0, margin=0.5 * ACTIVE_TOLERANCE)
+    phrases = joint_limits(at_bounds, BOUNDS, "static (gravity only)")
+    assert phrases == [
+        "motor at its smallest size",  # diameter at its lower bound, stack length fixed
+        "gear ratio at its upper bound (160)",
+        "software stiffness at its lower bound (50)",
+        "sized by peak torque",
+    ]
+    assert joint_limits(joint(diameter=0.14), BOUNDS, "static (gravity only)") == [
+        "motor at its largest size"
+    ]
+    # Inside every bound, with margin: nothing active.
+    assert joint_limits(joint(margin=2 * ACTIVE_TOLERANCE), BOUNDS, "static (gravity only)") == []
+
+
+def test_no_requirement_and_the_duty_cycle_margins():
+    free = joint(margin=None)
+    assert joint_limits(free, BOUNDS, "static (gravity only)") == [
+        "no torque requirement: static gravity-only requirement is zero for this joint"
+    ]
+    assert joint_limits(free, BOUNDS, "duty cycle") == ["no torque requirement"]
+    cycled = joint(margin=0.3, rms_margin=0.0, speed_margin=0.2 * ACTIVE_TOLERANCE, required_rms_torque=4.0)
+    assert joint_limits(cycled, BOUNDS, "duty cycle") == ["sized by RMS torque", "sized by speed"]
+    # Margins absent (a record before duty cycles) or None (no such requirement): nothing said about them.
+    assert joint_limits(joint(margin=0.3, rms_margin=None), BOUNDS, "duty cycle") == []
+
+
+def test_spans_in_percent_of_the_best():
+    points = [record(0.50, 2.0), record(0.55, 0.5)]
+    spans = objective_spans(points, ["worst_case_impulse", "actuator_mass"])
+    assert spans["worst_case_impulse"] == pytest.approx(10.0, rel=1e-12)  # 0.05 / 0.50
+    assert spans["actuator_mass"] == pytest.approx(300.0, rel=1e-12)  # 1.5 / 0.5
+    # A maximised objective spans relative to its largest value.
+    velocity = objective_spans(
+        [{"objectives": {"approach_velocity": 0.4}}, {"objectives": {"approach_velocity": 0.5}}],
+        ["approach_velocity"],
+    )
+    assert velocity["approach_velocity"] == pytest.approx(20.0, rel=1e-12)
+
+
+def test_the_flat_front_sentence_fires_on_a_flat_front_only():
+    flat = pareto([record(0.5000, 2.0), record(0.5005, 1.0), record(0.5011, 0.11)])  # 0.22 % vs 18x in mass
+    lines = front_sentences(flat)
+    assert (
+        "Flat front: all designs within 0.22 % of the best worst case impulse: actuator mass is the only "
+        "real choice." in lines
+    )
+    trade_off = pareto([record(0.40, 2.0), record(0.46, 1.0), record(0.60, 0.2)])  # 50 % vs 900 %
+    lines = front_sentences(trade_off)
+    assert lines[0] == "The front (3 designs) spans 50 % in worst case impulse, 900 % in actuator mass."
+    assert not any("Flat" in line or "Degenerate" in line for line in lines)
+
+
+def test_degenerate_fronts_are_said_in_plain_words():
+    one = front_sentences(pareto([record()], merged=2))
+    assert one[0].startswith("2 solved point(s) repeated a reported design") and "merged" in one[0]
+    assert one[1].startswith("Degenerate front: one design.")
+    same = front_sentences(pareto([record(0.5, 1.0), record(0.5001, 0.999)]))
+    assert any(line.startswith("Degenerate front: every design within 1 %") for line in same)
+
+
+def test_the_lightest_design_within_5_percent_of_the_best_impulse():
+    points = [record(0.40, 2.0), record(0.41, 1.0), record(0.418, 0.8), record(0.43, 0.2)]
+    index, sentence = lightest_near_best(pareto(points))
+    assert index == 2  # 0.418 <= 1.05 * 0.40 = 0.42; 0.43 is beyond
+    assert "Pareto design 2, 0.8 kg at 0.418 N·s (4.5 % above the best)" in sentence
+    assert (
+        lightest_near_best({"objectives": ["worst_case_impulse", "approach_velocity"], "points": points})
+        is None
+    )
+    assert lightest_near_best(pareto(points[:1])) is None  # one design: nothing to choose
+
+
+def test_oversized_joints_are_warned_unless_their_motor_is_smallest():
+    big = joint(diameter=0.08, margin=2.5)
+    smallest = joint("elbow", diameter=0.03, margin=25.0)
+    warnings = oversized_warnings(record(joints=[big, smallest]), BOUNDS)
+    assert len(warnings) == 1 and warnings[0].startswith("Warning: shoulder delivers 3.5× its required peak")
+    # The smallest motor's excess is said as such, not warned about.
+    assert "peak torque 26× its requirement: even the smallest motor is more than it needs" in joint_limits(
+        smallest, BOUNDS, "static (gravity only)"
+    )
+    assert oversized_warnings(record(joints=[joint(margin=1.9)]), BOUNDS) == []
+
+
+def test_the_verdict_opens_with_the_recommended_design():
+    recommended = {
+        **record(joints=[joint(diameter=0.03, margin=0.0), joint("elbow", margin=None)], threshold=1.0),
+        "source": "Pareto design 1",
+        "reason": "Pareto design 1 dominates the single-objective optimum",
+    }
+    results = {
+        "chosen": record(),
+        "recommended": recommended,
+        "pareto": pareto([record(0.40, 2.0), recommended]),
+        "bounds": BOUNDS,
+        "requirement": "static (gravity only)",
+    }
+    lines = verdict(results)
+    assert lines[0].startswith("Recommended design (Pareto design 1): shoulder: 30 mm × 12.5 mm motor")
+    assert "at N = 50" in lines[0] and "threshold 1 N, approach velocity 0.2 m/s" in lines[0]
+    assert lines[1] == "Why this design: Pareto design 1 dominates the single-objective optimum."
+    assert lines[2].startswith("Torque requirement: static (gravity only).")
+    assert "shoulder: motor at its smallest size, sized by peak torque." in lines
+    assert "elbow: no torque requirement: static gravity-only requirement is zero for this joint." in lines
+    assert "Sensing and approach: threshold at its lower bound (1)." in lines
+    assert any(line.startswith("Lightest design within 5 %") for line in lines)
