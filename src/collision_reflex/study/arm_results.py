@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any, TypedDict
 
-from ..optimize.pareto import built_problem, recommend
+from ..optimize.pareto import MERGE_TOLERANCE, built_problem, recommend
 from ..optimize.results import design_record
 from ..optimize.space import GLOBAL_VARIABLES, PER_JOINT_VARIABLES
 from .arm_setup import ArmSetup, SampleLayout, StudyProblems, sample_layout
@@ -110,7 +110,8 @@ def arm_results(problems: StudyProblems, chosen: DesignResult, front: ParetoSet 
             ],
             "merged": front.merged,
         }
-        chosen_record["dominated_by"] = front.dominating(chosen.numpy_objectives)
+        # The recommendation's rule: values within the solver tolerance count as equal.
+        chosen_record["dominated_by"] = front.dominating(chosen.numpy_objectives, MERGE_TOLERANCE)
     recommendation = recommend(chosen, front, problems.objective)
     recommended = (
         dict(pareto["points"][recommendation.pareto_index])
