@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..model.impulse import optimal_velocity, phase_impulses, series_stiffness
+from .constraints import STATIC_REQUIREMENT
 from .objectives import OBJECTIVES
 from .solve import Design, DesignResult
 
@@ -32,9 +33,18 @@ JOINT_COLUMNS = (
     ("reflected_inertia", "kg*m^2"),
     ("peak_torque", "N*m"),
     ("required_torque", "N*m"),
+    ("torque_margin", "-"),
+    ("required_rms_torque", "N*m"),
+    ("rms_margin", "-"),
+    ("max_motor_speed", "rad/s"),
+    ("speed_limit", "rad/s"),
+    ("speed_margin", "-"),
     ("motor_mass", "kg"),
 )
-"""Per-joint columns of a design's table row: (record key, unit)."""
+"""Per-joint columns of a design's table row: (record key, unit). A requirement that does not exist (no duty
+cycle, or a joint it does not load) is None, not a number."""
+DUTY_ARRAYS = ("required_rms_torque", "rms_margin", "max_motor_speed", "speed_limit", "speed_margin")
+"""The per-joint results of a duty cycle's requirements (None without one)."""
 
 
 def threshold_unit(sensing: str) -> str:
@@ -134,8 +144,19 @@ def result_to_json(result: DesignResult) -> dict[str, Any]:
         "solve_time": float(result.solve_time),
         "build_time": float(result.build_time),
         "epsilon": {k: float(v) for k, v in result.epsilon.items()},
+        "requirement": result.requirement,
+        **{name: _optional_list(getattr(result, name)) for name in DUTY_ARRAYS},
         "x": np.asarray(result.x, dtype=float).tolist(),
     }
+
+
+def _optional_list(values: np.ndarray | None) -> list[float] | None:
+    """An optional per-joint array as a JSON list (infinite margins as ``inf``, which JSON writes as Infinity)."""
+    return None if values is None else np.asarray(values, dtype=float).tolist()
+
+
+def _optional_array(values: list[float] | None) -> np.ndarray | None:
+    return None if values is None else np.asarray(values, dtype=float)
 
 
 def result_from_json(data: Mapping[str, Any]) -> DesignResult:
@@ -161,6 +182,8 @@ def result_from_json(data: Mapping[str, Any]) -> DesignResult:
         solve_time=float(data["solve_time"]),
         build_time=float(data["build_time"]),
         epsilon=dict(data["epsilon"]),
+        requirement=str(data.get("requirement", STATIC_REQUIREMENT)),
+        **{name: _optional_array(data.get(name)) for name in DUTY_ARRAYS},
         x=np.asarray(data["x"], dtype=float),
     )
 
@@ -170,6 +193,7 @@ def result_record(result: DesignResult, label: str) -> dict[str, Any]:
     design = result.design
     joints = []
     for i, name in enumerate(design.joint_names):
+        duty = {key: _finite_entry(getattr(result, key), i) for key in DUTY_ARRAYS}
         joints.append(
             {
                 "joint": name,
@@ -193,10 +217,12 @@ def result_record(result: DesignResult, label: str) -> dict[str, Any]:
                     series_stiffness(design.mechanical_stiffness[i], design.software_stiffness[i])
                 ),
                 "motor_mass": float(design.motor_mass[i]),
+                **duty,
             }
         )
     return {
         "label": label,
+        "requirement": result.requirement,
         "objectives": {k: float(v) for k, v in result.numpy_objectives.items()},
         "casadi_objectives": {k: float(v) for k, v in result.objectives.items()},
         "threshold": float(design.threshold),
@@ -212,6 +238,13 @@ def result_record(result: DesignResult, label: str) -> dict[str, Any]:
             "epsilon": {k: float(v) for k, v in result.epsilon.items()},
         },
     }
+
+
+def _finite_entry(values: np.ndarray | None, index: int) -> float | None:
+    """Entry ``index`` of an optional per-joint array; None where there is no array or no requirement (inf)."""
+    if values is None or not math.isfinite(values[index]):
+        return None
+    return float(values[index])
 
 
 def design_record(
@@ -277,7 +310,7 @@ def record_row(record: Mapping[str, Any], index: int) -> dict[str, Any]:
         row[f"{name} [{OBJECTIVES[name][1]}]"] = value
     for key, unit in JOINT_COLUMNS:
         for joint in record["joints"]:
-            row[f"{key}[{joint['joint']}] [{unit}]"] = joint[key]
+            row[f"{key}[{joint['joint']}] [{unit}]"] = joint.get(key)
     row[f"threshold [{threshold_unit(record['sensing'])}]"] = record["threshold"]
     row["status"] = record["solver"]["status"]
     row["iterations"] = record["solver"]["iterations"]
