@@ -154,7 +154,9 @@ def test_rotor_term_and_rms_against_direct_evaluation(lightest, cycle):
     # The NLP's own RMS rows: RMS^2 / (N tau_c)^2.
     rows = [i for i, label in enumerate(problem.constraint_labels) if label.startswith("RMS torque of")]
     g = np.asarray(ca.Function("g", [problem.nlp["x"]], [problem.nlp["g"]])(result.x)).ravel()[rows]
-    np.testing.assert_allclose(g, (direct_rms / (design.gear_ratio * motor.continuous_torque)) ** 2, rtol=1e-9)
+    np.testing.assert_allclose(
+        g, (direct_rms / (design.gear_ratio * motor.continuous_torque)) ** 2, rtol=1e-9
+    )
 
 
 def test_approach_rates_are_the_pseudo_inverse(samples):
@@ -211,7 +213,9 @@ def test_unreachable_peak_torque_names_joint_and_constraint(arm, samples):
 def test_motor_without_speed_limit_is_refused_before_building(arm, samples, cycle):
     motor = dataclasses.replace(cr.reference_motor(), max_speed=None)
     with pytest.raises(InvalidParameter, match="max_speed") as raised:
-        cr.build_problem(arm, samples, _space(), _technology(motor), constraints=cr.Constraints(duty_cycle=cycle))
+        cr.build_problem(
+            arm, samples, _space(), _technology(motor), constraints=cr.Constraints(duty_cycle=cycle)
+        )
     assert "OPN-060-013-A" in str(raised.value)
 
 

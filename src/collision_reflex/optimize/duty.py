@@ -281,9 +281,7 @@ def check_reachable(
         slopes = basis[:, 1:-1]
         low = basis[:, 0] + np.minimum(slopes * mass_low, slopes * mass_high).sum(axis=1)
         high = basis[:, 0] + np.maximum(slopes * mass_low, slopes * mass_high).sum(axis=1)
-        best = _best_margins(
-            duty, technology, bounds, j, (low, high, basis[:, -1]), weights, speed_need[j]
-        )
+        best = _best_margins(duty, technology, bounds, j, (low, high, basis[:, -1]), weights, speed_need[j])
         labels = (PEAK, RMS, SPEED)
         for label, value in zip(labels, best[:3], strict=True):
             if value < -REACHABLE_TOLERANCE:
@@ -312,7 +310,9 @@ def _best_margins(
     best = np.full(4, -np.inf)
     for length in grid("stack_length", 9):
         for diameter in grid("stator_diameter", 41):
-            motor = scaled_motor_quantities(technology.reference_motor, diameter, length, technology.scaling_law)
+            motor = scaled_motor_quantities(
+                technology.reference_motor, diameter, length, technology.scaling_law
+            )
             rotor = gears**2 * motor.rotor_inertia * acceleration  # (gears, n)
             # The smallest |demand| at each sample over the other motors' masses (0 if the interval holds 0).
             least = np.maximum(0.0, np.maximum(low + rotor, -(high + rotor)))

@@ -510,7 +510,9 @@ def _duty_setup(
     values at the lower and the upper bounds. The start's free gear ratios go up (within their bounds) to where
     the peak torque covers the peak demand at the start with 10 % to spare, as for the static requirement.
     """
-    numbers = ca.Function("duty_numbers", [x], [design.motor_mass, design.reflected_inertia, design.peak_torque])
+    numbers = ca.Function(
+        "duty_numbers", [x], [design.motor_mass, design.reflected_inertia, design.peak_torque]
+    )
     (mass_low, reflected_low, _), (mass_high, reflected_high, _) = (
         [np.asarray(v).ravel() for v in numbers(bound)] for bound in (lbx, ubx)
     )
@@ -530,7 +532,9 @@ def _duty_setup(
     return rows
 
 
-def _duty_required_torque(rows: list[tuple[np.ndarray, np.ndarray, np.ndarray]], n_joints: int) -> ca.Function:
+def _duty_required_torque(
+    rows: list[tuple[np.ndarray, np.ndarray, np.ndarray]], n_joints: int
+) -> ca.Function:
     """CasADi function: motor masses [kg], ``N^2 J_m`` [kg m^2] -> the peak requirement per joint [N m]."""
     masses = ca.MX.sym("motor_mass", n_joints)
     reflected = ca.MX.sym("reflected_inertia", n_joints)

@@ -183,7 +183,11 @@ def result_from_json(data: Mapping[str, Any]) -> DesignResult:
         build_time=float(data["build_time"]),
         epsilon=dict(data["epsilon"]),
         requirement=str(data.get("requirement", STATIC_REQUIREMENT)),
-        **{name: _optional_array(data.get(name)) for name in DUTY_ARRAYS},
+        required_rms_torque=_optional_array(data.get("required_rms_torque")),
+        rms_margin=_optional_array(data.get("rms_margin")),
+        max_motor_speed=_optional_array(data.get("max_motor_speed")),
+        speed_limit=_optional_array(data.get("speed_limit")),
+        speed_margin=_optional_array(data.get("speed_margin")),
         x=np.asarray(data["x"], dtype=float),
     )
 
