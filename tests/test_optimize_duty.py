@@ -234,8 +234,7 @@ def test_static_requirement_is_named_and_has_no_duty_margins(arm, samples):
     record = result_record(result, "static")
     assert record["requirement"] == "static (gravity only)"
     row = record_row(record, 0)
-    assert row["rms_margin[joint1] [-]"] is None and row["speed_limit[joint2] [rad/s]"] is None
-    assert row["torque_margin[joint1] [-]"] == record["joints"][0]["torque_margin"]
+    assert not any("margin" in column or "speed" in column for column in row)  # the row as before
     with pytest.raises(InvalidParameter, match="duty cycle"):
         torque_speed_points(problem, result.design)
 

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..model.impulse import optimal_velocity, phase_impulses, series_stiffness
-from .constraints import STATIC_REQUIREMENT
+from .constraints import DUTY_REQUIREMENT, STATIC_REQUIREMENT
 from .objectives import OBJECTIVES
 from .solve import Design, DesignResult
 
@@ -33,16 +33,19 @@ JOINT_COLUMNS = (
     ("reflected_inertia", "kg*m^2"),
     ("peak_torque", "N*m"),
     ("required_torque", "N*m"),
+    ("motor_mass", "kg"),
+)
+"""Per-joint columns of a design's table row: (record key, unit)."""
+DUTY_COLUMNS = (
     ("torque_margin", "-"),
     ("required_rms_torque", "N*m"),
     ("rms_margin", "-"),
     ("max_motor_speed", "rad/s"),
     ("speed_limit", "rad/s"),
     ("speed_margin", "-"),
-    ("motor_mass", "kg"),
 )
-"""Per-joint columns of a design's table row: (record key, unit). A requirement that does not exist (no duty
-cycle, or a joint it does not load) is None, not a number."""
+"""Per-joint columns a design sized by a duty cycle adds to its row: (record key, unit). A margin without a
+requirement (a joint the cycle neither loads nor moves) is None, an empty cell in a CSV file."""
 DUTY_ARRAYS = ("required_rms_torque", "rms_margin", "max_motor_speed", "speed_limit", "speed_margin")
 """The per-joint results of a duty cycle's requirements (None without one)."""
 
@@ -312,9 +315,10 @@ def record_row(record: Mapping[str, Any], index: int) -> dict[str, Any]:
     row: dict[str, Any] = {"point": index, "label": record["label"]}
     for name, value in record["objectives"].items():
         row[f"{name} [{OBJECTIVES[name][1]}]"] = value
-    for key, unit in JOINT_COLUMNS:
+    columns = JOINT_COLUMNS + (DUTY_COLUMNS if record.get("requirement") == DUTY_REQUIREMENT else ())
+    for key, unit in columns:
         for joint in record["joints"]:
-            row[f"{key}[{joint['joint']}] [{unit}]"] = joint.get(key)
+            row[f"{key}[{joint['joint']}] [{unit}]"] = joint[key]
     row[f"threshold [{threshold_unit(record['sensing'])}]"] = record["threshold"]
     row["status"] = record["solver"]["status"]
     row["iterations"] = record["solver"]["iterations"]
