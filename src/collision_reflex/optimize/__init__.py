@@ -5,10 +5,11 @@ CasADi + IPOPT choose motor size, gear ratio, stiffness, threshold and approach 
 Build and solve are separate: :func:`build_problem` returns an inspectable :class:`DesignProblem`,
 :func:`solve` runs IPOPT and returns a :class:`DesignResult`; :func:`pareto_front` sweeps objectives into a
 :class:`ParetoSet` (in-process or through any executor); :mod:`.results` makes the one result record and table
-row of a design.
+row of a design; :mod:`.duty` turns a duty cycle into peak, RMS and speed constraints.
 """
 
 from .constraints import Constraints
+from .duty import torque_speed_points
 from .objectives import OBJECTIVES
 from .pareto import ParetoSet, hypervolume, pareto_front
 from .problem import DesignProblem, build_problem
@@ -33,4 +34,5 @@ __all__ = [
     "hypervolume",
     "pareto_front",
     "solve",
+    "torque_speed_points",
 ]

@@ -88,7 +88,9 @@ class DesignProblem:
     by in the NLP; ``evaluate`` a CasADi function of ``x`` giving ``impulses`` (1 x n_samples), ``actuator_mass``,
     ``approach_velocity``, ``thresholds`` (1 x n_samples), ``required_torque`` and ``peak_torque`` (n_joints),
     and ``parameters`` (5 x n_samples: ``m_f, m_r, k, k_m, a``, see :meth:`sample_parameters`); use
-    :meth:`exact_point` first so that the auxiliary variables hold their exact values.
+    :meth:`exact_point` first so that the auxiliary variables hold their exact values. ``duty`` is the duty
+    cycle's requirement (:class:`collision_reflex.optimize.duty.DutyRequirement`), None without one; with one,
+    ``required_torque_function`` takes the motor masses [kg] and the reflected inertias ``N^2 J_m`` [kg m^2].
     """
 
     nlp: dict[str, ca.MX]
