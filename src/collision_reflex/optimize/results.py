@@ -153,13 +153,18 @@ def result_to_json(result: DesignResult) -> dict[str, Any]:
     }
 
 
-def _optional_list(values: np.ndarray | None) -> list[float] | None:
-    """An optional per-joint array as a JSON list (infinite margins as ``inf``, which JSON writes as Infinity)."""
-    return None if values is None else np.asarray(values, dtype=float).tolist()
+def _optional_list(values: np.ndarray | None) -> list[float | None] | None:
+    """An optional per-joint array as a JSON list; an infinite margin (no requirement) as None (JSON has no inf)."""
+    if values is None:
+        return None
+    return [float(v) if math.isfinite(v) else None for v in np.asarray(values, dtype=float)]
 
 
-def _optional_array(values: list[float] | None) -> np.ndarray | None:
-    return None if values is None else np.asarray(values, dtype=float)
+def _optional_array(values: list[float | None] | None) -> np.ndarray | None:
+    """The array written by :func:`_optional_list` (None entries back to inf)."""
+    if values is None:
+        return None
+    return np.array([math.inf if v is None else v for v in values], dtype=float)
 
 
 def result_from_json(data: Mapping[str, Any]) -> DesignResult:
