@@ -9,7 +9,6 @@ row of a design; :mod:`.duty` turns a duty cycle into peak, RMS and speed constr
 """
 
 from .constraints import Constraints
-from .duty import torque_speed_points
 from .objectives import OBJECTIVES
 from .pareto import ParetoSet, hypervolume, pareto_front
 from .problem import DesignProblem, build_problem
@@ -34,5 +33,4 @@ __all__ = [
     "hypervolume",
     "pareto_front",
     "solve",
-    "torque_speed_points",
 ]
