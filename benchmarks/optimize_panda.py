@@ -10,6 +10,10 @@ NSGA-II (population 100, 200 generations) on the same problem and the same refer
 NSGA-II's), and the sweep's warm-start policy (every point from the first anchor) against chaining each point
 from its neighbour's solution and multipliers. Run: ``python benchmarks/optimize_panda.py`` (``--quick`` for 5 Pareto points and a short GA).
 
+With ``--duty`` it prints only the problem size (variables, constraint rows, peak-torque rows kept) and the build
+and solve times of one solve with the static (gravity) requirement and with a duty cycle through four via
+configurations (about 200 samples, 1 kg payload) sizing peak torque, RMS torque and motor speed.
+
 The reflected rotor inertia is placed on the finger (``reflected_inertia_in="finger"``: a stiff transmission,
 the regime of the paper's geared A8): with the paper's arm model, where it acts in the reaction phase only, the
 worst-case impulse of a Panda is set by its link inertia and the motors cannot trade against it, so the front
@@ -32,6 +36,7 @@ from collision_reflex.optimize.nsga import nsga2_front
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="5 Pareto points, NSGA-II 40 x 30")
+    parser.add_argument("--duty", action="store_true", help="only: one solve without and with a duty cycle")
     args = parser.parse_args()
     points, population, generations = (5, 40, 30) if args.quick else (20, 100, 200)
 
@@ -61,6 +66,9 @@ def main() -> None:
         return build
 
     print(f"Panda: {arm.nv} joints, {samples.size} samples, {3 * arm.nv + 2} design variables")
+    if args.duty:
+        compare_duty_cycle(arm, samples, space, technology("finger"), constraints)
+        return
 
     started = time.perf_counter()
     problem = builder("finger")("worst_case_impulse", ())
@@ -113,6 +121,46 @@ def main() -> None:
         f"paper's arm model (reflected inertia in the reaction only): {len(robot.points)} non-dominated "
         f"point(s); worst-case impulse {spread[:, 0].min():.4f}-{spread[:, 0].max():.4f} N*s"
     )
+
+
+def compare_duty_cycle(
+    arm: Arm,
+    samples: cr.ContactSamples,
+    space: cr.DesignSpace,
+    technology: cr.ActuatorTechnology,
+    static: cr.Constraints,
+) -> None:
+    """One solve with the static requirement and one with a duty cycle: problem size, build and solve times."""
+    from collision_reflex.arm.duty_cycle import DutyCycle, Payload
+
+    home = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785]
+    via = [home, [0.8, -0.3, 0.2, -1.8, 0.3, 1.9, 0.4], [-0.6, 0.2, -0.3, -1.5, -0.4, 1.3, 1.2], home]
+    cycle = DutyCycle.through_via_points(
+        via,
+        arm.joint_names,
+        [2.0] * 4 + [2.5] * 3,
+        [8.0] * 4 + [10.0] * 3,
+        rate=73.0,
+        dwell=0.1,
+        payload=Payload(1.0),
+    )
+    duty = cr.Constraints(
+        safety_factor=static.safety_factor, threshold_floor=static.threshold_floor, duty_cycle=cycle
+    )
+    for constraints in (static, duty):
+        started = time.perf_counter()
+        problem = cr.build_problem(arm, samples, space, technology, "worst_case_impulse", constraints)
+        built = time.perf_counter() - started
+        result = cr.solve(problem)
+        peak_rows = sum(label.startswith("peak torque of") for label in problem.constraint_labels)
+        print(
+            f"{problem.requirement}: {problem.nlp['x'].shape[0]} variables, {len(problem.constraint_labels)} "
+            f"constraint rows ({peak_rows} peak-torque rows kept), build {built:.2f} s, solve "
+            f"{result.solve_time:.2f} s ({result.iterations} iterations); worst-case impulse "
+            f"{result.objectives['worst_case_impulse']:.4f} N*s, motor mass {result.objectives['actuator_mass']:.3f} kg"
+        )
+        if constraints is duty:
+            print(f"  duty cycle: {cycle.t.size} samples over {cycle.duration:.2f} s")
 
 
 def compare_warm_starts(build, names: tuple[str, ...], points: int) -> None:

@@ -5,7 +5,7 @@ CasADi + IPOPT choose motor size, gear ratio, stiffness, threshold and approach 
 Build and solve are separate: :func:`build_problem` returns an inspectable :class:`DesignProblem`,
 :func:`solve` runs IPOPT and returns a :class:`DesignResult`; :func:`pareto_front` sweeps objectives into a
 :class:`ParetoSet` (in-process or through any executor); :mod:`.results` makes the one result record and table
-row of a design.
+row of a design; :mod:`.duty` turns a duty cycle into peak, RMS and speed constraints.
 """
 
 from .constraints import Constraints

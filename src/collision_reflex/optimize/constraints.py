@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import casadi as ca
 import numpy as np
@@ -17,6 +18,16 @@ import numpy as np
 from ..errors import InvalidParameter
 from .samples import ContactSamples, kinematic_term, loaded_joints
 from .technology import ActuatorTechnology
+
+if TYPE_CHECKING:
+    from ..arm.duty_cycle import DutyCycle
+
+STATIC_REQUIREMENT = "static (gravity only)"
+"""The requirement without a duty cycle: gravity torques over the sampled configurations only."""
+GIVEN_REQUIREMENT = "given peak torques"
+"""The requirement when the caller gives the peak torques."""
+DUTY_REQUIREMENT = "duty cycle (peak, RMS, speed)"
+"""The requirement of a duty cycle: peak and RMS torque and the motor speed."""
 
 TorqueDemands = tuple[np.ndarray, np.ndarray, list[str]]
 """One joint's affine torque demands ``b + S m`` [N m]: bases ``b`` (R,), slopes ``S`` (R, n) per motor mass
@@ -32,12 +43,18 @@ class Constraints:
     torque_required: per-joint required torque [N m]; ``None`` derives it from Pinocchio gravity torques of the
         structure, the motors and the payload over the sampled configurations.
     threshold_floor: sensing noise floor [N]: the contact-force threshold may not go below it.
+    duty_cycle: the motion the arm must make, with its payload (:class:`collision_reflex.arm.DutyCycle`).
+        Given, it replaces the static requirement: per joint the peak torque over the cycle (rotor term and
+        safety factor included), the RMS torque within the continuous torque, and the motor speed over the
+        cycle and the approach within the motor's maximum speed (:mod:`collision_reflex.optimize.duty`).
+        Its payload is the cycle's own, so ``payload`` and ``torque_required`` must then be left unset.
     """
 
     payload: float = 0.0
     safety_factor: float = 1.0
     torque_required: Sequence[float] | None = None
     threshold_floor: float = 0.0
+    duty_cycle: DutyCycle | None = None
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.payload) and self.payload >= 0):
@@ -52,6 +69,26 @@ class Constraints:
                 raise InvalidParameter(
                     "torque_required", self.torque_required, "one torque >= 0 per joint [N m]"
                 )
+        if self.duty_cycle is not None:
+            from ..arm.duty_cycle import DutyCycle
+
+            if not isinstance(self.duty_cycle, DutyCycle):
+                raise InvalidParameter("duty_cycle", self.duty_cycle, "a DutyCycle or None")
+            if self.payload != 0 or self.torque_required is not None:
+                raise InvalidParameter(
+                    "duty_cycle",
+                    "given with payload or torque_required",
+                    "one requirement",
+                    "a duty cycle carries its own payload (DutyCycle.payload); leave payload and "
+                    "torque_required unset",
+                )
+
+    @property
+    def requirement(self) -> str:
+        """What sizes the torques: :data:`STATIC_REQUIREMENT`, :data:`GIVEN_REQUIREMENT` or :data:`DUTY_REQUIREMENT`."""
+        if self.duty_cycle is not None:
+            return DUTY_REQUIREMENT
+        return STATIC_REQUIREMENT if self.torque_required is None else GIVEN_REQUIREMENT
 
 
 @dataclass
@@ -190,13 +227,23 @@ def binding_torque_demands(
     for j in range(len(joint_names)):
         bases = np.array([base[j] for base, _ in rows])
         slopes = np.array([per_motor[j] for _, per_motor in rows])
-        low = bases + np.minimum(slopes * mass_low, slopes * mass_high).sum(axis=1)
-        high = bases + np.maximum(slopes * mass_low, slopes * mass_high).sum(axis=1)
-        keep = high >= low.max() - 1e-12 * abs(low.max())
+        keep = binding_rows(bases, slopes, mass_low, mass_high)
         demands.append(
             (bases[keep], slopes[keep], [label for label, k in zip(labels, keep, strict=True) if k])
         )
     return demands
+
+
+def binding_rows(bases: np.ndarray, slopes: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
+    """Mark the affine demands ``b + S v`` that can be the largest for some ``v`` in the box ``[low, high]``.
+
+    ``bases`` (R,), ``slopes`` (R, k), ``low``/``high`` (k,) bounds of the variables ``v``. A demand whose
+    largest value over the box is below another demand's smallest value there never is the largest: dropping
+    it leaves the maximum unchanged everywhere in the box (exact). Returns a (R,) bool mask.
+    """
+    smallest = bases + np.minimum(slopes * low, slopes * high).sum(axis=1)
+    largest = bases + np.maximum(slopes * low, slopes * high).sum(axis=1)
+    return largest >= smallest.max() - 1e-12 * abs(smallest.max())
 
 
 def required_torque_function(demands: list[TorqueDemands], n_joints: int) -> ca.Function:

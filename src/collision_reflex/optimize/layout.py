@@ -118,6 +118,9 @@ class DesignQuantities(NamedTuple):
     motor_mass: ca.MX
     peak_torque: ca.MX
     finger_inertia: ca.MX
+    reflected_inertia: ca.MX
+    continuous_torque: ca.MX
+    max_speed: ca.MX | None
 
     def joint_function(self, x: ca.MX) -> ca.Function:
         """CasADi function of ``x`` giving the joint numbers.
@@ -133,8 +136,10 @@ def design_quantities(
     """Symbolic joint quantities of the design variables ``z`` (log values).
 
     Gives the variables themselves, the per-sample function's design column, motor masses [kg], peak output
-    torques [N m] and the reflected inertia acting on the finger [kg m^2] (zero unless
-    ``reflected_inertia_in == "finger"``); ``k_mech`` is the joint mechanical stiffness [N m/rad].
+    torques [N m], the reflected inertia acting on the finger [kg m^2] (zero unless
+    ``reflected_inertia_in == "finger"``), the reflected rotor inertia ``N^2 J_m`` [kg m^2], the continuous
+    output torques ``N tau_c`` [N m] and the motors' maximum speeds [rad/s] (None when the reference motor's is
+    not known); ``k_mech`` is the joint mechanical stiffness [N m/rad].
     """
     values = layout.expressions(z)
     motor = scaled_motor_quantities(
@@ -150,4 +155,13 @@ def design_quantities(
         values["approach_velocity"],
     )
     finger_inertia = formulas.finger_inertia(reflected, technology.reflected_inertia_in)
-    return DesignQuantities(values, design_column, motor.mass, gear * motor.peak_torque, finger_inertia)
+    return DesignQuantities(
+        values,
+        design_column,
+        motor.mass,
+        gear * motor.peak_torque,
+        finger_inertia,
+        reflected,
+        gear * motor.continuous_torque,
+        motor.max_speed,
+    )

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import CollisionReflexError
+from ..errors import CollisionReflexError, InvalidParameter
 from .evaluate import evaluate_design
 from .objectives import OBJECTIVES
 from .problem import DesignProblem
@@ -50,8 +50,20 @@ def nsga2_front(
     objectives: objective names to minimise (maximised ones are negated internally, reported as is).
     population, generations: NSGA-II settings.
     seed: random seed, for reproducible fronts.
+
+    Raises
+    ------
+    InvalidParameter: a problem built with a duty cycle (this cross-check knows the static requirement only).
     """
     import time
+
+    if problem.duty is not None:
+        raise InvalidParameter(
+            "problem",
+            problem.requirement,
+            "a problem with the static torque requirement",
+            "the NSGA-II cross-check does not model a duty cycle's RMS and speed constraints",
+        )
 
     try:
         from pymoo.algorithms.moo.nsga2 import NSGA2

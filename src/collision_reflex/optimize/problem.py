@@ -47,6 +47,7 @@ from .constraints import (
     required_torque_function,
     torque_requirement_rows,
 )
+from .duty import DutyRequirement, add_duty_constraints, check_reachable, duty_requirement, peak_rows
 from .layout import DesignLayout, DesignQuantities, design_layout, design_quantities
 from .objectives import (
     OBJECTIVES,
@@ -87,7 +88,9 @@ class DesignProblem:
     by in the NLP; ``evaluate`` a CasADi function of ``x`` giving ``impulses`` (1 x n_samples), ``actuator_mass``,
     ``approach_velocity``, ``thresholds`` (1 x n_samples), ``required_torque`` and ``peak_torque`` (n_joints),
     and ``parameters`` (5 x n_samples: ``m_f, m_r, k, k_m, a``, see :meth:`sample_parameters`); use
-    :meth:`exact_point` first so that the auxiliary variables hold their exact values.
+    :meth:`exact_point` first so that the auxiliary variables hold their exact values. ``duty`` is the duty
+    cycle's requirement (:class:`collision_reflex.optimize.duty.DutyRequirement`), None without one; with one,
+    ``required_torque_function`` takes the motor masses [kg] and the reflected inertias ``N^2 J_m`` [kg m^2].
     """
 
     nlp: dict[str, ca.MX]
@@ -113,6 +116,7 @@ class DesignProblem:
     direction_index: slice
     direction_scale: np.ndarray
     build_time: float
+    duty: DutyRequirement | None
     _joint_numbers: ca.Function = field(repr=False)
     _sample_function: ca.Function = field(repr=False)
     _sample_data: np.ndarray = field(repr=False)
@@ -123,6 +127,11 @@ class DesignProblem:
     def n_joints(self) -> int:
         """Number of joints."""
         return len(self.joint_names)
+
+    @property
+    def requirement(self) -> str:
+        """What sizes the actuators: ``"static (gravity only)"``, given torques, or the duty cycle's."""
+        return self.constraints.requirement
 
     def exact_point(self, x: np.ndarray) -> np.ndarray:
         """Give ``x`` with the auxiliary variables set to their exact values for the design in ``x``.
@@ -164,7 +173,7 @@ class DesignProblem:
         """
         n = self.n_joints
         z = ca.MX.sym("z", self.layout.size)
-        _, design_column, motor_mass, peak_torque, finger_inertia = design_quantities(
+        _, design_column, motor_mass, peak_torque, finger_inertia, *_ = design_quantities(
             self.layout, z, self.technology, self.technology.joint_mechanical_stiffness(n)
         )
         w = self.samples.joint_moment_arms
@@ -232,8 +241,15 @@ def build_problem(
     objective: an objective name of :data:`OBJECTIVES` or a weighted sum ``{name: weight}``; each objective is
         divided by its value at the start point, so weights compare relative changes.
     constraints: torque requirement (gravity over the samples + payload, times a safety factor, or given
-        values) and the threshold noise floor.
+        values, or a duty cycle's peak, RMS and speed requirements: :mod:`collision_reflex.optimize.duty`) and
+        the threshold noise floor.
     bounded_objectives: objectives that may be bounded per solve (epsilon-constraint Pareto sweeps).
+
+    Raises
+    ------
+    InvalidParameter: bad input, a duty cycle with a reference motor of unknown maximum speed, or a duty-cycle
+        requirement that no design within the bounds can meet (naming the joint, the constraint and the best
+        margin reachable).
     """
     started = time.perf_counter()
     constraints = constraints or Constraints()
@@ -241,6 +257,11 @@ def build_problem(
     joint_names = _joint_names(arm, samples)
     n_joints = len(joint_names)
     layout = design_layout(space, technology, constraints, n_joints)
+    duty = (
+        None
+        if constraints.duty_cycle is None
+        else duty_requirement(arm, samples, constraints.duty_cycle, technology, constraints.safety_factor)
+    )
     n_samples, n_design = samples.size, layout.size
     epigraph_index, compliance_index, direction_index = _variable_slices(
         n_design, n_samples, n_joints, "worst_case_impulse" in set(weights) | set(bounded)
@@ -253,6 +274,9 @@ def build_problem(
     )
     joint_numbers = design.joint_function(x)
     lbx, ubx, x0 = _bounds_and_start(x.shape[0], layout, joint_numbers, samples, constraints, joint_names)
+    duty_rows: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+    if duty is not None:
+        duty_rows = _duty_setup(duty, x, x0, lbx, ubx, design, layout, technology, joint_names)
     lbx[compliance_index], ubx[compliance_index] = _compliance_bounds(samples, joint_numbers, lbx, ubx)
 
     start_mass, start_torque, start_finger = (np.asarray(v).ravel() for v in joint_numbers(x0))
@@ -261,9 +285,15 @@ def build_problem(
     )
     impulses, actuator_mass = per_sample.impulses, ca.sum1(design.motor_mass)
     mass_range = [np.asarray(joint_numbers(bound)[0]).ravel() for bound in (lbx, ubx)]
-    torque_demands = binding_torque_demands(samples, constraints, joint_names, *mass_range)
-    required_torque = required_torque_function(torque_demands, n_joints)
-    evaluate = _evaluate_function(x, design, per_sample, actuator_mass, required_torque)
+    if duty is None:
+        torque_demands = binding_torque_demands(samples, constraints, joint_names, *mass_range)
+        required_torque = required_torque_function(torque_demands, n_joints)
+        required_expression = required_torque(design.motor_mass)
+    else:
+        torque_demands = []
+        required_torque = _duty_required_torque(duty_rows, n_joints)
+        required_expression = required_torque(design.motor_mass, design.reflected_inertia)
+    evaluate = _evaluate_function(x, design, per_sample, actuator_mass, required_expression)
     # Start point: auxiliaries at their exact values for the start design.
     x0[direction_index] = (per_sample.start_directions / per_sample.direction_scale[:, None]).ravel()
     x0[compliance_index] = np.log(reaction_compliance(samples, start_torque))
@@ -276,11 +306,18 @@ def build_problem(
     g = ConstraintList()
     if epigraph_index is not None:
         expressions["worst_case_impulse"] = add_epigraph(g, x, epigraph_index, impulses, scale, x0, lbx)
-    torque_scale = np.maximum(np.asarray(required_torque(start_mass)).ravel(), 1e-3)
+    start_required = (
+        required_torque(start_mass)
+        if duty is None
+        else required_torque(start_mass, formulas.reflected_inertia(*_start_rotor(layout, x0, technology)))
+    )
+    torque_scale = np.maximum(np.asarray(start_required).ravel(), 1e-3)
     terms = _model_terms(x[compliance_index], design, per_sample)
     add_model_constraints(
         g, terms, torque_scale, torque_demands, samples, technology, constraints, joint_names
     )
+    if duty is not None:
+        add_duty_constraints(g, duty, design, duty_rows, torque_scale, joint_names)
     add_objective_bounds(g, bounded, expressions, scale, p)
 
     nlp = {"x": x, "f": objective_expression(weights, expressions, scale), "g": ca.vertcat(*g.parts), "p": p}
@@ -308,6 +345,7 @@ def build_problem(
         direction_index=direction_index,
         direction_scale=per_sample.direction_scale,
         build_time=time.perf_counter() - started,
+        duty=duty,
         _joint_numbers=joint_numbers,
         _sample_function=per_sample.function,
         _sample_data=per_sample.data,
@@ -442,7 +480,7 @@ def _evaluate_function(
     design: DesignQuantities,
     per_sample: _SampleTerms,
     actuator_mass: ca.MX,
-    required_torque: ca.Function,
+    required_torque: ca.MX,
 ) -> ca.Function:
     """CasADi function of the NLP's ``x`` giving the quantities :class:`DesignProblem` reports, by name."""
     outputs = {
@@ -450,8 +488,73 @@ def _evaluate_function(
         "actuator_mass": actuator_mass,
         "approach_velocity": design.values["approach_velocity"],
         "thresholds": per_sample.thresholds,
-        "required_torque": required_torque(design.motor_mass),
+        "required_torque": required_torque,
         "peak_torque": design.peak_torque,
         "parameters": per_sample.parameters,
     }
     return ca.Function("evaluate", [x], list(outputs.values()), ["x"], list(outputs))
+
+
+def _duty_setup(
+    duty: DutyRequirement,
+    x: ca.MX,
+    x0: np.ndarray,
+    lbx: np.ndarray,
+    ubx: np.ndarray,
+    design: DesignQuantities,
+    layout: DesignLayout,
+    technology: ActuatorTechnology,
+    joint_names: tuple[str, ...],
+) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """The duty cycle's binding peak rows; refuses an unreachable requirement and raises the start's gears.
+
+    Motor masses and reflected inertias grow with the motor size and the gear ratio, so their ranges are their
+    values at the lower and the upper bounds. The start's free gear ratios go up (within their bounds) to where
+    the peak torque covers the peak demand at the start with 10 % to spare, as for the static requirement.
+    """
+    numbers = ca.Function(
+        "duty_numbers", [x], [design.motor_mass, design.reflected_inertia, design.peak_torque]
+    )
+    (mass_low, reflected_low, _), (mass_high, reflected_high, _) = (
+        [np.asarray(v).ravel() for v in numbers(bound)] for bound in (lbx, ubx)
+    )
+    check_reachable(duty, layout, technology, mass_low, mass_high, joint_names)
+    n = len(joint_names)
+    x_low = np.column_stack([np.ones(n), np.tile(mass_low, (n, 1)), reflected_low])
+    x_high = np.column_stack([np.ones(n), np.tile(mass_high, (n, 1)), reflected_high])
+    rows = peak_rows(duty, x_low, x_high)
+    masses, reflected, torques = (np.asarray(v).ravel() for v in numbers(x0))
+    for j, index in enumerate(layout.slices["gear_ratio"]):
+        required = float(np.max(rows[j][0] @ np.concatenate([[1.0], masses, [reflected[j]]])))
+        if index is not None and required > torques[j]:
+            x0[index] = min(
+                x0[index] + math.log(1.1 * required / torques[j]),
+                math.log(layout.bounds["gear_ratio"][j].upper),
+            )
+    return rows
+
+
+def _duty_required_torque(
+    rows: list[tuple[np.ndarray, np.ndarray, np.ndarray]], n_joints: int
+) -> ca.Function:
+    """CasADi function: motor masses [kg], ``N^2 J_m`` [kg m^2] -> the peak requirement per joint [N m]."""
+    masses = ca.MX.sym("motor_mass", n_joints)
+    reflected = ca.MX.sym("reflected_inertia", n_joints)
+    required = [
+        ca.mmax(ca.mtimes(ca.DM(joint_rows), ca.vertcat(1.0, masses, reflected[j])))
+        for j, (joint_rows, _, _) in enumerate(rows)
+    ]
+    return ca.Function("required_torque", [masses, reflected], [ca.vertcat(*required)])
+
+
+def _start_rotor(
+    layout: DesignLayout, x0: np.ndarray, technology: ActuatorTechnology
+) -> tuple[np.ndarray, np.ndarray]:
+    """Gear ratios [-] and rotor inertias [kg m^2] of the start design."""
+    from ..hardware.motors import scaled_motor_quantities
+
+    values = layout.values(x0[: layout.size])
+    motor = scaled_motor_quantities(
+        technology.reference_motor, values["stator_diameter"], values["stack_length"], technology.scaling_law
+    )
+    return values["gear_ratio"], np.asarray(motor.rotor_inertia, dtype=float)

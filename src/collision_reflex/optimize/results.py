@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..model.impulse import optimal_velocity, phase_impulses, series_stiffness
+from .constraints import DUTY_REQUIREMENT, STATIC_REQUIREMENT
 from .objectives import OBJECTIVES
 from .solve import Design, DesignResult
 
@@ -35,6 +36,18 @@ JOINT_COLUMNS = (
     ("motor_mass", "kg"),
 )
 """Per-joint columns of a design's table row: (record key, unit)."""
+DUTY_COLUMNS = (
+    ("torque_margin", "-"),
+    ("required_rms_torque", "N*m"),
+    ("rms_margin", "-"),
+    ("max_motor_speed", "rad/s"),
+    ("speed_limit", "rad/s"),
+    ("speed_margin", "-"),
+)
+"""Per-joint columns a design sized by a duty cycle adds to its row: (record key, unit). A margin without a
+requirement (a joint the cycle neither loads nor moves) is None, an empty cell in a CSV file."""
+DUTY_ARRAYS = ("required_rms_torque", "rms_margin", "max_motor_speed", "speed_limit", "speed_margin")
+"""The per-joint results of a duty cycle's requirements (None without one)."""
 
 
 def threshold_unit(sensing: str) -> str:
@@ -134,8 +147,24 @@ def result_to_json(result: DesignResult) -> dict[str, Any]:
         "solve_time": float(result.solve_time),
         "build_time": float(result.build_time),
         "epsilon": {k: float(v) for k, v in result.epsilon.items()},
+        "requirement": result.requirement,
+        **{name: _optional_list(getattr(result, name)) for name in DUTY_ARRAYS},
         "x": np.asarray(result.x, dtype=float).tolist(),
     }
+
+
+def _optional_list(values: np.ndarray | None) -> list[float | None] | None:
+    """An optional per-joint array as a JSON list; an infinite margin (no requirement) as None (JSON has no inf)."""
+    if values is None:
+        return None
+    return [float(v) if math.isfinite(v) else None for v in np.asarray(values, dtype=float)]
+
+
+def _optional_array(values: list[float | None] | None) -> np.ndarray | None:
+    """The array written by :func:`_optional_list` (None entries back to inf)."""
+    if values is None:
+        return None
+    return np.array([math.inf if v is None else v for v in values], dtype=float)
 
 
 def result_from_json(data: Mapping[str, Any]) -> DesignResult:
@@ -161,6 +190,12 @@ def result_from_json(data: Mapping[str, Any]) -> DesignResult:
         solve_time=float(data["solve_time"]),
         build_time=float(data["build_time"]),
         epsilon=dict(data["epsilon"]),
+        requirement=str(data.get("requirement", STATIC_REQUIREMENT)),
+        required_rms_torque=_optional_array(data.get("required_rms_torque")),
+        rms_margin=_optional_array(data.get("rms_margin")),
+        max_motor_speed=_optional_array(data.get("max_motor_speed")),
+        speed_limit=_optional_array(data.get("speed_limit")),
+        speed_margin=_optional_array(data.get("speed_margin")),
         x=np.asarray(data["x"], dtype=float),
     )
 
@@ -170,6 +205,7 @@ def result_record(result: DesignResult, label: str) -> dict[str, Any]:
     design = result.design
     joints = []
     for i, name in enumerate(design.joint_names):
+        duty = {key: _finite_entry(getattr(result, key), i) for key in DUTY_ARRAYS}
         joints.append(
             {
                 "joint": name,
@@ -193,10 +229,12 @@ def result_record(result: DesignResult, label: str) -> dict[str, Any]:
                     series_stiffness(design.mechanical_stiffness[i], design.software_stiffness[i])
                 ),
                 "motor_mass": float(design.motor_mass[i]),
+                **duty,
             }
         )
     return {
         "label": label,
+        "requirement": result.requirement,
         "objectives": {k: float(v) for k, v in result.numpy_objectives.items()},
         "casadi_objectives": {k: float(v) for k, v in result.objectives.items()},
         "threshold": float(design.threshold),
@@ -212,6 +250,13 @@ def result_record(result: DesignResult, label: str) -> dict[str, Any]:
             "epsilon": {k: float(v) for k, v in result.epsilon.items()},
         },
     }
+
+
+def _finite_entry(values: np.ndarray | None, index: int) -> float | None:
+    """Entry ``index`` of an optional per-joint array; None where there is no array or no requirement (inf)."""
+    if values is None or not math.isfinite(values[index]):
+        return None
+    return float(values[index])
 
 
 def design_record(
@@ -275,7 +320,8 @@ def record_row(record: Mapping[str, Any], index: int) -> dict[str, Any]:
     row: dict[str, Any] = {"point": index, "label": record["label"]}
     for name, value in record["objectives"].items():
         row[f"{name} [{OBJECTIVES[name][1]}]"] = value
-    for key, unit in JOINT_COLUMNS:
+    columns = JOINT_COLUMNS + (DUTY_COLUMNS if record.get("requirement") == DUTY_REQUIREMENT else ())
+    for key, unit in columns:
         for joint in record["joints"]:
             row[f"{key}[{joint['joint']}] [{unit}]"] = joint[key]
     row[f"threshold [{threshold_unit(record['sensing'])}]"] = record["threshold"]

@@ -12,6 +12,8 @@ import casadi as ca
 import numpy as np
 
 from ..errors import InvalidParameter, SolverFailed
+from .constraints import STATIC_REQUIREMENT
+from .duty import duty_values
 from .evaluate import evaluate_design
 from .objectives import OBJECTIVES
 from .problem import DesignProblem
@@ -94,6 +96,13 @@ class DesignResult:
     impulses: (n_samples,) collision impulse per sample [N*s] (NumPy path).
     required_torque, torque_margin: per joint, the required peak torque [N m] (safety factor included) and
         ``peak_torque / required_torque - 1``.
+    requirement: what sized the torques (:attr:`collision_reflex.optimize.Constraints.requirement`), e.g.
+        ``"static (gravity only)"``.
+    required_rms_torque, rms_margin: per joint, the RMS torque over the duty cycle [N m] and
+        ``N tau_c / RMS - 1``; None without a duty cycle.
+    max_motor_speed, speed_limit, speed_margin: per joint, the motor speed ``N max |qd|`` over the cycle and
+        the approach [rad/s], the motor's maximum speed [rad/s] and ``limit / speed - 1``; None without a duty
+        cycle.
     status, success, iterations, solve_time [s], build_time [s]: solver statistics.
     """
 
@@ -109,6 +118,12 @@ class DesignResult:
     solve_time: float
     build_time: float
     epsilon: dict[str, float] = field(default_factory=dict)
+    requirement: str = STATIC_REQUIREMENT
+    required_rms_torque: np.ndarray | None = None
+    rms_margin: np.ndarray | None = None
+    max_motor_speed: np.ndarray | None = None
+    speed_limit: np.ndarray | None = None
+    speed_margin: np.ndarray | None = None
     x: np.ndarray = field(default_factory=lambda: np.empty(0), repr=False)
     multipliers: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)
 
@@ -259,6 +274,16 @@ def _result(
                 f"CasADi and NumPy evaluations of {name} differ: {a!r} vs {b!r}", RuntimeWarning, stacklevel=3
             )
     required = np.asarray(evaluated[4]).ravel()
+    duty: dict[str, Any] = {}
+    if problem.duty is not None:
+        values = duty_values(problem.duty, design, problem.technology)
+        duty = {
+            "required_rms_torque": values.required_rms_torque,
+            "rms_margin": _margin(values.continuous_torque, values.required_rms_torque),
+            "max_motor_speed": values.max_motor_speed,
+            "speed_limit": values.speed_limit,
+            "speed_margin": _margin(values.speed_limit, values.max_motor_speed),
+        }
     return DesignResult(
         design=design,
         objectives=objectives,
@@ -272,9 +297,17 @@ def _result(
         solve_time=elapsed,
         build_time=problem.build_time,
         epsilon=epsilon,
+        requirement=problem.requirement,
+        **duty,
         x=x,
         multipliers=multipliers,
     )
+
+
+def _margin(capacity: np.ndarray, need: np.ndarray) -> np.ndarray:
+    """``capacity / need - 1`` [-] per joint (infinite where nothing is needed; the record shows None)."""
+    with np.errstate(divide="ignore"):
+        return np.where(need > 0, capacity / np.where(need > 0, need, 1.0) - 1, np.inf)
 
 
 def design_at(problem: DesignProblem, x: np.ndarray) -> Design:

@@ -1,0 +1,343 @@
+"""The duty cycle's requirements on each joint's actuator: peak torque, RMS torque and motor speed.
+
+With a duty cycle (:class:`collision_reflex.arm.DutyCycle`, in :attr:`Constraints.duty_cycle`) joint ``j``
+must meet, over the cycle's samples ``t``:
+
+- peak: ``N_j tau_p,j >= SF max_t |d_j(t)|`` with the joint-side demand ``d_j(t) = tau_j(t) + N_j^2 J_m,j
+  qdd_j(t)`` (:func:`collision_reflex.arm.dynamics.joint_side_torque`). It is affine in ``x_j = [1, m_0, ...,
+  m_{nv-1}, N_j^2 J_m,j]`` (motor masses [kg], reflected rotor inertia [kg m^2]): ``d_j = B_j x_j``, so the
+  peak is the linear rows ``+-SF B_j(t) x_j <= N_j tau_p,j``; rows that can never be the largest within the
+  variable bounds are dropped exactly (:func:`collision_reflex.optimize.constraints.binding_rows`);
+- continuous (thermal): ``N_j tau_c,j >= RMS_t d_j`` as ``x_j^T Q_j x_j / (N_j tau_c,j)^2 <= 1`` (smooth, of
+  order one); no safety factor: the RMS is a thermal average, the safety factor covers the peak;
+- speed: ``N_j max_t |qd_j(t)| <= omega_max,j`` and, for the approach itself, ``N_j v0 max_s |(J_s^+ u_s)_j|
+  <= omega_max,j`` over the contact samples ``s`` (``J_s^+`` the pseudo-inverse of the contact Jacobian: the
+  joint speeds that move the contact point along ``u_s`` at ``v0``). Both are linear in the log design
+  variables (``omega_max`` of the scaled motor is a power law of its size); the approach needs one row per
+  joint, at the sample with the largest joint rate, since ``v0`` is common to all samples.
+
+The motor masses in the demand are the scaled motors' (the optimiser has no gearboxes); the payload is the
+cycle's. :func:`torque_speed_points` gives the cycle's motor-side (speed, torque) points and the approach's
+motor speeds of a design, for a torque-speed figure.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, NamedTuple
+
+import casadi as ca
+import numpy as np
+
+from ..arm.dynamics import CycleTorques, cycle_torques, max_speed, rms, time_weights
+from ..errors import InvalidParameter
+from ..hardware.motors import scaled_motor_quantities
+from .constraints import ConstraintList, binding_rows
+from .samples import ContactSamples
+
+if TYPE_CHECKING:
+    from ..arm.duty_cycle import DutyCycle
+    from ..arm.robot import Arm
+    from .layout import DesignLayout, DesignQuantities
+    from .problem import DesignProblem
+    from .solve import Design
+    from .technology import ActuatorTechnology
+
+PEAK, RMS, SPEED = "peak torque", "RMS torque", "speed"
+"""The duty cycle's constraints, as error messages and labels name them."""
+REACHABLE_TOLERANCE = 0.02
+"""Best margin, found on a grid (:func:`check_reachable`), below which a requirement is refused before solving:
+the grid's step in gear ratio (1/240 of the log range) can underestimate the best margin by about this much."""
+
+
+@dataclass(frozen=True)
+class DutyRequirement:
+    """What a duty cycle asks of every joint, as numbers the constraints are made of.
+
+    torques: the cycle's joint torques, split in the motor masses (:class:`collision_reflex.arm.dynamics.CycleTorques`).
+    approach_rates: (n_samples, nv) joint speeds per unit approach speed, ``J_s^+ u_s`` [rad/m or m/m].
+    safety_factor: the peak torque must be this times the peak demand [-].
+    """
+
+    torques: CycleTorques
+    approach_rates: np.ndarray
+    safety_factor: float
+
+    @property
+    def cycle_speed(self) -> np.ndarray:
+        """``max_t |qd_j(t)|`` per joint over the cycle [rad/s], (nv,)."""
+        return max_speed(self.torques.qd)
+
+    @property
+    def approach_rate(self) -> np.ndarray:
+        """``max_s |(J_s^+ u_s)_j|`` per joint [rad/m], (nv,): joint speed per unit approach speed."""
+        return np.abs(self.approach_rates).max(axis=0)
+
+    def demand(self, motor_mass: np.ndarray, reflected_inertia: np.ndarray) -> np.ndarray:
+        """Joint-side torques over the cycle [N m], (n, nv), for motor masses [kg] and ``N^2 J_m`` [kg m^2]."""
+        return self.torques.demand(motor_mass, reflected_inertia)
+
+    def joint_speed(self, approach_velocity: float) -> np.ndarray:
+        """Largest joint speed over the cycle and the approach at ``approach_velocity`` [m/s], [rad/s] (nv,)."""
+        return np.maximum(self.cycle_speed, approach_velocity * self.approach_rate)
+
+
+class DutyValues(NamedTuple):
+    """A design's requirements and capacities over a duty cycle, per joint (nv,) each.
+
+    required_torque: ``SF max_t |d_j|`` [N m]; required_rms_torque: ``RMS_t d_j`` [N m]; continuous_torque:
+    ``N tau_c`` [N m]; max_motor_speed: ``N`` times the largest joint speed over the cycle and the approach
+    [rad/s]; speed_limit: the scaled motor's maximum speed [rad/s].
+    """
+
+    required_torque: np.ndarray
+    required_rms_torque: np.ndarray
+    continuous_torque: np.ndarray
+    max_motor_speed: np.ndarray
+    speed_limit: np.ndarray
+
+
+class TorqueSpeedPoints(NamedTuple):
+    """One joint's motor-side operating points: the cycle's (speed, torque) and the approach's speeds.
+
+    cycle_speed: (n,) motor speed ``N qd(t)`` [rad/s]; cycle_torque: (n,) motor torque ``d(t) / N`` [N m]
+    (no safety factor); approach_speed: (n_samples,) motor speed ``N v0 |J^+ u|`` of each contact sample
+    [rad/s], signed as the joint moves.
+    """
+
+    cycle_speed: np.ndarray
+    cycle_torque: np.ndarray
+    approach_speed: np.ndarray
+
+
+def approach_joint_rates(samples: ContactSamples) -> np.ndarray:
+    """Joint speeds per unit approach speed ``J_s^+ u_s`` per contact sample, (n_samples, nv) [rad/m or m/m].
+
+    ``J_s`` is the contact Jacobian (task_dim, nv) of sample ``s``'s configuration and ``u_s`` its direction;
+    the pseudo-inverse gives the least-norm joint speeds that move the contact point at unit speed along ``u``.
+    """
+    jacobian = samples.kinematics.jacobian[samples.config_index]
+    return np.einsum("sjd,sd->sj", np.linalg.pinv(jacobian), samples.directions)
+
+
+def duty_requirement(
+    arm: Arm,
+    samples: ContactSamples,
+    cycle: DutyCycle,
+    technology: ActuatorTechnology,
+    safety_factor: float,
+) -> DutyRequirement:
+    """The duty cycle's requirement on ``arm`` (RNEA over the cycle, approach rates over ``samples``).
+
+    Raises
+    ------
+    InvalidParameter: the reference motor has no maximum speed (the speed requirement needs it).
+    """
+    motor = technology.reference_motor
+    if motor.max_speed is None:
+        raise InvalidParameter(
+            "reference_motor.max_speed",
+            None,
+            "a maximum speed [rad/s] when a duty cycle is given",
+            f"motor {motor.name!r} has none: add max_speed to its catalogue entry (e.g. '3000 rpm') or give "
+            "Motor(..., max_speed=...)",
+        )
+    return DutyRequirement(cycle_torques(arm, cycle), approach_joint_rates(samples), float(safety_factor))
+
+
+def peak_rows(
+    duty: DutyRequirement, x_low: np.ndarray, x_high: np.ndarray
+) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Per joint the peak demands that can bind: ``(rows (R, nv + 2), sample index (R,), sign (R,))``.
+
+    Row ``r`` is ``sign SF B_j(t)`` so that ``rows @ x_j <= N tau_p`` is the peak requirement. ``x_low`` and
+    ``x_high`` (nv, nv + 2) bound ``x_j`` per joint (its first entry is 1); rows that can never be the largest
+    within them are dropped (exact, :func:`collision_reflex.optimize.constraints.binding_rows`).
+    """
+    kept = []
+    for j in range(duty.torques.nv):
+        basis = duty.safety_factor * duty.torques.demand_basis(j)
+        rows = np.vstack([basis, -basis])
+        keep = binding_rows(rows[:, 0], rows[:, 1:], x_low[j, 1:], x_high[j, 1:])
+        index = np.tile(np.arange(basis.shape[0]), 2)
+        sign = np.repeat([1.0, -1.0], basis.shape[0])
+        kept.append((rows[keep], index[keep], sign[keep]))
+    return kept
+
+
+def add_duty_constraints(
+    g: ConstraintList,
+    duty: DutyRequirement,
+    design: DesignQuantities,
+    demands: list[tuple[np.ndarray, np.ndarray, np.ndarray]],
+    torque_scale: np.ndarray,
+    joint_names: tuple[str, ...],
+) -> None:
+    """Add the duty cycle's peak, RMS and speed rows to ``g`` (see the module's docstring).
+
+    ``demands``: :func:`peak_rows`; ``torque_scale``: per joint the peak requirement at the start [N m], which
+    the peak rows are divided by.
+    """
+    t = duty.torques.t
+    gear, velocity = design.values["gear_ratio"], design.values["approach_velocity"][0]
+    assert design.max_speed is not None  # duty_requirement checked the reference motor
+    log_limit = ca.log(design.max_speed)
+    for j, name in enumerate(joint_names):
+        x_j = ca.vertcat(1.0, design.motor_mass, design.reflected_inertia[j])
+        rows, index, sign = demands[j]
+        g.add(
+            (design.peak_torque[j] - ca.mtimes(ca.DM(rows), x_j)) / torque_scale[j],
+            0.0,
+            np.inf,
+            [
+                f"peak torque of {name} >= {'+' if s > 0 else '-'}{duty.safety_factor:g} x demand at t = {t[i]:.4g} s"
+                for i, s in zip(index, sign, strict=True)
+            ],
+        )
+        form = ca.DM(duty.torques.rms_form(j))
+        g.add(
+            ca.bilin(form, x_j, x_j) / design.continuous_torque[j] ** 2,
+            -np.inf,
+            1.0,
+            [f"RMS torque of {name} over the cycle <= continuous torque"],
+        )
+    for rate, label, speed in (
+        (duty.cycle_speed, "the cycle", 1.0),
+        (duty.approach_rate, "the approach", velocity),
+    ):
+        moving = np.flatnonzero(rate > 0).tolist()
+        if moving:
+            g.add(
+                ca.log(gear[moving] * speed) + ca.DM(np.log(rate[moving])) - log_limit[moving],
+                -np.inf,
+                0.0,
+                [f"motor speed of {joint_names[j]} over {label} <= its maximum speed" for j in moving],
+            )
+
+
+def duty_values(duty: DutyRequirement, design: Design, technology: ActuatorTechnology) -> DutyValues:
+    """A design's requirements and capacities over the cycle (NumPy; see :class:`DutyValues`)."""
+    motor = scaled_motor_quantities(
+        technology.reference_motor, design.stator_diameter, design.stack_length, technology.scaling_law
+    )
+    demand = duty.demand(design.motor_mass, design.reflected_inertia).T  # (nv, n)
+    return DutyValues(
+        required_torque=duty.safety_factor * np.abs(demand).max(axis=1),
+        required_rms_torque=np.asarray(rms(demand, duty.torques.t), dtype=float),
+        continuous_torque=design.gear_ratio * np.asarray(motor.continuous_torque, dtype=float),
+        max_motor_speed=design.gear_ratio * duty.joint_speed(design.approach_velocity),
+        speed_limit=np.asarray(motor.max_speed, dtype=float) * np.ones(design.gear_ratio.size),
+    )
+
+
+def torque_speed_points(problem: DesignProblem, design: Design) -> tuple[TorqueSpeedPoints, ...]:
+    """Per joint, the motor-side (speed [rad/s], torque [N m]) points of the cycle and the approach's speeds.
+
+    For a torque-speed figure over the motor's envelope (peak and continuous torque, maximum speed). Needs a
+    problem built with a duty cycle.
+    """
+    duty = problem.duty
+    if duty is None:
+        raise InvalidParameter(
+            "problem", "built without a duty cycle", "a problem with Constraints(duty_cycle=...)"
+        )
+    gear = design.gear_ratio
+    demand = duty.demand(design.motor_mass, design.reflected_inertia)
+    approach = design.approach_velocity * duty.approach_rates * gear
+    return tuple(
+        TorqueSpeedPoints(gear[j] * duty.torques.qd[:, j], demand[:, j] / gear[j], approach[:, j])
+        for j in range(duty.torques.nv)
+    )
+
+
+def check_reachable(
+    duty: DutyRequirement,
+    layout: DesignLayout,
+    technology: ActuatorTechnology,
+    mass_low: np.ndarray,
+    mass_high: np.ndarray,
+    joint_names: tuple[str, ...],
+) -> None:
+    """Refuse a requirement no design within the bounds can meet, naming the joint, the constraint and its best margin.
+
+    Per joint its own motor size and gear ratio go over a grid within their bounds (the gear ratio on 241
+    log-spaced values, the diameter on 41, the stack length on 9 when free, the bounds included), and the
+    other motors' masses are taken at their most favourable within ``[mass_low, mass_high]`` [kg] separately at
+    every sample: the margins found are upper bounds of the reachable ones, so a requirement refused here
+    cannot be met. The approach speed is taken at the lowest approach velocity allowed. Refused when the best
+    margin is below ``-REACHABLE_TOLERANCE``: one constraint alone, or peak, RMS and speed together.
+
+    Raises
+    ------
+    InvalidParameter: a requirement that cannot be met; the message names the joint, the constraint and the
+        best margin reachable.
+    """
+    bounds = layout.bounds
+    velocity = bounds["approach_velocity"][0].lower
+    speed_need = duty.joint_speed(velocity)
+    weights = time_weights(duty.torques.t) / float(duty.torques.t[-1] - duty.torques.t[0])
+    for j, name in enumerate(joint_names):
+        basis = duty.torques.demand_basis(j)
+        slopes = basis[:, 1:-1]
+        low = basis[:, 0] + np.minimum(slopes * mass_low, slopes * mass_high).sum(axis=1)
+        high = basis[:, 0] + np.maximum(slopes * mass_low, slopes * mass_high).sum(axis=1)
+        best = _best_margins(duty, technology, bounds, j, (low, high, basis[:, -1]), weights, speed_need[j])
+        labels = (PEAK, RMS, SPEED)
+        for label, value in zip(labels, best[:3], strict=True):
+            if value < -REACHABLE_TOLERANCE:
+                _refuse(name, label, value)
+        if best[3] < -REACHABLE_TOLERANCE:
+            _refuse(name, " and ".join(labels) + " together", best[3])
+
+
+def _best_margins(
+    duty: DutyRequirement,
+    technology: ActuatorTechnology,
+    bounds: dict,
+    joint: int,
+    demand: tuple[np.ndarray, np.ndarray, np.ndarray],
+    weights: np.ndarray,
+    joint_speed: float,
+) -> np.ndarray:
+    """Best (peak, RMS, speed, all three) margins of one joint over the grid of its own variables."""
+
+    def grid(name: str, count: int) -> np.ndarray:
+        b = bounds[name][joint]
+        return np.array([b.lower]) if b.is_fixed else np.geomspace(b.lower, b.upper, count)
+
+    gears = grid("gear_ratio", 241)[:, None]
+    low, high, acceleration = demand
+    best = np.full(4, -np.inf)
+    for length in grid("stack_length", 9):
+        for diameter in grid("stator_diameter", 41):
+            motor = scaled_motor_quantities(
+                technology.reference_motor, diameter, length, technology.scaling_law
+            )
+            rotor = gears**2 * motor.rotor_inertia * acceleration  # (gears, n)
+            # The smallest |demand| at each sample over the other motors' masses (0 if the interval holds 0).
+            least = np.maximum(0.0, np.maximum(low + rotor, -(high + rotor)))
+            margins = np.column_stack(
+                [
+                    _margin(gears[:, 0] * motor.peak_torque, duty.safety_factor * least.max(axis=1)),
+                    _margin(gears[:, 0] * motor.continuous_torque, np.sqrt((least**2) @ weights)),
+                    _margin(np.full(gears.shape[0], motor.max_speed), gears[:, 0] * joint_speed),
+                ]
+            )
+            best[:3] = np.maximum(best[:3], margins.max(axis=0))
+            best[3] = max(best[3], float(margins.min(axis=1).max()))
+    return best
+
+
+def _margin(capacity: np.ndarray, need: np.ndarray) -> np.ndarray:
+    """``capacity / need - 1``, infinite where nothing is needed."""
+    with np.errstate(divide="ignore"):
+        return np.where(need > 0, capacity / np.where(need > 0, need, 1.0) - 1.0, np.inf)
+
+
+def _refuse(joint: str, constraint: str, margin: float) -> None:
+    raise InvalidParameter(
+        f"duty cycle requirement of {joint}",
+        f"{constraint}: best margin reachable {margin:+.1%}",
+        f"a design within the bounds that meets its {constraint} requirement",
+        "widen the motor-size or gear-ratio bounds, or ask for a gentler cycle (slower, lighter payload)",
+    )
