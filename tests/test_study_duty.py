@@ -129,11 +129,22 @@ def test_constraints_payload_is_the_cycles_point_mass(tmp_path):
     np.testing.assert_array_equal(cycle.payload.inertia, np.zeros((3, 3)))
 
 
-def test_duty_cycle_payload_loads_the_static_requirement_too(tmp_path):
+def test_a_duty_cycle_replaces_the_static_requirement(tmp_path):
+    """The optimiser gets the cycle (its RNEA torques carry the payload) instead of the static payload."""
     loaded = load_study(_study(tmp_path, VIA))
     setup = arm_setup(loaded)
-    assert setup.constraints.payload == 1.5
-    assert setup.duty_cycle is not None and not setup.static_torque_requirement
+    assert setup.constraints.duty_cycle is setup.duty_cycle
+    assert setup.duty_cycle is not None and setup.duty_cycle.payload.mass == 1.5
+    assert setup.constraints.payload == 0.0 and setup.constraints.torque_required is None
+    assert not setup.static_torque_requirement and setup.constraints.requirement.startswith("duty cycle")
+
+
+def test_given_torques_and_a_duty_cycle_are_refused_at_their_line(tmp_path):
+    path = _study(tmp_path, VIA + "constraints: {torque_required: [1, 1]}\n")
+    with pytest.raises(
+        StudyFileError, match=r"constraints\.torque_required: found given torques with a duty"
+    ):
+        arm_setup(load_study(path))
 
 
 def test_a_study_without_a_cycle_says_its_requirement_is_static(tmp_path, capsys):

@@ -107,13 +107,33 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
         reaction=study.reaction,
         reflected_inertia_in=study.reflected_inertia_in,
     )
-    payload = payload_of(study)
-    constraints = Constraints(
-        payload=payload.mass if payload is not None else 0.0,  # the one payload (see .duty)
-        safety_factor=study.constraints.safety_factor,
-        torque_required=study.constraints.torque_required,
-        threshold_floor=study.constraints.threshold_floor,
-    )
+    duty_cycle = study_duty_cycle(loaded, arm)
+    if duty_cycle is not None and study.constraints.torque_required is not None:
+        raise StudyFileError(
+            loaded.source.file,
+            [
+                loaded.problem(
+                    ("constraints", "torque_required"),
+                    "given torques with a duty cycle",
+                    "one requirement: remove torque_required (the duty cycle's torques replace it) or the "
+                    "duty_cycle section",
+                )
+            ],
+        )
+    if duty_cycle is not None:  # the cycle's torques (RNEA, payload included) replace the static requirement
+        constraints = Constraints(
+            safety_factor=study.constraints.safety_factor,
+            threshold_floor=study.constraints.threshold_floor,
+            duty_cycle=duty_cycle,
+        )
+    else:
+        payload = payload_of(study)
+        constraints = Constraints(
+            payload=payload.mass if payload is not None else 0.0,  # the one payload (see .duty)
+            safety_factor=study.constraints.safety_factor,
+            torque_required=study.constraints.torque_required,
+            threshold_floor=study.constraints.threshold_floor,
+        )
     configurations = configuration_samples(loaded, arm)
     directions = direction_samples(loaded, arm)
     samples = ContactSamples.grid(arm.kinematics(configurations), directions)
@@ -127,7 +147,7 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
         space,
         technology,
         constraints,
-        duty_cycle=study_duty_cycle(loaded, arm),
+        duty_cycle=duty_cycle,
     )
 
 
