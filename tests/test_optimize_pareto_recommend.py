@@ -110,3 +110,20 @@ def test_single_optimum_refuses_a_bad_start_count_before_building(starts):
 
     with pytest.raises(InvalidParameter, match="starts"):
         single_optimum(None, "worst_case_impulse", starts=starts)  # type: ignore[arg-type]
+
+
+def test_a_front_tie_that_is_worse_in_the_studys_own_objective_does_not_win():
+    """The UR5 case: the front (impulse vs approach velocity) does not weigh mass, the study's objective does.
+    A front point that ties the optimum on the front but is five times heavier must not replace it."""
+    names = ("worst_case_impulse", "approach_velocity")
+    optimum = result(0.6354, 0.3156)
+    heavy_tie = result(0.6354, 1.6411)
+    faster = SimpleNamespace(
+        numpy_objectives={**result(8.67, 1.64).numpy_objectives, "approach_velocity": 0.68}
+    )
+    points = ParetoSet(names, (heavy_tie, faster), labels=("p0", "p1"))
+    weighted = (("actuator_mass", 0.1), ("worst_case_impulse", 1.0))
+    found = recommend(optimum, points, weighted)
+    assert found.result is optimum and found.pareto_index is None
+    # Judged on the front's objectives alone the heavy tie would be "the same point".
+    assert recommend(optimum, points, "worst_case_impulse").pareto_index == 0

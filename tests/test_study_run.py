@@ -549,3 +549,22 @@ def test_crx_run_prints_the_verdict(tmp_path, capsys):
     assert verdict and all(line in printed for line in verdict)
     assert main(["run", str(TWO_LINK), "--out", str(tmp_path / "out"), "--smoke", "--quiet"]) == 0
     assert "Recommended design" not in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("name", ARM_STUDIES, ids=ARM_STUDIES)
+def test_recommended_design_has_no_oversized_joint_unless_at_the_smallest_motor(runs, name):
+    """Issue bar: a peak-torque margin above 3x (margin > 2) only where the motor is at its smallest size (the
+    verdict then says so); every joint with a requirement reports its margin."""
+    results = json.loads((runs[name] / "designs.json").read_text())
+    recommended = results["recommended"]
+    smallest = {joint: bounds[0] for joint, bounds in results["bounds"]["stator_diameter"].items()}
+    verdict = "\n".join(results["verdict"])
+    for joint in recommended["joints"]:
+        required = joint["required_torque"]
+        if required is None or required == 0:
+            assert joint["torque_margin"] is None, joint["joint"]
+            continue
+        assert joint["torque_margin"] is not None and joint["torque_margin"] >= -1e-6, joint["joint"]
+        if joint["torque_margin"] > 2.0:
+            assert joint["stator_diameter"] <= smallest[joint["joint"]] * (1 + 1e-6), joint["joint"]
+            assert f"{joint['joint']}: motor at its smallest size" in verdict

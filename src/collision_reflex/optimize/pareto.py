@@ -19,10 +19,10 @@ import itertools
 import os
 import threading
 import time
-from collections.abc import Callable, Hashable, Mapping, Sequence
+from collections.abc import Callable, Hashable, Iterable, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Executor, Future, wait
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, ParamSpec, Protocol
+from typing import TYPE_CHECKING, Any, ParamSpec, Protocol, cast
 
 import numpy as np
 
@@ -144,13 +144,21 @@ class ParetoSet:
         return indices[0] if indices else None
 
     def all_dominating(
-        self, objectives: Mapping[str, float], tolerance: float = DOMINANCE_TOLERANCE
+        self,
+        objectives: Mapping[str, float],
+        tolerance: float = DOMINANCE_TOLERANCE,
+        names: Sequence[str] | None = None,
     ) -> list[int]:
-        """Indices of every point that dominates a design with these objective values (relative ``tolerance``)."""
+        """Indices of every point that dominates a design with these objective values (relative ``tolerance``).
+
+        ``names``: the objectives judged (default the front's own); every design carries every objective.
+        """
         if not self.points:
             return []
-        values = np.vstack([self.values(), [[objectives[name] for name in self.objectives]]])
-        beaten = _dominance(_minimised(values, self.objectives), tolerance)[:-1, -1]
+        names = tuple(self.objectives if names is None else names)
+        mine = [[objectives[name] for name in names]]
+        values = np.vstack([[[r.numpy_objectives[n] for n in names] for r in self.points], mine])
+        beaten = _dominance(_minimised(values, names), tolerance)[:-1, -1]
         return [int(i) for i in np.flatnonzero(beaten)]
 
     def hypervolume(self, reference: Sequence[float]) -> float:
@@ -630,15 +638,18 @@ def recommend(optimum: DesignResult, front: ParetoSet | None, objective: Hashabl
                 f"Pareto design {best} has a better {objective.replace('_', ' ')} than the single-objective "
                 f"optimum ({theirs:.6g} vs {mine[objective]:.6g} {unit}): the optimum stopped at a local optimum",
             )
+    # Judged on the front's objectives and on the study objective's own: a front point that ties the optimum
+    # on the front but is heavier, say, when the study also weighs mass, does not beat it.
+    judged = tuple(dict.fromkeys([*front.objectives, *_components(objective)]))
     for index, point in enumerate(front.points):
-        if same_point(point.numpy_objectives, mine, front.objectives):
+        if same_point(point.numpy_objectives, mine, judged):
             return Recommendation(
                 point,
                 index,
                 f"the single-objective optimum, which is Pareto design {index} (equal within the solver "
                 f"tolerance, {MERGE_TOLERANCE:g} relative)",
             )
-    beaten_by = front.all_dominating(mine, MERGE_TOLERANCE)
+    beaten_by = front.all_dominating(mine, MERGE_TOLERANCE, judged)
     if beaten_by:
         if isinstance(objective, str) and objective in front.objectives:
             sense = OBJECTIVES[objective][0]
@@ -647,7 +658,7 @@ def recommend(optimum: DesignResult, front: ParetoSet | None, objective: Hashabl
         gaps = ", ".join(
             f"{name.replace('_', ' ')} {front.points[index].numpy_objectives[name]:.6g} vs {mine[name]:.6g} "
             f"{OBJECTIVES[name][1]}"
-            for name in front.objectives
+            for name in judged
         )
         return Recommendation(
             front.points[index],
@@ -656,6 +667,18 @@ def recommend(optimum: DesignResult, front: ParetoSet | None, objective: Hashabl
             f"{MERGE_TOLERANCE:g} relative: {gaps})",
         )
     return Recommendation(optimum, None, "the single-objective optimum; no Pareto design dominates it")
+
+
+def _components(objective: Hashable) -> tuple[str, ...]:
+    """The objective names a study objective weighs: itself, or each name of a weighted sum."""
+    if isinstance(objective, str):
+        return (objective,)
+    pairs: Iterable[tuple[object, object]] = (
+        objective.items()
+        if isinstance(objective, Mapping)
+        else cast("Iterable[tuple[object, object]]", objective)
+    )
+    return tuple(str(name) for name, _ in pairs)
 
 
 def hypervolume(points: np.ndarray, reference: np.ndarray) -> float:
