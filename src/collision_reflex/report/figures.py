@@ -11,11 +11,19 @@ import functools
 import re
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..errors import InvalidParameter
+from .files import ResultsDamaged
 from .outputs import objective_unit
+
+if TYPE_CHECKING:
+    from ..plots.torque_speed import JointOperatingPoints
+
+TORQUE_SPEED_FIELD = "recommended.torque_speed"
+"""Where ``designs.json`` holds the recommended design's torque-speed data (duty-cycle studies only)."""
 
 
 @contextlib.contextmanager
@@ -98,6 +106,13 @@ def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
             title=f"impulse by contact direction [N*s]: {title}",
         )
         svgs[f"surface-{index}"] = _draw(directory, f"impulse_directions_{index}", formats, draw)
+    joints = recommended_torque_speed(results)
+    if joints is not None:
+        from ..plots.torque_speed import plot_torque_speed
+
+        svgs["torque_speed"] = _draw(
+            directory, "torque_speed", formats, lambda path: plot_torque_speed(path, joints)
+        )
     records = [("chosen", chosen)] + [(str(i), p) for i, p in enumerate(pareto["points"])]
     worst = [int(np.argmax(r["impulses"])) for _, r in records]
     svgs["phases"] = _draw(
@@ -114,6 +129,40 @@ def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
         ),
     )
     return svgs
+
+
+def recommended_torque_speed(results: dict[str, Any]) -> list[JointOperatingPoints] | None:
+    """The recommended design's saved torque-speed data, one entry per joint; None without a duty cycle.
+
+    Raises
+    ------
+    ResultsDamaged
+        The study has a duty cycle and :data:`TORQUE_SPEED_FIELD` is missing, or an entry is not a joint's
+        data as the run writes it (the message names the field).
+    """
+    from ..plots.torque_speed import JointOperatingPoints
+    from ..study.arm_results import DUTY_CYCLE_REQUIREMENT, JointTorqueSpeed
+
+    recommended = results.get("recommended")
+    saved = recommended.get("torque_speed") if isinstance(recommended, dict) else None
+    if saved is None:
+        if results.get("requirement") == DUTY_CYCLE_REQUIREMENT:
+            raise ResultsDamaged(f"{TORQUE_SPEED_FIELD} is missing although the study has a duty cycle")
+        return None
+    if not isinstance(saved, list) or not saved:
+        raise ResultsDamaged(f"{TORQUE_SPEED_FIELD} is not a list of joints' data")
+    fields = set(JointTorqueSpeed.__annotations__)
+    joints = []
+    for index, entry in enumerate(saved):
+        where = f"{TORQUE_SPEED_FIELD}[{index}]"
+        if not isinstance(entry, dict) or set(entry) != fields:
+            found = sorted(entry) if isinstance(entry, dict) else type(entry).__name__
+            raise ResultsDamaged(f"{where} has fields {found}, expected {sorted(fields)}")
+        try:
+            joints.append(JointOperatingPoints(**entry))
+        except InvalidParameter as error:
+            raise ResultsDamaged(f"{where}: {error}") from None
+    return joints
 
 
 def _words(name: str) -> str:
