@@ -20,7 +20,7 @@ from ..optimize.space import GLOBAL_VARIABLES, PER_JOINT_VARIABLES
 from .arm_setup import ArmSetup, SampleLayout, StudyProblems, sample_layout
 
 if TYPE_CHECKING:
-    from ..optimize import DesignResult, DesignProblem, ParetoSet
+    from ..optimize import DesignProblem, DesignResult, ParetoSet
 
 STATIC_REQUIREMENT = "static (gravity only)"
 """The torque requirement when the study gives no duty cycle: gravity (and payload) over the samples."""
@@ -28,8 +28,8 @@ DUTY_CYCLE_REQUIREMENT = "duty cycle"
 """The torque requirement when the study gives a duty cycle: the motion's peak, RMS and speed."""
 GIVEN_REQUIREMENT = "given per joint"
 """The torque requirement when the study gives each joint's required torque (``constraints.torque_required``)."""
-SAVED_DIGITS = 6
-"""Significant digits of the saved torque-speed data (compact; far finer than a figure can show)."""
+SAVED_DIGITS = 7
+"""Significant digits of the saved torque-speed data: compact, and within 5e-7 relative of the computed points."""
 
 
 class ParetoRecord(TypedDict):
