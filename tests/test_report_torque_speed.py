@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import shutil
 from pathlib import Path
@@ -14,6 +15,7 @@ from collision_reflex.cli import main
 from collision_reflex.optimize.duty import torque_speed_points
 from collision_reflex.optimize.pareto import built_problem
 from collision_reflex.optimize.solve import Design
+from collision_reflex.plots.torque_speed import JointOperatingPoints
 from collision_reflex.study.arm_results import SAVED_DIGITS, JointTorqueSpeed
 from collision_reflex.study.arm_setup import StudyProblems
 
@@ -90,7 +92,10 @@ def test_saved_points_are_the_recomputed_ones_and_the_envelope_is_the_records(ru
     recommended = results["recommended"]
     saved = recommended["torque_speed"]
     assert [entry["joint"] for entry in saved] == [j["joint"] for j in recommended["joints"]]
-    assert all(set(entry) == set(JointTorqueSpeed.__annotations__) for entry in saved)
+    # The saved layout is what the figure reads: JointOperatingPoints's fields.
+    fields = {field.name for field in dataclasses.fields(JointOperatingPoints)}
+    assert set(JointTorqueSpeed.__annotations__) == fields
+    assert all(set(entry) == fields for entry in saved)
     problems = StudyProblems((folder / "study.resolved.yaml").read_text(encoding="utf-8"))
     problem = built_problem(problems, problems.objective)
     points = torque_speed_points(problem, _recorded_design(recommended))

@@ -7,6 +7,7 @@ HTML report.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import functools
 import re
 from collections.abc import Callable, Iterator
@@ -131,8 +132,18 @@ def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
     return svgs
 
 
+def has_duty_cycle(results: dict[str, Any]) -> bool:
+    """Whether the recommended design was sized by a duty cycle (its record's ``requirement``)."""
+    from ..optimize.constraints import DUTY_REQUIREMENT
+
+    recommended = results.get("recommended")
+    return isinstance(recommended, dict) and recommended.get("requirement") == DUTY_REQUIREMENT
+
+
 def recommended_torque_speed(results: dict[str, Any]) -> list[JointOperatingPoints] | None:
     """The recommended design's saved torque-speed data, one entry per joint; None without a duty cycle.
+
+    Each entry holds :class:`~collision_reflex.plots.torque_speed.JointOperatingPoints`'s fields.
 
     Raises
     ------
@@ -141,23 +152,22 @@ def recommended_torque_speed(results: dict[str, Any]) -> list[JointOperatingPoin
         data as the run writes it (the message names the field).
     """
     from ..plots.torque_speed import JointOperatingPoints
-    from ..study.arm_results import DUTY_CYCLE_REQUIREMENT, JointTorqueSpeed
 
     recommended = results.get("recommended")
     saved = recommended.get("torque_speed") if isinstance(recommended, dict) else None
     if saved is None:
-        if results.get("requirement") == DUTY_CYCLE_REQUIREMENT:
+        if has_duty_cycle(results):
             raise ResultsDamaged(f"{TORQUE_SPEED_FIELD} is missing although the study has a duty cycle")
         return None
     if not isinstance(saved, list) or not saved:
         raise ResultsDamaged(f"{TORQUE_SPEED_FIELD} is not a list of joints' data")
-    fields = set(JointTorqueSpeed.__annotations__)
+    expected = sorted(field.name for field in dataclasses.fields(JointOperatingPoints))
     joints = []
     for index, entry in enumerate(saved):
         where = f"{TORQUE_SPEED_FIELD}[{index}]"
-        if not isinstance(entry, dict) or set(entry) != fields:
+        if not isinstance(entry, dict) or sorted(entry) != expected:
             found = sorted(entry) if isinstance(entry, dict) else type(entry).__name__
-            raise ResultsDamaged(f"{where} has fields {found}, expected {sorted(fields)}")
+            raise ResultsDamaged(f"{where} has fields {found}, expected {expected}")
         try:
             joints.append(JointOperatingPoints(**entry))
         except InvalidParameter as error:
