@@ -568,3 +568,27 @@ def test_recommended_design_has_no_oversized_joint_unless_at_the_smallest_motor(
         if joint["torque_margin"] > 2.0:
             assert joint["stator_diameter"] <= smallest[joint["joint"]] * (1 + 1e-6), joint["joint"]
             assert f"{joint['joint']}: motor at its smallest size" in verdict
+
+
+@pytest.mark.parametrize("name", ARM_STUDIES, ids=ARM_STUDIES)
+def test_torque_speed_figure_exactly_for_duty_cycle_studies(runs, name):
+    from collision_reflex.study.arm_results import DUTY_CYCLE_REQUIREMENT
+
+    folder = runs[name]
+    results = json.loads((folder / "designs.json").read_text())
+    html = (folder / "report.html").read_text()
+    recommended = results["recommended"]
+    if results["requirement"] == DUTY_CYCLE_REQUIREMENT:
+        saved = recommended["torque_speed"]
+        assert [e["joint"] for e in saved] == [j["joint"] for j in recommended["joints"]]
+        # The record's margins are the saved points' (motor side: peak torque over the largest cycle torque).
+        factor = results["resolved"]["constraints"]["safety_factor"]
+        for entry, joint in zip(saved, recommended["joints"], strict=True):
+            largest = factor * max(abs(t) for t in entry["torque"]) * joint["gear_ratio"]
+            assert largest == pytest.approx(joint["required_torque"], rel=1e-6), joint["joint"]
+        assert (folder / "figures" / "torque_speed.png").is_file()
+        assert 'id="torque-speed"' in html
+    else:
+        assert "torque_speed" not in recommended
+        assert not (folder / "figures" / "torque_speed.png").exists()
+        assert 'id="torque-speed-none"' in html

@@ -7,15 +7,24 @@ HTML report.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import functools
 import re
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..errors import InvalidParameter
+from .files import ResultsDamaged
 from .outputs import objective_unit
+
+if TYPE_CHECKING:
+    from ..plots.torque_speed import JointOperatingPoints
+
+TORQUE_SPEED_FIELD = "recommended.torque_speed"
+"""Where ``designs.json`` holds the recommended design's torque-speed data (duty-cycle studies only)."""
 
 
 @contextlib.contextmanager
@@ -98,6 +107,13 @@ def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
             title=f"impulse by contact direction [N*s]: {title}",
         )
         svgs[f"surface-{index}"] = _draw(directory, f"impulse_directions_{index}", formats, draw)
+    joints = recommended_torque_speed(results)
+    if joints is not None:
+        from ..plots.torque_speed import plot_torque_speed
+
+        svgs["torque_speed"] = _draw(
+            directory, "torque_speed", formats, lambda path: plot_torque_speed(path, joints)
+        )
     records = [("chosen", chosen)] + [(str(i), p) for i, p in enumerate(pareto["points"])]
     worst = [int(np.argmax(r["impulses"])) for _, r in records]
     svgs["phases"] = _draw(
@@ -114,6 +130,49 @@ def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
         ),
     )
     return svgs
+
+
+def has_duty_cycle(results: dict[str, Any]) -> bool:
+    """Whether the recommended design was sized by a duty cycle (its record's ``requirement``)."""
+    from ..optimize.constraints import DUTY_REQUIREMENT
+
+    recommended = results.get("recommended")
+    return isinstance(recommended, dict) and recommended.get("requirement") == DUTY_REQUIREMENT
+
+
+def recommended_torque_speed(results: dict[str, Any]) -> list[JointOperatingPoints] | None:
+    """The recommended design's saved torque-speed data, one entry per joint; None without a duty cycle.
+
+    Each entry holds :class:`~collision_reflex.plots.torque_speed.JointOperatingPoints`'s fields.
+
+    Raises
+    ------
+    ResultsDamaged
+        The study has a duty cycle and :data:`TORQUE_SPEED_FIELD` is missing, or an entry is not a joint's
+        data as the run writes it (the message names the field).
+    """
+    from ..plots.torque_speed import JointOperatingPoints
+
+    recommended = results.get("recommended")
+    saved = recommended.get("torque_speed") if isinstance(recommended, dict) else None
+    if saved is None:
+        if has_duty_cycle(results):
+            raise ResultsDamaged(f"{TORQUE_SPEED_FIELD} is missing although the study has a duty cycle")
+        return None
+    if not isinstance(saved, list) or not saved:
+        raise ResultsDamaged(f"{TORQUE_SPEED_FIELD} is not a list of joints' data")
+    expected = sorted(field.name for field in dataclasses.fields(JointOperatingPoints))
+    joints = []
+    for index, entry in enumerate(saved):
+        where = f"{TORQUE_SPEED_FIELD}[{index}]"
+        if not isinstance(entry, dict) or sorted(entry) != expected:
+            found = sorted(entry) if isinstance(entry, dict) else type(entry).__name__
+            raise ResultsDamaged(f"{where} has fields {found}, expected {expected}")
+        try:
+            joints.append(JointOperatingPoints(**entry))
+        except InvalidParameter as error:
+            raise ResultsDamaged(f"{where}: {error}") from None
+    return joints
 
 
 def _words(name: str) -> str:

@@ -19,6 +19,10 @@ class ResultsMissing(CollisionReflexError, FileNotFoundError):
     """A folder has no saved results to report on."""
 
 
+class ResultsDamaged(CollisionReflexError, ValueError):
+    """A field of the saved results is missing or not what the run writes; the message names the field."""
+
+
 def write_json(path: str | os.PathLike[str], data: object) -> None:
     """Write ``data`` as JSON, atomically (NaN refused: it is never a valid result)."""
     with atomic_open(path, "w", encoding="utf-8") as handle:

@@ -108,11 +108,13 @@ def render_html(results: dict[str, Any], rows: list[dict[str, Any]], svgs: dict[
         "version": __version__,
     }
     if results["kind"] == "arm":
+        from .figures import has_duty_cycle
         from .verdict import verdict
 
         # Redone from the record (the same function wrote designs.json's ``verdict``), so that a report
         # re-rendered from an edited designs.json says what its numbers say.
         context["verdict"] = verdict(results)
+        context["duty_cycle"] = has_duty_cycle(results)
         context["velocity"] = {
             "chosen": _velocity_summary(results["chosen"]),
             **{str(i): _velocity_summary(p) for i, p in enumerate(results["pareto"]["points"])},

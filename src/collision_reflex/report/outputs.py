@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import CollisionReflexError
-from .files import DESIGNS, PARETO, REPORT, ResultsMissing, read_json, write_json, write_text
+from .files import DESIGNS, PARETO, REPORT, ResultsDamaged, ResultsMissing, read_json, write_json, write_text
 
 
 def objective_unit(name: str) -> str:
@@ -81,6 +81,13 @@ def render_report(
     """Redraw the figures and rewrite the report from the results saved in ``folder``.
 
     Writes ``report.html`` (and ``report.pdf`` if the study asks).
+
+    Raises
+    ------
+    ResultsMissing
+        ``folder`` has no readable ``designs.json``.
+    ResultsDamaged
+        A field the report draws from is missing or damaged (the message names the file and the field).
     """
     from .figures import draw_figures
     from .html import render_html
@@ -97,12 +104,15 @@ def render_report(
         except ValueError as error:
             raise ResultsMissing(f"{path} cannot be read ({error}); run the study again") from None
     assert results is not None
-    svgs = (
-        draw_figures(folder / "figures", results, results["resolved"]["outputs"]["figures"])
-        if figures
-        else {}
-    )
-    html = render_html(results, pareto_rows(results), svgs)
+    try:
+        svgs = (
+            draw_figures(folder / "figures", results, results["resolved"]["outputs"]["figures"])
+            if figures
+            else {}
+        )
+        html = render_html(results, pareto_rows(results), svgs)
+    except ResultsDamaged as error:
+        raise ResultsDamaged(f"{folder / DESIGNS}: {error}; run the study again") from None
     write_text(folder / REPORT, html)
     if results["resolved"]["outputs"]["pdf"]:
         from .pdf import html_to_pdf

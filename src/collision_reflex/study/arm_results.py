@@ -2,20 +2,25 @@
 
 The record holds the chosen design (the single-objective optimum as solved), the recommended design and why,
 the Pareto front as the optimiser decided it, the bounds the designs were solved within, the torque
-requirement's kind, and where each contact sample comes from.
+requirement's kind, and where each contact sample comes from. With a duty cycle, the recommended design
+also holds its torque-speed data (``recommended.torque_speed``, :func:`torque_speed_record`).
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any, TypedDict
 
+import numpy as np
+
+from ..hardware.motors import scaled_motor_quantities
+from ..optimize.duty import torque_speed_points
 from ..optimize.pareto import MERGE_TOLERANCE, built_problem, recommend
 from ..optimize.results import design_record
 from ..optimize.space import GLOBAL_VARIABLES, PER_JOINT_VARIABLES
 from .arm_setup import ArmSetup, SampleLayout, StudyProblems, sample_layout
 
 if TYPE_CHECKING:
-    from ..optimize import DesignResult, ParetoSet
+    from ..optimize import DesignProblem, DesignResult, ParetoSet
 
 STATIC_REQUIREMENT = "static (gravity only)"
 """The torque requirement when the study gives no duty cycle: gravity (and payload) over the samples."""
@@ -23,6 +28,8 @@ DUTY_CYCLE_REQUIREMENT = "duty cycle"
 """The torque requirement when the study gives a duty cycle: the motion's peak, RMS and speed."""
 GIVEN_REQUIREMENT = "given per joint"
 """The torque requirement when the study gives each joint's required torque (``constraints.torque_required``)."""
+SAVED_DIGITS = 7
+"""Significant digits of the saved torque-speed data: compact, and within 5e-7 relative of the computed points."""
 
 
 class ParetoRecord(TypedDict):
@@ -57,6 +64,68 @@ class ArmResults(TypedDict):
     requirement: str
 
 
+class JointTorqueSpeed(TypedDict):
+    """One joint's saved torque-speed data, motor side, named as :class:`~collision_reflex.plots.torque_speed.JointOperatingPoints`'s fields.
+
+    ``speed`` [rad/s] and ``torque`` [N*m]: the duty cycle's motor speed ``N qd(t)`` and torque ``d(t) / N``
+    (signed, no safety factor); ``approach_speed`` [rad/s]: the approach's motor speed at each contact sample;
+    the envelope ``peak_torque`` and ``continuous_torque`` [N*m] and ``max_speed`` [rad/s] (None when the
+    catalogue gives none); ``rms_torque`` [N*m]: the cycle's RMS motor torque. Rounded to
+    :data:`SAVED_DIGITS` significant digits.
+    """
+
+    joint: str
+    speed: list[float]
+    torque: list[float]
+    approach_speed: list[float]
+    peak_torque: float
+    continuous_torque: float
+    max_speed: float | None
+    rms_torque: float
+
+
+def _rounded(values: Any) -> list[float]:
+    """``values`` flattened to floats rounded to :data:`SAVED_DIGITS` significant digits."""
+    return [float(f"{v:.{SAVED_DIGITS}g}") for v in np.asarray(values, dtype=float).ravel()]
+
+
+def torque_speed_record(problem: DesignProblem, result: DesignResult) -> list[JointTorqueSpeed] | None:
+    """Per joint, a design's motor-side torque-speed data for the report's figure; None without a duty cycle.
+
+    The points are :func:`collision_reflex.optimize.duty.torque_speed_points`; the envelope is the scaled
+    motor's (:func:`collision_reflex.hardware.motors.scaled_motor_quantities`); the RMS motor torque is the
+    record's joint-side RMS divided by the gear ratio.
+    """
+    if problem.duty is None or result.required_rms_torque is None:
+        return None
+    design = result.design
+    technology = problem.technology
+    motor = scaled_motor_quantities(
+        technology.reference_motor, design.stator_diameter, design.stack_length, technology.scaling_law
+    )
+    n = len(design.joint_names)
+    continuous = np.broadcast_to(np.asarray(motor.continuous_torque, dtype=float), (n,))
+    max_speed = None if motor.max_speed is None else np.broadcast_to(np.asarray(motor.max_speed, float), (n,))
+    rms_torque = np.asarray(result.required_rms_torque, dtype=float) / design.gear_ratio
+    out: list[JointTorqueSpeed] = []
+    for j, (name, points) in enumerate(
+        zip(design.joint_names, torque_speed_points(problem, design), strict=True)
+    ):
+        out.append(
+            {
+                "joint": name,
+                "speed": _rounded(points.cycle_speed),
+                "torque": _rounded(points.cycle_torque),
+                "approach_speed": _rounded(points.approach_speed),
+                "peak_torque": _rounded(design.motor_peak_torque[j])[0],
+                "continuous_torque": _rounded(continuous[j])[0],
+                "max_speed": None if max_speed is None else _rounded(max_speed[j])[0],
+                "rms_torque": _rounded(rms_torque[j])[0],
+            }
+        )
+    return out
+
+
 def design_bounds(setup: ArmSetup) -> dict[str, Any]:
     """The bounds every design of the study was solved within, as plain data [SI units]."""
     joints = list(setup.arm.joint_names)
@@ -88,7 +157,8 @@ def arm_results(problems: StudyProblems, chosen: DesignResult, front: ParetoSet 
     The chosen design (the optimum of the study's objective, as solved) records ``dominated_by``: the index of
     a Pareto design that dominates it, or None. The recommended design
     (:func:`collision_reflex.optimize.pareto.recommend`) records ``source`` (``optimum`` or ``Pareto design
-    <i>``), ``pareto_index`` and ``reason``.
+    <i>``), ``pareto_index`` and ``reason``, and with a duty cycle its ``torque_speed``
+    (:func:`torque_speed_record`).
     """
     setup = problems.setup
     # Every problem of a study shares its samples and technology: one of them evaluates every record.
@@ -121,6 +191,9 @@ def arm_results(problems: StudyProblems, chosen: DesignResult, front: ParetoSet 
     recommended.update(
         source=recommendation.source, pareto_index=recommendation.pareto_index, reason=recommendation.reason
     )
+    torque_speed = torque_speed_record(problem, recommendation.result)
+    if torque_speed is not None:
+        recommended["torque_speed"] = torque_speed
     return {
         "samples": sample_layout(setup),
         "chosen": chosen_record,
