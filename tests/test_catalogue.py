@@ -186,7 +186,9 @@ def test_reference_motor_unchanged():
 
 def test_torque_constant_read_with_units(tmp_path):
     entry = GOOD.replace("    source:", "    torque_constant: 75 mN*m/A\n    source:")
-    assert cr.load_catalogue(_write(tmp_path, entry))["small"].torque_constant == pytest.approx(0.075, rel=1e-12)
+    assert cr.load_catalogue(_write(tmp_path, entry))["small"].torque_constant == pytest.approx(
+        0.075, rel=1e-12
+    )
     assert cr.load_catalogue(_write(tmp_path, GOOD))["small"].torque_constant is None
 
 
@@ -204,7 +206,9 @@ PROVENANCE_BAD = {
         "empty",
     ),
     "sourced-and-estimated": (
-        GOOD.replace("    source:", "    sources:\n      mass: sheet\n    estimates:\n      mass: guess\n    source:"),
+        GOOD.replace(
+            "    source:", "    sources:\n      mass: sheet\n    estimates:\n      mass: guess\n    source:"
+        ),
         12,
         "motors.small.estimates.mass",
         "sourced or estimated",

@@ -124,7 +124,12 @@ GEARBOX_BAD = {
         "exactly one",
     ),
     "unknown-kind": (GEARBOX.replace("planetary", "worm"), 3, "gearboxes.small.kind", "one of"),
-    "unknown-field": (GEARBOX.replace("    source:", "    colour: red\n    source:"), 11, "colour", "unknown"),
+    "unknown-field": (
+        GEARBOX.replace("    source:", "    colour: red\n    source:"),
+        11,
+        "colour",
+        "unknown",
+    ),
 }
 
 

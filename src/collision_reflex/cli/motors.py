@@ -102,7 +102,9 @@ def _print_gearboxes(gearboxes: dict[str, CatalogueGearbox]) -> None:
     )
     for name, gearbox in gearboxes.items():
         low, high = gearbox.ratio_range
-        ratios = f"{low:g}..{high:g}" if gearbox.continuous_ratio else ",".join(f"{r:g}" for r in gearbox.ratios)
+        ratios = (
+            f"{low:g}..{high:g}" if gearbox.continuous_ratio else ",".join(f"{r:g}" for r in gearbox.ratios)
+        )
         efficiency = "unknown" if gearbox.efficiency is None else f"{gearbox.efficiency:.3g}"
         print(
             f"{name:<14}{gearbox.kind:<11}{ratios:<22}{gearbox.rated_torque:>12.4g}{gearbox.peak_torque:>11.4g}"

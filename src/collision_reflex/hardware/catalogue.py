@@ -292,7 +292,9 @@ def read_entries(path: Path, kind: str = "motors") -> dict[str, CatalogueEntry]:
     unknown = sorted(set(top) - {kind})
     if unknown:
         key_node, _ = top[unknown[0]]
-        raise CatalogueError(name, _line(key_node), unknown[0], f"unknown top-level key; only {kind!r} is allowed")
+        raise CatalogueError(
+            name, _line(key_node), unknown[0], f"unknown top-level key; only {kind!r} is allowed"
+        )
     _, parts_node = top[kind]
     if not isinstance(parts_node, yaml.MappingNode):
         raise CatalogueError(name, _line(parts_node), kind, "expected a mapping from part name to entry")
@@ -342,18 +344,25 @@ def _entry(file: str, kind: str, part: str, key_node: Any, entry_node: Any) -> C
     return CatalogueEntry(values, _provenance(file, where, fields, entry, given), _line(key_node))
 
 
-def _check_ratios(values: dict[str, Any], fields: dict[str, Any], refuse: Any, file: str, key: Any, where: str) -> None:
+def _check_ratios(
+    values: dict[str, Any], fields: dict[str, Any], refuse: Any, file: str, key: Any, where: str
+) -> None:
     """A gearbox gives exactly one of ``ratios`` (a list) and ``ratio_range`` (min, max, not inverted)."""
     if (values["ratios"] is None) == (values["ratio_range"] is None):
         raise CatalogueError(
-            file, _line(key), f"{where}.ratios", "give exactly one of 'ratios' (a list) or 'ratio_range' [min, max]"
+            file,
+            _line(key),
+            f"{where}.ratios",
+            "give exactly one of 'ratios' (a list) or 'ratio_range' [min, max]",
         )
     low_high = values["ratio_range"]
     if low_high is not None and (len(low_high) != 2 or low_high[0] > low_high[1]):
         raise refuse("ratio_range", f"expected [min, max] with min <= max, got {low_high!r}")
 
 
-def _provenance(file: str, where: str, fields: dict[str, Any], entry: _Cited, given: list[str]) -> dict[str, str]:
+def _provenance(
+    file: str, where: str, fields: dict[str, Any], entry: _Cited, given: list[str]
+) -> dict[str, str]:
     """Field -> its source or estimate; per-field keys must name given fields, and not both at once."""
     for table in ("sources", "estimates"):
         if table not in fields:
@@ -362,15 +371,23 @@ def _provenance(file: str, where: str, fields: dict[str, Any], entry: _Cited, gi
             key, text = str(key_node.value), _plain(value_node)
             if key not in given:
                 raise CatalogueError(
-                    file, _line(key_node), f"{where}.{table}.{key}", f"names no field of this entry ({', '.join(given)})"
+                    file,
+                    _line(key_node),
+                    f"{where}.{table}.{key}",
+                    f"names no field of this entry ({', '.join(given)})",
                 )
             if not str(text).strip():
-                raise CatalogueError(file, _line(key_node), f"{where}.{table}.{key}", "empty: say where or how")
+                raise CatalogueError(
+                    file, _line(key_node), f"{where}.{table}.{key}", "empty: say where or how"
+                )
     both = sorted(set(entry.sources) & set(entry.estimates))
     if both:
         key_node = next(k for k, _ in fields["estimates"][1].value if k.value == both[0])
         raise CatalogueError(
-            file, _line(key_node), f"{where}.estimates.{both[0]}", "also has a source: a field is sourced or estimated"
+            file,
+            _line(key_node),
+            f"{where}.estimates.{both[0]}",
+            "also has a source: a field is sourced or estimated",
         )
     return {
         field: f"ESTIMATE: {entry.estimates[field]}"
