@@ -34,11 +34,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     options.add_catalogue(parser)
     parser.add_argument(
         "--gearboxes",
-        nargs="?",
-        const="",
-        default=None,
-        metavar="FILE",
-        help="also list a gearbox catalogue (default file: the packaged designs/gearboxes.yaml)",
+        action="store_true",
+        help="also list the packaged gearbox catalogue, designs/gearboxes.yaml",
     )
     parser.set_defaults(run=run_list)
     actions = parser.add_subparsers(dest="motors_command", metavar="ACTION")
@@ -88,9 +85,9 @@ def run_list(args: argparse.Namespace) -> int:
     print()
     for name, motor in catalogue.items():
         print(f"{name}: {motor.source}")
-    if args.gearboxes is not None:
+    if args.gearboxes:
         print()
-        _print_gearboxes(load_gearbox_catalogue(args.gearboxes or None))
+        _print_gearboxes(load_gearbox_catalogue())
     return 0
 
 
