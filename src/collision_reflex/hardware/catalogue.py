@@ -334,7 +334,7 @@ def _entry(file: str, kind: str, part: str, key_node: Any, entry_node: Any) -> C
 
     values = entry.model_dump()
     for lower, upper in (("continuous_torque", "peak_torque"), ("rated_torque", "peak_torque")):
-        if values.get(lower) is not None and lower in values and values[lower] > values[upper]:
+        if values.get(lower) is not None and values[lower] > values[upper]:
             raise refuse(lower, f"{values[lower]:g} N m exceeds the peak torque {values[upper]:g} N m")
     if values.get("momentary_torque") is not None and values["momentary_torque"] < values["peak_torque"]:
         raise refuse("momentary_torque", "is below the (repeated) peak torque")

@@ -8,6 +8,9 @@ described by a real one (its own mass, inertia and rated torque at its size, wit
 between makers for one default to be honest, and the paper ignores gearbox inertia (as does
 :class:`~collision_reflex.hardware.actuators.Actuator` unless asked).
 
+Real gearboxes one can buy are :class:`CatalogueGearbox` entries of ``designs/gearboxes.yaml``
+(:func:`load_gearbox_catalogue`), each figure with its source.
+
 Inertia convention: ``inertia`` is the gearbox's own inertia seen at its input (motor) shaft [kg m^2], so its
 reflected inertia at the output is ``N**2 inertia`` (the table's ``l r^4 N^2``); a ball screw's ``inertia`` is
 already the reflected one (the table's ``l r^4``, without ``N``).
