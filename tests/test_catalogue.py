@@ -135,3 +135,98 @@ def test_unknown_motor_lists_the_catalogue():
 
     with pytest.raises(cr.UnknownMotor, match="OPN-060-013-A"):
         get_motor("OPN-999")
+
+
+def _given_fields(path, kind):
+    """Field names written in each entry of a catalogue file (provenance keys excluded), read independently."""
+    import yaml
+
+    entries = yaml.safe_load(path.read_text())[kind]
+    return {name: set(entry) - {"source", "sources", "estimates"} for name, entry in entries.items()}
+
+
+@pytest.mark.parametrize("kind, file", [("motors", "motors.yaml"), ("gearboxes", "gearboxes.yaml")])
+def test_every_packaged_field_has_a_source_or_an_estimate(kind, file):
+    from collision_reflex.hardware.catalogue import packaged_catalogue_path, read_entries
+
+    path = packaged_catalogue_path(file)
+    entries = read_entries(path, kind)
+    given = _given_fields(path, kind)
+    assert entries and set(entries) == set(given)
+    for name, entry in entries.items():
+        assert set(entry.provenance) == given[name], name
+        for field, text in entry.provenance.items():
+            origin, _, detail = text.partition(": ")
+            assert origin in ("source", "ESTIMATE") and len(detail.strip()) > 10, (name, field, text)
+
+
+def test_reference_motor_estimates_are_marked():
+    from collision_reflex.hardware.catalogue import packaged_catalogue_path, read_entries
+
+    provenance = read_entries(packaged_catalogue_path(), "motors")["OPN-060-013-A"].provenance
+    assert provenance["mass"].startswith("ESTIMATE: active-part volume")
+    assert provenance["max_speed"].startswith("ESTIMATE: a 10 m/s rotor surface speed")
+    assert provenance["rotor_inertia"].startswith("source: Bhatia, Mason, Johnson")
+
+
+def test_reference_motor_unchanged():
+    motor = cr.load_catalogue()["OPN-060-013-A"]
+    expected = (0.060, 0.0125, 2.21e-5, 1.3, 0.524, 0.195, 492.6)
+    got = (
+        motor.stator_diameter,
+        motor.stack_length,
+        motor.rotor_inertia,
+        motor.peak_torque,
+        motor.continuous_torque,
+        motor.mass,
+        motor.max_speed,
+    )
+    assert got == pytest.approx(expected, rel=1e-12)
+
+
+def test_torque_constant_read_with_units(tmp_path):
+    entry = GOOD.replace("    source:", "    torque_constant: 75 mN*m/A\n    source:")
+    assert cr.load_catalogue(_write(tmp_path, entry))["small"].torque_constant == pytest.approx(
+        0.075, rel=1e-12
+    )
+    assert cr.load_catalogue(_write(tmp_path, GOOD))["small"].torque_constant is None
+
+
+PROVENANCE_BAD = {
+    "source-of-absent-field": (
+        GOOD.replace("    source:", "    sources:\n      max_speed: a datasheet\n    source:"),
+        10,
+        "motors.small.sources.max_speed",
+        "names no field",
+    ),
+    "empty-estimate": (
+        GOOD.replace("    source:", "    estimates:\n      mass: ''\n    source:"),
+        10,
+        "motors.small.estimates.mass",
+        "empty",
+    ),
+    "sourced-and-estimated": (
+        GOOD.replace(
+            "    source:", "    sources:\n      mass: sheet\n    estimates:\n      mass: guess\n    source:"
+        ),
+        12,
+        "motors.small.estimates.mass",
+        "sourced or estimated",
+    ),
+    "no-source-key": (GOOD.replace("    source: a test entry\n", ""), 2, "motors.small.source", "missing"),
+    "torque-constant-wrong-unit": (
+        GOOD.replace("    source:", "    torque_constant: 3 N*m\n    source:"),
+        9,
+        "motors.small.torque_constant",
+        "cannot be converted",
+    ),
+}
+
+
+@pytest.mark.parametrize("text, line, field, words", PROVENANCE_BAD.values(), ids=PROVENANCE_BAD.keys())
+def test_bad_provenance_names_field_and_line(tmp_path, text, line, field, words):
+    path = _write(tmp_path, text)
+    with pytest.raises(cr.CatalogueError) as info:
+        cr.load_catalogue(path)
+    assert info.value.line == line and info.value.field == field
+    assert f"{path}:{line}" in str(info.value) and words in str(info.value)

@@ -118,3 +118,24 @@ def test_bad_arguments_exit_2(argv, words, capsys):
     assert main(argv) == 2
     last = capsys.readouterr().err.strip().splitlines()[-1]
     assert "error:" in last and words in last
+
+
+def test_motors_lists_gearbox_catalogue_too(capsys):
+    assert main(["motors", "--gearboxes"]) == 0
+    out = capsys.readouterr().out
+    assert "OPN-060-013-A" in out  # the motor catalogue first
+    row = next(line for line in out.splitlines() if line.startswith("NPS015-MF-1"))
+    assert row.split()[1:6] == ["planetary", "3,4,5,7,8,10", "17", "32", "1.8"]
+    assert "NPS015-MF-1: Beckhoff AG3300" in out
+    assert main(["motors"]) == 0
+    assert "NPS015" not in capsys.readouterr().out  # gearboxes only when asked
+
+
+def test_gearbox_rows_show_a_ratio_range_and_unknown_efficiency(capsys):
+    from collision_reflex.cli.motors import _print_gearboxes
+    from collision_reflex.hardware.gearboxes import CatalogueGearbox
+
+    harmonic = CatalogueGearbox("hd", "harmonic", (50.0, 160.0), True, 10.0, 20.0, 0.1, 1e-6, "a test entry")
+    _print_gearboxes({"hd": harmonic})
+    row = next(line for line in capsys.readouterr().out.splitlines() if line.startswith("hd"))
+    assert row.split()[1:3] == ["harmonic", "50..160"] and row.split()[-1] == "unknown"

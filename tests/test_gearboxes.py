@@ -49,3 +49,94 @@ def test_gearbox_needs_reference_figures_and_valid_stages():
         cr.Gearbox("harmonic", 2, **BASE)
     with pytest.raises(cr.InvalidParameter, match="kind"):
         cr.Gearbox("worm", **BASE)
+
+
+GEARBOX = """\
+gearboxes:
+  small:
+    kind: planetary
+    ratios: [3, 5, 10]
+    rated_torque: 17 N*m
+    peak_torque: 32
+    mass: 1800 g
+    inertia: 0.25 kg*cm^2
+    efficiency: 0.97
+    max_input_speed: 8000 rpm
+    source: a test entry
+"""
+
+
+def _catalogue(tmp_path, text):
+    from collision_reflex.hardware.gearboxes import load_gearbox_catalogue
+
+    path = tmp_path / "gearboxes.yaml"
+    path.write_text(text)
+    return path, lambda: load_gearbox_catalogue(path)
+
+
+def test_gearbox_catalogue_units_to_si(tmp_path):
+    _, load = _catalogue(tmp_path, GEARBOX)
+    gearbox = load()["small"]
+    assert gearbox.inertia == pytest.approx(0.25e-4, rel=1e-12)  # 1 kg cm^2 = 1e-4 kg m^2
+    assert gearbox.mass == pytest.approx(1.8, rel=1e-12)
+    assert gearbox.max_input_speed == pytest.approx(8000 * 2 * 3.141592653589793 / 60, rel=1e-12)
+    assert gearbox.ratios == (3.0, 5.0, 10.0) and not gearbox.continuous_ratio
+    assert gearbox.reflected_inertia(10.0) == pytest.approx(100 * 0.25e-4, rel=1e-12)
+
+
+def test_gearbox_ratio_range(tmp_path):
+    _, load = _catalogue(tmp_path, GEARBOX.replace("ratios: [3, 5, 10]", "ratio_range: [50, 160]"))
+    gearbox = load()["small"]
+    assert gearbox.continuous_ratio and gearbox.ratio_range == (50.0, 160.0)
+
+
+def test_packaged_gearboxes_match_their_datasheets():
+    from collision_reflex.hardware.gearboxes import load_gearbox_catalogue
+
+    gearboxes = load_gearbox_catalogue()
+    # Beckhoff AG3300 NPS015 MF, 1-stage: T2N 17 N m and T2B 32 N m at i = 3, 1.8 kg, J1 0.25 kg cm^2 (9 mm hub).
+    nps = gearboxes["NPS015-MF-1"]
+    assert (nps.rated_torque, nps.peak_torque, nps.mass) == (17.0, 32.0, 1.8)
+    assert nps.inertia == pytest.approx(0.25e-4, rel=1e-12) and nps.efficiency == 0.97
+    assert all(g.kind in cr.GEARBOX_KINDS and g.rated_torque <= g.peak_torque for g in gearboxes.values())
+
+
+GEARBOX_BAD = {
+    "no-source": (GEARBOX.replace("a test entry", "''"), 11, "gearboxes.small.source", "cite"),
+    "missing-mass": (GEARBOX.replace("    mass: 1800 g\n", ""), 2, "gearboxes.small.mass", "missing"),
+    "mistyped": (GEARBOX.replace("rated_torque: 17 N*m", "rated_torque: [17]"), 5, "rated_torque", ""),
+    "wrong-unit": (GEARBOX.replace("1800 g", "1800 N*m"), 7, "gearboxes.small.mass", "cannot be converted"),
+    "zero-inertia": (GEARBOX.replace("0.25 kg*cm^2", "0"), 8, "gearboxes.small.inertia", "> 0"),
+    "rated-above-peak": (GEARBOX.replace("peak_torque: 32", "peak_torque: 10"), 5, "rated_torque", "peak"),
+    "range-inverted": (
+        GEARBOX.replace("ratios: [3, 5, 10]", "ratio_range: [160, 50]"),
+        4,
+        "gearboxes.small.ratio_range",
+        "min <= max",
+    ),
+    "efficiency-above-one": (GEARBOX.replace("0.97", "1.2"), 9, "gearboxes.small.efficiency", "(0, 1]"),
+    "efficiency-zero": (GEARBOX.replace("0.97", "0"), 9, "gearboxes.small.efficiency", "(0, 1]"),
+    "ratio-below-one": (GEARBOX.replace("[3, 5, 10]", "[0.5, 5]"), 4, "gearboxes.small.ratios", ">= 1"),
+    "both-ratio-forms": (
+        GEARBOX.replace("ratios: [3, 5, 10]", "ratios: [3]\n    ratio_range: [3, 10]"),
+        2,
+        "gearboxes.small.ratios",
+        "exactly one",
+    ),
+    "unknown-kind": (GEARBOX.replace("planetary", "worm"), 3, "gearboxes.small.kind", "one of"),
+    "unknown-field": (
+        GEARBOX.replace("    source:", "    colour: red\n    source:"),
+        11,
+        "colour",
+        "unknown",
+    ),
+}
+
+
+@pytest.mark.parametrize("text, line, field, words", GEARBOX_BAD.values(), ids=GEARBOX_BAD.keys())
+def test_bad_gearbox_catalogue_names_field_and_line(tmp_path, text, line, field, words):
+    path, load = _catalogue(tmp_path, text)
+    with pytest.raises(cr.CatalogueError) as info:
+        load()
+    assert info.value.line == line and field in info.value.field
+    assert f"{path}:{line}" in str(info.value) and words in str(info.value)

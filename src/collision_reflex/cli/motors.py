@@ -7,6 +7,7 @@ import math
 from collections.abc import Sequence
 
 from ..hardware.actuators import Actuator, gear_ratio_for
+from ..hardware.gearboxes import CatalogueGearbox, load_gearbox_catalogue
 from ..hardware.motors import (
     DEFAULT_SCALING_LAW,
     REFERENCE_MOTOR_NAME,
@@ -31,6 +32,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         ),
     )
     options.add_catalogue(parser)
+    parser.add_argument(
+        "--gearboxes",
+        action="store_true",
+        help="also list the packaged gearbox catalogue, designs/gearboxes.yaml",
+    )
     parser.set_defaults(run=run_list)
     actions = parser.add_subparsers(dest="motors_command", metavar="ACTION")
     scale = options.add_subcommand(
@@ -79,7 +85,31 @@ def run_list(args: argparse.Namespace) -> int:
     print()
     for name, motor in catalogue.items():
         print(f"{name}: {motor.source}")
+    if args.gearboxes:
+        print()
+        _print_gearboxes(load_gearbox_catalogue())
     return 0
+
+
+def _print_gearboxes(gearboxes: dict[str, CatalogueGearbox]) -> None:
+    """Print a gearbox catalogue: one row per gearbox, then each one's source."""
+    print(
+        f"{'gearbox':<14}{'kind':<11}{'ratios':<22}{'rated [N m]':>12}{'peak [N m]':>11}{'mass [kg]':>10}"
+        f"{'J_in [kg m^2]':>14}{'efficiency':>11}"
+    )
+    for name, gearbox in gearboxes.items():
+        low, high = gearbox.ratio_range
+        ratios = (
+            f"{low:g}..{high:g}" if gearbox.continuous_ratio else ",".join(f"{r:g}" for r in gearbox.ratios)
+        )
+        efficiency = "unknown" if gearbox.efficiency is None else f"{gearbox.efficiency:.3g}"
+        print(
+            f"{name:<14}{gearbox.kind:<11}{ratios:<22}{gearbox.rated_torque:>12.4g}{gearbox.peak_torque:>11.4g}"
+            f"{gearbox.mass:>10.4g}{gearbox.inertia:>14.4g}{efficiency:>11}"
+        )
+    print()
+    for name, gearbox in gearboxes.items():
+        print(f"{name}: {gearbox.source}")
 
 
 _RPM_PER_RAD_S = 60 / (2 * math.pi)

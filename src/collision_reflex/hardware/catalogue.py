@@ -1,10 +1,16 @@
-"""Reading motor catalogue files: YAML with line numbers, validated by pydantic, units converted by pint.
+"""Reading part catalogues (motors, gearboxes): YAML with line numbers, validated by pydantic, units by pint.
 
 Kept apart from :mod:`collision_reflex.hardware.motors` so that the scaling arithmetic imports nothing heavy.
+
+Provenance: every entry cites a ``source`` (the default source of each of its numbers); ``sources: {field:
+text}`` names another source for some fields, and ``estimates: {field: method}`` marks a field that no source
+gives, with the method that estimated it. :func:`read_entries` returns each field's provenance, so that every
+number can be traced to a datasheet, a paper, or a stated estimate.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -15,7 +21,7 @@ from .._units import unit_registry
 from ..errors import CatalogueError
 
 # Field -> the unit a plain number is taken in (SI), and the pint dimensionality a quantity string must have.
-_UNITS = {
+_MOTOR_UNITS = {
     "stator_diameter": "m",
     "stack_length": "m",
     "rotor_inertia": "kg * m**2",
@@ -24,68 +30,68 @@ _UNITS = {
     "mass": "kg",
 }
 # Optional fields (None when omitted), same rules.
-_OPTIONAL_UNITS = {"max_speed": "rad/s"}
-_ALL_UNITS = {**_UNITS, **_OPTIONAL_UNITS}
-_FIELDS = ", ".join([*_UNITS, "source"]) + ", and optionally " + ", ".join(_OPTIONAL_UNITS)
+_MOTOR_OPTIONAL_UNITS = {"max_speed": "rad/s", "torque_constant": "N * m / A"}
+_GEARBOX_UNITS = {"rated_torque": "N * m", "peak_torque": "N * m", "mass": "kg", "inertia": "kg * m**2"}
+_GEARBOX_OPTIONAL_UNITS = {
+    "momentary_torque": "N * m",
+    "max_input_speed": "rad/s",
+    "diameter": "m",
+    "length": "m",
+}
+_PROVENANCE = ("source", "sources", "estimates")
 
 
-def packaged_catalogue_path() -> Path:
-    """The catalogue shipped with the package: ``designs/motors.yaml``.
+def packaged_catalogue_path(file: str = "motors.yaml") -> Path:
+    """Return the path of a catalogue shipped with the package, ``designs/<file>``.
 
     Looked for inside the package (a wheel that includes the ``designs`` data) and then in the source tree
     (a checkout or an editable install).
+
+    Parameters
+    ----------
+    file : str
+        The catalogue's file name: ``"motors.yaml"`` or ``"gearboxes.yaml"``.
     """
     package = Path(__file__).resolve().parents[1]
-    for candidate in (package / "designs" / "motors.yaml", package.parents[1] / "designs" / "motors.yaml"):
+    for candidate in (package / "designs" / file, package.parents[1] / "designs" / file):
         if candidate.is_file():
             return candidate
     raise CatalogueError(
-        str(package.parents[1] / "designs" / "motors.yaml"),
+        str(package.parents[1] / "designs" / file),
         None,
         "",
-        "the packaged motor catalogue is missing; reinstall collision-reflex or pass a catalogue file",
+        f"the packaged catalogue {file} is missing; reinstall collision-reflex or pass a catalogue file",
     )
 
 
-class _Entry(BaseModel):
-    """One motor entry; every number in SI after validation."""
+def _to_si(value: Any, unit: str) -> Any:
+    """A plain number (taken as SI) or a quantity string converted to ``unit``; ValueError saying why not."""
+    if isinstance(value, bool):
+        raise ValueError("expected a number or a quantity with units, got a boolean")
+    if isinstance(value, str):
+        try:  # YAML 1.1 reads "1e-5" (no dot) as text: a plain number is still SI
+            return float(value)
+        except ValueError:
+            return _quantity(value, unit)
+    if isinstance(value, int | float):
+        return float(value)
+    raise ValueError(f"expected a number (SI, {unit}) or a quantity string such as '60 mm'")
+
+
+def _positive(value: float | None) -> float | None:
+    if value is not None and not (value > 0 and value < float("inf")):
+        raise ValueError(f"expected a finite number > 0, got {value!r}")
+    return value
+
+
+class _Cited(BaseModel):
+    """The provenance every entry carries: a default source, and per-field sources and estimates."""
 
     model_config = ConfigDict(extra="forbid", strict=False)
 
-    stator_diameter: float
-    stack_length: float
-    rotor_inertia: float
-    peak_torque: float
-    continuous_torque: float
-    mass: float
     source: str
-    max_speed: float | None = None
-
-    @field_validator(*_ALL_UNITS, mode="before")
-    @classmethod
-    def _to_si(cls, value: Any, info: Any) -> Any:
-        unit = _ALL_UNITS[info.field_name]
-        if value is None and info.field_name in _OPTIONAL_UNITS:
-            return None
-        if isinstance(value, bool):
-            raise ValueError("expected a number or a quantity with units, got a boolean")
-        if isinstance(value, str):
-            try:  # YAML 1.1 reads "1e-5" (no dot) as text: a plain number is still SI
-                return float(value)
-            except ValueError:
-                return _quantity(value, unit)
-        if isinstance(value, int | float):
-            return float(value)
-        raise ValueError(f"expected a number (SI, {unit}) or a quantity string such as '60 mm'")
-
-    @field_validator(*_ALL_UNITS)
-    @classmethod
-    def _positive(cls, value: float | None) -> float | None:
-        if value is None:
-            return None
-        if not (value > 0 and value < float("inf")):
-            raise ValueError(f"expected a finite number > 0, got {value!r}")
-        return value
+    sources: dict[str, str] = {}
+    estimates: dict[str, str] = {}
 
     @field_validator("source")
     @classmethod
@@ -93,6 +99,122 @@ class _Entry(BaseModel):
         if not value.strip():
             raise ValueError("every entry must cite its source (datasheet, paper, or a stated assumption)")
         return value
+
+
+class _MotorEntry(_Cited):
+    """One motor entry; every number in SI after validation."""
+
+    stator_diameter: float
+    stack_length: float
+    rotor_inertia: float
+    peak_torque: float
+    continuous_torque: float
+    mass: float
+    max_speed: float | None = None
+    torque_constant: float | None = None
+
+    @field_validator(*_MOTOR_UNITS, *_MOTOR_OPTIONAL_UNITS, mode="before")
+    @classmethod
+    def _si(cls, value: Any, info: Any) -> Any:
+        if value is None and info.field_name in _MOTOR_OPTIONAL_UNITS:
+            return None
+        return _to_si(value, {**_MOTOR_UNITS, **_MOTOR_OPTIONAL_UNITS}[info.field_name])
+
+    @field_validator(*_MOTOR_UNITS, *_MOTOR_OPTIONAL_UNITS)
+    @classmethod
+    def _physical(cls, value: float | None) -> float | None:
+        return _positive(value)
+
+
+class _GearboxEntry(_Cited):
+    """One gearbox entry; every number in SI after validation."""
+
+    kind: str
+    ratios: list[float] | None = None
+    ratio_range: list[float] | None = None
+    rated_torque: float
+    peak_torque: float
+    mass: float
+    inertia: float
+    efficiency: float | None = None
+    stages: int = 1
+    momentary_torque: float | None = None
+    max_input_speed: float | None = None
+    diameter: float | None = None
+    length: float | None = None
+
+    @field_validator(*_GEARBOX_UNITS, *_GEARBOX_OPTIONAL_UNITS, mode="before")
+    @classmethod
+    def _si(cls, value: Any, info: Any) -> Any:
+        if value is None and info.field_name in _GEARBOX_OPTIONAL_UNITS:
+            return None
+        return _to_si(value, {**_GEARBOX_UNITS, **_GEARBOX_OPTIONAL_UNITS}[info.field_name])
+
+    @field_validator(*_GEARBOX_UNITS, *_GEARBOX_OPTIONAL_UNITS)
+    @classmethod
+    def _physical(cls, value: float | None) -> float | None:
+        return _positive(value)
+
+    @field_validator("kind")
+    @classmethod
+    def _known_kind(cls, value: str) -> str:
+        from .gearboxes import GEARBOX_KINDS
+
+        if value not in GEARBOX_KINDS:
+            raise ValueError("expected one of " + ", ".join(GEARBOX_KINDS))
+        return value
+
+    @field_validator("ratios", "ratio_range")
+    @classmethod
+    def _ratios(cls, value: list[float] | None) -> list[float] | None:
+        if value is not None and (not value or any(not (1 <= r < float("inf")) for r in value)):
+            raise ValueError(f"expected gear ratios >= 1, got {value!r}")
+        return value
+
+    @field_validator("efficiency")
+    @classmethod
+    def _efficiency(cls, value: float | None) -> float | None:
+        if value is not None and not 0 < value <= 1:
+            raise ValueError(f"expected an efficiency in (0, 1], got {value!r}")
+        return value
+
+    @field_validator("stages")
+    @classmethod
+    def _stages(cls, value: int) -> int:
+        if value < 1:
+            raise ValueError(f"expected an integer >= 1, got {value!r}")
+        return value
+
+
+@dataclass(frozen=True)
+class CatalogueEntry:
+    """One validated catalogue entry.
+
+    Parameters
+    ----------
+    fields : dict
+        The part's fields, numbers in SI units, with ``source`` (the default source).
+    provenance : dict
+        Field -> where its value comes from: ``"source: ..."`` or ``"ESTIMATE: <method>"``, for every field
+        the entry gives.
+    line : int
+        1-based line of the entry's name in its file.
+    """
+
+    fields: dict[str, Any]
+    provenance: dict[str, str]
+    line: int
+
+
+# kind -> (schema, required fields, optional fields), the last two for error messages.
+_KINDS: dict[str, tuple[type[_Cited], list[str], list[str]]] = {
+    "motors": (_MotorEntry, [*_MOTOR_UNITS, "source"], [*_MOTOR_OPTIONAL_UNITS, "sources", "estimates"]),
+    "gearboxes": (
+        _GearboxEntry,
+        ["kind", "ratios or ratio_range", *_GEARBOX_UNITS, "source"],
+        ["efficiency", "stages", *_GEARBOX_OPTIONAL_UNITS, "sources", "estimates"],
+    ),
+}
 
 
 def _quantity(text: str, unit: str) -> float:
@@ -121,7 +243,35 @@ def _radian_power(quantity: Any) -> int:
 
 
 def read_catalogue(path: Path) -> dict[str, dict[str, Any]]:
-    """The entries of a catalogue file, each a dict of :class:`~collision_reflex.hardware.motors.Motor` fields (SI)."""
+    """Return the entries of a motor catalogue file, each a dict of ``Motor`` fields (SI).
+
+    Parameters
+    ----------
+    path : Path
+        The YAML file, with a top-level ``motors`` mapping.
+    """
+    return {
+        name: {key: value for key, value in entry.fields.items() if key not in ("sources", "estimates")}
+        for name, entry in read_entries(path, "motors").items()
+    }
+
+
+def read_entries(path: Path, kind: str = "motors") -> dict[str, CatalogueEntry]:
+    """Return the validated entries of a catalogue file, with each field's provenance.
+
+    Parameters
+    ----------
+    path : Path
+        The YAML file.
+    kind : str
+        ``"motors"`` or ``"gearboxes"``: the file's one top-level key and the entries' schema.
+
+    Raises
+    ------
+    CatalogueError
+        Naming the file, the line and the field: bad YAML, a missing, unknown or mistyped field, a unit of
+        the wrong dimension, a non-physical value, or an entry without a source.
+    """
     name = str(path)
     try:
         text = path.read_text(encoding="utf-8")
@@ -135,53 +285,116 @@ def read_catalogue(path: Path) -> dict[str, dict[str, Any]]:
         problem = getattr(error, "problem", None) or str(error)
         raise CatalogueError(name, line, "", f"not valid YAML: {problem}") from None
     if not isinstance(root, yaml.MappingNode):
-        raise CatalogueError(name, _line(root), "", "expected a mapping with a top-level 'motors' key")
+        raise CatalogueError(name, _line(root), "", f"expected a mapping with a top-level {kind!r} key")
     top = _mapping(root)
-    if "motors" not in top:
-        raise CatalogueError(name, 1, "motors", "missing: the file needs a top-level 'motors' mapping")
-    unknown = sorted(set(top) - {"motors"})
+    if kind not in top:
+        raise CatalogueError(name, 1, kind, f"missing: the file needs a top-level {kind!r} mapping")
+    unknown = sorted(set(top) - {kind})
     if unknown:
         key_node, _ = top[unknown[0]]
         raise CatalogueError(
-            name, _line(key_node), unknown[0], "unknown top-level key; only 'motors' is allowed"
+            name, _line(key_node), unknown[0], f"unknown top-level key; only {kind!r} is allowed"
         )
-    _, motors_node = top["motors"]
-    if not isinstance(motors_node, yaml.MappingNode):
-        raise CatalogueError(
-            name, _line(motors_node), "motors", "expected a mapping from motor name to entry"
-        )
+    _, parts_node = top[kind]
+    if not isinstance(parts_node, yaml.MappingNode):
+        raise CatalogueError(name, _line(parts_node), kind, "expected a mapping from part name to entry")
+    return {
+        part: _entry(name, kind, part, key_node, entry_node)
+        for part, (key_node, entry_node) in _mapping(parts_node).items()
+    }
 
-    entries: dict[str, dict[str, Any]] = {}
-    for motor_name, (key_node, entry_node) in _mapping(motors_node).items():
-        where = f"motors.{motor_name}"
-        if not isinstance(entry_node, yaml.MappingNode):
-            raise CatalogueError(name, _line(key_node), where, "expected a mapping of the motor's fields")
-        fields = _mapping(entry_node)
-        raw = {key: _plain(value_node) for key, (_, value_node) in fields.items()}
-        try:
-            entry = _Entry.model_validate(raw)
-        except ValidationError as error:
-            first = error.errors()[0]
-            field = str(first["loc"][0]) if first["loc"] else ""
-            if first["type"] == "missing":
-                line = _line(key_node)
-                reason = f"missing (an entry needs {_FIELDS})"
-            elif first["type"] == "extra_forbidden":
-                line = _line(fields[field][0])
-                reason = f"unknown field (allowed: {_FIELDS})"
-            else:
-                line = _line(fields[field][1]) if field in fields else _line(key_node)
-                reason = f"{first['msg']} (got {raw.get(field)!r})"
-            raise CatalogueError(name, line, f"{where}.{field}", reason) from None
-        if entry.continuous_torque > entry.peak_torque:
-            raise CatalogueError(
-                name,
-                _line(fields["continuous_torque"][1]),
-                f"{where}.continuous_torque",
-                f"{entry.continuous_torque:g} N m exceeds the peak torque {entry.peak_torque:g} N m",
-            )
-        entries[motor_name] = entry.model_dump()
-    return entries
+
+def _entry(file: str, kind: str, part: str, key_node: Any, entry_node: Any) -> CatalogueEntry:
+    """One entry validated, or a located :class:`CatalogueError`."""
+    model, required, optional = _KINDS[kind]
+    allowed = ", ".join(required) + ", and optionally " + ", ".join(optional)
+    where = f"{kind}.{part}"
+    if not isinstance(entry_node, yaml.MappingNode):
+        raise CatalogueError(file, _line(key_node), where, "expected a mapping of the part's fields")
+    fields = _mapping(entry_node)
+    raw = {key: _plain(value_node) for key, (_, value_node) in fields.items()}
+    try:
+        entry = model.model_validate(raw)
+    except ValidationError as error:
+        first = error.errors()[0]
+        field = str(first["loc"][0]) if first["loc"] else ""
+        if first["type"] == "missing":
+            line = _line(key_node)
+            reason = f"missing (an entry needs {allowed})"
+        elif first["type"] == "extra_forbidden":
+            line = _line(fields[field][0])
+            reason = f"unknown field (allowed: {allowed})"
+        else:
+            line = _line(fields[field][1]) if field in fields else _line(key_node)
+            reason = f"{first['msg']} (got {raw.get(field)!r})"
+        raise CatalogueError(file, line, f"{where}.{field}", reason) from None
+
+    def refuse(field: str, reason: str) -> CatalogueError:
+        return CatalogueError(file, _line(fields[field][1]), f"{where}.{field}", reason)
+
+    values = entry.model_dump()
+    for lower, upper in (("continuous_torque", "peak_torque"), ("rated_torque", "peak_torque")):
+        if values.get(lower) is not None and values[lower] > values[upper]:
+            raise refuse(lower, f"{values[lower]:g} N m exceeds the peak torque {values[upper]:g} N m")
+    if values.get("momentary_torque") is not None and values["momentary_torque"] < values["peak_torque"]:
+        raise refuse("momentary_torque", "is below the (repeated) peak torque")
+    if kind == "gearboxes":
+        _check_ratios(values, fields, refuse, file, key_node, where)
+    given = [key for key in fields if key not in _PROVENANCE]
+    return CatalogueEntry(values, _provenance(file, where, fields, entry, given), _line(key_node))
+
+
+def _check_ratios(
+    values: dict[str, Any], fields: dict[str, Any], refuse: Any, file: str, key: Any, where: str
+) -> None:
+    """A gearbox gives exactly one of ``ratios`` (a list) and ``ratio_range`` (min, max, not inverted)."""
+    if (values["ratios"] is None) == (values["ratio_range"] is None):
+        raise CatalogueError(
+            file,
+            _line(key),
+            f"{where}.ratios",
+            "give exactly one of 'ratios' (a list) or 'ratio_range' [min, max]",
+        )
+    low_high = values["ratio_range"]
+    if low_high is not None and (len(low_high) != 2 or low_high[0] > low_high[1]):
+        raise refuse("ratio_range", f"expected [min, max] with min <= max, got {low_high!r}")
+
+
+def _provenance(
+    file: str, where: str, fields: dict[str, Any], entry: _Cited, given: list[str]
+) -> dict[str, str]:
+    """Field -> its source or estimate; per-field keys must name given fields, and not both at once."""
+    for table in ("sources", "estimates"):
+        if table not in fields:
+            continue
+        for key_node, value_node in fields[table][1].value:
+            key, text = str(key_node.value), _plain(value_node)
+            if key not in given:
+                raise CatalogueError(
+                    file,
+                    _line(key_node),
+                    f"{where}.{table}.{key}",
+                    f"names no field of this entry ({', '.join(given)})",
+                )
+            if not str(text).strip():
+                raise CatalogueError(
+                    file, _line(key_node), f"{where}.{table}.{key}", "empty: say where or how"
+                )
+    both = sorted(set(entry.sources) & set(entry.estimates))
+    if both:
+        key_node = next(k for k, _ in fields["estimates"][1].value if k.value == both[0])
+        raise CatalogueError(
+            file,
+            _line(key_node),
+            f"{where}.estimates.{both[0]}",
+            "also has a source: a field is sourced or estimated",
+        )
+    return {
+        field: f"ESTIMATE: {entry.estimates[field]}"
+        if field in entry.estimates
+        else f"source: {entry.sources.get(field, entry.source)}"
+        for field in given
+    }
 
 
 def _mapping(node: Any) -> dict[str, tuple[Any, Any]]:

@@ -8,6 +8,9 @@ described by a real one (its own mass, inertia and rated torque at its size, wit
 between makers for one default to be honest, and the paper ignores gearbox inertia (as does
 :class:`~collision_reflex.hardware.actuators.Actuator` unless asked).
 
+Real gearboxes one can buy are :class:`CatalogueGearbox` entries of ``designs/gearboxes.yaml``
+(:func:`load_gearbox_catalogue`), each figure with its source.
+
 Inertia convention: ``inertia`` is the gearbox's own inertia seen at its input (motor) shaft [kg m^2], so its
 reflected inertia at the output is ``N**2 inertia`` (the table's ``l r^4 N^2``); a ball screw's ``inertia`` is
 already the reflected one (the table's ``l r^4``, without ``N``).
@@ -17,14 +20,23 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from .. import _validate
 from ..errors import InvalidParameter
 
-__all__ = ["GEARBOX_KINDS", "GEARBOX_SCALING", "Gearbox", "GearboxScaling"]
+__all__ = [
+    "GEARBOX_KINDS",
+    "GEARBOX_SCALING",
+    "CatalogueGearbox",
+    "Gearbox",
+    "GearboxScaling",
+    "load_gearbox_catalogue",
+]
 
 
 @dataclass(frozen=True)
@@ -129,3 +141,99 @@ class Gearbox:
             rated_torque=self.rated_torque * torque_law.factor(*ratios),
             source=f"scaled by the {self.kind} law of Saerens et al. 2019 from: {self.source}",
         )
+
+
+@dataclass(frozen=True)
+class CatalogueGearbox:
+    """A gearbox one can buy: a catalogue entry's figures (SI), as its datasheet states them.
+
+    Parameters
+    ----------
+    name : str
+        The catalogue key (maker's designation).
+    kind : str
+        One of :data:`GEARBOX_KINDS`.
+    ratios : tuple of float
+        The ratios offered [-], ascending; or ``(min, max)`` when ``continuous_ratio``.
+    continuous_ratio : bool
+        True when any ratio between ``ratios[0]`` and ``ratios[-1]`` can be had (a range, not a list).
+    rated_torque : float
+        Rated (continuous) output torque [N m].
+    peak_torque : float
+        Repeated peak output torque (acceleration/braking) [N m].
+    mass : float
+        Mass [kg].
+    inertia : float
+        Inertia at the input (motor) shaft [kg m^2]; reflected to the output it is ``N**2 inertia``.
+    source : str
+        Where the figures come from (the default source of every field).
+    efficiency : float or None
+        Efficiency in (0, 1] [-], or None when not given.
+    stages : int
+        Number of stages.
+    momentary_torque : float or None
+        Momentary (emergency-stop) output torque [N m], or None.
+    max_input_speed : float or None
+        Maximum input speed [rad/s], or None.
+    diameter, length : float or None
+        Outer diameter and length [m], or None.
+    """
+
+    name: str
+    kind: str
+    ratios: tuple[float, ...]
+    continuous_ratio: bool
+    rated_torque: float
+    peak_torque: float
+    mass: float
+    inertia: float
+    source: str
+    efficiency: float | None = None
+    stages: int = 1
+    momentary_torque: float | None = None
+    max_input_speed: float | None = None
+    diameter: float | None = None
+    length: float | None = None
+
+    @property
+    def ratio_range(self) -> tuple[float, float]:
+        """The smallest and largest ratio offered [-]."""
+        return self.ratios[0], self.ratios[-1]
+
+    def reflected_inertia(self, gear_ratio: float) -> float:
+        """Gearbox inertia seen at the output [kg m^2]: ``N**2 inertia``."""
+        _validate.positive("gear_ratio", gear_ratio)
+        return float(gear_ratio**2 * self.inertia)
+
+
+def load_gearbox_catalogue(path: str | os.PathLike[str] | None = None) -> dict[str, CatalogueGearbox]:
+    """Gearboxes of a YAML catalogue file, by name (default: the packaged ``designs/gearboxes.yaml``).
+
+    The file has a top-level ``gearboxes`` mapping from name to entry; each entry gives ``kind``, ``ratios``
+    (a list) or ``ratio_range`` ([min, max]), ``rated_torque``, ``peak_torque``, ``mass``, ``inertia``
+    (input side) and a ``source``, optionally ``efficiency``, ``stages``, ``momentary_torque``,
+    ``max_input_speed``, ``diameter``, ``length``, and the per-field ``sources`` and ``estimates``. Numbers
+    are plain SI or strings with units (``"0.13 kg*cm^2"``). Bad input raises
+    :class:`~collision_reflex.errors.CatalogueError` naming the file, the line and the field.
+
+    Parameters
+    ----------
+    path : str or path-like, optional
+        The catalogue file; default the packaged one.
+    """
+    from .catalogue import packaged_catalogue_path, read_entries
+
+    target = Path(path) if path is not None else packaged_catalogue_path("gearboxes.yaml")
+    gearboxes = {}
+    for name, entry in read_entries(target, "gearboxes").items():
+        fields = dict(entry.fields)
+        listed, low_high = fields.pop("ratios"), fields.pop("ratio_range")
+        for provenance in ("sources", "estimates"):
+            fields.pop(provenance)
+        gearboxes[name] = CatalogueGearbox(
+            name=name,
+            ratios=tuple(sorted(listed if listed is not None else low_high)),
+            continuous_ratio=listed is None,
+            **fields,
+        )
+    return gearboxes

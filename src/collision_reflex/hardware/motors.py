@@ -188,6 +188,8 @@ class Motor:
     source: where the figures come from (datasheet, paper, scaling).
     max_speed: maximum speed ``omega_max`` [rad/s], or None when not known (none is made up:
         :meth:`speed_limit` then says so).
+    torque_constant: torque per ampere of phase current ``K_t`` [N m/A] as its datasheet states it, or None
+        when not given (informative: no model here uses it).
     """
 
     name: str
@@ -199,9 +201,11 @@ class Motor:
     mass: float
     source: str = ""
     max_speed: float | None = None
+    torque_constant: float | None = None
 
     def __post_init__(self) -> None:
-        numbers_given = _MOTOR_NUMBERS if self.max_speed is None else (*_MOTOR_NUMBERS, "max_speed")
+        optional_given = tuple(f for f in ("max_speed", "torque_constant") if getattr(self, f) is not None)
+        numbers_given = (*_MOTOR_NUMBERS, *optional_given)
         for field in numbers_given:
             value = getattr(self, field)
             if isinstance(value, bool) or not isinstance(value, numbers.Real):
