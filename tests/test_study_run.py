@@ -572,13 +572,13 @@ def test_recommended_design_has_no_oversized_joint_unless_at_the_smallest_motor(
 
 @pytest.mark.parametrize("name", ARM_STUDIES, ids=ARM_STUDIES)
 def test_torque_speed_figure_exactly_for_duty_cycle_studies(runs, name):
-    from collision_reflex.study.arm_results import DUTY_CYCLE_REQUIREMENT
+    from collision_reflex.optimize.constraints import DUTY_REQUIREMENT
 
     folder = runs[name]
     results = json.loads((folder / "designs.json").read_text())
     html = (folder / "report.html").read_text()
     recommended = results["recommended"]
-    if results["requirement"] == DUTY_CYCLE_REQUIREMENT:
+    if results["requirement"] == DUTY_REQUIREMENT:
         saved = recommended["torque_speed"]
         assert [e["joint"] for e in saved] == [j["joint"] for j in recommended["joints"]]
         # The record's margins are the saved points' (motor side: peak torque over the largest cycle torque).
@@ -592,3 +592,17 @@ def test_torque_speed_figure_exactly_for_duty_cycle_studies(runs, name):
         assert "torque_speed" not in recommended
         assert not (folder / "figures" / "torque_speed.png").exists()
         assert 'id="torque-speed-none"' in html
+
+
+@pytest.mark.parametrize("name", ARM_STUDIES, ids=ARM_STUDIES)
+def test_the_speed_limit_assumption_is_stated_exactly_when_a_duty_cycle_uses_it(runs, name):
+    from collision_reflex.hardware.motors import CONSTANT_SURFACE_SPEED
+    from collision_reflex.optimize.constraints import DUTY_REQUIREMENT
+
+    results = json.loads((runs[name] / "designs.json").read_text())
+    verdict = "\n".join(results["verdict"])
+    if results["requirement"] == DUTY_REQUIREMENT:
+        assert "Speed limits: the reference motor" in verdict
+        assert CONSTANT_SURFACE_SPEED.source in verdict
+    else:
+        assert results["speed_limits"] is None and "Speed limits" not in verdict

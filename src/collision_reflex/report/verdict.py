@@ -272,6 +272,8 @@ def verdict(results: Mapping[str, Any]) -> list[str]:
     if reason:
         lines.append(f"Why this design: {reason}.")
     lines.append(requirement_sentence(requirement))
+    if results.get("speed_limits"):
+        lines.append(str(results["speed_limits"]))
     if bounds is not None:
         for joint in recommended["joints"]:
             phrases = joint_limits(joint, bounds, requirement)

@@ -22,12 +22,6 @@ from .arm_setup import ArmSetup, SampleLayout, StudyProblems, sample_layout
 if TYPE_CHECKING:
     from ..optimize import DesignProblem, DesignResult, ParetoSet
 
-STATIC_REQUIREMENT = "static (gravity only)"
-"""The torque requirement when the study gives no duty cycle: gravity (and payload) over the samples."""
-DUTY_CYCLE_REQUIREMENT = "duty cycle"
-"""The torque requirement when the study gives a duty cycle: the motion's peak, RMS and speed."""
-GIVEN_REQUIREMENT = "given per joint"
-"""The torque requirement when the study gives each joint's required torque (``constraints.torque_required``)."""
 SAVED_DIGITS = 7
 """Significant digits of the saved torque-speed data: compact, and within 5e-7 relative of the computed points."""
 
@@ -52,8 +46,8 @@ class ArmResults(TypedDict):
 
     The samples, the chosen and recommended designs, the Pareto front, the bounds of the design variables
     (``{variable: {joint: [lower, upper]}}`` and ``{threshold|approach_velocity: [lower, upper]}``, SI units)
-    and the kind of torque requirement (:data:`STATIC_REQUIREMENT`, :data:`GIVEN_REQUIREMENT` or
-    :data:`DUTY_CYCLE_REQUIREMENT`).
+    the kind of torque requirement (:attr:`collision_reflex.optimize.Constraints.requirement`) and, with a duty
+    cycle, where the motors' speed limits come from.
     """
 
     samples: SampleLayout
@@ -62,6 +56,7 @@ class ArmResults(TypedDict):
     pareto: ParetoRecord
     bounds: dict[str, Any]
     requirement: str
+    speed_limits: str | None
 
 
 class JointTorqueSpeed(TypedDict):
@@ -142,15 +137,6 @@ def design_bounds(setup: ArmSetup) -> dict[str, Any]:
     return out
 
 
-def requirement_kind(setup: ArmSetup) -> str:
-    """What the torque requirement is made of: a duty cycle, torques given per joint, or gravity only."""
-    if getattr(setup, "duty_cycle", None) is not None:
-        return DUTY_CYCLE_REQUIREMENT
-    if setup.constraints.torque_required is not None:
-        return GIVEN_REQUIREMENT
-    return STATIC_REQUIREMENT
-
-
 def arm_results(problems: StudyProblems, chosen: DesignResult, front: ParetoSet | None) -> ArmResults:
     """``samples``, ``chosen``, ``recommended``, ``pareto``, ``bounds`` and ``requirement`` of an arm study.
 
@@ -200,5 +186,22 @@ def arm_results(problems: StudyProblems, chosen: DesignResult, front: ParetoSet 
         "recommended": recommended,
         "pareto": pareto,
         "bounds": design_bounds(setup),
-        "requirement": requirement_kind(setup),
+        "requirement": setup.constraints.requirement,
+        "speed_limits": speed_limits(setup),
     }
+
+
+def speed_limits(setup: ArmSetup) -> str | None:
+    """Where the motors' speed limits come from, for the report (None without a duty cycle, which uses none)."""
+    from ..hardware.motors import scaling_law
+
+    if setup.constraints.duty_cycle is None:
+        return None
+    motor = setup.technology.reference_motor
+    law = scaling_law(setup.technology.scaling_law).speed
+    return (
+        f"Speed limits: the reference motor {motor.name} turns at most {motor.max_speed:.4g} rad/s (its "
+        f"catalogue entry gives the source, or the method where the figure is an estimate); a scaled motor's "
+        f"limit follows omega_max ∝ (l/l0)^{law.length_exponent:g} (r/r0)^{law.diameter_exponent:g}. "
+        f"{law.source}"
+    )
