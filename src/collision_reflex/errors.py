@@ -77,7 +77,7 @@ class SolverFailed(CollisionReflexError):
     violated: ``(label, amount[, unit])`` of the constraints that could not be met, worst first
         (:class:`Violation` after a feasibility solve, in physical units).
     problem: the problem that was solved, for inspection.
-    attempts: ``(name, status, iterations)`` of every attempt made, in order (see
+    attempts: ``(name, status, iterations, solve_time [s])`` of every IPOPT run, in order (see
         :func:`collision_reflex.optimize.solve.solve`).
     """
 
@@ -88,7 +88,7 @@ class SolverFailed(CollisionReflexError):
         stats: dict,
         violated: Sequence[Violation | tuple[str, float]],
         problem: object = None,
-        attempts: Sequence[tuple[str, str, int]] = (),
+        attempts: Sequence[tuple[str, str, int, float]] = (),
     ) -> None:
         self.status = status
         self.stats = stats

@@ -5,7 +5,7 @@ from __future__ import annotations
 import time
 import warnings
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
 import casadi as ca
@@ -219,11 +219,7 @@ def solve(
     if found is None:
         found = _decide(problem, dict(epsilon or {}), {**requested, **RETRIES[0][1]}, attempts)
     x, stats, multipliers = found
-    elapsed = sum(attempt.solve_time for attempt in attempts.records)
-    result = _result(
-        problem, x, attempts.records[-1].status, stats, elapsed, dict(epsilon or {}), multipliers
-    )
-    return replace(result, attempts=tuple(attempts.records))
+    return _result(problem, x, tuple(attempts.records), stats, dict(epsilon or {}), multipliers)
 
 
 _Found = tuple[np.ndarray, dict, tuple[np.ndarray, np.ndarray]]
@@ -373,6 +369,8 @@ def _multi_start(
         try:
             result = solve(problem, epsilon, point, ipopt_options)
         except SolverFailed as error:
+            if error.confirmed_infeasible:  # no design meets the constraints, from any start
+                raise
             failure = error
             continue
         value = problem.objective_value(result.x)
@@ -387,12 +385,12 @@ def _multi_start(
 def _result(
     problem: DesignProblem,
     x: np.ndarray,
-    status: str,
+    attempts: tuple[Attempt, ...],
     stats: dict,
-    elapsed: float,
     epsilon: dict[str, float],
     multipliers: tuple[np.ndarray, np.ndarray],
 ) -> DesignResult:
+    """The result at ``x``, found by the last of ``attempts`` (IPOPT's ``stats``), all timed."""
     design = design_at(problem, x)
     evaluated = problem.evaluate(problem.exact_point(x))
     impulses = np.asarray(evaluated[0]).ravel()
@@ -433,16 +431,17 @@ def _result(
         impulses=numpy_impulses,
         required_torque=required,
         torque_margin=design.peak_torque / np.maximum(required, 1e-300) - 1,
-        status=status,
+        status=attempts[-1].status,
         success=True,
         iterations=int(stats.get("iter_count", -1)),
-        solve_time=elapsed,
+        solve_time=sum(attempt.solve_time for attempt in attempts),
         build_time=problem.build_time,
         epsilon=epsilon,
         requirement=problem.requirement,
         **duty,
         x=x,
         multipliers=multipliers,
+        attempts=attempts,
     )
 
 
