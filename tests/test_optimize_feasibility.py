@@ -141,7 +141,7 @@ def test_a_requirement_above_the_strongest_actuator_is_confirmed_infeasible(two_
     # The shortfall is the requirement less the strongest actuator's torque (the bound is met to ~1e-8).
     assert error.violated[0].unit == "N*m"
     assert error.violated[0].amount == pytest.approx(50.0 - strongest[0], rel=1e-6)
-    assert f"short by {50.0 - strongest[0]:.3g} N*m" in str(error)
+    assert f"joint1 >= the given required torque: not met by {50.0 - strongest[0]:.3g} N*m" in str(error)
     assert "raise the upper bounds of the gear ratio or the motor size" in str(error)
     assert [a.name for a in error.attempts][-1] == "feasibility"
     copy = pickle.loads(pickle.dumps(error))

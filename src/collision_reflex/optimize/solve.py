@@ -325,9 +325,9 @@ def _decide(
 
 
 def _shortfall(violation: Violation) -> str:
-    """``peak torque of joint1 >= given requirement (short by 37.2 N*m)``."""
+    """``peak torque of joint1 >= the given required torque: not met by 49.1 N*m``."""
     unit = "" if violation.unit == "-" else f" {violation.unit}"
-    return f"{violation.label} (short by {violation.amount:.3g}{unit})"
+    return f"{violation.label}: not met by {violation.amount:.3g}{unit}"
 
 
 ADVICE = {
