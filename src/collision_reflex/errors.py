@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 
 class CollisionReflexError(Exception):
@@ -51,15 +51,34 @@ def _describe(value: Any) -> str:
     return repr(value)
 
 
+class Violation(NamedTuple):
+    """A constraint that a design does not meet, and by how much.
+
+    Attributes
+    ----------
+    label: the NLP's label of the (worst) violated row, e.g. ``"peak torque of joint1 >= given requirement"``.
+    amount: how far it is from being met, in ``unit`` (> 0).
+    unit: the unit of ``amount``, e.g. ``"N*m"``; ``"-"`` for a row in the NLP's scaled units.
+    """
+
+    label: str
+    amount: float
+    unit: str = "-"
+
+
 class SolverFailed(CollisionReflexError):
     """The optimiser did not converge, or found the problem infeasible.
 
     Attributes
     ----------
-    status: IPOPT's return status (e.g. ``"Infeasible_Problem_Detected"``).
+    status: IPOPT's return status of the last attempt (e.g. ``"Maximum_Iterations_Exceeded"``), or
+        ``"Infeasible"`` when a feasibility solve confirmed that no design meets the constraints.
     stats: the solver statistics (iterations, timings, ...).
-    violated: ``(label, violation)`` pairs of the constraints that could not be met, worst first.
+    violated: ``(label, amount[, unit])`` of the constraints that could not be met, worst first
+        (:class:`Violation` after a feasibility solve, in physical units).
     problem: the problem that was solved, for inspection.
+    attempts: ``(name, status, iterations, solve_time [s])`` of every IPOPT run, in order (see
+        :func:`collision_reflex.optimize.solve.solve`).
     """
 
     def __init__(
@@ -67,18 +86,25 @@ class SolverFailed(CollisionReflexError):
         message: str,
         status: str,
         stats: dict,
-        violated: list[tuple[str, float]],
+        violated: Sequence[Violation | tuple[str, float]],
         problem: object = None,
+        attempts: Sequence[tuple[str, str, int, float]] = (),
     ) -> None:
         self.status = status
         self.stats = stats
-        self.violated = violated
+        self.violated = list(violated)
         self.problem = problem
+        self.attempts = tuple(attempts)
         super().__init__(message)
+
+    @property
+    def confirmed_infeasible(self) -> bool:
+        """Whether a feasibility solve confirmed that no design within the bounds meets the constraints."""
+        return self.status == "Infeasible"
 
     def __reduce__(self) -> tuple:
         # The problem holds CasADi functions, which do not cross process boundaries; the rest does.
-        return (type(self), (str(self), self.status, self.stats, self.violated, None))
+        return (type(self), (str(self), self.status, self.stats, self.violated, None, self.attempts))
 
 
 @dataclass(frozen=True)

@@ -6,15 +6,16 @@ import time
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, NamedTuple
 
 import casadi as ca
 import numpy as np
 
-from ..errors import InvalidParameter, SolverFailed
+from ..errors import InvalidParameter, SolverFailed, Violation
 from .constraints import STATIC_REQUIREMENT
 from .duty import duty_values
 from .evaluate import evaluate_design
+from .feasibility import solve_feasibility
 from .objectives import OBJECTIVES
 from .problem import DesignProblem
 
@@ -46,6 +47,29 @@ WARM_START_OPTIONS: dict[str, str | float] = {
 AGREEMENT_TOLERANCE = 1e-6
 """Largest relative difference allowed between the CasADi and NumPy evaluations of a design's objectives:
 both evaluate the same closed forms in double precision, so any larger difference is a modelling bug."""
+
+
+RETRIES = (
+    # Another barrier strategy from the same start: the monotone barrier's parameter can reach ~1e-9 before
+    # convergence, after which IPOPT's restoration phase may wrongly report infeasibility.
+    ("adaptive barrier", {"ipopt.mu_strategy": "adaptive"}, "start"),
+    # The problem's own start: the log-midpoint design with the gear ratios raised to cover the torques.
+    ("default start, adaptive barrier", {"ipopt.mu_strategy": "adaptive"}, "default"),
+)
+"""What :func:`solve` tries after a failed solve, in order: (name, options merged over the requested ones,
+start). After these, an elastic feasibility solve (:mod:`.feasibility`) decides: infeasible (raised) or a
+feasible point, from which a last attempt (``"feasible start, adaptive barrier"``) starts."""
+CONVERGED = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
+"""IPOPT statuses whose point is kept; the status is kept in the result (an acceptable point is marked)."""
+
+
+class Attempt(NamedTuple):
+    """One IPOPT run of :func:`solve`: its name (see :data:`RETRIES`), status, iterations and time [s]."""
+
+    name: str
+    status: str
+    iterations: int
+    solve_time: float
 
 
 @dataclass(frozen=True)
@@ -103,7 +127,10 @@ class DesignResult:
     max_motor_speed, speed_limit, speed_margin: per joint, the motor speed ``N max |qd|`` over the cycle and
         the approach [rad/s], the motor's maximum speed [rad/s] and ``limit / speed - 1``; None without a duty
         cycle.
-    status, success, iterations, solve_time [s], build_time [s]: solver statistics.
+    status, success, iterations, solve_time [s], build_time [s]: solver statistics: the status and iterations
+        of the attempt kept (``"Solved_To_Acceptable_Level"`` marks a point kept at IPOPT's acceptable
+        tolerance), the time of every attempt.
+    attempts: every IPOPT run of the solve (:class:`Attempt`), the kept one last; more than one means retries.
     """
 
     design: Design
@@ -126,6 +153,7 @@ class DesignResult:
     speed_margin: np.ndarray | None = None
     x: np.ndarray = field(default_factory=lambda: np.empty(0), repr=False)
     multipliers: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)
+    attempts: tuple[Attempt, ...] = ()
 
     @property
     def worst_sample(self) -> int:
@@ -143,12 +171,19 @@ def solve(
 ) -> DesignResult:
     """Solve ``problem`` with IPOPT (exact Hessian, MUMPS).
 
+    A failed solve (any status but those of :data:`CONVERGED`: infeasibility detected, restoration failed, the
+    iteration cap, ...) is retried as :data:`RETRIES` says, then an elastic feasibility solve decides whether
+    any design meets the constraints: only then is the problem reported infeasible. Each retry reuses the
+    problem's solvers (one per set of options, built on first use). ``DesignResult.attempts`` lists the runs.
+
     Parameters
     ----------
+    problem: the NLP (:func:`collision_reflex.optimize.build_problem`).
     epsilon: upper bounds on objectives built as bounded (lower bound for ``approach_velocity``) [their units].
     x0: start point in the NLP's variables, or a neighbouring :class:`DesignResult` of the same problem, whose
         point and multipliers then warm-start IPOPT; default the problem's start point.
-    ipopt_options: options merged over :data:`DEFAULT_IPOPT_OPTIONS` (e.g. ``{"ipopt.max_iter": 100}``).
+    ipopt_options: options merged over :data:`DEFAULT_IPOPT_OPTIONS` (e.g. ``{"ipopt.max_iter": 100}``), and
+        under each retry's.
     starts: number of start points (multi-start). The problem is not convex (a worst case over samples) and
         IPOPT finds a local optimum; with ``starts > 1`` it is also started from ``starts - 1`` points drawn
         log-uniformly within the bounds and the best feasible result is returned.
@@ -156,57 +191,160 @@ def solve(
 
     Raises
     ------
-    SolverFailed: IPOPT did not reach a (locally) optimal point; it carries the status, the statistics and the
-        constraints that could not be met.
+    SolverFailed: status ``"Infeasible"`` when the feasibility solve confirms that no design within the bounds
+        meets the constraints (``violated`` names them, with the shortfall in their units); otherwise the last
+        attempt's status, when no attempt converged although the problem is feasible (or undecided).
     """
     warm = x0 if isinstance(x0, DesignResult) and x0.multipliers is not None else None
     if not isinstance(starts, int) or starts < 1:
         raise InvalidParameter("starts", starts, "an integer >= 1")
     if starts > 1:
         return _multi_start(problem, epsilon, x0, ipopt_options, starts, rng or np.random.default_rng(0))
-    options = {**DEFAULT_IPOPT_OPTIONS, **(WARM_START_OPTIONS if warm else {}), **(ipopt_options or {})}
-    key = repr(sorted(options.items()))
-    solver = problem._solvers.get(key)
-    if solver is None:
-        solver = ca.nlpsol("actuator_design", "ipopt", problem.nlp, options)
-        problem._solvers[key] = solver
+    requested = {**DEFAULT_IPOPT_OPTIONS, **(ipopt_options or {})}
     parameters = problem.parameters(epsilon)
-    if isinstance(x0, DesignResult):
-        x0 = x0.x
-    start = np.clip(problem.x0 if x0 is None else np.asarray(x0, dtype=float), problem.lbx, problem.ubx)
-    warm_multipliers = warm.multipliers if warm is not None else None
-    multipliers = (
-        {"lam_x0": warm_multipliers[0], "lam_g0": warm_multipliers[1]} if warm_multipliers is not None else {}
-    )
-    started = time.perf_counter()
-    solution = solver(
-        x0=start,
-        lbx=problem.lbx,
-        ubx=problem.ubx,
-        lbg=problem.lbg,
-        ubg=problem.ubg,
-        p=parameters,
-        **multipliers,
-    )
-    elapsed = time.perf_counter() - started
-    stats = solver.stats()
-    status = str(stats.get("return_status", "unknown"))
-    x = np.asarray(solution["x"]).ravel()
-    if not stats.get("success", False) and status not in ("Solved_To_Acceptable_Level",):
-        violated = _violations(problem, np.asarray(solution["g"]).ravel())
-        what = "; ".join(f"{label} (short by {amount:.3g})" for label, amount in violated[:3])
-        raise SolverFailed(
-            f"the optimiser stopped with status {status} after {stats.get('iter_count')} iterations"
-            + (f": could not meet {what}" if what else "")
-            + ". Widen the bounds (gear ratio, motor size), lower the payload or safety factor, or relax the "
-            "objective bounds.",
-            status,
-            dict(stats),
-            violated,
-            problem,
+    point = x0.x if isinstance(x0, DesignResult) else x0
+    start = np.clip(problem.x0 if point is None else np.asarray(point, dtype=float), problem.lbx, problem.ubx)
+    attempts = _Attempts(problem, parameters)
+    found = attempts.run("requested", {**requested, **(WARM_START_OPTIONS if warm else {})}, start, warm)
+    tried = set() if warm else {(repr(sorted(requested.items())), start.tobytes())}
+    for name, change, where in RETRIES if found is None else ():
+        options = {**requested, **change}
+        retry_start = start if where == "start" else np.clip(problem.x0, problem.lbx, problem.ubx)
+        key = (repr(sorted(options.items())), retry_start.tobytes())
+        if key not in tried:
+            tried.add(key)
+            found = attempts.run(name, options, retry_start)
+            if found is not None:
+                break
+    if found is None:
+        found = _decide(problem, dict(epsilon or {}), {**requested, **RETRIES[0][1]}, attempts)
+    x, stats, multipliers = found
+    return _result(problem, x, tuple(attempts.records), stats, dict(epsilon or {}), multipliers)
+
+
+_Found = tuple[np.ndarray, dict, tuple[np.ndarray, np.ndarray]]
+"""A converged attempt: the point, IPOPT's statistics, the multipliers (bounds, constraints)."""
+
+
+class _Attempts:
+    """The IPOPT runs of one solve: runs each (the problem's solver for its options, built once) and records it."""
+
+    def __init__(self, problem: DesignProblem, parameters: np.ndarray) -> None:
+        self.problem = problem
+        self.parameters = parameters
+        self.records: list[Attempt] = []
+        self.last_stats: dict = {}
+
+    def run(
+        self,
+        name: str,
+        options: dict[str, str | float],
+        start: np.ndarray,
+        warm: DesignResult | None = None,
+    ) -> _Found | None:
+        """Run IPOPT from ``start`` (warm-started from ``warm``'s multipliers); None if it did not converge."""
+        problem = self.problem
+        key = repr(sorted(options.items()))
+        solver = problem._solvers.get(key)
+        if solver is None:
+            solver = ca.nlpsol("actuator_design", "ipopt", problem.nlp, options)
+            problem._solvers[key] = solver
+        multipliers = (
+            {"lam_x0": warm.multipliers[0], "lam_g0": warm.multipliers[1]}
+            if warm is not None and warm.multipliers is not None
+            else {}
         )
-    multipliers_out = (np.asarray(solution["lam_x"]).ravel(), np.asarray(solution["lam_g"]).ravel())
-    return _result(problem, x, status, stats, elapsed, dict(epsilon or {}), multipliers_out)
+        started = time.perf_counter()
+        solution = solver(
+            x0=start,
+            lbx=problem.lbx,
+            ubx=problem.ubx,
+            lbg=problem.lbg,
+            ubg=problem.ubg,
+            p=self.parameters,
+            **multipliers,
+        )
+        stats = dict(solver.stats())
+        status = str(stats.get("return_status", "unknown"))
+        iterations = int(stats.get("iter_count", -1))
+        self.records.append(Attempt(name, status, iterations, time.perf_counter() - started))
+        self.last_stats = stats
+        if status not in CONVERGED:
+            return None
+        lam = (np.asarray(solution["lam_x"]).ravel(), np.asarray(solution["lam_g"]).ravel())
+        return np.asarray(solution["x"]).ravel(), stats, lam
+
+
+def _decide(
+    problem: DesignProblem, epsilon: dict[str, float], options: dict[str, str | float], attempts: _Attempts
+) -> _Found:
+    """After every retry failed: a feasibility solve, then either infeasible (raised) or a last attempt.
+
+    Raises
+    ------
+    SolverFailed: ``"Infeasible"`` when the feasibility solve confirms it; otherwise the last attempt's
+        status, the problem being feasible (or, if the feasibility solve failed too, undecided).
+    """
+    started = time.perf_counter()
+    verdict = solve_feasibility(problem, problem.x0, attempts.parameters, options, epsilon)
+    attempts.records.append(
+        Attempt("feasibility", verdict.status, verdict.iterations, time.perf_counter() - started)
+    )
+    design_status = next(a.status for a in reversed(attempts.records) if a.name != "feasibility")
+    if verdict.converged and not verdict.feasible:
+        what = "; ".join(_shortfall(v) for v in verdict.violations[:3])
+        raise SolverFailed(
+            f"no design within the bounds meets the constraints (confirmed by a feasibility solve): {what}. "
+            + _advice(verdict.violations),
+            "Infeasible",
+            attempts.last_stats,
+            list(verdict.violations),
+            problem,
+            attempts.records,
+        )
+    if verdict.feasible:
+        found = attempts.run("feasible start, adaptive barrier", options, verdict.x)
+        if found is not None:
+            return found
+        design_status = attempts.records[-1].status
+    tried = ", ".join(f"{a.name}: {a.status} after {a.iterations} iterations" for a in attempts.records)
+    decided = (
+        "a feasibility solve found a design that meets every constraint"
+        if verdict.feasible
+        else "the feasibility solve did not converge either, so feasibility is undecided"
+    )
+    raise SolverFailed(
+        f"the optimiser did not converge ({tried}); {decided}. Raise ipopt.max_iter, try more start points "
+        "(starts), or narrow the bounds.",
+        design_status,
+        attempts.last_stats,
+        list(verdict.violations),
+        problem,
+        attempts.records,
+    )
+
+
+def _shortfall(violation: Violation) -> str:
+    """``peak torque of joint1 >= the given required torque: not met by 49.1 N*m``."""
+    unit = "" if violation.unit == "-" else f" {violation.unit}"
+    return f"{violation.label}: not met by {violation.amount:.3g}{unit}"
+
+
+ADVICE = {
+    "peak torque": "raise the upper bounds of the gear ratio or the motor size, or lower the payload, the "
+    "safety factor or the given torques",
+    "within its bound": "relax the objective bounds",
+    "noise floor": "lower the threshold floor or raise the threshold's upper bound",
+    "RMS torque": "raise the upper bound of the motor size or shorten the duty cycle's loads",
+    "motor speed": "lower the upper bound of the gear ratio or slow the duty cycle",
+}
+"""What to do about each kind of constraint that cannot be met (found in its label)."""
+
+
+def _advice(violations: tuple[Violation, ...]) -> str:
+    """What to change, for the kinds of constraints in ``violations``."""
+    hints = [hint for key, hint in ADVICE.items() if any(key in v.label for v in violations)]
+    return ("To meet them: " + "; ".join(hints) + ".") if hints else "Widen the bounds."
 
 
 def _multi_start(
@@ -231,6 +369,8 @@ def _multi_start(
         try:
             result = solve(problem, epsilon, point, ipopt_options)
         except SolverFailed as error:
+            if error.confirmed_infeasible:  # no design meets the constraints, from any start
+                raise
             failure = error
             continue
         value = problem.objective_value(result.x)
@@ -245,12 +385,12 @@ def _multi_start(
 def _result(
     problem: DesignProblem,
     x: np.ndarray,
-    status: str,
+    attempts: tuple[Attempt, ...],
     stats: dict,
-    elapsed: float,
     epsilon: dict[str, float],
     multipliers: tuple[np.ndarray, np.ndarray],
 ) -> DesignResult:
+    """The result at ``x``, found by the last of ``attempts`` (IPOPT's ``stats``), all timed."""
     design = design_at(problem, x)
     evaluated = problem.evaluate(problem.exact_point(x))
     impulses = np.asarray(evaluated[0]).ravel()
@@ -291,16 +431,17 @@ def _result(
         impulses=numpy_impulses,
         required_torque=required,
         torque_margin=design.peak_torque / np.maximum(required, 1e-300) - 1,
-        status=status,
+        status=attempts[-1].status,
         success=True,
         iterations=int(stats.get("iter_count", -1)),
-        solve_time=elapsed,
+        solve_time=sum(attempt.solve_time for attempt in attempts),
         build_time=problem.build_time,
         epsilon=epsilon,
         requirement=problem.requirement,
         **duty,
         x=x,
         multipliers=multipliers,
+        attempts=attempts,
     )
 
 
@@ -337,12 +478,3 @@ def design_at(problem: DesignProblem, x: np.ndarray) -> Design:
         approach_velocity=float(values["approach_velocity"][0]),
         sensing=technology.sensing,
     )
-
-
-def _violations(problem: DesignProblem, g: np.ndarray) -> list[tuple[str, float]]:
-    """Constraints violated at ``g``, worst first, as ``(label, amount)`` in the NLP's scaled units."""
-    below = problem.lbg - g
-    above = g - problem.ubg
-    amount = np.maximum(np.where(np.isfinite(below), below, 0.0), np.where(np.isfinite(above), above, 0.0))
-    order = np.argsort(-amount)
-    return [(problem.constraint_labels[i], float(amount[i])) for i in order if amount[i] > 1e-6][:10]
