@@ -427,3 +427,25 @@ def test_pareto_front_refuses_bad_settings_before_building(keyword, value):
 
     with pytest.raises(InvalidParameter):
         cr.pareto_front(build, **{keyword: value})
+
+
+def test_a_single_contact_sample_is_a_problem_like_any_other():
+    """One configuration and one direction: the CasADi and NumPy paths agree (a 1x1 expression once broke the
+    reaction-capacity rows with a dimension error)."""
+    arm = cr.Arm.from_example_robot_data("double_pendulum")
+    samples = cr.ContactSamples.grid(arm.kinematics(np.array([[0.3, 0.5]])), np.array([[1.0, 0.0]]))
+    space = cr.DesignSpace(
+        stator_diameter=(0.02, 0.12),
+        gear_ratio=(1, 30),
+        software_stiffness=300.0,
+        threshold=(3, 20),
+        approach_velocity=(0.02, 2.0),
+    )
+    technology = cr.ActuatorTechnology(cr.reference_motor(), mechanical_stiffness=[600.0, 400.0])
+    problem = cr.build_problem(
+        arm, samples, space, technology, "worst_case_impulse", cr.Constraints(payload=0.5, safety_factor=1.5)
+    )
+    result = cr.solve(problem)
+    assert result.objectives["worst_case_impulse"] == pytest.approx(
+        result.numpy_objectives["worst_case_impulse"], rel=1e-6
+    )

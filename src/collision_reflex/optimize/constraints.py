@@ -148,7 +148,10 @@ def add_model_constraints(
     pair_sample, pair_joint = np.nonzero(loaded)
     log_arm = np.log(np.abs(samples.joint_moment_arms[pair_sample, pair_joint]))
     g.add(
-        terms.log_compliance[pair_sample.tolist()] + ca.log(terms.peak_torque)[pair_joint.tolist()] - log_arm,
+        # ca.vec: CasADi indexes a 1x1 expression (one sample) into a row; every term here is a column.
+        ca.vec(terms.log_compliance[pair_sample.tolist()])
+        + ca.vec(ca.log(terms.peak_torque)[pair_joint.tolist()])
+        - log_arm,
         0.0,
         np.inf,
         [
