@@ -1,0 +1,116 @@
+"""Start-up: ``import collision_reflex`` and ``crx`` load the heavy libraries only when a command needs them.
+
+The public names are resolved on first access (PEP 562); these tests check that every name still resolves to
+the object its defining module holds, and what a fresh interpreter has imported after each start-up. Timings
+are printed by ``benchmarks/startup.py``, not asserted here.
+"""
+
+from __future__ import annotations
+
+import ast
+import importlib
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import collision_reflex as cr
+
+ROOT = Path(__file__).resolve().parents[1]
+HEAVY = ("casadi", "scipy", "pinocchio", "pandas", "matplotlib")
+
+
+def imported_after(code: str) -> set[str]:
+    """The top-level modules a fresh interpreter has in ``sys.modules`` after running ``code``."""
+    # The module list is the last line on stderr: the code may print on stdout.
+    probe = f"{code}\nimport sys\nprint(' '.join({{m.split('.')[0] for m in sys.modules}}), file=sys.stderr)"
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+    done = subprocess.run(
+        [sys.executable, "-c", probe], capture_output=True, text=True, check=True, env=env, cwd=ROOT
+    )
+    return set(done.stderr.splitlines()[-1].split())
+
+
+def test_import_loads_no_heavy_library():
+    loaded = imported_after("import collision_reflex")
+    assert "collision_reflex" in loaded
+    assert not loaded & set(HEAVY), sorted(loaded & set(HEAVY))
+
+
+def test_the_probe_sees_a_heavy_library_when_one_is_used():
+    # The check above must be able to fail: touching a name whose module needs CasADi loads it.
+    assert "casadi" in imported_after("import collision_reflex\ncollision_reflex.build_problem")
+
+
+def test_crx_help_loads_no_heavy_library():
+    loaded = imported_after("from collision_reflex.cli import main\nmain(['--help'])")
+    assert not loaded & {*HEAVY, "pint", "pydantic"}, sorted(loaded & {*HEAVY, "pint", "pydantic"})
+
+
+def test_crx_validate_schema_only_loads_no_solver_or_plotting_library():
+    code = "from collision_reflex.cli import main\nmain(['validate', '--schema-only', 'studies/two_link_paper.yaml'])"
+    loaded = imported_after(code)
+    assert "pydantic" in loaded  # it did check the study
+    assert not loaded & set(HEAVY), sorted(loaded & set(HEAVY))
+
+
+def test_every_public_name_resolves_and_dir_lists_it():
+    assert len(cr.__all__) == len(set(cr.__all__))
+    for name in cr.__all__:
+        assert getattr(cr, name) is not None, name
+    assert set(cr.__all__) <= set(dir(cr))
+
+
+def _type_checking_imports() -> dict[str, tuple[str, str]]:
+    """The names the ``if TYPE_CHECKING:`` block of the package root imports: name -> (module, attribute)."""
+    tree = ast.parse((ROOT / "src" / "collision_reflex" / "__init__.py").read_text(encoding="utf-8"))
+    block = next(n for n in tree.body if isinstance(n, ast.If) and ast.unparse(n.test) == "TYPE_CHECKING")
+    names: dict[str, tuple[str, str]] = {}
+    for node in block.body:
+        assert isinstance(node, ast.ImportFrom) and node.level == 1
+        for alias in node.names:
+            names[alias.asname or alias.name] = (node.module or "", alias.name)
+    return names
+
+
+def test_the_type_checkers_names_are_the_run_time_names():
+    # The TYPE_CHECKING imports (what mypy and IDEs see) and the lazy table must name the same objects.
+    declared = _type_checking_imports()
+    assert set(declared) == set(cr.__all__) - {"__version__"}
+    for name, (module, attribute) in declared.items():
+        where = importlib.import_module(f"collision_reflex.{module}" if module else "collision_reflex")
+        assert getattr(where, attribute) is getattr(cr, name), name
+
+
+def test_from_import_and_star_import_work():
+    namespace: dict[str, object] = {}
+    exec("from collision_reflex import *", namespace)
+    assert set(cr.__all__) <= set(namespace)
+    from collision_reflex import SimulationSweep, solve
+    from collision_reflex.optimize import solve as optimize_solve
+    from collision_reflex.simulate import Sweep
+
+    assert solve is optimize_solve and SimulationSweep is Sweep
+
+
+def test_subpackages_are_attributes():
+    assert cr.optimize.__name__ == "collision_reflex.optimize"
+    assert cr.experiments.__name__ == "collision_reflex.experiments"
+
+
+@pytest.mark.parametrize("name", ["not_a_name", "__wrapped__"])
+def test_an_unknown_name_is_an_attribute_error(name):
+    with pytest.raises(AttributeError, match=name):
+        getattr(cr, name)
+    assert not hasattr(cr, name)
+
+
+def test_crx_help_lists_every_subcommand(capsys):
+    from collision_reflex.cli import main
+
+    assert main(["--help"]) == 0
+    shown = capsys.readouterr().out
+    for command in ("impulse", "motors", "sweep", "surface", "fit", "simulate", "validate", "schema", "run", "report"):
+        assert f"    {command} " in shown, command
