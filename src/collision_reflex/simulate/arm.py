@@ -561,6 +561,7 @@ def _react(
     Watch ``watch`` [s] for a rebound into the wall before stopping (a constant torque kept on would spin the
     arm round into the wall again, which is no part of the reflex), and push again if there is one.
     """
+    from scipy.integrate import solve_ivp
 
     def separated(t: float, y: np.ndarray) -> float:
         return dynamics.penetration(y)
