@@ -131,3 +131,50 @@ def test_crx_help_lists_every_subcommand(capsys):
         "report",
     ):
         assert f"    {command} " in shown, command
+
+
+# The package's registry is built from pint's on-disk cache of its definitions (faster start-up); it must read
+# every unit as a registry parsed from pint's definition file does, and survive a cache it cannot read.
+UNIT_STRINGS = [
+    "60 mm",
+    "1.3 N*m",
+    "2e7 N/m",
+    "10 ms",
+    "45 deg",
+    "250 N*m/rad",
+    "2.21e-5 kg*m^2",
+    "3 lbf",
+    "1 rpm",
+]
+
+
+def test_the_cached_registry_reads_units_as_a_parsed_one():
+    import pint
+
+    from collision_reflex._units import unit_registry
+
+    cached, parsed = unit_registry(), pint.UnitRegistry()
+    for text in UNIT_STRINGS:
+        ours, reference = cached.Quantity(text), parsed.Quantity(text)
+        assert ours.dimensionality == reference.dimensionality, text
+        assert ours.to_base_units().magnitude == pytest.approx(reference.to_base_units().magnitude, rel=1e-15)
+    assert cached.Quantity("1 inch").to("mm").magnitude == pytest.approx(
+        25.4, rel=1e-15
+    )  # exact by definition
+
+
+def test_an_unreadable_cache_falls_back_to_parsing(monkeypatch):
+    import pint
+
+    from collision_reflex._units import unit_registry
+
+    real = pint.UnitRegistry
+
+    def damaged_cache(*args, cache_folder=None, **kwargs):
+        if cache_folder is not None:
+            raise EOFError("Ran out of input")  # what pickle says of a cache file still being written
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(pint, "UnitRegistry", damaged_cache)
+    registry = unit_registry.__wrapped__()
+    assert registry.Quantity("60 mm").to("m").magnitude == pytest.approx(0.06, rel=1e-15)
