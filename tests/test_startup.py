@@ -106,7 +106,7 @@ def test_subpackages_are_attributes():
     assert cr.experiments.__name__ == "collision_reflex.experiments"
 
 
-@pytest.mark.parametrize("name", ["not_a_name", "__wrapped__"])
+@pytest.mark.parametrize("name", ["not_a_name", "__wrapped__", "arm.not_a_module"])
 def test_an_unknown_name_is_an_attribute_error(name):
     with pytest.raises(AttributeError, match=name):
         getattr(cr, name)

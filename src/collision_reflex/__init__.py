@@ -381,7 +381,7 @@ if not TYPE_CHECKING:  # hidden from type checkers, so that a misspelt name is s
         if name in _WHERE:
             module, attribute = _WHERE[name]
             value = getattr(importlib.import_module(module, __name__), attribute)
-        elif name.startswith("__"):
+        elif name.startswith("__") or not name.isidentifier():
             raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
         else:  # a subpackage, bound as an attribute only once something imports it
             try:
