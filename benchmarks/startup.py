@@ -1,8 +1,8 @@
 """Start-up time of ``import collision_reflex``, ``crx --help`` and ``crx validate``.
 
 Each command runs in a fresh interpreter R times (default 7); the median wall time is printed with the machine's
-load average before and after, and with the heavy libraries the command imported (read from ``sys.modules``
-when it has finished, in one extra run). ``crx`` runs as ``python -m collision_reflex``, the same code as the
+load average before and after, and with the heavy libraries the command imported and their import times (one
+extra run with ``python -X importtime``; a library imported by another counts in both). ``crx`` runs as ``python -m collision_reflex``, the same code as the
 installed script.
 
 Run: ``PYTHONPATH=src python benchmarks/startup.py [--repeats R]``.
@@ -19,23 +19,9 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+# The libraries whose import time is worth knowing (NumPy for scale; pint imports Dask when it is installed).
 HEAVY = ("casadi", "scipy", "pinocchio", "pandas", "matplotlib", "pydantic", "pint", "jinja2", "rich", "yaml")
-
-# Runs a command's code in-process, then prints the heavy libraries it left in sys.modules on stderr.
-PROBE = """
-import sys
-HEAVY = {heavy!r}
-argv = sys.argv[1:]
-if argv:
-    from collision_reflex.cli import main
-    status = main(argv)
-else:
-    import collision_reflex
-    status = 0
-heavy = sorted(set(name.split('.')[0] for name in sys.modules) & set(HEAVY))
-print("HEAVY", " ".join(heavy) or "-", file=sys.stderr)
-sys.exit(status)
-"""
+HEAVY += ("dask", "numpy")
 
 COMMANDS = {
     "import collision_reflex": [],
@@ -57,12 +43,20 @@ def wall_time(argv: list[str]) -> float:
 
 
 def heavy_modules(argv: list[str]) -> str:
-    probe = PROBE.format(heavy=HEAVY)
+    """The heavy libraries the command imports, each with its import time (``-X importtime``, cumulative)."""
     done = subprocess.run(
-        [sys.executable, "-c", probe, *argv], cwd=ROOT, check=True, capture_output=True, text=True
+        [sys.executable, "-X", "importtime", *command_line(argv)[1:]],
+        cwd=ROOT,
+        check=True,
+        capture_output=True,
+        text=True,
     )
-    line = next(line for line in done.stderr.splitlines() if line.startswith("HEAVY "))
-    return line.removeprefix("HEAVY ")
+    found = {}
+    for line in done.stderr.splitlines():  # "import time: SELF | CUMULATIVE | <indent>NAME", in microseconds
+        if line.startswith("import time:") and (fields := line.split("|"))[2].strip() in HEAVY:
+            found[fields[2].strip()] = int(fields[1]) / 1e3
+    shown = sorted(found.items(), key=lambda item: -item[1])
+    return ", ".join(f"{name} {ms:.0f} ms" for name, ms in shown) or "none"
 
 
 def main() -> None:
