@@ -20,8 +20,11 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 # The libraries whose import time is worth knowing (NumPy for scale; pint imports Dask when it is installed).
-HEAVY = ("casadi", "scipy", "pinocchio", "pandas", "matplotlib", "pydantic", "pint", "jinja2", "rich", "yaml")
-HEAVY += ("dask", "numpy")
+LIBRARIES = (
+    *("casadi", "scipy", "pinocchio", "pandas", "matplotlib", "pydantic", "pint", "jinja2", "rich", "yaml"),
+    *("dask", "numpy"),
+)
+
 
 COMMANDS = {
     "import collision_reflex": [],
@@ -53,7 +56,7 @@ def heavy_modules(argv: list[str]) -> str:
     )
     found = {}
     for line in done.stderr.splitlines():  # "import time: SELF | CUMULATIVE | <indent>NAME", in microseconds
-        if line.startswith("import time:") and (fields := line.split("|"))[2].strip() in HEAVY:
+        if line.startswith("import time:") and (fields := line.split("|"))[2].strip() in LIBRARIES:
             found[fields[2].strip()] = int(fields[1]) / 1e3
     shown = sorted(found.items(), key=lambda item: -item[1])
     return ", ".join(f"{name} {ms:.0f} ms" for name, ms in shown) or "none"
