@@ -20,10 +20,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 # The libraries whose import time is worth knowing (NumPy for scale; pint imports Dask when it is installed).
-LIBRARIES = (
-    *("casadi", "scipy", "pinocchio", "pandas", "matplotlib", "pydantic", "pint", "jinja2", "rich", "yaml"),
-    *("dask", "numpy"),
-)
+LIBRARIES = "casadi scipy pinocchio pandas matplotlib pydantic pint jinja2 rich yaml dask numpy".split()
 
 
 COMMANDS = {
