@@ -4,120 +4,269 @@ The collision reflex is the total impulse a robot transfers to a rigid object wh
 contact and backs away (Bhatia, Mason and Johnson, "Reacting to Contact: Transparency and Collision Reflex in
 Actuation"). This package evaluates it from structure, actuation, stiffness and sensing, for single actuators and
 URDF arms, and optimises actuator designs against it.
+
+Every public name is imported on first use (PEP 562), so that ``import collision_reflex`` and the ``crx`` command
+start without loading CasADi, SciPy, Pinocchio or Matplotlib.
 """
 
-from . import experiments
-from .arm import (
-    Arm,
-    ArmSamples,
-    CollisionImpulses,
-    CycleTorques,
-    DutyCycle,
-    EffectiveParameters,
-    JointParameters,
-    Payload,
-    collision_impulses,
-    cycle_torques,
-    effective_parameters,
-    joint_side_torque,
-)
-from .arm.directions import circle_directions, sphere_directions, unit_directions
-from .arm.metrics import (
-    Ellipsoid,
-    ImpactMitigation,
-    dynamic_manipulability_ellipsoid,
-    effective_mass,
-    ellipsoid_of_gyration,
-    generalized_inertia_ellipsoid,
-    impact_mitigation_factor,
-)
-from .arm.surfaces import ReflexSurface, reflex_surface
-from .errors import (
-    CatalogueError,
-    CollisionReflexError,
-    FitFailed,
-    FrameNotFound,
-    InvalidParameter,
-    SimulationError,
-    SolverFailed,
-    StudyFileError,
-    StudyProblem,
-    StudyRunFailed,
-    TraceError,
-    TrajectoryError,
-    UnknownMotor,
-    UrdfError,
-)
-from .hardware.actuators import (
-    REFLECTED_INERTIA_PLACEMENTS,
-    Actuator,
-    CollisionParameters,
-    CurrentThreshold,
-    ForceThreshold,
-    PositionThreshold,
-    gear_ratio_for,
-)
-from .hardware.gearboxes import GEARBOX_KINDS, Gearbox
-from .hardware.motors import (
-    SCALING_LAWS,
-    Motor,
-    MotorQuantities,
-    ScalingLaw,
-    load_catalogue,
-    reference_motor,
-    scaled_motor_quantities,
-    scaling_law,
-)
-from .model.impulse import (
-    REACTION_MODES,
-    PhaseImpulses,
-    collision_times,
-    force_profile,
-    minimum_impulse,
-    optimal_velocity,
-    phase_impulses,
-    series_stiffness,
-    total_impulse,
-    velocity_coefficients,
-)
-from .model.sensing import SENSING_SCHEMES, current_threshold_torque, threshold_force
-from .optimize import (
-    OBJECTIVES,
-    ActuatorTechnology,
-    Bounds,
-    Constraints,
-    ContactSamples,
-    Design,
-    DesignProblem,
-    DesignResult,
-    DesignSpace,
-    ParetoSet,
-    build_problem,
-    hypervolume,
-    pareto_front,
-    solve,
-)
-from .optimize.results import result_from_json, result_to_json
-from .report import render_report
-from .simulate import (
-    DETECTION_KINDS,
-    DRIVES,
-    SWEEP_PARAMETERS,
-    ArmCollision,
-    CollisionSetup,
-    Detection,
-    SimulationResult,
-    contact_damping_for_restitution,
-    contact_restitution,
-    simulate_arm_collision,
-)
-from .simulate import Sweep as SimulationSweep
-from .simulate import simulate as simulate_collision
-from .simulate import sweep as simulation_sweep
-from .study import load_study, study_json_schema
-from .study.runner import run_study
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # the names as type checkers and IDEs see them; at run time `__getattr__` imports them
+    from . import experiments
+    from .arm import (
+        Arm,
+        ArmSamples,
+        CollisionImpulses,
+        CycleTorques,
+        DutyCycle,
+        EffectiveParameters,
+        JointParameters,
+        Payload,
+        collision_impulses,
+        cycle_torques,
+        effective_parameters,
+        joint_side_torque,
+    )
+    from .arm.directions import circle_directions, sphere_directions, unit_directions
+    from .arm.metrics import (
+        Ellipsoid,
+        ImpactMitigation,
+        dynamic_manipulability_ellipsoid,
+        effective_mass,
+        ellipsoid_of_gyration,
+        generalized_inertia_ellipsoid,
+        impact_mitigation_factor,
+    )
+    from .arm.surfaces import ReflexSurface, reflex_surface
+    from .errors import (
+        CatalogueError,
+        CollisionReflexError,
+        FitFailed,
+        FrameNotFound,
+        InvalidParameter,
+        SimulationError,
+        SolverFailed,
+        StudyFileError,
+        StudyProblem,
+        StudyRunFailed,
+        TraceError,
+        TrajectoryError,
+        UnknownMotor,
+        UrdfError,
+    )
+    from .hardware.actuators import (
+        REFLECTED_INERTIA_PLACEMENTS,
+        Actuator,
+        CollisionParameters,
+        CurrentThreshold,
+        ForceThreshold,
+        PositionThreshold,
+        gear_ratio_for,
+    )
+    from .hardware.gearboxes import GEARBOX_KINDS, Gearbox
+    from .hardware.motors import (
+        SCALING_LAWS,
+        Motor,
+        MotorQuantities,
+        ScalingLaw,
+        load_catalogue,
+        reference_motor,
+        scaled_motor_quantities,
+        scaling_law,
+    )
+    from .model.impulse import (
+        REACTION_MODES,
+        PhaseImpulses,
+        collision_times,
+        force_profile,
+        minimum_impulse,
+        optimal_velocity,
+        phase_impulses,
+        series_stiffness,
+        total_impulse,
+        velocity_coefficients,
+    )
+    from .model.sensing import SENSING_SCHEMES, current_threshold_torque, threshold_force
+    from .optimize import (
+        OBJECTIVES,
+        ActuatorTechnology,
+        Bounds,
+        Constraints,
+        ContactSamples,
+        Design,
+        DesignProblem,
+        DesignResult,
+        DesignSpace,
+        ParetoSet,
+        build_problem,
+        hypervolume,
+        pareto_front,
+    )
+    from .optimize.results import result_from_json, result_to_json
+    from .optimize.solve import solve  # from its module: mypy confuses it with `optimize.solve`
+    from .report import render_report
+    from .simulate import (
+        DETECTION_KINDS,
+        DRIVES,
+        SWEEP_PARAMETERS,
+        ArmCollision,
+        CollisionSetup,
+        Detection,
+        SimulationResult,
+        contact_damping_for_restitution,
+        contact_restitution,
+        simulate_arm_collision,
+    )
+    from .simulate import Sweep as SimulationSweep
+    from .simulate import simulate as simulate_collision
+    from .simulate import sweep as simulation_sweep
+    from .study import load_study, study_json_schema
+    from .study.runner import run_study
 
 __version__ = "0.1.0"
+
+# Where each public name lives: the module it is defined in (relative to this package), by module ...
+_EXPORTS: dict[str, tuple[str, ...]] = {
+    ".arm": (
+        "Arm",
+        "ArmSamples",
+        "CollisionImpulses",
+        "CycleTorques",
+        "DutyCycle",
+        "EffectiveParameters",
+        "JointParameters",
+        "Payload",
+        "collision_impulses",
+        "cycle_torques",
+        "effective_parameters",
+        "joint_side_torque",
+    ),
+    ".arm.directions": (
+        "circle_directions",
+        "sphere_directions",
+        "unit_directions",
+    ),
+    ".arm.metrics": (
+        "Ellipsoid",
+        "ImpactMitigation",
+        "dynamic_manipulability_ellipsoid",
+        "effective_mass",
+        "ellipsoid_of_gyration",
+        "generalized_inertia_ellipsoid",
+        "impact_mitigation_factor",
+    ),
+    ".arm.surfaces": (
+        "ReflexSurface",
+        "reflex_surface",
+    ),
+    ".errors": (
+        "CatalogueError",
+        "CollisionReflexError",
+        "FitFailed",
+        "FrameNotFound",
+        "InvalidParameter",
+        "SimulationError",
+        "SolverFailed",
+        "StudyFileError",
+        "StudyProblem",
+        "StudyRunFailed",
+        "TraceError",
+        "TrajectoryError",
+        "UnknownMotor",
+        "UrdfError",
+    ),
+    ".hardware.actuators": (
+        "REFLECTED_INERTIA_PLACEMENTS",
+        "Actuator",
+        "CollisionParameters",
+        "CurrentThreshold",
+        "ForceThreshold",
+        "PositionThreshold",
+        "gear_ratio_for",
+    ),
+    ".hardware.gearboxes": (
+        "GEARBOX_KINDS",
+        "Gearbox",
+    ),
+    ".hardware.motors": (
+        "SCALING_LAWS",
+        "Motor",
+        "MotorQuantities",
+        "ScalingLaw",
+        "load_catalogue",
+        "reference_motor",
+        "scaled_motor_quantities",
+        "scaling_law",
+    ),
+    ".model.impulse": (
+        "REACTION_MODES",
+        "PhaseImpulses",
+        "collision_times",
+        "force_profile",
+        "minimum_impulse",
+        "optimal_velocity",
+        "phase_impulses",
+        "series_stiffness",
+        "total_impulse",
+        "velocity_coefficients",
+    ),
+    ".model.sensing": (
+        "SENSING_SCHEMES",
+        "current_threshold_torque",
+        "threshold_force",
+    ),
+    ".optimize": (
+        "OBJECTIVES",
+        "ActuatorTechnology",
+        "Bounds",
+        "Constraints",
+        "ContactSamples",
+        "Design",
+        "DesignProblem",
+        "DesignResult",
+        "DesignSpace",
+        "ParetoSet",
+        "build_problem",
+        "hypervolume",
+        "pareto_front",
+        "solve",
+    ),
+    ".optimize.results": (
+        "result_from_json",
+        "result_to_json",
+    ),
+    ".report": ("render_report",),
+    ".simulate": (
+        "DETECTION_KINDS",
+        "DRIVES",
+        "SWEEP_PARAMETERS",
+        "ArmCollision",
+        "CollisionSetup",
+        "Detection",
+        "SimulationResult",
+        "contact_damping_for_restitution",
+        "contact_restitution",
+        "simulate_arm_collision",
+    ),
+    ".study": (
+        "load_study",
+        "study_json_schema",
+    ),
+    ".study.runner": ("run_study",),
+}
+# ... and the names exported under another name than their module's (new name: module, attribute).
+_RENAMED: dict[str, tuple[str, str]] = {
+    "SimulationSweep": (".simulate", "Sweep"),
+    "simulate_collision": (".simulate", "simulate"),
+    "simulation_sweep": (".simulate", "sweep"),
+}
+_WHERE: dict[str, tuple[str, str]] = {
+    **{name: (module, name) for module, names in _EXPORTS.items() for name in names},
+    **_RENAMED,
+}
 
 __all__ = [
     "DETECTION_KINDS",
@@ -224,3 +373,27 @@ __all__ = [
     "unit_directions",
     "velocity_coefficients",
 ]
+
+if not TYPE_CHECKING:  # hidden from type checkers, so that a misspelt name is still an error for them
+
+    def __getattr__(name: str) -> object:
+        """Import the public name ``name`` (or the subpackage ``name``) on first access."""
+        if name in _WHERE:
+            module, attribute = _WHERE[name]
+            value = getattr(importlib.import_module(module, __name__), attribute)
+        elif name.startswith("__") or not name.isidentifier():
+            raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+        else:  # a subpackage, bound as an attribute only once something imports it
+            try:
+                value = importlib.import_module(f".{name}", __name__)
+            except ModuleNotFoundError as missing:
+                if missing.name != f"{__name__}.{name}":
+                    raise
+                raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None
+        globals()[name] = value  # later accesses find it without calling __getattr__
+        return value
+
+
+def __dir__() -> list[str]:
+    """The module's attributes and every public name, imported or not."""
+    return sorted(set(globals()) | set(__all__))

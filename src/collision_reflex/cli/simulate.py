@@ -7,21 +7,18 @@ from __future__ import annotations
 
 import argparse
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .._io import atomic_open
 from ..errors import InvalidParameter
 from ..model.impulse import REACTION_MODES, optimal_velocity, total_impulse
-from ..simulate import (
-    DETECTION_KINDS,
-    CollisionSetup,
-    Detection,
-    Sweep,
-    contact_damping_for_restitution,
-    sweep,
-)
+from ..model.sensing import SENSING_SCHEMES
 from . import options
+
+if TYPE_CHECKING:  # the simulator is imported when the command runs, not when `crx` starts
+    from ..simulate import CollisionSetup, Detection, Sweep
 
 # Defaults: a light direct-drive finger (the README's example) whose robot mass the spring does push back.
 _DEFAULTS = {"m_f": 0.2, "m_r": 0.5, "k_m": 1000.0, "k_s": 100.0, "F_s": 3.0, "F_a": 10.0}
@@ -49,7 +46,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     options.FORCE_LIMIT.add(parser, _DEFAULTS["F_a"])
     add(
         "--detection",
-        choices=DETECTION_KINDS,
+        choices=SENSING_SCHEMES,  # what the simulator's detector can watch (simulate.DETECTION_KINDS)
         default=None,
         help="what the detector watches (default: position with --position-error, force otherwise)",
     )
@@ -101,6 +98,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def _detection(args: argparse.Namespace) -> Detection:
     """The detector: a force threshold [N] (force, current) or a position-error threshold [m] (position)."""
+    from ..simulate import Detection
+
     kind = args.detection or ("position" if args.e_th is not None else "force")
     if kind == "position":
         if args.F_s is not None:
@@ -124,6 +123,8 @@ def _detection(args: argparse.Namespace) -> Detection:
 
 def _setup(args: argparse.Namespace) -> CollisionSetup:
     """The simulated collision at a unit approach velocity (the sweep sets the velocity)."""
+    from ..simulate import CollisionSetup, contact_damping_for_restitution
+
     contact_damping = 0.0
     if args.restitution is not None:
         if math.isinf(args.contact_stiffness):
@@ -156,6 +157,8 @@ def _setup(args: argparse.Namespace) -> CollisionSetup:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``crx simulate`` with parsed ``args``; return the exit status."""
+    from ..simulate import sweep
+
     for figure in (args.plot, args.trace_plot):
         if figure is not None:
             from ..plots import check_figure_path

@@ -33,7 +33,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from .. import _validate
 from .._compat import renamed_keywords
@@ -512,6 +511,8 @@ def _integrate(
     Impact and sensing until detection, the delay, then the reaction until the finger has left the wall for
     good.
     """
+    from scipy.integrate import solve_ivp  # here: SciPy's import time is paid only by a simulation
+
     max_step, duration, finger_period = _time_scales(dynamics, closed, approach_velocity, threshold, delay)
     nv = dynamics.nv
     y = np.zeros(4 * nv + 1)
@@ -560,6 +561,7 @@ def _react(
     Watch ``watch`` [s] for a rebound into the wall before stopping (a constant torque kept on would spin the
     arm round into the wall again, which is no part of the reflex), and push again if there is one.
     """
+    from scipy.integrate import solve_ivp
 
     def separated(t: float, y: np.ndarray) -> float:
         return dynamics.penetration(y)

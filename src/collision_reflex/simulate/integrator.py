@@ -9,7 +9,6 @@ import math
 from typing import Any
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from ..errors import SimulationError
 from ..model.impulse import collision_times
@@ -262,6 +261,8 @@ class _Run:
     # -- one segment -----------------------------------------------------------------------------------------
     def _integrate(self, t_stop: float, events: list[Any]) -> Any:
         """Integrate the current mode up to ``t_stop`` or its first event; record the trace."""
+        from scipy.integrate import solve_ivp  # here: SciPy's import time is paid only by a simulation
+
         sim = self.sim
         solution = solve_ivp(
             sim.rhs,

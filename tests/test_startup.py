@@ -1,0 +1,180 @@
+"""Start-up: ``import collision_reflex`` and ``crx`` load the heavy libraries only when a command needs them.
+
+The public names are resolved on first access (PEP 562); these tests check that every name still resolves to
+the object its defining module holds, and what a fresh interpreter has imported after each start-up. Timings
+are printed by ``benchmarks/startup.py``, not asserted here.
+"""
+
+from __future__ import annotations
+
+import ast
+import importlib
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import collision_reflex as cr
+
+ROOT = Path(__file__).resolve().parents[1]
+HEAVY = ("casadi", "scipy", "pinocchio", "pandas", "matplotlib")
+
+
+def imported_after(code: str, *, submodules: bool = False) -> set[str]:
+    """The modules a fresh interpreter has in ``sys.modules`` after running ``code`` (top-level names only,
+    unless ``submodules``)."""
+    # The module list is the last line on stderr: the code may print on stdout.
+    probe = f"{code}\nimport sys\nprint(' '.join(sys.modules), file=sys.stderr)"
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+    done = subprocess.run(
+        [sys.executable, "-c", probe], capture_output=True, text=True, check=True, env=env, cwd=ROOT
+    )
+    names = set(done.stderr.splitlines()[-1].split())
+    return names if submodules else {name.split(".")[0] for name in names}
+
+
+def test_import_loads_no_heavy_library():
+    loaded = imported_after("import collision_reflex")
+    assert "collision_reflex" in loaded
+    assert not loaded & set(HEAVY), sorted(loaded & set(HEAVY))
+
+
+def test_the_probe_sees_a_heavy_library_when_one_is_used():
+    # The check above must be able to fail: touching a name whose module needs CasADi loads it.
+    assert "casadi" in imported_after("import collision_reflex\ncollision_reflex.build_problem")
+
+
+def test_crx_help_loads_no_heavy_library():
+    loaded = imported_after("from collision_reflex.cli import main\nmain(['--help'])")
+    assert not loaded & {*HEAVY, "pint", "pydantic"}, sorted(loaded & {*HEAVY, "pint", "pydantic"})
+
+
+def test_crx_validate_schema_only_loads_no_solver_or_plotting_library():
+    code = "from collision_reflex.cli import main\nmain(['validate', '--schema-only', 'studies/two_link_paper.yaml'])"
+    loaded = imported_after(code, submodules=True)
+    assert {"pydantic", "pint"} <= loaded  # it did check the study and its units
+    # pint imports the bare scipy package (its private modules and version) when it is installed; none of
+    # SciPy's public subpackages (integrate, optimize, linalg, ...) may follow.
+    pint_probe = {"scipy", "scipy.version"} | {name for name in loaded if name.startswith("scipy._")}
+    heavy = {name for name in loaded if name.split(".")[0] in HEAVY} - pint_probe
+    assert not heavy, sorted(heavy)
+
+
+def test_every_public_name_resolves_and_dir_lists_it():
+    assert len(cr.__all__) == len(set(cr.__all__))
+    for name in cr.__all__:
+        assert getattr(cr, name) is not None, name
+    assert set(cr.__all__) <= set(dir(cr))
+
+
+def _type_checking_imports() -> dict[str, tuple[str, str]]:
+    """The names the ``if TYPE_CHECKING:`` block of the package root imports: name -> (module, attribute)."""
+    tree = ast.parse((ROOT / "src" / "collision_reflex" / "__init__.py").read_text(encoding="utf-8"))
+    block = next(n for n in tree.body if isinstance(n, ast.If) and ast.unparse(n.test) == "TYPE_CHECKING")
+    names: dict[str, tuple[str, str]] = {}
+    for node in block.body:
+        assert isinstance(node, ast.ImportFrom) and node.level == 1
+        for alias in node.names:
+            names[alias.asname or alias.name] = (node.module or "", alias.name)
+    return names
+
+
+def test_the_type_checkers_names_are_the_run_time_names():
+    # The TYPE_CHECKING imports (what mypy and IDEs see) and the lazy table must name the same objects.
+    declared = _type_checking_imports()
+    assert set(declared) == set(cr.__all__) - {"__version__"}
+    for name, (module, attribute) in declared.items():
+        where = importlib.import_module(f"collision_reflex.{module}" if module else "collision_reflex")
+        assert getattr(where, attribute) is getattr(cr, name), name
+
+
+def test_from_import_and_star_import_work():
+    namespace: dict[str, object] = {}
+    exec("from collision_reflex import *", namespace)
+    assert set(cr.__all__) <= set(namespace)
+    from collision_reflex import SimulationSweep, solve
+    from collision_reflex.optimize import solve as optimize_solve
+    from collision_reflex.simulate import Sweep
+
+    assert solve is optimize_solve and SimulationSweep is Sweep
+
+
+def test_subpackages_are_attributes():
+    assert cr.optimize.__name__ == "collision_reflex.optimize"
+    assert cr.experiments.__name__ == "collision_reflex.experiments"
+
+
+@pytest.mark.parametrize("name", ["not_a_name", "__wrapped__", "arm.not_a_module"])
+def test_an_unknown_name_is_an_attribute_error(name):
+    with pytest.raises(AttributeError, match=name):
+        getattr(cr, name)
+    assert not hasattr(cr, name)
+
+
+def test_crx_help_lists_every_subcommand(capsys):
+    from collision_reflex.cli import main
+
+    assert main(["--help"]) == 0
+    shown = capsys.readouterr().out
+    for command in (
+        "impulse",
+        "motors",
+        "sweep",
+        "surface",
+        "fit",
+        "simulate",
+        "validate",
+        "schema",
+        "run",
+        "report",
+    ):
+        assert f"    {command} " in shown, command
+
+
+# The package's registry is built from pint's on-disk cache of its definitions (faster start-up); it must read
+# every unit as a registry parsed from pint's definition file does, and survive a cache it cannot read.
+UNIT_STRINGS = [
+    "60 mm",
+    "1.3 N*m",
+    "2e7 N/m",
+    "10 ms",
+    "45 deg",
+    "250 N*m/rad",
+    "2.21e-5 kg*m^2",
+    "3 lbf",
+    "1 rpm",
+]
+
+
+def test_the_cached_registry_reads_units_as_a_parsed_one():
+    import pint
+
+    from collision_reflex._units import unit_registry
+
+    cached, parsed = unit_registry(), pint.UnitRegistry()
+    for text in UNIT_STRINGS:
+        ours, reference = cached.Quantity(text), parsed.Quantity(text)
+        assert ours.dimensionality == reference.dimensionality, text
+        assert ours.to_base_units().magnitude == pytest.approx(reference.to_base_units().magnitude, rel=1e-15)
+    assert cached.Quantity("1 inch").to("mm").magnitude == pytest.approx(
+        25.4, rel=1e-15
+    )  # exact by definition
+
+
+def test_an_unreadable_cache_falls_back_to_parsing(monkeypatch):
+    import pint
+
+    from collision_reflex._units import unit_registry
+
+    real = pint.UnitRegistry
+
+    def damaged_cache(*args, cache_folder=None, **kwargs):
+        if cache_folder is not None:
+            raise EOFError("Ran out of input")  # what pickle says of a cache file still being written
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(pint, "UnitRegistry", damaged_cache)
+    registry = unit_registry.__wrapped__()
+    assert registry.Quantity("60 mm").to("m").magnitude == pytest.approx(0.06, rel=1e-15)
