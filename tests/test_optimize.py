@@ -107,6 +107,70 @@ def test_casadi_derivatives_match_numpy_finite_differences(arm, technology):
     np.testing.assert_allclose(hess, fd_hess, rtol=0, atol=1e-4 * np.abs(fd_hess).max())
 
 
+@pytest.mark.parametrize(
+    ("technology", "objective", "bounded"),
+    [
+        (dict(reflected_inertia_in="finger"), "worst_case_impulse", ()),
+        (
+            dict(reflected_inertia_in="robot"),
+            {"mean_impulse": 1.0, "actuator_mass": 0.5},
+            ("worst_case_impulse",),
+        ),
+        (
+            dict(sensing="position", reaction="moving"),
+            "actuator_mass",
+            ("worst_case_impulse", "mean_impulse"),
+        ),
+    ],
+    ids=["finger-worst", "robot-weighted-bounded", "position-mass-bounded"],
+)
+def test_per_sample_derivatives_equal_casadis_of_the_whole_nlp(arm, technology, objective, bounded):
+    import casadi as ca
+
+    from collision_reflex.optimize.derivatives import derivative_functions
+
+    space = FREE_SPACE
+    if technology.get("sensing") == "position":
+        space = cr.DesignSpace(**{**FREE_SPACE.__dict__, "threshold": (1e-3, 2e-2)})
+    problem = cr.build_problem(
+        arm,
+        _samples(arm, 3, 4),
+        space,
+        _technology(**technology),
+        objective,
+        cr.Constraints(payload=0.5, safety_factor=1.5),
+        bounded,
+    )
+    nlp, rng = problem.nlp, np.random.default_rng(4)
+    sigma, lam = ca.MX.sym("sigma"), ca.MX.sym("lam", problem.lbg.size)
+    lagrangian = sigma * nlp["f"] + ca.dot(lam, nlp["g"])
+    whole = ca.Function(
+        "whole",
+        [nlp["x"], nlp["p"], sigma, lam],
+        [
+            ca.gradient(nlp["f"], nlp["x"]),
+            ca.jacobian(nlp["g"], nlp["x"]),
+            ca.hessian(lagrangian, nlp["x"])[0],
+        ],
+    )
+    ours = derivative_functions(problem._structure)
+    for _ in range(3):  # random points: off the start, and random multipliers
+        x = problem.exact_point(problem.x0) + rng.normal(0.0, 0.1, problem.x0.size)
+        p = rng.uniform(0.5, 2.0, problem.parameters().size)
+        weights = (rng.uniform(0.5, 2.0), rng.normal(size=problem.lbg.size))
+        grad, jac, hess = (np.asarray(ca.DM(v)) for v in whole(x, p, *weights))
+        # Both are exact derivatives of the same expressions, in another order of operations: they agree to
+        # rounding, ~1e-15 relative to the largest entry; 1e-10 leaves room without hiding a wrong term.
+        for mine, theirs in [
+            (ours["grad_f"](x, p)[1], grad),
+            (ours["jac_g"](x, p)[1], jac),
+            (ours["hess_lag"](x, p, *weights), np.triu(hess)),
+        ]:
+            mine = np.asarray(ca.DM(mine))
+            np.testing.assert_allclose(mine, theirs, rtol=0, atol=1e-10 * np.abs(theirs).max())
+    assert np.abs(np.tril(np.asarray(ca.DM(ours["hess_lag"](x, p, *weights))), -1)).max() == 0.0
+
+
 def _brute_force_problem(arm, objective):
     space = cr.DesignSpace(
         stator_diameter=(0.02, 0.12),

@@ -47,6 +47,7 @@ from .constraints import (
     required_torque_function,
     torque_requirement_rows,
 )
+from .derivatives import SampleStructure, derivative_functions
 from .duty import DutyRequirement, add_duty_constraints, check_reachable, duty_requirement, peak_rows
 from .layout import DesignLayout, DesignQuantities, design_layout, design_quantities
 from .objectives import (
@@ -120,7 +121,9 @@ class DesignProblem:
     _joint_numbers: ca.Function = field(repr=False)
     _sample_function: ca.Function = field(repr=False)
     _sample_data: np.ndarray = field(repr=False)
+    _structure: SampleStructure = field(repr=False)
     _solvers: dict[str, ca.Function] = field(default_factory=dict, repr=False)
+    _derivatives: dict[str, ca.Function] | None = field(default=None, repr=False)
     _objective: ca.Function | None = field(default=None, repr=False)
 
     @property
@@ -195,6 +198,23 @@ class DesignProblem:
             )
             impulses.append(impulse)
         return ca.Function("design_impulses", [z], [ca.horzcat(*impulses)], ["z"], ["impulses"])
+
+    def solver(self, options: Mapping[str, str | float | bool], structural: bool = True) -> ca.Function:
+        """IPOPT for this NLP with ``options`` (CasADi's ``nlpsol`` options), built once per option set.
+
+        Every solver of the problem shares the same derivative functions, assembled per sample
+        (:mod:`.derivatives`): differentiating the whole NLP instead is most of a solver's construction.
+        ``structural=False`` lets CasADi differentiate the whole NLP (for comparison).
+        """
+        key = repr((sorted(options.items()), structural))
+        solver = self._solvers.get(key)
+        if solver is None:
+            if structural and self._derivatives is None:
+                self._derivatives = derivative_functions(self._structure)
+            derivatives = self._derivatives if structural else None
+            solver = ca.nlpsol("actuator_design", "ipopt", self.nlp, {**options, **(derivatives or {})})
+            self._solvers[key] = solver
+        return solver
 
     def objective_value(self, x: np.ndarray) -> float:
         """The NLP's (scaled) objective at ``x``, auxiliaries at their exact values: for comparing results."""
@@ -349,6 +369,7 @@ def build_problem(
         _joint_numbers=joint_numbers,
         _sample_function=per_sample.function,
         _sample_data=per_sample.data,
+        _structure=_sample_structure(nlp, layout, technology, per_sample, compliance_index, direction_index),
     )
 
 
@@ -393,6 +414,47 @@ def _sample_terms(
     compliance = ca.exp(ca.transpose(log_compliance))
     outputs = function.map(n_samples)(design.design_column, directions, compliance, ca.DM(data))
     return _SampleTerms(function, data, start_directions, direction_scale, *outputs)
+
+
+def _sample_structure(
+    nlp: dict[str, ca.MX],
+    layout: DesignLayout,
+    technology: ActuatorTechnology,
+    per_sample: _SampleTerms,
+    compliance_index: slice,
+    direction_index: slice,
+) -> SampleStructure:
+    """The NLP split into the per-sample function and the outer part (see :mod:`.derivatives`).
+
+    A sample's variables are the design's log values, its ``log(1/F_a)`` and its scaled finger-mass direction;
+    its outputs the impulse, the force threshold and ``w^T x``, the per-sample terms ``f`` and ``g`` use.
+    """
+    n_design, n_samples = layout.size, per_sample.data.shape[1]
+    n_joints = (direction_index.stop - direction_index.start) // n_samples
+    z = ca.MX.sym("z", n_design)
+    design = design_quantities(layout, z, technology, technology.joint_mechanical_stiffness(n_joints))
+    design_column = ca.Function("design_column", [z], [design.design_column]).expand()
+    local = ca.SX.sym("v", n_design + 1 + n_joints)
+    data = ca.SX.sym("data", per_sample.data.shape[0])
+    scale = ca.SX.sym("scale", n_joints)
+    column = design_column(local[:n_design])
+    outputs = per_sample.function(column, local[n_design + 1 :] * scale, ca.exp(local[n_design]), data)[:3]
+    sample = ca.Function("sample", [local, data, scale], [ca.vertcat(*outputs)])
+
+    y = ca.MX.sym("Y", 3, n_samples)
+    replaced = [per_sample.impulses, per_sample.thresholds, per_sample.normalisation]
+    f, g = ca.graph_substitute([nlp["f"], nlp["g"]], replaced, [y[0, :], y[1, :], y[2, :]])
+    outer = ca.Function("outer", [nlp["x"], y, nlp["p"]], [f, g]).expand()
+    samples = np.arange(n_samples)
+    variables = np.vstack(
+        [
+            np.repeat(np.arange(n_design)[:, None], n_samples, axis=1),
+            compliance_index.start + samples[None, :],
+            direction_index.start + n_joints * samples[None, :] + np.arange(n_joints)[:, None],
+        ]
+    )
+    scales = np.tile(per_sample.direction_scale, (n_joints, 1))
+    return SampleStructure(outer, sample, variables, per_sample.data, scales)
 
 
 def _model_terms(log_compliance: ca.MX, design: DesignQuantities, per_sample: _SampleTerms) -> ModelTerms:

@@ -8,7 +8,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
-import casadi as ca
 import numpy as np
 
 from ..errors import InvalidParameter, SolverFailed, Violation
@@ -244,11 +243,7 @@ class _Attempts:
     ) -> _Found | None:
         """Run IPOPT from ``start`` (warm-started from ``warm``'s multipliers); None if it did not converge."""
         problem = self.problem
-        key = repr(sorted(options.items()))
-        solver = problem._solvers.get(key)
-        if solver is None:
-            solver = ca.nlpsol("actuator_design", "ipopt", problem.nlp, options)
-            problem._solvers[key] = solver
+        solver = problem.solver(options)
         multipliers = (
             {"lam_x0": warm.multipliers[0], "lam_g0": warm.multipliers[1]}
             if warm is not None and warm.multipliers is not None

@@ -1,0 +1,129 @@
+"""The NLP's derivatives assembled per contact sample (gradient, constraint Jacobian, Hessian of the Lagrangian).
+
+The NLP is ``f, g = outer(x, Y(x), p)``, where column ``s`` of ``Y`` (impulse, force threshold, ``w^T x``) is the
+per-sample function of the sample's own variables ``v_s`` (the design's log values, ``log(1/F_a)`` and the
+finger-mass direction: about 30 entries). Differentiating the whole expanded NLP symbolically costs seconds
+(the Hessian alone has about a million nodes for 256 samples); here each sample's Jacobian and Hessian are
+differentiated once in SX over ``v_s``, mapped over the samples, and combined with the outer part's derivatives
+by the chain rule::
+
+    grad f = f_x + J^T f_Y,    jac g = g_x + g_Y J,
+    hess L = T^T hess(outer L) T + sum_s P_s^T (sum_k ybar_sk hess y_sk) P_s,   T = [I; J],
+
+with ``J = dY/dx`` (block-sparse), ``ybar = sigma f_Y + g_Y^T lambda`` and ``P_s`` the selection of ``v_s``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+__all__ = ["SampleStructure", "derivative_functions"]
+
+
+@dataclass(frozen=True)
+class SampleStructure:
+    """How the NLP splits into per-sample functions and an outer part (see the module docstring).
+
+    ``outer`` maps ``(x, Y, p)`` to ``(f, g)`` with ``Y`` of shape (n_outputs, n_samples); ``sample`` maps a
+    sample's variables ``v_s``, its data column and its direction scale to its column of ``Y``; ``variables``
+    (n_local, n_samples) holds the index in ``x`` of each entry of ``v_s``.
+    """
+
+    outer: ca.Function
+    sample: ca.Function
+    variables: np.ndarray
+    data: np.ndarray
+    direction_scale: np.ndarray
+
+
+def _scatter(rows: np.ndarray, cols: np.ndarray, shape: tuple[int, int]) -> tuple[ca.Sparsity, ca.DM]:
+    """Sparsity of the entries ``(rows, cols)`` and the 0/1 matrix summing values given in that order into it."""
+    keys = cols.astype(np.int64) * shape[0] + rows
+    unique, position = np.unique(keys, return_inverse=True)
+    pattern = ca.Sparsity.triplet(
+        shape[0], shape[1], (unique % shape[0]).tolist(), (unique // shape[0]).tolist()
+    )
+    summing = ca.DM.triplet(
+        position.tolist(), list(range(keys.size)), ca.DM.ones(keys.size), unique.size, keys.size
+    )
+    return pattern, summing
+
+
+def derivative_functions(structure: SampleStructure) -> dict[str, ca.Function]:
+    """IPOPT's ``grad_f``, ``jac_g`` and ``hess_lag`` functions for CasADi's ``nlpsol``, assembled per sample."""
+    outer, sample = structure.outer, structure.sample
+    n_x, n_p = outer.size1_in(0), outer.size1_in(2)
+    n_y, n_samples = outer.size_in(1)
+    n_local = structure.variables.shape[0]
+    n_g = outer.size1_out(1)
+
+    # Per sample, in SX: its outputs with their (dense) Jacobian, and the weighted Hessian, over its variables.
+    v = ca.SX.sym("v", n_local)
+    data = ca.SX.sym("data", sample.size1_in(1))
+    scale = ca.SX.sym("scale", sample.size1_in(2))
+    weights = ca.SX.sym("ybar", n_y)
+    y = sample(v, data, scale)
+    first = ca.Function("sample_jacobian", [v, data, scale], [y, ca.densify(ca.jacobian(y, v))])
+    second = ca.Function(
+        "sample_hessian", [v, data, scale, weights], [ca.densify(ca.hessian(ca.dot(weights, y), v)[0])]
+    )
+
+    x = ca.MX.sym("x", n_x)
+    p = ca.MX.sym("p", n_p)
+    lam_f = ca.MX.sym("lam_f")
+    lam_g = ca.MX.sym("lam_g", n_g)
+    flat_index = structure.variables.ravel(order="F")
+    variables = ca.reshape(x[flat_index.tolist()], n_local, n_samples)
+    constants = (ca.DM(structure.data), ca.DM(structure.direction_scale))
+    y_values, jac_blocks = first.map(n_samples)(variables, *constants)
+    # J = dY/dx: sample s's block sits in rows n_y*s..n_y*s+n_y-1 and the columns of its variables.
+    rows = np.tile(np.arange(n_y), n_local * n_samples) + n_y * np.repeat(np.arange(n_samples), n_y * n_local)
+    jac_pattern, jac_sum = _scatter(rows, np.repeat(flat_index, n_y), (n_y * n_samples, n_x))
+    jac_y = ca.sparsity_cast(ca.mtimes(jac_sum, ca.vec(jac_blocks)), jac_pattern)
+
+    # The outer part in (x, vec Y): its value and first derivatives, and the Hessian of its Lagrangian.
+    xo, yo, po = ca.SX.sym("x", n_x), ca.SX.sym("Y", n_y, n_samples), ca.SX.sym("p", n_p)
+    so, lo = ca.SX.sym("sigma"), ca.SX.sym("lambda", n_g)
+    fo, go = outer(xo, yo, po)
+    both = ca.vertcat(xo, ca.vec(yo))
+    lagrangian = so * fo + ca.dot(lo, go)
+    outer_first = ca.Function(
+        "outer_first", [xo, yo, po], [fo, go, ca.gradient(fo, both), ca.jacobian(go, both)]
+    )
+    outer_second = ca.Function(
+        "outer_second",
+        [xo, yo, po, so, lo],
+        [ca.gradient(lagrangian, ca.vec(yo)), ca.hessian(lagrangian, both)[0]],
+    )
+
+    f, g, grad, jac = outer_first(x, y_values, p)
+    grad_f = grad[:n_x] + ca.mtimes(ca.transpose(jac_y), grad[n_x:])
+    jac_g = jac[:, :n_x] + ca.mtimes(jac[:, n_x:], jac_y)
+
+    ybar, hess = outer_second(x, y_values, p, lam_f, lam_g)
+    hess_blocks = second.map(n_samples)(variables, *constants, ca.reshape(ybar, n_y, n_samples))
+    if np.all(np.array(outer_second.sparsity_out(1).get_triplet()) < n_x):
+        outer_part = hess[:n_x, :n_x]  # the outer part is linear in Y (the usual case): no product needed
+    else:
+        through = ca.vertcat(ca.MX.eye(n_x), jac_y)
+        outer_part = ca.mtimes(ca.transpose(through), ca.mtimes(hess, through))
+    # Each sample's Hessian block, upper triangle only, summed into the NLP's Hessian.
+    rows = np.tile(np.arange(n_local), n_local)
+    cols = np.repeat(np.arange(n_local), n_local)
+    upper = np.flatnonzero(rows <= cols)
+    local_rows = structure.variables[rows[upper]]
+    local_cols = structure.variables[cols[upper]]
+    top, bottom = np.minimum(local_rows, local_cols), np.maximum(local_rows, local_cols)
+    hess_pattern, hess_sum = _scatter(top.ravel(order="F"), bottom.ravel(order="F"), (n_x, n_x))
+    blocks = ca.reshape(hess_blocks, n_local * n_local, n_samples)[upper.tolist(), :]
+    hess_l = ca.triu(outer_part) + ca.sparsity_cast(ca.mtimes(hess_sum, ca.vec(blocks)), hess_pattern)
+    return {
+        "grad_f": ca.Function("nlp_grad_f", [x, p], [f, grad_f], ["x", "p"], ["f", "grad_f_x"]),
+        "jac_g": ca.Function("nlp_jac_g", [x, p], [g, jac_g], ["x", "p"], ["g", "jac_g_x"]),
+        "hess_lag": ca.Function(
+            "nlp_hess_l", [x, p, lam_f, lam_g], [hess_l], ["x", "p", "lam_f", "lam_g"], ["hess_gamma_x_x"]
+        ),
+    }
