@@ -10,6 +10,11 @@ NSGA-II (population 100, 200 generations) on the same problem and the same refer
 NSGA-II's), and the sweep's warm-start policy (every point from the first anchor) against chaining each point
 from its neighbour's solution and multipliers. Run: ``python benchmarks/optimize_panda.py`` (``--quick`` for 5 Pareto points and a short GA).
 
+It first prints the solver construction with the derivatives assembled per sample against CasADi's
+differentiation of the whole NLP (median of 3 repeats, fresh problems, with the load average before and after;
+target: construction <= 0.8 s, one solve including construction <= 1.5 s, the same optimum to 1e-8);
+``--construction`` prints only that.
+
 With ``--duty`` it prints only the problem size (variables, constraint rows, peak-torque rows kept) and the build
 and solve times of one solve with the static (gravity) requirement and with a duty cycle through four via
 configurations (about 200 samples, 1 kg payload) sizing peak torque, RMS torque and motor speed.
@@ -23,6 +28,7 @@ collapses to a point; the script reports that front's size too.
 from __future__ import annotations
 
 import argparse
+import os
 import time
 
 import numpy as np
@@ -37,6 +43,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="5 Pareto points, NSGA-II 40 x 30")
     parser.add_argument("--duty", action="store_true", help="only: one solve without and with a duty cycle")
+    parser.add_argument("--construction", action="store_true", help="only: solver construction, both ways")
     args = parser.parse_args()
     points, population, generations = (5, 40, 30) if args.quick else (20, 100, 200)
 
@@ -68,6 +75,9 @@ def main() -> None:
     print(f"Panda: {arm.nv} joints, {samples.size} samples, {3 * arm.nv + 2} design variables")
     if args.duty:
         compare_duty_cycle(arm, samples, space, technology("finger"), constraints)
+        return
+    compare_construction(builder("finger"))
+    if args.construction:
         return
 
     started = time.perf_counter()
@@ -120,6 +130,40 @@ def main() -> None:
     print(
         f"paper's arm model (reflected inertia in the reaction only): {len(robot.points)} non-dominated "
         f"point(s); worst-case impulse {spread[:, 0].min():.4f}-{spread[:, 0].max():.4f} N*s"
+    )
+
+
+def compare_construction(build, repeats: int = 3) -> None:
+    """Solver construction and one IPOPT run, derivatives per sample against the whole NLP's; medians."""
+    from collision_reflex.optimize.solve import DEFAULT_IPOPT_OPTIONS
+
+    load = os.getloadavg()[0]
+    figures: dict[bool, list[tuple[float, float, int, float]]] = {True: [], False: []}
+    for _ in range(repeats):
+        for structural in (True, False):
+            problem = build("worst_case_impulse", ())
+            started = time.perf_counter()
+            solver = problem.solver(DEFAULT_IPOPT_OPTIONS, structural=structural)
+            constructed = time.perf_counter() - started
+            started = time.perf_counter()
+            solution = solver(
+                x0=problem.x0, lbx=problem.lbx, ubx=problem.ubx, lbg=problem.lbg, ubg=problem.ubg, p=[]
+            )
+            solved = time.perf_counter() - started
+            iterations = int(solver.stats()["iter_count"])
+            figures[structural].append((constructed, solved, iterations, float(solution["f"])))
+    medians = {key: np.median(np.array(rows), axis=0) for key, rows in figures.items()}
+    objectives = {key: figures[key][0][3] for key in figures}
+    for structural, label in ((False, "whole NLP differentiated"), (True, "per-sample derivatives")):
+        constructed, solved, iterations, _ = medians[structural]
+        print(
+            f"{label}: construction {constructed:.2f} s, IPOPT {solved:.2f} s, one solve "
+            f"{constructed + solved:.2f} s ({int(iterations)} iterations; median of {repeats})"
+        )
+    difference = abs(objectives[True] - objectives[False]) / abs(objectives[False])
+    print(
+        f"  same optimum: objective {objectives[True]:.12g} vs {objectives[False]:.12g} ({difference:.1e} "
+        f"relative); load average {load:.2f} before, {os.getloadavg()[0]:.2f} after"
     )
 
 
