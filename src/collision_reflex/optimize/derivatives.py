@@ -52,6 +52,11 @@ def _scatter(rows: np.ndarray, cols: np.ndarray, shape: tuple[int, int]) -> tupl
     return pattern, summing
 
 
+def _nonzeros(matrix: ca.SX) -> ca.SX:
+    """The structural nonzeros of ``matrix`` as a column, in CasADi's (column-major) order."""
+    return ca.sparsity_cast(matrix, ca.Sparsity.dense(matrix.nnz(), 1))
+
+
 def derivative_functions(structure: SampleStructure) -> dict[str, ca.Function]:
     """IPOPT's ``grad_f``, ``jac_g`` and ``hess_lag`` functions for CasADi's ``nlpsol``, assembled per sample."""
     outer, sample = structure.outer, structure.sample
@@ -60,16 +65,17 @@ def derivative_functions(structure: SampleStructure) -> dict[str, ca.Function]:
     n_local = structure.variables.shape[0]
     n_g = outer.size1_out(1)
 
-    # Per sample, in SX: its outputs with their (dense) Jacobian, and the weighted Hessian, over its variables.
+    # Per sample, in SX: its outputs with their Jacobian, and the upper triangle of the weighted Hessian, over
+    # its own variables; only their structural nonzeros go into the NLP's (a denser KKT matrix costs MUMPS).
     v = ca.SX.sym("v", n_local)
     data = ca.SX.sym("data", sample.size1_in(1))
     scale = ca.SX.sym("scale", sample.size1_in(2))
     weights = ca.SX.sym("ybar", n_y)
     y = sample(v, data, scale)
-    first = ca.Function("sample_jacobian", [v, data, scale], [y, ca.densify(ca.jacobian(y, v))])
-    second = ca.Function(
-        "sample_hessian", [v, data, scale, weights], [ca.densify(ca.hessian(ca.dot(weights, y), v)[0])]
-    )
+    jacobian = ca.jacobian(y, v)
+    hessian = ca.triu(ca.hessian(ca.dot(weights, y), v)[0])
+    first = ca.Function("sample_jacobian", [v, data, scale], [y, _nonzeros(jacobian)])
+    second = ca.Function("sample_hessian", [v, data, scale, weights], [_nonzeros(hessian)])
 
     x = ca.MX.sym("x", n_x)
     p = ca.MX.sym("p", n_p)
@@ -80,8 +86,11 @@ def derivative_functions(structure: SampleStructure) -> dict[str, ca.Function]:
     constants = (ca.DM(structure.data), ca.DM(structure.direction_scale))
     y_values, jac_blocks = first.map(n_samples)(variables, *constants)
     # J = dY/dx: sample s's block sits in rows n_y*s..n_y*s+n_y-1 and the columns of its variables.
-    rows = np.tile(np.arange(n_y), n_local * n_samples) + n_y * np.repeat(np.arange(n_samples), n_y * n_local)
-    jac_pattern, jac_sum = _scatter(rows, np.repeat(flat_index, n_y), (n_y * n_samples, n_x))
+    local_rows, local_cols = (np.array(i) for i in jacobian.sparsity().get_triplet())
+    rows = (local_rows[:, None] + n_y * np.arange(n_samples)[None, :]).ravel(order="F")
+    jac_pattern, jac_sum = _scatter(
+        rows, structure.variables[local_cols].ravel(order="F"), (n_y * n_samples, n_x)
+    )
     jac_y = ca.sparsity_cast(ca.mtimes(jac_sum, ca.vec(jac_blocks)), jac_pattern)
 
     # The outer part in (x, vec Y): its value and first derivatives, and the Hessian of its Lagrangian.
@@ -110,16 +119,13 @@ def derivative_functions(structure: SampleStructure) -> dict[str, ca.Function]:
     else:
         through = ca.vertcat(ca.MX.eye(n_x), jac_y)
         outer_part = ca.mtimes(ca.transpose(through), ca.mtimes(hess, through))
-    # Each sample's Hessian block, upper triangle only, summed into the NLP's Hessian.
-    rows = np.tile(np.arange(n_local), n_local)
-    cols = np.repeat(np.arange(n_local), n_local)
-    upper = np.flatnonzero(rows <= cols)
-    local_rows = structure.variables[rows[upper]]
-    local_cols = structure.variables[cols[upper]]
-    top, bottom = np.minimum(local_rows, local_cols), np.maximum(local_rows, local_cols)
+    # Each sample's Hessian nonzeros (upper triangle), summed into the NLP's Hessian.
+    local_rows, local_cols = (np.array(i) for i in hessian.sparsity().get_triplet())
+    global_rows, global_cols = structure.variables[local_rows], structure.variables[local_cols]
+    top, bottom = np.minimum(global_rows, global_cols), np.maximum(global_rows, global_cols)
     hess_pattern, hess_sum = _scatter(top.ravel(order="F"), bottom.ravel(order="F"), (n_x, n_x))
-    blocks = ca.reshape(hess_blocks, n_local * n_local, n_samples)[upper.tolist(), :]
-    hess_l = ca.triu(outer_part) + ca.sparsity_cast(ca.mtimes(hess_sum, ca.vec(blocks)), hess_pattern)
+    summed = ca.sparsity_cast(ca.mtimes(hess_sum, ca.vec(hess_blocks)), hess_pattern)
+    hess_l = ca.triu(outer_part) + summed
     return {
         "grad_f": ca.Function("nlp_grad_f", [x, p], [f, grad_f], ["x", "p"], ["f", "grad_f_x"]),
         "jac_g": ca.Function("nlp_jac_g", [x, p], [g, jac_g], ["x", "p"], ["g", "jac_g_x"]),
