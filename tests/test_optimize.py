@@ -171,6 +171,40 @@ def test_per_sample_derivatives_equal_casadis_of_the_whole_nlp(arm, technology, 
     assert np.abs(np.tril(np.asarray(ca.DM(ours["hess_lag"](x, p, *weights))), -1)).max() == 0.0
 
 
+def test_every_solver_of_a_problem_shares_one_set_of_derivatives_and_the_optimum_is_unchanged(
+    arm, monkeypatch
+):
+    from collision_reflex.optimize import problem as problem_module
+    from collision_reflex.optimize.solve import DEFAULT_IPOPT_OPTIONS
+
+    built = []
+    original = problem_module.derivative_functions
+
+    def counting(structure):
+        built.append(structure)
+        return original(structure)
+
+    monkeypatch.setattr(problem_module, "derivative_functions", counting)
+    problem = cr.build_problem(
+        arm, _samples(arm, 3, 4), FREE_SPACE, _technology(), constraints=cr.Constraints(payload=0.5)
+    )
+    first = cr.solve(problem)
+    cr.solve(problem, x0=first)  # the warm-start option set: a second solver
+    cr.solve(problem, ipopt_options={"ipopt.mu_strategy": "adaptive"})  # the retries' option set: a third
+    assert len(problem._solvers) == 3 and len(built) == 1
+
+    # CasADi's own differentiation of the whole NLP reaches the same optimum in about the same iterations: the
+    # same start and the same derivatives up to rounding (~1e-15), so the same path to IPOPT's tol 1e-8.
+    runs = []
+    for structural in (True, False):
+        solver = problem.solver(DEFAULT_IPOPT_OPTIONS, structural=structural)
+        solution = solver(x0=problem.x0, lbx=problem.lbx, ubx=problem.ubx, lbg=problem.lbg, ubg=problem.ubg)
+        runs.append((float(solution["f"]), int(solver.stats()["iter_count"])))
+    (ours, our_iterations), (whole, whole_iterations) = runs
+    assert ours == pytest.approx(whole, rel=1e-8)
+    assert our_iterations == first.iterations and abs(our_iterations - whole_iterations) <= 2
+
+
 def _brute_force_problem(arm, objective):
     space = cr.DesignSpace(
         stator_diameter=(0.02, 0.12),
