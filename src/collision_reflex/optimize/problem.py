@@ -23,6 +23,8 @@ Structure (see the README's "Design optimisation" section):
 - Objectives (:mod:`.objectives`) can be bounded (``f_k <= eps_k``) through NLP parameters, so one solver serves
   a whole epsilon-constraint Pareto sweep.
 - The constraint rows (:mod:`.constraints`) each carry a label.
+- IPOPT gets the NLP's gradient, Jacobian and Hessian assembled per sample (:mod:`.derivatives`), which
+  :meth:`DesignProblem.solver` builds once and shares between all the problem's solvers.
 """
 
 from __future__ import annotations
