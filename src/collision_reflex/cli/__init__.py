@@ -8,6 +8,7 @@ exit with status 2.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from collections.abc import Sequence
 
@@ -59,8 +60,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"crx {args.command}: error: {error}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print(f"crx {args.command}: interrupted", file=sys.stderr)
+        hint = "; rerun the same command to resume" if args.command == "run" else ""
+        print(f"crx {args.command}: interrupted{hint}", file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        # The reader left (`crx ... | head`): stop quietly; point stdout at nothing so the exit flush is silent.
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+        return 0
 
 
 if __name__ == "__main__":  # pragma: no cover

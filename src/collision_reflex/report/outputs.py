@@ -12,7 +12,17 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import CollisionReflexError
-from .files import DESIGNS, PARETO, REPORT, ResultsDamaged, ResultsMissing, read_json, write_json, write_text
+from .files import (
+    DESIGNS,
+    PARETO,
+    REPORT,
+    TIMINGS,
+    ResultsDamaged,
+    ResultsMissing,
+    read_json,
+    write_json,
+    write_text,
+)
 
 
 def objective_unit(name: str) -> str:
@@ -33,7 +43,9 @@ def pareto_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
     if results["kind"] == "actuator":
         return _actuator_rows(results)
     points = results["pareto"]["points"] or [results["chosen"]]
-    return [record_row(record, index) for index, record in enumerate(points)]
+    rows = [record_row(record, index) for index, record in enumerate(points)]
+    # Wall times are not results (see TIMING_KEYS): the report's solver table shows them.
+    return [{k: v for k, v in row.items() if k.split(" [")[0] not in TIMING_KEYS} for row in rows]
 
 
 def _actuator_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
@@ -58,12 +70,57 @@ def _actuator_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
     return rows
 
 
+TIMING_KEYS = frozenset({"solve_time", "build_time"})
+"""Wall times in the results [s]: kept in ``timings.json``, so that the other result files are the same bytes
+for the same study on every executor and machine load."""
+
+
 def write_outputs(folder: str | os.PathLike[str], results: dict[str, Any], figures: bool = True) -> Path:
-    """Write ``designs.json``, ``pareto.csv`` and the report (with its figures) into ``folder``."""
+    """Write ``designs.json``, ``pareto.csv``, ``timings.json`` and the report (with its figures) into ``folder``."""
     folder = Path(folder)
-    write_json(folder / DESIGNS, results)
+    numbers, timings = split_timings(results)
+    write_json(folder / DESIGNS, numbers)
+    write_json(folder / TIMINGS, timings)
     _write_csv(folder / PARETO, pareto_rows(results))
     return render_report(folder, results, figures=figures)
+
+
+def split_timings(data: Any, at: str = "") -> tuple[Any, dict[str, float]]:
+    """``data`` without its wall times, and those times by their path (``pareto/points/0/solver/solve_time``)."""
+    timings: dict[str, float] = {}
+    if isinstance(data, dict):
+        kept = {}
+        for key, value in data.items():
+            if key in TIMING_KEYS and isinstance(value, (int, float)):
+                timings[f"{at}{key}"] = value
+            else:
+                kept[key], inner = split_timings(value, f"{at}{key}/")
+                timings.update(inner)
+        return kept, timings
+    if isinstance(data, list):
+        items = []
+        for index, value in enumerate(data):
+            item, inner = split_timings(value, f"{at}{index}/")
+            items.append(item)
+            timings.update(inner)
+        return items, timings
+    return data, timings
+
+
+def with_timings(data: Any, timings: dict[str, float]) -> Any:
+    """``data`` with the times of :func:`split_timings` put back (paths that no longer exist are skipped)."""
+    for path, value in timings.items():
+        *parents, key = path.split("/")
+        node = data
+        for part in parents:
+            try:
+                node = node[int(part)] if isinstance(node, list) else node[part]
+            except (KeyError, IndexError, ValueError, TypeError):
+                break
+        else:
+            if isinstance(node, dict):
+                node[key] = value
+    return data
 
 
 def _write_csv(path: Path, rows: list[dict[str, Any]]) -> None:
@@ -101,8 +158,11 @@ def render_report(
             )
         try:
             results = read_json(path)
+            timings = read_json(folder / TIMINGS) if (folder / TIMINGS).exists() else {}
         except ValueError as error:
             raise ResultsMissing(f"{path} cannot be read ({error}); run the study again") from None
+        if isinstance(results, dict) and isinstance(timings, dict):
+            results = with_timings(results, timings)
     assert results is not None
     try:
         svgs = (

@@ -157,14 +157,14 @@ def run_study(
                 results, counts = _run_arm(loaded.study, text, folder, pool, progress, window)
             else:
                 results, counts = _run_actuators(loaded, folder, progress)
+        progress.stop()
+        from ..report import write_outputs
+
+        write_outputs(folder.path, results, figures=figures)
     except BaseException as error:
         progress.stop()
         folder.update_manifest(status="failed" if isinstance(error, Exception) else "interrupted")
         raise
-    progress.stop()
-    from ..report import write_outputs
-
-    write_outputs(folder.path, results, figures=figures)
     elapsed = time.perf_counter() - started
     folder.update_manifest(status="finished", elapsed=elapsed, computed=counts[0], reused=counts[1])
     return RunResult(folder.path, resumed, counts[0], counts[1], elapsed, tuple(results.get("verdict", ())))

