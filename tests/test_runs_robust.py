@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 import collision_reflex as cr
+from collision_reflex.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
 PANDA = ROOT / "studies" / "panda.yaml"
@@ -126,3 +127,120 @@ def test_serial_and_process_pool_runs_give_byte_identical_result_files(tmp_path)
     _same_results(tmp_path / "processes", tmp_path / "serial")
     assert "solve_time" not in (tmp_path / "serial" / "designs.json").read_text()
     assert "solve_time" in (tmp_path / "serial" / "timings.json").read_text()
+
+
+def _run(folder: Path, *extra: str, study: Path = TWO_LINK) -> int:
+    return main(
+        ["run", str(study), "--smoke", "--quiet", "--executor", "serial", "--out", str(folder), *extra]
+    )
+
+
+@pytest.fixture(scope="module")
+def two_link_run(tmp_path_factory):
+    """The two-link smoke study run once in-process (serial)."""
+    folder = tmp_path_factory.mktemp("two_link") / "out"
+    assert _run(folder) == 0
+    return folder
+
+
+def _error_line(capsys) -> str:
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1, lines
+    return lines[0]
+
+
+def test_a_read_only_parent_is_one_line_exit_2(tmp_path, capsys, monkeypatch):
+    parent = tmp_path / "read-only"
+    mkdir = Path.mkdir
+
+    def refused(self, *args, **kwargs):  # as a read-only folder does (also when the tests run as root)
+        if parent in self.parents:
+            raise PermissionError(13, "Permission denied", str(self))
+        return mkdir(self, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "mkdir", refused)
+    assert _run(parent / "out") == 2
+    line = _error_line(capsys)
+    assert str(parent / "out") in line and "Permission denied" in line
+
+
+@pytest.mark.parametrize("below", [False, True], ids=["a file", "below a file"])
+def test_out_naming_a_file_or_below_one_is_one_line_exit_2(tmp_path, capsys, below):
+    regular = tmp_path / "file"
+    regular.write_text("mine\n")
+    out = regular / "below" if below else regular
+    assert _run(out) == 2
+    line = _error_line(capsys)
+    assert f"cannot write {out}" in line
+    assert regular.read_text() == "mine\n"
+
+
+def test_a_full_disk_during_the_solves_is_one_line_exit_1_and_keeps_finished_points(
+    tmp_path, capsys, monkeypatch
+):
+    import errno
+
+    from collision_reflex.study import store
+
+    write_json = store.write_json
+    saved = []
+
+    def full_after_the_first_point(path, data):
+        if Path(path).parent.name == "points":
+            if saved:
+                raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path))
+            saved.append(path)
+        write_json(path, data)
+
+    monkeypatch.setattr(store, "write_json", full_after_the_first_point)
+    folder = tmp_path / "out"
+    assert _run(folder) == 1
+    line = _error_line(capsys)
+    assert "No space left on device" in line and str(folder / "points") in line
+    assert [p.name for p in (folder / "points").iterdir()] == [Path(saved[0]).name]
+    assert '"status": "failed"' in (folder / "run.json").read_text()
+
+
+@pytest.mark.parametrize(
+    "damage", ["{}", "[]", '{"label": "anchor: mass", "res'], ids=["{}", "[]", "truncated"]
+)
+def test_a_damaged_point_file_is_reported_and_recomputed(two_link_run, tmp_path, capsys, damage):
+    import shutil
+
+    folder = tmp_path / "out"
+    shutil.copytree(two_link_run, folder)
+    point = sorted((folder / "points").glob("point-*.json"))[0]
+    point.write_text(damage)
+    capsys.readouterr()
+    assert _run(folder) == 0
+    assert f"warning: {point} is " in capsys.readouterr().err
+    assert "label" in point.read_text()  # recomputed and saved again
+    _same_results(folder, two_link_run)
+
+
+def test_a_resumed_run_removes_stale_temporary_files(two_link_run, tmp_path):
+    import shutil
+
+    folder = tmp_path / "out"
+    shutil.copytree(two_link_run, folder)
+    stale = [folder / ".tmp-designs.k1ll3d.json", folder / "points" / ".tmp-point-000.x.json"]
+    for path in stale:
+        path.write_text('{"half": ')
+    assert _run(folder) == 0
+    assert not any(path.exists() for path in stale)
+
+
+def test_output_files_get_the_umask_mode(tmp_path):
+    previous = os.umask(0o027)
+    try:
+        assert _run(tmp_path / "out") == 0
+    finally:
+        os.umask(previous)
+    files = [p for p in (tmp_path / "out").rglob("*") if p.is_file()]
+    assert files and {p.stat().st_mode & 0o777 for p in files} == {0o640}
+
+
+def test_a_smoke_run_has_its_own_default_folder(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", str(TWO_LINK), "--smoke", "--quiet", "--executor", "serial"]) == 0
+    assert [p.name for p in (tmp_path / "results").iterdir()] == ["two-link-paper-smoke"]

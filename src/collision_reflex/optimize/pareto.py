@@ -390,7 +390,7 @@ def _reusable(saved: Mapping[str, Any] | None) -> SweepPoint | None:
         return None
     try:
         return SweepPoint.from_json(saved)
-    except (KeyError, TypeError, ValueError):
+    except (AttributeError, KeyError, TypeError, ValueError):
         return None
 
 
