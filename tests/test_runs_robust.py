@@ -244,3 +244,69 @@ def test_a_smoke_run_has_its_own_default_folder(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert main(["run", str(TWO_LINK), "--smoke", "--quiet", "--executor", "serial"]) == 0
     assert [p.name for p in (tmp_path / "results").iterdir()] == ["two-link-paper-smoke"]
+
+
+@pytest.mark.parametrize(
+    ("edit", "words"),
+    [
+        (lambda d: d.update(kind="tampered"), "field 'kind' is 'tampered'"),
+        (lambda d: d.pop("study"), "field 'study' is missing"),
+        (lambda d: d["chosen"].pop("joints"), "field 'joints' is missing"),
+        (lambda d: d["chosen"].update(approach_velocity="fast"), "wrong kind"),
+    ],
+    ids=["kind", "study", "joints", "a string for a number"],
+)
+def test_crx_report_on_altered_designs_says_which_file_and_field(two_link_run, tmp_path, capsys, edit, words):
+    import json
+    import shutil
+
+    folder = tmp_path / "out"
+    shutil.copytree(two_link_run, folder)
+    designs = json.loads((folder / "designs.json").read_text())
+    edit(designs)
+    (folder / "designs.json").write_text(json.dumps(designs))
+    capsys.readouterr()
+    assert main(["report", str(folder)]) == 2
+    line = _error_line(capsys)
+    assert line.startswith(f"crx report: error: {folder / 'designs.json'}: ") and words in line, line
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").is_dir(), reason="reads a process's children from /proc")
+def test_pool_workers_die_with_a_killed_run(tmp_path):
+    folder = tmp_path / "out"
+    command = [*CRX, "run", str(PANDA), "--smoke", "--quiet", "--executor", "processes", "--out", str(folder)]
+    process = subprocess.Popen(command, stderr=subprocess.DEVNULL, env=_environment())
+    children: set[int] = set()
+    deadline = time.monotonic() + 120
+    while len(children) < 2:  # the resource tracker and at least one worker
+        assert process.poll() is None and time.monotonic() < deadline, "the run ended before the kill"
+        time.sleep(0.1)
+        task = Path(f"/proc/{process.pid}/task/{process.pid}/children")
+        children = {int(pid) for pid in task.read_text().split()}
+    process.kill()
+    process.wait()
+    deadline = time.monotonic() + 10
+    while any(Path(f"/proc/{pid}").exists() and _state(pid) != "Z" for pid in children):
+        assert time.monotonic() < deadline, "a worker outlived the killed run"
+        time.sleep(0.1)
+
+
+def _state(pid: int) -> str:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except (FileNotFoundError, IndexError):
+        return "gone"
+
+
+def test_piping_into_head_gives_no_traceback():
+    process = subprocess.Popen(
+        [*CRX, "impulse", "--velocities", "0.01:1:20000"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=_environment(),
+    )
+    assert process.stdout is not None and process.stdout.readline()
+    process.stdout.close()  # as `head -1` does after its line
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == 0 and stderr == "", stderr

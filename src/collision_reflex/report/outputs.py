@@ -8,6 +8,7 @@ alone.
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 from typing import Any
 
@@ -108,7 +109,11 @@ def split_timings(data: Any, at: str = "") -> tuple[Any, dict[str, float]]:
 
 
 def with_timings(data: Any, timings: dict[str, float]) -> Any:
-    """``data`` with the times of :func:`split_timings` put back (paths that no longer exist are skipped)."""
+    """``data`` with the times of :func:`split_timings` put back (paths that no longer exist are skipped).
+
+    A solver record without its times (``timings.json`` deleted) gets None: the report prints "–".
+    """
+    _unknown_timings(data)
     for path, value in timings.items():
         *parents, key = path.split("/")
         node = data
@@ -132,6 +137,20 @@ def _write_csv(path: Path, rows: list[dict[str, Any]]) -> None:
         pd.DataFrame(rows).to_csv(handle, index=False, float_format="%.10g")
 
 
+def _unknown_timings(data: Any) -> None:
+    """Set every solver record's times to None (unknown), in place."""
+    if isinstance(data, dict):
+        solver = data.get("solver")
+        if isinstance(solver, dict):
+            for key in TIMING_KEYS:
+                solver.setdefault(key, None)
+        for value in data.values():
+            _unknown_timings(value)
+    elif isinstance(data, list):
+        for value in data:
+            _unknown_timings(value)
+
+
 def render_report(
     folder: str | os.PathLike[str], results: dict[str, Any] | None = None, figures: bool = True
 ) -> Path:
@@ -146,35 +165,32 @@ def render_report(
     ResultsDamaged
         A field the report draws from is missing or damaged (the message names the file and the field).
     """
-    from .figures import draw_figures
+    import jinja2  # lazily, like every heavy library: importing the package stays quick
+
     from .html import render_html
 
     folder = Path(folder)
+    saved = results is None
     if results is None:
-        path = folder / DESIGNS
-        if not path.exists():
-            raise ResultsMissing(
-                f"{folder} has no {DESIGNS}: run the study first (crx run STUDY --out {folder})"
-            )
-        try:
-            results = read_json(path)
-            timings = read_json(folder / TIMINGS) if (folder / TIMINGS).exists() else {}
-        except ValueError as error:
-            raise ResultsMissing(f"{path} cannot be read ({error}); run the study again") from None
-        if isinstance(results, dict) and isinstance(timings, dict):
-            results = with_timings(results, timings)
-    assert results is not None
+        results = _read_results(folder)
     try:
-        svgs = (
-            draw_figures(folder / "figures", results, results["resolved"]["outputs"]["figures"])
-            if figures
-            else {}
-        )
-        html = render_html(results, pareto_rows(results), svgs)
+        html = render_html(results, pareto_rows(results), _figures(folder, results, figures))
+        pdf = bool(results["resolved"]["outputs"]["pdf"])
     except ResultsDamaged as error:
         raise ResultsDamaged(f"{folder / DESIGNS}: {error}; run the study again") from None
+    except (
+        AttributeError,
+        ArithmeticError,
+        LookupError,
+        TypeError,
+        ValueError,
+        jinja2.TemplateError,
+    ) as error:
+        if not saved:
+            raise  # results handed over by a run: a defect, not a damaged file
+        raise ResultsDamaged(f"{folder / DESIGNS}: {_unusable(error)}; run the study again") from None
     write_text(folder / REPORT, html)
-    if results["resolved"]["outputs"]["pdf"]:
+    if pdf:
         from .pdf import html_to_pdf
 
         try:
@@ -184,3 +200,48 @@ def render_report(
 
             warnings.warn(f"report.pdf not written: {error}", stacklevel=2)
     return folder / REPORT
+
+
+def _read_results(folder: Path) -> dict[str, Any]:
+    """The results saved in ``folder`` (``designs.json`` with ``timings.json``'s times)."""
+    path = folder / DESIGNS
+    if not path.exists():
+        raise ResultsMissing(f"{folder} has no {DESIGNS}: run the study first (crx run STUDY --out {folder})")
+    try:
+        results = read_json(path)
+        timings = read_json(folder / TIMINGS) if (folder / TIMINGS).exists() else {}
+    except ValueError as error:
+        raise ResultsMissing(f"{path} cannot be read ({error}); run the study again") from None
+    if not isinstance(results, dict) or results.get("kind") not in REPORT_KINDS:
+        kind = results.get("kind") if isinstance(results, dict) else None
+        raise ResultsDamaged(
+            f"{path}: field 'kind' is {kind!r}, expected one of {', '.join(REPORT_KINDS)}; run the study again"
+        )
+    return dict(with_timings(results, timings if isinstance(timings, dict) else {}))
+
+
+REPORT_KINDS = ("arm", "actuator")
+"""The kinds of results the report knows (one template each)."""
+
+
+def _figures(folder: Path, results: dict[str, Any], figures: bool) -> dict[str, str]:
+    from .figures import draw_figures
+
+    return (
+        draw_figures(folder / "figures", results, results["resolved"]["outputs"]["figures"])
+        if figures
+        else {}
+    )
+
+
+def _unusable(error: Exception) -> str:
+    """What a render error says about the saved results, on one line."""
+    import jinja2
+
+    if isinstance(error, KeyError):
+        return f"field {error.args[0]!r} is missing"
+    found = re.search(r"has no attribute '([^']+)'", str(error))
+    if isinstance(error, jinja2.UndefinedError) and found:
+        return f"field {found.group(1)!r} is missing"
+    text = " ".join(str(error).split())
+    return f"a field holds a value of the wrong kind ({type(error).__name__}: {text[:120]})"
