@@ -226,8 +226,12 @@ def test_a_resumed_run_removes_stale_temporary_files(two_link_run, tmp_path):
     stale = [folder / ".tmp-designs.k1ll3d.json", folder / "points" / ".tmp-point-000.x.json"]
     for path in stale:
         path.write_text('{"half": ')
+        os.utime(path, (time.time() - 120, time.time() - 120))  # left by a run killed two minutes ago
+    fresh = folder / ".tmp-report.in-progress.html"  # another writer's, just begun: kept
+    fresh.write_text("<html>")
     assert _run(folder) == 0
     assert not any(path.exists() for path in stale)
+    assert fresh.exists()
 
 
 def test_output_files_get_the_umask_mode(tmp_path):

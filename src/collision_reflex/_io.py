@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import os
 import tempfile
+import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
@@ -47,12 +48,16 @@ def atomic_open(path: str | os.PathLike[str], mode: str = "w", **kwargs: Any) ->
         yield handle
 
 
-def remove_temporary_files(folder: str | os.PathLike[str]) -> list[Path]:
-    """Remove the temporary files a killed writer left in ``folder`` (not below it); returns them."""
+def remove_temporary_files(folder: str | os.PathLike[str], older_than: float = 60.0) -> list[Path]:
+    """Remove the temporary files a killed writer left in ``folder`` (not below it); returns them.
+
+    Only files untouched for ``older_than`` [s] go: a younger one may be another process's write in progress.
+    """
     removed = []
+    now = time.time()
     for stale in Path(folder).glob(f"{TEMPORARY_PREFIX}*"):
-        if stale.is_file():
-            with contextlib.suppress(FileNotFoundError):
+        with contextlib.suppress(FileNotFoundError):
+            if stale.is_file() and now - stale.stat().st_mtime >= older_than:
                 stale.unlink()
                 removed.append(stale)
     return removed
