@@ -2,12 +2,13 @@
 
 Every option is declared once in :mod:`.options` (flag, unit, parser, range). Errors raised on purpose
 (:class:`~collision_reflex.errors.CollisionReflexError`) and usage errors are printed as one line on stderr and
-exit with status 2.
+exit with status 2 (or the error's ``exit_status``: 1 for a failure after work started); Ctrl-C exits with 130.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from collections.abc import Sequence
 
@@ -54,13 +55,22 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SystemExit as done:  # --help, --version, or a usage error already printed as one line
         return done.code if isinstance(done.code, int) else 0 if done.code is None else 2
     try:
-        return int(args.run(args) or 0)
+        status = int(args.run(args) or 0)
+        sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's exit flush
+        return status
     except CollisionReflexError as error:
         print(f"crx {args.command}: error: {error}", file=sys.stderr)
-        return 2
+        return int(getattr(error, "exit_status", 2))
     except KeyboardInterrupt:
-        print(f"crx {args.command}: interrupted", file=sys.stderr)
+        hint = "; rerun the same command to resume" if args.command == "run" else ""
+        print(f"crx {args.command}: interrupted{hint}", file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        # The reader left (`crx ... | head`): stop quietly; point stdout at nothing so the exit flush is silent.
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+        return 0
 
 
 if __name__ == "__main__":  # pragma: no cover

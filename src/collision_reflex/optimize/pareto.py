@@ -14,6 +14,7 @@ start takes 0.63 / 3.7 / 84 s (fewer iterations on UR5, more on the two-link arm
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import itertools
 import os
@@ -359,18 +360,28 @@ class _Sweep:
                     name, (function, args) = queue.pop(0)
                     pending[self.executor.submit(function, *args)] = name
                 done, _ = wait(pending, return_when=FIRST_COMPLETED)
-                for future in sorted(done, key=lambda f: pending[f]):
-                    name = pending.pop(future)
-                    out[name] = future.result()
-                    if self.save is not None:
-                        self.save(name, out[name].to_json())
-                    self.computed += 1
-                    self._tick()
+                self._collect(done, pending, out)
         except BaseException:
             for future in pending:
                 future.cancel()
+            # Interrupted (or failed): keep what finished meanwhile, so that the resumed run need not redo it.
+            finished = [f for f in pending if f.done() and not f.cancelled() and f.exception() is None]
+            with contextlib.suppress(Exception):
+                self._collect(finished, pending, out)
             raise
         return {name: out[name] for name in tasks}
+
+    def _collect(
+        self, done: Iterable[Future], pending: dict[Future, str], out: dict[str, SweepPoint]
+    ) -> None:
+        """Take the results of ``done`` futures out of ``pending`` into ``out``, saving each."""
+        for future in sorted(done, key=lambda f: pending[f]):
+            name = pending.pop(future)
+            out[name] = future.result()
+            if self.save is not None:
+                self.save(name, out[name].to_json())
+            self.computed += 1
+            self._tick()
 
 
 def _reusable(saved: Mapping[str, Any] | None) -> SweepPoint | None:
@@ -379,7 +390,7 @@ def _reusable(saved: Mapping[str, Any] | None) -> SweepPoint | None:
         return None
     try:
         return SweepPoint.from_json(saved)
-    except (KeyError, TypeError, ValueError):
+    except (AttributeError, KeyError, TypeError, ValueError):
         return None
 
 

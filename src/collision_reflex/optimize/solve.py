@@ -221,6 +221,9 @@ def solve(
     return _result(problem, x, tuple(attempts.records), stats, dict(epsilon or {}), multipliers)
 
 
+INTERRUPTED = "NonIpopt_Exception_Thrown"
+"""IPOPT's status when CasADi caught an exception in a callback (Ctrl-C among them)."""
+
 _Found = tuple[np.ndarray, dict, tuple[np.ndarray, np.ndarray]]
 """A converged attempt: the point, IPOPT's statistics, the multipliers (bounds, constraints)."""
 
@@ -261,6 +264,8 @@ class _Attempts:
         )
         stats = dict(solver.stats())
         status = str(stats.get("return_status", "unknown"))
+        if status == INTERRUPTED:
+            raise KeyboardInterrupt  # CasADi caught Ctrl-C: stop the solve, never retry or record it
         iterations = int(stats.get("iter_count", -1))
         self.records.append(Attempt(name, status, iterations, time.perf_counter() - started))
         self.last_stats = stats

@@ -13,6 +13,7 @@ from ..errors import CollisionReflexError
 DESIGNS = "designs.json"
 PARETO = "pareto.csv"
 REPORT = "report.html"
+TIMINGS = "timings.json"
 
 
 class ResultsMissing(CollisionReflexError, FileNotFoundError):

@@ -8,11 +8,22 @@ alone.
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 from typing import Any
 
 from ..errors import CollisionReflexError
-from .files import DESIGNS, PARETO, REPORT, ResultsDamaged, ResultsMissing, read_json, write_json, write_text
+from .files import (
+    DESIGNS,
+    PARETO,
+    REPORT,
+    TIMINGS,
+    ResultsDamaged,
+    ResultsMissing,
+    read_json,
+    write_json,
+    write_text,
+)
 
 
 def objective_unit(name: str) -> str:
@@ -33,7 +44,9 @@ def pareto_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
     if results["kind"] == "actuator":
         return _actuator_rows(results)
     points = results["pareto"]["points"] or [results["chosen"]]
-    return [record_row(record, index) for index, record in enumerate(points)]
+    rows = [record_row(record, index) for index, record in enumerate(points)]
+    # Wall times are not results (see TIMING_KEYS): the report's solver table shows them.
+    return [{k: v for k, v in row.items() if k.split(" [")[0] not in TIMING_KEYS} for row in rows]
 
 
 def _actuator_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
@@ -58,12 +71,61 @@ def _actuator_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
     return rows
 
 
+TIMING_KEYS = frozenset({"solve_time", "build_time"})
+"""Wall times in the results [s]: kept in ``timings.json``, so that the other result files are the same bytes
+for the same study on every executor and machine load."""
+
+
 def write_outputs(folder: str | os.PathLike[str], results: dict[str, Any], figures: bool = True) -> Path:
-    """Write ``designs.json``, ``pareto.csv`` and the report (with its figures) into ``folder``."""
+    """Write ``designs.json``, ``pareto.csv``, ``timings.json`` and the report (with its figures) into ``folder``."""
     folder = Path(folder)
-    write_json(folder / DESIGNS, results)
+    numbers, timings = split_timings(results)
+    write_json(folder / DESIGNS, numbers)
+    write_json(folder / TIMINGS, timings)
     _write_csv(folder / PARETO, pareto_rows(results))
     return render_report(folder, results, figures=figures)
+
+
+def split_timings(data: Any, at: str = "") -> tuple[Any, dict[str, float]]:
+    """``data`` without its wall times, and those times by their path (``pareto/points/0/solver/solve_time``)."""
+    timings: dict[str, float] = {}
+    if isinstance(data, dict):
+        kept = {}
+        for key, value in data.items():
+            if key in TIMING_KEYS and isinstance(value, (int, float)):
+                timings[f"{at}{key}"] = value
+            else:
+                kept[key], inner = split_timings(value, f"{at}{key}/")
+                timings.update(inner)
+        return kept, timings
+    if isinstance(data, list):
+        items = []
+        for index, value in enumerate(data):
+            item, inner = split_timings(value, f"{at}{index}/")
+            items.append(item)
+            timings.update(inner)
+        return items, timings
+    return data, timings
+
+
+def with_timings(data: Any, timings: dict[str, float]) -> Any:
+    """``data`` with the times of :func:`split_timings` put back (paths that no longer exist are skipped).
+
+    A solver record without its times (``timings.json`` deleted) gets None: the report prints "–".
+    """
+    _unknown_timings(data)
+    for path, value in timings.items():
+        *parents, key = path.split("/")
+        node = data
+        for part in parents:
+            try:
+                node = node[int(part)] if isinstance(node, list) else node[part]
+            except (KeyError, IndexError, ValueError, TypeError):
+                break
+        else:
+            if isinstance(node, dict):
+                node[key] = value
+    return data
 
 
 def _write_csv(path: Path, rows: list[dict[str, Any]]) -> None:
@@ -73,6 +135,20 @@ def _write_csv(path: Path, rows: list[dict[str, Any]]) -> None:
 
     with atomic_open(path, "w", newline="", encoding="utf-8") as handle:
         pd.DataFrame(rows).to_csv(handle, index=False, float_format="%.10g")
+
+
+def _unknown_timings(data: Any) -> None:
+    """Set every solver record's times to None (unknown), in place."""
+    if isinstance(data, dict):
+        solver = data.get("solver")
+        if isinstance(solver, dict):
+            for key in TIMING_KEYS:
+                solver.setdefault(key, None)
+        for value in data.values():
+            _unknown_timings(value)
+    elif isinstance(data, list):
+        for value in data:
+            _unknown_timings(value)
 
 
 def render_report(
@@ -89,32 +165,32 @@ def render_report(
     ResultsDamaged
         A field the report draws from is missing or damaged (the message names the file and the field).
     """
-    from .figures import draw_figures
+    import jinja2  # lazily, like every heavy library: importing the package stays quick
+
     from .html import render_html
 
     folder = Path(folder)
+    saved = results is None
     if results is None:
-        path = folder / DESIGNS
-        if not path.exists():
-            raise ResultsMissing(
-                f"{folder} has no {DESIGNS}: run the study first (crx run STUDY --out {folder})"
-            )
-        try:
-            results = read_json(path)
-        except ValueError as error:
-            raise ResultsMissing(f"{path} cannot be read ({error}); run the study again") from None
-    assert results is not None
+        results = _read_results(folder)
     try:
-        svgs = (
-            draw_figures(folder / "figures", results, results["resolved"]["outputs"]["figures"])
-            if figures
-            else {}
-        )
-        html = render_html(results, pareto_rows(results), svgs)
+        html = render_html(results, pareto_rows(results), _figures(folder, results, figures))
+        pdf = bool(results["resolved"]["outputs"]["pdf"])
     except ResultsDamaged as error:
         raise ResultsDamaged(f"{folder / DESIGNS}: {error}; run the study again") from None
+    except (
+        AttributeError,
+        ArithmeticError,
+        LookupError,
+        TypeError,
+        ValueError,
+        jinja2.TemplateError,
+    ) as error:
+        if not saved:
+            raise  # results handed over by a run: a defect, not a damaged file
+        raise ResultsDamaged(f"{folder / DESIGNS}: {_unusable(error)}; run the study again") from None
     write_text(folder / REPORT, html)
-    if results["resolved"]["outputs"]["pdf"]:
+    if pdf:
         from .pdf import html_to_pdf
 
         try:
@@ -124,3 +200,48 @@ def render_report(
 
             warnings.warn(f"report.pdf not written: {error}", stacklevel=2)
     return folder / REPORT
+
+
+def _read_results(folder: Path) -> dict[str, Any]:
+    """The results saved in ``folder`` (``designs.json`` with ``timings.json``'s times)."""
+    path = folder / DESIGNS
+    if not path.exists():
+        raise ResultsMissing(f"{folder} has no {DESIGNS}: run the study first (crx run STUDY --out {folder})")
+    try:
+        results = read_json(path)
+        timings = read_json(folder / TIMINGS) if (folder / TIMINGS).exists() else {}
+    except ValueError as error:
+        raise ResultsMissing(f"{path} cannot be read ({error}); run the study again") from None
+    if not isinstance(results, dict) or results.get("kind") not in REPORT_KINDS:
+        kind = results.get("kind") if isinstance(results, dict) else None
+        raise ResultsDamaged(
+            f"{path}: field 'kind' is {kind!r}, expected one of {', '.join(REPORT_KINDS)}; run the study again"
+        )
+    return dict(with_timings(results, timings if isinstance(timings, dict) else {}))
+
+
+REPORT_KINDS = ("arm", "actuator")
+"""The kinds of results the report knows (one template each)."""
+
+
+def _figures(folder: Path, results: dict[str, Any], figures: bool) -> dict[str, str]:
+    from .figures import draw_figures
+
+    return (
+        draw_figures(folder / "figures", results, results["resolved"]["outputs"]["figures"])
+        if figures
+        else {}
+    )
+
+
+def _unusable(error: Exception) -> str:
+    """What a render error says about the saved results, on one line."""
+    import jinja2
+
+    if isinstance(error, KeyError):
+        return f"field {error.args[0]!r} is missing"
+    found = re.search(r"has no attribute '([^']+)'", str(error))
+    if isinstance(error, jinja2.UndefinedError) and found:
+        return f"field {found.group(1)!r} is missing"
+    text = " ".join(str(error).split())
+    return f"a field holds a value of the wrong kind ({type(error).__name__}: {text[:120]})"

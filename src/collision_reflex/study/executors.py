@@ -7,7 +7,13 @@ nothing here schedules work itself.
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import multiprocessing
+import os
+import signal
+import sys
+import threading
+import time
 from collections.abc import Iterator
 from concurrent.futures import Executor, ProcessPoolExecutor
 
@@ -43,13 +49,58 @@ def open_executor(kind: str = "serial", workers: int = 2, scheduler: str | None 
         yield SerialExecutor()
     elif kind == "processes":
         # "spawn": workers start clean (no copied locks or solver state from this process), the same on every OS.
-        with ProcessPoolExecutor(
-            max_workers=workers, mp_context=multiprocessing.get_context("spawn")
-        ) as pool:
+        pool = ProcessPoolExecutor(
+            max_workers=workers,
+            mp_context=multiprocessing.get_context("spawn"),
+            initializer=_die_with_parent,
+            initargs=(os.getpid(),),
+        )
+        try:
             yield pool
+        except BaseException:
+            _stop(pool)  # an interrupt or a failure: do not wait for the solves in flight
+            raise
+        pool.shutdown(wait=True)
     else:
         with _dask_executor(workers, scheduler) as executor:
             yield executor
+
+
+def _stop(pool: ProcessPoolExecutor) -> None:
+    """Cancel the queued work and end the workers now."""
+    processes = list(getattr(pool, "_processes", {}).values())  # the pool offers no public way before 3.14
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        process.terminate()
+    for process in processes:
+        process.join(timeout=5)
+
+
+def _die_with_parent(parent: int) -> None:
+    """Worker initializer: end this worker when the run's process ends, even by ``kill -9``.
+
+    On Linux the kernel does it (``PR_SET_PDEATHSIG``); elsewhere a daemon thread watches the parent. Ctrl-C is
+    left to the parent, which stops the workers (a worker interrupted while idle would print a traceback).
+    """
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if sys.platform.startswith("linux"):
+        with contextlib.suppress(OSError, AttributeError):
+            libc = ctypes.CDLL(None, use_errno=True)
+            if libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0) == 0:
+                if os.getppid() != parent:  # the parent died before the call
+                    os._exit(1)
+                return
+    threading.Thread(target=_watch_parent, args=(parent,), daemon=True).start()
+
+
+_PR_SET_PDEATHSIG = 1
+"""``prctl`` option: the signal the kernel sends this process when its parent ends (linux/prctl.h)."""
+
+
+def _watch_parent(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(1.0)
+    os._exit(1)
 
 
 @contextlib.contextmanager

@@ -10,6 +10,7 @@ function of the resolved study and its own inputs.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import time
 from collections.abc import Callable
@@ -23,7 +24,7 @@ from .executors import open_executor
 from .load import LoadedStudy, load_study, parse_study
 from .resolve import fingerprint, resolved_study, resolved_yaml
 from .schema import ActuatorStudy, ArmStudy
-from .store import RunFolder
+from .store import OutputFolderUnusable, RunFolder
 
 SMOKE_ENVIRONMENT = "CRX_SMOKE"
 """Set to 1 to run every study with small sample counts (tests, quick checks): see :func:`smoke_study`."""
@@ -88,9 +89,13 @@ def smoke_study(data: dict[str, Any]) -> dict[str, Any]:
     return data
 
 
-def default_output_folder(loaded: LoadedStudy) -> Path:
-    """``results/<study name>`` under the working directory."""
-    return Path.cwd() / "results" / loaded.study.name
+def default_output_folder(loaded: LoadedStudy, smoke: bool = False) -> Path:
+    """``results/<study name>`` under the working directory (``results/<study name>-smoke`` for a smoke run).
+
+    A smoke run has its own folder, so that a later full run into the default folder is not refused as
+    another run's.
+    """
+    return Path.cwd() / "results" / (loaded.study.name + ("-smoke" if smoke else ""))
 
 
 def run_study(
@@ -104,7 +109,9 @@ def run_study(
     smoke: bool | None = None,
     figures: bool = True,
 ) -> RunResult:
-    """Run the study in file ``path`` and write its results to ``out`` (default ``results/<name>``).
+    """Run the study in file ``path`` and write its results to ``out``.
+
+    The default ``out`` is ``results/<name>`` (``results/<name>-smoke`` for a smoke run).
 
     Parameters
     ----------
@@ -130,7 +137,7 @@ def run_study(
     # Robot, motors, samples and the problem build: every problem is raised here, located in the file as
     # written, before any output.
     _prepare(as_written, text)
-    folder = RunFolder(Path(out) if out is not None else default_output_folder(loaded))
+    folder = RunFolder(Path(out) if out is not None else default_output_folder(loaded, smoke))
     execution = resolved.get("execution", {})
     kind = executor or execution.get("executor", "serial")
     if scheduler is None and kind == "dask":
@@ -157,14 +164,19 @@ def run_study(
                 results, counts = _run_arm(loaded.study, text, folder, pool, progress, window)
             else:
                 results, counts = _run_actuators(loaded, folder, progress)
+        progress.stop()
+        from ..report import write_outputs
+
+        write_outputs(folder.path, results, figures=figures)
+    except OSError as error:  # a full disk, a folder made read-only meanwhile: finished pieces are kept
+        progress.stop()
+        with contextlib.suppress(OSError):
+            folder.update_manifest(status="failed")
+        raise OutputFolderUnusable.from_os_error(error, folder.path, exit_status=1) from None
     except BaseException as error:
         progress.stop()
         folder.update_manifest(status="failed" if isinstance(error, Exception) else "interrupted")
         raise
-    progress.stop()
-    from ..report import write_outputs
-
-    write_outputs(folder.path, results, figures=figures)
     elapsed = time.perf_counter() - started
     folder.update_manifest(status="finished", elapsed=elapsed, computed=counts[0], reused=counts[1])
     return RunResult(folder.path, resumed, counts[0], counts[1], elapsed, tuple(results.get("verdict", ())))

@@ -12,10 +12,14 @@ Every file is written to a temporary name and renamed, so it is complete or abse
 
 from __future__ import annotations
 
+import json
+import os
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from .._io import remove_temporary_files
 from ..errors import CollisionReflexError
 from ..report.files import DESIGNS, PARETO, REPORT, ResultsMissing, read_json, write_json, write_text
 
@@ -28,6 +32,7 @@ __all__ = [
     "REPORT",
     "RESOLVED",
     "OutputFolderInUse",
+    "OutputFolderUnusable",
     "ResultsMissing",
     "RunFolder",
     "read_json",
@@ -38,6 +43,27 @@ __all__ = [
 
 class OutputFolderInUse(CollisionReflexError):
     """The output folder holds results of a different study (or of the same study with other settings)."""
+
+
+class OutputFolderUnusable(CollisionReflexError):
+    """The output folder cannot be made or written (a read-only parent, a regular file, a full disk).
+
+    ``exit_status``: 2 when nothing was computed yet, 1 when the failure came after work had started (the
+    finished pieces are kept).
+    """
+
+    def __init__(self, path: str | os.PathLike[str], reason: str, exit_status: int = 2) -> None:
+        self.path = Path(path)
+        self.exit_status = exit_status
+        super().__init__(f"cannot write {self.path}: {reason}")
+
+    @classmethod
+    def from_os_error(
+        cls, error: OSError, fallback: str | os.PathLike[str], exit_status: int = 2
+    ) -> OutputFolderUnusable:
+        """The error for ``error`` (its file, else ``fallback``; its reason)."""
+        reason = error.strerror or str(error)
+        return cls(error.filename or fallback, reason, exit_status)
 
 
 @dataclass(frozen=True)
@@ -61,8 +87,16 @@ class RunFolder:
 
         Raises :class:`OutputFolderInUse` if it holds another study's results.
         """
+        try:
+            return self._claim(fingerprint, resolved_yaml, details)
+        except OSError as error:
+            raise OutputFolderUnusable.from_os_error(error, self.path) from None
+
+    def _claim(self, fingerprint: str, resolved_yaml: str, details: dict[str, Any]) -> bool:
         manifest = self.path / MANIFEST
         resumed = False
+        if self.path.exists() and not self.path.is_dir():
+            raise OutputFolderUnusable(self.path, "it is a file, not a folder; give a folder with --out")
         if manifest.exists():
             try:
                 previous = read_json(manifest)
@@ -79,6 +113,8 @@ class RunFolder:
                 f"{self.path} exists and is not a study's output folder; give another folder with --out"
             )
         self.path.mkdir(parents=True, exist_ok=True)
+        for folder in (self.path, self.points, self.figures):
+            remove_temporary_files(folder)  # left by a writer killed before its rename
         write_text(self.path / RESOLVED, resolved_yaml)
         write_json(manifest, {"fingerprint": fingerprint, "status": "running", **details})
         return resumed
@@ -89,10 +125,20 @@ class RunFolder:
         if not path.exists():
             return None
         try:
-            record: dict[str, Any] = read_json(path)
-            return record
-        except (OSError, ValueError):
-            return None  # unreadable: do the work again
+            record = read_json(path)
+        except (OSError, ValueError) as error:
+            return self._damaged(path, f"unreadable ({error})")
+        if not isinstance(record, dict) or not record:
+            return self._damaged(
+                path, f"holds {type(record).__name__} {_excerpt(record)} instead of a record"
+            )
+        return record
+
+    @staticmethod
+    def _damaged(path: Path, reason: str) -> None:
+        """Report a damaged piece, which is then done again."""
+        print(f"warning: {path} is {reason}; computing it again", file=sys.stderr)
+        return None
 
     def save(self, name: str, record: dict[str, Any]) -> None:
         """Keep a finished piece of work under ``name`` (atomically)."""
@@ -104,3 +150,9 @@ class RunFolder:
         data = read_json(manifest) if manifest.exists() else {}
         data.update(fields)
         write_json(manifest, data)
+
+
+def _excerpt(value: Any, limit: int = 40) -> str:
+    """``value`` as short JSON text, for a message."""
+    text = json.dumps(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."

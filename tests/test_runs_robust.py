@@ -1,0 +1,316 @@
+"""Runs and their files under interrupts and faults: Ctrl-C, unusable output folders, damaged run folders, file
+modes, smoke folders, stale temporary files, orphaned workers, byte-identical results, closed pipes."""
+
+from __future__ import annotations
+
+import importlib
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import collision_reflex as cr
+from collision_reflex.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+PANDA = ROOT / "studies" / "panda.yaml"
+TWO_LINK = ROOT / "studies" / "two_link_paper.yaml"
+RESULT_FILES = ("pareto.csv", "designs.json")
+CRX = [sys.executable, "-c", "import sys; from collision_reflex.cli import main; sys.exit(main())"]
+
+
+def _environment() -> dict[str, str]:
+    src = str(ROOT / "src")
+    path = os.environ.get("PYTHONPATH")
+    return {**os.environ, "PYTHONPATH": src if not path else f"{src}{os.pathsep}{path}"}
+
+
+def _crx(*args: str, **kwargs) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [*CRX, *args], capture_output=True, text=True, env=_environment(), timeout=300, **kwargs
+    )
+
+
+@pytest.fixture(scope="module")
+def panda_run(tmp_path_factory):
+    """The Panda smoke study run once without interruption (serial)."""
+    folder = tmp_path_factory.mktemp("panda") / "out"
+    completed = _crx("run", str(PANDA), "--smoke", "--quiet", "--executor", "serial", "--out", str(folder))
+    assert completed.returncode == 0, completed.stderr
+    return folder
+
+
+def _same_results(folder: Path, reference: Path) -> None:
+    for name in RESULT_FILES:
+        assert (folder / name).read_bytes() == (reference / name).read_bytes(), name
+
+
+def test_ctrl_c_stops_a_run_saves_its_points_and_the_resumed_run_equals_an_uninterrupted_one(
+    panda_run, tmp_path
+):
+    folder = tmp_path / "out"
+    command = [*CRX, "run", str(PANDA), "--smoke", "--quiet", "--executor", "serial", "--out", str(folder)]
+    process = subprocess.Popen(command, stderr=subprocess.PIPE, text=True, env=_environment())
+    # Interrupt in the middle of the sweep: once the first pieces are saved.
+    deadline = time.monotonic() + 120
+    while not (folder / "points").exists() or len(list((folder / "points").iterdir())) < 2:
+        assert process.poll() is None and time.monotonic() < deadline, "the run ended before the interrupt"
+        time.sleep(0.05)
+    process.send_signal(signal.SIGINT)
+    sent = time.monotonic()
+    _, stderr = process.communicate(timeout=60)
+    assert time.monotonic() - sent < 2.0
+    assert process.returncode == 130
+    assert stderr.strip().splitlines()[-1] == "crx run: interrupted; rerun the same command to resume"
+    assert "Traceback" not in stderr
+    assert '"status": "interrupted"' in (folder / "run.json").read_text()
+    saved = {p.name for p in (folder / "points").iterdir() if p.suffix == ".json"}
+    assert len(saved) >= 2 and not (folder / "pareto.csv").exists()
+    for point in saved:  # an interrupted solve is never recorded
+        assert "NonIpopt" not in (folder / "points" / point).read_text()
+
+    resumed = _crx("run", str(PANDA), "--smoke", "--quiet", "--executor", "serial", "--out", str(folder))
+    assert resumed.returncode == 0, resumed.stderr
+    _same_results(folder, panda_run)
+
+
+def test_an_interrupted_ipopt_run_raises_keyboard_interrupt_and_is_not_retried(monkeypatch):
+    pendulum = cr.Arm.from_example_robot_data("double_pendulum")
+    q = np.array([[0.3, -0.5], [1.0, 0.4]])
+    samples = cr.ContactSamples.grid(pendulum.kinematics(q), np.array([[1.0, 0.0], [0.0, 1.0]]))
+    space = cr.DesignSpace(
+        stator_diameter=(0.02, 0.12),
+        gear_ratio=(1, 30),
+        software_stiffness=300.0,
+        threshold=(3, 20),
+        approach_velocity=(0.02, 2.0),
+    )
+    technology = cr.ActuatorTechnology(cr.reference_motor(), mechanical_stiffness=[600.0, 400.0])
+    problem = cr.build_problem(pendulum, samples, space, technology, "worst_case_impulse")
+    calls = []
+
+    class Interrupted:
+        """What CasADi's IPOPT returns after it caught Ctrl-C in a callback."""
+
+        def __call__(self, **kwargs):
+            calls.append(kwargs)
+            return {"x": kwargs["x0"], "lam_x": kwargs["x0"], "lam_g": np.zeros(0)}
+
+        def stats(self):
+            return {"return_status": "NonIpopt_Exception_Thrown", "iter_count": 3}
+
+    solve_module = importlib.import_module("collision_reflex.optimize.solve")
+    monkeypatch.setattr(solve_module.ca, "nlpsol", lambda *args, **kwargs: Interrupted())
+    with pytest.raises(KeyboardInterrupt):
+        cr.solve(problem)
+    assert len(calls) == 1  # neither retried nor followed by a feasibility solve
+
+
+def test_serial_and_process_pool_runs_give_byte_identical_result_files(tmp_path):
+    for executor in ("serial", "processes"):
+        completed = _crx(
+            "run",
+            str(TWO_LINK),
+            "--smoke",
+            "--quiet",
+            "--executor",
+            executor,
+            "--out",
+            str(tmp_path / executor),
+        )
+        assert completed.returncode == 0, completed.stderr
+    _same_results(tmp_path / "processes", tmp_path / "serial")
+    assert "solve_time" not in (tmp_path / "serial" / "designs.json").read_text()
+    assert "solve_time" in (tmp_path / "serial" / "timings.json").read_text()
+
+
+def _run(folder: Path, *extra: str, study: Path = TWO_LINK) -> int:
+    return main(
+        ["run", str(study), "--smoke", "--quiet", "--executor", "serial", "--out", str(folder), *extra]
+    )
+
+
+@pytest.fixture(scope="module")
+def two_link_run(tmp_path_factory):
+    """The two-link smoke study run once in-process (serial)."""
+    folder = tmp_path_factory.mktemp("two_link") / "out"
+    assert _run(folder) == 0
+    return folder
+
+
+def _error_line(capsys) -> str:
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1, lines
+    return lines[0]
+
+
+def test_a_read_only_parent_is_one_line_exit_2(tmp_path, capsys, monkeypatch):
+    parent = tmp_path / "read-only"
+    mkdir = Path.mkdir
+
+    def refused(self, *args, **kwargs):  # as a read-only folder does (also when the tests run as root)
+        if parent in self.parents:
+            raise PermissionError(13, "Permission denied", str(self))
+        return mkdir(self, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "mkdir", refused)
+    assert _run(parent / "out") == 2
+    line = _error_line(capsys)
+    assert str(parent / "out") in line and "Permission denied" in line
+
+
+@pytest.mark.parametrize("below", [False, True], ids=["a file", "below a file"])
+def test_out_naming_a_file_or_below_one_is_one_line_exit_2(tmp_path, capsys, below):
+    regular = tmp_path / "file"
+    regular.write_text("mine\n")
+    out = regular / "below" if below else regular
+    assert _run(out) == 2
+    line = _error_line(capsys)
+    assert f"cannot write {out}" in line
+    assert regular.read_text() == "mine\n"
+
+
+def test_a_full_disk_during_the_solves_is_one_line_exit_1_and_keeps_finished_points(
+    tmp_path, capsys, monkeypatch
+):
+    import errno
+
+    from collision_reflex.study import store
+
+    write_json = store.write_json
+    saved = []
+
+    def full_after_the_first_point(path, data):
+        if Path(path).parent.name == "points":
+            if saved:
+                raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path))
+            saved.append(path)
+        write_json(path, data)
+
+    monkeypatch.setattr(store, "write_json", full_after_the_first_point)
+    folder = tmp_path / "out"
+    assert _run(folder) == 1
+    line = _error_line(capsys)
+    assert "No space left on device" in line and str(folder / "points") in line
+    assert [p.name for p in (folder / "points").iterdir()] == [Path(saved[0]).name]
+    assert '"status": "failed"' in (folder / "run.json").read_text()
+
+
+@pytest.mark.parametrize(
+    "damage", ["{}", "[]", '{"label": "anchor: mass", "res'], ids=["{}", "[]", "truncated"]
+)
+def test_a_damaged_point_file_is_reported_and_recomputed(two_link_run, tmp_path, capsys, damage):
+    import shutil
+
+    folder = tmp_path / "out"
+    shutil.copytree(two_link_run, folder)
+    point = sorted((folder / "points").glob("point-*.json"))[0]
+    point.write_text(damage)
+    capsys.readouterr()
+    assert _run(folder) == 0
+    assert f"warning: {point} is " in capsys.readouterr().err
+    assert "label" in point.read_text()  # recomputed and saved again
+    _same_results(folder, two_link_run)
+
+
+def test_a_resumed_run_removes_stale_temporary_files(two_link_run, tmp_path):
+    import shutil
+
+    folder = tmp_path / "out"
+    shutil.copytree(two_link_run, folder)
+    stale = [folder / ".tmp-designs.k1ll3d.json", folder / "points" / ".tmp-point-000.x.json"]
+    for path in stale:
+        path.write_text('{"half": ')
+        os.utime(path, (time.time() - 120, time.time() - 120))  # left by a run killed two minutes ago
+    fresh = folder / ".tmp-report.in-progress.html"  # another writer's, just begun: kept
+    fresh.write_text("<html>")
+    assert _run(folder) == 0
+    assert not any(path.exists() for path in stale)
+    assert fresh.exists()
+
+
+def test_output_files_get_the_umask_mode(tmp_path):
+    previous = os.umask(0o027)
+    try:
+        assert _run(tmp_path / "out") == 0
+    finally:
+        os.umask(previous)
+    files = [p for p in (tmp_path / "out").rglob("*") if p.is_file()]
+    assert files and {p.stat().st_mode & 0o777 for p in files} == {0o640}
+
+
+def test_a_smoke_run_has_its_own_default_folder(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", str(TWO_LINK), "--smoke", "--quiet", "--executor", "serial"]) == 0
+    assert [p.name for p in (tmp_path / "results").iterdir()] == ["two-link-paper-smoke"]
+
+
+@pytest.mark.parametrize(
+    ("edit", "words"),
+    [
+        (lambda d: d.update(kind="tampered"), "field 'kind' is 'tampered'"),
+        (lambda d: d.pop("study"), "field 'study' is missing"),
+        (lambda d: d["chosen"].pop("joints"), "field 'joints' is missing"),
+        (lambda d: d["chosen"].update(approach_velocity="fast"), "wrong kind"),
+    ],
+    ids=["kind", "study", "joints", "a string for a number"],
+)
+def test_crx_report_on_altered_designs_says_which_file_and_field(two_link_run, tmp_path, capsys, edit, words):
+    import json
+    import shutil
+
+    folder = tmp_path / "out"
+    shutil.copytree(two_link_run, folder)
+    designs = json.loads((folder / "designs.json").read_text())
+    edit(designs)
+    (folder / "designs.json").write_text(json.dumps(designs))
+    capsys.readouterr()
+    assert main(["report", str(folder)]) == 2
+    line = _error_line(capsys)
+    assert line.startswith(f"crx report: error: {folder / 'designs.json'}: ") and words in line, line
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").is_dir(), reason="reads a process's children from /proc")
+def test_pool_workers_die_with_a_killed_run(tmp_path):
+    folder = tmp_path / "out"
+    command = [*CRX, "run", str(PANDA), "--smoke", "--quiet", "--executor", "processes", "--out", str(folder)]
+    process = subprocess.Popen(command, stderr=subprocess.DEVNULL, env=_environment())
+    children: set[int] = set()
+    deadline = time.monotonic() + 120
+    while len(children) < 2:  # the resource tracker and at least one worker
+        assert process.poll() is None and time.monotonic() < deadline, "the run ended before the kill"
+        time.sleep(0.1)
+        task = Path(f"/proc/{process.pid}/task/{process.pid}/children")
+        children = {int(pid) for pid in task.read_text().split()}
+    process.kill()
+    process.wait()
+    deadline = time.monotonic() + 10
+    while any(Path(f"/proc/{pid}").exists() and _state(pid) != "Z" for pid in children):
+        assert time.monotonic() < deadline, "a worker outlived the killed run"
+        time.sleep(0.1)
+
+
+def _state(pid: int) -> str:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except (FileNotFoundError, IndexError):
+        return "gone"
+
+
+def test_piping_into_head_gives_no_traceback():
+    process = subprocess.Popen(
+        [*CRX, "impulse", "--velocities", "0.01:1:20000"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=_environment(),
+    )
+    assert process.stdout is not None and process.stdout.readline()
+    process.stdout.close()  # as `head -1` does after its line
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == 0 and stderr == "", stderr
