@@ -3,7 +3,6 @@ modes, smoke folders, stale temporary files, orphaned workers, byte-identical re
 
 from __future__ import annotations
 
-import importlib
 import os
 import signal
 import subprocess
@@ -104,8 +103,8 @@ def test_an_interrupted_ipopt_run_raises_keyboard_interrupt_and_is_not_retried(m
         def stats(self):
             return {"return_status": "NonIpopt_Exception_Thrown", "iter_count": 3}
 
-    solve_module = importlib.import_module("collision_reflex.optimize.solve")
-    monkeypatch.setattr(solve_module.ca, "nlpsol", lambda *args, **kwargs: Interrupted())
+    # Every IPOPT solver of a problem comes from DesignProblem.solver.
+    monkeypatch.setattr(type(problem), "solver", lambda self, *args, **kwargs: Interrupted())
     with pytest.raises(KeyboardInterrupt):
         cr.solve(problem)
     assert len(calls) == 1  # neither retried nor followed by a feasibility solve
