@@ -133,15 +133,15 @@ def duty_requirement(
     ------
     InvalidParameter: the reference motor has no maximum speed (the speed requirement needs it).
     """
-    motor = technology.reference_motor
-    if motor.max_speed is None:
-        raise InvalidParameter(
-            "reference_motor.max_speed",
-            None,
-            "a maximum speed [rad/s] when a duty cycle is given",
-            f"motor {motor.name!r} has none: add max_speed to its catalogue entry (e.g. '3000 rpm') or give "
-            "Motor(..., max_speed=...)",
-        )
+    for motor in technology.motors:
+        if motor.max_speed is None:
+            raise InvalidParameter(
+                "reference_motor.max_speed",
+                None,
+                "a maximum speed [rad/s] when a duty cycle is given",
+                f"motor {motor.name!r} has none: add max_speed to its catalogue entry (e.g. '3000 rpm') or "
+                "give Motor(..., max_speed=...)",
+            )
     return DutyRequirement(cycle_torques(arm, cycle), approach_joint_rates(samples), float(safety_factor))
 
 
@@ -217,9 +217,7 @@ def add_duty_constraints(
 
 def duty_values(duty: DutyRequirement, design: Design, technology: ActuatorTechnology) -> DutyValues:
     """A design's requirements and capacities over the cycle (NumPy; see :class:`DutyValues`)."""
-    motor = scaled_motor_quantities(
-        technology.reference_motor, design.stator_diameter, design.stack_length, technology.scaling_law
-    )
+    motor = technology.motor_quantities(design.stator_diameter, design.stack_length)
     demand = duty.demand(design.motor_mass, design.reflected_inertia).T  # (nv, n)
     return DutyValues(
         required_torque=duty.safety_factor * np.abs(demand).max(axis=1),
@@ -305,14 +303,13 @@ def _best_margins(
         b = bounds[name][joint]
         return np.array([b.lower]) if b.is_fixed else np.geomspace(b.lower, b.upper, count)
 
+    reference = technology.joint_motors(len(bounds["gear_ratio"]))[joint]
     gears = grid("gear_ratio", 241)[:, None]
     low, high, acceleration = demand
     best = np.full(4, -np.inf)
     for length in grid("stack_length", 9):
         for diameter in grid("stator_diameter", 41):
-            motor = scaled_motor_quantities(
-                technology.reference_motor, diameter, length, technology.scaling_law
-            )
+            motor = scaled_motor_quantities(reference, diameter, length, technology.scaling_law)
             rotor = gears**2 * motor.rotor_inertia * acceleration  # (gears, n)
             # The smallest |demand| at each sample over the other motors' masses (0 if the interval holds 0).
             least = np.maximum(0.0, np.maximum(low + rotor, -(high + rotor)))

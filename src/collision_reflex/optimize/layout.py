@@ -16,7 +16,6 @@ import casadi as ca
 import numpy as np
 
 from ..errors import InvalidParameter
-from ..hardware.motors import scaled_motor_quantities
 from ..model import effective as formulas
 from ..model.impulse import series_stiffness
 from .constraints import Constraints
@@ -85,7 +84,7 @@ def design_layout(
     With force sensing the noise floor bounds the threshold from below.
     """
     layout = DesignLayout()
-    defaults = {"stack_length": technology.reference_motor.stack_length}
+    defaults = {"stack_length": technology.default_stack_lengths(n_joints)}
     for name in PER_JOINT_VARIABLES:
         layout.add(name, space.per_joint(name, n_joints, defaults.get(name)))
     for name in GLOBAL_VARIABLES:
@@ -142,9 +141,7 @@ def design_quantities(
     not known); ``k_mech`` is the joint mechanical stiffness [N m/rad].
     """
     values = layout.expressions(z)
-    motor = scaled_motor_quantities(
-        technology.reference_motor, values["stator_diameter"], values["stack_length"], technology.scaling_law
-    )
+    motor = technology.motor_quantities(values["stator_diameter"], values["stack_length"])
     gear = values["gear_ratio"]
     reflected = formulas.reflected_inertia(gear, motor.rotor_inertia)
     design_column = ca.vertcat(

@@ -621,10 +621,6 @@ def _start_rotor(
     layout: DesignLayout, x0: np.ndarray, technology: ActuatorTechnology
 ) -> tuple[np.ndarray, np.ndarray]:
     """Gear ratios [-] and rotor inertias [kg m^2] of the start design."""
-    from ..hardware.motors import scaled_motor_quantities
-
     values = layout.values(x0[: layout.size])
-    motor = scaled_motor_quantities(
-        technology.reference_motor, values["stator_diameter"], values["stack_length"], technology.scaling_law
-    )
+    motor = technology.motor_quantities(values["stator_diameter"], values["stack_length"])
     return values["gear_ratio"], np.asarray(motor.rotor_inertia, dtype=float)

@@ -453,14 +453,11 @@ def _margin(capacity: np.ndarray, need: np.ndarray) -> np.ndarray:
 
 def design_at(problem: DesignProblem, x: np.ndarray) -> Design:
     """The design (and its derived actuator quantities) at NLP point ``x``."""
-    from ..hardware.motors import scaled_motor_quantities
     from ..model import effective
 
     values = problem.layout.values(np.asarray(x, dtype=float))
     technology = problem.technology
-    motor = scaled_motor_quantities(
-        technology.reference_motor, values["stator_diameter"], values["stack_length"], technology.scaling_law
-    )
+    motor = technology.motor_quantities(values["stator_diameter"], values["stack_length"])
     gear = values["gear_ratio"]
     return Design(
         joint_names=problem.joint_names,

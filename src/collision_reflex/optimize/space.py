@@ -86,13 +86,18 @@ class DesignSpace:
     approach_velocity: BoundsLike
     stack_length: BoundsLike | Sequence[BoundsLike] | None = None
 
-    def per_joint(self, name: str, n_joints: int, default: float | None = None) -> list[Bounds]:
-        """The bounds of per-joint variable ``name`` for each of ``n_joints`` joints."""
+    def per_joint(
+        self, name: str, n_joints: int, default: float | Sequence[float] | None = None
+    ) -> list[Bounds]:
+        """The bounds of per-joint variable ``name`` for each of ``n_joints`` joints.
+
+        ``default`` (one value, or one per joint) fixes the variable when the space leaves it out (None).
+        """
         value = getattr(self, name)
         if value is None:
             if default is None:
                 raise InvalidParameter(name, value, "bounds or a value")
-            value = default
+            value = list(default) if isinstance(default, Sequence) else default
         if isinstance(value, Sequence) and not (
             isinstance(value, tuple) and len(value) == 2 and all(isinstance(v, (int, float)) for v in value)
         ):

@@ -12,7 +12,6 @@ from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
 
-from ..hardware.motors import scaled_motor_quantities
 from ..optimize.duty import torque_speed_points
 from ..optimize.pareto import MERGE_TOLERANCE, built_problem, recommend
 from ..optimize.results import design_record
@@ -95,9 +94,7 @@ def torque_speed_record(problem: DesignProblem, result: DesignResult) -> list[Jo
         return None
     design = result.design
     technology = problem.technology
-    motor = scaled_motor_quantities(
-        technology.reference_motor, design.stator_diameter, design.stack_length, technology.scaling_law
-    )
+    motor = technology.motor_quantities(design.stator_diameter, design.stack_length)
     n = len(design.joint_names)
     continuous = np.broadcast_to(np.asarray(motor.continuous_torque, dtype=float), (n,))
     max_speed = None if motor.max_speed is None else np.broadcast_to(np.asarray(motor.max_speed, float), (n,))
@@ -125,8 +122,7 @@ def design_bounds(setup: ArmSetup) -> dict[str, Any]:
     """The bounds every design of the study was solved within, as plain data [SI units]."""
     joints = list(setup.arm.joint_names)
     space = setup.space
-    reference = setup.technology.reference_motor
-    defaults = {"stack_length": reference.stack_length}
+    defaults = {"stack_length": setup.technology.default_stack_lengths(len(joints))}
     out: dict[str, Any] = {}
     for name in PER_JOINT_VARIABLES:
         bounds = space.per_joint(name, len(joints), defaults.get(name))
@@ -197,7 +193,7 @@ def speed_limits(setup: ArmSetup) -> str | None:
 
     if setup.constraints.duty_cycle is None:
         return None
-    motor = setup.technology.reference_motor
+    motor = setup.technology.motors[0]
     law = scaling_law(setup.technology.scaling_law).speed
     return (
         f"Speed limits: the reference motor {motor.name} turns at most {motor.max_speed:.4g} rad/s (its "

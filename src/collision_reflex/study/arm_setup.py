@@ -296,15 +296,15 @@ def _torque_out_of_reach(loaded: LoadedStudy, setup: ArmSetup) -> list[StudyProb
         return []
     joints = list(setup.arm.joint_names)
     n = len(joints)
-    reference = setup.technology.reference_motor
+    references = setup.technology.joint_motors(n)
     diameters = setup.space.per_joint("stator_diameter", n)
-    stacks = setup.space.per_joint("stack_length", n, reference.stack_length)
+    stacks = setup.space.per_joint("stack_length", n, setup.technology.default_stack_lengths(n))
     gears = setup.space.per_joint("gear_ratio", n)
     factor = setup.study.constraints.safety_factor
     problems = []
     for i, joint in enumerate(joints):
         motor = scaled_motor_quantities(
-            reference, diameters[i].upper, stacks[i].upper, setup.technology.scaling_law
+            references[i], diameters[i].upper, stacks[i].upper, setup.technology.scaling_law
         )
         reachable = gears[i].upper * float(motor.peak_torque)
         if factor * required[i] > reachable * (1 + 1e-9):
