@@ -39,11 +39,11 @@ def gearboxes():
 def test_catalogue_covers_makers_kinds_and_sizes(motors, motor_entries):
     assert len(motors) >= 12
     makers = {entry.description.get("maker") for entry in motor_entries.values()}
-    assert len(makers - {None}) >= 6
+    assert len(makers - {None}) >= 8
     kinds = {entry.description.get("construction") for entry in motor_entries.values()}
     assert kinds == {"frameless", "housed"}
     diameters = sorted(m.stator_diameter for m in motors.values())
-    assert diameters[0] <= 0.030 and diameters[-1] >= 0.120  # ~20 mm to ~120 mm asked; 28 to 127 mm shipped
+    assert diameters[0] <= 0.020 and diameters[-1] >= 0.120  # ~20 mm to ~120 mm asked; 16 to 127 mm shipped
     assert {"OPN-060-013-A", "U8-KV100"} <= set(motors)  # the paper's reference motor and its U8
 
 
@@ -143,6 +143,15 @@ def test_maxon(motors):
     assert flat.max_speed == pytest.approx(4380 * RPM, rel=1e-12)
     eci = motors["EC-i40-488607"]
     assert eci.rotor_inertia == pytest.approx(44 * G_CM2, rel=1e-12) and eci.mass == pytest.approx(0.39)
+
+
+def test_faulhaber(motors):
+    # 2250 S 024 BX4: 10 gcm2, 106 g, 36.9 mNm/A, stall 149 mNm, continuous up to 23 mNm, up to 9000 rpm.
+    bx4 = motors["2250S024BX4"]
+    assert bx4.rotor_inertia == pytest.approx(10 * G_CM2, rel=1e-12)
+    assert (bx4.mass, bx4.torque_constant) == pytest.approx((0.106, 0.0369), rel=1e-12)
+    assert (bx4.continuous_torque, bx4.peak_torque) == pytest.approx((0.023, 0.149), rel=1e-12)
+    assert bx4.max_speed == pytest.approx(9000 * RPM, rel=1e-12)
 
 
 def test_allied_motion_continuous_torque_estimate(motors):
