@@ -216,6 +216,39 @@ def add_gearbox_peak_constraints(
         )
 
 
+def check_gearbox_ratings(
+    torque_demands: list[TorqueDemands],
+    technology: ActuatorTechnology,
+    joint_names: tuple[str, ...],
+    mass_low: np.ndarray,
+    mass_high: np.ndarray,
+) -> None:
+    """Refuse a gearbox whose repeated peak torque is below the least its joint's requirement can be.
+
+    The requirement is the largest demand ``b + S m``; over the box of actuator masses ``[mass_low,
+    mass_high]`` [kg] it is at least each demand's smallest value there, so a rating below the largest of
+    those cannot be met by any design within the bounds.
+
+    Raises
+    ------
+    InvalidParameter: names the joint, the gearbox, its rating and the least requirement [N m].
+    """
+    figures = technology.gearbox_figures(len(joint_names))
+    for j, (bases, slopes, _) in enumerate(torque_demands):
+        rating = figures.peak_torque[j]
+        if not np.isfinite(rating) or bases.size == 0:
+            continue
+        least = float((bases + np.minimum(slopes * mass_low, slopes * mass_high).sum(axis=1)).max())
+        if least > rating * (1 + 1e-9):
+            raise InvalidParameter(
+                f"gearbox {figures.names[j]} of {joint_names[j]}",
+                f"repeated peak rating {rating:.4g} N*m",
+                f"a rating >= {least:.4g} N*m, the least torque {joint_names[j]} needs within the bounds "
+                "(safety factor included)",
+                "choose a gearbox of a higher rating, or lower the payload, the safety factor or the given torques",
+            )
+
+
 def torque_requirement_rows(
     samples: ContactSamples, constraints: Constraints, joint_names: tuple[str, ...]
 ) -> tuple[list[tuple[np.ndarray, np.ndarray]], list[str]]:

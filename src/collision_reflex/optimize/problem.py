@@ -48,6 +48,7 @@ from .constraints import (
     add_gearbox_peak_constraints,
     add_model_constraints,
     binding_torque_demands,
+    check_gearbox_ratings,
     required_torque_function,
     torque_requirement_rows,
 )
@@ -269,7 +270,7 @@ def build_problem(
     arm: the :class:`collision_reflex.arm.Arm` (joint names; ``samples.kinematics`` must come from it).
     samples: contact cases: configurations (with their Pinocchio data) and directions.
     space: bounds of the design variables.
-    technology: reference motor, scaling law, mechanical stiffness, sensing scheme, reaction model.
+    technology: reference motor, scaling law, mechanical stiffness, sensing scheme, reaction model, gearboxes.
     objective: an objective name of :data:`OBJECTIVES` or a weighted sum ``{name: weight}``; each objective is
         divided by its value at the start point, so weights compare relative changes.
     constraints: torque requirement (gravity over the samples + payload, times a safety factor, or given
@@ -281,7 +282,8 @@ def build_problem(
     ------
     InvalidParameter: bad input, a duty cycle with a reference motor of unknown maximum speed, or a duty-cycle
         requirement that no design within the bounds can meet (naming the joint, the constraint and the best
-        margin reachable).
+        margin reachable), a gearbox whose ratios miss the joint's gear-ratio bounds, or one whose peak rating
+        is below the least static (or given) requirement of its joint.
     """
     started = time.perf_counter()
     constraints = constraints or Constraints()
@@ -321,6 +323,7 @@ def build_problem(
     mass_range = [np.asarray(joint_numbers(bound)[0]).ravel() for bound in (lbx, ubx)]
     if duty is None:
         torque_demands = binding_torque_demands(samples, constraints, joint_names, *mass_range)
+        check_gearbox_ratings(torque_demands, technology, joint_names, *mass_range)
         required_torque = required_torque_function(torque_demands, n_joints)
         required_expression = required_torque(design.actuator_mass)
     else:
