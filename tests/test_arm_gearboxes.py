@@ -14,7 +14,7 @@ import pytest
 import collision_reflex as cr
 from collision_reflex.arm import Arm
 from collision_reflex.arm.duty_cycle import DutyCycle, Payload
-from collision_reflex.errors import InvalidParameter, SolverFailed, StudyFileError
+from collision_reflex.errors import InvalidParameter, StudyFileError
 from collision_reflex.hardware.gearboxes import CatalogueGearbox
 from collision_reflex.optimize.solve import design_at
 
@@ -133,7 +133,9 @@ def test_masses_and_armature_against_pinocchio(ur5, placement):
     required = 1.5 * np.abs(np.array(gravity)).max(axis=0)
     evaluated = problem.evaluate(problem.exact_point(x))
     # Joints gravity does not load (base yaw, last wrist) are rounding noise: tolerance relative to the largest.
-    np.testing.assert_allclose(np.asarray(evaluated[4]).ravel(), required, rtol=1e-9, atol=1e-12 * required.max())
+    np.testing.assert_allclose(
+        np.asarray(evaluated[4]).ravel(), required, rtol=1e-9, atol=1e-12 * required.max()
+    )
     np.testing.assert_allclose(float(evaluated[1]), carried.sum(), rtol=1e-12)
     np.testing.assert_allclose(design.reflected_inertia, armature, rtol=1e-12)
     np.testing.assert_array_equal(design.motor_mass, np.asarray(motor.mass))  # the motor's own
@@ -143,7 +145,9 @@ def test_masses_and_armature_against_pinocchio(ur5, placement):
 
 def _solve_two_link(arm, gearboxes=None, constraints=GIVEN, **technology):
     tech = cr.ActuatorTechnology(_motor(), mechanical_stiffness=1000.0, gearboxes=gearboxes, **technology)
-    problem = cr.build_problem(arm, _two_link_samples(arm), TWO_LINK_SPACE, tech, "worst_case_impulse", constraints)
+    problem = cr.build_problem(
+        arm, _two_link_samples(arm), TWO_LINK_SPACE, tech, "worst_case_impulse", constraints
+    )
     return problem, cr.solve(problem)
 
 
@@ -220,9 +224,15 @@ def test_a_rating_below_the_lightest_design_moves_the_optimum_onto_it(two_link, 
         "speed": ("max_input_speed", free.max_motor_speed[0]),
     }
     field, value = asked[rating]
-    capped_box = _gearbox("g", 0.3, 1e-5, **{field: 0.95 * value, **({} if field == "peak" else {"peak": 1e6})})
+    capped_box = _gearbox(
+        "g", 0.3, 1e-5, **{field: 0.95 * value, **({} if field == "peak" else {"peak": 1e6})}
+    )
     problem, capped = _lightest_with_duty(two_link, cycle, capped_box)
-    used = {"peak": capped.required_torque, "rms": capped.required_rms_torque, "speed": capped.max_motor_speed}
+    used = {
+        "peak": capped.required_torque,
+        "rms": capped.required_rms_torque,
+        "speed": capped.max_motor_speed,
+    }
     assert used[rating][0] == pytest.approx(0.95 * value, rel=1e-6)  # on the rating (IPOPT's tolerance)
     assert capped.objectives["actuator_mass"] > free.objectives["actuator_mass"] * (1 + 1e-3)
     constraint = ca.Function("g", [problem.nlp["x"], problem.nlp["p"]], [problem.nlp["g"]])
@@ -291,7 +301,12 @@ def test_gearbox_inertia_false_is_stated_in_the_report(tmp_path):
 @pytest.mark.parametrize(
     "old, new, line, message",
     [
-        ("gearbox: NPS015-MF-1", "gearbox: NPS999", 16, r"actuators\.gearbox.*NPS999.*NPS015-MF-1, SP100-MF-1"),
+        (
+            "gearbox: NPS015-MF-1",
+            "gearbox: NPS999",
+            16,
+            r"actuators\.gearbox.*NPS999.*NPS015-MF-1, SP100-MF-1",
+        ),
         ("gear_ratio: {min: 1, max: 10}", "gear_ratio: {min: 20, max: 50}", 16, r"ratios 3 to 10.*20 to 50"),
     ],
     ids=["unknown name", "ratio range missed"],

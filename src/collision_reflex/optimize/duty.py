@@ -383,7 +383,9 @@ def _best_margins(
                     _margin(
                         efficiency * gears[:, 0] * motor.peak_torque, duty.safety_factor * least.max(axis=1)
                     ),
-                    _margin(efficiency * gears[:, 0] * motor.continuous_torque, np.sqrt((least**2) @ weights)),
+                    _margin(
+                        efficiency * gears[:, 0] * motor.continuous_torque, np.sqrt((least**2) @ weights)
+                    ),
                     _margin(np.full(gears.shape[0], motor.max_speed), gears[:, 0] * joint_speed),
                 ]
             )

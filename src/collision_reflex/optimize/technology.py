@@ -149,7 +149,9 @@ class ActuatorTechnology:
         if self.gearboxes is None:
             return (None,) * n_joints
         if len(self.gearboxes) != n_joints:
-            raise InvalidParameter("gearboxes", len(self.gearboxes), f"one gearbox (or None) per joint: {n_joints}")
+            raise InvalidParameter(
+                "gearboxes", len(self.gearboxes), f"one gearbox (or None) per joint: {n_joints}"
+            )
         return self.gearboxes
 
     def gearbox_figures(self, n_joints: int) -> GearboxFigures:
@@ -192,7 +194,13 @@ class ActuatorTechnology:
         continuous = gear_ratio * motor.continuous_torque
         if self.gearboxes is None:  # no gearbox anywhere: the motor's quantities, not a term added
             return JointQuantities(
-                motor, gearbox, motor.mass, reflected_inertia(gear_ratio, motor.rotor_inertia), peak, peak, continuous
+                motor,
+                gearbox,
+                motor.mass,
+                reflected_inertia(gear_ratio, motor.rotor_inertia),
+                peak,
+                peak,
+                continuous,
             )
         mass, counted, efficiency = (
             _column(v, gear_ratio) for v in (gearbox.mass, gearbox.counted_inertia, gearbox.efficiency)

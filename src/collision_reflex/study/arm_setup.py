@@ -201,7 +201,9 @@ def _joint_gearboxes(
             if gearbox is None:
                 problems.append(
                     loaded.problem(
-                        path, repr(spec), "a gearbox of designs/gearboxes.yaml: " + ", ".join(sorted(catalogue))
+                        path,
+                        repr(spec),
+                        "a gearbox of designs/gearboxes.yaml: " + ", ".join(sorted(catalogue)),
                     )
                 )
                 continue

@@ -143,7 +143,7 @@ class GearboxSpec(_Model):
     efficiency: float | None = Field(
         None, gt=0, le=1, description="efficiency (0, 1] [-]; null: 1 (arm studies)"
     )
-    max_input_speed: AngularSpeed | None = Field(
+    max_input_speed: AngularSpeed | None = Field(  # type: ignore[valid-type]
         None, gt=0, description="maximum input speed [rad/s]; null: none (arm studies)"
     )
 
@@ -170,7 +170,8 @@ class ActuatorsSpec(_Model):
         "null: none (the gear ratio alone)",
     )
     gearbox_inertia: bool = Field(
-        True, description="add the gearbox's input inertia to the reflected inertia; false: the paper's choice"
+        True,
+        description="add the gearbox's input inertia to the reflected inertia; false: the paper's choice",
     )
     gear_ratio: Ratio = Field(1.0, ge=1)
     mechanical_stiffness: RotaryStiffness = Field(gt=0, description="joint mechanical stiffness [N m/rad]")
