@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import json
 from pathlib import Path
 
 import casadi as ca
@@ -241,6 +242,33 @@ def test_a_rating_below_the_lightest_design_moves_the_optimum_onto_it(two_link, 
     assert len(rows) >= 3  # peak rows, the RMS row and the cycle's and approach's speed rows
     slack = np.minimum(g[rows] - problem.lbg[rows], problem.ubg[rows] - g[rows])
     assert slack.min() == pytest.approx(0.0, abs=1e-6)  # a gearbox row is active, the others met
+
+
+def test_a_duty_cycle_beyond_the_gearbox_rating_is_refused_before_solving(two_link, cycle):
+    # The lightest design needs ~53 N*m (safety factor included) at joint 1: a 10 N*m rating is far short.
+    weak = _gearbox("weak", 0.3, 1e-5, peak=10.0)
+    with pytest.raises(
+        InvalidParameter, match=r"joint1.*gearbox weak peak rating: best margin reachable -7\d"
+    ):
+        _lightest_with_duty(two_link, cycle, weak)
+
+
+def test_the_gearbox_fields_survive_the_saved_result(two_link):
+    from collision_reflex.optimize.results import result_from_json, result_to_json
+
+    box = _gearbox("NPS", 0.25, 2e-6, efficiency=0.9)
+    _, result = _solve_two_link(two_link, (box, None))
+    again = result_from_json(json.loads(json.dumps(result_to_json(result)))).design
+    assert again.gearbox == ("NPS", "")
+    for name in (
+        "gearbox_mass",
+        "gearbox_inertia",
+        "gearbox_efficiency",
+        "actuator_mass",
+        "reflected_inertia",
+    ):
+        np.testing.assert_array_equal(getattr(again, name), getattr(result.design, name))
+    np.testing.assert_array_equal(again.gearbox_efficiency, [0.9, 1.0])
 
 
 def test_ratio_ranges_are_intersected_and_a_miss_is_named(two_link):
