@@ -333,20 +333,26 @@ def test_gearbox_inertia_false_is_stated_in_the_report(tmp_path):
             "gearbox: NPS015-MF-1",
             "gearbox: NPS999",
             16,
-            r"actuators\.gearbox.*NPS999.*NPS015-MF-1, SP100-MF-1",
+            r"actuators\.gearbox: found 'NPS999'; expected a gearbox of the catalogue.*'NPS015-MF-1', 'SP100-MF-1'",
+        ),
+        (
+            "  mechanical_stiffness",
+            "  joints: {joint2: {gearbox: SP10}}\n  mechanical_stiffness",
+            19,
+            r"actuators\.joints\.joint2\.gearbox: found 'SP10'",
         ),
         ("gear_ratio: {min: 1, max: 10}", "gear_ratio: {min: 20, max: 50}", 16, r"ratios 3 to 10.*20 to 50"),
     ],
-    ids=["unknown name", "ratio range missed"],
+    ids=["unknown name", "unknown name at a joint", "ratio range missed"],
 )
 def test_bad_gearboxes_are_located(tmp_path, old, new, line, message):
     from collision_reflex.study.arm_setup import arm_setup
     from collision_reflex.study.load import parse_study
 
-    loaded = parse_study(_study_text(**{old: new}), "study.yaml", ROOT / "studies")
-    with pytest.raises(StudyFileError, match=message) as caught:
-        arm_setup(loaded)
+    with pytest.raises(StudyFileError, match=message) as caught:  # the schema, or the setup with the bounds
+        arm_setup(parse_study(_study_text(**{old: new}), "study.yaml", ROOT / "studies"))
     assert caught.value.problems[0].line == line
+    assert len({str(p) for p in caught.value.problems}) == len(caught.value.problems)  # each once
 
 
 def test_a_per_joint_gearbox_of_figures_is_scaled_into_a_joint_gearbox():

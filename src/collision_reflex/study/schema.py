@@ -14,6 +14,7 @@ Every model forbids unknown keys. Quantities are floats in SI units once validat
 from __future__ import annotations
 
 import builtins
+import difflib
 import re
 from typing import Annotated, Any, Literal
 
@@ -148,6 +149,25 @@ class GearboxSpec(_Model):
     )
 
 
+def _catalogue_gearbox(value: Any) -> Any:
+    """A gearbox name must be one of the packaged catalogue's (figures are checked by :class:`GearboxSpec`)."""
+    if not isinstance(value, str):
+        return value
+    from ..hardware.gearboxes import load_gearbox_catalogue
+
+    names = sorted(load_gearbox_catalogue())
+    if value not in names:
+        close = difflib.get_close_matches(value, names, n=1)
+        raise ValueError(
+            "a gearbox of the catalogue (designs/gearboxes.yaml): "
+            + (f"{close[0]!r}? " if close else "")
+            + "one of "
+            + ", ".join(map(repr, names))
+            + ", or the gearbox's figures"
+        )
+    return value
+
+
 class JointActuatorSpec(_Model):
     """Per-joint overrides of the actuator defaults (every field optional)."""
 
@@ -158,6 +178,8 @@ class JointActuatorSpec(_Model):
     gear_ratio: Ratio | None = Field(None, ge=1)
     mechanical_stiffness: RotaryStiffness | None = Field(None, gt=0)
     software_stiffness: RotaryStiffness | None = Field(None, gt=0)
+
+    _known_gearbox = field_validator("gearbox")(_catalogue_gearbox)
 
 
 class ActuatorsSpec(_Model):
@@ -177,6 +199,8 @@ class ActuatorsSpec(_Model):
     mechanical_stiffness: RotaryStiffness = Field(gt=0, description="joint mechanical stiffness [N m/rad]")
     software_stiffness: RotaryStiffness = Field(gt=0, description="joint controller stiffness [N m/rad]")
     joints: dict[str, JointActuatorSpec] = Field(default_factory=dict)
+
+    _known_gearbox = field_validator("gearbox")(_catalogue_gearbox)
 
 
 # --- sensing -----------------------------------------------------------------------------------------------------
