@@ -98,6 +98,10 @@ class CollisionSetup:
         (contacts, detection) are found by sign changes between steps, so a step longer than a contact can
         miss it: steps above a quarter of the contact time are refused.
     rtol: relative tolerance of the integrator.
+    max_steps: budget of integrator steps. A setup whose up-front estimate (its phases' spans over their
+        fastest time scales, :mod:`collision_reflex.simulate.budget`) exceeds it is refused at once with what
+        to change; a run that uses it up (counted as 12 right-hand-side evaluations a step) stops with a
+        :class:`~collision_reflex.errors.SimulationError`. The default takes seconds to a minute at most.
     """
 
     m_f: float
@@ -121,6 +125,7 @@ class CollisionSetup:
     duration: float | None = None
     max_step: float | None = None
     rtol: float = 1e-10
+    max_steps: int = 200_000
 
     def __post_init__(self) -> None:
         _validate.choice("drive", self.drive, DRIVES)
@@ -233,6 +238,8 @@ def _check_signs(setup: CollisionSetup) -> None:
     _validate.positive("rtol", setup.rtol)
     if not 1e-14 <= setup.rtol <= 1e-3:
         raise InvalidParameter("rtol", setup.rtol, "between 1e-14 and 1e-3")
+    if isinstance(setup.max_steps, bool) or not isinstance(setup.max_steps, int) or setup.max_steps < 1:
+        raise InvalidParameter("max_steps", setup.max_steps, "a whole number >= 1")
 
 
 def _check_drive(setup: CollisionSetup) -> None:
