@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 from decimal import Decimal, getcontext
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,6 +16,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import collision_reflex as cr
+from collision_reflex.arm import Arm, effective_parameters
 from collision_reflex.errors import InvalidParameter
 
 ARGS = (0.2, 90.9, 1000.0, 200.0, 20.0, 0.1)  # m_f, k, k_m, F_s, a, v0 of the reproduction
@@ -146,3 +148,62 @@ def test_collision_setups_are_valid_or_refused(exponents: list[float], drive: st
     except InvalidParameter:
         return
     assert all(math.isfinite(value) for value in (phases.initial, phases.sensing, phases.reaction))
+
+
+# ----- arm, design space and solver inputs ---------------------------------------------------------------------
+TWO_LINK = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
+
+
+@pytest.fixture(scope="module")
+def small_problem() -> cr.DesignProblem:
+    arm = Arm.from_urdf(TWO_LINK, "tip")
+    kinematics = arm.kinematics(arm.sample_configurations(2, np.random.default_rng(0)))
+    angles = np.array([0.3, 0.3 + np.pi])
+    samples = cr.ContactSamples.grid(kinematics, np.c_[np.cos(angles), np.sin(angles)])
+    space = cr.DesignSpace(
+        stator_diameter=(0.02, 0.04),
+        gear_ratio=(1, 2),
+        software_stiffness=100.0,
+        threshold=3.0,
+        approach_velocity=(0.1, 1.0),
+    )
+    technology = cr.ActuatorTechnology(cr.reference_motor(), mechanical_stiffness=200.0)
+    return cr.build_problem(arm, samples, space, technology, bounded_objectives=("actuator_mass",))
+
+
+def test_infinite_mechanical_stiffness_is_refused() -> None:
+    arm = Arm.from_urdf(TWO_LINK, "tip")
+    samples = arm.kinematics(arm.sample_configurations(1, np.random.default_rng(0)))
+    with pytest.raises(InvalidParameter, match=r"^mechanical_stiffness = "):
+        effective_parameters(samples, [[1.0, 0.0]], 1e-3, 100.0, math.inf, 10.0)
+    effective_parameters(samples, [[1.0, 0.0]], 1e-3, 100.0, 1e12, 10.0)  # very stiff, finite: fine
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (dict(stator_diameter=(1e-300, 1e300)), r"stator_diameter bounds .* supported range \[1e-06, 1000\]"),
+        (dict(gear_ratio=[(1, 10), (1, 1e9)]), r"gear_ratio\[1\] bounds .* supported range \[1, 1e\+06\]"),
+        (dict(threshold=("1", 3)), r"^threshold = "),
+        (dict(approach_velocity=True), r"^approach_velocity"),
+    ],
+)
+def test_design_space_refuses_bounds_the_model_cannot_evaluate(change: dict, message: str) -> None:
+    space = dict(stator_diameter=(0.02, 0.1), gear_ratio=(1, 10), software_stiffness=100.0, threshold=3.0)
+    with pytest.raises(InvalidParameter, match=message):
+        cr.DesignSpace(**{"approach_velocity": (0.1, 1.0), **space, **change})
+
+
+def test_solve_refuses_a_nan_start(small_problem: cr.DesignProblem) -> None:
+    start = small_problem.x0.copy()
+    start[0] = math.nan
+    with pytest.raises(InvalidParameter, match=r"^x0 = .*finite numbers"):
+        cr.solve(small_problem, x0=start)
+    with pytest.raises(InvalidParameter, match=r"^x0 = "):
+        cr.solve(small_problem, x0=start[:-1])
+
+
+@pytest.mark.parametrize("bound", [math.nan, "2", math.inf, [1.0, 2.0]])
+def test_solve_refuses_a_bad_epsilon(small_problem: cr.DesignProblem, bound: object) -> None:
+    with pytest.raises(InvalidParameter, match=r"^epsilon\['actuator_mass'\] = .*a finite number"):
+        cr.solve(small_problem, epsilon={"actuator_mass": bound})
