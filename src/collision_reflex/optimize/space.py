@@ -128,7 +128,7 @@ class DesignSpace:
             entries = _entries(value) if name in PER_JOINT_VARIABLES else None
             for i, entry in enumerate([value] if entries is None else entries):
                 label = name if entries is None else f"{name}[{i}]"
-                _within_supported(as_bounds(entry, label), name)  # type: ignore[arg-type]
+                _within_supported(as_bounds(entry, label), name)
 
     def per_joint(self, name: str, n_joints: int, default: float | None = None) -> list[Bounds]:
         """The bounds of per-joint variable ``name`` for each of ``n_joints`` joints."""
