@@ -207,3 +207,17 @@ def test_solve_refuses_a_nan_start(small_problem: cr.DesignProblem) -> None:
 def test_solve_refuses_a_bad_epsilon(small_problem: cr.DesignProblem, bound: object) -> None:
     with pytest.raises(InvalidParameter, match=r"^epsilon\['actuator_mass'\] = .*a finite number"):
         cr.solve(small_problem, epsilon={"actuator_mass": bound})
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(LOG_MAGNITUDE, min_size=5, max_size=5))
+def test_moving_optimum_is_finite_or_refused(exponents: list[float]) -> None:
+    # Found by a bounded search on ln v0 and ln I: no overflow inside the minimiser, whatever the scale.
+    m_f, k, k_m, F_s, a = (10.0**e for e in exponents)
+    try:
+        v_opt = cr.optimal_velocity(m_f, k, F_s, "moving", k_m, a)
+        impulse = cr.minimum_impulse(m_f, k, k_m, F_s, a, "moving")
+    except InvalidParameter:
+        return
+    assert 0 < v_opt <= cr.optimal_velocity(m_f, k, F_s) * (1 + 1e-12)
+    assert math.isfinite(impulse) and impulse > 0

@@ -169,6 +169,12 @@ def optimal_velocity(
             "the moving-robot optimum has no closed form; use numeric values",
         )
     k_m, a = _validate.positive("k_m", k_m), _validate.positive("a", a)
+    if np.any(np.asarray(v_star) < np.finfo(np.float64).tiny):
+        raise InvalidParameter(
+            "the optimal velocity F_s / sqrt(2 k m_f)",
+            v_star,
+            "a result within the float64 range (above 2.2e-308)",
+        )
     return _moving_optimum(m_f, k, k_m, F_s, a, v_star)
 
 
@@ -367,21 +373,31 @@ def _checked(
 
 
 def _moving_optimum(m_f: Any, k: Any, k_m: Any, F_s: Any, a: Any, v_star: Any) -> Any:
-    """Minimise ``I(v0)`` with the moving-robot reaction (``v_r = v0``) per element on ``(0, v*]``."""
+    """Minimise ``I(v0)`` with the moving-robot reaction (``v_r = v0``) per element on ``(0, v*]``.
+
+    The search runs on ``ln v0`` and ``ln I``: scale-free, so that it neither overflows nor loses digits
+    whatever the magnitudes (the minimiser is the same).
+    """
     from scipy.optimize import minimize_scalar
 
     args = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (m_f, k, k_m, F_s, a, v_star)))
     out = np.empty(args[0].shape)
     for index in np.ndindex(out.shape):
         mf_i, k_i, km_i, fs_i, a_i, vs_i = (float(x[index]) for x in args)
-        impulse = functools.partial(_moving_impulse, mf_i, k_i, km_i, fs_i, a_i)
+        log_impulse = functools.partial(_moving_log_impulse, mf_i, k_i, km_i, fs_i, a_i)
         # The reaction impulse grows with v_r = v0, so the optimum is below the at-rest v*; I -> inf as v0 -> 0.
+        top = math.log(vs_i)
         found = minimize_scalar(
-            impulse, bounds=(1e-6 * vs_i, vs_i), method="bounded", options={"xatol": 1e-12 * vs_i}
+            log_impulse, bounds=(top + math.log(1e-6), top), method="bounded", options={"xatol": 1e-12}
         )
-        out[index] = found.x
+        out[index] = math.exp(found.x)
     return out if out.ndim else float(out)
 
 
-def _moving_impulse(m_f: float, k: float, k_m: float, F_s: float, a: float, v0: float) -> float:
-    return float(total_impulse(m_f, k, k_m, F_s, a, v0, "moving"))
+def _moving_log_impulse(m_f: float, k: float, k_m: float, F_s: float, a: float, log_v0: float) -> float:
+    impulse = float(total_impulse(m_f, k, k_m, F_s, a, math.exp(log_v0), "moving"))
+    if impulse < np.finfo(np.float64).tiny:  # below the normal floats: no digits left to minimise
+        raise InvalidParameter(
+            "the moving-robot impulse", impulse, "a result within the float64 range (above 2.2e-308)"
+        )
+    return math.log(impulse)
