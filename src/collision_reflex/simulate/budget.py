@@ -40,7 +40,7 @@ _SCALE_HINTS = {
 _PHASE_HINTS = {
     "approach until detection": "raise v0 or lower the detection threshold",
     "delay": "shorten the delay",
-    "reaction": "raise k_m or lower m_f (the watch lasts five periods of the finger on k_m)",
+    "reaction and watch": "raise k_m or lower m_f (the watch lasts five periods of the finger on k_m)",
 }
 
 
@@ -50,7 +50,7 @@ class Phase:
 
     Attributes
     ----------
-    name: ``"approach until detection"``, ``"delay"`` or ``"reaction"`` (with the watch for a new contact
+    name: ``"approach until detection"``, ``"delay"`` or ``"reaction and watch"`` (the watch for a new contact
         after it).
     span: its expected duration [s].
     step: the largest step its fastest time scale allows [s] (``inf`` if none).
@@ -95,7 +95,7 @@ def phases(setup: CollisionSetup) -> tuple[Phase, Phase, Phase]:
     return (
         Phase("approach until detection", spans[0], *_fastest(setup, approach), samples[0]),
         Phase("delay", spans[1], *_fastest(setup, approach), samples[1]),
-        Phase("reaction", spans[2], *_fastest(setup, reaction), samples[2]),
+        Phase("reaction and watch", spans[2], *_fastest(setup, reaction), samples[2]),
     )
 
 
@@ -113,12 +113,12 @@ def check_work(setup: CollisionSetup) -> None:
     worst = max(run, key=lambda phase: phase.steps)
     if worst.samples > worst.span / worst.step:
         why = (
-            f"the {worst.name} lasts {worst.span:.3g} s and the run stops at each of its "
+            f"the {worst.name} phase lasts {worst.span:.3g} s and the run stops at each of its "
             f"{worst.samples:.3g} control samples (control_rate = {setup.control_rate:g} Hz)"
         )
         change = _SCALE_HINTS["the control period"]
     else:
-        why = f"the {worst.name} lasts {worst.span:.3g} s while {worst.scale} limits the step to {worst.step:.3g} s"
+        why = f"the {worst.name} phase lasts {worst.span:.3g} s while {worst.scale} limits the step to {worst.step:.3g} s"
         ratio_phase = worst.span / _typical_span(setup)
         change = _PHASE_HINTS[worst.name] if ratio_phase > 1e3 else _SCALE_HINTS[worst.scale]
     raise SimulationError(
