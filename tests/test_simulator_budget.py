@@ -42,7 +42,7 @@ def test_hopeless_settings_are_refused_at_once(name: str) -> None:
 
 
 def test_ordinary_runs_stay_well_inside_the_budget() -> None:
-    # The shipped setups take ~150 steps; the estimate must not refuse them, nor be a vacuous bound.
+    # These take ~150 steps (4000 with the compliant wall); the estimate must not refuse them, nor be vacuous.
     for setup in (
         BASE,
         IMPEDANCE,
@@ -50,7 +50,7 @@ def test_ordinary_runs_stay_well_inside_the_budget() -> None:
         replace(BASE, contact_stiffness=1e6),
     ):
         steps = budget.estimated_steps(setup)
-        assert 50 < steps < setup.max_steps / 20
+        assert 50 < steps < setup.max_steps / 10
         cr.simulate_collision(setup)
 
 

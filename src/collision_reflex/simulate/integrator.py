@@ -12,13 +12,12 @@ import numpy as np
 
 from ..errors import SimulationError
 from ..model.impulse import collision_times
-from .budget import EVALUATIONS_PER_STEP, WATCH_PERIODS, check_work, reference_force
+from .budget import EVALUATIONS_PER_STEP, SEGMENT_STEPS, WATCH_PERIODS, check_work, reference_force
 from .dynamics import DEFL, ERR, IMP, LOSS, NSTATE, SURF, VF, VR, WORK, XF, HybridCollision
 from .result import SimulationResult
 from .setup import CollisionSetup, oscillation_period
 
 _TRACE_POINTS = 40  # interpolated trace points per integration segment
-_MAX_SEGMENTS = 100_000  # mode changes and control samples before a run is taken to chatter
 _MAX_REPEATS = 20  # one event at one instant, again and again, before the run is taken to be stuck
 
 
@@ -39,7 +38,7 @@ def simulate(setup: CollisionSetup) -> SimulationResult:
 
 
 class _OutOfBudget(Exception):
-    """The run has used up its budget of right-hand-side evaluations."""
+    """The run has used up its budget of steps (evaluations and segments, :func:`_Run.work`)."""
 
 
 def _default_duration(setup: CollisionSetup) -> float:
@@ -156,6 +155,7 @@ class _Run:
         self.last_event: tuple[float, str] = (math.nan, "")
         self.repeats = 0
         self.evaluations = 0
+        self.segments = 0
         self.samples = 0
         self.t = 0.0
         # The finger touches the wall at v0; the spring carries no force, with `play` still to take up.
@@ -177,16 +177,27 @@ class _Run:
         try:
             return self._segments()
         except _OutOfBudget:
+            modes = len(self.sim.events)
+            if modes > self.samples and SEGMENT_STEPS * modes > 0.2 * self.work():
+                why = "the contact chatters (the finger bounces, or a mode is entered and left over and over)"
+            elif SEGMENT_STEPS * self.samples > 0.2 * self.work():
+                why = "mostly control samples: lower control_rate"
+            else:
+                why = "a time scale far shorter than the run is in play (a stiff or non-smooth force, e.g. a saturated controller)"
             raise SimulationError(
                 f"the simulation used up its budget of max_steps = {self.setup.max_steps} integrator steps at "
-                f"t = {self.t:.3g} s of {self.duration:.3g} s ({len(self.sim.events)} mode changes, "
-                f"{self.samples} control samples); a time scale far shorter than the run is in play: raise "
+                f"t = {self.t:.3g} s of {self.duration:.3g} s ({self.evaluations / EVALUATIONS_PER_STEP:.3g} "
+                f"steps of integration, {modes} mode changes, {self.samples} control samples): {why}; raise "
                 "max_steps, or see collision_reflex.simulate.budget for what sets the steps"
             ) from None
 
+    def work(self) -> float:
+        """Steps used so far: right-hand-side evaluations over 12, plus the cost of each segment started."""
+        return self.evaluations / EVALUATIONS_PER_STEP + SEGMENT_STEPS * self.segments
+
     def _segments(self) -> SimulationResult:
         sim = self.sim
-        for _ in range(_MAX_SEGMENTS):
+        while True:
             self._react_if_due()
             if self._finished():
                 break
@@ -202,17 +213,6 @@ class _Run:
                 continue
             if self.t >= sample_time - self.tiny:
                 self._on_control_sample()
-        else:
-            modes = _MAX_SEGMENTS - self.samples
-            why = (
-                "a chattering contact"
-                if modes > self.samples
-                else "mostly control samples: lower control_rate"
-            )
-            raise SimulationError(
-                f"the simulation stopped {_MAX_SEGMENTS} times without ending ({modes} mode changes, "
-                f"{self.samples} control samples: {why})"
-            )
         return self._result()
 
     # -- what is due -----------------------------------------------------------------------------------------
@@ -293,11 +293,13 @@ class _Run:
         from scipy.integrate import solve_ivp  # here: SciPy's import time is paid only by a simulation
 
         sim = self.sim
-        budget = EVALUATIONS_PER_STEP * self.setup.max_steps
+        self.segments += 1
+        if self.work() > self.setup.max_steps:
+            raise _OutOfBudget
 
         def rhs(t: float, y: np.ndarray) -> np.ndarray:
             self.evaluations += 1
-            if self.evaluations > budget:
+            if self.evaluations % EVALUATIONS_PER_STEP == 0 and self.work() > self.setup.max_steps:
                 raise _OutOfBudget
             return sim.rhs(t, y)
 

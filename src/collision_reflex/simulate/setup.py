@@ -105,8 +105,9 @@ class CollisionSetup:
     rtol: relative tolerance of the integrator.
     max_steps: budget of integrator steps. A setup whose up-front estimate (its phases' spans over their
         fastest time scales, :mod:`collision_reflex.simulate.budget`) exceeds it is refused at once with what
-        to change; a run that uses it up (counted as 12 right-hand-side evaluations a step) stops with a
-        :class:`~collision_reflex.errors.SimulationError`. The default takes seconds to a minute at most.
+        to change; a run that uses it up (12 right-hand-side evaluations a step, 3 steps a control sample or
+        mode change) stops with a :class:`~collision_reflex.errors.SimulationError`. The default is about ten
+        seconds of work at most; ordinary collisions take a few hundred steps.
     """
 
     m_f: float
@@ -130,7 +131,7 @@ class CollisionSetup:
     duration: float | None = None
     max_step: float | None = None
     rtol: float = 1e-10
-    max_steps: int = 200_000
+    max_steps: int = 50_000
 
     def __post_init__(self) -> None:
         _validate.choice("drive", self.drive, DRIVES)
