@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 
 from collision_reflex.cli import main
-from collision_reflex.report.html import SOLVER_TOLERANCE, settled
+from collision_reflex.report.html import SOLVER_TOLERANCE, _settled_rows, settled
 from collision_reflex.report.pdf import find_browser
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -100,6 +100,18 @@ def test_solver_noise_is_settled_to_zero() -> None:
     assert settled(3.562e-15, 1.3) == 0.0  # a required torque beside a 1.3 N*m peak torque
     assert settled(-2e-5) == -2e-5 and settled(2e-5 * 1.3, 1.3) == 2e-5 * 1.3  # beyond the tolerance: kept
     assert settled("OPN-060-013-A", 1.3) == "OPN-060-013-A"
+
+
+def test_pareto_rows_settle_required_torques_and_margins() -> None:
+    row = {
+        "required_torque[j1] [N*m]": 3.562e-15,
+        "peak_torque[j1] [N*m]": 1.3,
+        "required_rms_torque[j1] [N*m]": 0.25,
+        "torque_margin[j1] [-]": 1.703e-06,
+        "speed_margin[j1] [-]": 0.0175,
+        "reflected_inertia[j1] [kg*m^2]": 2.2e-7,  # small, but a value: untouched
+    }
+    assert _settled_rows([row]) == [{**row, "required_torque[j1] [N*m]": 0.0, "torque_margin[j1] [-]": 0.0}]
 
 
 def test_printed_margins_and_torques_carry_no_solver_noise(reports: dict[str, Path]) -> None:

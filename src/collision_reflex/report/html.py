@@ -59,19 +59,25 @@ def settled(value: object, scale: object = 1.0) -> object:
 
 
 def _settled_rows(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """``pareto.csv``'s rows with each joint's required torques settled against its peak torque."""
+    """``pareto.csv``'s rows with the solver noise settled.
+
+    Each joint's required torques against its peak torque, and its margins (relative: against 1).
+    """
     settled_rows = []
     for row in rows:
         copy = dict(row)
         for column, value in row.items():
-            match = _REQUIRED.match(column)
-            if match:
-                copy[column] = settled(value, row.get(f"peak_torque[{match.group('joint')}] [N*m]"))
+            required = _REQUIRED.match(column)
+            if required:
+                copy[column] = settled(value, row.get(f"peak_torque[{required.group('joint')}] [N*m]"))
+            elif _MARGIN.match(column):
+                copy[column] = settled(value)
         settled_rows.append(copy)
     return settled_rows
 
 
 _REQUIRED = re.compile(r"^required_\w*torque\[(?P<joint>.+)\] \[N\*m\]$")
+_MARGIN = re.compile(r"^\w*margin\[.+\] \[-\]$")
 
 
 def _shown_path(value: str) -> str:
