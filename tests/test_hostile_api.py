@@ -221,3 +221,11 @@ def test_moving_optimum_is_finite_or_refused(exponents: list[float]) -> None:
         return
     assert 0 < v_opt <= cr.optimal_velocity(m_f, k, F_s) * (1 + 1e-12)
     assert math.isfinite(impulse) and impulse > 0
+
+
+@pytest.mark.parametrize(
+    ("change", "name"), [(dict(ipopt_options="max_iter=5"), "ipopt_options"), (dict(starts=True), "starts")]
+)
+def test_solve_refuses_wrong_types(small_problem: cr.DesignProblem, change: dict, name: str) -> None:
+    with pytest.raises(InvalidParameter, match=rf"^{name} = "):
+        cr.solve(small_problem, **change)

@@ -198,8 +198,10 @@ def solve(
     warm = x0 if isinstance(x0, DesignResult) and x0.multipliers is not None else None
     epsilon = _checked_epsilon(epsilon)
     start = np.clip(_start_point(problem, x0), problem.lbx, problem.ubx)
-    if not isinstance(starts, int) or starts < 1:
+    if isinstance(starts, bool) or not isinstance(starts, int) or starts < 1:
         raise InvalidParameter("starts", starts, "an integer >= 1")
+    if ipopt_options is not None and not isinstance(ipopt_options, Mapping):
+        raise InvalidParameter("ipopt_options", ipopt_options, "a mapping of IPOPT option name to value")
     if starts > 1:
         return _multi_start(problem, epsilon, x0, ipopt_options, starts, rng or np.random.default_rng(0))
     requested = {**DEFAULT_IPOPT_OPTIONS, **(ipopt_options or {})}
