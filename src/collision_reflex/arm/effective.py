@@ -91,7 +91,8 @@ def effective_parameters(
         pairing ``directions[s]`` with configuration ``config_index[s]``. Normalised here.
     reflected_inertia: ``N^2 J_m`` per joint [kg m^2], > 0 (scalar or (nv,)).
     stiffness: lumped joint stiffness (mechanical and software in series) [N m/rad], > 0, ``inf`` allowed.
-    mechanical_stiffness: joint mechanical stiffness [N m/rad], > 0, ``inf`` allowed.
+    mechanical_stiffness: joint mechanical stiffness [N m/rad], finite and > 0 (a rigid joint is a very stiff
+        one: the two-mass model needs a spring between finger and robot mass).
     torque_limit: largest output torque per joint [N m], > 0, ``inf`` allowed.
     config_index: (n_samples,) configuration of each paired sample; None for the grid.
     motor_mass: motor mass per joint [kg], added to the structure as ``sum_i m_i A_i``; None for none.
@@ -170,7 +171,9 @@ def _joint_arrays(
     return (
         joint_array("reflected_inertia", reflected_inertia, nv),
         joint_array("stiffness", stiffness, nv, allow_inf=True),
-        joint_array("mechanical_stiffness", mechanical_stiffness, nv, allow_inf=True),
+        # Finite: a rigid joint would join the finger and the robot mass into one body, which the two-mass
+        # collision does not describe (its impact would miss the robot mass).
+        joint_array("mechanical_stiffness", mechanical_stiffness, nv),
         joint_array("torque_limit", torque_limit, nv, allow_inf=True),
         None if joint_threshold is None else joint_array("joint_threshold", joint_threshold, nv),
     )

@@ -79,6 +79,9 @@ def run(args: argparse.Namespace) -> int:
             f"no usable trial among {len(results.rejected)} rejected trace(s); see the reasons above"
         )
     _print_trials(results)
+    for trial in results.trials:
+        for note in trial.fit.notes if trial.fit is not None else ():
+            print(f"crx fit: note: {trial.trace.source or trial.trace.label}: {note}", file=sys.stderr)
     _print_summary(results)
     if args.out is not None:
         _write_outputs(Path(args.out), results, figures=not args.no_figures)

@@ -95,14 +95,15 @@ class ExperimentResults:
                     row[f"model {name} [N*s]"] = float(getattr(phases, name))
                 row["k_m [N/m]"] = t.fit.k_m
                 row["fit rms [N]"] = t.fit.residual_rms
-            row["fit note"] = t.fit_problem
+            row["fit note"] = "; ".join([t.fit_problem] if t.fit is None else t.fit.notes)
             rows.append(row)
         return pd.DataFrame(rows)
 
     def one_shot_summary(self) -> Any:
         """Mean and standard deviation of each fitted parameter over the trials of each system.
 
-        As the paper's ``tab:one_shot`` (a pandas DataFrame, one row per system and parameter).
+        As the paper's ``tab:one_shot`` (a pandas DataFrame, one row per system and parameter). A parameter
+        that a trial's fit could not identify (infinite uncertainty) is left out of that parameter's mean.
         """
         import pandas as pd
 
@@ -110,7 +111,7 @@ class ExperimentResults:
         for system in self.systems:
             fits = [t.fit for t in self.trials if t.trace.system == system and t.fit is not None]
             for name in PARAMETERS:
-                values = np.array([getattr(f, name) for f in fits])
+                values = np.array([getattr(f, name) for f in fits if np.isfinite(f.stderr[name])])
                 rows.append(
                     {
                         "system": system,

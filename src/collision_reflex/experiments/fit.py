@@ -28,7 +28,12 @@ What the samples identify
 
 Uncertainties are one standard deviation from the Jacobian at the optimum, ``cov = s^2 (J^T J)^-1`` with
 ``s^2`` the residual variance, so a model that fits badly (e.g. a geared actuator with backlash) reports
-larger uncertainties. Parameters are fitted as logarithms (positive by construction, well scaled); their
+larger uncertainties. A direction of the parameters that the samples do not determine to within a factor
+``e`` (a singular value of ``J`` below ``s``; e.g. ``F_s`` and ``a`` when detection and the end of contact
+fall into one sampling interval) is not identifiable: each parameter along it gets an infinite uncertainty
+and a note, rather than the tiny one a pseudo-inverse would give by dropping that direction. A fit whose
+residual is far above the noise floor (:data:`RESIDUAL_LIMIT`) gets a note as well: the model does not
+describe the trace, and its parameters are not to be trusted. Parameters are fitted as logarithms (positive by construction, well scaled); their
 uncertainties are mapped back to linear units to first order. Phase-impulse uncertainties are propagated
 through :func:`collision_reflex.phase_impulses` the same way.
 """
@@ -49,6 +54,7 @@ from ..model.impulse import (
     PhaseImpulses,
     impact_pulse_duration,
     phase_impulses,
+    reaction_duration,
     series_stiffness,
 )
 from .sensor import SensorModel, model_samples
@@ -64,6 +70,15 @@ PAPER_SENSOR_STIFFNESS = 2e7
 """Stiffness of the paper's ATI Mini40 force sensor along the sensing direction [N/m] (its §Experiments)."""
 
 _PHASES = ("initial", "sensing", "reaction", "total")
+
+RESIDUAL_LIMIT = 1.5
+"""Residual rms over the noise floor's deviation beyond which a fit is noted as not describing the trace.
+
+The ratio of a good fit is 1 within ``1/sqrt(2 n)`` (``n`` samples, at least 20): 1.5 is well outside that."""
+
+_RESOLVED_SAMPLES = 2  # fewest sampling intervals a reaction must span for its curvature (a) to be seen
+# Largest uncertainty along a direction, in log units (a factor e), that counts as determined.
+_IDENTIFIED = 1.0
 
 
 @dataclass(frozen=True)
@@ -86,6 +101,8 @@ class OneShotFit:
     samples: number of samples fitted.
     phase_stderr: one-standard-deviation uncertainty of the phase impulses [N*s], keys ``initial``,
         ``sensing``, ``reaction``, ``total``.
+    notes: what to be wary of: parameters that are not identifiable (their ``stderr`` is ``inf``), a
+        residual far above the noise.
     """
 
     m_f: float
@@ -101,6 +118,7 @@ class OneShotFit:
     residual_rms: float = 0.0
     samples: int = 0
     phase_stderr: Mapping[str, float] = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         for name in (*PARAMETERS, "k_m", "v0"):
@@ -184,13 +202,14 @@ def fit_one_shot(
         impact_guess=start["impact_time"],
     )
     x0 = np.array([math.log(start[name]) for name in PARAMETERS] + [0.0, 0.0])
-    delay = 0.0 if bandwidth is None else sensor.sampling_rate / bandwidth  # filter delay, in samples
+    earliest, latest = _impact_range(trace, window, sensor, start["impact_time"])
     wide = math.log(1e3)  # parameters are searched within three decades of the initial guess
     offset = 10.0  # the floor's level is known from the pre-impact samples to far better than 10 sigma
-    half_range = np.array([wide, wide, wide, wide, 3.0 + 2.0 * delay, offset])
+    half_range = np.array([wide, wide, wide, wide, 0.0, offset])
     bounds = (x0 - half_range, x0 + half_range)
+    bounds[0][4], bounds[1][4] = earliest - 1.0, latest + 1.0
 
-    best = _plateau_ends(problem, _scanned_solve(problem, x0, bounds), bounds)
+    best = _plateau_ends(problem, _scanned_solve(problem, x0, bounds, (earliest, latest)), bounds)
     if not best.success:
         raise FitFailed(f"one-shot fit of {trace.source or trace.label}", best.message)
     return _fit_record(problem, best)
@@ -242,11 +261,39 @@ def _shifted(x: np.ndarray, shift: float) -> np.ndarray:
     return moved
 
 
-def _scanned_solve(problem: _Residuals, x0: np.ndarray, bounds: tuple[np.ndarray, np.ndarray]) -> Any:
-    """Scan the impact time (the other parameters at their guesses) and refine from the best phase."""
-    shifts = np.linspace(-1.5, 1.5, 61)  # the centroid guess is good to a fraction of a sample
-    scan = [float(np.sum(problem(_shifted(x0, shift)) ** 2)) for shift in shifts]
-    return _solve(problem, _shifted(x0, float(shifts[int(np.argmin(scan))])), bounds)
+def _impact_range(
+    trace: Trace, window: ContactWindow, sensor: SensorModel, guess: float
+) -> tuple[float, float]:
+    """Earliest and latest impact time the samples allow, as shifts from ``guess`` [samples].
+
+    The impact follows the last sample at the floor before the contact (less the filter's delay, by which
+    the filtered rise lags) and precedes the first sample above the contact threshold.
+    """
+    period = sensor.period
+    first = window.start + int(np.argmax(trace.force[window.slice] > window.threshold))
+    delay = 0.0 if sensor.bandwidth is None else 2 * sensor.sampling_rate / sensor.bandwidth
+    earliest = (float(trace.time[window.start]) - guess) / period - 1.0 - delay
+    latest = (float(trace.time[first]) - guess) / period
+    return min(earliest, -1.5), max(latest, 1.5)
+
+
+def _scanned_solve(
+    problem: _Residuals, x0: np.ndarray, bounds: tuple[np.ndarray, np.ndarray], shifts: tuple[float, float]
+) -> Any:
+    """Scan the impact time over ``shifts`` [samples] (the other parameters at their guesses) and refine.
+
+    The refinement starts from the scan's best point and from the centroid guess; the better fit wins. A
+    centroid guess can be samples off when the pulse is resolved, so the scan covers every impact time the
+    samples allow (:func:`_impact_range`), not just a neighbourhood of the guess.
+    """
+    grid = np.arange(shifts[0], shifts[1] + 0.05, 0.05)  # a twentieth of a sample
+    scan = [float(np.sum(problem(_shifted(x0, shift)) ** 2)) for shift in grid]
+    best = _solve(problem, _shifted(x0, float(grid[int(np.argmin(scan))])), bounds)
+    if abs(float(grid[int(np.argmin(scan))])) > 1.0:
+        from_guess = _solve(problem, x0, bounds)
+        if from_guess.cost < best.cost:
+            best = from_guess
+    return best
 
 
 def _plateau_ends(problem: _Residuals, best: Any, bounds: tuple[np.ndarray, np.ndarray]) -> Any:
@@ -279,14 +326,19 @@ def _fit_record(problem: _Residuals, best: Any) -> OneShotFit:
     """The fit's record: values at the optimum, uncertainties from the Jacobian (module docstring)."""
     n, p = problem.times.size, best.x.size
     residual_variance = 2 * best.cost / max(n - p, 1)
-    jac = best.jac
-    covariance = np.linalg.pinv(jac.T @ jac) * residual_variance
+    covariance, unidentified = _covariance(best.jac, residual_variance)
     m_f, k_s, F_s, a, t0 = problem.unpack(best.x)
+    # Within a couple of samples the reaction shows only as an area that trades with the ramp's last sample:
+    # its curvature (a) is not seen, whatever the local Jacobian says about the fit found.
+    unidentified[3] |= _reaction_time(problem, F_s, a) < _RESOLVED_SAMPLES * problem.sensor.period
     log_stderr = np.sqrt(np.clip(np.diag(covariance), 0.0, None))
+    log_stderr[unidentified] = math.inf
     stderr = {
         name: value * s for name, value, s in zip(PARAMETERS, (m_f, k_s, F_s, a), log_stderr, strict=False)
     }
     stderr["impact_time"] = float(log_stderr[4] * problem.sensor.period)
+    residual_rms = float(np.sqrt(2 * best.cost / n)) * problem.sigma
+    names = [name for name, bad in zip((*PARAMETERS, "impact_time"), unidentified, strict=False) if bad]
     return OneShotFit(
         m_f=m_f,
         k_s=k_s,
@@ -298,10 +350,59 @@ def _fit_record(problem: _Residuals, best: Any) -> OneShotFit:
         v0=problem.v0,
         sensor=problem.sensor,
         reaction=problem.reaction,
-        residual_rms=float(np.sqrt(2 * best.cost / n)) * problem.sigma,
+        residual_rms=residual_rms,
         samples=n,
-        phase_stderr=_phase_stderr(best.x, covariance, problem.k_m, problem.v0, problem.reaction),
+        phase_stderr=_phase_stderr(
+            best.x, covariance, unidentified, problem.k_m, problem.v0, problem.reaction
+        ),
+        notes=_notes(problem, names, residual_rms, F_s, a),
     )
+
+
+def _covariance(jac: np.ndarray, residual_variance: float) -> tuple[np.ndarray, np.ndarray]:
+    """Covariance of the fit's vector over its determined directions, and which entries are not identifiable.
+
+    From the singular values ``s_i`` of the Jacobian (in noise units): the uncertainty along direction ``i``
+    is ``sqrt(residual_variance) / s_i``; a direction beyond :data:`_IDENTIFIED` is not determined, and every
+    entry with a share of it (a component above 0.1) is not identifiable.
+    """
+    _, singular, vt = np.linalg.svd(jac, full_matrices=False)
+    with np.errstate(divide="ignore"):
+        spread = np.sqrt(residual_variance) / singular
+    determined = spread <= _IDENTIFIED
+    v = vt.T
+    covariance = (v[:, determined] * spread[determined] ** 2) @ v[:, determined].T
+    unidentified = np.any(np.abs(v[:, ~determined]) > 0.1, axis=1)
+    return covariance, unidentified
+
+
+def _reaction_time(problem: _Residuals, F_s: float, a: float) -> float:
+    """The fitted model's reaction time ``t2 - t1`` [s] (the robot moving at ``v0`` for ``"moving"``)."""
+    v_r = problem.v0 if problem.reaction == "moving" else 0.0
+    return float(reaction_duration(F_s, problem.k_m, a, v_r))
+
+
+def _notes(
+    problem: _Residuals, unidentified: list[str], residual_rms: float, F_s: float, a: float
+) -> tuple[str, ...]:
+    """What the fit's user must know: unidentifiable parameters, a residual far above the noise."""
+    notes = []
+    if unidentified:
+        why = "the samples determine only a combination of them, or nothing of them"
+        reaction = _reaction_time(problem, F_s, a)
+        if {"F_s", "a"} & set(unidentified) and reaction < _RESOLVED_SAMPLES * problem.sensor.period:
+            why = (
+                f"the fitted reaction lasts {reaction:.2g} s, under {_RESOLVED_SAMPLES} sampling intervals of "
+                f"{problem.sensor.period:.2g} s: detection and the end of contact share a sample or two"
+            )
+        notes.append(f"not identifiable: {', '.join(unidentified)} ({why}); their uncertainty is infinite")
+    ratio = residual_rms / problem.sigma
+    if problem.sigma > 0 and ratio > RESIDUAL_LIMIT:
+        notes.append(
+            f"residual rms {residual_rms:.3g} N is {ratio:.1f} times the noise floor's {problem.sigma:.3g} N: "
+            "the model does not describe this trace; do not trust its parameters"
+        )
+    return tuple(notes)
 
 
 def _sensor_for(trace: Trace, bandwidth: float | None) -> SensorModel:
@@ -388,9 +489,12 @@ def _filter_delay(sensor: SensorModel) -> float:
 
 
 def _phase_stderr(
-    x: np.ndarray, covariance: np.ndarray, k_m: float, v0: float, reaction: str
+    x: np.ndarray, covariance: np.ndarray, unidentified: np.ndarray, k_m: float, v0: float, reaction: str
 ) -> dict[str, float]:
-    """First-order propagation of the (log-)parameter covariance through the phase impulses."""
+    """First-order propagation of the (log-)parameter covariance through the phase impulses.
+
+    A phase that depends on a parameter that is not identifiable has an infinite uncertainty.
+    """
 
     def phases(xx: np.ndarray) -> np.ndarray:
         m_f, k_s, F_s, a = np.exp(xx[:4])
@@ -405,4 +509,7 @@ def _phase_stderr(
         down[j] -= step
         gradient[:, j] = (phases(up) - phases(down)) / (2 * step)
     variance = np.einsum("ij,jk,ik->i", gradient, covariance, gradient)
+    # A dependence below a millionth (relative) of the phase is no dependence (central-difference noise).
+    depends = np.abs(gradient[:, unidentified]) > 1e-6 * np.abs(phases(x))[:, None]
+    variance[np.any(depends, axis=1)] = math.inf
     return {name: float(np.sqrt(max(v, 0.0))) for name, v in zip(_PHASES, variance, strict=True)}

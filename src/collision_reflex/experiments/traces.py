@@ -223,7 +223,7 @@ def read_traces(
         raise TraceError(source, "", "no header line and no samples")
     table = _read_table(lines, header_line, source)
     file_lines = np.arange(len(table)) + header_line + 2  # header is line header_line + 1
-    columns = {HEADER.match(str(c)).group("name").lower(): str(c) for c in table.columns}  # type: ignore[union-attr]
+    columns = _column_names(table, header_line + 1, source)
     time, force = _samples(table, columns, time_unit, force_unit, source)
 
     default_system = system if system is not None else Path(path).resolve().parent.name
@@ -265,6 +265,23 @@ def read_traces(
             )
         )
     return traces
+
+
+def _column_names(table: pd.DataFrame, line: int, source: str) -> dict[str, str]:
+    """Lower-case column name (its unit left out) -> the header as written; a malformed header is refused."""
+    columns = {}
+    for header in map(str, table.columns):
+        match = HEADER.match(header)
+        if match is None:
+            shown = header if len(header) <= 40 else header[:37] + "..."
+            raise TraceError(
+                source,
+                "",
+                f"column header {shown!r} is not a name with an optional unit in brackets, e.g. 'time [ms]'",
+                line,
+            )
+        columns[match.group("name").lower()] = header
+    return columns
 
 
 def _leading_metadata(lines: list[str]) -> tuple[dict[str, str], int]:

@@ -1,8 +1,13 @@
 """The contact window of a trace: noise floor from the pre-impact samples, first rise, return to the floor.
 
 The noise floor (level and standard deviation) is estimated from the samples before the contact. To find
-them without knowing the contact, a robust first guess (median and median absolute deviation of the first
-quarter of the trace) locates the first rise; the floor is then re-estimated from the samples before it.
+them without knowing the contact, a robust first guess locates the first rise: the trace is cut into short
+blocks, and the blocks whose median lies within a few noise deviations of the lowest one are taken to be
+free of contact (a contact only adds force; the noise deviation is the median of the blocks' robust
+spreads, since most blocks are either at the floor or on a slow ramp). Their pooled median and median
+absolute deviation are the guess, wherever those blocks lie: before the impact, after the contact, or both.
+A slow approach, whose ramp fills most of the trace, no longer passes for the floor. The floor is then
+re-estimated from the samples before the first rise.
 The contact runs from the first sample above ``level + n_sigma * sigma`` to the last one, and is widened on
 each side until the force is back at the floor's level, so the rising and falling edges are integrated too.
 Samples inside the contact that dip below the threshold (after a short impact pulse the sensing ramp starts
@@ -92,9 +97,7 @@ def find_contact(trace: Trace, n_sigma: float = 5.0, clip_run: int = 3) -> Conta
     trace.check()
     force = trace.force
     n = force.size
-    guess = force[: max(MIN_BASELINE_SAMPLES, n // 4)]
-    level = float(np.median(guess))
-    spread = _MAD_TO_SIGMA * float(np.median(np.abs(guess - level)))
+    level, spread = _quiet_floor(force)
     first = _first_rise(force, level, n_sigma * spread, force.max())
     if first is None:
         trace.fail(
@@ -129,6 +132,19 @@ def find_contact(trace: Trace, n_sigma: float = 5.0, clip_run: int = 3) -> Conta
         )
     # Include the first sample back at the floor on each side, so the edges are integrated to the floor.
     return ContactWindow(max(start - 1, 0), stop + 1, floor, threshold)
+
+
+def _quiet_floor(force: np.ndarray) -> tuple[float, float]:
+    """A robust first guess of the floor's level and noise deviation [N], from the blocks free of contact."""
+    size = 2 * MIN_BASELINE_SAMPLES
+    count = max(force.size // size, 1)
+    blocks = force[: count * size].reshape(count, -1) if force.size >= size else force[None, :]
+    medians = np.median(blocks, axis=1)
+    spreads = _MAD_TO_SIGMA * np.median(np.abs(blocks - medians[:, None]), axis=1)
+    noise = float(np.median(spreads))
+    quiet = blocks[medians <= medians.min() + 3 * noise].ravel()
+    level = float(np.median(quiet))
+    return level, _MAD_TO_SIGMA * float(np.median(np.abs(quiet - level)))
 
 
 def _margin(noise: float, peak: float) -> float:

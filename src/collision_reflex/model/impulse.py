@@ -13,11 +13,19 @@ joined by a spring, move at ``v0`` into a rigid constraint. The impulse transfer
 Every function here accepts floats, NumPy arrays (broadcast against each other) and CasADi ``SX``/``MX``
 symbols alike, from one implementation. Units are SI throughout: masses [kg], stiffnesses [N/m], forces [N],
 accelerations [m/s^2], velocities [m/s], times [s], impulses [N*s].
+
+Supported range of numeric inputs: any finite positive number (integers and integer arrays are converted to
+float64 first; strings, booleans and complex numbers are refused with :class:`InvalidParameter`). A result is
+computed without intermediate overflow or underflow wherever it is representable: where the direct formula
+overflows, it is evaluated from logarithms instead. A result beyond the float64 range (about ``1.8e308``)
+raises :class:`InvalidParameter`; one below the smallest float64 (about ``5e-324``) is 0. None is ever NaN.
 """
 
 from __future__ import annotations
 
 import functools
+import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -85,8 +93,15 @@ def phase_impulses(
         (an ideally velocity-controlled robot mass).
     """
     m_f, k, k_m, F_s, a, v0, v_r = _checked(m_f, k, k_m, F_s, a, v0, reaction, v_r)
-    initial = m_f * v0
-    sensing = F_s**2 / (2 * k * v0)
+    initial = _representable(
+        "the impact impulse m_f v0", (m_f, v0), lambda: m_f * v0, lambda: np.log(m_f) + np.log(v0)
+    )
+    sensing = _representable(
+        "the sensing impulse F_s^2 / (2 k v0)",
+        (F_s, k, v0),
+        lambda: F_s**2 / (2 * k * v0),
+        lambda: 2 * np.log(F_s) - np.log(2.0) - np.log(k) - np.log(v0),
+    )
     _, reaction_impulse = _reaction_phase(F_s, k_m, a, v_r)
     return PhaseImpulses(initial, sensing, reaction_impulse)
 
@@ -95,7 +110,7 @@ def total_impulse(
     m_f: Any, k: Any, k_m: Any, F_s: Any, a: Any, v0: Any, reaction: str = "at_rest", v_r: Any = None
 ) -> Any:
     """Collision-reflex metric ``I = I1 + I2 + I3`` [N*s]; arguments as :func:`phase_impulses`."""
-    return phase_impulses(m_f, k, k_m, F_s, a, v0, reaction, v_r).total
+    return _finite("the total impulse", phase_impulses(m_f, k, k_m, F_s, a, v0, reaction, v_r).total)
 
 
 def collision_times(
@@ -106,9 +121,9 @@ def collision_times(
     Arguments as :func:`phase_impulses`.
     """
     m_f, k, k_m, F_s, a, v0, v_r = _checked(m_f, k, k_m, F_s, a, v0, reaction, v_r)
-    t1 = F_s / (k * v0)  # eq:t1def
+    t1 = _detection_time(F_s, k, v0)
     duration, _ = _reaction_phase(F_s, k_m, a, v_r)
-    return t1, t1 + duration
+    return t1, _finite("the end of contact t2", t1 + duration)
 
 
 def velocity_coefficients(m_f: Any, k: Any, k_m: Any, F_s: Any, a: Any) -> tuple[Any, Any, Any]:
@@ -133,9 +148,13 @@ def optimal_velocity(
     (bounded scalar minimisation per element, numeric inputs only) and needs ``k_m`` and ``a``.
     """
     _validate.choice("reaction", reaction, REACTION_MODES)
-    for name, value in (("m_f", m_f), ("k", k), ("F_s", F_s)):
-        _validate.positive(name, value)
-    v_star = F_s / sqrt(2 * k * m_f)
+    m_f, k, F_s = (_validate.positive(name, value) for name, value in (("m_f", m_f), ("k", k), ("F_s", F_s)))
+    v_star = _representable(
+        "the optimal velocity F_s / sqrt(2 k m_f)",
+        (F_s, k, m_f),
+        lambda: F_s / sqrt(2 * k * m_f),
+        lambda: np.log(F_s) - (np.log(2.0) + np.log(k) + np.log(m_f)) / 2,
+    )
     if reaction == "at_rest":
         return v_star
     if k_m is None or a is None:
@@ -148,6 +167,13 @@ def optimal_velocity(
             reaction,
             "'at_rest' for symbolic arguments",
             "the moving-robot optimum has no closed form; use numeric values",
+        )
+    k_m, a = _validate.positive("k_m", k_m), _validate.positive("a", a)
+    if np.any(np.asarray(v_star) < np.finfo(np.float64).tiny):
+        raise InvalidParameter(
+            "the optimal velocity F_s / sqrt(2 k m_f)",
+            v_star,
+            "a result within the float64 range (above 2.2e-308)",
         )
     return _moving_optimum(m_f, k, k_m, F_s, a, v_star)
 
@@ -164,9 +190,14 @@ def minimum_impulse(m_f: Any, k: Any, k_m: Any, F_s: Any, a: Any, reaction: str 
         v_opt = optimal_velocity(m_f, k, F_s, "moving", k_m, a)
         return total_impulse(m_f, k, k_m, F_s, a, v_opt, "moving")
     m_f, k, k_m, F_s, a, _, _ = _checked(m_f, k, k_m, F_s, a, 1.0, reaction, None)
-    omega_s = sqrt(k / m_f)
+    sensing = _representable(
+        "the sensing-and-impact impulse sqrt(2) F_s / w_s",
+        (F_s, k, m_f),
+        lambda: np.sqrt(2.0) * F_s / sqrt(k / m_f),  # w_s = sqrt(k / m_f)
+        lambda: np.log(2.0) / 2 + np.log(F_s) - (np.log(k) - np.log(m_f)) / 2,
+    )
     _, reaction_impulse = _reaction_phase(F_s, k_m, a, 0.0)
-    return np.sqrt(2.0) * F_s / omega_s + reaction_impulse
+    return _finite("the minimum impulse", sensing + reaction_impulse)
 
 
 def force_profile(
@@ -184,7 +215,7 @@ def force_profile(
     """
     m_f, k, k_m, F_s, a, v0, v_r = _checked(m_f, k, k_m, F_s, a, v0, reaction, v_r)
     omega = sqrt(k_m / m_f)
-    t1 = F_s / (k * v0)
+    t1 = _detection_time(F_s, k, v0)
     duration, _ = _reaction_phase(F_s, k_m, a, v_r)
     tau = t - t1
     pulse_end = impact_pulse_duration(m_f, k_m)
@@ -219,7 +250,8 @@ def reaction_duration(F_s: Any, k_m: Any, a: Any, v_r: Any = 0.0) -> Any:
     accelerating away at ``a`` [m/s^2] from a velocity ``v_r`` [m/s] toward the constraint (0: the paper's
     robot at rest, ``sqrt(2 F_s / (a k_m))``).
     """
-    duration, _ = _reaction_phase(F_s, k_m, a, v_r)
+    F_s, k_m, a = (_validate.positive(name, value) for name, value in (("F_s", F_s), ("k_m", k_m), ("a", a)))
+    duration, _ = _reaction_phase(F_s, k_m, a, _validate.non_negative("v_r", v_r))
     return duration
 
 
@@ -228,13 +260,96 @@ def _reaction_phase(F_s: Any, k_m: Any, a: Any, v_r: Any) -> tuple[Any, Any]:
 
     The spring starts compressed by ``x1 = F_s/k_m`` and the robot mass moves toward the constraint at ``v_r``
     while accelerating away at ``a``: compression ``x1 + v_r tau - a tau^2/2``, zero at
-    ``tau_e = (v_r + sqrt(v_r^2 + 2 a x1)) / a``. With ``v_r = 0`` this is the paper's ``eq:reaction``:
-    ``tau_e = sqrt(2 F_s/(a k_m))`` and ``I3 = sqrt(8 F_s^3 / (9 a k_m))``.
+    ``tau_e = (v_r + sqrt(v_r^2 + 2 a x1)) / a``, impulse ``k_m (x1 tau_e + v_r tau_e^2/2 - a tau_e^3/6)``.
+    With ``v_r = 0`` this is the paper's ``eq:reaction``: ``tau_e = tau_0 = sqrt(2 F_s/(a k_m))`` and
+    ``I3 = sqrt(8 F_s^3 / (9 a k_m))``.
+
+    Written in the scale-free velocity ``r = v_r / (a tau_0)``, with ``g = r + sqrt(1 + r^2)`` (so that
+    ``g^2 = 2 r g + 1``): ``tau_e = tau_0 g`` and ``I3 = F_s tau_0 (2 g (1 + r^2) + r) / 3``, a sum of positive
+    terms that cannot cancel, whatever the velocity.
     """
-    x1 = F_s / k_m
-    duration = (v_r + sqrt(v_r**2 + 2 * a * x1)) / a
-    impulse = k_m * (x1 * duration + v_r * duration**2 / 2 - a * duration**3 / 6)
+
+    def direct() -> tuple[Any, Any]:
+        tau_0 = sqrt(2 * F_s / (a * k_m))
+        r = v_r / (a * tau_0)
+        g = r + sqrt(1 + r**2)
+        return tau_0 * g, F_s * tau_0 * (2 * g * (1 + r**2) + r) / 3
+
+    if is_symbolic(F_s, k_m, a, v_r):
+        return direct()
+    inputs = (F_s, k_m, a, v_r)
+    logs = functools.cache(lambda: _reaction_logarithms(F_s, k_m, a, v_r))
+    duration = _representable("the reaction time", inputs, lambda: direct()[0], lambda: logs()[0])
+    impulse = _representable("the reaction impulse", inputs, lambda: direct()[1], lambda: logs()[1])
     return duration, impulse
+
+
+def _reaction_logarithms(F_s: Any, k_m: Any, a: Any, v_r: Any) -> tuple[Any, Any]:
+    """Logarithms of the reaction's duration and impulse, from the inputs' logarithms (no overflow)."""
+    log_tau_0 = (np.log(2.0) + np.log(F_s) - np.log(a) - np.log(k_m)) / 2
+    log_r = np.log(v_r) - np.log(a) - log_tau_0  # -inf for v_r = 0
+    log_1r2 = np.logaddexp(0.0, 2 * log_r)  # ln(1 + r^2)
+    log_g = np.logaddexp(log_r, log_1r2 / 2)  # ln(r + sqrt(1 + r^2))
+    log_bracket = np.logaddexp(np.log(2.0) + log_g + log_1r2, log_r) - np.log(3.0)
+    return log_tau_0 + log_g, np.log(F_s) + log_tau_0 + log_bracket
+
+
+def _detection_time(F_s: Any, k: Any, v0: Any) -> Any:
+    """Detection time ``t1 = F_s / (k v0)`` (``eq:t1def``) [s]."""
+    return _representable(
+        "the detection time F_s / (k v0)",
+        (F_s, k, v0),
+        lambda: F_s / (k * v0),
+        lambda: np.log(F_s) - np.log(k) - np.log(v0),
+    )
+
+
+_LOG_MAX = float(np.log(np.finfo(np.float64).max))
+_EVERYDAY = (1e-25, 1e25)
+"""Inputs within this range (or 0) keep every intermediate of the direct formulas (products of at most a few
+such factors and their square roots) far from overflow to inf and from underflow into subnormals, where
+digits are lost silently; the direct form is then exact to a few ulps."""
+
+
+def _representable(
+    what: str, inputs: tuple[Any, ...], direct: Callable[[], Any], logarithm: Callable[[], Any]
+) -> Any:
+    """``direct()`` where ``inputs`` are everyday values and it is finite, else ``exp(logarithm())``.
+
+    A symbolic ``direct()`` is returned as it is; a result beyond the float64 range raises
+    :class:`InvalidParameter` naming ``what``. The logarithmic form is accurate to about ``|ln x|`` ulps.
+    """
+    if is_symbolic(*inputs):
+        return direct()
+    with np.errstate(over="ignore", under="ignore", invalid="ignore", divide="ignore"):
+        try:
+            value = direct()
+        except (ZeroDivisionError, OverflowError):  # Python floats raise where NumPy's give inf
+            value = np.full(np.shape(logarithm()), np.nan)
+        value = np.asarray(value, dtype=float)
+        bad = ~np.isfinite(value)
+        for x in inputs:
+            x = np.asarray(x, dtype=float)
+            bad = bad | ~((x == 0) | ((x >= _EVERYDAY[0]) & (x <= _EVERYDAY[1])))
+        if np.any(bad):
+            logs = np.broadcast_to(np.asarray(logarithm(), dtype=float), value.shape)
+            if np.any(logs[bad] > _LOG_MAX) or np.any(np.isnan(logs[bad])):
+                exponent = float(np.max(logs[bad])) / np.log(10.0)
+                raise InvalidParameter(
+                    what,
+                    math.inf,
+                    "a result within the float64 range (below 1.8e308)",
+                    f"it would be about 1e{exponent:.0f}; see collision_reflex.model.impulse for the inputs' range",
+                )
+            value = np.where(bad, np.exp(logs), value)
+    return value if value.ndim else float(value)
+
+
+def _finite(what: str, value: Any) -> Any:
+    """``value`` if it is symbolic or finite; else :class:`InvalidParameter` (a sum beyond the float64 range)."""
+    if not is_symbolic(value) and not np.all(np.isfinite(value)):
+        raise InvalidParameter(what, value, "a result within the float64 range (below 1.8e308)")
+    return value
 
 
 def _checked(
@@ -242,8 +357,8 @@ def _checked(
 ) -> tuple[Any, Any, Any, Any, Any, Any, Any]:
     """Validate the model's inputs and resolve ``v_r`` from the reaction mode."""
     _validate.choice("reaction", reaction, REACTION_MODES)
-    for name, value in (("m_f", m_f), ("k", k), ("k_m", k_m), ("F_s", F_s), ("a", a), ("v0", v0)):
-        _validate.positive(name, value)
+    inputs = (("m_f", m_f), ("k", k), ("k_m", k_m), ("F_s", F_s), ("a", a), ("v0", v0))
+    m_f, k, k_m, F_s, a, v0 = (_validate.positive(name, value) for name, value in inputs)
     if reaction == "at_rest":
         if v_r is not None:
             raise InvalidParameter(
@@ -253,26 +368,36 @@ def _checked(
     elif v_r is None:
         v_r = v0
     else:
-        _validate.non_negative("v_r", v_r)
+        v_r = _validate.non_negative("v_r", v_r)
     return m_f, k, k_m, F_s, a, v0, v_r
 
 
 def _moving_optimum(m_f: Any, k: Any, k_m: Any, F_s: Any, a: Any, v_star: Any) -> Any:
-    """Minimise ``I(v0)`` with the moving-robot reaction (``v_r = v0``) per element on ``(0, v*]``."""
+    """Minimise ``I(v0)`` with the moving-robot reaction (``v_r = v0``) per element on ``(0, v*]``.
+
+    The search runs on ``ln v0`` and ``ln I``: scale-free, so that it neither overflows nor loses digits
+    whatever the magnitudes (the minimiser is the same).
+    """
     from scipy.optimize import minimize_scalar
 
     args = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (m_f, k, k_m, F_s, a, v_star)))
     out = np.empty(args[0].shape)
     for index in np.ndindex(out.shape):
         mf_i, k_i, km_i, fs_i, a_i, vs_i = (float(x[index]) for x in args)
-        impulse = functools.partial(_moving_impulse, mf_i, k_i, km_i, fs_i, a_i)
+        log_impulse = functools.partial(_moving_log_impulse, mf_i, k_i, km_i, fs_i, a_i)
         # The reaction impulse grows with v_r = v0, so the optimum is below the at-rest v*; I -> inf as v0 -> 0.
+        top = math.log(vs_i)
         found = minimize_scalar(
-            impulse, bounds=(1e-6 * vs_i, vs_i), method="bounded", options={"xatol": 1e-12 * vs_i}
+            log_impulse, bounds=(top + math.log(1e-6), top), method="bounded", options={"xatol": 1e-12}
         )
-        out[index] = found.x
+        out[index] = math.exp(found.x)
     return out if out.ndim else float(out)
 
 
-def _moving_impulse(m_f: float, k: float, k_m: float, F_s: float, a: float, v0: float) -> float:
-    return float(total_impulse(m_f, k, k_m, F_s, a, v0, "moving"))
+def _moving_log_impulse(m_f: float, k: float, k_m: float, F_s: float, a: float, log_v0: float) -> float:
+    impulse = float(total_impulse(m_f, k, k_m, F_s, a, math.exp(log_v0), "moving"))
+    if impulse < np.finfo(np.float64).tiny:  # below the normal floats: no digits left to minimise
+        raise InvalidParameter(
+            "the moving-robot impulse", impulse, "a result within the float64 range (above 2.2e-308)"
+        )
+    return math.log(impulse)

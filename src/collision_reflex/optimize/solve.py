@@ -10,6 +10,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from .. import _validate
 from ..errors import InvalidParameter, SolverFailed, Violation
 from .constraints import STATIC_REQUIREMENT
 from .duty import duty_values
@@ -220,14 +221,16 @@ def solve(
         attempt's status, when no attempt converged although the problem is feasible (or undecided).
     """
     warm = x0 if isinstance(x0, DesignResult) and x0.multipliers is not None else None
-    if not isinstance(starts, int) or starts < 1:
+    epsilon = _checked_epsilon(epsilon)
+    start = np.clip(_start_point(problem, x0), problem.lbx, problem.ubx)
+    if isinstance(starts, bool) or not isinstance(starts, int) or starts < 1:
         raise InvalidParameter("starts", starts, "an integer >= 1")
+    if ipopt_options is not None and not isinstance(ipopt_options, Mapping):
+        raise InvalidParameter("ipopt_options", ipopt_options, "a mapping of IPOPT option name to value")
     if starts > 1:
         return _multi_start(problem, epsilon, x0, ipopt_options, starts, rng or np.random.default_rng(0))
     requested = {**DEFAULT_IPOPT_OPTIONS, **(ipopt_options or {})}
     parameters = problem.parameters(epsilon)
-    point = x0.x if isinstance(x0, DesignResult) else x0
-    start = np.clip(problem.x0 if point is None else np.asarray(point, dtype=float), problem.lbx, problem.ubx)
     attempts = _Attempts(problem, parameters)
     found = attempts.run("requested", {**requested, **(WARM_START_OPTIONS if warm else {})}, start, warm)
     tried = set() if warm else {(repr(sorted(requested.items())), start.tobytes())}
@@ -372,6 +375,34 @@ def _advice(violations: tuple[Violation, ...]) -> str:
     """What to change, for the kinds of constraints in ``violations``."""
     hints = [hint for key, hint in ADVICE.items() if any(key in v.label for v in violations)]
     return ("To meet them: " + "; ".join(hints) + ".") if hints else "Widen the bounds."
+
+
+def _checked_epsilon(epsilon: Mapping[str, float] | None) -> dict[str, float] | None:
+    """``epsilon`` with every bound a finite number; NaN, infinities and non-numbers refused."""
+    if epsilon is None:
+        return None
+    if not isinstance(epsilon, Mapping):
+        raise InvalidParameter("epsilon", epsilon, "a mapping of objective name to bound")
+    checked = {}
+    for name, bound in epsilon.items():
+        allowed = "a finite number (leave the objective out for no bound)"
+        value = _validate.real(f"epsilon[{name!r}]", bound, allowed)
+        if value.ndim or not np.isfinite(value):
+            raise InvalidParameter(f"epsilon[{name!r}]", bound, allowed)
+        checked[name] = float(value)
+    return checked
+
+
+def _start_point(problem: DesignProblem, x0: np.ndarray | DesignResult | None) -> np.ndarray:
+    """The start point in the NLP's variables: ``x0`` (or its point) checked, or the problem's own."""
+    if x0 is None:
+        return problem.x0
+    point = x0.x if isinstance(x0, DesignResult) else x0
+    allowed = f"{problem.x0.size} finite numbers (the NLP's variables), a DesignResult, or None"
+    array = _validate.real("x0", point, allowed)
+    if array.shape != problem.x0.shape or not np.all(np.isfinite(array)):
+        raise InvalidParameter("x0", point, allowed)
+    return array
 
 
 def _multi_start(

@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
+
+import numpy as np
 
 from ..errors import InvalidParameter
 
@@ -15,6 +18,21 @@ OPTIMIZED_SENSING_SCHEMES: tuple[str, ...] = ("force", "position")
 contact-force threshold ``F_s`` [N] or a contact-point position-error threshold ``e_th`` [m] with
 ``F_s = k(u) e_th``. A motor-current threshold (``"current"``) makes the contact threshold a minimum over joints,
 which is evaluated but not optimised."""
+
+
+SUPPORTED_RANGES: dict[str, tuple[float, float]] = {
+    "stator_diameter": (1e-6, 1e3),
+    "stack_length": (1e-6, 1e3),
+    "gear_ratio": (1.0, 1e6),
+    "software_stiffness": (1e-9, 1e12),
+    "threshold": (1e-12, 1e12),
+    "approach_velocity": (1e-9, 1e6),
+}
+"""Range of each design variable that the model evaluates without overflow [its SI unit].
+
+The motor and gearbox scaling laws raise the diameter to the fourth power and the gear ratio to the second,
+and the problem's scaling takes logarithms; bounds outside these (far wider than any actuator) are refused.
+The study files' physical ranges are narrower still."""
 
 
 @dataclass(frozen=True)
@@ -31,7 +49,7 @@ class Bounds:
 
     def __post_init__(self) -> None:
         for side, value in (("lower", self.lower), ("upper", self.upper)):
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            if not (_is_number(value) and math.isfinite(value) and value > 0):
                 raise InvalidParameter(f"{self.name} {side} bound", value, "a finite number > 0")
         if self.lower > self.upper:
             raise InvalidParameter(
@@ -61,11 +79,26 @@ def as_bounds(value: BoundsLike, name: str) -> Bounds:
     """A ``Bounds`` from bounds, a ``(lower, upper)`` pair, or a number (fixed)."""
     if isinstance(value, Bounds):
         return Bounds(value.lower, value.upper, name)
-    if isinstance(value, (int, float)):
-        return Bounds.fixed(float(value), name)
+    allowed = "Bounds, a (lower, upper) pair or a number (fixed)"
+    if _is_number(value):
+        return Bounds.fixed(float(value), name)  # type: ignore[arg-type]
     if isinstance(value, (tuple, list)) and len(value) == 2:
+        if not all(_is_number(v) for v in value):
+            raise InvalidParameter(name, value, allowed)
         return Bounds(float(value[0]), float(value[1]), name)
-    raise InvalidParameter(name, value, "Bounds, a (lower, upper) pair or a number (fixed)")
+    raise InvalidParameter(name, value, allowed)
+
+
+def _is_number(value: object) -> bool:
+    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+
+
+def _entries(value: object) -> list[object] | None:
+    """The per-joint entries of a per-joint variable's value, or None if one bounds covers every joint."""
+    if isinstance(value, Sequence) and not isinstance(value, str):
+        if not (isinstance(value, tuple) and len(value) == 2 and all(_is_number(v) for v in value)):
+            return list(value)
+    return None
 
 
 @dataclass(frozen=True)
@@ -76,7 +109,8 @@ class DesignSpace:
     with one bounds per joint: ``stator_diameter`` [m], ``stack_length`` [m] (``None``: the reference motor's,
     fixed), ``gear_ratio`` [-] (>= 1), ``software_stiffness`` [N m/rad]. Global variables: ``threshold`` (the
     contact-force threshold [N] for force sensing, the contact position-error threshold [m] for position
-    sensing) and ``approach_velocity`` [m/s]. Any variable is fixed by giving a number.
+    sensing) and ``approach_velocity`` [m/s]. Any variable is fixed by giving a number. Bounds must lie within
+    :data:`SUPPORTED_RANGES` (checked here, naming the variable).
     """
 
     stator_diameter: BoundsLike | Sequence[BoundsLike]
@@ -85,6 +119,16 @@ class DesignSpace:
     threshold: BoundsLike
     approach_velocity: BoundsLike
     stack_length: BoundsLike | Sequence[BoundsLike] | None = None
+
+    def __post_init__(self) -> None:
+        for name in (*PER_JOINT_VARIABLES, *GLOBAL_VARIABLES):
+            value = getattr(self, name)
+            if value is None and name == "stack_length":
+                continue
+            entries = _entries(value) if name in PER_JOINT_VARIABLES else None
+            for i, entry in enumerate([value] if entries is None else entries):
+                label = name if entries is None else f"{name}[{i}]"
+                _within_supported(as_bounds(entry, label), name)
 
     def per_joint(
         self, name: str, n_joints: int, default: float | Sequence[float] | None = None
@@ -98,20 +142,29 @@ class DesignSpace:
             if default is None:
                 raise InvalidParameter(name, value, "bounds or a value")
             value = list(default) if isinstance(default, Sequence) else default
-        if isinstance(value, Sequence) and not (
-            isinstance(value, tuple) and len(value) == 2 and all(isinstance(v, (int, float)) for v in value)
-        ):
-            if len(value) != n_joints:
+        entries = _entries(value)
+        if entries is not None:
+            if len(entries) != n_joints:
                 raise InvalidParameter(name, value, f"one bounds for all joints or a sequence of {n_joints}")
-            bounds = [as_bounds(v, f"{name}[{i}]") for i, v in enumerate(value)]
+            bounds = [as_bounds(v, f"{name}[{i}]") for i, v in enumerate(entries)]  # type: ignore[arg-type]
         else:
             bounds = [as_bounds(value, f"{name}[{i}]") for i in range(n_joints)]
-        if name == "gear_ratio":
-            for b in bounds:
-                if b.lower < 1:
-                    raise InvalidParameter(f"{b.name} lower bound", b.lower, "a gear ratio >= 1")
         return bounds
 
     def global_bounds(self, name: str) -> Bounds:
         """The bounds of global variable ``name`` (``threshold`` or ``approach_velocity``)."""
         return as_bounds(getattr(self, name), name)
+
+
+def _within_supported(bounds: Bounds, variable: str) -> None:
+    """Raise if ``bounds`` of ``variable`` leave :data:`SUPPORTED_RANGES`."""
+    low, high = SUPPORTED_RANGES[variable]
+    if variable == "gear_ratio" and bounds.lower < 1:
+        raise InvalidParameter(f"{bounds.name} lower bound", bounds.lower, "a gear ratio >= 1")
+    if bounds.lower < low or bounds.upper > high:
+        raise InvalidParameter(
+            f"{bounds.name} bounds",
+            (bounds.lower, bounds.upper),
+            f"within the supported range [{low:g}, {high:g}] (SI units)",
+            "beyond it the scaling laws overflow; physical actuators lie far inside",
+        )

@@ -3,10 +3,16 @@
 from __future__ import annotations
 
 import math
+import re
 import statistics
+from pathlib import PurePath
 from typing import Any
 
 from .. import __version__
+
+SOLVER_TOLERANCE = 1e-5
+"""Relative tolerance to which the report trusts the optimiser's numbers (that of
+:data:`collision_reflex.optimize.pareto.MERGE_TOLERANCE`): smaller values beside their scale print as 0."""
 
 UNITS = {
     "stator_diameter": "m",
@@ -40,6 +46,46 @@ def number(value: object, digits: int = 4) -> str:
     return f"{value:.{digits}g}"
 
 
+def settled(value: object, scale: object = 1.0) -> object:
+    """``value``, or 0 where it is solver noise: within :data:`SOLVER_TOLERANCE` of zero relative to ``scale``.
+
+    A margin of ``-9.7e-9`` (a constraint met to the solver's tolerance) or a required torque of ``3.6e-15``
+    N·m next to a peak torque of 1.3 N·m are zeros that the optimiser did not round; printed, they read as
+    values.
+    """
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not isinstance(scale, (int, float)):
+        return value
+    return 0.0 if abs(value) <= SOLVER_TOLERANCE * abs(scale) else value
+
+
+def _settled_rows(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """``pareto.csv``'s rows with the solver noise settled.
+
+    Each joint's required torques against its peak torque, and its margins (relative: against 1).
+    """
+    settled_rows = []
+    for row in rows:
+        copy = dict(row)
+        for column, value in row.items():
+            required = _REQUIRED.match(column)
+            if required:
+                copy[column] = settled(value, row.get(f"peak_torque[{required.group('joint')}] [N*m]"))
+            elif _MARGIN.match(column):
+                copy[column] = settled(value)
+        settled_rows.append(copy)
+    return settled_rows
+
+
+_REQUIRED = re.compile(r"^required_\w*torque\[(?P<joint>.+)\] \[N\*m\]$")
+_MARGIN = re.compile(r"^\w*margin\[.+\] \[-\]$")
+
+
+def _shown_path(value: str) -> str:
+    """An absolute local path as its file name: a report names no folder of the machine it was made on."""
+    path = PurePath(value)
+    return path.name if path.is_absolute() or re.match(r"^[A-Za-z]:[\\/]", value) else value
+
+
 def _assumptions(resolved: dict[str, Any]) -> list[tuple[str, str]]:
     """The resolved study flattened to (field, value with unit) rows."""
     rows: list[tuple[str, str]] = []
@@ -63,6 +109,8 @@ def _assumptions(resolved: dict[str, Any]) -> list[tuple[str, str]]:
                 rows.append((prefix, "[]"))
         elif isinstance(value, (int, float)) and not isinstance(value, bool):
             rows.append((prefix, number(value) + (f" {unit}" if unit else "")))
+        elif isinstance(value, str):
+            rows.append((prefix, _shown_path(value)))
         else:
             rows.append((prefix, "–" if value is None else str(value)))
 
@@ -98,10 +146,11 @@ def render_html(results: dict[str, Any], rows: list[dict[str, Any]], svgs: dict[
         lstrip_blocks=True,
     )
     environment.filters["n"] = number
+    environment.filters["settled"] = settled
     template = environment.get_template(f"{results['kind']}_report.html.j2")
     context: dict[str, Any] = {
         "results": results,
-        "rows": rows,
+        "rows": _settled_rows(rows),
         "columns": list(rows[0]) if rows else [],
         "svgs": svgs,
         "assumptions": _assumptions(results["resolved"]),

@@ -38,7 +38,8 @@ variants idealise:
 mass (saturated at ``F_a``), whose momentum then loads the spring as well. ``drive="free"`` applies no actuator
 force at all (an uncontrolled collision; detection is ignored), for energy bookkeeping.
 
-Modules: :mod:`.setup` (the parameters and their checks), :mod:`.contact` (wall restitution),
+Modules: :mod:`.setup` (the parameters and their checks), :mod:`.budget` (the work estimate that refuses
+hopeless settings), :mod:`.contact` (wall restitution),
 :mod:`.dynamics` (the hybrid model), :mod:`.integrator` (the event-driven integration), :mod:`.result`,
 :mod:`.sweeps` (against the closed form), :mod:`.arm` (the arm-level collision). Everything is SI: kg, m, s,
 N, N/m, N*s/m, N*s.

@@ -12,15 +12,13 @@ import numpy as np
 
 from ..errors import SimulationError
 from ..model.impulse import collision_times
-from ..model.sensing import threshold_force
+from .budget import EVALUATIONS_PER_STEP, SEGMENT_STEPS, WATCH_PERIODS, check_work, reference_force
 from .dynamics import DEFL, ERR, IMP, LOSS, NSTATE, SURF, VF, VR, WORK, XF, HybridCollision
 from .result import SimulationResult
 from .setup import CollisionSetup, oscillation_period
 
 _TRACE_POINTS = 40  # interpolated trace points per integration segment
-_MAX_SEGMENTS = 100_000  # mode changes before a contact is taken to chatter
 _MAX_REPEATS = 20  # one event at one instant, again and again, before the run is taken to be stuck
-_WATCH_PERIODS = 5  # periods of the finger on its spring watched for a new contact after it leaves
 
 
 def simulate(setup: CollisionSetup) -> SimulationResult:
@@ -31,19 +29,16 @@ def simulate(setup: CollisionSetup) -> SimulationResult:
 
     Returns a :class:`~collision_reflex.simulate.SimulationResult` with the force trace, the phase times and
     impulses and the energy bookkeeping. Raises :class:`~collision_reflex.errors.SimulationError` if nothing
-    is detected, or the contact does not end, within ``setup.duration``.
+    is detected, or the contact does not end, within ``setup.duration``; at once if the run would need more
+    than ``setup.max_steps`` integrator steps (:func:`~collision_reflex.simulate.budget.check_work`), and when
+    it has used them up.
     """
+    check_work(setup)
     return _Run(setup).run()
 
 
-def _reference_force(setup: CollisionSetup) -> float:
-    """Spring force [N] at which the detector trips in the ideal limit, ignoring play and friction.
-
-    It is the scale of the forces in the run.
-    """
-    if setup.detection.kind == "position":
-        return float(threshold_force("position", setup.detection.threshold, setup.lumped_stiffness))
-    return setup.detection.threshold
+class _OutOfBudget(Exception):
+    """The run has used up its budget of steps (evaluations and segments, :func:`_Run.work`)."""
 
 
 def _default_duration(setup: CollisionSetup) -> float:
@@ -52,7 +47,7 @@ def _default_duration(setup: CollisionSetup) -> float:
     It covers 20 generous contact times, twice the delay, the watch after the contact, and ten control
     periods.
     """
-    F_ref = _reference_force(setup)
+    F_ref = reference_force(setup)
     # The closed form's contact time with the robot still moving at v0, plus a period of both masses on the
     # spring and the time to take up the play.
     _, t2 = collision_times(
@@ -67,12 +62,12 @@ def _default_duration(setup: CollisionSetup) -> float:
 
 
 def _watch_time(setup: CollisionSetup) -> float:
-    return _WATCH_PERIODS * oscillation_period(setup.m_f, setup.k_m)
+    return WATCH_PERIODS * oscillation_period(setup.m_f, setup.k_m)
 
 
 def _absolute_tolerances(setup: CollisionSetup) -> np.ndarray:
     """Absolute tolerance of each state, from its scale."""
-    F_ref, k, v0 = _reference_force(setup), setup.lumped_stiffness, setup.v0
+    F_ref, k, v0 = reference_force(setup), setup.lumped_stiffness, setup.v0
     deflection = F_ref / setup.k_m
     admittance_yield = F_ref / setup.k_s if math.isfinite(setup.k_s) else 0.0
     finger = deflection
@@ -85,6 +80,19 @@ def _absolute_tolerances(setup: CollisionSetup) -> np.ndarray:
     scales[ERR] = max(admittance_yield, deflection)
     scales[[SURF, IMP, WORK, LOSS]] = finger, impulse, energy, energy
     return 1e-3 * setup.rtol * scales
+
+
+def _integrator_failure(t: float, message: str) -> str:
+    """The integrator's failure at ``t`` [s], with what SciPy's terse message means."""
+    text = f"the integrator failed at t = {t:.6g} s: {message}"
+    if "spacing between numbers" in message:
+        spacing = np.spacing(t)
+        text += (
+            f" (the step it needs is below the resolution of double precision at this time, {spacing:.2g} s: "
+            "the run is too long for its fastest time scale; raise v0, shorten the delay, or set a shorter "
+            "duration)"
+        )
+    return text
 
 
 class _Trace:
@@ -146,6 +154,9 @@ class _Run:
         self.contact_end = math.nan
         self.last_event: tuple[float, str] = (math.nan, "")
         self.repeats = 0
+        self.evaluations = 0
+        self.segments = 0
+        self.samples = 0
         self.t = 0.0
         # The finger touches the wall at v0; the spring carries no force, with `play` still to take up.
         y = np.zeros(NSTATE)
@@ -163,8 +174,30 @@ class _Run:
 
     def run(self) -> SimulationResult:
         """Integrate segment by segment, applying each mode change, until the watch ends."""
+        try:
+            return self._segments()
+        except _OutOfBudget:
+            modes = len(self.sim.events)
+            if modes > self.samples and SEGMENT_STEPS * modes > 0.2 * self.work():
+                why = "the contact chatters (the finger bounces, or a mode is entered and left over and over)"
+            elif SEGMENT_STEPS * self.samples > 0.2 * self.work():
+                why = "mostly control samples: lower control_rate"
+            else:
+                why = "a time scale far shorter than the run is in play (a stiff or non-smooth force, e.g. a saturated controller)"
+            raise SimulationError(
+                f"the simulation used up its budget of max_steps = {self.setup.max_steps} integrator steps at "
+                f"t = {self.t:.3g} s of {self.duration:.3g} s ({self.evaluations / EVALUATIONS_PER_STEP:.3g} "
+                f"steps of integration, {modes} mode changes, {self.samples} control samples): {why}; raise "
+                "max_steps, or see collision_reflex.simulate.budget for what sets the steps"
+            ) from None
+
+    def work(self) -> float:
+        """Steps used so far: right-hand-side evaluations over 12, plus the cost of each segment started."""
+        return self.evaluations / EVALUATIONS_PER_STEP + SEGMENT_STEPS * self.segments
+
+    def _segments(self) -> SimulationResult:
         sim = self.sim
-        for _ in range(_MAX_SEGMENTS):
+        while True:
             self._react_if_due()
             if self._finished():
                 break
@@ -180,10 +213,6 @@ class _Run:
                 continue
             if self.t >= sample_time - self.tiny:
                 self._on_control_sample()
-        else:
-            raise SimulationError(
-                f"the simulation changed mode {_MAX_SEGMENTS} times without ending (a chattering contact)"
-            )
         return self._result()
 
     # -- what is due -----------------------------------------------------------------------------------------
@@ -264,8 +293,18 @@ class _Run:
         from scipy.integrate import solve_ivp  # here: SciPy's import time is paid only by a simulation
 
         sim = self.sim
+        self.segments += 1
+        if self.work() > self.setup.max_steps:
+            raise _OutOfBudget
+
+        def rhs(t: float, y: np.ndarray) -> np.ndarray:
+            self.evaluations += 1
+            if self.evaluations % EVALUATIONS_PER_STEP == 0 and self.work() > self.setup.max_steps:
+                raise _OutOfBudget
+            return sim.rhs(t, y)
+
         solution = solve_ivp(
-            sim.rhs,
+            rhs,
             (self.t, t_stop),
             self.y,
             method="DOP853",
@@ -276,7 +315,7 @@ class _Run:
             dense_output=True,
         )
         if solution.status < 0:
-            raise SimulationError(f"the integrator failed at t = {self.t:.6g} s: {solution.message}")
+            raise SimulationError(_integrator_failure(self.t, solution.message))
         self.trace.add(solution, sim)
         self.t = float(solution.t[-1])
         self.y = sim.resolved(solution.y[:, -1])
@@ -328,6 +367,7 @@ class _Run:
     def _on_control_sample(self) -> None:
         """Update the held impedance force and check a sampled detector."""
         sim, setup = self.sim, self.setup
+        self.samples += 1
         if sim.drive == "impedance":
             sim.held_force = sim.impedance_law(self.y)
         if (

@@ -60,7 +60,12 @@ class Detection:
 
     def __post_init__(self) -> None:
         _validate.choice("detection kind", self.kind, DETECTION_KINDS)
-        _validate.positive("detection threshold", self.threshold)
+        _scalar(
+            self,
+            "threshold",
+            _validate.positive("detection threshold", self.threshold),
+            "detection threshold",
+        )
 
 
 @dataclass(frozen=True)
@@ -98,6 +103,11 @@ class CollisionSetup:
         (contacts, detection) are found by sign changes between steps, so a step longer than a contact can
         miss it: steps above a quarter of the contact time are refused.
     rtol: relative tolerance of the integrator.
+    max_steps: budget of integrator steps. A setup whose up-front estimate (its phases' spans over their
+        fastest time scales, :mod:`collision_reflex.simulate.budget`) exceeds it is refused at once with what
+        to change; a run that uses it up (12 right-hand-side evaluations a step, 3 steps a control sample or
+        mode change) stops with a :class:`~collision_reflex.errors.SimulationError`. The default is about ten
+        seconds of work at most; ordinary collisions take a few hundred steps.
     """
 
     m_f: float
@@ -121,6 +131,7 @@ class CollisionSetup:
     duration: float | None = None
     max_step: float | None = None
     rtol: float = 1e-10
+    max_steps: int = 50_000
 
     def __post_init__(self) -> None:
         _validate.choice("drive", self.drive, DRIVES)
@@ -215,12 +226,22 @@ _renamed = renamed_keywords(**RENAMED_FIELDS)
 CollisionSetup.__init__ = _renamed(CollisionSetup.__init__)  # type: ignore[method-assign]
 
 
+def _scalar(owner: object, name: str, value: object, label: str | None = None) -> None:
+    """Store a checked value on a frozen dataclass as a float; an array is refused."""
+    if not isinstance(value, float):
+        raise InvalidParameter(label or name, getattr(owner, name), "a single number")
+    object.__setattr__(owner, name, value)
+
+
 def _check_signs(setup: CollisionSetup) -> None:
-    """Masses, stiffnesses, the force limit and the velocity > 0; damping, delay, friction and play >= 0."""
+    """Masses, stiffnesses, the force limit and the velocity > 0; damping, delay, friction and play >= 0.
+
+    Each is stored as a float: integers and NumPy scalars are converted, strings and arrays refused.
+    """
     for name in ("m_f", "m_r", "k_m", "F_a", "v0"):
-        _validate.positive(name, getattr(setup, name))
-    _validate.positive("k_s", setup.k_s, allow_inf=True)
-    _validate.positive("contact_stiffness", setup.contact_stiffness, allow_inf=True)
+        _scalar(setup, name, _validate.positive(name, getattr(setup, name)))
+    for name in ("k_s", "contact_stiffness"):
+        _scalar(setup, name, _validate.positive(name, getattr(setup, name), allow_inf=True))
     for name in (
         "software_damping",
         "delay",
@@ -229,10 +250,12 @@ def _check_signs(setup: CollisionSetup) -> None:
         "viscous_friction",
         "backlash",
     ):
-        _validate.non_negative(name, getattr(setup, name))
-    _validate.positive("rtol", setup.rtol)
+        _scalar(setup, name, _validate.non_negative(name, getattr(setup, name)))
+    _scalar(setup, "rtol", _validate.positive("rtol", setup.rtol))
     if not 1e-14 <= setup.rtol <= 1e-3:
         raise InvalidParameter("rtol", setup.rtol, "between 1e-14 and 1e-3")
+    if isinstance(setup.max_steps, bool) or not isinstance(setup.max_steps, int) or setup.max_steps < 1:
+        raise InvalidParameter("max_steps", setup.max_steps, "a whole number >= 1")
 
 
 def _check_drive(setup: CollisionSetup) -> None:
@@ -264,7 +287,7 @@ def _check_play_and_friction(setup: CollisionSetup) -> None:
             "the actuator could not move the robot mass at all",
         )
     if setup.initial_play is not None:
-        _validate.non_negative("initial_play", setup.initial_play)
+        _scalar(setup, "initial_play", _validate.non_negative("initial_play", setup.initial_play))
         if setup.initial_play > setup.backlash:
             raise InvalidParameter(
                 "initial_play", setup.initial_play, f"at most backlash = {setup.backlash:g} m"
@@ -274,11 +297,12 @@ def _check_play_and_friction(setup: CollisionSetup) -> None:
 def _check_timing(setup: CollisionSetup) -> None:
     """Control rate, sample phase, duration and step that the integration can honour."""
     if setup.control_rate is not None:
-        _validate.positive("control_rate", setup.control_rate)
+        _scalar(setup, "control_rate", _validate.positive("control_rate", setup.control_rate))
+    _scalar(setup, "sample_phase", _validate.non_negative("sample_phase", setup.sample_phase))
     if not 0.0 <= setup.sample_phase < 1.0:
         raise InvalidParameter("sample_phase", setup.sample_phase, "a fraction in [0, 1)")
     if setup.duration is not None:
-        _validate.positive("duration", setup.duration)
+        _scalar(setup, "duration", _validate.positive("duration", setup.duration))
         if setup.delay >= setup.duration:
             raise InvalidParameter(
                 "delay",
@@ -287,7 +311,7 @@ def _check_timing(setup: CollisionSetup) -> None:
                 "lengthen duration (or leave it unset) or shorten the delay",
             )
     if setup.max_step is not None:
-        _validate.positive("max_step", setup.max_step)
+        _scalar(setup, "max_step", _validate.positive("max_step", setup.max_step))
         contact_time = setup.contact_time
         if contact_time > 0 and setup.max_step > contact_time / 4:
             raise InvalidParameter(

@@ -1,0 +1,207 @@
+"""The work a simulated collision needs, estimated before it starts: its phases' spans over their time scales.
+
+The run length comes from the slow time scales (the approach until detection, the delay, the watch after the
+contact) and the step from the fast ones (the periods of the masses on their springs, friction and damping
+time constants, the control period). Their ratio is the number of integrator steps; a setting that needs more
+than the budget ``setup.max_steps`` is refused at once with what to change, instead of running for hours.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from ..errors import SimulationError
+from ..model.impulse import collision_times
+from ..model.sensing import threshold_force
+from .setup import CollisionSetup, oscillation_period
+
+STEP_PER_PERIOD = 16
+"""Integrator steps per period of the fastest oscillation in play (the default ``max_step`` rule)."""
+
+EVALUATIONS_PER_STEP = 12
+"""Right-hand-side evaluations of one DOP853 step: the run's budget counts steps as evaluations / 12."""
+
+WATCH_PERIODS = 5
+"""Periods of the finger on its spring watched for a new contact after it leaves the wall."""
+
+SEGMENT_STEPS = 3
+"""Steps' worth of work that each segment costs (a control sample or a mode change): a new solver, its first
+step and its trace points (measured: 0.35-0.6 ms a sample against 0.15 ms a step)."""
+
+_MIN_STEPS_PER_PHASE = 10  # a phase without a time scale of its own still takes a few steps
+
+# What to change, for each time scale that can limit the step and each phase that can be long.
+_SCALE_HINTS = {
+    "the finger on the mechanical spring": "lower k_m or raise m_f",
+    "the finger on the wall contact": "lower contact_stiffness or make the wall rigid (contact_stiffness=inf)",
+    "the robot mass on its springs": "raise m_r (or lower k_m, k_s)",
+    "viscous friction on the robot mass": "lower viscous_friction (its time constant is m_r / viscous_friction)",
+    "the software damping": "lower software_damping (its time constant is m_r / software_damping)",
+    "the control period": "lower control_rate, or use continuous control (control_rate=None)",
+    "max_step": "raise max_step or leave it unset",
+}
+_PHASE_HINTS = {
+    "approach until detection": "raise v0 or lower the detection threshold",
+    "delay": "shorten the delay",
+    "reaction and watch": "raise k_m or lower m_f (the watch lasts five periods of the finger on k_m)",
+}
+
+
+@dataclass(frozen=True)
+class Phase:
+    """One phase of the run and the time scale that limits its step.
+
+    Attributes
+    ----------
+    name: ``"approach until detection"``, ``"delay"`` or ``"reaction and watch"`` (the watch for a new contact
+        after it).
+    span: its expected duration [s].
+    step: the largest step its fastest time scale allows [s] (``inf`` if none).
+    scale: that time scale's name (``""`` if none).
+    samples: control samples the run stops at in this phase.
+    """
+
+    name: str
+    span: float
+    step: float
+    scale: str
+    samples: float
+
+    @property
+    def steps(self) -> float:
+        """Estimated integrator steps of the phase, control samples included (each as a segment)."""
+        if self.span <= 0:
+            return 0.0
+        return _MIN_STEPS_PER_PHASE + self.span / self.step + SEGMENT_STEPS * self.samples
+
+
+def phases(setup: CollisionSetup) -> tuple[Phase, Phase, Phase]:
+    """The three phases of ``setup``'s run with their spans and step-limiting time scales."""
+    approach = _approach_scales(setup)
+    reaction = _reaction_scales(setup)
+    rate = setup.control_rate
+    sensing_span = _sensing_time(setup)
+    delay_span = setup.delay + (1 / rate if rate is not None else 0.0)
+    watch = WATCH_PERIODS * oscillation_period(setup.m_f, setup.k_m)
+    reaction_span = _reaction_time(setup) + watch
+    spans = [sensing_span, delay_span, reaction_span]
+    if setup.duration is not None:  # the run stops at the duration at the latest
+        left = setup.duration
+        for i, span in enumerate(spans):
+            spans[i], left = min(span, left), max(left - span, 0.0)
+    # The run stops at every control sample while a sampled detector watches (until detection) or a
+    # sampled controller acts (the impedance law until the reaction; the free drive never detects).
+    active = (True, setup.drive != "ideal", setup.drive == "free")
+    samples = [
+        span * rate if rate is not None and on else 0.0 for span, on in zip(spans, active, strict=True)
+    ]
+    return (
+        Phase("approach until detection", spans[0], *_fastest(setup, approach), samples[0]),
+        Phase("delay", spans[1], *_fastest(setup, approach), samples[1]),
+        Phase("reaction and watch", spans[2], *_fastest(setup, reaction), samples[2]),
+    )
+
+
+def estimated_steps(setup: CollisionSetup) -> float:
+    """Integrator steps the run of ``setup`` is expected to take."""
+    return sum(phase.steps for phase in phases(setup))
+
+
+def check_work(setup: CollisionSetup) -> None:
+    """Raise :class:`SimulationError` if ``setup`` needs more steps than ``setup.max_steps``, saying why."""
+    run = phases(setup)
+    total = sum(phase.steps for phase in run)
+    if total <= setup.max_steps:  # (an inf or NaN estimate, from extreme settings, is refused)
+        return
+    worst = max(run, key=lambda phase: phase.steps)
+    if SEGMENT_STEPS * worst.samples > worst.span / worst.step:
+        why = (
+            f"the {worst.name} phase lasts {worst.span:.3g} s and the run stops at each of its "
+            f"{worst.samples:.3g} control samples (control_rate = {setup.control_rate:g} Hz; each costs "
+            f"{SEGMENT_STEPS} steps)"
+        )
+        change = _SCALE_HINTS["the control period"]
+    else:
+        why = f"the {worst.name} phase lasts {worst.span:.3g} s while {worst.scale} limits the step to {worst.step:.3g} s"
+        ratio_phase = worst.span / _typical_span(setup)
+        change = _PHASE_HINTS[worst.name] if ratio_phase > 1e3 else _SCALE_HINTS[worst.scale]
+    raise SimulationError(
+        f"this collision needs about {total:.2g} integrator steps, beyond the budget max_steps = "
+        f"{setup.max_steps:g}: {why}; {change}, or raise max_steps"
+    )
+
+
+def _typical_span(setup: CollisionSetup) -> float:
+    """A contact's natural duration, a period of the finger on its spring [s]: what a phase is long against."""
+    return oscillation_period(setup.m_f, setup.k_m)
+
+
+def reference_force(setup: CollisionSetup) -> float:
+    """Spring force [N] at which the detector trips in the ideal limit, ignoring play and friction.
+
+    It is the scale of the forces in the run.
+    """
+    if setup.detection.kind == "position":
+        return float(threshold_force("position", setup.detection.threshold, setup.lumped_stiffness))
+    return setup.detection.threshold
+
+
+def _sensing_time(setup: CollisionSetup) -> float:
+    """Time from the impact to detection in the ideal limit, the play taken up first [s]."""
+    return reference_force(setup) / (setup.lumped_stiffness * setup.v0) + setup.play / setup.v0
+
+
+def _reaction_time(setup: CollisionSetup) -> float:
+    """The closed form's reaction time ``t2 - t1``, robot still moving at ``v0`` [s]."""
+    F_ref, k, a = reference_force(setup), setup.lumped_stiffness, setup.acceleration
+    t1, t2 = collision_times(setup.m_f, k, setup.k_m, F_ref, a, setup.v0, "moving", setup.v0)
+    return float(t2 - t1)
+
+
+def _approach_scales(setup: CollisionSetup) -> dict[str, float]:
+    """Periods (``"period"`` keys) and time constants of the phases before the reaction [s]."""
+    scales: dict[str, float] = {}
+    if math.isfinite(setup.contact_stiffness):
+        scales["the finger on the mechanical spring"] = oscillation_period(setup.m_f, setup.k_m)
+    if setup.drive != "ideal":
+        stiffness = setup.k_m + (setup.k_s if setup.drive == "impedance" else 0.0)
+        scales["the robot mass on its springs"] = oscillation_period(setup.m_r, stiffness)
+        _add_constants(setup, scales, impedance=setup.drive == "impedance")
+    return scales
+
+
+def _reaction_scales(setup: CollisionSetup) -> dict[str, float]:
+    """Periods and time constants of the reaction and the watch after it [s]."""
+    scales = {
+        "the finger on the mechanical spring": oscillation_period(setup.m_f, setup.k_m),
+        "the robot mass on its springs": oscillation_period(setup.m_r, setup.k_m),
+    }
+    _add_constants(setup, scales, impedance=False)
+    return scales
+
+
+def _add_constants(setup: CollisionSetup, scales: dict[str, float], impedance: bool) -> None:
+    """Add the friction and damping time constants acting on the robot mass [s]."""
+    # An explicit integrator is stable only for steps of about a time constant: 16 steps per "period" of
+    # 16 time constants.
+    if setup.viscous_friction > 0:
+        scales["viscous friction on the robot mass"] = STEP_PER_PERIOD * setup.m_r / setup.viscous_friction
+    if impedance and setup.software_damping > 0:
+        scales["the software damping"] = STEP_PER_PERIOD * setup.m_r / setup.software_damping
+
+
+def _fastest(setup: CollisionSetup, scales: dict[str, float]) -> tuple[float, str]:
+    """The step [s] the fastest of ``scales`` (and the wall contact) allows, and that scale's name."""
+    scales = dict(scales)
+    if math.isfinite(setup.contact_stiffness):
+        k_c = setup.contact_stiffness + setup.k_m
+        scales["the finger on the wall contact"] = oscillation_period(setup.m_f, k_c)
+    if setup.max_step is not None:
+        # A given max_step replaces the period rule; the time constants still bound an explicit step.
+        scales = {name: value for name, value in scales.items() if "friction" in name or "damping" in name}
+        scales["max_step"] = STEP_PER_PERIOD * setup.max_step
+    if not scales:
+        return math.inf, ""
+    name = min(scales, key=lambda key: scales[key])
+    return scales[name] / STEP_PER_PERIOD, name

@@ -1,0 +1,143 @@
+"""The printed report (``crx report DIR --pdf``) holds every number of the HTML tables, and the report itself
+prints no solver noise, one unit per quantity and no local paths.
+
+Every number of every table visible in print must appear in ``pdftotext``'s text of the PDF at least as often:
+a table cut at the page edge, a column lost to a scrollbar, or a ``<details>`` section printed folded fails it.
+"""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+from collections import Counter
+from html.parser import HTMLParser
+from pathlib import Path
+
+import pytest
+
+from collision_reflex.cli import main
+from collision_reflex.report.html import SOLVER_TOLERANCE, _settled_rows, settled
+from collision_reflex.report.pdf import find_browser
+
+ROOT = Path(__file__).resolve().parents[1]
+STUDIES = {
+    "arm": ROOT / "studies" / "two_link_paper.yaml",
+    "actuator": ROOT / "studies" / "direct_drive_vs_geared.yaml",
+}
+NUMBER = re.compile(r"(?<![\w.−-])[−-]?\d+(?:\.\d+)?(?:e[+−-]?\d+)?(?![\w.])")
+
+
+class _PrintedTables(HTMLParser):
+    """Cell texts of the tables that print (not inside a ``screen-only`` element), with their headers."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.cells: list[str] = []
+        self.headers: list[str] = []
+        self.stack: list[bool] = []  # per open element: hidden in print?
+        self.cell: list[str] | None = None
+        self.header = False
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        classes = (dict(attrs).get("class") or "").split()
+        hidden = bool(self.stack and self.stack[-1]) or "screen-only" in classes
+        if tag not in ("br", "meta", "col", "img"):
+            self.stack.append(hidden)
+        if tag in ("td", "th") and not hidden:
+            self.cell, self.header = [], tag == "th"
+
+    def handle_endtag(self, tag: str) -> None:
+        if tag in ("td", "th") and self.cell is not None:
+            text = " ".join("".join(self.cell).split())
+            (self.headers if self.header else self.cells).append(text)
+            self.cell = None
+        if self.stack and tag not in ("br", "meta", "col", "img"):
+            self.stack.pop()
+
+    def handle_data(self, data: str) -> None:
+        if self.cell is not None:
+            self.cell.append(data)
+
+
+def printed_tables(html: str) -> _PrintedTables:
+    parser = _PrintedTables()
+    parser.feed(html)
+    return parser
+
+
+@pytest.fixture(scope="module")
+def reports(tmp_path_factory) -> dict[str, Path]:
+    if find_browser() is None or shutil.which("pdftotext") is None:
+        pytest.skip("printing needs Chromium and pdftotext (apt-get install chromium poppler-utils)")
+    folders = {}
+    for kind, study in STUDIES.items():
+        folder = tmp_path_factory.mktemp(kind) / "out"
+        assert (
+            main(["run", str(study), "--out", str(folder), "--quiet", "--smoke", "--executor", "serial"]) == 0
+        )
+        assert main(["report", str(folder), "--pdf"]) == 0
+        folders[kind] = folder
+    return folders
+
+
+@pytest.mark.parametrize("kind", list(STUDIES))
+def test_every_table_number_is_in_the_pdf(reports: dict[str, Path], kind: str) -> None:
+    folder = reports[kind]
+    tables = printed_tables((folder / "report.html").read_text())
+    wanted = Counter(n for cell in tables.cells for n in NUMBER.findall(cell))
+    text = subprocess.run(
+        ["pdftotext", "-layout", str(folder / "report.pdf"), "-"], capture_output=True, text=True, check=True
+    ).stdout
+    found = Counter(NUMBER.findall(text))
+    missing = {number: count - found[number] for number, count in wanted.items() if found[number] < count}
+    assert sum(wanted.values()) > 50  # the tables are there to be checked
+    assert not missing, f"numbers of the HTML tables missing from the PDF: {missing}"
+
+
+def test_solver_noise_is_settled_to_zero() -> None:
+    assert settled(-9.74e-9) == 0.0  # a margin of -9.74e-07 %, met to the solver's tolerance
+    assert settled(3.562e-15, 1.3) == 0.0  # a required torque beside a 1.3 N*m peak torque
+    assert settled(-2e-5) == -2e-5 and settled(2e-5 * 1.3, 1.3) == 2e-5 * 1.3  # beyond the tolerance: kept
+    assert settled("OPN-060-013-A", 1.3) == "OPN-060-013-A"
+
+
+def test_pareto_rows_settle_required_torques_and_margins() -> None:
+    row = {
+        "required_torque[j1] [N*m]": 3.562e-15,
+        "peak_torque[j1] [N*m]": 1.3,
+        "required_rms_torque[j1] [N*m]": 0.25,
+        "torque_margin[j1] [-]": 1.703e-06,
+        "speed_margin[j1] [-]": 0.0175,
+        "reflected_inertia[j1] [kg*m^2]": 2.2e-7,  # small, but a value: untouched
+    }
+    assert _settled_rows([row]) == [{**row, "required_torque[j1] [N*m]": 0.0, "torque_margin[j1] [-]": 0.0}]
+
+
+def test_printed_margins_and_torques_carry_no_solver_noise(reports: dict[str, Path]) -> None:
+    cells = printed_tables((reports["arm"] / "report.html").read_text()).cells
+    margins = [float(cell.rstrip(" %")) for cell in cells if cell.endswith(" %")]
+    assert margins  # the joint tables have margins
+    # 0, or at least the tolerance (in per cent): nothing like -9.74e-07 %.
+    assert all(m == 0 or abs(m) >= 100 * SOLVER_TOLERANCE for m in margins), margins
+    assert not [cell for cell in cells if re.fullmatch(r"-?\d(\.\d+)?e-(0[6-9]|[1-9]\d)", cell)]
+
+
+@pytest.mark.parametrize("kind", list(STUDIES))
+def test_one_unit_per_quantity_across_tables(reports: dict[str, Path], kind: str) -> None:
+    headers = printed_tables((reports[kind] / "report.html").read_text()).headers
+    for quantity in ("stator diameter", "stack length", "gear ratio", "reflected inertia", "peak torque"):
+        units = set()
+        for header in headers:
+            if header.replace("_", " ").lower().startswith(quantity):
+                units.update(re.findall(r"\[([^\]]+)\]$", header) or ["-"])
+        units = {unit.replace("kg*m^2", "kg·m²").replace("N*m", "N·m") for unit in units}
+        assert len(units) <= 1, (quantity, units)
+
+
+@pytest.mark.parametrize("kind", list(STUDIES))
+def test_no_local_path_in_the_report(reports: dict[str, Path], kind: str) -> None:
+    html = (reports[kind] / "report.html").read_text()
+    for folder in (ROOT, reports[kind], Path.home()):
+        assert str(folder) not in html
+    assert "planar_two_link.urdf" in html or kind == "actuator"  # the file is still named

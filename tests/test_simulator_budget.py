@@ -1,0 +1,98 @@
+"""The simulator's work budget: hopeless settings are refused at once, a run stops when its budget is used up.
+
+Each reproduction of issue 15 ran for minutes or forever; now each ends within a second with a message that
+names the time scale at fault and what to change.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import replace
+
+import pytest
+
+import collision_reflex as cr
+from collision_reflex.errors import InvalidParameter, SimulationError
+from collision_reflex.simulate import budget, integrator
+
+BASE = cr.CollisionSetup(0.2, 1.0, 1000.0, 100.0, 10.0, 0.3, cr.Detection("force", 3.0))
+IMPEDANCE = replace(BASE, drive="impedance")
+
+# setting -> words the refusal must contain (the time scale at fault or the change to make)
+HOPELESS = {
+    "robot_mass=1e-9": (replace(BASE, m_r=1e-9), "raise m_r"),
+    "control_rate=1e7": (replace(IMPEDANCE, control_rate=1e7), "lower control_rate"),
+    "velocity=1e-9": (replace(IMPEDANCE, v0=1e-9), "raise v0"),
+    "delay=1e9": (replace(IMPEDANCE, delay=1e9), "shorten the delay"),
+    "viscous_friction=1e6": (replace(IMPEDANCE, viscous_friction=1e6), "lower viscous_friction"),
+    "contact_stiffness=1e10": (replace(BASE, contact_stiffness=1e10), "lower contact_stiffness"),
+}
+
+
+@pytest.mark.parametrize("name", list(HOPELESS), ids=list(HOPELESS))
+def test_hopeless_settings_are_refused_at_once(name: str) -> None:
+    setup, hint = HOPELESS[name]
+    start = time.perf_counter()
+    with pytest.raises(SimulationError, match="integrator steps, beyond the budget max_steps") as error:
+        cr.simulate_collision(setup)
+    assert time.perf_counter() - start < 1.0
+    assert hint in str(error.value)
+    assert "\n" not in str(error.value)
+
+
+def test_ordinary_runs_stay_well_inside_the_budget() -> None:
+    # These take ~150 steps (4000 with the compliant wall); the estimate must not refuse them, nor be vacuous.
+    for setup in (
+        BASE,
+        IMPEDANCE,
+        replace(IMPEDANCE, control_rate=1000.0),
+        replace(BASE, contact_stiffness=1e6),
+    ):
+        steps = budget.estimated_steps(setup)
+        assert 50 < steps < setup.max_steps / 10
+        cr.simulate_collision(setup)
+
+
+def test_estimate_scales_with_span_over_time_scale() -> None:
+    # A delay 10x longer in the delay-limited regime needs ~10x the steps: span / step, not a constant.
+    long, longer = (budget.estimated_steps(replace(IMPEDANCE, delay=d)) for d in (100.0, 1000.0))
+    assert longer / long == pytest.approx(10.0, rel=0.02)
+    # The delay phase is stepped at a sixteenth of the robot's period on k_m + k_s.
+    step = budget.phases(replace(IMPEDANCE, delay=100.0))[1].step
+    assert step == pytest.approx(2 * math.pi * math.sqrt(1.0 / 1100.0) / 16, rel=1e-12)
+
+
+def test_a_raised_budget_lets_a_long_run_through() -> None:
+    setup = replace(IMPEDANCE, delay=5000.0)
+    with pytest.raises(SimulationError, match="shorten the delay"):
+        budget.check_work(setup)
+    budget.check_work(replace(setup, max_steps=10**7))
+
+
+def test_the_run_stops_when_the_budget_is_used_up(monkeypatch: pytest.MonkeyPatch) -> None:
+    # Without the up-front check the tiny robot mass would run for minutes; the step budget ends it.
+    monkeypatch.setattr(integrator, "check_work", lambda setup: None)
+    start = time.perf_counter()
+    with pytest.raises(SimulationError, match="used up its budget of max_steps = 2000 integrator steps"):
+        cr.simulate_collision(replace(BASE, m_r=1e-9, max_steps=2000))
+    assert time.perf_counter() - start < 3.0
+
+
+def test_budget_counts_steps_of_an_ordinary_run() -> None:
+    # The ordinary run needs ~140 steps: a budget of 20 stops it, one of 1000 does not.
+    with pytest.raises(SimulationError, match="used up its budget"):
+        integrator._Run(replace(BASE, max_steps=20)).run()
+    integrator._Run(replace(BASE, max_steps=1000)).run()
+
+
+@pytest.mark.parametrize("bad", [0, -1, 2.5, True, "100"])
+def test_max_steps_is_a_whole_number(bad: object) -> None:
+    with pytest.raises(InvalidParameter, match="max_steps"):
+        replace(BASE, max_steps=bad)
+
+
+def test_step_below_float_spacing_is_explained() -> None:
+    with pytest.raises(SimulationError, match="below the resolution of double precision") as error:
+        cr.simulate_collision(replace(BASE, v0=1e-15))
+    assert "raise v0" in str(error.value)
