@@ -8,7 +8,7 @@ model (frames, joint names, configuration sizes) are in :mod:`.robot` and run wh
 from __future__ import annotations
 
 import difflib
-import json
+import reprlib
 import os
 import types
 import typing
@@ -29,6 +29,10 @@ from .schema import (
 from .source import StudySource, parse_study_source, read_study_source
 
 _FOUND_LIMIT = 60
+# reprlib looks at a few items of each level only, so describing a huge value costs no more than a small one.
+_EXCERPT = reprlib.Repr()
+_EXCERPT.maxlevel, _EXCERPT.maxdict, _EXCERPT.maxlist, _EXCERPT.maxtuple = 3, 4, 4, 4
+_EXCERPT.maxstring = _EXCERPT.maxother = _FOUND_LIMIT
 
 
 @dataclass(frozen=True)
@@ -131,14 +135,8 @@ def _lower_first(text: str) -> str:
 
 
 def _found(value: Any) -> str:
-    """A short description of a value found in the file."""
-    if isinstance(value, (dict, list)):
-        try:
-            text = json.dumps(value, default=str)
-        except (TypeError, ValueError, RecursionError):
-            text = type(value).__name__
-    else:
-        text = repr(value)
+    """A short description of a value found in the file: an excerpt, never the whole of a large value."""
+    text = _EXCERPT.repr(value)
     return text if len(text) <= _FOUND_LIMIT else text[: _FOUND_LIMIT - 3] + "..."
 
 

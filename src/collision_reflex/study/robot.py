@@ -91,6 +91,12 @@ def load_arm(loaded: LoadedStudy) -> Arm:
             f"a URDF that cannot be loaded ({error.reason})",
             "a URDF file Pinocchio can parse",
         ) from None
+    except OSError as error:  # a file that exists but cannot be read (a device, /proc, permissions)
+        raise loaded.fail(
+            ("robot", "urdf"),
+            f"{spec.urdf!r}, which cannot be read ({error.strerror or error})",
+            "a readable URDF file",
+        ) from None
     except InvalidParameter as error:
         field = error.name if error.name in type(spec).model_fields else None
         raise loaded.fail(
