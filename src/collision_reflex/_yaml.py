@@ -20,12 +20,17 @@ MAX_SCALAR_LENGTH = 10_000
 _PLAIN_TAGS = (frozenset(yaml.SafeLoader.yaml_constructors) - {None}) | {"tag:yaml.org,2002:merge"}
 
 
-class NodeProblem(ValueError):
-    """A node tree over a limit: ``reason`` (a short phrase) and the 1-based ``line`` and ``column``."""
+NodePath = tuple[str | int, ...]
+"""Where a node is: the mapping keys (as written) and list indices from the root."""
 
-    def __init__(self, reason: str, node: yaml.Node) -> None:
+
+class NodeProblem(ValueError):
+    """A node tree over a limit: ``reason`` (a short phrase), the node's ``path`` and 1-based ``line``, ``column``."""
+
+    def __init__(self, reason: str, node: yaml.Node, path: NodePath = ()) -> None:
         super().__init__(reason)
         self.reason = reason
+        self.path = path
         self.line = node.start_mark.line + 1
         self.column = node.start_mark.column + 1
 
@@ -44,7 +49,7 @@ def check_nodes(root: yaml.Node) -> None:
     """
     sizes: dict[int, int] = {}
     try:
-        expanded = _expanded_size(root, sizes, set())
+        expanded = _expanded_size(root, sizes, set(), ())
     except RecursionError:
         raise NodeProblem("nesting too deep", root) from None
     if expanded - len(sizes) > ALIAS_BUDGET:
@@ -55,39 +60,42 @@ def check_nodes(root: yaml.Node) -> None:
         )
 
 
-def _expanded_size(node: yaml.Node, sizes: dict[int, int], open_nodes: set[int]) -> int:
+def _expanded_size(node: yaml.Node, sizes: dict[int, int], open_nodes: set[int], path: NodePath) -> int:
     """Number of nodes below and including ``node`` with every alias expanded (memoised in ``sizes``)."""
     key = id(node)
     if key in sizes:
         return sizes[key]
     if key in open_nodes:
-        raise NodeProblem("a recursive alias (a node that contains itself)", node)
-    _check_node(node)
+        raise NodeProblem("a recursive alias (a node that contains itself)", node, path)
+    _check_node(node, path)
     open_nodes.add(key)
     size = 1
     if isinstance(node, yaml.SequenceNode):
-        size += sum(_expanded_size(item, sizes, open_nodes) for item in node.value)
+        for index, item in enumerate(node.value):
+            size += _expanded_size(item, sizes, open_nodes, (*path, index))
     elif isinstance(node, yaml.MappingNode):
         for key_node, value_node in node.value:
-            size += _expanded_size(key_node, sizes, open_nodes) + _expanded_size(value_node, sizes, open_nodes)
+            name = key_node.value if isinstance(key_node, yaml.ScalarNode) else "?"
+            size += _expanded_size(key_node, sizes, open_nodes, (*path, name))
+            size += _expanded_size(value_node, sizes, open_nodes, (*path, name))
     open_nodes.discard(key)
     sizes[key] = size
     return size
 
 
-def _check_node(node: yaml.Node) -> None:
+def _check_node(node: yaml.Node, path: NodePath) -> None:
     if node.tag not in _PLAIN_TAGS:
-        raise NodeProblem(f"the tag {_shown(node.tag)} (only plain YAML values are read)", node)
+        raise NodeProblem(f"the tag {_shown(node.tag)} (only plain YAML values are read)", node, path)
     if isinstance(node, yaml.ScalarNode):
         text = node.value
         if len(text) > MAX_SCALAR_LENGTH:
-            raise NodeProblem(f"a value of {len(text)} characters (at most {MAX_SCALAR_LENGTH})", node)
+            raise NodeProblem(f"a value of {len(text)} characters (at most {MAX_SCALAR_LENGTH})", node, path)
         if "\x00" in text:
-            raise NodeProblem("a NUL character in a value", node)
+            raise NodeProblem("a NUL character in a value", node, path)
         try:
             text.encode("utf-8")
         except UnicodeEncodeError:
-            raise NodeProblem("a lone surrogate (not a character) in a value", node) from None
+            raise NodeProblem("a lone surrogate (not a character) in a value", node, path) from None
 
 
 def _largest_repeated(root: yaml.Node, sizes: dict[int, int]) -> yaml.Node:

@@ -281,7 +281,8 @@ def read_entries(path: Path, kind: str = "motors") -> dict[str, CatalogueEntry]:
         if root is not None:
             check_nodes(root)  # before constructing any value: tags, alias bombs, huge values
     except NodeProblem as error:
-        raise CatalogueError(name, error.line, "", f"not valid YAML: {error.reason}") from None
+        field = ".".join(map(str, error.path)).encode("unicode_escape").decode("ascii")
+        raise CatalogueError(name, error.line, field, f"not valid YAML: {error.reason}") from None
     except yaml.YAMLError as error:
         mark = getattr(error, "problem_mark", None)
         line = mark.line + 1 if mark is not None else None

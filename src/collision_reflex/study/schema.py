@@ -564,7 +564,9 @@ class ExecutionSpec(_Model):
     """Where the independent work runs: in-process, a local process pool, or a Dask cluster."""
 
     executor: Literal["serial", "processes", "dask"] = "serial"
-    workers: Annotated[int, Field(ge=1, le=1024, strict=True)] = 2  # more processes than any machine runs
+    # Local worker processes: more than 256 is more than the cores of any one machine (a Dask cluster scales
+    # with a scheduler address instead).
+    workers: Annotated[int, Field(ge=1, le=256, strict=True)] = 2
     scheduler: str | None = Field(None, description="Dask scheduler address, e.g. tcp://host:8786")
 
     @model_validator(mode="after")

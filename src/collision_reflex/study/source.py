@@ -25,7 +25,7 @@ PathKey = tuple[Hashable, ...]
 MAX_FILE_SIZE = 1 << 20
 """Largest study file read [bytes]: the shipped studies are a few kB."""
 
-_FOUND_LENGTH = 200
+_FOUND_LENGTH = 300
 
 
 @dataclass(frozen=True)
@@ -165,7 +165,8 @@ def parse_study_source(text: str, file: str = "<string>", directory: Path | None
         data = loader.construct_document(node) if node is not None else None
     except NodeProblem as error:
         found = f"invalid YAML ({error.reason})"
-        problem = problem_at(file, error.line, error.column, "", found, "well-formed YAML of plain values")
+        where = format_path(error.path)
+        problem = problem_at(file, error.line, error.column, where, found, "well-formed YAML of plain values")
         raise StudyFileError(file, [problem]) from None
     except yaml.MarkedYAMLError as error:
         mark = error.problem_mark or error.context_mark
