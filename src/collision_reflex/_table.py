@@ -52,9 +52,21 @@ def read_table(lines: list[str], header_line: int) -> pd.DataFrame:
             skipinitialspace=True,
         )
     except (pd.errors.ParserError, pd.errors.EmptyDataError) as error:
-        # pandas' message spans lines and names the line within the table: one line, in file lines.
+        # pandas' message spans lines and counts from the header: one line, located by file line.
         reason = " ".join(str(error).split())
-        raise TableProblem(f"not a CSV table ({reason})", header_line + 1) from None
+        raise TableProblem(f"not a CSV table ({reason})", _file_line(reason, header_line)) from None
     blank = (table == "").all(axis=1).to_numpy()
     last = len(blank) - int(np.argmin(blank[::-1])) if not blank.all() else 0
     return table.iloc[:last]
+
+
+def _file_line(reason: str, header_line: int) -> int:
+    """The 1-based file line a pandas parser message points at (the header's if it names none).
+
+    pandas counts "line N" from 1 at the header, and "row N" from 0 at the header.
+    """
+    match = re.search(r"\b(line|row) (\d+)", reason)
+    if match is None:
+        return header_line + 1
+    number = int(match[2])
+    return header_line + number + (1 if match[1] == "row" else 0)

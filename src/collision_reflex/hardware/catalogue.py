@@ -304,6 +304,13 @@ def read_entries(path: Path, kind: str = "motors") -> dict[str, CatalogueEntry]:
     _, parts_node = top[kind]
     if not isinstance(parts_node, yaml.MappingNode):
         raise CatalogueError(name, _line(parts_node), kind, "expected a mapping from part name to entry")
+    for key_node, _ in parts_node.value:
+        part = key_node.value if isinstance(key_node, yaml.ScalarNode) else None
+        if not isinstance(part, str) or not part.isprintable():
+            shown = _excerpt(part) if isinstance(part, str) else "a mapping or list"
+            raise CatalogueError(
+                name, _line(key_node), kind, f"a part name must be text on one line, got {shown}"
+            )
     return {
         part: _entry(name, kind, part, key_node, entry_node)
         for part, (key_node, entry_node) in _mapping(parts_node).items()
