@@ -60,6 +60,7 @@ def unit_registry() -> pint.UnitRegistry:
     return pint.UnitRegistry()
 
 
+@functools.lru_cache(maxsize=4096)  # files repeat their units; a pint conversion costs ~0.2 ms
 def parse_quantity(text: str, unit: str, *, angle_explicit: bool = False) -> float:
     """The quantity ``text`` (e.g. ``"60 mm"``, or a bare number taken in ``unit``) as a float in ``unit``.
 

@@ -95,7 +95,7 @@ def _check_node(node: yaml.Node, path: NodePath) -> None:
         try:
             text.encode("utf-8")
         except UnicodeEncodeError:
-            raise NodeProblem("a lone surrogate (not a character) in a value", node, path) from None
+            raise NodeProblem("a lone surrogate (not a Unicode character) in a value", node, path) from None
 
 
 def _largest_repeated(root: yaml.Node, sizes: dict[int, int]) -> yaml.Node:

@@ -277,7 +277,7 @@ def read_entries(path: Path, kind: str = "motors") -> dict[str, CatalogueEntry]:
         line = data.count(b"\n", 0, error.start) + 1
         raise CatalogueError(name, line, "", f"the byte 0x{data[error.start]:02x} is not UTF-8 text") from None
     try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
+        root = yaml.compose(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))  # libyaml if built
         if root is not None:
             check_nodes(root)  # before constructing any value: tags, alias bombs, huge values
     except NodeProblem as error:
