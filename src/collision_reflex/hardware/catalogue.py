@@ -283,15 +283,19 @@ def read_entries(path: Path, kind: str = "motors") -> dict[str, CatalogueEntry]:
     except NodeProblem as error:
         field = ".".join(map(str, error.path)).encode("unicode_escape").decode("ascii")
         raise CatalogueError(name, error.line, field, f"not valid YAML: {error.reason}") from None
+    except yaml.reader.ReaderError as error:  # a character YAML does not allow
+        line = text.count("\n", 0, error.position) + 1
+        raise CatalogueError(name, line, "", f"not valid YAML: {' '.join(error.reason.split())}") from None
     except yaml.YAMLError as error:
         mark = getattr(error, "problem_mark", None)
         line = mark.line + 1 if mark is not None else None
         problem = getattr(error, "problem", None) or str(error)
-        raise CatalogueError(name, line, "", f"not valid YAML: {problem}") from None
+        raise CatalogueError(name, line, "", f"not valid YAML: {' '.join(problem.split())}") from None
     except RecursionError:
         raise CatalogueError(name, None, "", "not valid YAML: nesting too deep") from None
     if not isinstance(root, yaml.MappingNode):
-        raise CatalogueError(name, _line(root), "", f"expected a mapping with a top-level {kind!r} key")
+        line = _line(root) if root is not None else 1  # None: an empty file
+        raise CatalogueError(name, line, "", f"expected a mapping with a top-level {kind!r} key")
     top = _mapping(root)
     if kind not in top:
         raise CatalogueError(name, 1, kind, f"missing: the file needs a top-level {kind!r} mapping")

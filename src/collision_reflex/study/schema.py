@@ -410,10 +410,40 @@ class DutyCycleSpec(_Model):
                 f"dwell: one time for all via points or one per via point ({len(self.via or [])})"
             )
         rate = self.rate if self.rate is not None else DEFAULT_RATE
+        samples = _motion_duration_bound(self.via or [], self.max_speed, self.max_acceleration, dwell) * rate
+        if samples > MAX_CYCLE_SAMPLES:
+            raise ValueError(
+                f"a motion of at most {MAX_CYCLE_SAMPLES:.0e} samples (these via points, limits and rate may "
+                f"need up to {samples:.2g}): raise max_speed or max_acceleration, or lower the rate"
+            )
         # The defaults become explicit (the resolved study shows them).
         object.__setattr__(self, "dwell", dwell)
         object.__setattr__(self, "rate", rate)
         return self
+
+
+MAX_CYCLE_SAMPLES = 500_000
+"""Most samples of a via-point motion: 500 s at 1 kHz; each sample costs the dynamics of every joint."""
+
+
+def _motion_duration_bound(via: Any, speed: Any, acceleration: Any, dwell: Any) -> float:
+    """An upper bound of a via-point motion's duration [s], before the joints are known.
+
+    A rest-to-rest move of distance d within speed v and acceleration a takes at most d/v + v/a (less when it
+    never reaches v). Bounded with the largest step between via points, the lowest speed limit and the highest
+    speed over the lowest acceleration limit.
+    """
+    speeds = list(speed.values()) if isinstance(speed, dict) else [speed]
+    accelerations = list(acceleration.values()) if isinstance(acceleration, dict) else [acceleration]
+    if not speeds or not accelerations:
+        return 0.0
+    v_min, v_max, a_min = min(speeds), max(speeds), min(accelerations)
+    steps = [
+        max((abs(b - a) for a, b in zip(start, end, strict=False)), default=0.0)
+        for start, end in zip(via[:-1], via[1:], strict=False)
+    ]
+    rests = sum(dwell) if isinstance(dwell, builtins.list) else dwell * len(via)
+    return sum(step / v_min + v_max / a_min for step in steps) + rests
 
 
 # --- design variables --------------------------------------------------------------------------------------------

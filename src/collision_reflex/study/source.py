@@ -151,7 +151,13 @@ def read_study_source(path: str | os.PathLike[str]) -> StudySource:
 def parse_study_source(text: str, file: str = "<string>", directory: Path | None = None) -> StudySource:
     """Parse YAML text into a :class:`StudySource`; errors as for :func:`read_study_source`."""
     directory = directory if directory is not None else Path.cwd()
-    loader = _LOADER(text)
+    try:
+        loader = _LOADER(text)
+    except UnicodeEncodeError as error:  # a lone surrogate in text given directly (a file's text has none)
+        line = text.count("\n", 0, error.start) + 1
+        column = error.start - (text.rfind("\n", 0, error.start) + 1) + 1
+        found = "a lone surrogate (not a Unicode character)"
+        raise StudyFileError(file, [problem_at(file, line, column, "", found, "text")]) from None
     try:
         node = loader.get_single_node()
         if node is not None:
