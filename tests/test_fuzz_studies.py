@@ -172,10 +172,12 @@ def _structure_mutant(rng: random.Random, original: Any) -> str:
             break
         path = rng.choice(paths)
         parent, key = _get(data, path[:-1]), path[-1]
-        operation = rng.choice(["replace", "replace", "scale", "unit", "delete", "rename", "swap", "add"])
+        operation = rng.choice(
+            ["replace", "replace", "scale", "unit", "delete", "rename", "swap", "add", "alias", "bomb"]
+        )
         value = parent[key]
         if operation == "replace":
-            parent[key] = rng.choice(HOSTILE_VALUES)
+            parent[key] = copy.deepcopy(rng.choice(HOSTILE_VALUES))  # never the shared original
         elif operation == "scale" and isinstance(value, (int, float)) and not isinstance(value, bool):
             parent[key] = value * 10.0 ** rng.choice([-300, -30, -9, -3, 3, 9, 30, 300])
         elif operation == "unit" and isinstance(value, (int, float, str)) and not isinstance(value, bool):
@@ -188,8 +190,22 @@ def _structure_mutant(rng: random.Random, original: Any) -> str:
         elif operation == "swap":
             other = rng.choice(paths)
             parent[key] = copy.deepcopy(_get(data, other)) if other[: len(path)] != path else value
+        elif operation == "alias":
+            # The same object twice: the dump writes an anchor and an alias (a valid use of them).
+            parent[key] = [value, value] if rng.random() < 0.5 else value
+            if isinstance(parent, dict):
+                parent[f"{key}_again"] = value
+        elif operation == "bomb":
+            # Shared lists nested ``depth`` deep: the dump is a few lines, the expansion 9**depth nodes.
+            bomb: Any = value
+            for _ in range(rng.randint(2, 8)):
+                bomb = [bomb] * 9
+            parent[key] = bomb
+            break  # walking the data again would expand the bomb here
         elif operation == "add" and isinstance(parent, dict):
-            parent[rng.choice(["colour", "count", "min", "joints", "value", key])] = rng.choice(HOSTILE_VALUES)
+            parent[rng.choice(["colour", "count", "min", "joints", "value", key])] = copy.deepcopy(
+                rng.choice(HOSTILE_VALUES)
+            )
     return _dump(data)
 
 

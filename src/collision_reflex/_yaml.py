@@ -3,7 +3,8 @@
 Study files and part catalogues may come from anyone. A YAML alias repeats a node without repeating its text,
 so nine levels of nine aliases ("billion laughs") describe 387 million nodes in a few hundred bytes: every
 walk over the constructed data (validation, messages) would take minutes and gigabytes. Tags name Python
-objects (``!!python/name:os.system``). :func:`check_nodes` refuses such trees at the offending node.
+objects (``!!python/name:os.system``). :func:`check_nodes` refuses such trees at the offending node, and
+:func:`one_line` keeps a message that quotes the file on one printable line.
 """
 
 from __future__ import annotations
@@ -122,3 +123,13 @@ def _shown(tag: str) -> str:
 
 def _count(number: int) -> str:
     return f"{number:.2g}" if number >= 1e6 else str(number)
+
+
+def one_line(text: str) -> str:
+    """``text`` with line breaks, control characters and lone surrogates escaped (``\\n``, ``\\ud800``).
+
+    For messages that quote a file: each stays one line of printable text, whatever the file holds.
+    """
+    if text.isprintable():
+        return text
+    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii") for c in text)

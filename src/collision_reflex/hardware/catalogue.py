@@ -18,7 +18,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError, field_validator
 
 from .._units import QuantityError, parse_quantity
-from .._yaml import NodeProblem, check_nodes
+from .._yaml import NodeProblem, check_nodes, one_line
 from ..errors import CatalogueError
 
 # Field -> the unit a plain number is taken in (SI), and the pint dimensionality a quantity string must have.
@@ -265,6 +265,18 @@ def read_entries(path: Path, kind: str = "motors") -> dict[str, CatalogueEntry]:
         Naming the file, the line and the field: bad YAML, a missing, unknown or mistyped field, a unit of
         the wrong dimension, a non-physical value, or an entry without a source.
     """
+    try:
+        return _read_entries(path, kind)
+    except CatalogueError as error:
+        texts = (str(error.path), error.field, error.reason)
+        if all(text.isprintable() for text in texts):
+            raise
+        # A message quotes field names and values of the file: escape what would break or hide its line.
+        path_text, field, reason = map(one_line, texts)
+        raise CatalogueError(path_text, error.line, field, reason) from None
+
+
+def _read_entries(path: Path, kind: str) -> dict[str, CatalogueEntry]:
     name = str(path)
     try:
         data = Path(path).read_bytes()
@@ -281,7 +293,7 @@ def read_entries(path: Path, kind: str = "motors") -> dict[str, CatalogueEntry]:
         if root is not None:
             check_nodes(root)  # before constructing any value: tags, alias bombs, huge values
     except NodeProblem as error:
-        field = ".".join(map(str, error.path)).encode("unicode_escape").decode("ascii")
+        field = ".".join(map(str, error.path))
         raise CatalogueError(name, error.line, field, f"not valid YAML: {error.reason}") from None
     except yaml.reader.ReaderError as error:  # a character YAML does not allow
         line = text.count("\n", 0, error.position) + 1

@@ -16,7 +16,7 @@ from typing import Any
 
 import yaml
 
-from .._yaml import NodeProblem, check_nodes
+from .._yaml import NodeProblem, check_nodes, one_line
 from ..errors import StudyFileError, StudyProblem
 
 PathKey = tuple[Hashable, ...]
@@ -86,13 +86,6 @@ def problem_at(file: str, line: int, column: int, path: str, found: str, expecte
     if len(found) > _FOUND_LENGTH:  # what the file holds, quoted as a short excerpt
         found = found[: _FOUND_LENGTH - 3] + "..."
     return StudyProblem(one_line(file), line, column, one_line(path), found, one_line(expected))
-
-
-def one_line(text: str) -> str:
-    """``text`` with line breaks, control characters and lone surrogates escaped (``\\n``, ``\\ud800``)."""
-    if text.isprintable():
-        return text
-    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii") for c in text)
 
 
 def _looks_internal(key: Hashable) -> bool:
