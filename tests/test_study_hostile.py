@@ -368,3 +368,17 @@ def test_a_catalogue_quantity_is_read_by_the_study_grammar(tmp_path):
     path.write_text(_replaced("rotor_inertia: 1e-6", "rotor_inertia: 0.25 kg*cm^2", MOTOR))
     inertia = read_entries(path, "motors")["small"].fields["rotor_inertia"]
     assert inertia == pytest.approx(0.25e-4, rel=1e-12)  # 1 cm^2 = 1e-4 m^2
+
+
+def test_a_unit_tower_in_a_trajectory_header_is_refused_at_once(tmp_path):
+    """Units in CSV headers go through the same bounded grammar (pint alone ran for minutes on this)."""
+    rows = "\n".join(f"{0.01 * i:.2f}, 0, 0" for i in range(200))
+    (tmp_path / "cycle.csv").write_text("time [s**9**9**9], joint1, joint2\n" + rows + "\n")
+    text = BASE + "duty_cycle: {file: cycle.csv}\n"
+    start = time.perf_counter()
+    with pytest.raises(StudyFileError) as caught:
+        describe_study(parse_study(text, "hostile.yaml", tmp_path))
+    assert time.perf_counter() - start < MAX_SECONDS
+    (problem,) = caught.value.problems
+    assert problem.path == "duty_cycle.file" and problem.line == text.count("\n")
+    assert problem.found.startswith("cycle.csv:1:") and "unit" in problem.found

@@ -95,6 +95,12 @@ def parse_quantity(text: str, unit: str, *, angle_explicit: bool = False) -> flo
     return magnitude
 
 
+@functools.cache
+def si_scale(unit: str) -> float:
+    """The factor from ``unit`` (the package's own unit text, never a file's) to SI base units."""
+    return float(unit_registry().Quantity(1.0, unit).to_base_units().magnitude)
+
+
 def _converted(number: float, text: str, unit: str, angle_explicit: bool) -> float:
     """``number`` in the unit ``text`` (already of the bounded grammar), converted to ``unit``."""
     import pint
