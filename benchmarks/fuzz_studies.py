@@ -27,8 +27,10 @@ def main() -> None:
     parser.add_argument("--mutants", type=int, default=100_000, help="number of mutants (default 100,000)")
     parser.add_argument("--first", type=int, default=10_000, help="index of the first (default: after CI's)")
     args = parser.parse_args()
-    print(f"{args.mutants} mutants from index {args.first} of {len(SOURCES)} files: "
-          + ", ".join(path.name for path in SOURCES))
+    print(
+        f"{args.mutants} mutants from index {args.first} of {len(SOURCES)} files: "
+        + ", ".join(path.name for path in SOURCES)
+    )
     with tempfile.TemporaryDirectory() as folder:
         report = fuzz(
             args.mutants, Path(folder), args.first, progress=lambda done: print(f"  {done} done", flush=True)
@@ -37,8 +39,10 @@ def main() -> None:
         print(f"{outcome:>18}: {count}")
     elapsed, index = report.slowest
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # kB on Linux
-    print(f"all valid or located: {sum(report.counts.values())} mutants in {report.seconds:.1f} s "
-          f"({sum(report.counts.values()) / report.seconds:.0f} per s)")
+    print(
+        f"all valid or located: {sum(report.counts.values())} mutants in {report.seconds:.1f} s "
+        f"({sum(report.counts.values()) / report.seconds:.0f} per s)"
+    )
     print(f"slowest mutant: {elapsed * 1e3:.0f} ms (index {index})")
     print(f"peak memory: {peak_mb:.0f} MB, {report.peak_growth_mb:.0f} MB more than before the first mutant")
 

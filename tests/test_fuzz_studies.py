@@ -297,7 +297,9 @@ def _check_catalogue(item: Mutant, folder: Path) -> str:
         path.write_bytes(item.data)
     else:
         path.write_text(item.text, encoding="utf-8", errors="surrogatepass")
-    n_lines = len((item.data.decode("utf-8", "replace") if item.data is not None else item.text).splitlines()) + 1
+    n_lines = (
+        len((item.data.decode("utf-8", "replace") if item.data is not None else item.text).splitlines()) + 1
+    )
     try:
         read_entries(path, CATALOGUES[item.source])
     except CatalogueError as error:
@@ -316,7 +318,9 @@ class FuzzReport:
     seconds: float
 
 
-def fuzz(n_mutants: int, folder: Path, first: int = 0, progress: Callable[[int], None] | None = None) -> FuzzReport:
+def fuzz(
+    n_mutants: int, folder: Path, first: int = 0, progress: Callable[[int], None] | None = None
+) -> FuzzReport:
     """Check mutants ``first`` to ``first + n_mutants - 1``; a failing mutant's assertion names its index."""
     counts: dict[str, int] = {}
     slowest = (0.0, -1)

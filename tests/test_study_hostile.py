@@ -152,14 +152,27 @@ def test_a_long_value_is_refused_before_it_is_read():
             "integer",
         ),
         ("{circle: 8}", "{sphere: 3000000000}", "samples.directions.sphere", "less than or equal to 10000"),
-        ("  locked_joints: []", "  locked_joints: [joint1, joint1]", "robot.locked_joints", "each joint once"),
+        (
+            "  locked_joints: []",
+            "  locked_joints: [joint1, joint1]",
+            "robot.locked_joints",
+            "each joint once",
+        ),
         ("  locked_joints: []", "  locked_joints: [joint1, joint2]", "robot", "at least one joint"),
         # libyaml refuses the escape itself (no field path yet); PyYAML's own parser lets us name the field.
         ("  locked_joints: []", '  contact_frame: "\\ud800"', None, "Unicode"),
         ("  example_robot_data: double_pendulum", '  urdf: "a\\0b.urdf"', "robot.urdf", "NUL"),
     ],
-    ids=["negative-seed", "huge-count", "float-count", "huge-sphere", "duplicate-locked", "all-locked",
-         "surrogate-frame", "nul-path"],
+    ids=[
+        "negative-seed",
+        "huge-count",
+        "float-count",
+        "huge-sphere",
+        "duplicate-locked",
+        "all-locked",
+        "surrogate-frame",
+        "nul-path",
+    ],
 )
 def test_bad_values_are_located_not_raised(line, replacement, path, words):
     text = _replaced(line, replacement)
@@ -176,9 +189,7 @@ def test_an_unreadable_urdf_is_located():
     # /proc/self/mem is a regular file to stat() but reading it fails with EIO.
     if not Path("/proc/self/mem").is_file():
         pytest.skip("no /proc")
-    text = _replaced(
-        "  example_robot_data: double_pendulum", "  urdf: /proc/self/mem\n  contact_frame: tip"
-    )
+    text = _replaced("  example_robot_data: double_pendulum", "  urdf: /proc/self/mem\n  contact_frame: tip")
     problem = _only_problem(text)
     assert problem.path == "robot.urdf" and "cannot be read" in problem.found
 
@@ -206,7 +217,11 @@ ACTUATOR = (ROOT / "studies" / "direct_drive_vs_geared.yaml").read_text()
     [
         (_replaced("workers: 2}", "workers: 100000000000}"), "execution.workers", "256"),
         (_replaced("lever: 114.3 mm", "lever: 1e-300 mm", ACTUATOR), "load.lever", "from 0.001 to 10 m"),
-        (_replaced("finger_mass: 0.1 kg", "finger_mass: 1e300 kg", ACTUATOR), "load.finger_mass", "to 1000 kg"),
+        (
+            _replaced("finger_mass: 0.1 kg", "finger_mass: 1e300 kg", ACTUATOR),
+            "load.finger_mass",
+            "to 1000 kg",
+        ),
         (
             _replaced("contact_stiffness: 2e7 ", "contact_stiffness: 1e-300 ", ACTUATOR),
             "load.contact_stiffness",
@@ -289,7 +304,7 @@ def test_a_key_with_a_line_break_is_printed_on_one_line(tmp_path, capsys):
     ("csv", "csv_line", "words"),
     [
         ('joint1,joint2\n0,0\n"1,2\n', 3, "not a CSV table"),
-        ('# comment\n\njoint1,joint2\n0,0\n1,2,3\n', 5, "not a CSV table"),
+        ("# comment\n\njoint1,joint2\n0,0\n1,2,3\n", 5, "not a CSV table"),
         ("joint1,joint2\n0,0\n1,2,3,4\n", 3, "not a CSV table"),
         ("# comment\njoint1,joint2\n0,0\n0.1,x\n", 4, "not a finite number"),
     ],
@@ -341,12 +356,28 @@ def _catalogue_error(tmp_path: Path, text: str) -> CatalogueError:
 @pytest.mark.parametrize(
     ("old", "new", "line", "field", "words"),
     [
-        ("rotor_inertia: 1e-6", "rotor_inertia: !!python/name:os.system", 5, "motors.small.rotor_inertia", "tag"),
+        (
+            "rotor_inertia: 1e-6",
+            "rotor_inertia: !!python/name:os.system",
+            5,
+            "motors.small.rotor_inertia",
+            "tag",
+        ),
         ("  small:", "  !!python/name:os.system small:", 2, "motors.small", "tag"),
-        ("stator_diameter: 30 mm", 'stator_diameter: "10**10**10 mm"', 3, "motors.small.stator_diameter",
-         "not a quantity"),
-        ("stator_diameter: 30 mm", "stator_diameter: 30 mm" + " * m/m" * 1500, 3, "motors.small.stator_diameter",
-         "not a quantity"),
+        (
+            "stator_diameter: 30 mm",
+            'stator_diameter: "10**10**10 mm"',
+            3,
+            "motors.small.stator_diameter",
+            "not a quantity",
+        ),
+        (
+            "stator_diameter: 30 mm",
+            "stator_diameter: 30 mm" + " * m/m" * 1500,
+            3,
+            "motors.small.stator_diameter",
+            "not a quantity",
+        ),
         ("mass: 80 g", "mass: 2001-02-30", 8, "motors.small.mass", "number"),
     ],
     ids=["tag-value", "tag-name", "tower", "9k-unit", "impossible-date"],
@@ -382,3 +413,19 @@ def test_a_unit_tower_in_a_trajectory_header_is_refused_at_once(tmp_path):
     (problem,) = caught.value.problems
     assert problem.path == "duty_cycle.file" and problem.line == text.count("\n")
     assert problem.found.startswith("cycle.csv:1:") and "unit" in problem.found
+
+
+def test_a_catalogue_byte_that_is_not_utf8_is_located(tmp_path):
+    path = tmp_path / "motors.yaml"
+    path.write_bytes(MOTOR.encode().replace(b"mass: 80 g", b"mass: 80 \xff"))
+    with pytest.raises(CatalogueError) as caught:
+        read_entries(path, "motors")
+    assert caught.value.line == 8 and "0xff" in caught.value.reason
+
+
+def test_catalogue_messages_escape_what_cannot_be_printed(tmp_path):
+    # A zero-width no-break space inside a field name (invisible in an editor) is shown, escaped.
+    error = _catalogue_error(
+        tmp_path, _replaced("    mass: 80 g", "    mass: 80 g\n    ma\ufeffss: 80 g", MOTOR)
+    )
+    assert error.line == 9 and error.field == "motors.small.ma\\ufeffss" and "unknown field" in error.reason

@@ -14,7 +14,7 @@ from __future__ import annotations
 import functools
 import math
 import re
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     import pint
@@ -80,8 +80,11 @@ def parse_quantity(text: str, unit: str, *, angle_explicit: bool = False) -> flo
         Saying why the text is not a quantity of ``unit``'s dimension.
     """
     if len(text) > MAX_QUANTITY_LENGTH:
-        raise QuantityError("syntax", f"a text of {len(text)} characters; expected {_GRAMMAR}, at most "
-                            f"{MAX_QUANTITY_LENGTH} characters")
+        raise QuantityError(
+            "syntax",
+            f"a text of {len(text)} characters; expected {_GRAMMAR}, at most "
+            f"{MAX_QUANTITY_LENGTH} characters",
+        )
     match = _QUANTITY.fullmatch(text)
     if match is None:
         raise QuantityError("syntax", f"not {_GRAMMAR}")
@@ -119,7 +122,9 @@ def _converted(number: float, text: str, unit: str, angle_explicit: bool) -> flo
             _dimension(target),
         )
     if angle_explicit and _radian_power(given) != _radian_power(target):
-        raise QuantityError("angle", f"no angle unit; give an angle per time, e.g. '3000 rpm' or '314 {unit}'")
+        raise QuantityError(
+            "angle", f"no angle unit; give an angle per time, e.g. '3000 rpm' or '314 {unit}'"
+        )
     try:
         with_number = registry.Quantity(number, text.replace("^", "**"))
         return float(with_number.to(unit).magnitude)
@@ -132,6 +137,6 @@ def _dimension(quantity: pint.Quantity) -> str:
     return "dimensionless" if text in ("", "dimensionless") else text
 
 
-def _radian_power(quantity: pint.Quantity) -> int:
+def _radian_power(quantity: Any) -> int:
     """The power of the angle (radian) in ``quantity``'s unit: 1 for ``rpm`` and ``rad/s``, 0 for ``Hz``."""
     return int(dict(quantity.to_root_units().unit_items()).get("radian", 0))

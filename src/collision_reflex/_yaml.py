@@ -126,7 +126,7 @@ def _count(number: int) -> str:
 
 
 def one_line(text: str) -> str:
-    """``text`` with line breaks, control characters and lone surrogates escaped (``\\n``, ``\\ud800``).
+    r"""``text`` with line breaks, control characters and lone surrogates escaped (``\n``, ``\ud800``).
 
     For messages that quote a file: each stays one line of printable text, whatever the file holds.
     """

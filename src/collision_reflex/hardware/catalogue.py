@@ -286,8 +286,8 @@ def _read_entries(path: Path, kind: str) -> dict[str, CatalogueEntry]:
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as error:
-        line = data.count(b"\n", 0, error.start) + 1
-        raise CatalogueError(name, line, "", f"the byte 0x{data[error.start]:02x} is not UTF-8 text") from None
+        at = data.count(b"\n", 0, error.start) + 1
+        raise CatalogueError(name, at, "", f"the byte 0x{data[error.start]:02x} is not UTF-8 text") from None
     try:
         root = yaml.compose(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))  # libyaml if built
         if root is not None:
@@ -296,8 +296,8 @@ def _read_entries(path: Path, kind: str) -> dict[str, CatalogueEntry]:
         field = ".".join(map(str, error.path))
         raise CatalogueError(name, error.line, field, f"not valid YAML: {error.reason}") from None
     except yaml.reader.ReaderError as error:  # a character YAML does not allow
-        line = text.count("\n", 0, error.position) + 1
-        raise CatalogueError(name, line, "", f"not valid YAML: {' '.join(error.reason.split())}") from None
+        at = text.count("\n", 0, error.position) + 1
+        raise CatalogueError(name, at, "", f"not valid YAML: {' '.join(error.reason.split())}") from None
     except yaml.YAMLError as error:
         mark = getattr(error, "problem_mark", None)
         line = mark.line + 1 if mark is not None else None

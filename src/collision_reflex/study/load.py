@@ -8,8 +8,8 @@ model (frames, joint names, configuration sizes) are in :mod:`.robot` and run wh
 from __future__ import annotations
 
 import difflib
-import reprlib
 import os
+import reprlib
 import types
 import typing
 from collections.abc import Hashable, Sequence

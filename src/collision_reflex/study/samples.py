@@ -11,8 +11,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..arm.directions import circle_directions, sphere_directions, unit_directions
 from .._table import TableProblem, header_index, read_table
+from ..arm.directions import circle_directions, sphere_directions, unit_directions
 from ..errors import InvalidParameter
 from .load import LoadedStudy
 from .schema import ArmStudy, ConfigurationSamples, DirectionSamples
@@ -124,11 +124,15 @@ def _trajectory(loaded: LoadedStudy, arm: Arm, file: str, every: int) -> np.ndar
     finite = np.isfinite(values).all(axis=1)
     if not finite.all():
         line = header + 2 + int(np.argmin(finite))  # file lines are 1-based; the header is one line
-        raise loaded.fail(where, f"{file}:{line}: a value that is not a finite number", "finite joint positions [rad]")
+        raise loaded.fail(
+            where, f"{file}:{line}: a value that is not a finite number", "finite joint positions [rad]"
+        )
     values = values[::every]
     if values.size == 0:
         raise loaded.fail(where, f"{file}: no rows below the header", "finite joint positions [rad]")
     try:
         return np.asarray(arm.configuration(values), dtype=float)
     except InvalidParameter as error:
-        raise loaded.fail(where, f"{file}: {error}", "joint positions within the joints' limits [rad]") from None
+        raise loaded.fail(
+            where, f"{file}: {error}", "joint positions within the joints' limits [rad]"
+        ) from None

@@ -14,6 +14,7 @@ Every model forbids unknown keys. Quantities are floats in SI units once validat
 from __future__ import annotations
 
 import builtins
+import itertools
 import re
 from typing import Annotated, Any, Literal
 
@@ -124,7 +125,9 @@ class MotorSpec(_Model):
     stator_diameter: PartSize | None = Field(
         None, gt=0, description="scaled stator diameter [m]; null: reference's"
     )
-    stack_length: PartSize | None = Field(None, gt=0, description="scaled stack length [m]; null: reference's")
+    stack_length: PartSize | None = Field(
+        None, gt=0, description="scaled stack length [m]; null: reference's"
+    )
 
     @classmethod
     def __get_pydantic_json_schema__(cls, core_schema: Any, handler: Any) -> Any:
@@ -186,8 +189,12 @@ class SensingSpec(_Model):
     """
 
     scheme: Literal["force", "position", "current"]
-    threshold: ThresholdForce | None = Field(None, gt=0, description="contact-force threshold [N] (scheme: force)")
-    error: PositionError | None = Field(None, gt=0, description="position-error threshold [m] (scheme: position)")
+    threshold: ThresholdForce | None = Field(
+        None, gt=0, description="contact-force threshold [N] (scheme: force)"
+    )
+    error: PositionError | None = Field(
+        None, gt=0, description="position-error threshold [m] (scheme: position)"
+    )
     motor_torque: MotorTorque | None = Field(
         None, gt=0, description="motor-side torque threshold [N m] (scheme: current)"
     )
@@ -217,7 +224,9 @@ class SensingSpec(_Model):
 class RandomConfigurations(_Model):
     """Configurations drawn at random within the joint limits."""
 
-    count: ConfigurationCount = Field(description="number of configurations drawn uniformly within joint limits")
+    count: ConfigurationCount = Field(
+        description="number of configurations drawn uniformly within joint limits"
+    )
     seed: int = Field(0, ge=0, lt=2**64, strict=True, description="seed of the numpy Generator (>= 0)")
 
 
@@ -277,9 +286,7 @@ class SamplesSpec(_Model):
 Rate = quantity_type("Hz", "a sampling rate", "500 Hz", 1.0, 1e4)
 
 
-def _quantities(
-    unit: str, what: str, example: str, collection: type, minimum: str, maximum: float
-) -> Any:
+def _quantities(unit: str, what: str, example: str, collection: type, minimum: str, maximum: float) -> Any:
     """A quantity for every item (a number or a string with units), or a ``collection`` of them, in ``unit``.
 
     ``collection`` is ``dict`` (by joint name) or ``list`` (one per item); ``minimum`` is ``"> 0"`` or
@@ -324,9 +331,7 @@ def _quantities(
 
 # Limits a joint could physically reach (1000 rad/s is ~10,000 rpm at the output; 1e6 rad/s^2 ~ 100 g at 0.01
 # m), and an hour at rest: beyond these a duty cycle is a typing error.
-JointSpeed = _quantities(
-    "rad/s", "a joint speed (m/s for a prismatic joint)", "90 deg/s", dict, "> 0", 1e3
-)
+JointSpeed = _quantities("rad/s", "a joint speed (m/s for a prismatic joint)", "90 deg/s", dict, "> 0", 1e3)
 JointAcceleration = _quantities(
     "rad/s^2", "a joint acceleration (m/s^2 for a prismatic joint)", "300 deg/s^2", dict, "> 0", 1e6
 )
@@ -440,7 +445,7 @@ def _motion_duration_bound(via: Any, speed: Any, acceleration: Any, dwell: Any) 
     v_min, v_max, a_min = min(speeds), max(speeds), min(accelerations)
     steps = [
         max((abs(b - a) for a, b in zip(start, end, strict=False)), default=0.0)
-        for start, end in zip(via[:-1], via[1:], strict=False)
+        for start, end in itertools.pairwise(via)
     ]
     rests = sum(dwell) if isinstance(dwell, builtins.list) else dwell * len(via)
     return sum(step / v_min + v_max / a_min for step in steps) + rests
@@ -519,7 +524,9 @@ SoftwareStiffnessVariable = _per_joint(
     "SoftwareStiffnessVariable", _SoftBounds, "software stiffness [N m/rad]"
 )
 ThresholdVariable = _variable_model("ThresholdVariable", ThresholdForce, None, "contact-force threshold [N]")
-PositionErrorVariable = _variable_model("PositionErrorVariable", PositionError, None, "position-error threshold [m]")
+PositionErrorVariable = _variable_model(
+    "PositionErrorVariable", PositionError, None, "position-error threshold [m]"
+)
 VelocityVariable = _variable_model("VelocityVariable", ApproachVelocity, None, "approach velocity [m/s]")
 
 PER_JOINT_DESIGN_VARIABLES = ("stator_diameter", "stack_length", "gear_ratio", "software_stiffness")
@@ -553,7 +560,9 @@ class ConstraintsSpec(_Model):
         description="mass carried at the contact point [kg], a point mass (also over a duty cycle); or "
         "duty_cycle.payload with its inertia, not both",
     )
-    safety_factor: SafetyFactor = Field(1.0, ge=1, description="peak torque >= safety_factor x required torque")
+    safety_factor: SafetyFactor = Field(
+        1.0, ge=1, description="peak torque >= safety_factor x required torque"
+    )
     threshold_floor: NoiseFloor = Field(0.0, ge=0, description="sensing noise floor [N]")
     torque_required: list[JointTorque] | None = Field(
         None, description="required torque per joint [N m]; null: gravity (+ payload) over the samples"

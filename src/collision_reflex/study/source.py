@@ -137,7 +137,9 @@ def read_study_source(path: str | os.PathLike[str]) -> StudySource:
         start = data.rfind(b"\n", 0, error.start) + 1
         line = data.count(b"\n", 0, error.start) + 1
         column = len(data[start : error.start].decode("utf-8", "replace")) + 1
-        raise fail(line, column, f"the byte 0x{data[error.start]:02x}, not UTF-8 text", "a UTF-8 file") from None
+        raise fail(
+            line, column, f"the byte 0x{data[error.start]:02x}, not UTF-8 text", "a UTF-8 file"
+        ) from None
     return parse_study_source(text, name, file.resolve().parent)
 
 
