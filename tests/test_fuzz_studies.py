@@ -45,7 +45,8 @@ SEED = 15
 N_MUTANTS = 10_000  # per CI run, ~40 s on one core
 MAX_SECONDS = 3.0  # any one mutant: parse, validate, load the (cached) robot
 MAX_PEAK_GROWTH_MB = 300  # the process's peak memory over the whole run
-MAX_MESSAGE = 600  # characters of one problem's line
+MAX_FOUND = 160  # characters of what a problem quotes from the file: an excerpt
+MAX_MESSAGE = 2000  # characters of one problem's line, with what is expected (e.g. the robot's frame names)
 
 # Values a hostile or careless author writes: extremes, non-numbers, expressions, wrong units and types.
 HOSTILE_VALUES: list[Any] = [
@@ -286,6 +287,7 @@ def check_mutant(item: Mutant, folder: Path) -> str:
             _check_line(str(problem), file, n_lines, problem.line)
             assert problem.line >= 1 or item.data is not None, problem
             assert problem.found and problem.expected, problem
+            assert len(problem.found) <= MAX_FOUND, problem
         return "error"
     yaml.load(resolved_yaml(loaded), Loader=_LOADER)  # what validates resolves to YAML that reads back
     return "valid"

@@ -25,7 +25,7 @@ PathKey = tuple[Hashable, ...]
 MAX_FILE_SIZE = 1 << 20
 """Largest study file read [bytes]: the shipped studies are a few kB."""
 
-_FOUND_LENGTH = 300
+_FOUND_LENGTH = 160
 
 
 @dataclass(frozen=True)
