@@ -194,6 +194,14 @@ def test_an_unreadable_urdf_is_located():
     assert problem.path == "robot.urdf" and "cannot be read" in problem.found
 
 
+def test_a_path_too_long_for_the_system_is_no_such_file():
+    text = _replaced(
+        "  example_robot_data: double_pendulum", f"  urdf: {'d' * 5000}.urdf\n  contact_frame: tip"
+    )
+    problem = _only_problem(text)
+    assert problem.path == "robot.urdf" and "no such file" in problem.found
+
+
 def test_validation_counts_random_samples_without_drawing_them(monkeypatch):
     from collision_reflex.arm import Arm
 

@@ -15,7 +15,7 @@ from ..errors import StudyFileError, StudyProblem
 from .duty import describe_duty_cycle, prismatic_joints, static_requirement, study_duty_cycle
 from .load import LoadedStudy
 from .schema import PER_JOINT_DESIGN_VARIABLES, ActuatorStudy, ArmStudy, GearboxSpec, MotorSpec
-from .source import PathKey
+from .source import PathKey, excerpt
 
 if TYPE_CHECKING:
     from ..hardware.gearboxes import Gearbox
@@ -47,7 +47,7 @@ def check_motors(loaded: LoadedStudy, catalogue: dict[str, Motor] | None = None)
             problems.append(
                 loaded.problem(
                     field,
-                    f"motor {spec.reference!r}, not in the catalogue",
+                    f"motor {excerpt(spec.reference)}, not in the catalogue",
                     (f"{close[0]!r}? " if close else "") + "one of " + ", ".join(map(repr, names)),
                 )
             )

@@ -16,6 +16,7 @@ from ..arm.directions import circle_directions, sphere_directions, unit_directio
 from ..errors import InvalidParameter
 from .load import LoadedStudy
 from .schema import ArmStudy, ConfigurationSamples, DirectionSamples
+from .source import excerpt
 
 if TYPE_CHECKING:
     from ..arm import Arm
@@ -100,11 +101,13 @@ def _trajectory(loaded: LoadedStudy, arm: Arm, file: str, every: int) -> np.ndar
         with loaded.path(file).open("rb") as stream:
             data = stream.read(_MAX_TRAJECTORY_SIZE + 1)
         if len(data) > _MAX_TRAJECTORY_SIZE:
-            raise loaded.fail(where, f"{file!r}, a file over {_MAX_TRAJECTORY_SIZE >> 20} MiB", expected)
+            raise loaded.fail(
+                where, f"{excerpt(file)}, a file over {_MAX_TRAJECTORY_SIZE >> 20} MiB", expected
+            )
         lines = data.decode("utf-8").splitlines()
     except (OSError, ValueError) as error:  # unreadable, not UTF-8, a NUL in the path
         reason = getattr(error, "strerror", None) or str(error)
-        raise loaded.fail(where, f"{file!r}, which cannot be read ({reason})", expected) from None
+        raise loaded.fail(where, f"{excerpt(file)}, which cannot be read ({reason})", expected) from None
     header = header_index(lines)
     if header is None:
         raise loaded.fail(where, f"{file}: no header line and no rows", expected)
@@ -117,7 +120,7 @@ def _trajectory(loaded: LoadedStudy, arm: Arm, file: str, every: int) -> np.ndar
     if missing:
         raise loaded.fail(
             where,
-            f"{file!r} without columns {', '.join(missing)}",
+            f"{excerpt(file)} without columns {', '.join(missing)}",
             "a header row naming every joint: " + ", ".join(joints),
         )
     values = table[joints].apply(pd.to_numeric, errors="coerce").to_numpy(dtype=float)

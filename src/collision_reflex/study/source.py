@@ -9,6 +9,7 @@ line and column. Every problem is one line of printable text, whatever the file 
 from __future__ import annotations
 
 import os
+import reprlib
 from collections.abc import Hashable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -78,6 +79,20 @@ class StudySource:
         """A :class:`StudyProblem` at ``path`` (a path in the file's data)."""
         line, column = self.locate(path)
         return problem_at(self.file, line, column, format_path(path), found, expected)
+
+
+def excerpt(value: Any, limit: int = 60) -> str:
+    """A short description of a value found in the file: its repr, cut to ``limit`` characters.
+
+    reprlib looks at a few items of each level only, so describing a huge value costs no more than a small one.
+    """
+    text = _EXCERPT.repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+_EXCERPT = reprlib.Repr()
+_EXCERPT.maxlevel, _EXCERPT.maxdict, _EXCERPT.maxlist, _EXCERPT.maxtuple = 3, 4, 4, 4
+_EXCERPT.maxstring = _EXCERPT.maxother = 60
 
 
 def problem_at(file: str, line: int, column: int, path: str, found: str, expected: str) -> StudyProblem:
