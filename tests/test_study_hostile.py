@@ -437,3 +437,46 @@ def test_catalogue_messages_escape_what_cannot_be_printed(tmp_path):
         tmp_path, _replaced("    mass: 80 g", "    mass: 80 g\n    ma\ufeffss: 80 g", MOTOR)
     )
     assert error.line == 9 and error.field == "motors.small.ma\\ufeffss" and "unknown field" in error.reason
+
+
+@pytest.mark.parametrize(
+    ("text", "unit", "si"),
+    [
+        ("60 mm", "m", 0.06),
+        ("60mm", "m", 0.06),
+        (".5 m", "m", 0.5),
+        ("1.3 N·m", "N*m", 1.3),
+        ("1 N m/rad", "N*m/rad", 1.0),
+        ("45 deg", "rad", math.pi / 4),
+        ("300 deg/s^2", "rad/s^2", 300 * math.pi / 180),
+        ("3000 rpm", "rad/s", 3000 * 2 * math.pi / 60),
+        ("2.21e-5 kg*m**2", "kg*m^2", 2.21e-5),
+        ("0.25 kg*cm^2", "kg*m^2", 0.25e-4),
+        ("1 m^-1", "1/m", 1.0),
+        ("2e7", "N/m", 2e7),
+    ],
+)
+def test_the_quantity_grammar_reads_what_designers_write(text, unit, si):
+    from collision_reflex._units import parse_quantity
+
+    assert parse_quantity(text, unit) == pytest.approx(si, rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("text", "kind"),
+    [
+        ("1 m 2", "syntax"),
+        ("m", "syntax"),
+        ("2 * 3 m", "syntax"),
+        ("1 m^100", "syntax"),
+        ("1 furlong_per_fortnight", "unit"),
+        ("3 kg", "dimension"),
+        ("1e308 km", "value"),
+    ],
+)
+def test_the_quantity_grammar_refuses_the_rest(text, kind):
+    from collision_reflex._units import QuantityError, parse_quantity
+
+    with pytest.raises(QuantityError) as caught:
+        parse_quantity(text, "m")
+    assert caught.value.kind == kind
