@@ -105,7 +105,7 @@ def test_defaults_are_explicit_in_the_resolved_study():
             "approach_velocity: 50 cm/s",
             "approach_velocity: -1",
             "approach_velocity",
-            ["-1", "greater than 0"],
+            ["-1", "from 1e-06 to 10 m/s"],
         ),
         ("approach_velocity: 50 cm/s", "approach_velocity: .nan", "approach_velocity", ["finite"]),
         (

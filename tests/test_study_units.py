@@ -194,8 +194,8 @@ def test_wrong_dimension_message_names_the_value():
     """The message shows the text that was given (pydantic fills plain {name} fields only)."""
     from pydantic_core import PydanticCustomError
 
-    from collision_reflex.study.quantities import _parse
+    from collision_reflex.study.quantities import to_si
 
     with pytest.raises(PydanticCustomError) as caught:
-        _parse("3 N", "kg", "mass", "a mass in kg")
+        to_si("3 N", "kg", "a mass", "0.5 kg")
     assert "'3 N' is [mass] * [length] / [time] ** 2, not [mass]" in str(caught.value)

@@ -37,7 +37,7 @@ import numpy as np
 from .._compat import renamed_keywords
 from .._io import atomic_open
 from .._table import HEADER, TableProblem, read_table
-from .._units import unit_registry
+from .._units import QuantityError, parse_quantity, si_scale
 from ..errors import TraceError
 
 if TYPE_CHECKING:
@@ -147,39 +147,30 @@ def to_si(
 ) -> float:
     """A number with an optional unit (``"100 mm/s"``, ``"2e7"``) in SI, as a float.
 
-    ``default_unit`` is the unit of a plain number and also fixes the dimension expected.
+    ``default_unit`` is the unit of a plain number and also fixes the dimension expected. Text is read by the
+    package's bounded quantity grammar (:func:`collision_reflex._units.parse_quantity`).
     """
-    import pint
-
-    ureg = unit_registry()
     try:
-        quantity = ureg.Quantity(value) if isinstance(value, str) else ureg.Quantity(float(value))
-        if quantity.dimensionless:  # a plain number is in the default unit
-            quantity = ureg.Quantity(float(quantity.magnitude), default_unit)
-        return float(quantity.to(ureg.Quantity(1.0, default_unit).to_base_units().units).magnitude)
-    except (pint.errors.PintError, ValueError, TypeError, AttributeError) as error:
+        magnitude = parse_quantity(value, default_unit) if isinstance(value, str) else float(value)
+        return magnitude * si_scale(default_unit)
+    except (QuantityError, ValueError, TypeError) as error:
         raise TraceError(
             source,
             "",
-            f"{what} = {value!r} is not a quantity in {default_unit} or a compatible unit ({error})",
+            f"{what} = {value!r:.60} is not a quantity in {default_unit} or a compatible unit ({error})",
             line,
         ) from None
 
 
 def unit_factor(unit: str, default_unit: str, what: str, source: str = "") -> float:
     """The factor converting values in ``unit`` to SI; ``unit`` must have ``default_unit``'s dimension."""
-    import pint
-
-    ureg = unit_registry()
     try:
-        return float(
-            ureg.Quantity(1.0, unit).to(ureg.Quantity(1.0, default_unit).to_base_units().units).magnitude
-        )
-    except (pint.errors.PintError, ValueError, TypeError, AttributeError) as error:
+        return parse_quantity(f"1 {unit}", default_unit) * si_scale(default_unit)
+    except QuantityError as error:
         raise TraceError(
             source,
             "",
-            f"the {what} column's unit {unit!r} is not a unit of {default_unit}'s kind ({error})",
+            f"the {what} column's unit {unit!r:.60} is not a unit of {default_unit}'s kind ({error})",
             1,
         ) from None
 

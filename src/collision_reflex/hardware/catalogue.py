@@ -18,7 +18,8 @@ from typing import Any, Literal
 import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError, field_validator
 
-from .._units import unit_registry
+from .._units import QuantityError, parse_quantity
+from .._yaml import NodeProblem, check_nodes, one_line
 from ..errors import CatalogueError
 
 # Field -> the unit a plain number is taken in (SI), and the pint dimensionality a quantity string must have.
@@ -74,11 +75,8 @@ def _to_si(value: Any, unit: str) -> Any:
     """A plain number (taken as SI) or a quantity string converted to ``unit``; ValueError saying why not."""
     if isinstance(value, bool):
         raise ValueError("expected a number or a quantity with units, got a boolean")
-    if isinstance(value, str):
-        try:  # YAML 1.1 reads "1e-5" (no dot) as text: a plain number is still SI
-            return float(value)
-        except ValueError:
-            return _quantity(value, unit)
+    if isinstance(value, str):  # YAML 1.1 reads "1e-5" (no dot) as text: a plain number is still SI
+        return _quantity(value, unit)
     if isinstance(value, int | float):
         return float(value)
     raise ValueError(f"expected a number (SI, {unit}) or a quantity string such as '60 mm'")
@@ -240,28 +238,23 @@ _KINDS: dict[str, tuple[type[_Cited], list[str], list[str]]] = {
 
 
 def _quantity(text: str, unit: str) -> float:
-    """``text`` (e.g. ``"60 mm"``) in ``unit``, or ValueError saying why not."""
-    import pint
-
-    registry = unit_registry()
+    """``text`` (e.g. ``"60 mm"``) in ``unit``, or ValueError saying why not (the bounded grammar of units)."""
     try:
-        quantity: Any = registry.Quantity(text)
-        converted = float(quantity.to(unit).magnitude)
-    except pint.DimensionalityError:
-        raise ValueError(f"{text!r} cannot be converted to {unit}") from None
-    except Exception:
-        raise ValueError(f"{text!r} is not a quantity (a number and a unit, e.g. '60 mm')") from None
-    # pint takes angles as dimensionless: "50 Hz" would pass as 50 rad/s, though it may mean 50 rev/s.
-    if _radian_power(registry.Quantity(1, unit)) != _radian_power(quantity):
-        raise ValueError(
-            f"{text!r} has no angle unit; give an angle per time, e.g. '3000 rpm' or '314 rad/s'"
-        )
-    return converted
+        # An angular speed needs its angle unit: "50 Hz" may mean 50 rev/s.
+        return parse_quantity(text, unit, angle_explicit=True)
+    except QuantityError as error:
+        shown = _excerpt(text)
+        if error.kind == "dimension":
+            raise ValueError(f"{shown} cannot be converted to {unit} ({error.reason})") from None
+        if error.kind == "angle":
+            raise ValueError(f"{shown} has {error.reason}") from None
+        raise ValueError(f"{shown} is not a quantity ({error.reason})") from None
 
 
-def _radian_power(quantity: Any) -> int:
-    """The power of the angle (radian) in ``quantity``'s unit: 1 for ``rpm`` and ``rad/s``, 0 for ``Hz``."""
-    return int(dict(quantity.to_root_units().unit_items()).get("radian", 0))
+def _excerpt(value: Any, limit: int = 40) -> str:
+    """``repr(value)``, cut to ``limit`` characters: a message quotes a bad value, never all of it."""
+    shown = repr(value)
+    return shown if len(shown) <= limit else shown[: limit - 3] + "..."
 
 
 def read_catalogue(path: Path) -> dict[str, dict[str, Any]]:
@@ -294,20 +287,49 @@ def read_entries(path: Path, kind: str = "motors") -> dict[str, CatalogueEntry]:
         Naming the file, the line and the field: bad YAML, a missing, unknown or mistyped field, a unit of
         the wrong dimension, a non-physical value, or an entry without a source.
     """
+    try:
+        return _read_entries(path, kind)
+    except CatalogueError as error:
+        texts = (str(error.path), error.field, error.reason)
+        if all(text.isprintable() for text in texts):
+            raise
+        # A message quotes field names and values of the file: escape what would break or hide its line.
+        path_text, field, reason = map(one_line, texts)
+        raise CatalogueError(path_text, error.line, field, reason) from None
+
+
+def _read_entries(path: Path, kind: str) -> dict[str, CatalogueEntry]:
     name = str(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as error:
-        raise CatalogueError(name, None, "", f"cannot read the file ({error.strerror})") from None
+        data = Path(path).read_bytes()
+    except (OSError, ValueError) as error:  # ValueError: a NUL byte in the path
+        reason = getattr(error, "strerror", None) or str(error)
+        raise CatalogueError(name, None, "", f"cannot read the file ({reason})") from None
     try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        at = data.count(b"\n", 0, error.start) + 1
+        raise CatalogueError(name, at, "", f"the byte 0x{data[error.start]:02x} is not UTF-8 text") from None
+    try:
+        root = yaml.compose(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))  # libyaml if built
+        if root is not None:
+            check_nodes(root)  # before constructing any value: tags, alias bombs, huge values
+    except NodeProblem as error:
+        field = ".".join(map(str, error.path))
+        raise CatalogueError(name, error.line, field, f"not valid YAML: {error.reason}") from None
+    except yaml.reader.ReaderError as error:  # a character YAML does not allow
+        at = text.count("\n", 0, error.position) + 1
+        raise CatalogueError(name, at, "", f"not valid YAML: {' '.join(error.reason.split())}") from None
     except yaml.YAMLError as error:
         mark = getattr(error, "problem_mark", None)
         line = mark.line + 1 if mark is not None else None
         problem = getattr(error, "problem", None) or str(error)
-        raise CatalogueError(name, line, "", f"not valid YAML: {problem}") from None
+        raise CatalogueError(name, line, "", f"not valid YAML: {' '.join(problem.split())}") from None
+    except RecursionError:
+        raise CatalogueError(name, None, "", "not valid YAML: nesting too deep") from None
     if not isinstance(root, yaml.MappingNode):
-        raise CatalogueError(name, _line(root), "", f"expected a mapping with a top-level {kind!r} key")
+        line = _line(root) if root is not None else 1  # None: an empty file
+        raise CatalogueError(name, line, "", f"expected a mapping with a top-level {kind!r} key")
     top = _mapping(root, name, "")
     if kind not in top:
         raise CatalogueError(name, 1, kind, f"missing: the file needs a top-level {kind!r} mapping")
@@ -320,6 +342,13 @@ def read_entries(path: Path, kind: str = "motors") -> dict[str, CatalogueEntry]:
     _, parts_node = top[kind]
     if not isinstance(parts_node, yaml.MappingNode):
         raise CatalogueError(name, _line(parts_node), kind, "expected a mapping from part name to entry")
+    for key_node, _ in parts_node.value:
+        part = key_node.value if isinstance(key_node, yaml.ScalarNode) else None
+        if not isinstance(part, str) or not part.isprintable():
+            shown = _excerpt(part) if isinstance(part, str) else "a mapping or list"
+            raise CatalogueError(
+                name, _line(key_node), kind, f"a part name must be text on one line, got {shown}"
+            )
     return {
         part: _entry(name, kind, part, key_node, entry_node)
         for part, (key_node, entry_node) in _mapping(parts_node, name, kind).items()
@@ -348,7 +377,7 @@ def _entry(file: str, kind: str, part: str, key_node: Any, entry_node: Any) -> C
             reason = f"unknown field (allowed: {allowed})"
         else:
             line = _line(fields[field][1]) if field in fields else _line(key_node)
-            reason = f"{first['msg']} (got {raw.get(field)!r})"
+            reason = f"{first['msg']} (got {_excerpt(raw.get(field))})"
         raise CatalogueError(file, line, f"{where}.{field}", reason) from None
 
     def refuse(field: str, reason: str) -> CatalogueError:
@@ -459,5 +488,12 @@ def _line(node: Any) -> int:
 
 
 def _plain(node: Any) -> Any:
-    """A scalar node as Python (int/float/str/bool/None); other nodes as their constructed value."""
-    return yaml.SafeLoader("").construct_document(node)
+    """A scalar node as Python (int/float/str/bool/None); other nodes as their constructed value.
+
+    A value the safe loader cannot construct (an impossible date, an integer of 5,000 digits) is returned as
+    its text, which validation then refuses at its line.
+    """
+    try:
+        return yaml.SafeLoader("").construct_document(node)
+    except (yaml.YAMLError, ValueError, OverflowError):
+        return node.value if isinstance(node, yaml.ScalarNode) else None

@@ -8,7 +8,6 @@ model (frames, joint names, configuration sizes) are in :mod:`.robot` and run wh
 from __future__ import annotations
 
 import difflib
-import json
 import os
 import types
 import typing
@@ -26,7 +25,7 @@ from .schema import (
     ArmStudy,
     Study,
 )
-from .source import StudySource, parse_study_source, read_study_source
+from .source import StudySource, excerpt, parse_study_source, read_study_source
 
 _FOUND_LIMIT = 60
 
@@ -77,7 +76,7 @@ def parse_study(
 
 def _validated(source: StudySource) -> LoadedStudy:
     problems = [
-        source.problem(path, f"the key {path[-1]!r} more than once", "each key once in a mapping")
+        source.problem(path, f"the key {excerpt(path[-1])} more than once", "each key once in a mapping")
         for path in source.duplicate_keys
     ]
     data = source.data
@@ -114,7 +113,7 @@ def _problem_from_pydantic(source: StudySource, model: type[BaseModel], item: An
         if allowed:
             close = difflib.get_close_matches(str(path[-1]), allowed, n=1)
             known = (f"{close[0]!r}? " if close else "") + "one of " + ", ".join(allowed)
-        return source.problem(path, f"unknown key {path[-1]!r}", known)
+        return source.problem(path, f"unknown key {excerpt(path[-1])}", known)
     if kind == "missing":
         return source.problem(path, "nothing", f"the required field {path[-1]!r}" if path else "a value")
     expected: str | None = context.get("expected") if kind.startswith("quantity") else None
@@ -131,15 +130,8 @@ def _lower_first(text: str) -> str:
 
 
 def _found(value: Any) -> str:
-    """A short description of a value found in the file."""
-    if isinstance(value, (dict, list)):
-        try:
-            text = json.dumps(value, default=str)
-        except (TypeError, ValueError, RecursionError):
-            text = type(value).__name__
-    else:
-        text = repr(value)
-    return text if len(text) <= _FOUND_LIMIT else text[: _FOUND_LIMIT - 3] + "..."
+    """A short description of a value found in the file: an excerpt, never the whole of a large value."""
+    return excerpt(value, _FOUND_LIMIT)
 
 
 def _allowed_keys(model: type[BaseModel], path: Sequence[Hashable]) -> list[str]:
@@ -236,25 +228,25 @@ def _arm_checks(loaded: LoadedStudy, study: ArmStudy) -> list[StudyProblem]:
                     )
                 )
     robot = study.robot
-    if robot.urdf is not None and not loaded.path(robot.urdf).is_file():
+    if robot.urdf is not None and not _is_file(loaded.path(robot.urdf)):
         problems.append(
-            loaded.problem(("robot", "urdf"), f"{robot.urdf!r} (no such file)", _relative_hint(loaded))
+            loaded.problem(("robot", "urdf"), f"{excerpt(robot.urdf)} (no such file)", _relative_hint(loaded))
         )
     for index, directory in enumerate(robot.package_dirs):
-        if not loaded.path(directory).is_dir():
+        if not _is_dir(loaded.path(directory)):
             problems.append(
                 loaded.problem(
                     ("robot", "package_dirs", index),
-                    f"{directory!r} (no such directory)",
+                    f"{excerpt(directory)} (no such directory)",
                     _relative_hint(loaded),
                 )
             )
     trajectory = study.samples.configurations.trajectory
-    if trajectory is not None and not loaded.path(trajectory.file).is_file():
+    if trajectory is not None and not _is_file(loaded.path(trajectory.file)):
         problems.append(
             loaded.problem(
                 ("samples", "configurations", "trajectory", "file"),
-                f"{trajectory.file!r} (no such file)",
+                f"{excerpt(trajectory.file)} (no such file)",
                 _relative_hint(loaded),
             )
         )
@@ -286,9 +278,11 @@ def _duty_cycle_checks(loaded: LoadedStudy, study: ArmStudy) -> list[StudyProble
     if cycle is None:
         return []
     problems = []
-    if cycle.file is not None and not loaded.path(cycle.file).is_file():
+    if cycle.file is not None and not _is_file(loaded.path(cycle.file)):
         problems.append(
-            loaded.problem(("duty_cycle", "file"), f"{cycle.file!r} (no such file)", _relative_hint(loaded))
+            loaded.problem(
+                ("duty_cycle", "file"), f"{excerpt(cycle.file)} (no such file)", _relative_hint(loaded)
+            )
         )
     if cycle.payload is not None and study.constraints.payload != 0:
         problems.append(
@@ -300,6 +294,22 @@ def _duty_cycle_checks(loaded: LoadedStudy, study: ArmStudy) -> list[StudyProble
             )
         )
     return problems
+
+
+def _is_file(path: Path) -> bool:
+    """Whether ``path`` is a regular file; False for a path the system refuses (too long, a NUL)."""
+    try:
+        return path.is_file()
+    except (OSError, ValueError):
+        return False
+
+
+def _is_dir(path: Path) -> bool:
+    """Whether ``path`` is a directory; False for a path the system refuses."""
+    try:
+        return path.is_dir()
+    except (OSError, ValueError):
+        return False
 
 
 def _fixed(variable: Any) -> bool:

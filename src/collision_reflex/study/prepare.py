@@ -15,7 +15,7 @@ from ..errors import StudyFileError, StudyProblem
 from .duty import describe_duty_cycle, prismatic_joints, static_requirement, study_duty_cycle
 from .load import LoadedStudy
 from .schema import PER_JOINT_DESIGN_VARIABLES, ActuatorStudy, ArmStudy, GearboxSpec, MotorSpec
-from .source import PathKey
+from .source import PathKey, excerpt
 
 if TYPE_CHECKING:
     from ..hardware.gearboxes import Gearbox
@@ -47,7 +47,7 @@ def check_motors(loaded: LoadedStudy, catalogue: dict[str, Motor] | None = None)
             problems.append(
                 loaded.problem(
                     field,
-                    f"motor {spec.reference!r}, not in the catalogue",
+                    f"motor {excerpt(spec.reference)}, not in the catalogue",
                     (f"{close[0]!r}? " if close else "") + "one of " + ", ".join(map(repr, names)),
                 )
             )
@@ -183,13 +183,12 @@ def describe_study(loaded: LoadedStudy, load_robot: bool = True) -> str:
     n_joints = None
     if load_robot:
         from .robot import load_arm
-        from .samples import configuration_samples, direction_samples
+        from .samples import sample_counts
 
         check_motors(loaded)
         arm = load_arm(loaded)
         n_joints = len(arm.joint_names)
-        n_config = configuration_samples(loaded, arm).shape[0]
-        n_dir = direction_samples(loaded, arm).shape[0]
+        n_config, n_dir = sample_counts(loaded, arm)  # random samples are counted, not drawn
         text += f" ({n_joints} joints: {', '.join(arm.joint_names)}), {n_config} configurations x {n_dir} directions"
         cycle_summary = describe_duty_cycle(study_duty_cycle(loaded, arm), study, prismatic_joints(arm))
     else:

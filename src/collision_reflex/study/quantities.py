@@ -1,40 +1,52 @@
-"""Physical quantities in study files: plain SI numbers or strings with units, read with pint.
+"""Physical quantities in study files: plain SI numbers or strings with units, each within a physical range.
 
 ``60 mm``, ``"1.3 N*m"``, ``0.2 m/s`` and ``0.06`` (metres, as a plain number is SI) all give a float in the
-field's SI unit. A string whose dimension differs from the field's (``"3 kg"`` for a stiffness) is refused with a
-message naming both. The field types here are ``typing.Annotated`` floats for pydantic; their JSON Schema
-accepts a number or a string.
+field's SI unit. Strings are read by :func:`collision_reflex._units.parse_quantity` (a bounded grammar: a number
+and a unit expression). A string whose dimension differs from the field's (``"3 kg"`` for a stiffness) is
+refused with a message naming both. A field type may carry a physical range (``1 mm .. 1 m`` for a stator
+diameter): a value outside it is refused with the range in the message, so that a study that validates also
+runs. The field types here are ``typing.Annotated`` floats for pydantic; their JSON Schema accepts a number
+(within the range) or a string.
 """
 
 from __future__ import annotations
 
 import functools
 import math
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import Annotated, Any
 
 from pydantic import BeforeValidator, WithJsonSchema
 from pydantic_core import PydanticCustomError
 
-from .._units import unit_registry
-
-if TYPE_CHECKING:
-    import pint
+from .._units import QuantityError, parse_quantity
 
 
-def to_si(value: Any, unit: str, what: str, example: str) -> float:
+def to_si(value: Any, unit: str, what: str, example: str, bounds: tuple[float, float] | None = None) -> float:
     """``value`` (a number in ``unit``, or a string with units of the same dimension) as a float in ``unit``.
+
+    Parameters
+    ----------
+    value : Any
+        What the file holds: a number (in ``unit``) or a string such as ``"60 mm"``.
+    unit : str
+        The field's SI unit (pint syntax).
+    what, example : str
+        The field's kind (``"a length"``) and an example value (``"60 mm"``), for messages.
+    bounds : tuple of float, optional
+        The physical range ``(low, high)`` in ``unit``, both included.
 
     Raises ``PydanticCustomError`` (turned into a located :class:`~collision_reflex.errors.StudyProblem`).
     """
-    expected = f"{what} in {unit}: a number (SI) or a string with units such as {example!r}"
+    in_unit = f" in {unit}" if unit else ""
+    expected = f"{what}{in_unit}: a number (SI) or a string with units such as {example!r}"
     if isinstance(value, bool) or not isinstance(value, (int, float, str)):
         raise PydanticCustomError("quantity", "{expected}", {"expected": expected})
     if isinstance(value, str):
         try:
             # YAML 1.1 reads "2e7" (no dot) as a string: a number written as text is still a plain SI number.
-            magnitude = float(value)
-        except ValueError:
-            magnitude = _parse(value, unit, what, expected)
+            magnitude = parse_quantity(value, unit)
+        except QuantityError as error:
+            _refuse(error, value, expected)
     else:
         try:
             magnitude = float(value)
@@ -42,55 +54,57 @@ def to_si(value: Any, unit: str, what: str, example: str) -> float:
             magnitude = math.inf
     if not math.isfinite(magnitude):
         raise PydanticCustomError("quantity", "{expected}", {"expected": "a finite " + expected})
+    if bounds is not None and not bounds[0] <= magnitude <= bounds[1]:
+        low, high = bounds
+        expected = f"{what} from {low:g} to {high:g} {unit}".rstrip()
+        if isinstance(value, str):  # the file's text is quoted as found: say what it is in SI
+            expected += f" ({value.strip()} is {magnitude:.6g} {unit})".replace(" )", ")")
+        raise PydanticCustomError("quantity_range", "{expected}", {"expected": expected})
     return magnitude
 
 
-def _parse(text: str, unit: str, what: str, expected: str) -> float:
-    registry = unit_registry()
-    try:
-        quantity: pint.Quantity = registry.Quantity(text.strip())
-        target = registry.Quantity(1.0, unit)
-    except Exception:  # pint's parser raises many kinds of errors on arbitrary text; any is "not a quantity"
-        raise PydanticCustomError("quantity", "{expected}", {"expected": expected}) from None
-    if quantity.dimensionality != target.dimensionality:
+def _refuse(error: QuantityError, text: str, expected: str) -> Any:
+    if error.kind == "dimension":
         raise PydanticCustomError(
             "quantity_dimension",
             "{expected} ({found} is {found_dimension}, not {dimension})",
             {
                 "expected": expected,
-                "found": repr(text),  # pydantic fills {name} only, without format specs
-                "found_dimension": _dimension(quantity),
-                "dimension": _dimension(target),
+                "found": _excerpt(text),  # pydantic fills {name} only, without format specs
+                "found_dimension": error.found_dimension,
+                "dimension": error.dimension,
             },
         )
-    try:
-        magnitude = quantity.to(unit).magnitude
-        return float(magnitude)
-    except Exception:  # offset units (degC), complex magnitudes, ...: not a plain quantity
-        raise PydanticCustomError("quantity", "{expected}", {"expected": expected}) from None
+    raise PydanticCustomError("quantity", "{expected}", {"expected": f"{expected} ({error.reason})"})
 
 
-def _dimension(quantity: Any) -> str:
-    text = str(quantity.dimensionality)
-    return "dimensionless" if text in ("", "dimensionless") else text
+def _excerpt(text: str, limit: int = 40) -> str:
+    shown = repr(text)
+    return shown if len(shown) <= limit else shown[: limit - 3] + "..."
 
 
-def quantity_type(unit: str, what: str, example: str) -> Any:
-    """An ``Annotated[float, ...]`` field type holding a quantity converted to ``unit``."""
+def quantity_type(
+    unit: str, what: str, example: str, low: float | None = None, high: float | None = None
+) -> Any:
+    """An ``Annotated[float, ...]`` field type holding a quantity converted to ``unit``.
+
+    ``low`` and ``high`` [``unit``] bound it (both or neither): the range a designer could mean.
+    """
+    bounds = (low, high) if low is not None and high is not None else None
+    number: dict[str, Any] = {"type": "number"}
+    description = f"{what} [{unit}]: a number in {unit} or a string with units, e.g. {example!r}"
+    if bounds is not None:
+        number.update(minimum=bounds[0], maximum=bounds[1])
+        description += f"; from {bounds[0]:g} to {bounds[1]:g} {unit}"
     return Annotated[
         float,
-        BeforeValidator(functools.partial(_validate, unit=unit, what=what, example=example)),
-        WithJsonSchema(
-            {
-                "anyOf": [{"type": "number"}, {"type": "string"}],
-                "description": f"{what} [{unit}]: a number in {unit} or a string with units, e.g. {example!r}",
-            }
-        ),
+        BeforeValidator(functools.partial(_validate, unit=unit, what=what, example=example, bounds=bounds)),
+        WithJsonSchema({"anyOf": [number, {"type": "string"}], "description": description}),
     ]
 
 
-def _validate(value: Any, unit: str, what: str, example: str) -> float:
-    return to_si(value, unit, what, example)
+def _validate(value: Any, unit: str, what: str, example: str, bounds: tuple[float, float] | None) -> float:
+    return to_si(value, unit, what, example, bounds)
 
 
 # Field types of the study schema, by what they measure. Angles are dimensionless to pint (rad = 1), so a
@@ -105,3 +119,41 @@ RotaryStiffness = quantity_type("N*m/rad", "a rotary stiffness", "1000 N*m/rad")
 LinearStiffness = quantity_type("N/m", "a linear stiffness", "2e7 N/m")
 Inertia = quantity_type("kg*m^2", "a moment of inertia", "2.21e-5 kg*m^2")
 Ratio = quantity_type("", "a dimensionless number", "9")
+
+# Physical ranges of the design quantities. Each is generous for a robot actuator, from a fingertip to a
+# heavy industrial arm, and keeps every derived number (N^2 J_m, k/N^2, impulses) far from float limits.
+# Motor and gearbox sizes: 1 mm (the smallest micromotors) to 1 m (torque motors of machine tools).
+PartSize = quantity_type("m", "a length", "60 mm", 1e-3, 1.0)
+# Gear ratios: 1 (direct drive) to 10,000 (multi-stage harmonic or worm drives).
+GearRatio = quantity_type("", "a gear ratio", "9", 1.0, 1e4)
+# Joint stiffness (mechanical or controller): 1e-3 N m/rad (a compliant finger joint) to 1e9 N m/rad (far
+# stiffer than any steel joint; the stiffest industrial joints are ~1e7).
+JointStiffness = quantity_type("N*m/rad", "a rotary stiffness", "1000 N*m/rad", 1e-3, 1e9)
+# Contact stiffness of the object hit: 1 N/m (a soft foam) to 1e12 N/m (steel on steel).
+ContactStiffness = quantity_type("N/m", "a linear stiffness", "2e7 N/m", 1.0, 1e12)
+# Contact-force thresholds: 1 mN (a tactile skin) to 10 kN (beyond a heavy arm's rated force).
+ThresholdForce = quantity_type("N", "a force", "3 N", 1e-3, 1e4)
+# Position-error thresholds: 1 um (an encoder count of a precise joint) to 1 m.
+PositionError = quantity_type("m", "a length", "1 mm", 1e-6, 1.0)
+# Motor torque thresholds (current sensing): 1 uN m to 10 kN m.
+MotorTorque = quantity_type("N*m", "a torque", "0.1 N*m", 1e-6, 1e4)
+# Approach velocities: 1 um/s (a creeping approach) to 10 m/s (faster than any collaborative robot moves).
+ApproachVelocity = quantity_type("m/s", "a velocity", "0.5 m/s", 1e-6, 10.0)
+# Levers (joint axis to contact): 1 mm to 10 m.
+Lever = quantity_type("m", "a length", "0.3 m", 1e-3, 10.0)
+# Masses (finger, structure, payload, gearbox): 1 mg to 1 t.
+PartMass = quantity_type("kg", "a mass", "0.5 kg", 1e-6, 1e3)
+# Required or rated torques: up to 1e5 N m (the largest industrial robot joints are ~1e4 N m).
+JointTorque = quantity_type("N*m", "a torque", "1.3 N*m", 0.0, 1e5)
+# Inertias (payload, gearbox input): within 1e3 kg m^2 (a tonne at one metre); products of inertia may be < 0.
+PartInertia = quantity_type("kg*m^2", "a moment of inertia", "2.21e-5 kg*m^2", -1e3, 1e3)
+# Payloads: none to 1 t.
+Payload = quantity_type("kg", "a mass", "0.5 kg", 0.0, 1e3)
+# Contact offsets from the contact frame: within 10 m.
+Offset = quantity_type("m", "a length", "50 mm", -10.0, 10.0)
+# Joint positions: within 1000 rad (160 turns; or 1 km for a prismatic joint).
+JointPosition = quantity_type("rad", "an angle", "45 deg", -1e3, 1e3)
+# Safety factors on torque: 1 to 100.
+SafetyFactor = quantity_type("", "a dimensionless number", "1.5", 1.0, 100.0)
+# Sensing noise floors: up to the largest threshold.
+NoiseFloor = quantity_type("N", "a force", "0.5 N", 0.0, 1e4)

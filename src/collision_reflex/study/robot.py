@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 from ..errors import FrameNotFound, InvalidParameter, StudyFileError, StudyProblem, UrdfError
 from .load import LoadedStudy
 from .schema import PER_JOINT_DESIGN_VARIABLES, ArmStudy
-from .source import PathKey
+from .source import PathKey, excerpt
 
 if TYPE_CHECKING:
     from ..arm import Arm
@@ -48,7 +48,7 @@ def load_arm(loaded: LoadedStudy) -> Arm:
                 close = difflib.get_close_matches(spec.example_robot_data, names, n=3)
                 raise loaded.fail(
                     ("robot", "example_robot_data"),
-                    f"{spec.example_robot_data!r}, not an example-robot-data model",
+                    f"{excerpt(spec.example_robot_data)}, not an example-robot-data model",
                     ("one of " + ", ".join(map(repr, close)) + " or another of " if close else "one of ")
                     + f"the {len(names)} models of example-robot-data (e.g. ur5, panda, double_pendulum)",
                 )
@@ -81,7 +81,7 @@ def load_arm(loaded: LoadedStudy) -> Arm:
         close = difflib.get_close_matches(error.name, error.available, n=1)
         raise loaded.fail(
             where,
-            f"{error.kind} {error.name!r}, not in the robot",
+            f"{error.kind} {excerpt(error.name)}, not in the robot",
             (f"{close[0]!r}? " if close else "") + f"one of the {len(error.available)} "
             f"{error.kind}s: " + ", ".join(error.available),
         ) from None
@@ -90,6 +90,12 @@ def load_arm(loaded: LoadedStudy) -> Arm:
             ("robot", "urdf"),
             f"a URDF that cannot be loaded ({error.reason})",
             "a URDF file Pinocchio can parse",
+        ) from None
+    except OSError as error:  # a file that exists but cannot be read (a device, /proc, permissions)
+        raise loaded.fail(
+            ("robot", "urdf"),
+            f"{excerpt(spec.urdf)}, which cannot be read ({error.strerror or error})",
+            "a readable URDF file",
         ) from None
     except InvalidParameter as error:
         field = error.name if error.name in type(spec).model_fields else None
@@ -117,7 +123,7 @@ def check_against_arm(loaded: LoadedStudy, arm: Arm) -> list[StudyProblem]:
             problems.append(
                 loaded.problem(
                     path,
-                    f"joint {name!r}, not a joint of the robot",
+                    f"joint {excerpt(name)}, not a joint of the robot",
                     (f"{close[0]!r}? " if close else "") + "one of " + ", ".join(map(repr, joints)),
                 )
             )

@@ -11,10 +11,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .._table import TableProblem, header_index, read_table
 from ..arm.directions import circle_directions, sphere_directions, unit_directions
 from ..errors import InvalidParameter
 from .load import LoadedStudy
 from .schema import ArmStudy, ConfigurationSamples, DirectionSamples
+from .source import excerpt
 
 if TYPE_CHECKING:
     from ..arm import Arm
@@ -66,25 +68,74 @@ def configuration_samples(loaded: LoadedStudy, arm: Arm) -> np.ndarray:
     return _trajectory(loaded, arm, spec.trajectory.file, spec.trajectory.every)
 
 
+def sample_counts(loaded: LoadedStudy, arm: Arm) -> tuple[int, int]:
+    """The numbers of configurations and of directions of an arm study, without drawing the random samples.
+
+    Listed samples and trajectory files are checked as :func:`configuration_samples` and
+    :func:`direction_samples` check them (each problem at its line); counts come from the file.
+    """
+    study = loaded.study
+    assert isinstance(study, ArmStudy)
+    configurations = study.samples.configurations
+    directions = study.samples.directions
+    if configurations.random is not None:
+        n_configurations = configurations.random.count
+    else:
+        n_configurations = configuration_samples(loaded, arm).shape[0]
+    counted = directions.circle if directions.circle is not None else directions.sphere
+    n_directions = counted if counted is not None else direction_samples(loaded, arm).shape[0]
+    return int(n_configurations), int(n_directions)
+
+
+_MAX_TRAJECTORY_SIZE = 64 << 20
+"""Largest trajectory file read [bytes]: a million rows of seven joints."""
+
+
 def _trajectory(loaded: LoadedStudy, arm: Arm, file: str, every: int) -> np.ndarray:
+    """Every ``every``-th row of a trajectory CSV; each problem located at the study line and the CSV line."""
     import pandas as pd
 
     where = ("samples", "configurations", "trajectory", "file")
+    expected = "a CSV file with a header row naming every joint, one row per configuration [rad]"
     try:
-        table = pd.read_csv(loaded.path(file))
-    except (OSError, ValueError) as error:
-        raise loaded.fail(where, f"{file!r}, which cannot be read as CSV ({error})", "a CSV file") from None
+        with loaded.path(file).open("rb") as stream:
+            data = stream.read(_MAX_TRAJECTORY_SIZE + 1)
+        if len(data) > _MAX_TRAJECTORY_SIZE:
+            raise loaded.fail(
+                where, f"{excerpt(file)}, a file over {_MAX_TRAJECTORY_SIZE >> 20} MiB", expected
+            )
+        lines = data.decode("utf-8").splitlines()
+    except (OSError, ValueError) as error:  # unreadable, not UTF-8, a NUL in the path
+        reason = getattr(error, "strerror", None) or str(error)
+        raise loaded.fail(where, f"{excerpt(file)}, which cannot be read ({reason})", expected) from None
+    header = header_index(lines)
+    if header is None:
+        raise loaded.fail(where, f"{file}: no header line and no rows", expected)
+    try:
+        table = read_table(lines, header)
+    except TableProblem as problem:
+        raise loaded.fail(where, f"{file}:{problem.line}: {problem.reason}", expected) from None
     joints = list(arm.joint_names)
     missing = [name for name in joints if name not in table.columns]
     if missing:
         raise loaded.fail(
             where,
-            f"{file!r} without columns {', '.join(missing)}",
+            f"{excerpt(file)} without columns {', '.join(missing)}",
             "a header row naming every joint: " + ", ".join(joints),
         )
-    values = table[joints].to_numpy(dtype=float)[::every]
-    if values.size == 0 or not np.all(np.isfinite(values)):
+    values = table[joints].apply(pd.to_numeric, errors="coerce").to_numpy(dtype=float)
+    finite = np.isfinite(values).all(axis=1)
+    if not finite.all():
+        line = header + 2 + int(np.argmin(finite))  # file lines are 1-based; the header is one line
         raise loaded.fail(
-            where, f"{file!r} with no rows or with non-numeric values", "finite joint positions [rad]"
+            where, f"{file}:{line}: a value that is not a finite number", "finite joint positions [rad]"
         )
-    return np.asarray(arm.configuration(values), dtype=float)
+    values = values[::every]
+    if values.size == 0:
+        raise loaded.fail(where, f"{file}: no rows below the header", "finite joint positions [rad]")
+    try:
+        return np.asarray(arm.configuration(values), dtype=float)
+    except InvalidParameter as error:
+        raise loaded.fail(
+            where, f"{file}: {error}", "joint positions within the joints' limits [rad]"
+        ) from None

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import builtins
 import difflib
+import itertools
 import re
 from typing import Annotated, Any, Literal
 
@@ -30,16 +31,23 @@ from pydantic import (
 from pydantic_core import PydanticCustomError
 
 from .quantities import (
-    Angle,
-    Force,
-    Inertia,
-    Length,
-    LinearStiffness,
-    Mass,
-    Ratio,
-    RotaryStiffness,
-    Torque,
-    Velocity,
+    ApproachVelocity,
+    ContactStiffness,
+    GearRatio,
+    JointPosition,
+    JointStiffness,
+    JointTorque,
+    Lever,
+    MotorTorque,
+    NoiseFloor,
+    Offset,
+    PartInertia,
+    PartMass,
+    PartSize,
+    Payload,
+    PositionError,
+    SafetyFactor,
+    ThresholdForce,
     quantity_type,
     to_si,
 )
@@ -52,6 +60,12 @@ NAMED_DIRECTIONS = ("+x", "-x", "+y", "-y", "+z", "-z")
 DEFAULT_REFERENCE_MOTOR = "OPN-060-013-A"
 
 PositiveInt = Annotated[int, Field(ge=1, strict=True)]
+# Sample counts: a run evaluates every configuration in every direction, so more than these would take days;
+# the bounds also keep a validation from allocating what the file merely names.
+ConfigurationCount = Annotated[int, Field(ge=1, le=10_000, strict=True)]
+DirectionCount = Annotated[int, Field(ge=1, le=10_000, strict=True)]
+# A direction's components before normalisation: a bound keeps their squares finite.
+Component = Annotated[float, Field(ge=-1e6, le=1e6, allow_inf_nan=False)]
 Name = Annotated[str, Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9._-]*$", max_length=80)]
 
 
@@ -82,10 +96,18 @@ class RobotSpec(_Model):
     contact_frame: str | None = Field(
         None, description="frame of the contact point (default: the robot's tip)"
     )
-    contact_offset: tuple[Length, Length, Length] = Field(
+    contact_offset: tuple[Offset, Offset, Offset] = Field(
         (0.0, 0.0, 0.0), description="contact point in the contact frame [m]"
     )
     locked_joints: list[str] = Field(default_factory=list, description="joints held fixed (not actuated)")
+
+    @field_validator("locked_joints")
+    @classmethod
+    def _distinct_joints(cls, value: list[str]) -> list[str]:
+        twice = sorted({name for name in value if value.count(name) > 1})
+        if twice:
+            raise ValueError(f"each joint once (found {', '.join(map(repr, twice))} more than once)")
+        return value
 
     @model_validator(mode="after")
     def _one_source(self) -> RobotSpec:
@@ -101,10 +123,12 @@ class MotorSpec(_Model):
 
     reference: str = Field(DEFAULT_REFERENCE_MOTOR, description="catalogue name of the (reference) motor")
     scaling_law: Literal["haddadin", "isometric", "empirical", "quadruped"] = "haddadin"
-    stator_diameter: Length | None = Field(
+    stator_diameter: PartSize | None = Field(
         None, gt=0, description="scaled stator diameter [m]; null: reference's"
     )
-    stack_length: Length | None = Field(None, gt=0, description="scaled stack length [m]; null: reference's")
+    stack_length: PartSize | None = Field(
+        None, gt=0, description="scaled stack length [m]; null: reference's"
+    )
 
     @classmethod
     def __get_pydantic_json_schema__(cls, core_schema: Any, handler: Any) -> Any:
@@ -118,7 +142,8 @@ class MotorSpec(_Model):
         return {"reference": value} if isinstance(value, str) else value
 
 
-AngularSpeed = quantity_type("rad/s", "an angular speed", "3000 rpm")
+# A gearbox's input speed: from a slow hand crank (1e-3 rad/s) to beyond the fastest spindles (1e5 rad/s).
+AngularSpeed = quantity_type("rad/s", "an angular speed", "3000 rpm", 1e-3, 1e5)
 
 
 class GearboxSpec(_Model):
@@ -131,14 +156,14 @@ class GearboxSpec(_Model):
 
     kind: Literal["planetary", "parallel_shaft", "harmonic", "cycloidal", "ball_screw"]
     stages: PositiveInt = 1
-    diameter: Length = Field(gt=0, description="outer diameter [m]")
-    length: Length = Field(gt=0, description="length [m]")
-    mass: Mass = Field(gt=0, description="mass [kg]")
-    inertia: Inertia = Field(gt=0, description="inertia at the input shaft [kg m^2]")
-    rated_torque: Torque = Field(gt=0, description="rated output torque [N m]")
+    diameter: PartSize = Field(gt=0, description="outer diameter [m]")
+    length: PartSize = Field(gt=0, description="length [m]")
+    mass: PartMass = Field(gt=0, description="mass [kg]")
+    inertia: PartInertia = Field(gt=0, description="inertia at the input shaft [kg m^2]")
+    rated_torque: JointTorque = Field(gt=0, description="rated output torque [N m]")
     source: str = Field("", description="where the figures come from")
     name: str | None = Field(None, min_length=1, description="what reports call it (arm studies)")
-    peak_torque: Torque | None = Field(
+    peak_torque: JointTorque | None = Field(
         None, gt=0, description="repeated peak output torque [N m]; null: the rated torque (arm studies)"
     )
     efficiency: float | None = Field(
@@ -175,9 +200,9 @@ class JointActuatorSpec(_Model):
     gearbox: str | GearboxSpec | None = Field(
         None, description="catalogue name (designs/gearboxes.yaml) or a gearbox's figures; null: the default"
     )
-    gear_ratio: Ratio | None = Field(None, ge=1)
-    mechanical_stiffness: RotaryStiffness | None = Field(None, gt=0)
-    software_stiffness: RotaryStiffness | None = Field(None, gt=0)
+    gear_ratio: GearRatio | None = Field(None, ge=1)
+    mechanical_stiffness: JointStiffness | None = Field(None, gt=0)
+    software_stiffness: JointStiffness | None = Field(None, gt=0)
 
     _known_gearbox = field_validator("gearbox")(_catalogue_gearbox)
 
@@ -195,9 +220,9 @@ class ActuatorsSpec(_Model):
         True,
         description="add the gearbox's input inertia to the reflected inertia; false: the paper's choice",
     )
-    gear_ratio: Ratio = Field(1.0, ge=1)
-    mechanical_stiffness: RotaryStiffness = Field(gt=0, description="joint mechanical stiffness [N m/rad]")
-    software_stiffness: RotaryStiffness = Field(gt=0, description="joint controller stiffness [N m/rad]")
+    gear_ratio: GearRatio = Field(1.0, ge=1)
+    mechanical_stiffness: JointStiffness = Field(gt=0, description="joint mechanical stiffness [N m/rad]")
+    software_stiffness: JointStiffness = Field(gt=0, description="joint controller stiffness [N m/rad]")
     joints: dict[str, JointActuatorSpec] = Field(default_factory=dict)
 
     _known_gearbox = field_validator("gearbox")(_catalogue_gearbox)
@@ -214,9 +239,13 @@ class SensingSpec(_Model):
     """
 
     scheme: Literal["force", "position", "current"]
-    threshold: Force | None = Field(None, gt=0, description="contact-force threshold [N] (scheme: force)")
-    error: Length | None = Field(None, gt=0, description="position-error threshold [m] (scheme: position)")
-    motor_torque: Torque | None = Field(
+    threshold: ThresholdForce | None = Field(
+        None, gt=0, description="contact-force threshold [N] (scheme: force)"
+    )
+    error: PositionError | None = Field(
+        None, gt=0, description="position-error threshold [m] (scheme: position)"
+    )
+    motor_torque: MotorTorque | None = Field(
         None, gt=0, description="motor-side torque threshold [N m] (scheme: current)"
     )
 
@@ -245,22 +274,24 @@ class SensingSpec(_Model):
 class RandomConfigurations(_Model):
     """Configurations drawn at random within the joint limits."""
 
-    count: PositiveInt = Field(description="number of configurations drawn uniformly within joint limits")
-    seed: int = Field(0, strict=True, description="seed of the numpy Generator")
+    count: ConfigurationCount = Field(
+        description="number of configurations drawn uniformly within joint limits"
+    )
+    seed: int = Field(0, ge=0, lt=2**64, strict=True, description="seed of the numpy Generator (>= 0)")
 
 
 class TrajectorySpec(_Model):
     """Configurations read from a trajectory file (joint positions [rad])."""
 
     file: str = Field(description="CSV of joint positions [rad], one row per time step, one column per joint")
-    every: PositiveInt = Field(1, description="use every n-th row")
+    every: Annotated[int, Field(ge=1, le=1_000_000, strict=True)] = Field(1, description="use every n-th row")
 
 
 class ConfigurationSamples(_Model):
     """Exactly one of ``random``, ``list`` or ``trajectory``."""
 
     random: RandomConfigurations | None = None
-    list: builtins.list[builtins.list[Angle]] | None = Field(
+    list: builtins.list[builtins.list[JointPosition]] | None = Field(
         None, min_length=1, description="configurations [rad]"
     )
     trajectory: TrajectorySpec | None = None
@@ -278,10 +309,10 @@ class DirectionSamples(_Model):
     spread evenly over the sphere; ``named`` or ``list``: vectors, normalised.
     """
 
-    circle: PositiveInt | None = None
-    sphere: PositiveInt | None = None
+    circle: DirectionCount | None = None
+    sphere: DirectionCount | None = None
     named: builtins.list[Literal["+x", "-x", "+y", "-y", "+z", "-z"]] | None = Field(None, min_length=1)
-    list: builtins.list[builtins.list[float]] | None = Field(None, min_length=1)
+    list: builtins.list[builtins.list[Component]] | None = Field(None, min_length=1)
 
     @model_validator(mode="after")
     def _one(self) -> DirectionSamples:
@@ -301,18 +332,20 @@ class SamplesSpec(_Model):
 
 # --- duty cycle --------------------------------------------------------------------------------------------------
 
-Rate = quantity_type("Hz", "a sampling rate", "500 Hz")
+# Sampling rates of a via-point motion: 1 Hz to 10 kHz (a servo loop's rate).
+Rate = quantity_type("Hz", "a sampling rate", "500 Hz", 1.0, 1e4)
 
 
-def _quantities(unit: str, what: str, example: str, collection: type, minimum: str) -> Any:
+def _quantities(unit: str, what: str, example: str, collection: type, minimum: str, maximum: float) -> Any:
     """A quantity for every item (a number or a string with units), or a ``collection`` of them, in ``unit``.
 
     ``collection`` is ``dict`` (by joint name) or ``list`` (one per item); ``minimum`` is ``"> 0"`` or
-    ``">= 0"``. One validator for both forms, so that a bad value gives one located problem.
+    ``">= 0"``; ``maximum`` [``unit``] the largest physical value. One validator for both forms, so that a bad
+    value gives one located problem.
     """
 
     def one(value: Any) -> float:
-        number = to_si(value, unit, what, example)
+        number = to_si(value, unit, what, example, (-maximum, maximum))
         if not (number > 0 or (minimum == ">= 0" and number == 0)):
             raise PydanticCustomError(
                 "quantity", "{expected}", {"expected": f"{what} {minimum} (found {number:g})"}
@@ -327,7 +360,7 @@ def _quantities(unit: str, what: str, example: str, collection: type, minimum: s
         return one(value)
 
     bound = "exclusiveMinimum" if minimum == "> 0" else "minimum"
-    quantity = {"anyOf": [{"type": "number", bound: 0}, {"type": "string"}]}
+    quantity = {"anyOf": [{"type": "number", bound: 0, "maximum": maximum}, {"type": "string"}]}
     many = (
         {"type": "object", "additionalProperties": quantity}
         if collection is dict
@@ -346,11 +379,13 @@ def _quantities(unit: str, what: str, example: str, collection: type, minimum: s
     ]
 
 
-JointSpeed = _quantities("rad/s", "a joint speed (m/s for a prismatic joint)", "90 deg/s", dict, "> 0")
+# Limits a joint could physically reach (1000 rad/s is ~10,000 rpm at the output; 1e6 rad/s^2 ~ 100 g at 0.01
+# m), and an hour at rest: beyond these a duty cycle is a typing error.
+JointSpeed = _quantities("rad/s", "a joint speed (m/s for a prismatic joint)", "90 deg/s", dict, "> 0", 1e3)
 JointAcceleration = _quantities(
-    "rad/s^2", "a joint acceleration (m/s^2 for a prismatic joint)", "300 deg/s^2", dict, "> 0"
+    "rad/s^2", "a joint acceleration (m/s^2 for a prismatic joint)", "300 deg/s^2", dict, "> 0", 1e6
 )
-Dwell = _quantities("s", "a time at rest", "0.5 s", list, ">= 0")
+Dwell = _quantities("s", "a time at rest", "0.5 s", list, ">= 0", 3600.0)
 DEFAULT_DWELL = 0.0
 DEFAULT_RATE = 1000.0
 _VIA_ONLY = ("max_speed", "max_acceleration", "dwell", "rate")
@@ -359,9 +394,11 @@ _VIA_ONLY = ("max_speed", "max_acceleration", "dwell", "rate")
 class PayloadSpec(_Model):
     """The payload the arm carries over its duty cycle, its centre of mass at the contact point."""
 
-    mass: Mass = Field(gt=0, description="payload mass [kg]")
+    mass: PartMass = Field(gt=0, description="payload mass [kg]")
     inertia: tuple[
-        tuple[Inertia, Inertia, Inertia], tuple[Inertia, Inertia, Inertia], tuple[Inertia, Inertia, Inertia]
+        tuple[PartInertia, PartInertia, PartInertia],
+        tuple[PartInertia, PartInertia, PartInertia],
+        tuple[PartInertia, PartInertia, PartInertia],
     ] = Field(
         ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)),
         description="3x3 inertia about the centre of mass, contact-frame axes [kg m^2]; default a point mass",
@@ -390,7 +427,7 @@ class DutyCycleSpec(_Model):
     """
 
     file: str | None = Field(None, description="trajectory CSV, relative to the study file")
-    via: builtins.list[builtins.list[Angle]] | None = Field(
+    via: builtins.list[builtins.list[JointPosition]] | None = Field(
         None, min_length=2, description="via configurations [rad], one position per joint, at least 2"
     )
     max_speed: JointSpeed | None = Field(  # type: ignore[valid-type]
@@ -428,10 +465,40 @@ class DutyCycleSpec(_Model):
                 f"dwell: one time for all via points or one per via point ({len(self.via or [])})"
             )
         rate = self.rate if self.rate is not None else DEFAULT_RATE
+        samples = _motion_duration_bound(self.via or [], self.max_speed, self.max_acceleration, dwell) * rate
+        if samples > MAX_CYCLE_SAMPLES:
+            raise ValueError(
+                f"a motion of at most {MAX_CYCLE_SAMPLES:.0e} samples (these via points, limits and rate may "
+                f"need up to {samples:.2g}): raise max_speed or max_acceleration, or lower the rate"
+            )
         # The defaults become explicit (the resolved study shows them).
         object.__setattr__(self, "dwell", dwell)
         object.__setattr__(self, "rate", rate)
         return self
+
+
+MAX_CYCLE_SAMPLES = 500_000
+"""Most samples of a via-point motion: 500 s at 1 kHz; each sample costs the dynamics of every joint."""
+
+
+def _motion_duration_bound(via: Any, speed: Any, acceleration: Any, dwell: Any) -> float:
+    """An upper bound of a via-point motion's duration [s], before the joints are known.
+
+    A rest-to-rest move of distance d within speed v and acceleration a takes at most d/v + v/a (less when it
+    never reaches v). Bounded with the largest step between via points, the lowest speed limit and the highest
+    speed over the lowest acceleration limit.
+    """
+    speeds = list(speed.values()) if isinstance(speed, dict) else [speed]
+    accelerations = list(acceleration.values()) if isinstance(acceleration, dict) else [acceleration]
+    if not speeds or not accelerations:
+        return 0.0
+    v_min, v_max, a_min = min(speeds), max(speeds), min(accelerations)
+    steps = [
+        max((abs(b - a) for a, b in zip(start, end, strict=False)), default=0.0)
+        for start, end in itertools.pairwise(via)
+    ]
+    rests = sum(dwell) if isinstance(dwell, builtins.list) else dwell * len(via)
+    return sum(step / v_min + v_max / a_min for step in steps) + rests
 
 
 # --- design variables --------------------------------------------------------------------------------------------
@@ -496,19 +563,21 @@ def _per_joint(name: str, bound: type[_Model], doc: str) -> type[_Model]:
     return PerJoint
 
 
-_StatorBounds = _variable_model("StatorDiameter", Length, None, "motor stator diameter [m]")
-_StackBounds = _variable_model("StackLength", Length, None, "motor stack length [m]")
-_GearBounds = _variable_model("GearRatio", Ratio, 1.0, "gear ratio [-], >= 1")
-_SoftBounds = _variable_model("SoftwareStiffness", RotaryStiffness, None, "software stiffness [N m/rad]")
+_StatorBounds = _variable_model("StatorDiameter", PartSize, None, "motor stator diameter [m]")
+_StackBounds = _variable_model("StackLength", PartSize, None, "motor stack length [m]")
+_GearBounds = _variable_model("GearRatio", GearRatio, 1.0, "gear ratio [-], >= 1")
+_SoftBounds = _variable_model("SoftwareStiffness", JointStiffness, None, "software stiffness [N m/rad]")
 StatorDiameterVariable = _per_joint("StatorDiameterVariable", _StatorBounds, "motor stator diameter [m]")
 StackLengthVariable = _per_joint("StackLengthVariable", _StackBounds, "motor stack length [m]")
 GearRatioVariable = _per_joint("GearRatioVariable", _GearBounds, "gear ratio [-], >= 1")
 SoftwareStiffnessVariable = _per_joint(
     "SoftwareStiffnessVariable", _SoftBounds, "software stiffness [N m/rad]"
 )
-ThresholdVariable = _variable_model("ThresholdVariable", Force, None, "contact-force threshold [N]")
-PositionErrorVariable = _variable_model("PositionErrorVariable", Length, None, "position-error threshold [m]")
-VelocityVariable = _variable_model("VelocityVariable", Velocity, None, "approach velocity [m/s]")
+ThresholdVariable = _variable_model("ThresholdVariable", ThresholdForce, None, "contact-force threshold [N]")
+PositionErrorVariable = _variable_model(
+    "PositionErrorVariable", PositionError, None, "position-error threshold [m]"
+)
+VelocityVariable = _variable_model("VelocityVariable", ApproachVelocity, None, "approach velocity [m/s]")
 
 PER_JOINT_DESIGN_VARIABLES = ("stator_diameter", "stack_length", "gear_ratio", "software_stiffness")
 
@@ -535,15 +604,17 @@ class DesignSpec(_Model):
 class ConstraintsSpec(_Model):
     """Design constraints: payload [kg], torque safety factor, threshold noise floor [N], torques [N m]."""
 
-    payload: Mass = Field(
+    payload: Payload = Field(
         0.0,
         ge=0,
         description="mass carried at the contact point [kg], a point mass (also over a duty cycle); or "
         "duty_cycle.payload with its inertia, not both",
     )
-    safety_factor: Ratio = Field(1.0, ge=1, description="peak torque >= safety_factor x required torque")
-    threshold_floor: Force = Field(0.0, ge=0, description="sensing noise floor [N]")
-    torque_required: list[Torque] | None = Field(
+    safety_factor: SafetyFactor = Field(
+        1.0, ge=1, description="peak torque >= safety_factor x required torque"
+    )
+    threshold_floor: NoiseFloor = Field(0.0, ge=0, description="sensing noise floor [N]")
+    torque_required: list[JointTorque] | None = Field(
         None, description="required torque per joint [N m]; null: gravity (+ payload) over the samples"
     )
 
@@ -582,7 +653,9 @@ class ExecutionSpec(_Model):
     """Where the independent work runs: in-process, a local process pool, or a Dask cluster."""
 
     executor: Literal["serial", "processes", "dask"] = "serial"
-    workers: PositiveInt = 2
+    # Local worker processes: more than 256 is more than the cores of any one machine (a Dask cluster scales
+    # with a scheduler address instead).
+    workers: Annotated[int, Field(ge=1, le=256, strict=True)] = 2
     scheduler: str | None = Field(None, description="Dask scheduler address, e.g. tcp://host:8786")
 
     @model_validator(mode="after")
@@ -592,7 +665,8 @@ class ExecutionSpec(_Model):
         return self
 
 
-Weight = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+# Objective weights: a ratio of 1e6 between two terms already makes the smaller one vanish.
+Weight = Annotated[float, Field(gt=0, le=1e6, allow_inf_nan=False)]
 
 
 class ArmStudy(_Model):
@@ -604,7 +678,7 @@ class ArmStudy(_Model):
     robot: RobotSpec
     actuators: ActuatorsSpec
     sensing: SensingSpec
-    approach_velocity: Velocity = Field(gt=0, description="approach velocity [m/s]")
+    approach_velocity: ApproachVelocity = Field(gt=0, description="approach velocity [m/s]")
     reaction: Literal["at_rest", "moving"] = "at_rest"
     reflected_inertia_in: Literal["robot", "finger"] = Field(
         "robot",
@@ -652,9 +726,9 @@ class ActuatorCandidate(_Model):
     motor: MotorSpec
     gearbox: GearboxSpec | None = None
     gearbox_inertia: bool = False
-    gear_ratio: Ratio = Field(1.0, ge=1)
-    mechanical_stiffness: RotaryStiffness = Field(gt=0)
-    software_stiffness: RotaryStiffness = Field(gt=0)
+    gear_ratio: GearRatio = Field(1.0, ge=1)
+    mechanical_stiffness: JointStiffness = Field(gt=0)
+    software_stiffness: JointStiffness = Field(gt=0)
     reflected_inertia_in: Literal["robot", "finger"] = Field(
         "robot",
         description="'finger': N^2 J_m also in the impact (a stiff transmission, like the paper's A8)",
@@ -665,9 +739,9 @@ class ActuatorCandidate(_Model):
 class LoadSpec(_Model):
     """What the actuator drives: a link of given lever, whose structure mass is seen at the contact."""
 
-    lever: Length = Field(gt=0, description="distance from the joint axis to the contact [m]")
-    finger_mass: Mass = Field(gt=0, description="structure (sprung) mass seen at the contact [kg]")
-    contact_stiffness: LinearStiffness | None = Field(
+    lever: Lever = Field(gt=0, description="distance from the joint axis to the contact [m]")
+    finger_mass: PartMass = Field(gt=0, description="structure (sprung) mass seen at the contact [kg]")
+    contact_stiffness: ContactStiffness | None = Field(
         None, gt=0, description="stiffness of the object hit [N/m], in series with the joint; null: rigid"
     )
 
@@ -675,8 +749,8 @@ class LoadSpec(_Model):
 class VelocityRange(_Model):
     """Approach velocities [m/s]: ``count`` values from ``min`` to ``max``, evenly spaced in log scale."""
 
-    min: Velocity = Field(gt=0)
-    max: Velocity = Field(gt=0)
+    min: ApproachVelocity = Field(gt=0)
+    max: ApproachVelocity = Field(gt=0)
     count: Annotated[int, Field(ge=2, le=10000, strict=True)] = 50
 
     @model_validator(mode="after")
@@ -698,7 +772,7 @@ class ActuatorStudy(_Model):
     load: LoadSpec
     actuators: dict[Name, ActuatorCandidate] = Field(min_length=1)
     sensing: SensingSpec
-    approach_velocity: Velocity = Field(gt=0, description="approach velocity of the tables [m/s]")
+    approach_velocity: ApproachVelocity = Field(gt=0, description="approach velocity of the tables [m/s]")
     velocities: VelocityRange
     reaction: Literal["at_rest", "moving"] = "at_rest"
     outputs: OutputsSpec = Field(default_factory=OutputsSpec)  # type: ignore[arg-type]

@@ -1,12 +1,15 @@
 """Reading a study file's YAML with the position of every node, so that any problem can name its line.
 
 PyYAML's composer gives the node tree with start marks; the same safe loader then constructs plain Python data
-from it. :class:`StudySource` keeps both and maps a field path (keys and list indices) to a line and column.
+from it, once the tree is known to be of bounded size (:func:`collision_reflex._yaml.check_nodes`: no alias bomb,
+no tags, no huge values). :class:`StudySource` keeps both and maps a field path (keys and list indices) to a
+line and column. Every problem is one line of printable text, whatever the file holds.
 """
 
 from __future__ import annotations
 
 import os
+import reprlib
 from collections.abc import Hashable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -14,10 +17,16 @@ from typing import Any
 
 import yaml
 
+from .._yaml import NodeProblem, check_nodes, one_line
 from ..errors import StudyFileError, StudyProblem
 
 PathKey = tuple[Hashable, ...]
 """A field path in a study: mapping keys (as YAML constructs them) and list indices."""
+
+MAX_FILE_SIZE = 1 << 20
+"""Largest study file read [bytes]: the shipped studies are a few kB."""
+
+_FOUND_LENGTH = 160
 
 
 @dataclass(frozen=True)
@@ -69,7 +78,29 @@ class StudySource:
     def problem(self, path: Sequence[Hashable], found: str, expected: str) -> StudyProblem:
         """A :class:`StudyProblem` at ``path`` (a path in the file's data)."""
         line, column = self.locate(path)
-        return StudyProblem(self.file, line, column, format_path(path), found, expected)
+        return problem_at(self.file, line, column, format_path(path), found, expected)
+
+
+def excerpt(value: Any, limit: int = 60) -> str:
+    """A short description of a value found in the file: its repr, cut to ``limit`` characters.
+
+    reprlib looks at a few items of each level only, so describing a huge value costs no more than a small one.
+    """
+    text = _EXCERPT.repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+_EXCERPT = reprlib.Repr()
+_EXCERPT.maxlevel, _EXCERPT.maxdict, _EXCERPT.maxlist, _EXCERPT.maxtuple = 3, 4, 4, 4
+_EXCERPT.maxstring = _EXCERPT.maxother = 60
+
+
+def problem_at(file: str, line: int, column: int, path: str, found: str, expected: str) -> StudyProblem:
+    """A :class:`StudyProblem` whose texts are each one line of printable characters (others escaped)."""
+    found = one_line(found)
+    if len(found) > _FOUND_LENGTH:  # what the file holds, quoted as a short excerpt
+        found = found[: _FOUND_LENGTH - 3] + "..."
+    return StudyProblem(one_line(file), line, column, one_line(path), found, one_line(expected))
 
 
 def _looks_internal(key: Hashable) -> bool:
@@ -94,54 +125,76 @@ def format_path(path: Sequence[Hashable]) -> str:
 def read_study_source(path: str | os.PathLike[str]) -> StudySource:
     """Read a study file.
 
-    A missing or unreadable file, or YAML that does not parse, raises
-    :class:`~collision_reflex.errors.StudyFileError` with the line.
+    A missing or unreadable file, one over :data:`MAX_FILE_SIZE`, text that is not UTF-8, or YAML that does
+    not parse raises :class:`~collision_reflex.errors.StudyFileError` with the line.
     """
     name = str(path)
+
+    def fail(line: int, column: int, found: str, expected: str) -> StudyFileError:
+        return StudyFileError(name, [problem_at(name, line, column, "", found, expected)])
+
+    file = Path(path)
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        if file.exists() and not file.is_file():
+            raise fail(0, 0, "not a regular file", "the path of a study file (YAML)")
+        with file.open("rb") as stream:
+            data = stream.read(MAX_FILE_SIZE + 1)
     except FileNotFoundError:
-        raise StudyFileError(
-            name, [StudyProblem(name, 0, 0, "", "no such file", "the path of a study file (YAML)")]
+        raise fail(0, 0, "no such file", "the path of a study file (YAML)") from None
+    except (OSError, ValueError) as error:  # ValueError: a NUL byte in the path
+        reason = getattr(error, "strerror", None) or str(error)
+        raise fail(0, 0, f"a file that cannot be read ({reason})", "a UTF-8 YAML file") from None
+    if len(data) > MAX_FILE_SIZE:
+        raise fail(0, 0, f"a file over {MAX_FILE_SIZE >> 20} MiB", "a study file (a few kB of YAML)")
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        start = data.rfind(b"\n", 0, error.start) + 1
+        line = data.count(b"\n", 0, error.start) + 1
+        column = len(data[start : error.start].decode("utf-8", "replace")) + 1
+        raise fail(
+            line, column, f"the byte 0x{data[error.start]:02x}, not UTF-8 text", "a UTF-8 file"
         ) from None
-    except (OSError, UnicodeDecodeError) as error:
-        raise StudyFileError(
-            name, [StudyProblem(name, 0, 0, "", f"a file that cannot be read ({error})", "a UTF-8 YAML file")]
-        ) from None
-    return parse_study_source(text, name, Path(path).resolve().parent)
+    return parse_study_source(text, name, file.resolve().parent)
 
 
 def parse_study_source(text: str, file: str = "<string>", directory: Path | None = None) -> StudySource:
     """Parse YAML text into a :class:`StudySource`; errors as for :func:`read_study_source`."""
     directory = directory if directory is not None else Path.cwd()
     try:
-        loader = yaml.SafeLoader(text)
-    except yaml.reader.ReaderError as error:  # a character YAML does not allow, found before parsing starts
-        line = text.count("\n", 0, error.position) + 1
-        column = error.position - (text.rfind("\n", 0, error.position) + 1) + 1
-        raise StudyFileError(
-            file,
-            [
-                StudyProblem(
-                    file, line, column, "", f"the character {chr(error.character)!r}", "printable text"
-                )
-            ],
-        ) from None
+        loader = _LOADER(text)
+    except UnicodeEncodeError as error:  # a lone surrogate in text given directly (a file's text has none)
+        line = text.count("\n", 0, error.start) + 1
+        column = error.start - (text.rfind("\n", 0, error.start) + 1) + 1
+        found = "a lone surrogate (not a Unicode character)"
+        raise StudyFileError(file, [problem_at(file, line, column, "", found, "text")]) from None
     try:
         node = loader.get_single_node()
+        if node is not None:
+            check_nodes(node)  # before constructing: an alias bomb or a tag is refused here
         data = loader.construct_document(node) if node is not None else None
+    except yaml.reader.ReaderError as error:  # a character YAML does not allow
+        line = text.count("\n", 0, error.position) + 1
+        column = error.position - (text.rfind("\n", 0, error.position) + 1) + 1
+        character = error.character if isinstance(error.character, str) else chr(error.character)
+        found = f"the character {character!r}"
+        raise StudyFileError(file, [problem_at(file, line, column, "", found, "printable text")]) from None
+    except NodeProblem as error:
+        found = f"invalid YAML ({error.reason})"
+        where = format_path(error.path)
+        problem = problem_at(file, error.line, error.column, where, found, "well-formed YAML of plain values")
+        raise StudyFileError(file, [problem]) from None
     except yaml.MarkedYAMLError as error:
         mark = error.problem_mark or error.context_mark
         line, column = (mark.line + 1, mark.column + 1) if mark is not None else (1, 1)
         what = " ".join(part for part in (error.context, error.problem) if part)
         raise StudyFileError(
-            file, [StudyProblem(file, line, column, "", f"invalid YAML ({what})", "well-formed YAML")]
+            file, [problem_at(file, line, column, "", f"invalid YAML ({what})", "well-formed YAML")]
         ) from None
     except (yaml.YAMLError, ValueError, OverflowError, RecursionError) as error:
         # The safe constructor can still fail on odd scalars (e.g. an impossible date): report it at the start.
-        raise StudyFileError(
-            file, [StudyProblem(file, 1, 1, "", f"YAML that cannot be read ({error})", "well-formed YAML")]
-        ) from None
+        found = f"YAML that cannot be read ({error})"
+        raise StudyFileError(file, [problem_at(file, 1, 1, "", found, "well-formed YAML")]) from None
     finally:
         loader.dispose()
     positions: dict[PathKey, tuple[int, int]] = {}
@@ -199,6 +252,13 @@ def _constructed_key(key_node: yaml.Node, raw: Any) -> Any:
     if not isinstance(key_node, yaml.ScalarNode):
         return raw
     try:
-        return yaml.safe_load(yaml.serialize(key_node))
-    except yaml.YAMLError:
+        return _KEY_CONSTRUCTOR.construct_document(key_node)
+    except (yaml.YAMLError, ValueError, OverflowError):
         return raw
+
+
+_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+"""The safe loader, on libyaml's parser where PyYAML was built with it (six times faster; the same marks)."""
+
+_KEY_CONSTRUCTOR = yaml.SafeLoader("")
+"""Constructs single key nodes (a loader over no text: only its constructor is used)."""
