@@ -57,6 +57,8 @@ def export_design(
     out = Path(out)
     if out.is_dir():
         raise ExportUnwritable(f"cannot write {out}: it is a folder; give a file name")
+    if out.parent.exists() and not out.parent.is_dir():
+        raise ExportUnwritable(f"cannot write {out}: {out.parent} is a file, not a folder")
     chosen = read_run_design(run_dir, design)
     from .urdf import design_urdf
 

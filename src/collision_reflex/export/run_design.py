@@ -35,6 +35,7 @@ class JointActuator:
     the study leaves it out); reflected_inertia ``N^2 (J_m + J_g)`` [kg m^2]; peak_torque ``N tau_p`` [N m];
     motor_peak_torque ``tau_p`` [N m]; motor_mass, gearbox_mass [kg]; gearbox: its catalogue name ("" for
     none); gearbox_efficiency [-]; motor_max_speed ``omega_max`` [rad/s] (None when the catalogue gives none);
+    gearbox_max_speed: the catalogue gearbox's maximum input speed [rad/s] (None for none or not known);
     stator_diameter, stack_length [m]; nearest_motor: the nearest catalogue motor ("" for none).
     """
 
@@ -50,6 +51,7 @@ class JointActuator:
     gearbox: str
     gearbox_efficiency: float
     motor_max_speed: float | None
+    gearbox_max_speed: float | None
     stator_diameter: float
     stack_length: float
     nearest_motor: str
@@ -61,8 +63,12 @@ class JointActuator:
 
     @property
     def max_speed(self) -> float | None:
-        """The joint's speed limit ``omega_max / N`` [rad/s], None when the motor's is not known."""
-        return None if self.motor_max_speed is None else self.motor_max_speed / self.gear_ratio
+        """The joint's speed limit [rad/s]: the motor's ``omega_max`` (or the gearbox's input limit, if lower) / N.
+
+        None when neither is known.
+        """
+        known = [s for s in (self.motor_max_speed, self.gearbox_max_speed) if s is not None]
+        return min(known) / self.gear_ratio if known else None
 
 
 @dataclass(frozen=True)
@@ -121,6 +127,8 @@ def read_run_design(run_dir: str | os.PathLike[str], design: str | int = "recomm
         raise ResultsMissing(f"{folder} has no {RESOLVED}: run the study again")
     try:
         return _run_design(results, record, label, resolved)
+    except ResultsDamaged as error:
+        raise ResultsDamaged(f"{path}: {error}; run the study again") from None
     except (KeyError, TypeError, ValueError, AttributeError) as error:
         if isinstance(error, CollisionReflexError):
             raise
@@ -173,6 +181,7 @@ def _run_design(results: Mapping[str, Any], record: Mapping[str, Any], label: st
     law = study.actuators.motor.scaling_law
     arm = load_arm(loaded)
     by_name = {str(j["joint"]): j for j in record["joints"]}
+    gearboxes = _gearbox_catalogue(by_name.values())
     missing = [name for name in arm.joint_names if name not in by_name]
     if missing:
         raise ResultsDamaged(f"the design has no actuator for joint(s) {', '.join(missing)}")
@@ -198,6 +207,7 @@ def _run_design(results: Mapping[str, Any], record: Mapping[str, Any], label: st
                 gearbox=str(saved.get("gearbox") or ""),
                 gearbox_efficiency=float(saved.get("gearbox_efficiency", 1.0)),
                 motor_max_speed=None if speed is None or not math.isfinite(speed) else float(speed),
+                gearbox_max_speed=_gearbox_input_speed(str(saved.get("gearbox") or ""), gearboxes),
                 stator_diameter=diameter,
                 stack_length=stack,
                 nearest_motor=str(saved.get("nearest_catalogue_motor") or ""),
@@ -208,23 +218,39 @@ def _run_design(results: Mapping[str, Any], record: Mapping[str, Any], label: st
         label=label,
         arm=arm,
         joints=tuple(joints),
-        parts=_parts(joints, catalogue, reference.name, law),
+        parts=_parts(joints, catalogue, gearboxes, reference.name, law),
         catalogue=record.get("catalogue"),
     )
 
 
-def _parts(joints: list[JointActuator], catalogue: Mapping[str, Any], reference: str, law: str) -> tuple[str, ...]:
+def _gearbox_input_speed(name: str, gearboxes: Mapping[str, Any]) -> float | None:
+    """A catalogue gearbox's maximum input speed [rad/s]; None without a gearbox, or one the catalogue lacks."""
+    speed = getattr(gearboxes.get(name), "max_input_speed", None) if name else None
+    return float(speed) if speed is not None and math.isfinite(speed) else None
+
+
+def _gearbox_catalogue(joints: Any) -> Mapping[str, Any]:
+    """The gearbox catalogue by name where a joint has a gearbox (empty otherwise: no file read)."""
+    if not any(j.get("gearbox") for j in joints):
+        return {}
+    from ..hardware.gearboxes import load_gearbox_catalogue
+
+    return load_gearbox_catalogue()
+
+
+def _parts(
+    joints: list[JointActuator],
+    catalogue: Mapping[str, Any],
+    gearboxes: Mapping[str, Any],
+    reference: str,
+    law: str,
+) -> tuple[str, ...]:
     """Provenance lines: the reference motor, each nearest catalogue motor and gearbox, with their sources."""
     lines = [f"motors scaled from {reference} by the {law} law; {reference}: {catalogue[reference].source}"]
     nearest = {j.nearest_motor for j in joints if j.nearest_motor in catalogue and j.nearest_motor != reference}
     for name in sorted(nearest):
         lines.append(f"nearest catalogue motor {name}: {catalogue[name].source}")
-    gearboxes = sorted({j.gearbox for j in joints if j.gearbox})
-    if gearboxes:
-        from ..hardware.gearboxes import load_gearbox_catalogue
-
-        known = load_gearbox_catalogue()
-        for name in gearboxes:
-            source = getattr(known.get(name), "source", "") or "figures given in the study"
-            lines.append(f"gearbox {name}: {source}")
+    for name in sorted({j.gearbox for j in joints if j.gearbox}):
+        source = getattr(gearboxes.get(name), "source", "") or "figures given in the study"
+        lines.append(f"gearbox {name}: {source}")
     return tuple(lines)

@@ -89,7 +89,8 @@ def _header(design: RunDesign, locked: list[str]) -> str:
         "fixed to the parent link, as the optimiser models it.",
         "Rotor inertia: transmissions (mechanicalReduction = N, drake:rotor_inertia = J_m + J_g); the armature "
         "N^2 (J_m + J_g) per joint is in the companion FILE.armature.json (set it as model.armature).",
-        "Joint effort = the design's peak output torque N tau_p [N m]; velocity = motor maximum speed / N [rad/s].",
+        "Joint effort = the design's peak output torque N tau_p [N m]; velocity = the motor's maximum speed (or the "
+        "gearbox's maximum input speed, if lower) / N [rad/s].",
     ]
     if locked:
         lines.append("Joints locked by the study (fixed here at 0): " + ", ".join(locked) + ".")
