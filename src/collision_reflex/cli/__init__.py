@@ -28,7 +28,19 @@ from . import sweep as _sweep
 from . import validate as _validate
 
 # Subcommand modules, in the order `crx --help` lists them.
-_SUBCOMMANDS = [_impulse, _motors, _sweep, _surface, _fit, _simulate, _validate, _schema, _run, _report, _export]
+_SUBCOMMANDS = [
+    _impulse,
+    _motors,
+    _sweep,
+    _surface,
+    _fit,
+    _simulate,
+    _validate,
+    _schema,
+    _run,
+    _report,
+    _export,
+]
 
 
 def build_parser() -> argparse.ArgumentParser:

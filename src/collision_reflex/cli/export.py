@@ -6,7 +6,10 @@ import argparse
 
 from . import options
 
-FORMATS = ("urdf", "mjcf")  # as collision_reflex.export.FORMATS, kept here so that `crx --help` imports nothing
+FORMATS = (
+    "urdf",
+    "mjcf",
+)  # as collision_reflex.export.FORMATS, kept here so that `crx --help` imports nothing
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:

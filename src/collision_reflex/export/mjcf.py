@@ -55,7 +55,9 @@ def design_mjcf(design: RunDesign, urdf_text: str) -> str:
     try:
         model = mujoco.MjModel.from_xml_string(_mujoco_urdf(urdf_text))
     except ValueError as error:
-        raise UrdfError(design.label, f"MuJoCo cannot read the exported URDF: {' '.join(str(error).split())}") from None
+        raise UrdfError(
+            design.label, f"MuJoCo cannot read the exported URDF: {' '.join(str(error).split())}"
+        ) from None
     root = ET.Element("mujoco", model=design.arm.name)
     root.append(ET.Comment(_header(design)))
     ET.SubElement(root, "compiler", angle="radian", autolimits="true", inertiafromgeom="false")
@@ -122,7 +124,9 @@ def _vector(values: Any) -> str:
 def _body(mujoco: Any, model: Any, body: int, parent: ET.Element) -> ET.Element:
     """A body with its placement and its inertial (bodies without mass have none)."""
     name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, body) or f"body{body}"
-    element = ET.SubElement(parent, "body", name=name, pos=_vector(model.body_pos[body]), quat=_vector(model.body_quat[body]))
+    element = ET.SubElement(
+        parent, "body", name=name, pos=_vector(model.body_pos[body]), quat=_vector(model.body_quat[body])
+    )
     if model.body_mass[body] > 0:
         ET.SubElement(
             element,
@@ -143,7 +147,12 @@ def _joint(mujoco: Any, model: Any, joint: int, body: ET.Element, actuators: dic
     )
     if kind is None:
         raise UrdfError(name, "a joint that is neither revolute nor prismatic")
-    attributes = {"name": name, "type": kind, "pos": _vector(model.jnt_pos[joint]), "axis": _vector(model.jnt_axis[joint])}
+    attributes = {
+        "name": name,
+        "type": kind,
+        "pos": _vector(model.jnt_pos[joint]),
+        "axis": _vector(model.jnt_axis[joint]),
+    }
     if model.jnt_limited[joint]:
         attributes["range"] = _vector(model.jnt_range[joint])
     actuator = actuators.get(name)

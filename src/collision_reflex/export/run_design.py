@@ -111,9 +111,13 @@ def read_run_design(run_dir: str | os.PathLike[str], design: str | int = "recomm
     try:
         results = read_json(path)
     except (OSError, ValueError) as error:
-        raise ResultsDamaged(f"{path} cannot be read ({' '.join(str(error).split())}); run the study again") from None
+        raise ResultsDamaged(
+            f"{path} cannot be read ({' '.join(str(error).split())}); run the study again"
+        ) from None
     if not isinstance(results, dict):
-        raise ResultsDamaged(f"{path} holds {type(results).__name__}, not a run's results; run the study again")
+        raise ResultsDamaged(
+            f"{path} holds {type(results).__name__}, not a run's results; run the study again"
+        )
     if results.get("kind") != "arm":
         raise InvalidParameter(
             "run_dir",
@@ -151,12 +155,16 @@ def _pick(results: Mapping[str, Any], design: str | int, path: Path) -> tuple[st
             raise InvalidParameter(
                 "design",
                 design,
-                f"a Pareto design 0 to {len(points) - 1}" if points else "'recommended' (the run has no Pareto front)",
+                f"a Pareto design 0 to {len(points) - 1}"
+                if points
+                else "'recommended' (the run has no Pareto front)",
                 f"or one of {', '.join(DESIGN_CHOICES)}",
             )
         return f"Pareto design {design} ({points[design].get('label', '')})", points[design]
     if design not in DESIGN_CHOICES:
-        raise InvalidParameter("design", design, f"a Pareto design number or one of {', '.join(DESIGN_CHOICES)}")
+        raise InvalidParameter(
+            "design", design, f"a Pareto design number or one of {', '.join(DESIGN_CHOICES)}"
+        )
     record = results.get(design)
     if not isinstance(record, dict):
         raise InvalidParameter("design", design, "a design the run has", f"{path} has no {design!r} design")
@@ -164,7 +172,9 @@ def _pick(results: Mapping[str, Any], design: str | int, path: Path) -> tuple[st
     return f"{design} design ({source})" if source else f"{design} design", record
 
 
-def _run_design(results: Mapping[str, Any], record: Mapping[str, Any], label: str, resolved: Path) -> RunDesign:
+def _run_design(
+    results: Mapping[str, Any], record: Mapping[str, Any], label: str, resolved: Path
+) -> RunDesign:
     """The :class:`RunDesign` of a design record, with the arm and motors of the resolved study."""
     from ..hardware.motors import scaled_motor_quantities
     from ..study.load import parse_study
@@ -247,7 +257,9 @@ def _parts(
 ) -> tuple[str, ...]:
     """Provenance lines: the reference motor, each nearest catalogue motor and gearbox, with their sources."""
     lines = [f"motors scaled from {reference} by the {law} law; {reference}: {catalogue[reference].source}"]
-    nearest = {j.nearest_motor for j in joints if j.nearest_motor in catalogue and j.nearest_motor != reference}
+    nearest = {
+        j.nearest_motor for j in joints if j.nearest_motor in catalogue and j.nearest_motor != reference
+    }
     for name in sorted(nearest):
         lines.append(f"nearest catalogue motor {name}: {catalogue[name].source}")
     for name in sorted({j.gearbox for j in joints if j.gearbox}):

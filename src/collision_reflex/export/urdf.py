@@ -54,7 +54,7 @@ def design_urdf(design: RunDesign, out: str | os.PathLike[str]) -> str:
         root = ET.parse(source).getroot()
     except (OSError, ET.ParseError) as error:
         raise UrdfError(source, str(error)) from None
-    joints = {j.get("name"): j for j in root.findall("joint")}
+    joints = {str(j.get("name")): j for j in root.findall("joint")}
     names = {j.joint for j in design.joints}
     for missing in names - joints.keys():
         raise UrdfError(source, f"no joint {missing!r}")
@@ -145,7 +145,9 @@ def _add_actuator_link(root: ET.Element, joint: ET.Element, actuator: JointActua
         raise UrdfError("URDF", f"joint {actuator.joint!r} has no parent link")
     name = ACTUATOR_LINK.format(joint=actuator.joint)
     gearbox = f" + gearbox {actuator.gearbox} {number(actuator.gearbox_mass)} kg" if actuator.gearbox else ""
-    root.append(ET.Comment(f" {actuator.joint}: motor {number(actuator.motor_mass)} kg{gearbox}, a point mass "))
+    root.append(
+        ET.Comment(f" {actuator.joint}: motor {number(actuator.motor_mass)} kg{gearbox}, a point mass ")
+    )
     link = ET.SubElement(root, "link", name=name)
     inertial = ET.SubElement(link, "inertial")
     ET.SubElement(inertial, "origin", xyz="0 0 0", rpy="0 0 0")
