@@ -295,6 +295,21 @@ def test_no_absolute_path_in_the_exported_files(runs, tmp_path):
         assert not [f for f in forbidden if f in text], path
 
 
+def test_a_relative_mesh_path_is_rewritten_relative_to_the_output(tmp_path):
+    robot = tmp_path / "robot"
+    robot.mkdir()
+    urdf = (REPO / "designs" / "planar_two_link.urdf").read_text()
+    mesh = '<visual><geometry><mesh filename="meshes/link1.stl"/></geometry></visual>'
+    (robot / "arm.urdf").write_text(urdf.replace('<link name="link1">', f'<link name="link1">{mesh}', 1))
+    study = (REPO / "studies" / "two_link_paper.yaml").read_text()
+    (tmp_path / "study.yaml").write_text(study.replace("../designs/planar_two_link.urdf", "robot/arm.urdf"))
+    run = synthetic_run(tmp_path / "run", tmp_path / "study.yaml", 4)
+    (tmp_path / "out").mkdir()
+    export_design(run, "recommended", "urdf", tmp_path / "out" / "arm.urdf")
+    (written,) = ET.parse(tmp_path / "out" / "arm.urdf").getroot().iter("mesh")
+    assert written.get("filename") == "../robot/meshes/link1.stl"
+
+
 def _one_line_error(argv: list[str], capsys: pytest.CaptureFixture[str]) -> str:
     """Run ``crx`` expecting exit status 2, no output and a one-line error; return the line."""
     assert main(argv) == 2

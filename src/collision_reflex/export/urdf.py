@@ -20,6 +20,7 @@ What the optimiser models, written into the robot's own URDF:
 
 from __future__ import annotations
 
+import json
 import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -97,7 +98,7 @@ def _header(design: RunDesign, locked: list[str]) -> str:
     for actuator in design.joints:
         lines.append(_joint_summary(actuator))
     if design.catalogue is not None:
-        lines.append(f"Catalogue selection of the design: {design.catalogue}")
+        lines.append(f"Catalogue selection of the design: {json.dumps(design.catalogue)}")
     return "\n  " + "\n  ".join(line.replace("--", "- -") for line in lines) + "\n"
 
 
