@@ -57,8 +57,9 @@ def design_urdf(design: RunDesign, out: str | os.PathLike[str]) -> str:
         raise UrdfError(source, str(error)) from None
     joints = {str(j.get("name")): j for j in root.findall("joint")}
     names = {j.joint for j in design.joints}
-    for missing in names - joints.keys():
-        raise UrdfError(source, f"no joint {missing!r}")
+    missing = sorted(names - joints.keys())
+    if missing:
+        raise UrdfError(source, "no joint " + ", ".join(map(repr, missing)))
     locked = [n for n, j in joints.items() if j.get("type") != "fixed" and n not in names]
     for name in locked:
         _lock(joints[name])
