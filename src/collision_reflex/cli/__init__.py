@@ -14,6 +14,7 @@ from collections.abc import Sequence
 
 from .. import __version__
 from ..errors import CollisionReflexError
+from . import export as _export
 from . import fit as _fit
 from . import impulse as _impulse
 from . import motors as _motors
@@ -27,7 +28,19 @@ from . import sweep as _sweep
 from . import validate as _validate
 
 # Subcommand modules, in the order `crx --help` lists them.
-_SUBCOMMANDS = [_impulse, _motors, _sweep, _surface, _fit, _simulate, _validate, _schema, _run, _report]
+_SUBCOMMANDS = [
+    _impulse,
+    _motors,
+    _sweep,
+    _surface,
+    _fit,
+    _simulate,
+    _validate,
+    _schema,
+    _run,
+    _report,
+    _export,
+]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -11,7 +11,8 @@ Rules, the same for every subcommand:
 - A contact-level quantity (1D, along the contact direction) and a joint-level one are different quantities
   with different flags: ``--mech-stiffness`` [N/m] at the contact, ``--joint-mech-stiffness`` [N*m/rad] at a
   joint.
-- ``--plot FILE`` for a figure, ``--csv FILE`` for a table, ``--out DIR`` for an output folder.
+- ``--plot FILE`` for a figure, ``--csv FILE`` for a table, ``--out DIR`` for an output folder (``--out FILE``
+  for the one file a command exports).
 - An old spelling is a hidden alias that still works and prints one deprecation line on stderr.
 """
 
@@ -491,6 +492,11 @@ def add_out_dir(parser: argparse.ArgumentParser, *, what: str, shown: str = "") 
     """``--out DIR``: an output folder."""
     default = f" (default {shown})" if shown else ""
     parser.add_argument("--out", default=None, metavar="DIR", help=f"write {what} to the folder DIR{default}")
+
+
+def add_out_file(parser: argparse.ArgumentParser, *, what: str) -> None:
+    """``--out FILE``: the one file a command exports (required)."""
+    parser.add_argument("--out", required=True, metavar="FILE", help=f"write {what} to FILE")
 
 
 def add_catalogue(parser: argparse.ArgumentParser) -> None:

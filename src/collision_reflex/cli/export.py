@@ -1,0 +1,49 @@
+"""``crx export``: write a run's design as a robot model for simulators (URDF with motors, MJCF with armature)."""
+
+from __future__ import annotations
+
+import argparse
+
+from . import options
+
+FORMATS = (
+    "urdf",
+    "mjcf",
+)  # as collision_reflex.export.FORMATS, kept here so that `crx --help` imports nothing
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``crx export`` and its options to ``subparsers``."""
+    parser = subparsers.add_parser(
+        "export",
+        help="write a run's design as URDF (motor masses, transmissions, limits) or MJCF (armature, motors)",
+        description=(
+            "Write the arm of a `crx run` output folder with the actuators of one of its designs. URDF: each "
+            "motor (and gearbox) as a point mass on its parent link at the joint origin (a link JOINT_actuator "
+            "on a fixed joint), a transmission per joint with the gear ratio and rotor inertia, effort limits "
+            "N tau_p [N*m] and velocity limits omega_max / N [rad/s], and beside it FILE.armature.json with the "
+            "armature N^2 (J_m + J_g) [kg*m^2] per joint for Pinocchio's model.armature. MJCF (needs the "
+            "'mujoco' extra): the same arm with the armature, a geared motor actuator per joint and its torque "
+            "ranges. Exit status 2 if the folder, the design or the output is unusable."
+        ),
+    )
+    parser.add_argument("run_dir", metavar="RUN_DIR", help="output folder of `crx run` (an arm study)")
+    parser.add_argument(
+        "--design",
+        default="recommended",
+        metavar="N|recommended|chosen",
+        help="the Pareto design N (the point column of pareto.csv), the recommended design, or the chosen one "
+        "(the single-objective optimum); default recommended",
+    )
+    parser.add_argument("--format", choices=FORMATS, required=True, help="the robot format to write")
+    options.add_out_file(parser, what="the robot model (.urdf or MJCF .xml)")
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``crx export`` with parsed ``args``; return the exit status."""
+    from ..export import export_design
+
+    for path in export_design(args.run_dir, args.design, args.format, args.out):
+        print(path)
+    return 0

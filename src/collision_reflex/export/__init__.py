@@ -1,0 +1,83 @@
+"""Export a design of a run to the robot formats simulators read: URDF with motors, MJCF with armature.
+
+:func:`export_design` writes the arm of a run folder with one of its designs: URDF (:mod:`.urdf`, with its
+armature companion :mod:`.armature`) or MJCF (:mod:`.mjcf`, needs the ``mujoco`` extra).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from .._io import atomic_open
+from ..errors import CollisionReflexError, InvalidParameter
+from .armature import armature_record, companion_path, set_armature
+from .run_design import DESIGN_CHOICES, RunDesign, read_run_design
+
+FORMATS = ("urdf", "mjcf")
+"""The export formats."""
+
+__all__ = [
+    "DESIGN_CHOICES",
+    "FORMATS",
+    "ExportUnwritable",
+    "RunDesign",
+    "companion_path",
+    "export_design",
+    "read_run_design",
+    "set_armature",
+]
+
+
+class ExportUnwritable(CollisionReflexError):
+    """The exported file cannot be written (a missing or read-only folder, a folder in the way)."""
+
+
+def export_design(
+    run_dir: str | os.PathLike[str],
+    design: str | int = "recommended",
+    format: str = "urdf",
+    out: str | os.PathLike[str] = "design.urdf",
+) -> list[Path]:
+    """Write the arm of the run folder ``run_dir`` with the actuators of one of its designs.
+
+    Parameters
+    ----------
+    run_dir: the output folder of ``crx run`` of an arm study.
+    design: ``"recommended"``, ``"chosen"`` (the single-objective optimum) or a Pareto design's index.
+    format: ``"urdf"`` (with the armature companion ``OUT.armature.json``) or ``"mjcf"``.
+    out: the file to write.
+
+    Returns
+    -------
+    The files written.
+    """
+    if format not in FORMATS:
+        raise InvalidParameter("format", format, " or ".join(FORMATS))
+    out = Path(out)
+    if out.is_dir():
+        raise ExportUnwritable(f"cannot write {out}: it is a folder; give a file name")
+    if out.parent.exists() and not out.parent.is_dir():
+        raise ExportUnwritable(f"cannot write {out}: {out.parent} is a file, not a folder")
+    chosen = read_run_design(run_dir, design)
+    from .urdf import design_urdf
+
+    urdf = design_urdf(chosen, out)
+    if format == "mjcf":
+        from .mjcf import design_mjcf
+
+        return [_write(out, design_mjcf(chosen, urdf))]
+    import json
+
+    companion = json.dumps(armature_record(chosen, out.name), indent=1) + "\n"
+    return [_write(out, urdf), _write(companion_path(out), companion)]
+
+
+def _write(path: Path, text: str) -> Path:
+    """Write ``text`` to ``path`` atomically; an unwritable place is :class:`ExportUnwritable`."""
+    try:
+        with atomic_open(path, "w", encoding="utf-8") as handle:
+            handle.write(text)
+    except OSError as error:
+        raise ExportUnwritable(f"cannot write {path}: {error.strerror or error}") from None
+    return path

@@ -1,0 +1,268 @@
+"""One design of a run folder, with the arm and the catalogue parts it was designed for.
+
+A run folder of ``crx run`` holds the design records (``designs.json``) and the study as it was run
+(``study.resolved.yaml``); this module reads one design out of them and rebuilds what the record does not hold:
+the arm (from the resolved study's robot) and each motor's maximum speed (the reference motor scaled to the
+design's size, as the optimiser scales it).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from ..errors import CollisionReflexError, InvalidParameter
+from ..report.files import DESIGNS, ResultsDamaged, ResultsMissing, read_json
+
+if TYPE_CHECKING:
+    from ..arm import Arm
+
+RESOLVED = "study.resolved.yaml"
+DESIGN_CHOICES = ("recommended", "chosen")
+"""Designs named by word: the run's recommended design and its single-objective optimum as solved."""
+
+
+@dataclass(frozen=True)
+class JointActuator:
+    """One joint's actuator as the design gives it (SI units, joint side unless named motor).
+
+    joint: the joint's name; gear_ratio ``N`` [-]; rotor_inertia ``J_m`` [kg m^2]; gearbox_inertia: the gearbox's
+    input-side inertia ``J_g`` as the design's reflected inertia counts it [kg m^2] (0 without a gearbox or when
+    the study leaves it out); reflected_inertia ``N^2 (J_m + J_g)`` [kg m^2]; peak_torque ``N tau_p`` [N m];
+    motor_peak_torque ``tau_p`` [N m]; motor_mass, gearbox_mass [kg]; gearbox: its catalogue name ("" for
+    none); gearbox_efficiency [-]; motor_max_speed ``omega_max`` [rad/s] (None when the catalogue gives none);
+    gearbox_max_speed: the catalogue gearbox's maximum input speed [rad/s] (None for none or not known);
+    stator_diameter, stack_length [m]; nearest_motor: the nearest catalogue motor ("" for none).
+    """
+
+    joint: str
+    gear_ratio: float
+    rotor_inertia: float
+    gearbox_inertia: float
+    reflected_inertia: float
+    peak_torque: float
+    motor_peak_torque: float
+    motor_mass: float
+    gearbox_mass: float
+    gearbox: str
+    gearbox_efficiency: float
+    motor_max_speed: float | None
+    gearbox_max_speed: float | None
+    stator_diameter: float
+    stack_length: float
+    nearest_motor: str
+
+    @property
+    def actuator_mass(self) -> float:
+        """The mass carried by the parent link at the joint [kg]: the motor's and the gearbox's."""
+        return self.motor_mass + self.gearbox_mass
+
+    @property
+    def max_speed(self) -> float | None:
+        """The joint's speed limit [rad/s]: the motor's ``omega_max`` (or the gearbox's input limit, if lower) / N.
+
+        None when neither is known.
+        """
+        known = [s for s in (self.motor_max_speed, self.gearbox_max_speed) if s is not None]
+        return min(known) / self.gear_ratio if known else None
+
+
+@dataclass(frozen=True)
+class RunDesign:
+    """A design of a run folder and what an export needs about it.
+
+    study: the study's name; label: which design (``"recommended design (Pareto design 0)"``); arm: the arm
+    as the study loads it (locked joints removed, contact point set); joints: one :class:`JointActuator` per
+    joint of the arm, in its order; parts: provenance lines (catalogue parts and their sources);
+    catalogue: the design record's ``catalogue`` entry where it has one (None otherwise).
+    """
+
+    study: str
+    label: str
+    arm: Arm
+    joints: tuple[JointActuator, ...]
+    parts: tuple[str, ...]
+    catalogue: Any = None
+
+
+def read_run_design(run_dir: str | os.PathLike[str], design: str | int = "recommended") -> RunDesign:
+    """The design ``design`` of the run folder ``run_dir``.
+
+    Parameters
+    ----------
+    run_dir: the output folder of ``crx run`` of an arm study.
+    design: ``"recommended"``, ``"chosen"`` (the single-objective optimum) or the index of a Pareto design
+        (as ``pareto.csv``'s ``point`` column numbers them).
+
+    Raises
+    ------
+    ResultsMissing: the folder has no ``designs.json`` or no resolved study.
+    ResultsDamaged: ``designs.json`` cannot be read or lacks a field the export needs.
+    InvalidParameter: the study is not an arm study, or it has no design ``design``.
+    """
+    folder = Path(run_dir)
+    path = folder / DESIGNS
+    if not path.is_file():
+        raise ResultsMissing(f"{folder} has no {DESIGNS}: run the study first (crx run STUDY --out {folder})")
+    try:
+        results = read_json(path)
+    except (OSError, ValueError) as error:
+        raise ResultsDamaged(
+            f"{path} cannot be read ({' '.join(str(error).split())}); run the study again"
+        ) from None
+    if not isinstance(results, dict):
+        raise ResultsDamaged(
+            f"{path} holds {type(results).__name__}, not a run's results; run the study again"
+        )
+    if results.get("kind") != "arm":
+        raise InvalidParameter(
+            "run_dir",
+            f"{folder} ({results.get('kind')!r} study)",
+            "the folder of an arm study",
+            "an actuator study has no arm to export",
+        )
+    label, record = _pick(results, design, path)
+    resolved = folder / RESOLVED
+    if not resolved.is_file():
+        raise ResultsMissing(f"{folder} has no {RESOLVED}: run the study again")
+    try:
+        return _run_design(results, record, label, resolved)
+    except ResultsDamaged as error:
+        raise ResultsDamaged(f"{path}: {error}; run the study again") from None
+    except (KeyError, TypeError, ValueError, AttributeError) as error:
+        if isinstance(error, CollisionReflexError):
+            raise
+        what = f"field {error.args[0]!r} is missing" if isinstance(error, KeyError) else str(error)
+        raise ResultsDamaged(f"{path}: {' '.join(what.split())}; run the study again") from None
+
+
+def _pick(results: Mapping[str, Any], design: str | int, path: Path) -> tuple[str, Mapping[str, Any]]:
+    """The label and record of ``design`` in the results."""
+    try:
+        points = results["pareto"]["points"]
+        if not isinstance(points, list):
+            raise TypeError("field 'pareto.points' is not a list")
+    except (KeyError, TypeError) as error:
+        raise ResultsDamaged(f"{path}: {error}; run the study again") from None
+    if isinstance(design, str) and design.isdigit():
+        design = int(design)
+    if isinstance(design, int) and not isinstance(design, bool):
+        if not 0 <= design < len(points):
+            raise InvalidParameter(
+                "design",
+                design,
+                f"a Pareto design 0 to {len(points) - 1}"
+                if points
+                else "'recommended' (the run has no Pareto front)",
+                f"or one of {', '.join(DESIGN_CHOICES)}",
+            )
+        return f"Pareto design {design} ({points[design].get('label', '')})", points[design]
+    if design not in DESIGN_CHOICES:
+        raise InvalidParameter(
+            "design", design, f"a Pareto design number or one of {', '.join(DESIGN_CHOICES)}"
+        )
+    record = results.get(design)
+    if not isinstance(record, dict):
+        raise InvalidParameter("design", design, "a design the run has", f"{path} has no {design!r} design")
+    source = record.get("source") or record.get("label", "")
+    return f"{design} design ({source})" if source else f"{design} design", record
+
+
+def _run_design(
+    results: Mapping[str, Any], record: Mapping[str, Any], label: str, resolved: Path
+) -> RunDesign:
+    """The :class:`RunDesign` of a design record, with the arm and motors of the resolved study."""
+    from ..hardware.motors import scaled_motor_quantities
+    from ..study.load import parse_study
+    from ..study.prepare import check_motors
+    from ..study.robot import load_arm
+    from ..study.schema import ArmStudy
+
+    loaded = parse_study(resolved.read_text(encoding="utf-8"), str(resolved), resolved.parent)
+    study = loaded.study
+    if not isinstance(study, ArmStudy):
+        raise InvalidParameter("run_dir", str(resolved.parent), "the folder of an arm study")
+    catalogue = check_motors(loaded)
+    reference = catalogue[study.actuators.motor.reference]
+    law = study.actuators.motor.scaling_law
+    arm = load_arm(loaded)
+    by_name = {str(j["joint"]): j for j in record["joints"]}
+    gearboxes = _gearbox_catalogue(by_name.values())
+    missing = [name for name in arm.joint_names if name not in by_name]
+    if missing:
+        raise ResultsDamaged(f"the design has no actuator for joint(s) {', '.join(missing)}")
+    joints = []
+    for name in arm.joint_names:
+        saved = by_name[name]
+        diameter, stack = float(saved["stator_diameter"]), float(saved["stack_length"])
+        speed = scaled_motor_quantities(reference, diameter, stack, law).max_speed
+        rotor, ratio = float(saved["rotor_inertia"]), float(saved["gear_ratio"])
+        reflected = float(saved["reflected_inertia"])
+        joints.append(
+            JointActuator(
+                joint=name,
+                gear_ratio=ratio,
+                rotor_inertia=rotor,
+                # What the reflected inertia counts beyond the rotor: J_g, or 0 where the study leaves it out.
+                gearbox_inertia=max(0.0, reflected / ratio**2 - rotor),
+                reflected_inertia=reflected,
+                peak_torque=float(saved["peak_torque"]),
+                motor_peak_torque=float(saved["motor_peak_torque"]),
+                motor_mass=float(saved["motor_mass"]),
+                gearbox_mass=float(saved.get("gearbox_mass", 0.0)),
+                gearbox=str(saved.get("gearbox") or ""),
+                gearbox_efficiency=float(saved.get("gearbox_efficiency", 1.0)),
+                motor_max_speed=None if speed is None or not math.isfinite(speed) else float(speed),
+                gearbox_max_speed=_gearbox_input_speed(str(saved.get("gearbox") or ""), gearboxes),
+                stator_diameter=diameter,
+                stack_length=stack,
+                nearest_motor=str(saved.get("nearest_catalogue_motor") or ""),
+            )
+        )
+    return RunDesign(
+        study=str(results.get("study", study.name)),
+        label=label,
+        arm=arm,
+        joints=tuple(joints),
+        parts=_parts(joints, catalogue, gearboxes, reference.name, law),
+        catalogue=record.get("catalogue"),
+    )
+
+
+def _gearbox_input_speed(name: str, gearboxes: Mapping[str, Any]) -> float | None:
+    """A catalogue gearbox's maximum input speed [rad/s]; None without a gearbox, or one the catalogue lacks."""
+    speed = getattr(gearboxes.get(name), "max_input_speed", None) if name else None
+    return float(speed) if speed is not None and math.isfinite(speed) else None
+
+
+def _gearbox_catalogue(joints: Any) -> Mapping[str, Any]:
+    """The gearbox catalogue by name where a joint has a gearbox (empty otherwise: no file read)."""
+    if not any(j.get("gearbox") for j in joints):
+        return {}
+    from ..hardware.gearboxes import load_gearbox_catalogue
+
+    return load_gearbox_catalogue()
+
+
+def _parts(
+    joints: list[JointActuator],
+    catalogue: Mapping[str, Any],
+    gearboxes: Mapping[str, Any],
+    reference: str,
+    law: str,
+) -> tuple[str, ...]:
+    """Provenance lines: the reference motor, each nearest catalogue motor and gearbox, with their sources."""
+    lines = [f"motors scaled from {reference} by the {law} law; {reference}: {catalogue[reference].source}"]
+    nearest = {
+        j.nearest_motor for j in joints if j.nearest_motor in catalogue and j.nearest_motor != reference
+    }
+    for name in sorted(nearest):
+        lines.append(f"nearest catalogue motor {name}: {catalogue[name].source}")
+    for name in sorted({j.gearbox for j in joints if j.gearbox}):
+        source = getattr(gearboxes.get(name), "source", "") or "figures given in the study"
+        lines.append(f"gearbox {name}: {source}")
+    return tuple(lines)

@@ -1,0 +1,201 @@
+"""The arm's URDF with a design's actuators: motor masses, transmissions, torque and speed limits.
+
+What the optimiser models, written into the robot's own URDF:
+
+- each joint's motor (and gearbox) is a point mass carried by the parent link at the joint origin (the
+  motor-mass terms of :class:`collision_reflex.arm.ArmSamples`). It is written as its own link,
+  ``<joint>_actuator``, fixed to the parent link at the joint's origin, with the mass and no rotational inertia
+  of its own: the URDF's link inertials stay as their authors gave them, the motors can be edited or removed
+  on their own, and every URDF reader (Pinocchio, MuJoCo, Drake) lumps a fixed child into its parent exactly;
+- URDF has no field for the rotor inertia: each joint gets a ``<transmission>`` with
+  ``mechanicalReduction`` = N, Drake's ``drake:gear_ratio`` and ``drake:rotor_inertia`` (``J_m + J_g``,
+  motor side), and a comment with the armature ``N^2 (J_m + J_g)``; the armature companion file
+  (:mod:`.armature`) carries it for Pinocchio;
+- the joint's effort limit is the design's peak output torque ``N tau_p``, its velocity limit the motor's
+  maximum speed over N (the URDF's own velocity limit is kept where the catalogue gives no motor speed);
+- joints the study locks (gripper fingers) become fixed joints at their locked position, zero;
+- mesh references: ``package://`` references are kept (resolve them with the robot's package directory);
+  any other path is rewritten relative to the output file, so the file names no absolute local path.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+from ..errors import InvalidParameter, UrdfError
+from .run_design import JointActuator, RunDesign
+
+DRAKE_NAMESPACE = "http://drake.mit.edu"
+"""Drake's URDF extensions: ``drake:rotor_inertia`` and ``drake:gear_ratio`` of a transmission's actuator."""
+ET.register_namespace("drake", DRAKE_NAMESPACE)
+
+ACTUATOR_LINK = "{joint}_actuator"
+"""Name of the link that carries a joint's motor (and gearbox) mass."""
+
+
+def number(value: float) -> str:
+    """A float as text that reads back to the same double."""
+    return repr(float(value))
+
+
+def design_urdf(design: RunDesign, out: str | os.PathLike[str]) -> str:
+    """The URDF text of ``design``'s arm with its actuators, to be written at ``out`` (mesh paths relative to it).
+
+    Raises
+    ------
+    UrdfError: the arm's URDF cannot be read, or lacks a joint or link the arm has.
+    """
+    source = design.arm.urdf_path
+    if source is None:
+        raise InvalidParameter("design", design.label, "an arm loaded from a URDF file")
+    try:
+        root = ET.parse(source).getroot()
+    except (OSError, ET.ParseError) as error:
+        raise UrdfError(source, str(error)) from None
+    joints = {str(j.get("name")): j for j in root.findall("joint")}
+    names = {j.joint for j in design.joints}
+    missing = sorted(names - joints.keys())
+    if missing:
+        raise UrdfError(source, "no joint " + ", ".join(map(repr, missing)))
+    locked = [n for n, j in joints.items() if j.get("type") != "fixed" and n not in names]
+    for name in locked:
+        _lock(joints[name])
+    for transmission in root.findall("transmission"):
+        driven = {j.get("name") for j in transmission.findall("joint")}
+        if driven & (names | set(locked)):
+            root.remove(transmission)
+    header = _header(design, locked)
+    root.insert(0, ET.Comment(header))
+    for actuator in design.joints:
+        _set_limits(joints[actuator.joint], actuator)
+        if actuator.actuator_mass > 0:
+            _add_actuator_link(root, joints[actuator.joint], actuator)
+        _add_transmission(root, actuator)
+    _relocate_meshes(root, Path(source).resolve().parent, Path(out).resolve().parent)
+    ET.indent(root, space="  ")
+    return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def _header(design: RunDesign, locked: list[str]) -> str:
+    """The header comment: study, design, catalogue parts and sources, and how the model is written."""
+    lines = [
+        f"Exported by collision-reflex from study {design.study!r}, {design.label}.",
+        f"Robot: {design.arm.name}; contact frame {design.arm.contact_frame!r}"
+        + (f" at {list(design.arm.contact_offset)} m" if any(design.arm.contact_offset) else "")
+        + ".",
+        *design.parts,
+        "Each motor (and gearbox) is a point mass on its parent link at the joint origin: link JOINT_actuator, "
+        "fixed to the parent link, as the optimiser models it.",
+        "Rotor inertia: transmissions (mechanicalReduction = N, drake:rotor_inertia = J_m + J_g); the armature "
+        "N^2 (J_m + J_g) per joint is in the companion FILE.armature.json (set it as model.armature).",
+        "Joint effort = the design's peak output torque N tau_p [N m]; velocity = the motor's maximum speed (or the "
+        "gearbox's maximum input speed, if lower) / N [rad/s].",
+    ]
+    if locked:
+        lines.append("Joints locked by the study (fixed here at 0): " + ", ".join(locked) + ".")
+    for actuator in design.joints:
+        lines.append(_joint_summary(actuator))
+    if design.catalogue is not None:
+        lines.append(f"Catalogue selection of the design: {json.dumps(design.catalogue)}")
+    return "\n  " + "\n  ".join(line.replace("--", "- -") for line in lines) + "\n"
+
+
+def _joint_summary(actuator: JointActuator) -> str:
+    """One line describing a joint's actuator."""
+    gearbox = f", gearbox {actuator.gearbox} ({actuator.gearbox_mass:.4g} kg)" if actuator.gearbox else ""
+    nearest = f" (nearest catalogue motor {actuator.nearest_motor})" if actuator.nearest_motor else ""
+    return (
+        f"{actuator.joint}: motor {actuator.stator_diameter * 1e3:.4g} mm x {actuator.stack_length * 1e3:.4g} mm"
+        f"{nearest}, {actuator.motor_mass:.4g} kg, N = {actuator.gear_ratio:.6g}{gearbox}"
+    )
+
+
+def _lock(joint: ET.Element) -> None:
+    """Make a joint fixed at its zero position (its origin), as the study locks it."""
+    joint.set("type", "fixed")
+    for tag in ("axis", "limit", "dynamics", "safety_controller", "mimic", "calibration"):
+        for child in joint.findall(tag):
+            joint.remove(child)
+
+
+def _set_limits(joint: ET.Element, actuator: JointActuator) -> None:
+    """Effort limit ``N tau_p`` [N m]; velocity limit ``omega_max / N`` [rad/s] where the motor's is known."""
+    limit = joint.find("limit")
+    if limit is None:
+        limit = ET.SubElement(joint, "limit")
+    limit.set("effort", number(actuator.peak_torque))
+    if actuator.max_speed is not None:
+        limit.set("velocity", number(actuator.max_speed))
+    elif limit.get("velocity") is None:
+        raise InvalidParameter(
+            "design",
+            actuator.joint,
+            "a motor with a maximum speed, or a URDF velocity limit",
+            "add max_speed to the reference motor's catalogue entry",
+        )
+    else:
+        joint.append(ET.Comment(" velocity limit of the source URDF: the catalogue gives no motor speed "))
+
+
+def _add_actuator_link(root: ET.Element, joint: ET.Element, actuator: JointActuator) -> None:
+    """A link with the actuator's point mass, fixed to the joint's parent link at the joint origin."""
+    parent = joint.find("parent")
+    if parent is None or parent.get("link") is None:
+        raise UrdfError("URDF", f"joint {actuator.joint!r} has no parent link")
+    name = ACTUATOR_LINK.format(joint=actuator.joint)
+    gearbox = f" + gearbox {actuator.gearbox} {number(actuator.gearbox_mass)} kg" if actuator.gearbox else ""
+    root.append(
+        ET.Comment(f" {actuator.joint}: motor {number(actuator.motor_mass)} kg{gearbox}, a point mass ")
+    )
+    link = ET.SubElement(root, "link", name=name)
+    inertial = ET.SubElement(link, "inertial")
+    ET.SubElement(inertial, "origin", xyz="0 0 0", rpy="0 0 0")
+    ET.SubElement(inertial, "mass", value=number(actuator.actuator_mass))
+    ET.SubElement(inertial, "inertia", ixx="0", ixy="0", ixz="0", iyy="0", iyz="0", izz="0")
+    mount = ET.SubElement(root, "joint", name=f"{name}_mount", type="fixed")
+    ET.SubElement(mount, "parent", link=str(parent.get("link")))
+    ET.SubElement(mount, "child", link=name)
+    origin = joint.find("origin")
+    ET.SubElement(
+        mount,
+        "origin",
+        xyz=origin.get("xyz", "0 0 0") if origin is not None else "0 0 0",
+        rpy=origin.get("rpy", "0 0 0") if origin is not None else "0 0 0",
+    )
+
+
+def _add_transmission(root: ET.Element, actuator: JointActuator) -> None:
+    """A simple transmission: reduction N, rotor (+ gearbox input) inertia, and the armature as a comment."""
+    armature = actuator.reflected_inertia
+    root.append(
+        ET.Comment(
+            f" {actuator.joint}: armature N^2 (J_m + J_g) = {number(actuator.gear_ratio)}^2 x "
+            f"({number(actuator.rotor_inertia)} + {number(actuator.gearbox_inertia)}) = {number(armature)} kg m^2 "
+        )
+    )
+    transmission = ET.SubElement(root, "transmission", name=f"{actuator.joint}_transmission")
+    ET.SubElement(transmission, "type").text = "transmission_interface/SimpleTransmission"
+    joint = ET.SubElement(transmission, "joint", name=actuator.joint)
+    ET.SubElement(joint, "hardwareInterface").text = "hardware_interface/EffortJointInterface"
+    motor = ET.SubElement(transmission, "actuator", name=f"{actuator.joint}_motor")
+    ET.SubElement(motor, "mechanicalReduction").text = number(actuator.gear_ratio)
+    ET.SubElement(motor, f"{{{DRAKE_NAMESPACE}}}gear_ratio", value=number(actuator.gear_ratio))
+    ET.SubElement(
+        motor,
+        f"{{{DRAKE_NAMESPACE}}}rotor_inertia",
+        value=number(actuator.rotor_inertia + actuator.gearbox_inertia),
+    )
+
+
+def _relocate_meshes(root: ET.Element, source_dir: Path, out_dir: Path) -> None:
+    """Mesh paths that are not ``package://`` references, rewritten relative to the output's folder."""
+    for mesh in root.iter("mesh"):
+        filename = mesh.get("filename", "")
+        if not filename or filename.startswith("package://"):
+            continue
+        path = Path(filename.removeprefix("file://"))
+        absolute = path if path.is_absolute() else source_dir / path
+        mesh.set("filename", Path(os.path.relpath(absolute.resolve(), out_dir)).as_posix())
