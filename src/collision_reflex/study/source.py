@@ -187,6 +187,9 @@ def parse_study_source(text: str, file: str = "<string>", directory: Path | None
     except yaml.MarkedYAMLError as error:
         mark = error.problem_mark or error.context_mark
         line, column = (mark.line + 1, mark.column + 1) if mark is not None else (1, 1)
+        last = text.count("\n") + 1
+        if line > last:  # libyaml marks the end of a file without a final line break on a line after it
+            line, column = last, len(text) - (text.rfind("\n") + 1) + 1
         what = " ".join(part for part in (error.context, error.problem) if part)
         raise StudyFileError(
             file, [problem_at(file, line, column, "", f"invalid YAML ({what})", "well-formed YAML")]
