@@ -13,7 +13,7 @@ from collision_reflex.optimize.active_set import ActiveSetResult, sample_subset,
 # Both solves to a KKT tolerance far below the comparison's: at IPOPT's default 1e-8 the worst case of these
 # flat problems (set by the link inertia, the motors trade little against it) is only fixed to ~3e-7 relative,
 # by either solve.
-TIGHT = {"ipopt.tol": 1e-12, "ipopt.acceptable_tol": 1e-10}
+TIGHT = {"ipopt.tol": 1e-12, "ipopt.constr_viol_tol": 1e-12, "ipopt.acceptable_tol": 1e-10}
 OBJECTIVE_TOLERANCE = 1e-7
 """Relative agreement of the objectives: the scheme is exact, the tolerance covers the solves' accuracy
 (measured: 1e-10) and the tie-break's pull toward the active samples' mean (measured: below 1e-11 in the worst
@@ -24,7 +24,9 @@ case, 1e-9 in the full NLP's objective)."""
 def panda():
     rng = np.random.default_rng(7)
     arm = Arm.from_example_robot_data("panda")
-    samples = cr.ContactSamples.grid(arm.kinematics(arm.sample_configurations(64, rng)), rng.normal(size=(4, 3)))
+    samples = cr.ContactSamples.grid(
+        arm.kinematics(arm.sample_configurations(64, rng)), rng.normal(size=(4, 3))
+    )
     space = cr.DesignSpace(
         stator_diameter=(0.02, 0.15),
         gear_ratio=(1.0, 100.0),
@@ -37,8 +39,8 @@ def panda():
     )
     constraints = cr.Constraints(payload=1.0, safety_factor=1.5, threshold_floor=5.0)
 
-    def builder(objective, given=constraints):
-        return lambda chosen: cr.build_problem(arm, chosen, space, technology, objective, given)
+    def builder(objective, given=constraints, bounded=()):
+        return lambda chosen: cr.build_problem(arm, chosen, space, technology, objective, given, bounded)
 
     return samples, builder
 
@@ -63,7 +65,10 @@ def test_the_active_set_optimum_is_the_full_optimum_on_fewer_samples(panda, full
     # The full NLP's objective (worst case and tie-break on every sample) at both designs, and the worst case.
     assert _relative(problem.objective_value(result.x), problem.objective_value(full.x)) < OBJECTIVE_TOLERANCE
     worst_case = "worst_case_impulse"
-    assert _relative(result.numpy_objectives[worst_case], full.numpy_objectives[worst_case]) < OBJECTIVE_TOLERANCE
+    assert (
+        _relative(result.numpy_objectives[worst_case], full.numpy_objectives[worst_case])
+        < OBJECTIVE_TOLERANCE
+    )
     # The mean is the tie-break's: on the active samples it pulls the undetermined variables elsewhere (1e-6
     # relative in the mean here), never below the full solve's, which minimises it among the worst-case optima.
     mean = "mean_impulse"
@@ -103,11 +108,30 @@ def test_the_torque_requirement_is_every_configurations(panda, full_solve):
     samples, builder = panda
     problem, full = full_solve
     # One sample: its configuration's gravity torque alone would size the joints.
-    result = solve_active_set(builder("worst_case_impulse"), samples, ipopt_options=TIGHT, initial=np.array([5]))
+    result = solve_active_set(
+        builder("worst_case_impulse"), samples, ipopt_options=TIGHT, initial=np.array([5])
+    )
     required = np.asarray(problem.required_torque_function(result.design.actuator_mass)).ravel()
     np.testing.assert_allclose(result.required_torque, required, rtol=1e-9)
     assert np.all(result.design.driving_peak_torque >= required * (1 - 1e-7))
     np.testing.assert_allclose(result.required_torque, full.required_torque, rtol=1e-3)
+
+
+def test_a_bounded_worst_case_adds_the_samples_above_the_bound(panda):
+    samples, builder = panda
+    few = sample_subset(samples, np.arange(0, samples.size, 2))
+    build = builder("actuator_mass", bounded=("worst_case_impulse",))
+    # The lightest design's worst case is 0.843 N*s on all samples: a bound below it binds.
+    epsilon = {"worst_case_impulse": 0.84}
+    problem = build(few)
+    full = cr.solve(problem, epsilon, ipopt_options=TIGHT)
+    result = solve_active_set(build, few, epsilon, TIGHT, start_samples=8)
+    assert full.numpy_objectives["worst_case_impulse"] == pytest.approx(0.84, rel=1e-8)
+    assert result.numpy_objectives["worst_case_impulse"] <= 0.84 * (1 + 1e-8)
+    assert result.active_samples.size < few.size / 2
+    mass = "actuator_mass"
+    assert _relative(result.numpy_objectives[mass], full.numpy_objectives[mass]) < OBJECTIVE_TOLERANCE
+    assert _relative(problem.objective_value(result.x), problem.objective_value(full.x)) < OBJECTIVE_TOLERANCE
 
 
 def test_a_mean_impulse_objective_is_solved_on_every_sample(panda):

@@ -141,12 +141,18 @@ def solve_active_set(
     started = time.perf_counter()
     full = build(samples)
     if full.samples.size != samples.size:
-        raise InvalidParameter("build", f"a problem on {full.samples.size} samples", f"{samples.size} samples")
+        raise InvalidParameter(
+            "build", f"a problem on {full.samples.size} samples", f"{samples.size} samples"
+        )
     needs_all = _needs_every_sample(full)
     if needs_all is not None:
         result = solve(full, epsilon, ipopt_options=ipopt_options)
         record = ActiveSetRound(
-            samples.size, np.empty(0, dtype=int), result.iterations, time.perf_counter() - started, *[result.impulses.max()] * 2
+            samples.size,
+            np.empty(0, dtype=int),
+            result.iterations,
+            time.perf_counter() - started,
+            *[result.impulses.max()] * 2,
         )
         return _with_rounds(result, result.impulses, np.arange(samples.size), (record,), needs_all)
 
@@ -214,7 +220,12 @@ def _first_active_set(full: DesignProblem, size: int, initial: np.ndarray | None
     impulses = evaluate_design(full, design_at(full, full.x0))
     if initial is not None:
         chosen = np.asarray(initial).ravel()
-        if chosen.size == 0 or not np.issubdtype(chosen.dtype, np.integer) or chosen.min() < 0 or chosen.max() >= n:
+        if (
+            chosen.size == 0
+            or not np.issubdtype(chosen.dtype, np.integer)
+            or chosen.min() < 0
+            or chosen.max() >= n
+        ):
             raise InvalidParameter("initial", initial, f"sample indices in [0, {n})")
     elif size >= n:
         return np.arange(n)
@@ -236,7 +247,9 @@ def _requirement_samples(full: DesignProblem, impulses: np.ndarray) -> np.ndarra
     return _torque_violated(full, design_at(full, full.x0), impulses, np.inf)
 
 
-def _torque_violated(full: DesignProblem, design: Design, impulses: np.ndarray, tolerance: float) -> np.ndarray:
+def _torque_violated(
+    full: DesignProblem, design: Design, impulses: np.ndarray, tolerance: float
+) -> np.ndarray:
     """Per configuration whose gravity demand exceeds a joint's driving torque, its worst sample.
 
     With the static requirement the torque rows are per sampled configuration (plus and minus the gravity
@@ -249,7 +262,9 @@ def _torque_violated(full: DesignProblem, design: Design, impulses: np.ndarray, 
     if full.duty is not None or full.constraints.torque_required is not None:
         return np.empty(0, dtype=int)
     rows, _ = torque_requirement_rows(samples, full.constraints, full.joint_names)
-    demands = np.array([base + per_motor @ design.actuator_mass for base, per_motor in rows])  # (rows, joints)
+    demands = np.array(
+        [base + per_motor @ design.actuator_mass for base, per_motor in rows]
+    )  # (rows, joints)
     configurations = np.repeat(np.unique(samples.config_index), 2)  # a + and a - row per configuration
     if np.isinf(tolerance):
         flagged = configurations[demands.argmax(axis=0)]
@@ -270,9 +285,12 @@ def _violated(
     epsilon: Mapping[str, float] | None,
     tolerance: float,
 ) -> np.ndarray:
-    """Samples outside ``active`` that the design violates: their impulse exceeds the active worst case (or
-    the worst case's bound), their contact threshold is below the noise floor, or their configuration's gravity
-    demand exceeds a joint's driving torque, each by more than the relative ``tolerance``."""
+    """Samples outside ``active`` that ``design`` violates, by more than the relative ``tolerance``.
+
+    A sample is violated when its impulse [N*s] exceeds the active worst case (or the worst case's bound), its
+    contact threshold is below the noise floor, or its configuration's gravity demand exceeds a joint's driving
+    torque.
+    """
     levels = []
     if "worst_case_impulse" in full.objective:
         levels.append(impulses[active].max())
@@ -309,8 +327,13 @@ def _check_full_rows(full: DesignProblem, x: np.ndarray, epsilon: Mapping[str, f
         )
 
 
-def _full_result(full: DesignProblem, last: DesignResult, x: np.ndarray, impulses: np.ndarray) -> DesignResult:
-    """``last`` (the last subset's result) with the objectives of every sample at full-problem point ``x``."""
+def _full_result(
+    full: DesignProblem, last: DesignResult, x: np.ndarray, impulses: np.ndarray
+) -> dict[str, object]:
+    """The fields of ``last`` (the last subset's result) with the objectives of every sample at ``x``.
+
+    ``x`` is the full problem's point, ``impulses`` [N*s] the NumPy path's of every sample.
+    """
     evaluated = full.evaluate(x)
     casadi_impulses = np.asarray(evaluated[0]).ravel()
     objectives = {
