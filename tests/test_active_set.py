@@ -7,7 +7,8 @@ import pytest
 
 import collision_reflex as cr
 from collision_reflex.arm import Arm
-from collision_reflex.errors import InvalidParameter
+from collision_reflex.errors import InvalidParameter, SolverFailed
+from collision_reflex.optimize import active_set
 from collision_reflex.optimize.active_set import ActiveSetResult, sample_subset, solve_active_set
 
 # Both solves to a KKT tolerance far below the comparison's: at IPOPT's default 1e-8 the worst case of these
@@ -132,6 +133,15 @@ def test_a_bounded_worst_case_adds_the_samples_above_the_bound(panda):
     mass = "actuator_mass"
     assert _relative(result.numpy_objectives[mass], full.numpy_objectives[mass]) < OBJECTIVE_TOLERANCE
     assert _relative(problem.objective_value(result.x), problem.objective_value(full.x)) < OBJECTIVE_TOLERANCE
+
+
+def test_a_design_that_misses_a_row_of_the_full_problem_is_refused(panda, monkeypatch):
+    samples, builder = panda
+    # Without the torque check, one sample's configuration sizes the joints: the full problem's rows catch it.
+    monkeypatch.setattr(active_set, "_torque_violated", lambda *args: np.empty(0, dtype=int))
+    with pytest.raises(SolverFailed, match="peak torque of") as raised:
+        solve_active_set(builder("worst_case_impulse"), samples, initial=np.array([5]))
+    assert raised.value.status == "Active_Set_Inconsistent"
 
 
 def test_a_mean_impulse_objective_is_solved_on_every_sample(panda):
