@@ -50,8 +50,9 @@ if TYPE_CHECKING:
 __all__ = ["ACTIVE_SET_THRESHOLD", "ActiveSetResult", "ActiveSetRound", "sample_subset", "solve_active_set"]
 
 ACTIVE_SET_THRESHOLD = 1024
-"""Number of samples from which the active set pays on arm problems (benchmarks/optimize_samples_scaling.py:
-at 256 Panda samples a full solve takes about 2 s, at 1,024 the full NLP's solve grows to tens of seconds)."""
+"""Number of samples from which a problem should be solved on an active set (``benchmarks/
+optimize_samples_scaling.py``: on the Panda the full NLP solves 256 samples in seconds, and the multi-start and
+Pareto machinery of :mod:`.solve` and :mod:`.pareto` apply; 1,024 did not finish in 400 s)."""
 
 FULL_PROBLEM_TOLERANCE = 1e-6
 """Largest violation of a row of the full NLP (rows are scaled to order one) allowed at the design found."""
