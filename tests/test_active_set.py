@@ -144,6 +144,17 @@ def test_a_design_that_misses_a_row_of_the_full_problem_is_refused(panda, monkey
     assert raised.value.status == "Active_Set_Inconsistent"
 
 
+def test_multi_start_is_never_worse_and_reproducible(panda, full_solve):
+    samples, builder = panda
+    problem, _ = full_solve
+    build = builder("worst_case_impulse")
+    single = solve_active_set(build, samples)
+    multi = solve_active_set(build, samples, starts=3)
+    assert problem.objective_value(multi.x) <= problem.objective_value(single.x) * (1 + 1e-12)
+    again = solve_active_set(build, samples, starts=3)
+    np.testing.assert_array_equal(again.x, multi.x)
+
+
 def test_a_mean_impulse_objective_is_solved_on_every_sample(panda):
     samples, builder = panda
     few = sample_subset(samples, np.arange(0, samples.size, 4))
@@ -167,7 +178,13 @@ def test_sample_subset_keeps_every_configuration():
 
 @pytest.mark.parametrize(
     "keyword, value",
-    [("start_samples", 0), ("tolerance", -1e-3), ("max_rounds", 0), ("initial", np.array([10_000]))],
+    [
+        ("start_samples", 0),
+        ("tolerance", -1e-3),
+        ("max_rounds", 0),
+        ("initial", np.array([10_000])),
+        ("starts", 0),
+    ],
 )
 def test_bad_settings_are_clear_errors(panda, keyword, value):
     samples, builder = panda

@@ -32,7 +32,7 @@ import time
 import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, fields
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import casadi as ca
 import numpy as np
@@ -83,8 +83,8 @@ class ActiveSetResult(DesignResult):
 
     Its impulses, objectives and NumPy objectives are those of every sample; ``x`` is the full problem's point
     (auxiliaries at their exact values) and ``multipliers`` None (they belong to the last subset's NLP).
-    ``iterations`` and ``solve_time`` [s] add up all rounds (``solve_time`` with the problem builds and the
-    evaluations on all samples); ``status`` and ``attempts`` are the last round's.
+    ``iterations`` add up the rounds of the start kept, ``solve_time`` [s] is the whole solve's (every start,
+    the problem builds and the evaluations on all samples); ``status`` and ``attempts`` are the last round's.
 
     active_samples: indices (into all samples) of the samples in the last NLP.
     rounds: every NLP solved (:class:`ActiveSetRound`), in order.
@@ -112,6 +112,8 @@ def solve_active_set(
     tolerance: float = 1e-8,
     max_rounds: int = 20,
     initial: np.ndarray | None = None,
+    starts: int = 1,
+    rng: np.random.Generator | None = None,
 ) -> ActiveSetResult:
     """Solve the problem ``build(samples)`` on an active set of its samples (see the module's description).
 
@@ -130,15 +132,19 @@ def solve_active_set(
     max_rounds: most NLPs solved before giving up.
     initial: indices of the first active samples instead of ``start_samples`` chosen ones (e.g. the active set
         of an earlier solve); those that set the torque and speed requirements at the start are added.
+    starts: start designs (multi-start, as :func:`collision_reflex.optimize.solve`): the problem's start and
+        ``starts - 1`` drawn log-uniformly within the bounds by ``rng`` (default
+        ``numpy.random.default_rng(0)``); each settles its own active set, the best on the full NLP's
+        objective is returned (its rounds).
 
     Raises
     ------
-    InvalidParameter: bad ``start_samples``, ``tolerance``, ``max_rounds`` or ``initial``.
+    InvalidParameter: bad ``start_samples``, ``tolerance``, ``max_rounds``, ``initial`` or ``starts``.
     SolverFailed: as :func:`collision_reflex.optimize.solve` for a round; status ``"Active_Set_Not_Settled"``
         when samples are still added after ``max_rounds``, ``"Active_Set_Inconsistent"`` when the design found
         violates a row of the full NLP (a modelling bug).
     """
-    _check_settings(start_samples, tolerance, max_rounds)
+    _check_settings(start_samples, tolerance, max_rounds, starts)
     started = time.perf_counter()
     full = build(samples)
     if full.samples.size != samples.size:
@@ -147,7 +153,7 @@ def solve_active_set(
         )
     needs_all = _needs_every_sample(full)
     if needs_all is not None:
-        result = solve(full, epsilon, ipopt_options=ipopt_options)
+        result = solve(full, epsilon, ipopt_options=ipopt_options, starts=starts, rng=rng)
         record = ActiveSetRound(
             samples.size,
             np.empty(0, dtype=int),
@@ -158,12 +164,69 @@ def solve_active_set(
         return _with_rounds(result, result.impulses, np.arange(samples.size), (record,), needs_all)
 
     n_design = full.layout.size
-    active = _first_active_set(full, start_samples, initial)
-    x_design = full.x0[:n_design]
+    generator = rng or np.random.default_rng(0)
+    designs = [full.x0[:n_design]] + [
+        generator.uniform(full.lbx[:n_design], full.ubx[:n_design]) for _ in range(starts - 1)
+    ]
+    best: _Settled | None = None
+    failure: SolverFailed | None = None
+    for design in designs:
+        active = _first_active_set(full, start_samples, initial, design)
+        try:
+            settled = _settle(build, full, active, design, epsilon, ipopt_options, tolerance, max_rounds)
+        except SolverFailed as error:
+            if starts == 1 or error.confirmed_infeasible:
+                raise
+            failure = error  # another start may settle
+            continue
+        if best is None or settled.value < best.value:
+            best = settled
+    if best is None:
+        assert failure is not None  # every start failed
+        raise failure
+    final = _full_result(full, best.result, best.x, best.impulses)
+    return _with_rounds(
+        final, best.impulses, best.active, best.rounds, "active set", time.perf_counter() - started
+    )
+
+
+class _Settled(NamedTuple):
+    """An active set from which no sample is added: the last subset's result and its full-problem figures.
+
+    ``x`` is the full problem's point, ``impulses`` [N*s] every sample's (NumPy path), ``value`` the full NLP's
+    objective at ``x``.
+    """
+
+    result: DesignResult
+    x: np.ndarray
+    impulses: np.ndarray
+    active: np.ndarray
+    rounds: tuple[ActiveSetRound, ...]
+    value: float
+
+
+def _settle(
+    build: Callable[[ContactSamples], DesignProblem],
+    full: DesignProblem,
+    active: np.ndarray,
+    x_design: np.ndarray,
+    epsilon: Mapping[str, float] | None,
+    ipopt_options: IpoptOptions | None,
+    tolerance: float,
+    max_rounds: int,
+) -> _Settled:
+    """Solve on ``active`` from the design ``x_design`` (log values), add the violated samples, repeat.
+
+    Raises
+    ------
+    SolverFailed: a round's solve failed; ``"Active_Set_Not_Settled"`` after ``max_rounds``;
+        ``"Active_Set_Inconsistent"`` (see :func:`_check_full_rows`).
+    """
+    n_design = full.layout.size
     rounds: list[ActiveSetRound] = []
     while True:
         round_started = time.perf_counter()
-        problem = build(sample_subset(samples, active))
+        problem = build(sample_subset(full.samples, active))
         start = problem.exact_point(np.concatenate([x_design, problem.x0[n_design:]]))
         result = solve(problem, epsilon, start, ipopt_options)
         impulses = evaluate_design(full, result.design)
@@ -194,12 +257,13 @@ def solve_active_set(
         active = np.union1d(active, added)
     x = full.exact_point(np.concatenate([x_design, full.x0[n_design:]]))
     _check_full_rows(full, x, problem, result.x, epsilon)
-    final = _full_result(full, result, x, impulses)
-    return _with_rounds(final, impulses, active, tuple(rounds), "active set", time.perf_counter() - started)
+    return _Settled(result, x, impulses, active, tuple(rounds), full.objective_value(x))
 
 
-def _check_settings(start_samples: int, tolerance: float, max_rounds: int) -> None:
+def _check_settings(start_samples: int, tolerance: float, max_rounds: int, starts: int) -> None:
     """Refuse settings that cannot work, with what they must be."""
+    if not isinstance(starts, int) or starts < 1:
+        raise InvalidParameter("starts", starts, "an integer >= 1")
     if not isinstance(start_samples, int) or start_samples < 1:
         raise InvalidParameter("start_samples", start_samples, "an integer >= 1")
     if not (np.isfinite(tolerance) and tolerance >= 0):
@@ -215,10 +279,16 @@ def _needs_every_sample(problem: DesignProblem) -> str | None:
     return None
 
 
-def _first_active_set(full: DesignProblem, size: int, initial: np.ndarray | None) -> np.ndarray:
-    """The first active samples: ``initial`` or the worst at the start and a spread, and the requirement's."""
+def _first_active_set(
+    full: DesignProblem, size: int, initial: np.ndarray | None, x_design: np.ndarray
+) -> np.ndarray:
+    """The first active samples: ``initial`` or the worst at the start and a spread, and the requirement's.
+
+    ``x_design`` is the start design (log values, the first ``layout.size`` entries of ``x``).
+    """
     n = full.samples.size
-    impulses = evaluate_design(full, design_at(full, full.x0))
+    start = design_at(full, x_design)
+    impulses = evaluate_design(full, start)
     if initial is not None:
         chosen = np.asarray(initial).ravel()
         if (
@@ -233,10 +303,10 @@ def _first_active_set(full: DesignProblem, size: int, initial: np.ndarray | None
     else:
         worst = np.argsort(impulses)[::-1][: max(size // 2, 1)]
         chosen = np.concatenate([worst, np.linspace(0, n - 1, size - worst.size).round().astype(int)])
-    return np.unique(np.concatenate([chosen, _requirement_samples(full, impulses)]))
+    return np.unique(np.concatenate([chosen, _requirement_samples(full, start, impulses)]))
 
 
-def _requirement_samples(full: DesignProblem, impulses: np.ndarray) -> np.ndarray:
+def _requirement_samples(full: DesignProblem, start: Design, impulses: np.ndarray) -> np.ndarray:
     """Samples that carry the requirement rows of the start design: the first active set's torque and speed.
 
     Static requirement: per joint the configuration of the largest gravity demand at the start design (its
@@ -245,7 +315,7 @@ def _requirement_samples(full: DesignProblem, impulses: np.ndarray) -> np.ndarra
     """
     if full.duty is not None:
         return np.abs(full.duty.approach_rates).argmax(axis=0)
-    return _torque_violated(full, design_at(full, full.x0), impulses, np.inf)
+    return _torque_violated(full, start, impulses, np.inf)
 
 
 def _torque_violated(
