@@ -10,6 +10,7 @@ from collision_reflex.arm import Arm
 from collision_reflex.errors import InvalidParameter, SolverFailed
 from collision_reflex.optimize import active_set
 from collision_reflex.optimize.active_set import ActiveSetResult, sample_subset, solve_active_set
+from collision_reflex.optimize.evaluate import design_collision_parameters
 
 # Both solves to a KKT tolerance far below the comparison's: at IPOPT's default 1e-8 the worst case of these
 # flat problems (set by the link inertia, the motors trade little against it) is only fixed to ~3e-7 relative,
@@ -142,6 +143,36 @@ def test_a_design_that_misses_a_row_of_the_full_problem_is_refused(panda, monkey
     with pytest.raises(SolverFailed, match="peak torque of") as raised:
         solve_active_set(builder("worst_case_impulse"), samples, initial=np.array([5]))
     assert raised.value.status == "Active_Set_Inconsistent"
+
+
+def test_samples_below_the_noise_floor_are_added(panda):
+    samples, _ = panda
+    few = sample_subset(samples, np.arange(0, samples.size, 2))
+    arm = Arm.from_example_robot_data("panda")
+    # Position sensing: each sample's force threshold is k_s e_th [N], the floor binds where k_s is smallest.
+    space = cr.DesignSpace(
+        stator_diameter=(0.02, 0.15),
+        gear_ratio=(1.0, 100.0),
+        software_stiffness=(100.0, 1e4),
+        threshold=(1e-4, 0.05),
+        approach_velocity=(0.05, 1.0),
+    )
+    technology = cr.ActuatorTechnology(
+        cr.reference_motor(), mechanical_stiffness=5000.0, reflected_inertia_in="finger", sensing="position"
+    )
+    floor = 5.0
+    constraints = cr.Constraints(payload=1.0, safety_factor=1.5, threshold_floor=floor)
+
+    def build(chosen):
+        return cr.build_problem(arm, chosen, space, technology, "worst_case_impulse", constraints)
+
+    problem = build(few)
+    result = solve_active_set(build, few, ipopt_options=TIGHT, start_samples=4)
+    _, thresholds = design_collision_parameters(problem, result.design)
+    assert result.rounds[0].added.size > 0
+    assert thresholds.min() >= floor * (1 - 1e-8)
+    full = cr.solve(problem, ipopt_options=TIGHT)
+    assert _relative(problem.objective_value(result.x), problem.objective_value(full.x)) < OBJECTIVE_TOLERANCE
 
 
 def test_multi_start_is_never_worse_and_reproducible(panda, full_solve):

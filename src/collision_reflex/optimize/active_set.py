@@ -20,10 +20,11 @@ Two things depend on all samples and are handled as follows, never silently:
 
 - A mean-impulse objective or bound needs every sample: the problem is then solved on all samples
   (``ActiveSetResult.method`` says so).
-- The tie-break pull toward a lower mean impulse (:data:`collision_reflex.optimize.TIE_BREAK_WEIGHT`, 1e-3 of
-  the objective) acts on the active samples' mean: it picks among designs of equal worst case, and may place
-  the undetermined variables elsewhere than the full solve does; the worst case itself moves by the tie-break's
-  second-order effect (measured on the tests' problems: below 1e-7 relative).
+- The tie-break pull toward a lower mean impulse (:data:`collision_reflex.optimize.objectives.TIE_BREAK_WEIGHT`,
+  1e-3 of the objective) acts on the active samples' mean: it picks among designs of equal worst case, and may
+  place the undetermined variables elsewhere than the full solve does (measured on the tests' Panda problem:
+  the mean impulse 1e-6 relative above the full solve's, the worst case within 1e-10 and the full NLP's
+  objective within 1e-9).
 """
 
 from __future__ import annotations
