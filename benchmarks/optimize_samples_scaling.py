@@ -90,9 +90,11 @@ def measured(n_config: int, method: str, budget: float) -> dict[str, float | int
     """``run_case`` in a fresh process; None when it does not finish within ``budget`` seconds."""
     command = [sys.executable, __file__, "--case", str(n_config), method]
     try:
-        done = subprocess.run(command, capture_output=True, text=True, timeout=budget, check=True)
+        done = subprocess.run(command, capture_output=True, text=True, timeout=budget)
     except subprocess.TimeoutExpired:
         return None
+    if done.returncode != 0:
+        raise RuntimeError(f"{' '.join(command[1:])} failed:\n{done.stderr[-2000:]}")
     figures: dict[str, float | int | str] = json.loads(done.stdout.strip().splitlines()[-1])
     return figures
 
