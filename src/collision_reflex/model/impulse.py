@@ -294,7 +294,7 @@ def sprung_reaction(F_s: Any, k_m: Any, F_a: Any, m_r: Any, v_r: Any = 0.0) -> t
     sin wt``; it is zero first at ``w tau_e = phi + arccos(A / R)``, ``R = hypot(x1 + A, v_r / w)``, ``phi =
     atan2(v_r / w, x1 + A)``, and the impulse is ``k_m (-A tau_e + (x1 + A) sin(w tau_e) / w + v_r (1 - cos(w
     tau_e)) / w^2)``. It tends to the constant-acceleration reaction as ``F_s / F_a -> 0`` (the spring's push
-    ``k_m x1 = F_s`` against the motor's ``F_a``); at ``F_s = F_a`` it is about 25 % smaller.
+    ``k_m x1 = F_s`` against the motor's ``F_a``); at ``F_s = F_a`` and ``v_r = 0`` it is 27 % smaller.
 
     Parameters
     ----------
