@@ -8,6 +8,7 @@ it carries the impulse and shows that a wrong ``a`` (x2) or ``m_f`` (x1.1) fails
 
 from __future__ import annotations
 
+import time
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +16,7 @@ import pytest
 
 import collision_reflex as cr
 from collision_reflex.arm import Arm
-from collision_reflex.errors import InvalidParameter
+from collision_reflex.errors import InvalidParameter, SimulationError
 from collision_reflex.model.impulse import sprung_reaction
 from collision_reflex.simulate.arm import simulate_arm_collision
 
@@ -149,3 +150,90 @@ def test_old_keywords_still_work(arm):
     assert "'wall_stiffness' is deprecated; call it 'contact_stiffness'" in messages[1]
     assert old.impulse == new.impulse
     assert new.approach_velocity == 0.05
+
+
+def test_configuration_at_joint_limit_is_refused(arm):
+    with pytest.raises(InvalidParameter, match="joint limits"):
+        simulate_arm_collision(arm, [np.pi, 1.2], [1.0, 0.0], 0.1, 3.0, detection="force", **JOINTS)
+
+
+def test_singular_configuration_is_refused(arm):
+    """Stretched out, the tip cannot move along the arm: a clear error, not a hang or a NaN."""
+    with pytest.raises(InvalidParameter, match="singular"):
+        simulate_arm_collision(arm, [0.0, 0.0], [1.0, 0.0], 0.1, 3.0, detection="force", **JOINTS)
+
+
+def test_collapsing_step_is_refused_at_once(arm):
+    """A wall of 1e14 N/m needs a step of about 1e-9 s: refused by the work budget before it starts."""
+    start = time.perf_counter()
+    with pytest.raises(SimulationError, match="budget"):
+        simulate_arm_collision(arm, HONEST_Q, HONEST_U, 0.1, 3.0, contact_stiffness=1e14, **JOINTS)
+    assert time.perf_counter() - start < 5.0
+
+
+def test_unknown_scheme_is_refused(arm):
+    with pytest.raises(InvalidParameter, match="detection"):
+        simulate_arm_collision(arm, HONEST_Q, HONEST_U, 0.1, 3.0, detection="sonar", **JOINTS)
+
+
+@pytest.fixture(scope="module")
+def slow_v0(honest_runs):
+    """0.1 v* [m/s] of the honest configuration."""
+    return honest_runs[1][0.1].approach_velocity
+
+
+def test_position_error_detects_at_the_closed_form_time(arm, slow_v0):
+    """``F_s = k e``: with the velocity-controlled motors the error is ``v0 t``, so ``t1 = F_s / (k v0)``.
+
+    Less the wall's own deflection ``F / k_c``: ``e = v0 t (1 - k / k_c)``, so ``t1`` is later by ``k / k_c``
+    (7e-4 here), the tolerance.
+    """
+    result = simulate_arm_collision(arm, HONEST_Q, HONEST_U, slow_v0, 3.0, detection="position", **JOINTS)
+    k = result.effective["k"]
+    t1 = 3.0 / (k * slow_v0)
+    assert result.detection_time == pytest.approx(t1 * (1 + k / 1e6), rel=1e-4)
+    assert abs(result.detection_time / t1 - 1) > 0.5 * k / 1e6  # the wall's deflection is seen
+
+
+def test_observer_lags_by_its_time_constant(arm, slow_v0, honest_runs):
+    """A ramp through a first-order lag ``r' = K (tau_ext - r)`` crosses the threshold ``1/K`` later.
+
+    Tolerance 15 % of 1/K: the contact force's own ramp differs from the contact sensor's by the impact's
+    transient (measured 6 %).
+    """
+    gain = 100.0
+    result = simulate_arm_collision(
+        arm, HONEST_Q, HONEST_U, slow_v0, 3.0, detection="observer", observer_gain=gain, **JOINTS
+    )
+    sensor = honest_runs[1][0.1]
+    assert result.detection_time - sensor.detection_time == pytest.approx(1 / gain, rel=0.15)
+
+
+def test_sampled_detector_detects_on_its_grid(arm, slow_v0, honest_runs):
+    """At 200 Hz the detection is the first sample at or after the continuous crossing."""
+    result = simulate_arm_collision(
+        arm, HONEST_Q, HONEST_U, slow_v0, 3.0, detection="force", sample_rate=200.0, **JOINTS
+    )
+    continuous = honest_runs[1][0.1].detection_time
+    assert result.detection_time == pytest.approx(np.ceil(continuous * 200.0) / 200.0, rel=1e-9)
+    assert continuous <= result.detection_time < continuous + 1 / 200.0
+
+
+def test_current_thresholds_detect_near_the_contact_force(arm, slow_v0):
+    """Default thresholds ``F_s |J^T u|``: statically every joint reaches its own at the contact force F_s.
+
+    With ideal velocity drives the motor torque is the spring torque, so the detection is within the
+    spring-torque estimate's own error of the contact sensor's (measured 2 % in impulse).
+    """
+    result = simulate_arm_collision(arm, HONEST_Q, HONEST_U, slow_v0, 3.0, detection="current", **JOINTS)
+    assert result.detected_impulse == pytest.approx(result.closed_form_detected, rel=0.04)
+
+
+def test_saturated_retreat_pushes_harder(arm, honest_runs):
+    """Every joint at its limit gives at least the force of the limit along u: a smaller reaction impulse."""
+    along_u = honest_runs[1][1.0]
+    saturated = simulate_arm_collision(
+        arm, HONEST_Q, HONEST_U, along_u.approach_velocity, 3.0, detection="force", retreat="saturated", **JOINTS
+    )
+    assert saturated.detected_impulse == pytest.approx(along_u.detected_impulse, rel=1e-9)
+    assert saturated.impulse < along_u.impulse

@@ -769,14 +769,19 @@ def _react(
     """Push until the finger leaves the wall; then the reflex is over: the motors stop pushing and coast away.
 
     Watch ``watch`` [s] for a rebound into the wall before stopping (a constant torque kept on would spin the
-    arm round into the wall again, which is no part of the reflex), and push again if there is one.
+    arm round into the wall again, which is no part of the reflex), and push again from the moment it touches
+    again, until it leaves again.
     """
     from scipy.integrate import solve_ivp
 
     def separated(t: float, y: np.ndarray) -> float:
         return dynamics.penetration(y)
 
+    def touched(t: float, y: np.ndarray) -> float:
+        return dynamics.penetration(y)
+
     separated.terminal, separated.direction = True, -1  # type: ignore[attr-defined]
+    touched.terminal, touched.direction = True, 1  # type: ignore[attr-defined]
 
     for _ in range(_MAX_REBOUNDS):
         solution = solve_ivp(dynamics.rhs, (t, duration), y, events=separated, **options)
@@ -786,11 +791,10 @@ def _react(
             raise SimulationError(f"the contact had not ended after {duration:.3g} s; lengthen it")
         trace.contact_end = t
         dynamics.torque = np.zeros(dynamics.nv)
-        coast = solve_ivp(dynamics.rhs, (t, t + watch), y, **options)
+        coast = solve_ivp(dynamics.rhs, (t, t + watch), y, events=touched, **options)
         trace.add(coast, dynamics)
-        rebound = coast.y[-1, -1] > y[-1]
         y, t = coast.y[:, -1].copy(), float(coast.t[-1])
-        if not rebound:
+        if coast.status != 1:  # no new touch within the watch
             break
         dynamics.torque = dynamics.push
     else:
