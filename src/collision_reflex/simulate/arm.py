@@ -12,18 +12,36 @@ Each joint is a link side and a motor side coupled by the joint's mechanical spr
 ``f`` the wall force, a stiff Kelvin-Voigt contact that cannot pull (the wall is frictionless: the contact point
 may slide along it). Gravity is left out, as in the closed form.
 
-Approach and sensing follow the 1D ideal drive (:mod:`collision_reflex.simulate`) joint by joint: each motor is
-ideally velocity-controlled along ``theta_ref' = J(q0)^+ u v0`` (the contact point approaches along ``u`` at
-``v0``) and its software stiffness ``k_s,i`` acts as an admittance, so that the joint springs are the series
-``K = K_m K_s / (K_m + K_s)`` of the closed form. Detection is on the contact force estimated from the joint
-spring torques (a joint-torque sensor or observer): ``f_est = (J^T u) . tau_spring / |J^T u|^2``. At
-detection (plus an optional delay) the admittance is switched off and the motors push with
-``tau = -F_a J^T u``, ``F_a = min_i tau_max,i / |(J^T u)_i|``: the largest force along ``-u`` before the first
-joint saturates, as the closed form's ``a = F_a / m_r`` assumes.
+Approach follows the 1D ideal drive (:mod:`collision_reflex.simulate`) joint by joint: each motor is ideally
+velocity-controlled along ``theta_ref' = J(q0)^+ u v0`` (the contact point approaches along ``u`` at ``v0``)
+and its software stiffness ``k_s,i`` acts as an admittance, so that the joint springs are the series ``K = K_m
+K_s / (K_m + K_s)`` of the closed form. Detection (``detection=``, :mod:`.arm_detection`): a contact-force
+sensor (``"force"``, the closed form's meaning of ``F_s``), a generalized-momentum observer (``"observer"``),
+the joint spring torques projected on ``u`` (``"spring_torque"``, the default, kept from the first version),
+the contact point's position error (``"position"``) or the motor torques (``"current"``), optionally sampled.
+At detection (plus an optional delay) the admittance is switched off and the motors push (``retreat=``) with
+``tau = -F_a J^T u``, ``F_a = min_i tau_max,i / |(J^T u)_i|``, the largest force along ``-u`` before the first
+joint saturates, as the closed form's ``a = F_a / m_r`` assumes, or every joint saturated (``"saturated"``).
 
 What the closed form leaves out and this model keeps: the links' motion along the wall after the impact (the
 finger's momentum is only removed along ``u``), the motors' acceleration off the direction ``u`` during the
-reaction, the wall's compliance and rebound, and the change of ``J`` during the contact.
+reaction, the spring's push on the motors during the reaction, the wall's compliance and rebound, and the
+change of ``J`` during the contact.
+
+Why ``a/2`` matched the first test better than ``a`` (0.1 v*, spring-torque detection; elbow-up-x,
+elbow-up-oblique, folded-x of ``tests/test_simulate_arm.py``): two errors of opposite sign, not a factor in
+``a``. (1) The closed form's reaction moves the robot mass at the constant ``a``; the spring compressed by
+``F_s`` pushes it away as well, ``m_r x'' = -F_a - k_m x``, and with ``F_s / F_a = 0.6-1`` the simulated
+reaction impulse is 37 %, 26 % and 18 % *below* the closed form's;
+:func:`collision_reflex.model.impulse.sprung_reaction` (derived there, an option beside the paper's reaction:
+``ArmCollision.closed_form_sprung``) matches it within 1.3 %, 1.4 % and 0.5 %. A smaller ``a`` moves the reaction the wrong way. (2) The
+spring-torque detector fires late: the impulse until detection is 5.1 %, 3.2 % and 0.9 % above ``m_f v0 +
+F_s^2 / (2 k v0)`` (the contact force at detection is 2.6 N, not 3 N, on elbow-up-x: the joint torques carry
+the links' inertia as they oscillate along the wall). ``a/2`` adds ``(sqrt(2) - 1) I3``, 2-3 % of the impulse,
+which cancels (2) less (1). With the contact-force sensor the sensing phase matches on folded-x (-0.2 %), and
+the total with the sprung reaction is within 0.1 %; on the elbow-up configurations the contact force itself
+ramps up slower than ``k v0 t`` (impulse until detection +4 % and +21 %): the operational-space inertia couples
+the wall normal to the tangent, and the 1D reduction has no term for it.
 """
 
 from __future__ import annotations
