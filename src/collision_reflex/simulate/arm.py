@@ -63,6 +63,10 @@ from .dynamics import admittance_share
 from .setup import oscillation_period
 
 ARM_REACTIONS: tuple[str, ...] = ("at_rest", "moving")
+ARM_DRIVES: tuple[str, ...] = ("ideal", "impedance")
+"""``"ideal"``: velocity-controlled motors with the software stiffness as an ideal admittance (massless).
+``"impedance"``: the 1D simulator's impedance drive per joint, motor torque ``k_s (theta_ref - theta) + d_s
+(theta_ref' - theta')`` saturated at the torque limit, the rotor inertia integrated."""
 RETREATS: tuple[str, ...] = ("along_u", "saturated")
 """``"along_u"``: the motors push with ``tau = -F_a J^T n``, each joint at most at its limit and the first at
 it, the closed form's reaction. ``"saturated"``: a retreat command saturates every joint, ``tau_i = -tau_max,i
@@ -153,6 +157,8 @@ def simulate_arm_collision(
     retreat: str = "along_u",
     max_steps: float = 2e5,
     blanking: float | None = None,
+    drive: str = "ideal",
+    software_damping: Any = 0.0,
 ) -> ArmCollision:
     """Simulate the collision of the arm's contact point with a wall.
 
@@ -197,12 +203,16 @@ def simulate_arm_collision(
         over about half a period, would trip a contact sensor at once: the closed form's threshold means the
         force after it), 0 for the other schemes (their signal passes through the joints or a filter; an
         observer with ``K m_f v0 > F_s`` does detect the impact itself).
+    drive: ``"ideal"`` (default) or ``"impedance"`` (finite ``software_stiffness`` needed), see
+        :data:`ARM_DRIVES`.
+    software_damping: the impedance drive's joint damping ``d_s`` [N m s/rad], >= 0 (scalar or (nv,)).
     max_steps: the work budget [integrator steps]: a setting expected to need more is refused at once, and a
         run that takes four times as many right-hand-side evaluations as the budget allows is stopped.
     """
     _validate.choice("reaction", reaction, ARM_REACTIONS)
     _validate.choice("detection", detection, DETECTIONS)
     _validate.choice("retreat", retreat, RETREATS)
+    _validate.choice("drive", drive, ARM_DRIVES)
     _validate.positive("observer_gain", observer_gain)
     _validate.positive("max_steps", max_steps)
     if sample_rate is not None:
@@ -228,6 +238,8 @@ def simulate_arm_collision(
         _current_threshold(arm, joints, float(threshold), current_threshold),
         retreat,
         blanking,
+        drive,
+        _impedance_damping(joints, drive, software_damping),
     )
     dynamics = ArmDynamics(arm, joints, closed, contact_stiffness, contact_damping_ratio, sensing)
     trace = _integrate(dynamics, closed, float(approach_velocity), float(threshold), delay, rtol, max_steps)
@@ -255,10 +267,11 @@ def simulate_arm_collision(
 
 @dataclass(frozen=True)
 class _Sensing:
-    """The detector and the reaction's torques.
+    """The controller: detector, reaction and drive.
 
     Scheme, observer gain [1/s], sample rate [Hz] (or None), per-joint current thresholds [N m] (nv,), the
-    retreat and the blanking after the impact [s] (None: the scheme's default).
+    retreat, the blanking after the impact [s] (None: the scheme's default), the drive and its joint damping
+    [N m s/rad] (nv,).
     """
 
     detection: str
@@ -267,6 +280,23 @@ class _Sensing:
     current_threshold: np.ndarray
     retreat: str
     blanking: float | None
+    drive: str
+    software_damping: np.ndarray
+
+
+def _impedance_damping(joints: _Joints, drive: str, software_damping: Any) -> np.ndarray:
+    """The impedance drive's joint damping (nv,) [N m s/rad]; its software stiffness must be finite."""
+    nv = joints.q0.size
+    damping = np.broadcast_to(np.asarray(software_damping, dtype=float), (nv,)).copy()
+    _validate.non_negative("software_damping", damping)
+    if drive == "impedance" and not np.all(np.isfinite(joints.k_s)):
+        raise InvalidParameter(
+            "software_stiffness",
+            joints.k_s,
+            "finite joint stiffnesses [N m/rad]",
+            "the impedance drive needs them",
+        )
+    return damping
 
 
 def _current_threshold(arm: Any, joints: _Joints, threshold: float, given: Any) -> np.ndarray:
@@ -464,6 +494,13 @@ def _time_scales(
         oscillation_period(eff["m_r"], eff["k_m"]),
         min(oscillation_period(b, k) for b, k in zip(dynamics.inertia, dynamics.k_m, strict=True)),
     ]
+    if dynamics.drive == "impedance":  # the rotors on the software and joint springs
+        periods.append(
+            min(
+                oscillation_period(b, k)
+                for b, k in zip(dynamics.inertia, dynamics.k_s + dynamics.k_m, strict=True)
+            )
+        )
     if dynamics.detection == "observer":
         periods.append(2 * math.pi / dynamics.observer_gain)  # the observer's time constant, as a period
     max_step = min(periods) / 16  # a sixteenth of the shortest period in play
@@ -506,6 +543,7 @@ def _integrate(
     y = np.zeros(5 * nv + 1)
     y[:nv] = dynamics.q0
     y[nv : 2 * nv] = dynamics.v_ref  # the links move with the motors before the impact
+    y[2 * nv : 3 * nv], y[3 * nv : 4 * nv] = dynamics.q0, dynamics.v_ref  # unloaded springs
     options: dict[str, Any] = {"method": "DOP853", "rtol": rtol, "atol": 1e-12, "max_step": max_step}
     trace = _ArmTrace([np.array([0.0])], [np.array([0.0])])
 

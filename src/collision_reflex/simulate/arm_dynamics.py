@@ -88,6 +88,7 @@ class ArmDynamics:
         self.detection, self.retreat = sensing.detection, sensing.retreat
         self.observer_gain, self.current_threshold = sensing.observer_gain, sensing.current_threshold
         self.sample_rate = sensing.sample_rate
+        self.drive, self.software_damping = sensing.drive, sensing.software_damping
         wall_period = oscillation_period(closed.effective["m_f"], contact_stiffness)
         default_blanking = 20 * wall_period if sensing.detection == "force" else 0.0
         self.blanking = default_blanking if sensing.blanking is None else sensing.blanking
@@ -123,9 +124,9 @@ class ArmDynamics:
         return theta, dtheta
 
     def motor_state(self, t: float, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Motor angles and velocities: integrated during the reaction, the admittance's before."""
+        """Motor angles and velocities: integrated (reaction, impedance drive), else the admittance's."""
         nv = self.nv
-        if self.reacting:
+        if self.reacting or self.drive == "impedance":
             return y[2 * nv : 3 * nv], y[3 * nv : 4 * nv]
         return self.motors(t, y[:nv], y[nv : 2 * nv])
 
@@ -156,7 +157,9 @@ class ArmDynamics:
         out[:nv] = dq
         out[nv : 2 * nv] = ddq
         out[2 * nv : 3 * nv] = dtheta
-        out[3 * nv : 4 * nv] = (self.torque - spring) / self.inertia if self.reacting else 0.0
+        if self.reacting or self.drive == "impedance":
+            torque = self.torque if self.reacting else self.impedance_torque(t, theta, dtheta)
+            out[3 * nv : 4 * nv] = (torque - spring) / self.inertia
         if self.detection == "observer":
             coriolis = self.pin.computeCoriolisMatrix(self.model, self.data, qs, dq)
             out[4 * nv : 5 * nv] = spring + coriolis.T @ dq + self.observer_residual(y)  # no gravity here
@@ -174,10 +177,17 @@ class ArmDynamics:
         momentum = self.mass_matrix(y[:nv]) @ y[nv : 2 * nv]
         return self.observer_gain * (momentum - self.initial_momentum - y[4 * nv : 5 * nv])
 
+    def impedance_torque(self, t: float, theta: np.ndarray, dtheta: np.ndarray) -> np.ndarray:
+        """The impedance law ``k_s (theta_ref - theta) + d_s (theta_ref' - theta')`` saturated at the limit [N m]."""
+        torque = self.k_s * (self.q0 + self.v_ref * t - theta) + self.software_damping * (self.v_ref - dtheta)
+        return np.clip(torque, -self.tau_max, self.tau_max)
+
     def motor_torque(self, t: float, y: np.ndarray) -> np.ndarray:
         """Output-side motor torques ``B theta'' + K_m (theta - q)`` (nv,) [N m] (current times torque constant)."""
         if self.reacting:
             return self.torque.copy()
+        if self.drive == "impedance":
+            return self.impedance_torque(t, *self.motor_state(t, y))
         nv = self.nv
         theta, _ = self.motor_state(t, y)
         spring = self.k_m * (theta - y[:nv])
@@ -211,7 +221,8 @@ class ArmDynamics:
         """
         nv = self.nv
         y = y.copy()
-        y[2 * nv : 3 * nv], y[3 * nv : 4 * nv] = self.motors(t, y[:nv], y[nv : 2 * nv])
+        if self.drive != "impedance":  # the impedance drive's motors are integrated already
+            y[2 * nv : 3 * nv], y[3 * nv : 4 * nv] = self.motors(t, y[:nv], y[nv : 2 * nv])
         lever = self.contact_kinematics(y[:nv])[1].T @ self.normal
         if self.retreat == "saturated":
             self.push = -self.tau_max * np.sign(lever)
