@@ -46,6 +46,9 @@ def _cachedexample_robot(name: str) -> tuple[Any, str, np.ndarray]:
         raise InvalidParameter(
             "name", name, "an installed example-robot-data", "pip install example-robot-data"
         ) from error
+    fast = _kinematic_model(name)
+    if fast is not None:
+        return fast
     try:
         robot = example_robot_data.load(name)
     except Exception as error:  # the loader raises plain ValueErrors for unknown names
@@ -56,6 +59,39 @@ def _cachedexample_robot(name: str) -> tuple[Any, str, np.ndarray]:
             str(error),
         ) from None
     return robot.model, str(robot.urdf), np.array(robot.q0, dtype=float)
+
+
+def _kinematic_model(name: str) -> tuple[Any, str, np.ndarray] | None:
+    """The robot's model, URDF path and reference posture read as its loader does, without its meshes.
+
+    ``example_robot_data.load`` also builds the visual and collision geometry (0.6-0.7 s for the Panda or
+    UR5); the kinematic and inertial model alone takes milliseconds. The loader's own class attributes say
+    where its files are. None (and the caller loads the whole robot) for anything this does not cover.
+    """
+    import pinocchio as pin
+    from example_robot_data import robots_loader
+
+    loader = robots_loader.ROBOTS.get(name)
+    if loader is None or not loader.urdf_filename:
+        return None
+    try:
+        relative = os.path.join(loader.path, loader.urdf_subpath, loader.urdf_filename)
+        root = loader.model_path or robots_loader.getModelPath(relative)
+        urdf = os.path.join(root, relative)
+        if loader.free_flyer:
+            model = pin.buildModelFromUrdf(urdf, pin.JointModelFreeFlyer())
+        else:
+            model = pin.buildModelFromUrdf(urdf)
+        if loader.srdf_filename:
+            srdf = os.path.join(root, loader.path, loader.srdf_subpath, loader.srdf_filename)
+            q0 = robots_loader.readParamsFromSrdf(
+                model, srdf, False, loader.has_rotor_parameters, loader.ref_posture
+            )
+        else:
+            q0 = pin.neutral(model)
+    except Exception:  # another layout of the package: its own loader knows it
+        return None
+    return model, urdf, np.array(q0, dtype=float)
 
 
 @dataclass(frozen=True)
