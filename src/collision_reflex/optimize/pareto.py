@@ -540,14 +540,18 @@ def epsilon_grid(
     """Bounds on the bounded objectives spread between their values at the anchors [their units].
 
     The points are ordered so that each is near the previous one (a snake through the grid for three
-    objectives).
+    objectives). An objective whose values at the anchors agree within :data:`MERGE_TOLERANCE` (relative) spans
+    no front: it is left unbounded, and with no objective left there are no points (each would repeat an
+    anchor; a duty cycle that fixes the motors collapses a front so).
     """
-    if count <= 0:
-        return []
     ranges = {}
     for name in bounded:
         values = [anchor.numpy_objectives[name] for anchor in anchors.values()]
-        ranges[name] = (max(values), min(values)) if OBJECTIVES[name][0] > 0 else (min(values), max(values))
+        if max(values) - min(values) > MERGE_TOLERANCE * max(abs(v) for v in values):
+            ranges[name] = (max(values), min(values)) if OBJECTIVES[name][0] > 0 else (min(values), max(values))
+    bounded = tuple(ranges)
+    if count <= 0 or not bounded:
+        return []
     if len(bounded) == 1:
         (name,) = bounded
         loose, tight = ranges[name]
