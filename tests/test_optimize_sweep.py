@@ -87,7 +87,9 @@ def test_epsilon_points_start_from_the_anchor_and_match_cold_solves(build):
 
 
 def test_a_lexicographic_step_at_its_cap_is_recorded_and_keeps_the_anchor(build, monkeypatch):
-    monkeypatch.setattr(pareto, "LEXICOGRAPHIC_OPTIONS", {**pareto.LEXICOGRAPHIC_OPTIONS, "ipopt.max_iter": 1})
+    monkeypatch.setattr(
+        pareto, "LEXICOGRAPHIC_OPTIONS", {**pareto.LEXICOGRAPHIC_OPTIONS, "ipopt.max_iter": 1}
+    )
     pareto.built_problem.cache_clear()  # fresh problems: the capped solver is built for this test
     try:
         front = pareto.pareto_front(build, NAMES, points=3)
@@ -98,7 +100,13 @@ def test_a_lexicographic_step_at_its_cap_is_recorded_and_keeps_the_anchor(build,
     # Each anchor is its first solve's result, which the capped step did not replace.
     for name in NAMES:
         alone = cr.solve(build(name, tuple(n for n in NAMES if n != name)))
-        anchor = [r for r, label in zip(front.points + front.dominated, front.labels + front.dominated_labels, strict=True) if label == f"anchor: {name}"]
+        anchor = [
+            r
+            for r, label in zip(
+                front.points + front.dominated, front.labels + front.dominated_labels, strict=True
+            )
+            if label == f"anchor: {name}"
+        ]
         assert len(anchor) == 1
         assert anchor[0].numpy_objectives[name] == pytest.approx(alone.numpy_objectives[name], rel=AGREEMENT)
 
@@ -139,7 +147,9 @@ def test_a_front_that_collapses_to_a_point_has_no_epsilon_points():
     # Masses equal within the merge tolerance: every bound between them repeats an anchor.
     same = {
         "worst_case_impulse": _anchor(worst_case_impulse=0.2, actuator_mass=0.4, approach_velocity=0.3),
-        "actuator_mass": _anchor(worst_case_impulse=0.3, actuator_mass=0.4 * (1 - 1e-7), approach_velocity=0.5),
+        "actuator_mass": _anchor(
+            worst_case_impulse=0.3, actuator_mass=0.4 * (1 - 1e-7), approach_velocity=0.5
+        ),
     }
     assert pareto.epsilon_grid(same, ("actuator_mass",), 6) == []
     # With a third objective that does span a front, only it is bounded.

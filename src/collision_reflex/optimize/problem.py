@@ -225,14 +225,16 @@ class DesignProblem:
         key = repr((sorted(options.items()), structural))
         solver = self._solvers.get(key)
         if solver is None:
-            nlp, options = self.nlp, dict(options)
-            if structural:
-                if self._derivatives is None:
-                    self._derivatives = derivative_functions(self._structure)
-                options.update(self._derivatives)
-                if options.get("expand", False):
-                    nlp, options["expand"] = self._expanded_nlp(), False
-            solver = ca.nlpsol("actuator_design", "ipopt", nlp, options)
+            if structural and self._derivatives is None:
+                self._derivatives = derivative_functions(self._structure)
+            derivatives = self._derivatives if structural else None
+            shared = bool(derivatives) and bool(options.get("expand", False))
+            solver = ca.nlpsol(
+                "actuator_design",
+                "ipopt",
+                self._expanded_nlp() if shared else self.nlp,
+                {**options, **(derivatives or {}), **({"expand": False} if shared else {})},
+            )
             self._solvers[key] = solver
         return solver
 

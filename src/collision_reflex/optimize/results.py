@@ -166,14 +166,21 @@ def result_to_json(result: DesignResult) -> dict[str, Any]:
         **{name: _optional_list(getattr(result, name)) for name in DUTY_ARRAYS},
         "x": np.asarray(result.x, dtype=float).tolist(),
         "attempts": attempt_records(result.attempts),
-        "multipliers": None if multipliers is None else [np.asarray(m, dtype=float).tolist() for m in multipliers],
+        "multipliers": None
+        if multipliers is None
+        else [np.asarray(m, dtype=float).tolist() for m in multipliers],
     }
 
 
 def attempt_records(attempts: tuple[Attempt, ...]) -> list[dict[str, Any]]:
     """Every IPOPT run of a solve (retries included) as JSON: name, status, iterations, ``solve_time`` [s]."""
     return [
-        {"name": a.name, "status": a.status, "iterations": int(a.iterations), "solve_time": float(a.solve_time)}
+        {
+            "name": a.name,
+            "status": a.status,
+            "iterations": int(a.iterations),
+            "solve_time": float(a.solve_time),
+        }
         for a in attempts
     ]
 
@@ -227,7 +234,10 @@ def result_from_json(data: Mapping[str, Any]) -> DesignResult:
         multipliers=(
             None
             if data.get("multipliers") is None
-            else (np.asarray(data["multipliers"][0], dtype=float), np.asarray(data["multipliers"][1], dtype=float))
+            else (
+                np.asarray(data["multipliers"][0], dtype=float),
+                np.asarray(data["multipliers"][1], dtype=float),
+            )
         ),
         attempts=tuple(
             Attempt(str(a["name"]), str(a["status"]), int(a["iterations"]), float(a["solve_time"]))
