@@ -4,12 +4,19 @@ This is the one sweep, for the library and for studies alike, in-process or thro
 :class:`concurrent.futures.Executor`.
 
 Warm-start policy (one for every caller): each anchor's lexicographic steps start from the anchor found so
-far; every epsilon point starts from the first objective's anchor (its point, not its multipliers). A point's
-result is then a pure function of the problem and its bounds, whatever the executor and the order in which the
-points finish; the points run in parallel. Starting from the neighbour (with its multipliers) instead chains
-the points, with no parallelism, and was not faster even in series: on the full shipped studies, one process,
-the same fronts to 3e-7, the neighbour chain took 0.77 / 8.5 / 133 s (two-link / Panda / UR5) where the anchor
-start takes 0.63 / 3.7 / 84 s (fewer iterations on UR5, more on the two-link arm, where each is cheap).
+far; every epsilon point starts from the first objective's anchor as solved on the sweep's own problem, its
+point and multipliers (:data:`collision_reflex.optimize.solve.WARM_START_OPTIONS`), or its point alone when
+the approach velocity is bounded (:func:`warm_started_points`). A point's result is then a
+pure function of the problem and its bounds, whatever the executor and the order in which the points finish;
+the points run in parallel. Chaining each point from its neighbour instead leaves no parallelism and was not
+faster even in series.
+
+Barrier strategy per kind of solve (measured on the Panda benchmark, 256 samples): a cold anchor with IPOPT's
+monotone barrier from ``mu = 1e-2`` (77 iterations; adaptive: 122, each dearer); an epsilon point warm-started
+from the anchor with the adaptive barrier (25-27 iterations; from the point alone, monotone: 63-134; on the
+UR5 study the point alone with the monotone barrier is the better start, :func:`warm_started_points`); a
+lexicographic step with the adaptive barrier and at most :data:`LEXICOGRAPHIC_MAX_ITER` iterations (about 35;
+monotone: the 500-iteration cap, its bound held within :data:`ANCHOR_SLACK` being nearly degenerate).
 """
 
 from __future__ import annotations
@@ -60,6 +67,15 @@ IPOPT stops at ``tol = 1e-8`` on its scaled optimality error, so one optimum rea
 under different bounds repeats its objective values to about 1e-7 relative; a lexicographic anchor holds its
 first objective within :data:`ANCHOR_SLACK` (1e-6) of the optimum. Ten times the larger, 1e-5, merges such
 repeats and stays far below any difference a designer acts on."""
+
+LEXICOGRAPHIC_MAX_ITER = 150
+"""Iteration cap of an anchor's lexicographic step: a step that reaches it stops there, keeps the anchor found
+so far and is recorded among the sweep's failures (status ``Maximum_Iterations_Exceeded``)."""
+LEXICOGRAPHIC_OPTIONS: dict[str, str | float] = {
+    "ipopt.mu_strategy": "adaptive",
+    "ipopt.max_iter": LEXICOGRAPHIC_MAX_ITER,
+}
+"""IPOPT options of a lexicographic step, over the sweep's (module docstring)."""
 
 OPTIMUM_STARTS = 4
 """Start points of the single-objective solve by default: the given start and three seeded random ones (see
@@ -261,7 +277,8 @@ def pareto_front(
             )
         by_objective[name] = anchor.result
     grid = epsilon_grid(by_objective, names[1:], points - len(names))
-    start = by_objective[names[0]].x
+    first = anchors[f"anchor-{names[0]}"].start
+    start = first if first is not None and warm_started_points(names) else by_objective[names[0]].x
     sweep.total = len(names) + len(grid)
     point_tasks = {
         f"point-{i:03d}": (solve_point, (build, names, epsilon, start, ipopt_options))
@@ -422,6 +439,16 @@ def _one_at_a_time(function: Callable[_P, SweepPoint]) -> Callable[_P, SweepPoin
     return locked
 
 
+def warm_started_points(names: Sequence[str]) -> bool:
+    """Whether a sweep of ``names`` starts its epsilon points from the anchor's multipliers (module docstring).
+
+    Not when the approach velocity is bounded: measured on the UR5 study (impulse against approach velocity),
+    the points warm-started from the anchor took 111-400+ iterations with the adaptive barrier (153-400+
+    monotone), from the anchor's point alone with the monotone barrier 94-127.
+    """
+    return "approach_velocity" not in names[1:]
+
+
 def _others(names: Sequence[str], name: str) -> tuple[str, ...]:
     return tuple(other for other in names if other != name)
 
@@ -437,8 +464,9 @@ def solve_anchor(
     """A Pareto anchor: ``objective`` minimised, then each other objective with it held at its optimum.
 
     The first solve runs from ``starts`` start points; the lexicographic steps make the anchor non-dominated.
-    A lexicographic step the solver cannot do keeps the anchor found so far and is recorded among the
-    failures.
+    A lexicographic step runs without retries, within :data:`LEXICOGRAPHIC_MAX_ITER` iterations; one that
+    fails or stops early keeps the anchor found so far and is recorded among the failures. The first
+    objective's anchor keeps its first solve as the start of the epsilon points (``SweepPoint.start``).
     """
     label = f"anchor: {objective}"
     try:
@@ -449,6 +477,7 @@ def solve_anchor(
         )
     except SolverFailed as error:
         return SweepPoint(label, None, (PointFailure(objective, {}, error.status, str(error.args[0])),))
+    start = result if objective == objectives[0] else None
     held = {objective: anchor_bound(objective, result.objectives[objective])}
     failures = []
     for other in _others(objectives, objective):
@@ -457,11 +486,12 @@ def solve_anchor(
                 built_problem(build, other, _others(objectives, other)),
                 epsilon=held,
                 x0=result.x,
-                ipopt_options=ipopt_options,
+                ipopt_options={**(ipopt_options or {}), **LEXICOGRAPHIC_OPTIONS},
+                retry=False,
             )
         except SolverFailed as error:
             failures.append(PointFailure(other, dict(held), error.status, str(error.args[0])))
-    return SweepPoint(label, result, tuple(failures))
+    return SweepPoint(label, result, tuple(failures), start)
 
 
 @_one_at_a_time
@@ -469,17 +499,19 @@ def solve_point(
     build: ProblemBuilder,
     objectives: tuple[str, ...],
     epsilon: dict[str, float],
-    start: np.ndarray,
+    start: np.ndarray | DesignResult,
     ipopt_options: IpoptOptions | None,
 ) -> SweepPoint:
     """One epsilon-constraint point: the first objective minimised with the others bounded by ``epsilon``.
 
-    The bounds are in the objectives' units; the solve starts from ``start`` (a point of the NLP's variables).
+    The bounds are in the objectives' units; the solve starts from ``start``: a point of the NLP's variables,
+    or a result of the same problem, whose multipliers then warm-start IPOPT.
     """
     label = "epsilon: " + ", ".join(_bound_text(k, v) for k, v in epsilon.items())
     problem = built_problem(build, objectives[0], objectives[1:])
+    x0 = start if isinstance(start, DesignResult) else np.asarray(start)
     try:
-        result = solve(problem, epsilon=epsilon, x0=np.asarray(start), ipopt_options=ipopt_options)
+        result = solve(problem, epsilon=epsilon, x0=x0, ipopt_options=ipopt_options)
     except SolverFailed as error:
         return SweepPoint(
             label, None, (PointFailure(objectives[0], epsilon, error.status, str(error.args[0])),)
@@ -521,14 +553,20 @@ def epsilon_grid(
     """Bounds on the bounded objectives spread between their values at the anchors [their units].
 
     The points are ordered so that each is near the previous one (a snake through the grid for three
-    objectives).
+    objectives). An objective whose values at the anchors agree within :data:`MERGE_TOLERANCE` (relative) spans
+    no front: it is left unbounded, and with no objective left there are no points (each would repeat an
+    anchor; a duty cycle that fixes the motors collapses a front so).
     """
-    if count <= 0:
-        return []
     ranges = {}
     for name in bounded:
         values = [anchor.numpy_objectives[name] for anchor in anchors.values()]
-        ranges[name] = (max(values), min(values)) if OBJECTIVES[name][0] > 0 else (min(values), max(values))
+        if max(values) - min(values) > MERGE_TOLERANCE * max(abs(v) for v in values):
+            ranges[name] = (
+                (max(values), min(values)) if OBJECTIVES[name][0] > 0 else (min(values), max(values))
+            )
+    bounded = tuple(ranges)
+    if count <= 0 or not bounded:
+        return []
     if len(bounded) == 1:
         (name,) = bounded
         loose, tight = ranges[name]

@@ -19,7 +19,7 @@ import numpy as np
 from ..model.impulse import optimal_velocity, phase_impulses, series_stiffness
 from .constraints import DUTY_REQUIREMENT, STATIC_REQUIREMENT
 from .objectives import OBJECTIVES
-from .solve import Design, DesignResult
+from .solve import Attempt, Design, DesignResult
 
 if TYPE_CHECKING:
     from ..hardware.motors import Motor
@@ -99,12 +99,15 @@ class SweepPoint:
 
     label: what was solved (``"anchor: actuator_mass"``, ``"epsilon: actuator_mass <= 0.1"``, ``"optimum"``);
     result: the design found, or None if the solve failed; failures: the solves that failed on the way (a failed
-    point's own solve, or an anchor's lexicographic steps, whose anchor then is the one found so far).
+    point's own solve, or an anchor's lexicographic steps, whose anchor then is the one found so far);
+    start: for the first objective's anchor, its solution on the sweep's own problem (point and multipliers),
+    from which every epsilon point starts; None otherwise.
     """
 
     label: str
     result: DesignResult | None
     failures: tuple[PointFailure, ...] = field(default=())
+    start: DesignResult | None = None
 
     def to_json(self) -> dict[str, Any]:
         """The piece as JSON types (floats round-trip exactly)."""
@@ -112,16 +115,18 @@ class SweepPoint:
             "label": self.label,
             "result": None if self.result is None else result_to_json(self.result),
             "failures": [f.as_dict() for f in self.failures],
+            "start": None if self.start is None else result_to_json(self.start),
         }
 
     @classmethod
     def from_json(cls, data: Mapping[str, Any]) -> SweepPoint:
         """The piece written by :meth:`to_json` (bitwise the same numbers)."""
-        result = data["result"]
+        result, start = data["result"], data.get("start")
         return cls(
             str(data["label"]),
             None if result is None else result_from_json(result),
             tuple(PointFailure.from_dict(f) for f in data["failures"]),
+            None if start is None else result_from_json(start),
         )
 
 
@@ -142,10 +147,8 @@ _GEARBOX_ARRAYS = ("gearbox_mass", "gearbox_inertia", "gearbox_efficiency")
 
 
 def result_to_json(result: DesignResult) -> dict[str, Any]:
-    """A :class:`DesignResult` as JSON types.
-
-    The solver's multipliers are left out: sweeps start from points.
-    """
+    """A :class:`DesignResult` as JSON types, with its solver attempts and multipliers (for warm starts)."""
+    multipliers = result.multipliers
     return {
         "design": result.design.as_dict(),
         "objectives": dict(result.objectives),
@@ -162,7 +165,24 @@ def result_to_json(result: DesignResult) -> dict[str, Any]:
         "requirement": result.requirement,
         **{name: _optional_list(getattr(result, name)) for name in DUTY_ARRAYS},
         "x": np.asarray(result.x, dtype=float).tolist(),
+        "attempts": attempt_records(result.attempts),
+        "multipliers": None
+        if multipliers is None
+        else [np.asarray(m, dtype=float).tolist() for m in multipliers],
     }
+
+
+def attempt_records(attempts: tuple[Attempt, ...]) -> list[dict[str, Any]]:
+    """Every IPOPT run of a solve (retries included) as JSON: name, status, iterations, ``solve_time`` [s]."""
+    return [
+        {
+            "name": a.name,
+            "status": a.status,
+            "iterations": int(a.iterations),
+            "solve_time": float(a.solve_time),
+        }
+        for a in attempts
+    ]
 
 
 def _optional_list(values: np.ndarray | None) -> list[float | None] | None:
@@ -211,6 +231,18 @@ def result_from_json(data: Mapping[str, Any]) -> DesignResult:
         speed_limit=_optional_array(data.get("speed_limit")),
         speed_margin=_optional_array(data.get("speed_margin")),
         x=np.asarray(data["x"], dtype=float),
+        multipliers=(
+            None
+            if data.get("multipliers") is None
+            else (
+                np.asarray(data["multipliers"][0], dtype=float),
+                np.asarray(data["multipliers"][1], dtype=float),
+            )
+        ),
+        attempts=tuple(
+            Attempt(str(a["name"]), str(a["status"]), int(a["iterations"]), float(a["solve_time"]))
+            for a in data.get("attempts", ())
+        ),
     )
 
 
@@ -267,6 +299,7 @@ def result_record(result: DesignResult, label: str) -> dict[str, Any]:
             "solve_time": float(result.solve_time),
             "build_time": float(result.build_time),
             "epsilon": {k: float(v) for k, v in result.epsilon.items()},
+            "attempts": attempt_records(result.attempts),
         },
     }
 

@@ -1,0 +1,158 @@
+"""Pareto sweeps: solvers shared per problem, warm-started epsilon points, bounded lexicographic steps, and
+the solver attempts kept in the sweep's records."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+import pytest
+
+import collision_reflex as cr
+from collision_reflex.arm import Arm
+from collision_reflex.errors import SolverFailed
+from collision_reflex.optimize import pareto
+from collision_reflex.optimize.derivatives import derivative_functions
+from collision_reflex.optimize.results import SweepPoint, result_record
+from collision_reflex.optimize.solve import DEFAULT_IPOPT_OPTIONS, Attempt
+from collision_reflex.report.outputs import split_timings
+
+TWO_LINK = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
+NAMES = ("worst_case_impulse", "actuator_mass")
+AGREEMENT = 1e-6
+"""Relative agreement of one optimum reached from two starts: IPOPT stops at ``tol = 1e-8`` on its scaled
+optimality error, which repeats objective values to about 1e-7 (see ``pareto.MERGE_TOLERANCE``)."""
+
+
+@pytest.fixture(scope="module")
+def build():
+    arm = Arm.from_urdf(TWO_LINK, "tip")
+    rng = np.random.default_rng(0)
+    angles = np.linspace(0, 2 * np.pi, 4, endpoint=False) + 0.3
+    samples = cr.ContactSamples.grid(
+        arm.kinematics(arm.sample_configurations(3, rng)), np.c_[np.cos(angles), np.sin(angles)]
+    )
+    space = cr.DesignSpace(
+        stator_diameter=(0.02, 0.12),
+        gear_ratio=(1, 30),
+        software_stiffness=(5, 500),
+        threshold=(1, 10),
+        approach_velocity=0.3,
+    )
+    # The reflected inertia on the finger trades impulse against motor mass: a front, not a point.
+    technology = cr.ActuatorTechnology(
+        cr.reference_motor(), mechanical_stiffness=200.0, reflected_inertia_in="finger"
+    )
+    constraints = cr.Constraints(torque_required=[3.0, 1.5], safety_factor=1.2)
+
+    def build(objective, bounded):
+        return cr.build_problem(arm, samples, space, technology, objective, constraints, bounded)
+
+    return build
+
+
+def test_solvers_share_one_expansion_and_match_casadis_own(build):
+    problem = build("worst_case_impulse", ("actuator_mass",))
+    shared = problem.solver(DEFAULT_IPOPT_OPTIONS)
+    expanded = problem._expanded
+    problem.solver({**DEFAULT_IPOPT_OPTIONS, "ipopt.mu_strategy": "adaptive"})
+    assert problem._expanded is expanded and len(problem._solvers) == 2
+    # Independent: CasADi expanding the NLP itself, with the same derivative functions.
+    own = ca.nlpsol(
+        "own", "ipopt", problem.nlp, {**DEFAULT_IPOPT_OPTIONS, **derivative_functions(problem._structure)}
+    )
+    bounds = dict(lbx=problem.lbx, ubx=problem.ubx, lbg=problem.lbg, ubg=problem.ubg, p=problem.parameters())
+    a, b = shared(x0=problem.x0, **bounds), own(x0=problem.x0, **bounds)
+    assert shared.stats()["iter_count"] == own.stats()["iter_count"]
+    np.testing.assert_allclose(np.asarray(a["x"]), np.asarray(b["x"]), rtol=1e-12, atol=1e-14)
+
+
+def test_epsilon_points_start_from_the_anchor_and_match_cold_solves(build):
+    front = pareto.pareto_front(build, NAMES, points=6)
+    assert not front.failed
+    problem = pareto.built_problem(build, NAMES[0], NAMES[1:])
+    warm = cold = 0
+    for result, label in zip(front.points, front.labels, strict=True):
+        if not label.startswith("epsilon"):
+            continue
+        # One IPOPT run per point: warm-started, no retry needed.
+        assert [a.name for a in result.attempts] == ["requested"]
+        again = cr.solve(problem, epsilon=result.epsilon)
+        for name in NAMES:
+            assert result.numpy_objectives[name] == pytest.approx(again.numpy_objectives[name], rel=AGREEMENT)
+        warm, cold = warm + result.iterations, cold + again.iterations
+    assert warm < cold  # the anchor's point and multipliers are a better start than the problem's own
+
+
+def test_a_lexicographic_step_at_its_cap_is_recorded_and_keeps_the_anchor(build, monkeypatch):
+    monkeypatch.setattr(
+        pareto, "LEXICOGRAPHIC_OPTIONS", {**pareto.LEXICOGRAPHIC_OPTIONS, "ipopt.max_iter": 1}
+    )
+    pareto.built_problem.cache_clear()  # fresh problems: the capped solver is built for this test
+    try:
+        front = pareto.pareto_front(build, NAMES, points=3)
+    finally:
+        pareto.built_problem.cache_clear()
+    assert sorted(f.objective for f in front.failed) == sorted(NAMES)
+    assert {f.status for f in front.failed} == {"Maximum_Iterations_Exceeded"}
+    # Each anchor is its first solve's result, which the capped step did not replace.
+    for name in NAMES:
+        alone = cr.solve(build(name, tuple(n for n in NAMES if n != name)))
+        anchor = [
+            r
+            for r, label in zip(
+                front.points + front.dominated, front.labels + front.dominated_labels, strict=True
+            )
+            if label == f"anchor: {name}"
+        ]
+        assert len(anchor) == 1
+        assert anchor[0].numpy_objectives[name] == pytest.approx(alone.numpy_objectives[name], rel=AGREEMENT)
+
+
+def test_solve_without_retries_raises_its_status(build):
+    problem = build("worst_case_impulse", ())
+    with pytest.raises(SolverFailed) as raised:
+        cr.solve(problem, ipopt_options={"ipopt.max_iter": 2}, retry=False)
+    assert raised.value.status == "Maximum_Iterations_Exceeded"
+    assert [a[0] for a in raised.value.attempts] == ["requested"]
+
+
+def test_sweep_records_keep_every_attempt_and_the_multipliers(build):
+    problem = build("worst_case_impulse", ())
+    result = cr.solve(problem)
+    retried = (Attempt("requested", "Infeasible_Problem_Detected", 104, 0.5), *result.attempts)
+    result = dataclasses.replace(result, attempts=retried)
+    point = SweepPoint("anchor: worst_case_impulse", result, start=result)
+    back = SweepPoint.from_json(point.to_json())
+    assert back.result is not None and back.start is not None
+    assert back.result.attempts == retried
+    assert back.result.multipliers is not None and result.multipliers is not None
+    for saved, kept in zip(back.result.multipliers, result.multipliers, strict=True):
+        assert np.array_equal(saved, kept)
+    record = result_record(result, "optimum")
+    assert [a["status"] for a in record["solver"]["attempts"]] == [a.status for a in retried]
+    # Wall times go to timings.json, so the result files stay the same bytes across runs.
+    numbers, timings = split_timings(record)
+    assert all("solve_time" not in a for a in numbers["solver"]["attempts"])
+    assert timings["solver/attempts/0/solve_time"] == 0.5
+
+
+def _anchor(**objectives):
+    return type("Anchor", (), {"numpy_objectives": objectives})()
+
+
+def test_a_front_that_collapses_to_a_point_has_no_epsilon_points():
+    # Masses equal within the merge tolerance: every bound between them repeats an anchor.
+    same = {
+        "worst_case_impulse": _anchor(worst_case_impulse=0.2, actuator_mass=0.4, approach_velocity=0.3),
+        "actuator_mass": _anchor(
+            worst_case_impulse=0.3, actuator_mass=0.4 * (1 - 1e-7), approach_velocity=0.5
+        ),
+    }
+    assert pareto.epsilon_grid(same, ("actuator_mass",), 6) == []
+    # With a third objective that does span a front, only it is bounded.
+    grid = pareto.epsilon_grid(same, ("actuator_mass", "approach_velocity"), 3)
+    assert [set(g) for g in grid] == [{"approach_velocity"}] * 3
+    assert [g["approach_velocity"] for g in grid] == pytest.approx([0.35, 0.4, 0.45], rel=1e-12)
