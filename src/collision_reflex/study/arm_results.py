@@ -8,7 +8,12 @@ also holds its torque-speed data (``recommended.torque_speed``, :func:`torque_sp
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, TypedDict
+import hashlib
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, NotRequired, TypedDict
 
 import numpy as np
 
@@ -17,9 +22,13 @@ from ..optimize.pareto import MERGE_TOLERANCE, built_problem, recommend
 from ..optimize.results import design_record
 from ..optimize.space import GLOBAL_VARIABLES, PER_JOINT_VARIABLES
 from .arm_setup import ArmSetup, SampleLayout, StudyProblems, sample_layout
+from .schema import ArmStudy
 
 if TYPE_CHECKING:
+    from ..hardware.motors import Motor
     from ..optimize import DesignProblem, DesignResult, ParetoSet
+    from ..optimize.snap import CataloguePart
+    from .load import LoadedStudy
 
 SAVED_DIGITS = 7
 """Significant digits of the saved torque-speed data: compact, and within 5e-7 relative of the computed points."""
@@ -56,6 +65,7 @@ class ArmResults(TypedDict):
     bounds: dict[str, Any]
     requirement: str
     speed_limits: str | None
+    catalogue: NotRequired[CatalogueRecord]
 
 
 class JointTorqueSpeed(TypedDict):
@@ -133,14 +143,21 @@ def design_bounds(setup: ArmSetup) -> dict[str, Any]:
     return out
 
 
-def arm_results(problems: StudyProblems, chosen: DesignResult, front: ParetoSet | None) -> ArmResults:
+def arm_results(
+    problems: StudyProblems,
+    chosen: DesignResult,
+    front: ParetoSet | None,
+    catalogue: CatalogueRecord | None = None,
+) -> ArmResults:
     """``samples``, ``chosen``, ``recommended``, ``pareto``, ``bounds`` and ``requirement`` of an arm study.
 
     The chosen design (the optimum of the study's objective, as solved) records ``dominated_by``: the index of
     a Pareto design that dominates it, or None. The recommended design
     (:func:`collision_reflex.optimize.pareto.recommend`) records ``source`` (``optimum`` or ``Pareto design
     <i>``), ``pareto_index`` and ``reason``, and with a duty cycle its ``torque_speed``
-    (:func:`torque_speed_record`).
+    (:func:`torque_speed_record`). With ``catalogue`` (:func:`catalogue_results`), the results gain its
+    ``catalogue`` entry and each Pareto design (the chosen one without a front) its quick snap, ``catalogue``,
+    with ``catalogue_part`` per joint.
     """
     setup = problems.setup
     # Every problem of a study shares its samples and technology: one of them evaluates every record.
@@ -176,7 +193,7 @@ def arm_results(problems: StudyProblems, chosen: DesignResult, front: ParetoSet 
     torque_speed = torque_speed_record(problem, recommendation.result)
     if torque_speed is not None:
         recommended["torque_speed"] = torque_speed
-    return {
+    out: ArmResults = {
         "samples": sample_layout(setup),
         "chosen": chosen_record,
         "recommended": recommended,
@@ -185,6 +202,14 @@ def arm_results(problems: StudyProblems, chosen: DesignResult, front: ParetoSet 
         "requirement": setup.constraints.requirement,
         "speed_limits": speed_limits(setup),
     }
+    if catalogue is not None:
+        rows = pareto["points"] or [chosen_record]
+        for row, snapped in zip(rows, catalogue["pareto"], strict=True):
+            row["catalogue"] = snapped
+            for joint, part in zip(row["joints"], snapped["parts"], strict=True):
+                joint["catalogue_part"] = part
+        out["catalogue"] = catalogue
+    return out
 
 
 def speed_limits(setup: ArmSetup) -> str | None:
@@ -201,3 +226,217 @@ def speed_limits(setup: ArmSetup) -> str | None:
         f"limit follows omega_max ∝ (l/l0)^{law.length_exponent:g} (r/r0)^{law.diameter_exponent:g}. "
         f"{law.source}"
     )
+
+
+class CatalogueRecord(TypedDict):
+    """The catalogue snap of a study as plain data (``designs.json``: ``catalogue``).
+
+    ``key``: a digest of the catalogue file and the snap settings (a resumed run reuses a saved snap only with
+    the same key); ``snapped``: which design was snapped (``optimum`` or ``Pareto design <i>``); ``method``: how
+    the answer was found; ``joints``: per joint the chosen part and its provenance, the candidates, and the
+    nearest part with what it misses when none is within bounds; ``objectives``, ``continuous_objectives``,
+    ``difference`` (catalogue minus continuous), ``relative_difference`` (over the continuous value; None where
+    that is zero) [each objective's unit]; ``design``: the catalogue design's record, None when none was found;
+    ``tried``: every combination re-solved; ``pareto``: the quick snap of every Pareto design (the chosen
+    design's without a front), see :func:`quick_snap_record`.
+    """
+
+    key: str
+    snapped: str
+    method: str
+    candidates: int
+    max_combinations: int
+    warnings: list[str]
+    joints: list[dict[str, Any]]
+    objectives: dict[str, float]
+    continuous_objectives: dict[str, float]
+    difference: dict[str, float]
+    relative_difference: dict[str, float | None]
+    design: dict[str, Any] | None
+    tried: list[dict[str, Any]]
+    pareto: list[dict[str, Any]]
+
+
+@dataclass(frozen=True)
+class SnapCatalogue:
+    """The catalogue a study snaps to, and its settings.
+
+    motors: the catalogue's motors by name; provenance: per motor, each field's source or estimate (as
+    :func:`collision_reflex.hardware.catalogue.read_entries` gives it); file: the catalogue file;
+    candidates, max_combinations: :func:`collision_reflex.optimize.snap.snap_to_catalogue`'s settings.
+    """
+
+    motors: dict[str, Motor]
+    provenance: dict[str, dict[str, str]]
+    file: Path
+    candidates: int
+    max_combinations: int
+
+    @property
+    def key(self) -> str:
+        """A digest of the catalogue file's bytes and the settings."""
+        digest = hashlib.sha256(self.file.read_bytes())
+        digest.update(f"{self.candidates}/{self.max_combinations}".encode())
+        return digest.hexdigest()[:16]
+
+
+def study_catalogue(loaded: LoadedStudy) -> SnapCatalogue | None:
+    """The catalogue an arm study snaps to (None when its ``catalogue.snap`` is false).
+
+    Raises
+    ------
+    CatalogueError: the catalogue file cannot be read or has a bad entry (file, line and field).
+    """
+    from ..hardware.catalogue import packaged_catalogue_path, read_entries
+    from ..hardware.motors import Motor
+
+    study = loaded.study
+    assert isinstance(study, ArmStudy)
+    spec = study.catalogue
+    if not spec.snap:
+        return None
+    file = loaded.path(spec.motors) if spec.motors is not None else packaged_catalogue_path()
+    entries = read_entries(file, "motors")
+    motors = {
+        name: Motor(name=name, **{k: v for k, v in e.fields.items() if k not in ("sources", "estimates")})
+        for name, e in entries.items()
+    }
+    provenance = {name: dict(e.provenance) for name, e in entries.items()}
+    return SnapCatalogue(motors, provenance, file, spec.candidates, spec.max_combinations)
+
+
+def catalogue_results(
+    problems: StudyProblems,
+    chosen: DesignResult,
+    front: ParetoSet | None,
+    catalogue: SnapCatalogue,
+    progress: Callable[[int, int], None] | None = None,
+) -> CatalogueRecord:
+    """The recommended design snapped to ``catalogue`` (re-solved), and every Pareto design's quick snap.
+
+    The recommended design is snapped by :func:`collision_reflex.optimize.snap.snap_to_catalogue` (exact or
+    heuristic); each Pareto design (the chosen one without a front) by :func:`quick_snap_record`.
+    """
+    from ..optimize.snap import snap_to_catalogue
+    from .arm_setup import IPOPT_OPTIONS
+
+    problem = built_problem(problems, problems.objective)
+    recommendation = recommend(chosen, front, problems.objective)
+    snap = snap_to_catalogue(
+        problem,
+        recommendation.result,
+        catalogue.motors,
+        arm=problems.setup.arm,
+        candidates=catalogue.candidates,
+        max_combinations=catalogue.max_combinations,
+        ipopt_options=IPOPT_OPTIONS,
+        progress=progress,
+    )
+    joints = []
+    for j, candidates in enumerate(snap.joints):
+        part = snap.parts[j] if snap.parts is not None else None
+        joints.append(
+            {
+                "joint": candidates.joint,
+                "part": None if part is None else part.label,
+                "motor": None if part is None else part.motor.name,
+                "gearbox": None if part is None else part.gearbox,
+                "gear_ratio": None if snap.result is None else float(snap.result.design.gear_ratio[j]),
+                "continuous_gear_ratio": float(recommendation.result.design.gear_ratio[j]),
+                "stator_diameter": None if part is None else part.motor.stator_diameter,
+                "continuous_stator_diameter": float(recommendation.result.design.stator_diameter[j]),
+                **_provenance(part, catalogue),
+                "candidates": [p.label for p in candidates.parts],
+                "nearest": candidates.nearest,
+                "misses": list(candidates.misses),
+                "warning": candidates.warning,
+            }
+        )
+    results = front.points if front is not None and front.points else (chosen,)
+    return {
+        "key": catalogue.key,
+        "snapped": recommendation.source,
+        "method": snap.method,
+        "candidates": catalogue.candidates,
+        "max_combinations": catalogue.max_combinations,
+        "warnings": list(snap.warnings),
+        "joints": joints,
+        "objectives": snap.objectives,
+        "continuous_objectives": snap.continuous_objectives,
+        "difference": snap.difference,
+        "relative_difference": {k: _finite(v) for k, v in snap.relative_difference.items()},
+        "design": None
+        if snap.result is None
+        else design_record(problem, snap.result, "catalogue design", catalogue.motors),
+        "tried": [{"parts": list(t.parts), "objective": t.objective, "status": t.status} for t in snap.tried],
+        "pareto": [quick_snap_record(problem, r, catalogue) for r in results],
+    }
+
+
+def quick_snap_record(
+    problem: DesignProblem, result: DesignResult, catalogue: SnapCatalogue
+) -> dict[str, Any]:
+    """A design's quick catalogue snap: the nearest candidate per joint, evaluated without a re-solve.
+
+    Each joint's nearest part within bounds (:func:`collision_reflex.optimize.snap.joint_candidates`) at the
+    gear ratio that keeps the joint's peak torque (:func:`collision_reflex.optimize.snap.matched_gear_ratio`),
+    the other variables the design's (:func:`collision_reflex.optimize.snap.evaluate_parts`). ``parts``: the
+    part per joint (None: no catalogue part within bounds, with ``missing``: the nearest part and what it
+    misses); ``feasible`` and ``shortfalls``: whether it meets every torque and speed requirement as it is;
+    ``objectives``, ``difference``, ``relative_difference``: as in :class:`CatalogueRecord` (empty without
+    parts).
+    """
+    from ..optimize.snap import evaluate_parts, joint_candidates
+
+    joints = joint_candidates(problem, result, catalogue.motors, 1)
+    missing = [
+        {"joint": j.joint, "nearest": j.nearest, "misses": list(j.misses)} for j in joints if not j.parts
+    ]
+    record: dict[str, Any] = {
+        "parts": [j.parts[0].label if j.parts else None for j in joints],
+        "missing": missing,
+        "feasible": False,
+        "shortfalls": [],
+        "objectives": {},
+        "difference": {},
+        "relative_difference": {},
+    }
+    if missing:
+        return record
+    evaluated = evaluate_parts(problem, result.design, [j.parts[0] for j in joints])
+    continuous = result.numpy_objectives
+    difference = {k: v - continuous[k] for k, v in evaluated.objectives.items()}
+    record.update(
+        feasible=evaluated.feasible,
+        shortfalls=list(evaluated.shortfalls),
+        objectives=evaluated.objectives,
+        difference=difference,
+        relative_difference={
+            k: _finite(d / continuous[k]) if continuous[k] != 0 else None for k, d in difference.items()
+        },
+    )
+    return record
+
+
+def _provenance(part: CataloguePart | None, catalogue: SnapCatalogue) -> dict[str, Any]:
+    """A part's ``source`` (its entry's), the fields with another ``sources``, and its ``estimates`` (methods)."""
+    if part is None:
+        return {"source": None, "sources": {}, "estimates": {}}
+    fields = catalogue.provenance.get(part.motor.name, {})
+    default = f"source: {part.motor.source}"
+    return {
+        "source": part.motor.source,
+        "sources": {
+            k: v.removeprefix("source: ")
+            for k, v in fields.items()
+            if v.startswith("source: ") and v != default
+        },
+        "estimates": {
+            k: v.removeprefix("ESTIMATE: ") for k, v in fields.items() if v.startswith("ESTIMATE: ")
+        },
+    }
+
+
+def _finite(value: float) -> float | None:
+    """``value``, or None where it is not finite (JSON has no inf)."""
+    return float(value) if math.isfinite(value) else None

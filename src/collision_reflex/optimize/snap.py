@@ -1,0 +1,604 @@
+"""Snap a continuous optimum to catalogue parts: the best design built from motors one can buy.
+
+A continuous optimum sizes each joint's motor freely ("a 41.7 mm motor at N = 200"). Here each joint gets a
+catalogue motor instead (a joint's reference motor with its stator diameter and stack length fixed at its own,
+so that its quantities are its datasheet figures), and the continuous variables that remain (gear ratio,
+software stiffness, threshold, approach velocity) are re-optimised for that choice.
+
+- **Candidates per joint**: among the catalogue motors within the design space's free motor bounds (stator
+  diameter, and stack length where it is a design variable) whose peak torque at the largest allowed gear ratio
+  covers the joint's required torque at the continuous optimum (and, with a duty cycle, that state a maximum
+  speed), the ``candidates`` nearest to the continuous optimum's motor in :func:`motor_distance` (log peak
+  torque and log rotor inertia). A joint whose gearbox offers discrete ratios gets, per motor, the offered
+  ratios bracketing the continuous one as fixed gear ratios. A joint with no candidate is reported ("no
+  catalogue part within bounds") with the nearest motor and what it misses.
+- **Exact** when the combinations of candidates number at most ``max_combinations``: every one is re-solved
+  (warm started from the continuous optimum's values) and the best feasible by the problem's objective is kept.
+- **Heuristic** beyond that: coordinate descent over joints from the nearest part of every joint; each pass
+  tries, joint by joint, every other candidate of that joint with the rest held, and moves to any better
+  design; it stops when a whole pass improves nothing. It is never worse than the nearest-part design (its
+  start); ``benchmarks/snap_gap.py`` measures its gap to enumeration.
+
+A catalogue design is the continuous problem with more constraints, so it is never better than the (global)
+continuous optimum in the optimised objective; a continuous optimum that is only local can be beaten.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import InvalidParameter, SolverFailed
+from .objectives import objective_expression
+from .solve import Design, DesignResult, IpoptOptions, solve
+from .space import Bounds
+
+if TYPE_CHECKING:
+    from ..arm.robot import Arm
+    from ..hardware.motors import Motor
+    from .problem import DesignProblem
+
+__all__ = [
+    "DEFAULT_CANDIDATES",
+    "DEFAULT_MAX_COMBINATIONS",
+    "CatalogueDesign",
+    "CataloguePart",
+    "JointCandidates",
+    "PartsEvaluation",
+    "Trial",
+    "evaluate_parts",
+    "joint_candidates",
+    "motor_distance",
+    "snap_to_catalogue",
+]
+
+DEFAULT_CANDIDATES = 3
+"""Catalogue motors considered per joint by default."""
+DEFAULT_MAX_COMBINATIONS = 64
+"""Largest number of combinations enumerated exactly by default; beyond it the heuristic runs."""
+COVERAGE_MARGIN = 0.1
+"""Relative margin of the catalogue's range: a continuous motor within 10 % beyond the catalogue's smallest or
+largest stator diameter and peak torque counts as covered (its nearest part is then at most that far)."""
+BOUND_TOLERANCE = 1e-9
+"""Relative slack on the motor bounds and the torque screen (a part at a bound is within it)."""
+
+
+def motor_distance(motor: Motor, peak_torque: float, rotor_inertia: float) -> float:
+    """Distance of a catalogue motor from a sized one (peak torque [N*m], rotor inertia [kg*m^2]) [-].
+
+    The Euclidean distance in (log peak torque, log rotor inertia): the two figures that, with the gear ratio,
+    set a joint's output torque and reflected inertia. A factor of e in one of them is a distance of 1.
+    """
+    return math.hypot(
+        math.log(motor.peak_torque / peak_torque), math.log(motor.rotor_inertia / rotor_inertia)
+    )
+
+
+@dataclass(frozen=True)
+class CataloguePart:
+    """One joint's catalogue choice: a motor, and the gear-ratio bounds that go with it.
+
+    motor: the catalogue motor; gear_ratio: the ratio's bounds for this part (fixed at an offered ratio when
+    the joint's gearbox offers discrete ratios); gearbox: the joint's gearbox name, or None; distance: the
+    motor's :func:`motor_distance` from the continuous optimum's motor [-].
+    """
+
+    motor: Motor
+    gear_ratio: Bounds
+    distance: float
+    gearbox: str | None = None
+
+    @property
+    def label(self) -> str:
+        """The motor's name, with the fixed gear ratio when the gearbox offers discrete ratios."""
+        fixed = f" at N = {self.gear_ratio.lower:g}" if self.gear_ratio.is_fixed else ""
+        return f"{self.motor.name}{fixed}"
+
+
+@dataclass(frozen=True)
+class JointCandidates:
+    """One joint's candidate parts, nearest first, and what the catalogue offers around its optimum.
+
+    joint: the joint's name; parts: the candidates (empty: no catalogue part within bounds); nearest: the
+    nearest catalogue motor of all, within bounds or not; misses: what ``nearest`` misses when ``parts`` is
+    empty (which bound, by how much); warning: set when the continuous optimum's motor lies outside the range
+    the catalogue covers (its nearest part is then far away).
+    """
+
+    joint: str
+    parts: tuple[CataloguePart, ...]
+    nearest: str | None
+    misses: tuple[str, ...] = ()
+    warning: str | None = None
+
+
+@dataclass(frozen=True)
+class Trial:
+    """One combination tried: a part label per joint, its objective value (None: no feasible design) and status."""
+
+    parts: tuple[str, ...]
+    objective: float | None
+    status: str
+
+
+@dataclass(frozen=True)
+class CatalogueDesign:
+    """The best design built from catalogue parts, next to the continuous optimum it was snapped from.
+
+    joints: per joint the candidates and catalogue coverage (:class:`JointCandidates`); parts: the chosen part
+    per joint, None when no combination gave a feasible design; result: the re-optimised design (None with
+    ``parts``); continuous: the continuous optimum; objectives, continuous_objectives: every objective of each
+    [its unit] (NumPy path; empty without a result); difference: catalogue minus continuous [its unit];
+    relative_difference: the same over the continuous value [-]; tried: every combination solved; method: how
+    the answer was found (``"exact: enumerated 9 combinations"`` or ``"heuristic: ..."``); warnings: the
+    joints' catalogue-coverage warnings and why no design was found, if none was.
+    """
+
+    joints: tuple[JointCandidates, ...]
+    parts: tuple[CataloguePart, ...] | None
+    result: DesignResult | None
+    continuous: DesignResult
+    objectives: dict[str, float]
+    continuous_objectives: dict[str, float]
+    difference: dict[str, float]
+    relative_difference: dict[str, float]
+    tried: tuple[Trial, ...]
+    method: str
+    warnings: tuple[str, ...] = field(default=())
+
+    @property
+    def found(self) -> bool:
+        """Whether a feasible catalogue design was found."""
+        return self.result is not None
+
+
+def joint_candidates(
+    problem: DesignProblem,
+    optimum: DesignResult,
+    motors: Mapping[str, Motor] | Sequence[Motor],
+    candidates: int = DEFAULT_CANDIDATES,
+) -> tuple[JointCandidates, ...]:
+    """Each joint's candidate parts near the continuous ``optimum`` of ``problem`` (module docstring).
+
+    Parameters
+    ----------
+    problem: the continuous design problem (its bounds, requirement and gearboxes).
+    optimum: its solution.
+    motors: the catalogue motors, by name or as a sequence.
+    candidates: motors kept per joint (>= 1), nearest first.
+    """
+    catalogue = _motor_list(motors)
+    if not isinstance(candidates, int) or isinstance(candidates, bool) or candidates < 1:
+        raise InvalidParameter("candidates", candidates, "an integer >= 1")
+    design = optimum.design
+    layout = problem.layout
+    out = []
+    for j, joint in enumerate(problem.joint_names):
+        torque, inertia = float(design.motor_peak_torque[j]), float(design.rotor_inertia[j])
+        ranked = sorted(catalogue, key=lambda m: motor_distance(m, torque, inertia))
+        required = float(optimum.required_torque[j])
+        ratio = layout.bounds["gear_ratio"][j]
+        misses = {
+            m.name: _misses(m, j, layout.bounds, required, ratio.upper, problem.duty is not None)
+            for m in ranked
+        }
+        fitting = [m for m in ranked if not misses[m.name]][:candidates]
+        parts = tuple(
+            part
+            for m in fitting
+            for part in _parts_of(
+                m, ratio, _joint_gearbox(problem, j), float(design.gear_ratio[j]), torque, inertia
+            )
+        )
+        nearest = ranked[0].name if ranked else None
+        out.append(
+            JointCandidates(
+                joint,
+                parts,
+                nearest,
+                () if parts or nearest is None else misses[nearest],
+                _coverage_warning(joint, catalogue, float(design.stator_diameter[j]), torque),
+            )
+        )
+    return tuple(out)
+
+
+def _motor_list(motors: Mapping[str, Motor] | Sequence[Motor]) -> list[Motor]:
+    """The catalogue as a list of motors (a mapping's values), refused when empty or not motors."""
+    from ..hardware.motors import Motor
+
+    listed = list(motors.values()) if isinstance(motors, Mapping) else list(motors)
+    if not listed or not all(isinstance(m, Motor) for m in listed):
+        raise InvalidParameter("motors", motors, "a non-empty catalogue of Motors (a mapping or a sequence)")
+    return listed
+
+
+def _misses(
+    motor: Motor,
+    joint: int,
+    bounds: Mapping[str, list[Bounds]],
+    required: float,
+    largest_ratio: float,
+    needs_speed: bool,
+) -> tuple[str, ...]:
+    """What keeps ``motor`` from joint ``joint``: a free motor bound, the torque screen, a missing speed."""
+    found = []
+    for name in ("stator_diameter", "stack_length"):
+        b = bounds[name][joint]
+        value = getattr(motor, name)
+        if b.is_fixed:  # not a design variable: the catalogue motor brings its own size
+            continue
+        if value < b.lower * (1 - BOUND_TOLERANCE):
+            found.append(
+                f"{name.replace('_', ' ')} {value * 1e3:.4g} mm below the lower bound "
+                f"{b.lower * 1e3:.4g} mm by {(b.lower - value) * 1e3:.3g} mm"
+            )
+        elif value > b.upper * (1 + BOUND_TOLERANCE):
+            found.append(
+                f"{name.replace('_', ' ')} {value * 1e3:.4g} mm above the upper bound "
+                f"{b.upper * 1e3:.4g} mm by {(value - b.upper) * 1e3:.3g} mm"
+            )
+    reachable = motor.peak_torque * largest_ratio
+    if reachable < required * (1 - BOUND_TOLERANCE):
+        found.append(
+            f"peak torque {motor.peak_torque:.4g} N*m x the largest gear ratio {largest_ratio:.4g} = "
+            f"{reachable:.4g} N*m, short of the required {required:.4g} N*m by {required - reachable:.3g} N*m"
+        )
+    if needs_speed and motor.max_speed is None:
+        found.append("no maximum speed in its catalogue entry (the duty cycle's speed limit needs one)")
+    return tuple(found)
+
+
+def _joint_gearbox(problem: DesignProblem, joint: int) -> Any:
+    """The joint's catalogue gearbox, or None (no gearbox, or a technology without gearboxes)."""
+    gearboxes = getattr(problem.technology, "gearboxes", None)
+    return None if gearboxes is None else gearboxes[joint]
+
+
+def _parts_of(
+    motor: Motor, ratio: Bounds, gearbox: Any, continuous_ratio: float, torque: float, inertia: float
+) -> list[CataloguePart]:
+    """``motor``'s parts: the ratio bounds as they are, or the offered ratios bracketing the continuous one."""
+    distance = motor_distance(motor, torque, inertia)
+    name = None if gearbox is None else str(gearbox.name)
+    if gearbox is None or gearbox.continuous_ratio:
+        return [CataloguePart(motor, ratio, distance, name)]
+    offered = [
+        r
+        for r in gearbox.ratios
+        if ratio.lower * (1 - BOUND_TOLERANCE) <= r <= ratio.upper * (1 + BOUND_TOLERANCE)
+    ]
+    below = [r for r in offered if r <= continuous_ratio]
+    above = [r for r in offered if r >= continuous_ratio]
+    bracket = sorted({*below[-1:], *above[:1]})
+    return [CataloguePart(motor, Bounds.fixed(float(r), ratio.name), distance, name) for r in bracket]
+
+
+def _coverage_warning(joint: str, catalogue: list[Motor], diameter: float, torque: float) -> str | None:
+    """A warning when the continuous motor (stator diameter [m], peak torque [N*m]) is outside the catalogue."""
+    diameters = [m.stator_diameter for m in catalogue]
+    torques = [m.peak_torque for m in catalogue]
+    outside = []
+    low, high = 1 / (1 + COVERAGE_MARGIN), 1 + COVERAGE_MARGIN
+    if not min(diameters) * low <= diameter <= max(diameters) * high:
+        outside.append(
+            f"stator diameter {diameter * 1e3:.4g} mm (catalogue {min(diameters) * 1e3:.4g}–"
+            f"{max(diameters) * 1e3:.4g} mm)"
+        )
+    if not min(torques) * low <= torque <= max(torques) * high:
+        outside.append(f"peak torque {torque:.4g} N*m (catalogue {min(torques):.4g}–{max(torques):.4g} N*m)")
+    if not outside:
+        return None
+    return (
+        f"{joint}: the continuous optimum lies outside the range the catalogue covers, "
+        + " and ".join(outside)
+        + ": the nearest part is far from it"
+    )
+
+
+def snap_to_catalogue(
+    problem: DesignProblem,
+    optimum: DesignResult,
+    motors: Mapping[str, Motor] | Sequence[Motor],
+    *,
+    arm: Arm,
+    candidates: int = DEFAULT_CANDIDATES,
+    max_combinations: int = DEFAULT_MAX_COMBINATIONS,
+    ipopt_options: IpoptOptions | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> CatalogueDesign:
+    """The best design built from catalogue motors near ``optimum``, re-optimised (module docstring).
+
+    Parameters
+    ----------
+    problem: the continuous design problem (:func:`collision_reflex.optimize.build_problem`); each combination
+        is this problem with every joint's motor fixed at a catalogue motor, its objective and constraints.
+    optimum: the continuous optimum of ``problem`` (:func:`collision_reflex.optimize.solve`).
+    motors: the catalogue motors (e.g. :func:`collision_reflex.load_catalogue`), by name or as a sequence.
+    arm: the arm ``problem`` was built for (each combination's problem is built for it).
+    candidates: motors considered per joint (>= 1), the nearest first.
+    max_combinations: the most combinations enumerated exactly (>= 1); beyond, the heuristic runs.
+    ipopt_options: options of every re-solve (see :func:`collision_reflex.optimize.solve`).
+    progress: called as ``progress(done, total)`` after each combination solved.
+
+    Raises
+    ------
+    InvalidParameter: an empty catalogue, ``candidates`` or ``max_combinations`` not an integer >= 1.
+    KeyboardInterrupt: Ctrl-C, from any re-solve (nothing is returned).
+    """
+    if not isinstance(max_combinations, int) or isinstance(max_combinations, bool) or max_combinations < 1:
+        raise InvalidParameter("max_combinations", max_combinations, "an integer >= 1")
+    joints = joint_candidates(problem, optimum, motors, candidates)
+    warnings = [j.warning for j in joints if j.warning]
+    empty = [j for j in joints if not j.parts]
+    if empty:
+        reasons = [
+            f"{j.joint}: no catalogue part within bounds; the nearest, {j.nearest}, misses: "
+            + "; ".join(j.misses)
+            for j in empty
+        ]
+        return _design(joints, None, None, optimum, (), "none: " + " / ".join(reasons), [*warnings, *reasons])
+    search = _Search(problem, optimum, arm, [j.parts for j in joints], ipopt_options, progress)
+    total = math.prod(len(j.parts) for j in joints)
+    if total <= max_combinations:
+        search.total = total
+        for combination in itertools.product(*(range(len(j.parts)) for j in joints)):
+            search.value(combination)
+        method = f"exact: enumerated {total} combinations"
+    else:
+        passes = search.descend()
+        method = (
+            f"heuristic: coordinate descent over joints from the nearest parts, {len(search.tried)} of {total} "
+            f"combinations solved in {passes} passes (more than max_combinations = {max_combinations})"
+        )
+    best = search.best()
+    if best is None:
+        reason = "no combination of candidates gives a feasible design (every re-solve failed)"
+        return _design(joints, None, None, optimum, search.trials(), method, [*warnings, reason])
+    parts = tuple(j.parts[c] for j, c in zip(joints, best, strict=True))
+    return _design(joints, parts, search.results[best], optimum, search.trials(), method, warnings)
+
+
+def _design(
+    joints: tuple[JointCandidates, ...],
+    parts: tuple[CataloguePart, ...] | None,
+    result: DesignResult | None,
+    optimum: DesignResult,
+    tried: tuple[Trial, ...],
+    method: str,
+    warnings: list[str],
+) -> CatalogueDesign:
+    """The :class:`CatalogueDesign` with its objectives compared to the continuous optimum's."""
+    continuous = dict(optimum.numpy_objectives)
+    mine = dict(result.numpy_objectives) if result is not None else {}
+    difference = {name: mine[name] - continuous[name] for name in mine}
+    relative = {
+        name: difference[name] / continuous[name] if continuous[name] != 0 else math.inf for name in mine
+    }
+    return CatalogueDesign(
+        joints, parts, result, optimum, mine, continuous, difference, relative, tried, method, tuple(warnings)
+    )
+
+
+class _Search:
+    """Solves combinations of candidate parts (by index per joint) once each, and keeps their values."""
+
+    def __init__(
+        self,
+        problem: DesignProblem,
+        optimum: DesignResult,
+        arm: Arm,
+        parts: list[tuple[CataloguePart, ...]],
+        ipopt_options: IpoptOptions | None,
+        progress: Callable[[int, int], None] | None,
+    ) -> None:
+        self.problem, self.optimum, self.arm, self.parts = problem, optimum, arm, parts
+        self.ipopt_options, self.progress = ipopt_options, progress
+        self.values: dict[tuple[int, ...], float] = {}
+        self.results: dict[tuple[int, ...], DesignResult] = {}
+        self.tried: dict[tuple[int, ...], Trial] = {}
+        self.total = 0
+
+    def value(self, combination: tuple[int, ...]) -> float:
+        """The problem's objective of the combination re-optimised; inf when it has no feasible design."""
+        if combination in self.values:
+            return self.values[combination]
+        chosen = tuple(self.parts[j][c] for j, c in enumerate(combination))
+        labels = tuple(p.label for p in chosen)
+        try:
+            result = solve_parts(self.problem, self.optimum, chosen, self.arm, self.ipopt_options)
+        except SolverFailed as error:
+            self.values[combination] = math.inf
+            self.tried[combination] = Trial(labels, None, error.status)
+        else:
+            value = objective_value(self.problem, result.numpy_objectives)
+            self.values[combination], self.results[combination] = value, result
+            self.tried[combination] = Trial(labels, value, result.status)
+        if self.progress is not None:
+            self.progress(len(self.tried), max(self.total, len(self.tried)))
+        return self.values[combination]
+
+    def descend(self) -> int:
+        """Coordinate descent from the nearest parts until a pass improves nothing; the number of passes."""
+        current = (0,) * len(self.parts)
+        value, passes, improved = self.value(current), 0, True
+        while improved:
+            improved, passes = False, passes + 1
+            for j, joint_parts in enumerate(self.parts):
+                for c in range(len(joint_parts)):
+                    trial = (*current[:j], c, *current[j + 1 :])
+                    if trial != current and self.value(trial) < value:
+                        current, value, improved = trial, self.values[trial], True
+        return passes
+
+    def best(self) -> tuple[int, ...] | None:
+        """The feasible combination of least value (the first tried among equals), or None."""
+        feasible = [c for c in self.tried if math.isfinite(self.values[c])]
+        return min(feasible, key=lambda c: self.values[c]) if feasible else None
+
+    def trials(self) -> tuple[Trial, ...]:
+        """Every combination tried, in the order tried."""
+        return tuple(self.tried.values())
+
+
+def objective_value(problem: DesignProblem, objectives: Mapping[str, float]) -> float:
+    """``problem``'s objective for a design's objective values [their units]: the NLP's, at its scale.
+
+    The weighted, start-normalised objectives with the tie-break term, scaled as ``problem`` scales them, so
+    that designs of different (catalogue) problems compare on one scale.
+    """
+    return float(objective_expression(problem.objective, objectives, problem.objective_scale))
+
+
+def catalogue_problem(problem: DesignProblem, parts: Sequence[CataloguePart], arm: Arm) -> DesignProblem:
+    """``problem`` with each joint's motor the catalogue motor of ``parts`` at its own size.
+
+    Each joint's stator diameter and stack length are fixed at its part's, its gear ratio within the part's
+    bounds; the objective, constraints and the other bounds are ``problem``'s.
+    """
+    from .problem import build_problem
+
+    space = replace(
+        problem.space,
+        stator_diameter=[p.motor.stator_diameter for p in parts],
+        stack_length=[p.motor.stack_length for p in parts],
+        gear_ratio=[p.gear_ratio for p in parts],
+    )
+    technology = replace(problem.technology, reference_motor=tuple(p.motor for p in parts))
+    return build_problem(
+        arm,
+        problem.samples,
+        space,
+        technology,
+        problem.objective,
+        problem.constraints,
+        problem.bounded_objectives,
+    )
+
+
+def matched_gear_ratio(part: CataloguePart, design: Design, joint: int) -> float:
+    """The gear ratio that gives ``part``'s motor the continuous design's peak output torque, within its bounds.
+
+    ``N = N_c tau_c / tau_p`` (``N_c tau_c`` the continuous joint's peak torque [N*m]), clipped to the part's
+    gear-ratio bounds: the catalogue design's start, and the ratio of a part evaluated without a re-solve.
+    """
+    wanted = float(design.peak_torque[joint]) / part.motor.peak_torque
+    return float(np.clip(wanted, part.gear_ratio.lower, part.gear_ratio.upper))
+
+
+def solve_parts(
+    problem: DesignProblem,
+    optimum: DesignResult,
+    parts: Sequence[CataloguePart],
+    arm: Arm,
+    ipopt_options: IpoptOptions | None = None,
+) -> DesignResult:
+    """The design of ``parts`` with the remaining continuous variables re-optimised.
+
+    Started from ``optimum``'s values of those variables (clipped to their bounds), the gear ratios at
+    :func:`matched_gear_ratio`.
+
+    Raises
+    ------
+    SolverFailed: no design of these parts meets the constraints (or the solver did not converge).
+    """
+    built = catalogue_problem(problem, parts, arm)
+    design = optimum.design
+    known: dict[str, np.ndarray] = {
+        "gear_ratio": np.array([matched_gear_ratio(p, design, j) for j, p in enumerate(parts)]),
+        "software_stiffness": design.software_stiffness,
+        "threshold": np.array([design.threshold]),
+        "approach_velocity": np.array([design.approach_velocity]),
+    }
+    start = built.x0.copy()
+    for name, values in known.items():
+        for i, b, value in zip(built.layout.slices[name], built.layout.bounds[name], values, strict=True):
+            if i is not None:
+                start[i] = math.log(min(max(float(value), b.lower), b.upper))
+    return solve(built, x0=built.exact_point(start), ipopt_options=ipopt_options)
+
+
+@dataclass(frozen=True)
+class PartsEvaluation:
+    """A design of catalogue parts evaluated without a re-solve (the quick snap of every Pareto design).
+
+    parts: the part per joint; design: the continuous design with each joint's motor replaced by its part's at
+    :func:`matched_gear_ratio`; objectives: every objective [its unit] (NumPy path); required_torque: per joint
+    [N*m]; shortfalls: the requirements it misses (peak torque, and with a duty cycle RMS torque and motor
+    speed), empty when it meets them all.
+    """
+
+    parts: tuple[CataloguePart, ...]
+    design: Design
+    objectives: dict[str, float]
+    required_torque: np.ndarray
+    shortfalls: tuple[str, ...]
+
+    @property
+    def feasible(self) -> bool:
+        """Whether the design meets every torque and speed requirement."""
+        return not self.shortfalls
+
+
+def evaluate_parts(problem: DesignProblem, design: Design, parts: Sequence[CataloguePart]) -> PartsEvaluation:
+    """``design`` with each joint's motor the catalogue motor of ``parts``, evaluated (no re-solve).
+
+    The gear ratios are :func:`matched_gear_ratio`; software stiffness, threshold and approach velocity are
+    ``design``'s. Impulses by the NumPy path (:func:`collision_reflex.optimize.evaluate.evaluate_design`), the
+    requirement by ``problem``'s own torque-requirement function (and duty cycle).
+    """
+    from ..model import effective
+    from .duty import duty_values
+    from .evaluate import evaluate_design
+
+    parts = tuple(parts)
+    gear = np.array([matched_gear_ratio(p, design, j) for j, p in enumerate(parts)])
+    inertia = np.array([p.motor.rotor_inertia for p in parts])
+    torque = np.array([p.motor.peak_torque for p in parts])
+    snapped = replace(
+        design,
+        stator_diameter=np.array([p.motor.stator_diameter for p in parts]),
+        stack_length=np.array([p.motor.stack_length for p in parts]),
+        gear_ratio=gear,
+        rotor_inertia=inertia,
+        reflected_inertia=effective.reflected_inertia(gear, inertia),
+        motor_peak_torque=torque,
+        peak_torque=gear * torque,
+        motor_mass=np.array([p.motor.mass for p in parts]),
+    )
+    impulses = evaluate_design(problem, snapped)
+    arguments = (
+        (snapped.motor_mass,) if problem.duty is None else (snapped.motor_mass, snapped.reflected_inertia)
+    )
+    required = np.asarray(problem.required_torque_function(*arguments), dtype=float).ravel()
+    shortfalls = [
+        f"{name}: peak torque {snapped.peak_torque[j]:.4g} N*m below the required {required[j]:.4g} N*m"
+        for j, name in enumerate(design.joint_names)
+        if snapped.peak_torque[j] < required[j] * (1 - BOUND_TOLERANCE)
+    ]
+    if problem.duty is not None:
+        technology = replace(problem.technology, reference_motor=tuple(p.motor for p in parts))
+        values = duty_values(problem.duty, snapped, technology)
+        for j, name in enumerate(design.joint_names):
+            if values.continuous_torque[j] < values.required_rms_torque[j] * (1 - BOUND_TOLERANCE):
+                shortfalls.append(
+                    f"{name}: continuous torque {values.continuous_torque[j]:.4g} N*m below the cycle's RMS "
+                    f"{values.required_rms_torque[j]:.4g} N*m"
+                )
+            if values.max_motor_speed[j] > values.speed_limit[j] * (1 + BOUND_TOLERANCE):
+                shortfalls.append(
+                    f"{name}: motor speed {values.max_motor_speed[j]:.4g} rad/s above its limit "
+                    f"{values.speed_limit[j]:.4g} rad/s"
+                )
+    objectives = {
+        "worst_case_impulse": float(impulses.max()),
+        "mean_impulse": float(impulses.mean()),
+        "actuator_mass": float(snapped.motor_mass.sum()),
+        "approach_velocity": float(snapped.approach_velocity),
+    }
+    return PartsEvaluation(parts, snapped, objectives, required, tuple(shortfalls))
