@@ -64,8 +64,9 @@ DEFAULT_MAX_COMBINATIONS = 64
 COVERAGE_MARGIN = 0.1
 """Relative margin of the catalogue's range: a continuous motor within 10 % beyond the catalogue's smallest or
 largest stator diameter and peak torque counts as covered (its nearest part is then at most that far)."""
-BOUND_TOLERANCE = 1e-9
-"""Relative slack on the motor bounds and the torque screen (a part at a bound is within it)."""
+BOUND_TOLERANCE = 1e-6
+"""Relative slack on the motor bounds and the torque screen: a part at a bound is within it, and IPOPT's
+optimum may pass a bound by its relaxation (1e-8 relative)."""
 
 
 def motor_distance(motor: Motor, peak_torque: float, rotor_inertia: float) -> float:
