@@ -112,6 +112,35 @@ BAD = {
         "motors.small.max_speed",
         "> 0",
     ),
+    "zero-inertia": (GOOD.replace("12 g*cm^2", "0"), 5, "motors.small.rotor_inertia", "> 0"),
+    "nan-mass": (GOOD.replace("mass: 80 g", "mass: .nan"), 8, "motors.small.mass", "> 0"),
+    # 12 kg cm^2 on a 30 mm, 80 g motor: 8 times the inertia of its whole mass at 2 x its stator radius.
+    "inertia-unit-slip": (
+        GOOD.replace("12 g*cm^2", "12 kg*cm^2"),
+        5,
+        "motors.small.rotor_inertia",
+        "check the unit",
+    ),
+    "unknown-construction": (
+        GOOD.replace("    source:", "    construction: geared\n    source:"),
+        9,
+        "motors.small.construction",
+        "'frameless' or 'housed'",
+    ),
+    "empty-maker": (GOOD.replace("    source:", "    maker: ''\n    source:"), 9, "motors.small.maker", "empty"),
+    "duplicate-part": (GOOD + GOOD.replace("motors:\n", ""), 10, "motors.small", "given twice (first on line 2)"),
+    "duplicate-field": (
+        GOOD.replace("    source:", "    mass: 0.5 kg\n    source:"),
+        9,
+        "motors.small.mass",
+        "given twice (first on line 8)",
+    ),
+    "duplicate-estimate": (
+        GOOD.replace("    source:", "    estimates:\n      mass: a\n      mass: b\n    source:"),
+        11,
+        "motors.small.estimates.mass",
+        "given twice",
+    ),
     "bad-yaml": ("motors:\n  small: [1,\n", 3, "", "YAML"),
     "no-motors-key": ("engines: {}\n", 1, "motors", "missing"),
 }
@@ -142,7 +171,8 @@ def _given_fields(path, kind):
     import yaml
 
     entries = yaml.safe_load(path.read_text())[kind]
-    return {name: set(entry) - {"source", "sources", "estimates"} for name, entry in entries.items()}
+    text_only = {"source", "sources", "estimates", "maker", "construction"}
+    return {name: set(entry) - text_only for name, entry in entries.items()}
 
 
 @pytest.mark.parametrize("kind, file", [("motors", "motors.yaml"), ("gearboxes", "gearboxes.yaml")])
@@ -230,3 +260,14 @@ def test_bad_provenance_names_field_and_line(tmp_path, text, line, field, words)
         cr.load_catalogue(path)
     assert info.value.line == line and info.value.field == field
     assert f"{path}:{line}" in str(info.value) and words in str(info.value)
+
+
+def test_descriptive_fields_are_text_apart_from_the_numbers(tmp_path):
+    from collision_reflex.hardware.catalogue import read_entries
+
+    text = GOOD.replace("    source:", "    maker: Acme\n    construction: frameless\n    source:")
+    entry = read_entries(_write(tmp_path, text), "motors")["small"]
+    assert entry.description == {"maker": "Acme", "construction": "frameless"}
+    assert "maker" not in entry.provenance and "construction" not in entry.fields
+    assert cr.load_catalogue(_write(tmp_path, text))["small"].mass == pytest.approx(0.080, rel=1e-12)
+    assert read_entries(_write(tmp_path, GOOD), "motors")["small"].description == {}

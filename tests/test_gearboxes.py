@@ -117,6 +117,20 @@ GEARBOX_BAD = {
     "efficiency-above-one": (GEARBOX.replace("0.97", "1.2"), 9, "gearboxes.small.efficiency", "(0, 1]"),
     "efficiency-zero": (GEARBOX.replace("0.97", "0"), 9, "gearboxes.small.efficiency", "(0, 1]"),
     "ratio-below-one": (GEARBOX.replace("[3, 5, 10]", "[0.5, 5]"), 4, "gearboxes.small.ratios", ">= 1"),
+    "ratio-zero": (GEARBOX.replace("[3, 5, 10]", "[0, 5]"), 4, "gearboxes.small.ratios", ">= 1"),
+    "ratio-negative": (GEARBOX.replace("[3, 5, 10]", "[-3]"), 4, "gearboxes.small.ratios", ">= 1"),
+    "range-negative": (
+        GEARBOX.replace("ratios: [3, 5, 10]", "ratio_range: [-10, 50]"),
+        4,
+        "gearboxes.small.ratio_range",
+        ">= 1",
+    ),
+    "empty-maker": (
+        GEARBOX.replace("    source:", "    maker: ' '\n    source:"),
+        11,
+        "gearboxes.small.maker",
+        "empty",
+    ),
     "both-ratio-forms": (
         GEARBOX.replace("ratios: [3, 5, 10]", "ratios: [3]\n    ratio_range: [3, 10]"),
         2,

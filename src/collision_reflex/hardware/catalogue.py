@@ -5,14 +5,15 @@ Kept apart from :mod:`collision_reflex.hardware.motors` so that the scaling arit
 Provenance: every entry cites a ``source`` (the default source of each of its numbers); ``sources: {field:
 text}`` names another source for some fields, and ``estimates: {field: method}`` marks a field that no source
 gives, with the method that estimated it. :func:`read_entries` returns each field's provenance, so that every
-number can be traced to a datasheet, a paper, or a stated estimate.
+number can be traced to a datasheet, a paper, or a stated estimate. The descriptive fields ``maker`` and, for
+motors, ``construction`` (``frameless`` or ``housed``) are optional, carry no number and need no provenance.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError, field_validator
@@ -39,6 +40,11 @@ _GEARBOX_OPTIONAL_UNITS = {
     "length": "m",
 }
 _PROVENANCE = ("source", "sources", "estimates")
+# Optional text fields that describe a part; returned apart from the numbers (CatalogueEntry.description).
+_DESCRIPTIVE = ("maker", "construction")
+# A rotor cannot hold more inertia than the whole motor mass at 1.4 x the stator radius (2 ~ 1.4^2), even
+# for an outer rotor: a larger value is a unit slip (kg*cm^2 written as kg*m^2) or a wrong field.
+_MAX_INERTIA_PER_MASS_RADIUS2 = 2.0
 
 
 def packaged_catalogue_path(file: str = "motors.yaml") -> Path:
@@ -92,12 +98,20 @@ class _Cited(BaseModel):
     source: str
     sources: dict[str, str] = {}
     estimates: dict[str, str] = {}
+    maker: str | None = None
 
     @field_validator("source")
     @classmethod
     def _cited(cls, value: str) -> str:
         if not value.strip():
             raise ValueError("every entry must cite its source (datasheet, paper, or a stated assumption)")
+        return value
+
+    @field_validator("maker")
+    @classmethod
+    def _named(cls, value: str | None) -> str | None:
+        if value is not None and not value.strip():
+            raise ValueError("empty: name the maker, or leave the field out")
         return value
 
 
@@ -112,6 +126,7 @@ class _MotorEntry(_Cited):
     mass: float
     max_speed: float | None = None
     torque_constant: float | None = None
+    construction: Literal["frameless", "housed"] | None = None
 
     @field_validator(*_MOTOR_UNITS, *_MOTOR_OPTIONAL_UNITS, mode="before")
     @classmethod
@@ -199,20 +214,27 @@ class CatalogueEntry:
         the entry gives.
     line : int
         1-based line of the entry's name in its file.
+    description : dict
+        The descriptive fields the entry gives (``maker``, ``construction``), text only.
     """
 
     fields: dict[str, Any]
     provenance: dict[str, str]
     line: int
+    description: dict[str, str]
 
 
 # kind -> (schema, required fields, optional fields), the last two for error messages.
 _KINDS: dict[str, tuple[type[_Cited], list[str], list[str]]] = {
-    "motors": (_MotorEntry, [*_MOTOR_UNITS, "source"], [*_MOTOR_OPTIONAL_UNITS, "sources", "estimates"]),
+    "motors": (
+        _MotorEntry,
+        [*_MOTOR_UNITS, "source"],
+        [*_MOTOR_OPTIONAL_UNITS, "sources", "estimates", *_DESCRIPTIVE],
+    ),
     "gearboxes": (
         _GearboxEntry,
         ["kind", "ratios or ratio_range", *_GEARBOX_UNITS, "source"],
-        ["efficiency", "stages", *_GEARBOX_OPTIONAL_UNITS, "sources", "estimates"],
+        ["efficiency", "stages", *_GEARBOX_OPTIONAL_UNITS, "sources", "estimates", "maker"],
     ),
 }
 
@@ -286,7 +308,7 @@ def read_entries(path: Path, kind: str = "motors") -> dict[str, CatalogueEntry]:
         raise CatalogueError(name, line, "", f"not valid YAML: {problem}") from None
     if not isinstance(root, yaml.MappingNode):
         raise CatalogueError(name, _line(root), "", f"expected a mapping with a top-level {kind!r} key")
-    top = _mapping(root)
+    top = _mapping(root, name, "")
     if kind not in top:
         raise CatalogueError(name, 1, kind, f"missing: the file needs a top-level {kind!r} mapping")
     unknown = sorted(set(top) - {kind})
@@ -300,7 +322,7 @@ def read_entries(path: Path, kind: str = "motors") -> dict[str, CatalogueEntry]:
         raise CatalogueError(name, _line(parts_node), kind, "expected a mapping from part name to entry")
     return {
         part: _entry(name, kind, part, key_node, entry_node)
-        for part, (key_node, entry_node) in _mapping(parts_node).items()
+        for part, (key_node, entry_node) in _mapping(parts_node, name, kind).items()
     }
 
 
@@ -311,7 +333,7 @@ def _entry(file: str, kind: str, part: str, key_node: Any, entry_node: Any) -> C
     where = f"{kind}.{part}"
     if not isinstance(entry_node, yaml.MappingNode):
         raise CatalogueError(file, _line(key_node), where, "expected a mapping of the part's fields")
-    fields = _mapping(entry_node)
+    fields = _mapping(entry_node, file, where)
     raw = {key: _plain(value_node) for key, (_, value_node) in fields.items()}
     try:
         entry = model.model_validate(raw)
@@ -340,8 +362,24 @@ def _entry(file: str, kind: str, part: str, key_node: Any, entry_node: Any) -> C
         raise refuse("momentary_torque", "is below the (repeated) peak torque")
     if kind == "gearboxes":
         _check_ratios(values, fields, refuse, file, key_node, where)
-    given = [key for key in fields if key not in _PROVENANCE]
-    return CatalogueEntry(values, _provenance(file, where, fields, entry, given), _line(key_node))
+    else:
+        _check_inertia(values, refuse)
+    description = {key: values.pop(key) for key in _DESCRIPTIVE if key in values}
+    description = {key: text for key, text in description.items() if text is not None}
+    given = [key for key in fields if key not in (*_PROVENANCE, *_DESCRIPTIVE)]
+    return CatalogueEntry(values, _provenance(file, where, fields, entry, given), _line(key_node), description)
+
+
+def _check_inertia(values: dict[str, Any], refuse: Any) -> None:
+    """Refuse a rotor inertia [kg m^2] that no motor of that mass [kg] and stator diameter [m] can have."""
+    bound = _MAX_INERTIA_PER_MASS_RADIUS2 * values["mass"] * (values["stator_diameter"] / 2) ** 2
+    if values["rotor_inertia"] > bound:
+        raise refuse(
+            "rotor_inertia",
+            f"{values['rotor_inertia']:g} kg m^2 exceeds {_MAX_INERTIA_PER_MASS_RADIUS2:g} x mass x (stator "
+            f"diameter / 2)^2 = {bound:g} kg m^2, more than the whole motor could hold: check the unit "
+            "(kg*cm^2 or g*cm^2 written as kg*m^2?)",
+        )
 
 
 def _check_ratios(
@@ -367,8 +405,8 @@ def _provenance(
     for table in ("sources", "estimates"):
         if table not in fields:
             continue
-        for key_node, value_node in fields[table][1].value:
-            key, text = str(key_node.value), _plain(value_node)
+        for key, (key_node, value_node) in _mapping(fields[table][1], file, f"{where}.{table}").items():
+            text = _plain(value_node)
             if key not in given:
                 raise CatalogueError(
                     file,
@@ -397,9 +435,21 @@ def _provenance(
     }
 
 
-def _mapping(node: Any) -> dict[str, tuple[Any, Any]]:
-    """Key -> (key node, value node) of a YAML mapping node (keys as text)."""
-    return {str(key.value): (key, value) for key, value in node.value}
+def _mapping(node: Any, file: str, where: str) -> dict[str, tuple[Any, Any]]:
+    """Key -> (key node, value node) of a YAML mapping node (keys as text); a repeated key is refused.
+
+    YAML keeps the last of two equal keys: a part or field written twice would silently lose one of them.
+    """
+    items: dict[str, tuple[Any, Any]] = {}
+    for key, value in node.value:
+        text = str(key.value)
+        if text in items:
+            first = _line(items[text][0])
+            raise CatalogueError(
+                file, _line(key), f"{where}.{text}".lstrip("."), f"given twice (first on line {first})"
+            )
+        items[text] = (key, value)
+    return items
 
 
 def _line(node: Any) -> int:
