@@ -142,6 +142,51 @@ class Gearbox:
             source=f"scaled by the {self.kind} law of Saerens et al. 2019 from: {self.source}",
         )
 
+    def catalogue_entry(
+        self,
+        name: str,
+        ratio_range: tuple[float, float],
+        peak_torque: float | None = None,
+        efficiency: float | None = None,
+        max_input_speed: float | None = None,
+    ) -> CatalogueGearbox:
+        """This gearbox as a joint's gearbox entry, for the arm optimiser (one mechanism for every gearbox).
+
+        Parameters
+        ----------
+        name : str
+            What reports call it.
+        ratio_range : (float, float)
+            The ratios it may have [-], ``(min, max)``: a scaled gearbox has no list of ratios, so the design's
+            gear-ratio bounds.
+        peak_torque : float, optional
+            Repeated peak output torque [N m]; default the rated torque (nothing known above it).
+        efficiency : float, optional
+            Efficiency in (0, 1] [-]; default 1 (lossless).
+        max_input_speed : float, optional
+            Maximum input speed [rad/s]; default none.
+        """
+        low, high = (float(r) for r in ratio_range)
+        _validate.positive("ratio_range", np.array([low, high]))
+        if low > high:
+            raise InvalidParameter("ratio_range", ratio_range, "(min, max) with min <= max")
+        return CatalogueGearbox(
+            name=name,
+            kind=self.kind,
+            ratios=(low, high),
+            continuous_ratio=True,
+            rated_torque=self.rated_torque,
+            peak_torque=self.rated_torque if peak_torque is None else float(peak_torque),
+            mass=self.mass,
+            inertia=self.inertia,
+            source=self.source,
+            efficiency=1.0 if efficiency is None else float(efficiency),
+            stages=self.stages,
+            max_input_speed=max_input_speed,
+            diameter=self.diameter,
+            length=self.length,
+        )
+
 
 @dataclass(frozen=True)
 class CatalogueGearbox:

@@ -30,7 +30,7 @@ DUTY_REQUIREMENT = "duty cycle (peak, RMS, speed)"
 """The requirement of a duty cycle: peak and RMS torque and the motor speed."""
 
 TorqueDemands = tuple[np.ndarray, np.ndarray, list[str]]
-"""One joint's affine torque demands ``b + S m`` [N m]: bases ``b`` (R,), slopes ``S`` (R, n) per motor mass
+"""One joint's affine torque demands ``b + S m`` [N m]: bases ``b`` (R,), slopes ``S`` (R, n) per actuator mass
 [N m/kg] and one label per demand."""
 
 
@@ -116,14 +116,18 @@ class ModelTerms:
     peak_torque: peak output torques [N m] (n_joints).
     normalisation: ``w_s^T x_s`` per sample (1 x n_samples).
     thresholds: contact-force thresholds [N] (1 x n_samples).
-    motor_mass: motor masses [kg] (n_joints).
+    actuator_mass: actuator (motor and gearbox) masses carried at the joints [kg] (n_joints).
+    driving_torque: driving peak output torques ``eta N tau_p`` [N m] (n_joints), what the torque requirement
+        must be within (the reaction capacity keeps ``N tau_p``, see
+        :meth:`~collision_reflex.optimize.technology.ActuatorTechnology.joint_quantities`).
     """
 
     log_compliance: ca.MX
     peak_torque: ca.MX
     normalisation: ca.MX
     thresholds: ca.MX
-    motor_mass: ca.MX
+    actuator_mass: ca.MX
+    driving_torque: ca.MX
 
 
 def add_model_constraints(
@@ -162,13 +166,13 @@ def add_model_constraints(
 
     g.add(ca.transpose(terms.normalisation), 1.0, 1.0, [f"w^T x = 1 at sample {s}" for s in range(n_samples)])
 
-    # Torque: peak output torque covers the requirement in every sampled configuration, as linear constraints
-    # scaled by the requirement at the start; only demands that can be the largest somewhere in the box of
-    # motor masses allowed by the bounds can bind, the others are dropped (exactly).
+    # Torque: driving peak output torque covers the requirement in every sampled configuration, as linear
+    # constraints scaled by the requirement at the start; only demands that can be the largest somewhere in
+    # the box of actuator masses allowed by the bounds can bind, the others are dropped (exactly).
     for j, (bases, slopes, demand_labels) in enumerate(torque_demands):
-        demand = ca.DM(bases) + ca.mtimes(ca.DM(slopes), terms.motor_mass)
+        demand = ca.DM(bases) + ca.mtimes(ca.DM(slopes), terms.actuator_mass)
         g.add(
-            (terms.peak_torque[j] - demand) / torque_scale[j],
+            (terms.driving_torque[j] - demand) / torque_scale[j],
             0.0,
             np.inf,
             [f"peak torque of {joint_names[j]} >= {label}" for label in demand_labels],
@@ -183,10 +187,72 @@ def add_model_constraints(
         )
 
 
+def add_gearbox_peak_constraints(
+    g: ConstraintList,
+    terms: ModelTerms,
+    torque_demands: list[TorqueDemands],
+    technology: ActuatorTechnology,
+    joint_names: tuple[str, ...],
+) -> None:
+    """Add, per joint with a gearbox, its rating: every torque demand within its repeated peak torque.
+
+    The demands are the static (or given) requirement's, safety factor included, as the motor's rows; each
+    row is divided by the rating, so that its margin reads as a fraction of it.
+    """
+    figures = technology.gearbox_figures(len(joint_names))
+    for j, (bases, slopes, demand_labels) in enumerate(torque_demands):
+        rating = figures.peak_torque[j]
+        if not np.isfinite(rating):
+            continue
+        demand = ca.DM(bases) + ca.mtimes(ca.DM(slopes), terms.actuator_mass)
+        g.add(
+            1.0 - demand / rating,
+            0.0,
+            np.inf,
+            [
+                f"gearbox {figures.names[j]} of {joint_names[j]}: repeated peak rating {rating:.4g} N*m >= {label}"
+                for label in demand_labels
+            ],
+        )
+
+
+def check_gearbox_ratings(
+    torque_demands: list[TorqueDemands],
+    technology: ActuatorTechnology,
+    joint_names: tuple[str, ...],
+    mass_low: np.ndarray,
+    mass_high: np.ndarray,
+) -> None:
+    """Refuse a gearbox whose repeated peak torque is below the least its joint's requirement can be.
+
+    The requirement is the largest demand ``b + S m``; over the box of actuator masses ``[mass_low,
+    mass_high]`` [kg] it is at least each demand's smallest value there, so a rating below the largest of
+    those cannot be met by any design within the bounds.
+
+    Raises
+    ------
+    InvalidParameter: names the joint, the gearbox, its rating and the least requirement [N m].
+    """
+    figures = technology.gearbox_figures(len(joint_names))
+    for j, (bases, slopes, _) in enumerate(torque_demands):
+        rating = figures.peak_torque[j]
+        if not np.isfinite(rating) or bases.size == 0:
+            continue
+        least = float((bases + np.minimum(slopes * mass_low, slopes * mass_high).sum(axis=1)).max())
+        if least > rating * (1 + 1e-9):
+            raise InvalidParameter(
+                f"gearbox {figures.names[j]} of {joint_names[j]}",
+                f"repeated peak rating {rating:.4g} N*m",
+                f"a rating >= {least:.4g} N*m, the least torque {joint_names[j]} needs within the bounds "
+                "(safety factor included)",
+                "choose a gearbox of a higher rating, or lower the payload, the safety factor or the given torques",
+            )
+
+
 def torque_requirement_rows(
     samples: ContactSamples, constraints: Constraints, joint_names: tuple[str, ...]
 ) -> tuple[list[tuple[np.ndarray, np.ndarray]], list[str]]:
-    """Affine torque demands ``d0 + D m`` [N m] (``m``: motor masses [kg]) the peak torques must cover.
+    """Affine torque demands ``d0 + D m`` [N m] (``m``: actuator masses [kg]) the peak torques must cover.
 
     Given torques: one demand. Otherwise, per sampled configuration, plus and minus the gravity torque of the
     structure, the motors (linear in their masses) and the payload at the contact point, all times the safety
@@ -221,7 +287,7 @@ def binding_torque_demands(
 ) -> list[TorqueDemands]:
     """Per joint, the torque demands ``b + S m`` [N m] that can bind: ``(b (R,), S (R, n), labels)``.
 
-    A demand whose largest value over the box of motor masses ``[mass_low, mass_high]`` [kg] is below another
+    A demand whose largest value over the box of actuator masses ``[mass_low, mass_high]`` [kg] is below another
     demand's smallest value there never sets the requirement, so it is left out: an exact reduction (on arms,
     from two rows per sampled configuration to a handful).
     """
@@ -250,10 +316,10 @@ def binding_rows(bases: np.ndarray, slopes: np.ndarray, low: np.ndarray, high: n
 
 
 def required_torque_function(demands: list[TorqueDemands], n_joints: int) -> ca.Function:
-    """CasADi function: motor masses [kg] -> required peak torque per joint [N m].
+    """CasADi function: actuator masses [kg] -> required peak torque per joint [N m].
 
     The requirement is the largest binding demand (safety factor included), for reporting.
     """
-    masses = ca.MX.sym("motor_mass", n_joints)
+    masses = ca.MX.sym("actuator_mass", n_joints)
     required = [ca.mmax(ca.DM(bases) + ca.mtimes(ca.DM(slopes), masses)) for bases, slopes, _ in demands]
     return ca.Function("required_torque", [masses], [ca.vertcat(*required)])

@@ -3,21 +3,24 @@
 With a duty cycle (:class:`collision_reflex.arm.DutyCycle`, in :attr:`Constraints.duty_cycle`) joint ``j``
 must meet, over the cycle's samples ``t``:
 
-- peak: ``N_j tau_p,j >= SF max_t |d_j(t)|`` with the joint-side demand ``d_j(t) = tau_j(t) + N_j^2 J_m,j
-  qdd_j(t)`` (:func:`collision_reflex.arm.dynamics.joint_side_torque`). It is affine in ``x_j = [1, m_0, ...,
-  m_{nv-1}, N_j^2 J_m,j]`` (motor masses [kg], reflected rotor inertia [kg m^2]): ``d_j = B_j x_j``, so the
-  peak is the linear rows ``+-SF B_j(t) x_j <= N_j tau_p,j``; rows that can never be the largest within the
-  variable bounds are dropped exactly (:func:`collision_reflex.optimize.constraints.binding_rows`);
-- continuous (thermal): ``N_j tau_c,j >= RMS_t d_j`` as ``x_j^T Q_j x_j / (N_j tau_c,j)^2 <= 1`` (smooth, of
-  order one); no safety factor: the RMS is a thermal average, the safety factor covers the peak;
+- peak: ``eta_j N_j tau_p,j >= SF max_t |d_j(t)|`` with the joint-side demand ``d_j(t) = tau_j(t) + N_j^2
+  (J_m,j + J_g,j) qdd_j(t)`` (:func:`collision_reflex.arm.dynamics.joint_side_torque`; ``eta``, ``J_g`` the
+  gearbox's efficiency and input inertia, 1 and 0 without one). It is affine in ``x_j = [1, m_0, ...,
+  m_{nv-1}, N_j^2 (J_m,j + J_g,j)]`` (actuator masses, motor and gearbox [kg], reflected inertia [kg m^2]):
+  ``d_j = B_j x_j``, so the peak is the linear rows ``+-SF B_j(t) x_j <= eta_j N_j tau_p,j``; rows that can
+  never be the largest within the variable bounds are dropped exactly
+  (:func:`collision_reflex.optimize.constraints.binding_rows`);
+- continuous (thermal): ``eta_j N_j tau_c,j >= RMS_t d_j`` as ``x_j^T Q_j x_j / (eta_j N_j tau_c,j)^2 <= 1``
+  (smooth, of order one); no safety factor: the RMS is a thermal average, the safety factor covers the peak;
 - speed: ``N_j max_t |qd_j(t)| <= omega_max,j`` and, for the approach itself, ``N_j v0 max_s |(J_s^+ u_s)_j|
   <= omega_max,j`` over the contact samples ``s`` (``J_s^+`` the pseudo-inverse of the contact Jacobian: the
   joint speeds that move the contact point along ``u_s`` at ``v0``). Both are linear in the log design
   variables (``omega_max`` of the scaled motor is a power law of its size); the approach needs one row per
   joint, at the sample with the largest joint rate, since ``v0`` is common to all samples.
 
-The motor masses in the demand are the scaled motors' (the optimiser has no gearboxes); the payload is the
-cycle's. :func:`torque_speed_points` gives the cycle's motor-side (speed, torque) points and the approach's
+A joint's gearbox adds its ratings (:func:`add_gearbox_duty_constraints`): the peak demand within its repeated
+peak torque, the RMS demand within its rated torque, the motor speed within its maximum input speed. The
+payload is the cycle's. :func:`torque_speed_points` gives the cycle's motor-side (speed, torque) points and the approach's
 motor speeds of a design, for a torque-speed figure.
 """
 
@@ -73,9 +76,13 @@ class DutyRequirement:
         """``max_s |(J_s^+ u_s)_j|`` per joint [rad/m], (nv,): joint speed per unit approach speed."""
         return np.abs(self.approach_rates).max(axis=0)
 
-    def demand(self, motor_mass: np.ndarray, reflected_inertia: np.ndarray) -> np.ndarray:
-        """Joint-side torques over the cycle [N m], (n, nv), for motor masses [kg] and ``N^2 J_m`` [kg m^2]."""
-        return self.torques.demand(motor_mass, reflected_inertia)
+    def demand(self, actuator_mass: np.ndarray, reflected_inertia: np.ndarray) -> np.ndarray:
+        """Joint-side torques over the cycle [N m], (n, nv).
+
+        For the actuator (motor and gearbox) masses carried at the joints [kg] and ``N^2 (J_m + J_g)``
+        [kg m^2].
+        """
+        return self.torques.demand(actuator_mass, reflected_inertia)
 
     def joint_speed(self, approach_velocity: float) -> np.ndarray:
         """Largest joint speed over the cycle and the approach at ``approach_velocity`` [m/s], [rad/s] (nv,)."""
@@ -86,7 +93,7 @@ class DutyValues(NamedTuple):
     """A design's requirements and capacities over a duty cycle, per joint (nv,) each.
 
     required_torque: ``SF max_t |d_j|`` [N m]; required_rms_torque: ``RMS_t d_j`` [N m]; continuous_torque:
-    ``N tau_c`` [N m]; max_motor_speed: ``N`` times the largest joint speed over the cycle and the approach
+    the driving continuous torque ``eta N tau_c`` [N m]; max_motor_speed: ``N`` times the largest joint speed over the cycle and the approach
     [rad/s]; speed_limit: the scaled motor's maximum speed [rad/s].
     """
 
@@ -100,8 +107,8 @@ class DutyValues(NamedTuple):
 class TorqueSpeedPoints(NamedTuple):
     """One joint's motor-side operating points: the cycle's (speed, torque) and the approach's speeds.
 
-    cycle_speed: (n,) motor speed ``N qd(t)`` [rad/s]; cycle_torque: (n,) motor torque ``d(t) / N`` [N m]
-    (no safety factor); approach_speed: (n_samples,) motor speed ``N v0 |J^+ u|`` of each contact sample
+    cycle_speed: (n,) motor speed ``N qd(t)`` [rad/s]; cycle_torque: (n,) motor torque ``d(t) / (eta N)``
+    [N m] (no safety factor; ``eta`` the gearbox efficiency, 1 without one); approach_speed: (n_samples,) motor speed ``N v0 |J^+ u|`` of each contact sample
     [rad/s], signed as the joint moves.
     """
 
@@ -183,10 +190,10 @@ def add_duty_constraints(
     assert design.max_speed is not None  # duty_requirement checked the reference motor
     log_limit = ca.log(design.max_speed)
     for j, name in enumerate(joint_names):
-        x_j = ca.vertcat(1.0, design.motor_mass, design.reflected_inertia[j])
+        x_j = ca.vertcat(1.0, design.actuator_mass, design.reflected_inertia[j])
         rows, index, sign = demands[j]
         g.add(
-            (design.peak_torque[j] - ca.mtimes(ca.DM(rows), x_j)) / torque_scale[j],
+            (design.driving_peak_torque[j] - ca.mtimes(ca.DM(rows), x_j)) / torque_scale[j],
             0.0,
             np.inf,
             [
@@ -199,7 +206,7 @@ def add_duty_constraints(
             ca.bilin(form, x_j, x_j) / design.continuous_torque[j] ** 2,
             -np.inf,
             1.0,
-            [f"RMS torque of {name} over the cycle <= continuous torque"],
+            [f"RMS torque of {name} over the cycle <= driving continuous torque"],
         )
     for rate, label, speed in (
         (duty.cycle_speed, "the cycle", 1.0),
@@ -215,16 +222,70 @@ def add_duty_constraints(
             )
 
 
+def add_gearbox_duty_constraints(
+    g: ConstraintList,
+    duty: DutyRequirement,
+    design: DesignQuantities,
+    demands: list[tuple[np.ndarray, np.ndarray, np.ndarray]],
+    technology: ActuatorTechnology,
+    joint_names: tuple[str, ...],
+) -> None:
+    """Add each gearbox's ratings over the cycle to ``g``: peak, RMS and input speed.
+
+    Per joint with a gearbox: the peak rows ``demands`` (:func:`peak_rows`, safety factor included) within its
+    repeated peak torque, the RMS demand within its rated torque (no safety factor, as the motor's), and the
+    motor speed over the cycle and the approach within its maximum input speed where the catalogue gives one.
+    Rows are divided by the rating, so their margins read as fractions of it.
+    """
+    figures = technology.gearbox_figures(len(joint_names))
+    gear, velocity = design.values["gear_ratio"], design.values["approach_velocity"][0]
+    for j, name in enumerate(joint_names):
+        if not figures.names[j]:
+            continue
+        label = f"gearbox {figures.names[j]} of {name}"
+        x_j = ca.vertcat(1.0, design.actuator_mass, design.reflected_inertia[j])
+        rows, index, sign = demands[j]
+        t = duty.torques.t
+        g.add(
+            1.0 - ca.mtimes(ca.DM(rows), x_j) / figures.peak_torque[j],
+            0.0,
+            np.inf,
+            [
+                f"{label}: repeated peak rating {figures.peak_torque[j]:.4g} N*m >= "
+                f"{'+' if s > 0 else '-'}{duty.safety_factor:g} x demand at t = {t[i]:.4g} s"
+                for i, s in zip(index, sign, strict=True)
+            ],
+        )
+        g.add(
+            ca.bilin(ca.DM(duty.torques.rms_form(j)), x_j, x_j) / figures.rated_torque[j] ** 2,
+            -np.inf,
+            1.0,
+            [f"{label}: RMS output over the cycle <= rated {figures.rated_torque[j]:.4g} N*m"],
+        )
+        limit = figures.max_input_speed[j]
+        for rate, over, speed in (
+            (duty.cycle_speed[j], "the cycle", 1.0),
+            (duty.approach_rate[j], "the approach", velocity),
+        ):
+            if np.isfinite(limit) and rate > 0:
+                g.add(
+                    ca.log(gear[j] * speed * rate / limit),
+                    -np.inf,
+                    0.0,
+                    [f"{label}: input speed over {over} <= its maximum {limit:.4g} rad/s"],
+                )
+
+
 def duty_values(duty: DutyRequirement, design: Design, technology: ActuatorTechnology) -> DutyValues:
     """A design's requirements and capacities over the cycle (NumPy; see :class:`DutyValues`)."""
-    motor = technology.motor_quantities(design.stator_diameter, design.stack_length)
-    demand = duty.demand(design.motor_mass, design.reflected_inertia).T  # (nv, n)
+    joint = technology.joint_quantities(design.stator_diameter, design.stack_length, design.gear_ratio)
+    demand = duty.demand(design.actuator_mass, design.reflected_inertia).T  # (nv, n)
     return DutyValues(
         required_torque=duty.safety_factor * np.abs(demand).max(axis=1),
         required_rms_torque=np.asarray(rms(demand, duty.torques.t), dtype=float),
-        continuous_torque=design.gear_ratio * np.asarray(motor.continuous_torque, dtype=float),
+        continuous_torque=np.asarray(joint.driving_continuous_torque, dtype=float),
         max_motor_speed=design.gear_ratio * duty.joint_speed(design.approach_velocity),
-        speed_limit=np.asarray(motor.max_speed, dtype=float) * np.ones(design.gear_ratio.size),
+        speed_limit=np.asarray(joint.motor.max_speed, dtype=float) * np.ones(design.gear_ratio.size),
     )
 
 
@@ -240,10 +301,11 @@ def torque_speed_points(problem: DesignProblem, design: Design) -> tuple[TorqueS
             "problem", "built without a duty cycle", "a problem with Constraints(duty_cycle=...)"
         )
     gear = design.gear_ratio
-    demand = duty.demand(design.motor_mass, design.reflected_inertia)
+    demand = duty.demand(design.actuator_mass, design.reflected_inertia)
     approach = design.approach_velocity * duty.approach_rates * gear
+    ratio = design.gearbox_efficiency * gear  # output torque per motor torque
     return tuple(
-        TorqueSpeedPoints(gear[j] * duty.torques.qd[:, j], demand[:, j] / gear[j], approach[:, j])
+        TorqueSpeedPoints(gear[j] * duty.torques.qd[:, j], demand[:, j] / ratio[j], approach[:, j])
         for j in range(duty.torques.nv)
     )
 
@@ -303,20 +365,25 @@ def _best_margins(
         b = bounds[name][joint]
         return np.array([b.lower]) if b.is_fixed else np.geomspace(b.lower, b.upper, count)
 
-    reference = technology.joint_motors(len(bounds["gear_ratio"]))[joint]
+    n_joints = len(bounds["gear_ratio"])
+    reference = technology.joint_motors(n_joints)[joint]
+    gearbox = technology.gearbox_figures(n_joints)
+    efficiency, gearbox_inertia = gearbox.efficiency[joint], gearbox.counted_inertia[joint]
     gears = grid("gear_ratio", 241)[:, None]
     low, high, acceleration = demand
     best = np.full(4, -np.inf)
     for length in grid("stack_length", 9):
         for diameter in grid("stator_diameter", 41):
             motor = scaled_motor_quantities(reference, diameter, length, technology.scaling_law)
-            rotor = gears**2 * motor.rotor_inertia * acceleration  # (gears, n)
+            rotor = gears**2 * (motor.rotor_inertia + gearbox_inertia) * acceleration  # (gears, n)
             # The smallest |demand| at each sample over the other motors' masses (0 if the interval holds 0).
             least = np.maximum(0.0, np.maximum(low + rotor, -(high + rotor)))
             margins = np.column_stack(
                 [
-                    _margin(gears[:, 0] * motor.peak_torque, duty.safety_factor * least.max(axis=1)),
-                    _margin(gears[:, 0] * motor.continuous_torque, np.sqrt((least**2) @ weights)),
+                    _margin(
+                        efficiency * gears[:, 0] * motor.peak_torque, duty.safety_factor * least.max(axis=1)
+                    ),
+                    _margin(efficiency * gears[:, 0] * motor.continuous_torque, np.sqrt((least**2) @ weights)),
                     _margin(np.full(gears.shape[0], motor.max_speed), gears[:, 0] * joint_speed),
                 ]
             )

@@ -38,7 +38,7 @@ def design_collision_parameters(
         stiffness=series_stiffness(design.mechanical_stiffness, design.software_stiffness),
         mechanical_stiffness=design.mechanical_stiffness,
         torque_limit=design.peak_torque,
-        motor_mass=design.motor_mass,
+        motor_mass=design.actuator_mass,
         finger_joint_inertia=(
             design.reflected_inertia if problem.technology.reflected_inertia_in == "finger" else None
         ),

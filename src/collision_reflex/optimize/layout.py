@@ -16,6 +16,7 @@ import casadi as ca
 import numpy as np
 
 from ..errors import InvalidParameter
+from ..hardware.gearboxes import CatalogueGearbox
 from ..model import effective as formulas
 from ..model.impulse import series_stiffness
 from .constraints import Constraints
@@ -77,22 +78,55 @@ class DesignLayout:
 
 
 def design_layout(
-    space: DesignSpace, technology: ActuatorTechnology, constraints: Constraints, n_joints: int
+    space: DesignSpace,
+    technology: ActuatorTechnology,
+    constraints: Constraints,
+    n_joints: int,
+    joint_names: tuple[str, ...] | None = None,
 ) -> DesignLayout:
     """The design variables with their bounds: per joint, then global.
 
-    With force sensing the noise floor bounds the threshold from below.
+    With force sensing the noise floor bounds the threshold from below; a joint's gear-ratio bounds are
+    intersected with its gearbox's ratio range (``joint_names`` name the joints in errors).
     """
     layout = DesignLayout()
     defaults = {"stack_length": technology.default_stack_lengths(n_joints)}
     for name in PER_JOINT_VARIABLES:
-        layout.add(name, space.per_joint(name, n_joints, defaults.get(name)))
+        bounds = space.per_joint(name, n_joints, defaults.get(name))
+        if name == "gear_ratio":
+            names = joint_names or tuple(f"joint{j + 1}" for j in range(n_joints))
+            gearboxes = technology.joint_gearboxes(n_joints)
+            bounds = [
+                _within_ratio_range(b, g, joint) for b, g, joint in zip(bounds, gearboxes, names, strict=True)
+            ]
+        layout.add(name, bounds)
     for name in GLOBAL_VARIABLES:
         bounds = space.global_bounds(name)
         if name == "threshold" and technology.sensing == "force":
             bounds = _with_noise_floor(bounds, constraints.threshold_floor)
         layout.add(name, [bounds])
     return layout
+
+
+def _within_ratio_range(bounds: Bounds, gearbox: CatalogueGearbox | None, joint: str) -> Bounds:
+    """The gear-ratio bounds of ``joint`` intersected with its gearbox's ratio range.
+
+    Raises
+    ------
+    InvalidParameter: the two ranges do not overlap (the message names the joint, the gearbox and both).
+    """
+    if gearbox is None:
+        return bounds
+    low, high = gearbox.ratio_range
+    lower, upper = max(bounds.lower, low), min(bounds.upper, high)
+    if lower > upper:
+        raise InvalidParameter(
+            f"gear_ratio bounds of {joint}",
+            (bounds.lower, bounds.upper),
+            f"a range that overlaps the ratios of its gearbox {gearbox.name!r}, {low:g} to {high:g}",
+            "widen the gear-ratio bounds or choose another gearbox",
+        )
+    return Bounds(lower, upper, bounds.name)
 
 
 def _with_noise_floor(bounds: Bounds, floor: float) -> Bounds:
@@ -114,19 +148,21 @@ class DesignQuantities(NamedTuple):
 
     values: dict[str, ca.MX]
     design_column: ca.MX
-    motor_mass: ca.MX
+    actuator_mass: ca.MX
     peak_torque: ca.MX
     finger_inertia: ca.MX
     reflected_inertia: ca.MX
     continuous_torque: ca.MX
     max_speed: ca.MX | None
+    driving_peak_torque: ca.MX
 
     def joint_function(self, x: ca.MX) -> ca.Function:
         """CasADi function of ``x`` giving the joint numbers.
 
-        Outputs (n_joints each): motor masses [kg], peak torques [N m], finger inertias [kg m^2].
+        Outputs (n_joints each): actuator (motor and gearbox) masses [kg], peak torques ``N tau_p`` [N m],
+        finger inertias [kg m^2].
         """
-        return ca.Function("joint_numbers", [x], [self.motor_mass, self.peak_torque, self.finger_inertia])
+        return ca.Function("joint_numbers", [x], [self.actuator_mass, self.peak_torque, self.finger_inertia])
 
 
 def design_quantities(
@@ -134,31 +170,32 @@ def design_quantities(
 ) -> DesignQuantities:
     """Symbolic joint quantities of the design variables ``z`` (log values).
 
-    Gives the variables themselves, the per-sample function's design column, motor masses [kg], peak output
-    torques [N m], the reflected inertia acting on the finger [kg m^2] (zero unless
-    ``reflected_inertia_in == "finger"``), the reflected rotor inertia ``N^2 J_m`` [kg m^2], the continuous
-    output torques ``N tau_c`` [N m] and the motors' maximum speeds [rad/s] (None when the reference motor's is
-    not known); ``k_mech`` is the joint mechanical stiffness [N m/rad].
+    Gives the variables themselves, the per-sample function's design column, the actuator masses carried at
+    the joints (motor and gearbox) [kg], the peak output torques ``N tau_p`` of the reaction [N m], the
+    reflected inertia acting on the finger [kg m^2] (zero unless ``reflected_inertia_in == "finger"``), the
+    reflected inertia ``N^2 (J_m + J_g)`` [kg m^2], the driving continuous torques ``eta N tau_c`` [N m], the
+    motors' maximum speeds [rad/s] (None when the reference motor's is not known) and the driving peak torques
+    ``eta N tau_p`` [N m] (:meth:`ActuatorTechnology.joint_quantities`); ``k_mech`` is the joint mechanical
+    stiffness [N m/rad].
     """
     values = layout.expressions(z)
-    motor = technology.motor_quantities(values["stator_diameter"], values["stack_length"])
-    gear = values["gear_ratio"]
-    reflected = formulas.reflected_inertia(gear, motor.rotor_inertia)
+    joint = technology.joint_quantities(values["stator_diameter"], values["stack_length"], values["gear_ratio"])
     design_column = ca.vertcat(
-        motor.mass,
-        reflected,
+        joint.actuator_mass,
+        joint.reflected_inertia,
         series_stiffness(ca.DM(k_mech), values["software_stiffness"]),
         values["threshold"],
         values["approach_velocity"],
     )
-    finger_inertia = formulas.finger_inertia(reflected, technology.reflected_inertia_in)
+    finger_inertia = formulas.finger_inertia(joint.reflected_inertia, technology.reflected_inertia_in)
     return DesignQuantities(
         values,
         design_column,
-        motor.mass,
-        gear * motor.peak_torque,
+        joint.actuator_mass,
+        joint.peak_torque,
         finger_inertia,
-        reflected,
-        gear * motor.continuous_torque,
-        motor.max_speed,
+        joint.reflected_inertia,
+        joint.driving_continuous_torque,
+        joint.motor.max_speed,
+        joint.driving_peak_torque,
     )

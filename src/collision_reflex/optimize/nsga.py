@@ -84,12 +84,12 @@ def nsga2_front(
         values = {
             "worst_case_impulse": impulses.max(),
             "mean_impulse": impulses.mean(),
-            "actuator_mass": design.motor_mass.sum(),
+            "actuator_mass": design.actuator_mass.sum(),
             "approach_velocity": design.approach_velocity,
         }
-        required = np.asarray(problem.required_torque_function(design.motor_mass)).ravel()
+        required = np.asarray(problem.required_torque_function(design.actuator_mass)).ravel()
         # pymoo's convention: constraint values <= 0 are satisfied.
-        return np.array([values[n] for n in names]) * senses, required - design.peak_torque
+        return np.array([values[n] for n in names]) * senses, required - design.driving_peak_torque
 
     class _Design(ElementwiseProblem):
         def __init__(self) -> None:

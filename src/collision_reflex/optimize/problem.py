@@ -14,7 +14,8 @@ Structure (see the README's "Design optimisation" section):
   linear in the log design variables -- and the impulse is evaluated with ``F_a = exp(-g_s)``. The impulse grows
   with ``g_s``, so at an optimum ``g_s`` sits on the largest ratio, i.e. ``F_a`` on the minimum: exact, smooth,
   and the 1D impulse is evaluated once per sample.
-- The finger mass ``m_f = 1 / (w^T M_f^-1 w)`` has motor masses (and optionally reflected inertias) inside
+- The finger mass ``m_f = 1 / (w^T M_f^-1 w)`` has the actuator masses (motor and gearbox, carried at the
+  joints) and optionally the reflected inertias inside
   ``M_f``. It is also ``min x^T M_f x`` over ``x`` with ``w^T x = 1`` (attained at ``x = M_f^-1 w / w^T M_f^-1
   w``). The impulse grows with ``m_f``, so each sample gets a variable ``x_s`` with the linear constraint
   ``w_s^T x_s = 1`` and uses ``x_s^T M_f x_s``: minimising over the design and ``x`` together is exact, and
@@ -44,13 +45,22 @@ from .constraints import (
     ConstraintList,
     Constraints,
     ModelTerms,
+    add_gearbox_peak_constraints,
     add_model_constraints,
     binding_torque_demands,
+    check_gearbox_ratings,
     required_torque_function,
     torque_requirement_rows,
 )
 from .derivatives import SampleStructure, derivative_functions
-from .duty import DutyRequirement, add_duty_constraints, check_reachable, duty_requirement, peak_rows
+from .duty import (
+    DutyRequirement,
+    add_duty_constraints,
+    add_gearbox_duty_constraints,
+    check_reachable,
+    duty_requirement,
+    peak_rows,
+)
 from .layout import DesignLayout, DesignQuantities, design_layout, design_quantities
 from .objectives import (
     OBJECTIVES,
@@ -93,7 +103,8 @@ class DesignProblem:
     and ``parameters`` (5 x n_samples: ``m_f, m_r, k, k_m, a``, see :meth:`sample_parameters`); use
     :meth:`exact_point` first so that the auxiliary variables hold their exact values. ``duty`` is the duty
     cycle's requirement (:class:`collision_reflex.optimize.duty.DutyRequirement`), None without one; with one,
-    ``required_torque_function`` takes the motor masses [kg] and the reflected inertias ``N^2 J_m`` [kg m^2].
+    ``required_torque_function`` takes the actuator masses (motor and gearbox) [kg] and the reflected inertias
+    ``N^2 (J_m + J_g)`` [kg m^2], without one the actuator masses alone.
     """
 
     nlp: dict[str, ca.MX]
@@ -178,7 +189,7 @@ class DesignProblem:
         """
         n = self.n_joints
         z = ca.MX.sym("z", self.layout.size)
-        _, design_column, motor_mass, peak_torque, finger_inertia, *_ = design_quantities(
+        _, design_column, actuator_mass, peak_torque, finger_inertia, *_ = design_quantities(
             self.layout, z, self.technology, self.technology.joint_mechanical_stiffness(n)
         )
         w = self.samples.joint_moment_arms
@@ -189,7 +200,7 @@ class DesignProblem:
         for s_index, config in enumerate(self.samples.config_index):
             influence = [ca.DM(motor_influence[config, i]) for i in range(n)]
             structure = formulas.finger_mass_matrix(
-                ca.DM(structure_mass[config]), influence, motor_mass, finger_inertia
+                ca.DM(structure_mass[config]), influence, actuator_mass, finger_inertia
             )
             direction = formulas.finger_mass_direction(ca.DM(w[s_index]), structure)
             joints = np.flatnonzero(loaded[s_index]).tolist()
@@ -259,7 +270,7 @@ def build_problem(
     arm: the :class:`collision_reflex.arm.Arm` (joint names; ``samples.kinematics`` must come from it).
     samples: contact cases: configurations (with their Pinocchio data) and directions.
     space: bounds of the design variables.
-    technology: reference motor, scaling law, mechanical stiffness, sensing scheme, reaction model.
+    technology: reference motor, scaling law, mechanical stiffness, sensing scheme, reaction model, gearboxes.
     objective: an objective name of :data:`OBJECTIVES` or a weighted sum ``{name: weight}``; each objective is
         divided by its value at the start point, so weights compare relative changes.
     constraints: torque requirement (gravity over the samples + payload, times a safety factor, or given
@@ -271,14 +282,15 @@ def build_problem(
     ------
     InvalidParameter: bad input, a duty cycle with a reference motor of unknown maximum speed, or a duty-cycle
         requirement that no design within the bounds can meet (naming the joint, the constraint and the best
-        margin reachable).
+        margin reachable), a gearbox whose ratios miss the joint's gear-ratio bounds, or one whose peak rating
+        is below the least static (or given) requirement of its joint.
     """
     started = time.perf_counter()
     constraints = constraints or Constraints()
     weights, bounded = objective_weights(objective), checked_bounded_objectives(bounded_objectives)
     joint_names = _joint_names(arm, samples)
     n_joints = len(joint_names)
-    layout = design_layout(space, technology, constraints, n_joints)
+    layout = design_layout(space, technology, constraints, n_joints, joint_names)
     duty = (
         None
         if constraints.duty_cycle is None
@@ -295,7 +307,9 @@ def build_problem(
         layout, x[:n_design], technology, technology.joint_mechanical_stiffness(n_joints)
     )
     joint_numbers = design.joint_function(x)
-    lbx, ubx, x0 = _bounds_and_start(x.shape[0], layout, joint_numbers, samples, constraints, joint_names)
+    lbx, ubx, x0 = _bounds_and_start(
+        x.shape[0], layout, joint_numbers, samples, constraints, joint_names, technology
+    )
     duty_rows: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
     if duty is not None:
         duty_rows = _duty_setup(duty, x, x0, lbx, ubx, design, layout, technology, joint_names)
@@ -305,16 +319,17 @@ def build_problem(
     per_sample = _sample_terms(
         x[direction_index], x[compliance_index], design, samples, technology, start_mass, start_finger
     )
-    impulses, actuator_mass = per_sample.impulses, ca.sum1(design.motor_mass)
+    impulses, actuator_mass = per_sample.impulses, ca.sum1(design.actuator_mass)
     mass_range = [np.asarray(joint_numbers(bound)[0]).ravel() for bound in (lbx, ubx)]
     if duty is None:
         torque_demands = binding_torque_demands(samples, constraints, joint_names, *mass_range)
+        check_gearbox_ratings(torque_demands, technology, joint_names, *mass_range)
         required_torque = required_torque_function(torque_demands, n_joints)
-        required_expression = required_torque(design.motor_mass)
+        required_expression = required_torque(design.actuator_mass)
     else:
         torque_demands = []
         required_torque = _duty_required_torque(duty_rows, n_joints)
-        required_expression = required_torque(design.motor_mass, design.reflected_inertia)
+        required_expression = required_torque(design.actuator_mass, design.reflected_inertia)
     evaluate = _evaluate_function(x, design, per_sample, actuator_mass, required_expression)
     # Start point: auxiliaries at their exact values for the start design.
     x0[direction_index] = (per_sample.start_directions / per_sample.direction_scale[:, None]).ravel()
@@ -331,7 +346,7 @@ def build_problem(
     start_required = (
         required_torque(start_mass)
         if duty is None
-        else required_torque(start_mass, formulas.reflected_inertia(*_start_rotor(layout, x0, technology)))
+        else required_torque(start_mass, _start_reflected_inertia(layout, x0, technology))
     )
     torque_scale = np.maximum(np.asarray(start_required).ravel(), 1e-3)
     terms = _model_terms(x[compliance_index], design, per_sample)
@@ -340,6 +355,9 @@ def build_problem(
     )
     if duty is not None:
         add_duty_constraints(g, duty, design, duty_rows, torque_scale, joint_names)
+        add_gearbox_duty_constraints(g, duty, design, duty_rows, technology, joint_names)
+    else:
+        add_gearbox_peak_constraints(g, terms, torque_demands, technology, joint_names)
     add_objective_bounds(g, bounded, expressions, scale, p)
 
     nlp = {"x": x, "f": objective_expression(weights, expressions, scale), "g": ca.vertcat(*g.parts), "p": p}
@@ -400,7 +418,7 @@ def _sample_terms(
     """The per-sample function mapped over all samples, on the NLP's auxiliaries of every sample.
 
     ``scaled_directions`` are the finger-mass directions ``x_s`` (n_joints * n_samples) divided by their size
-    at the start (motor masses ``start_mass`` [kg], finger inertias ``start_finger`` [kg m^2]): across samples
+    at the start (actuator masses ``start_mass`` [kg], finger inertias ``start_finger`` [kg m^2]): across samples
     they span orders of magnitude. ``log_compliance`` is ``log(1/F_a)`` per sample.
     """
     n_joints, n_samples = start_mass.size, samples.size
@@ -468,7 +486,12 @@ def _sample_structure(
 def _model_terms(log_compliance: ca.MX, design: DesignQuantities, per_sample: _SampleTerms) -> ModelTerms:
     """The symbolic quantities the model's constraints bound; ``log_compliance``: ``log(1/F_a)`` in ``x``."""
     return ModelTerms(
-        log_compliance, design.peak_torque, per_sample.normalisation, per_sample.thresholds, design.motor_mass
+        log_compliance,
+        design.peak_torque,
+        per_sample.normalisation,
+        per_sample.thresholds,
+        design.actuator_mass,
+        design.driving_peak_torque,
     )
 
 
@@ -503,6 +526,7 @@ def _bounds_and_start(
     samples: ContactSamples,
     constraints: Constraints,
     joint_names: tuple[str, ...],
+    technology: ActuatorTechnology,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Bounds ``lbx``, ``ubx`` and start ``x0`` of the design part of ``x`` (auxiliaries unbounded, at 0).
 
@@ -510,7 +534,8 @@ def _bounds_and_start(
     """
     lbx, ubx, x0 = (np.full(size, value) for value in (-np.inf, np.inf, 0.0))
     lbx[: layout.size], ubx[: layout.size], x0[: layout.size] = layout.log_bounds()
-    _feasible_gear_start(x0, layout, joint_numbers, samples, constraints, joint_names)
+    efficiency = technology.gearbox_figures(len(joint_names)).efficiency
+    _feasible_gear_start(x0, layout, joint_numbers, samples, constraints, joint_names, efficiency)
     return lbx, ubx, x0
 
 
@@ -529,12 +554,15 @@ def _feasible_gear_start(
     samples: ContactSamples,
     constraints: Constraints,
     joint_names: tuple[str, ...],
+    efficiency: np.ndarray,
 ) -> None:
-    """Move the start's free gear ratios up to where the peak torque covers the requirement, in place.
+    """Move the start's free gear ratios up to where the driving peak torque covers the requirement, in place.
 
     With 10 % to spare and within their bounds: IPOPT converges much faster from a torque-feasible start.
+    ``efficiency`` is each joint's gearbox efficiency [-].
     """
-    masses, torques, _ = (np.asarray(v).ravel() for v in joint_numbers(x0))
+    masses, peak, _ = (np.asarray(v).ravel() for v in joint_numbers(x0))
+    torques = efficiency * peak
     rows, _ = torque_requirement_rows(samples, constraints, joint_names)
     required = np.max([base + per_motor @ masses for base, per_motor in rows], axis=0)
     for joint, index in enumerate(layout.slices["gear_ratio"]):
@@ -583,7 +611,7 @@ def _duty_setup(
     the peak torque covers the peak demand at the start with 10 % to spare, as for the static requirement.
     """
     numbers = ca.Function(
-        "duty_numbers", [x], [design.motor_mass, design.reflected_inertia, design.peak_torque]
+        "duty_numbers", [x], [design.actuator_mass, design.reflected_inertia, design.driving_peak_torque]
     )
     (mass_low, reflected_low, _), (mass_high, reflected_high, _) = (
         [np.asarray(v).ravel() for v in numbers(bound)] for bound in (lbx, ubx)
@@ -607,8 +635,8 @@ def _duty_setup(
 def _duty_required_torque(
     rows: list[tuple[np.ndarray, np.ndarray, np.ndarray]], n_joints: int
 ) -> ca.Function:
-    """CasADi function: motor masses [kg], ``N^2 J_m`` [kg m^2] -> the peak requirement per joint [N m]."""
-    masses = ca.MX.sym("motor_mass", n_joints)
+    """CasADi function: actuator masses [kg], ``N^2 (J_m + J_g)`` [kg m^2] -> the peak requirement per joint [N m]."""
+    masses = ca.MX.sym("actuator_mass", n_joints)
     reflected = ca.MX.sym("reflected_inertia", n_joints)
     required = [
         ca.mmax(ca.mtimes(ca.DM(joint_rows), ca.vertcat(1.0, masses, reflected[j])))
@@ -617,10 +645,8 @@ def _duty_required_torque(
     return ca.Function("required_torque", [masses, reflected], [ca.vertcat(*required)])
 
 
-def _start_rotor(
-    layout: DesignLayout, x0: np.ndarray, technology: ActuatorTechnology
-) -> tuple[np.ndarray, np.ndarray]:
-    """Gear ratios [-] and rotor inertias [kg m^2] of the start design."""
+def _start_reflected_inertia(layout: DesignLayout, x0: np.ndarray, technology: ActuatorTechnology) -> np.ndarray:
+    """Reflected inertias ``N^2 (J_m + J_g)`` [kg m^2] of the start design."""
     values = layout.values(x0[: layout.size])
-    motor = technology.motor_quantities(values["stator_diameter"], values["stack_length"])
-    return values["gear_ratio"], np.asarray(motor.rotor_inertia, dtype=float)
+    joint = technology.joint_quantities(values["stator_diameter"], values["stack_length"], values["gear_ratio"])
+    return np.asarray(joint.reflected_inertia, dtype=float)

@@ -36,6 +36,16 @@ JOINT_COLUMNS = (
     ("motor_mass", "kg"),
 )
 """Per-joint columns of a design's table row: (record key, unit)."""
+GEARBOX_COLUMNS = (
+    ("gearbox", "-"),
+    ("gearbox_mass", "kg"),
+    ("gearbox_inertia", "kg*m^2"),
+    ("gearbox_efficiency", "-"),
+    ("actuator_mass", "kg"),
+)
+"""Per-joint columns a design with a gearbox at any joint adds to its row: (record key, unit). ``gearbox`` is
+the catalogue name (empty for none), ``gearbox_inertia`` its input-side inertia, ``actuator_mass`` the motor's
+and the gearbox's mass together."""
 DUTY_COLUMNS = (
     ("torque_margin", "-"),
     ("required_rms_torque", "N*m"),
@@ -127,6 +137,8 @@ _DESIGN_ARRAYS = (
     "peak_torque",
     "motor_mass",
 )
+_GEARBOX_ARRAYS = ("gearbox_mass", "gearbox_inertia", "gearbox_efficiency")
+"""The design's gearbox arrays; a result saved before gearboxes has none (no gearbox at any joint)."""
 
 
 def result_to_json(result: DesignResult) -> dict[str, Any]:
@@ -176,6 +188,8 @@ def result_from_json(data: Mapping[str, Any]) -> DesignResult:
         threshold=float(saved["threshold"]),
         approach_velocity=float(saved["approach_velocity"]),
         sensing=str(saved["sensing"]),
+        gearbox=tuple(saved.get("gearbox", ())),
+        **{name: np.asarray(saved.get(name, ()), dtype=float) for name in _GEARBOX_ARRAYS},
     )
     return DesignResult(
         design=design,
@@ -220,7 +234,7 @@ def result_record(result: DesignResult, label: str) -> dict[str, Any]:
                 # No requirement (a joint gravity does not load): a margin is meaningless, not a huge number.
                 "torque_margin": (
                     float(result.torque_margin[i])
-                    if result.required_torque[i] > 1e-9 * design.peak_torque[i]
+                    if result.required_torque[i] > 1e-9 * design.driving_peak_torque[i]
                     else None
                 ),
                 "mechanical_stiffness": float(design.mechanical_stiffness[i]),
@@ -229,6 +243,11 @@ def result_record(result: DesignResult, label: str) -> dict[str, Any]:
                     series_stiffness(design.mechanical_stiffness[i], design.software_stiffness[i])
                 ),
                 "motor_mass": float(design.motor_mass[i]),
+                "gearbox": design.gearbox[i],
+                "gearbox_mass": float(design.gearbox_mass[i]),
+                "gearbox_inertia": float(design.gearbox_inertia[i]),
+                "gearbox_efficiency": float(design.gearbox_efficiency[i]),
+                "actuator_mass": float(design.actuator_mass[i]),
                 **duty,
             }
         )
@@ -320,7 +339,12 @@ def record_row(record: Mapping[str, Any], index: int) -> dict[str, Any]:
     row: dict[str, Any] = {"point": index, "label": record["label"]}
     for name, value in record["objectives"].items():
         row[f"{name} [{OBJECTIVES[name][1]}]"] = value
-    columns = JOINT_COLUMNS + (DUTY_COLUMNS if record.get("requirement") == DUTY_REQUIREMENT else ())
+    geared = any(joint.get("gearbox") for joint in record["joints"])
+    columns = (
+        JOINT_COLUMNS
+        + (GEARBOX_COLUMNS if geared else ())
+        + (DUTY_COLUMNS if record.get("requirement") == DUTY_REQUIREMENT else ())
+    )
     for key, unit in columns:
         for joint in record["joints"]:
             row[f"{key}[{joint['joint']}] [{unit}]"] = joint[key]

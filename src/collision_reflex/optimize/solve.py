@@ -77,9 +77,12 @@ class Design:
 
     Per joint (arrays of length n_joints): ``stator_diameter`` [m], ``stack_length`` [m], ``gear_ratio`` [-],
     ``software_stiffness`` and ``mechanical_stiffness`` [N m/rad], ``rotor_inertia`` [kg m^2],
-    ``reflected_inertia`` = N^2 J_m [kg m^2], ``motor_peak_torque`` [N m], ``peak_torque`` = N tau_p [N m],
-    ``motor_mass`` [kg]. Global: ``threshold`` ([N] for force sensing, [m] for position sensing) and
-    ``approach_velocity`` [m/s].
+    ``reflected_inertia`` = N^2 (J_m + J_g) [kg m^2] (``J_g`` the gearbox's input inertia where counted),
+    ``motor_peak_torque`` [N m], ``peak_torque`` = N tau_p [N m], ``motor_mass`` [kg] (the motor's own).
+    Global: ``threshold`` ([N] for force sensing, [m] for position sensing) and ``approach_velocity`` [m/s].
+    Per joint, its gearbox: ``gearbox`` its catalogue name ("" for none), ``gearbox_mass`` [kg],
+    ``gearbox_inertia`` its input-side inertia [kg m^2] (as the catalogue gives it, also when the reflected
+    inertia leaves it out), ``gearbox_efficiency`` [-] (1 without a gearbox). Left out, there are none.
     """
 
     joint_names: tuple[str, ...]
@@ -96,6 +99,28 @@ class Design:
     threshold: float
     approach_velocity: float
     sensing: str
+    gearbox: tuple[str, ...] = ()
+    gearbox_mass: np.ndarray = field(default_factory=lambda: np.empty(0))
+    gearbox_inertia: np.ndarray = field(default_factory=lambda: np.empty(0))
+    gearbox_efficiency: np.ndarray = field(default_factory=lambda: np.empty(0))
+
+    def __post_init__(self) -> None:
+        n = len(self.joint_names)
+        if not self.gearbox:
+            object.__setattr__(self, "gearbox", ("",) * n)
+        for name, absent in (("gearbox_mass", 0.0), ("gearbox_inertia", 0.0), ("gearbox_efficiency", 1.0)):
+            value = np.asarray(getattr(self, name), dtype=float)
+            object.__setattr__(self, name, np.full(n, absent) if value.size == 0 else value)
+
+    @property
+    def actuator_mass(self) -> np.ndarray:
+        """Per joint the mass carried at the joint [kg]: the motor's and the gearbox's."""
+        return self.motor_mass + self.gearbox_mass
+
+    @property
+    def driving_peak_torque(self) -> np.ndarray:
+        """Per joint the peak output torque that drives the arm ``eta N tau_p`` [N m]."""
+        return self.gearbox_efficiency * self.peak_torque
 
     def as_dict(self) -> dict[str, Any]:
         """Plain lists and floats, for JSON."""
@@ -337,6 +362,8 @@ ADVICE = {
     "noise floor": "lower the threshold floor or raise the threshold's upper bound",
     "RMS torque": "raise the upper bound of the motor size or shorten the duty cycle's loads",
     "motor speed": "lower the upper bound of the gear ratio or slow the duty cycle",
+    "gearbox": "choose a gearbox of a higher torque (or speed) rating, or lower the payload, the safety factor "
+    "or the given torques",
 }
 """What to do about each kind of constraint that cannot be met (found in its label)."""
 
@@ -404,7 +431,7 @@ def _result(
     numpy_objectives = {
         "worst_case_impulse": float(numpy_impulses.max()),
         "mean_impulse": float(numpy_impulses.mean()),
-        "actuator_mass": float(design.motor_mass.sum()),
+        "actuator_mass": float(design.actuator_mass.sum()),
         "approach_velocity": float(design.approach_velocity),
     }
     for name in OBJECTIVES:
@@ -430,7 +457,7 @@ def _result(
         numpy_objectives=numpy_objectives,
         impulses=numpy_impulses,
         required_torque=required,
-        torque_margin=design.peak_torque / np.maximum(required, 1e-300) - 1,
+        torque_margin=design.driving_peak_torque / np.maximum(required, 1e-300) - 1,
         status=attempts[-1].status,
         success=True,
         iterations=int(stats.get("iter_count", -1)),
@@ -453,12 +480,11 @@ def _margin(capacity: np.ndarray, need: np.ndarray) -> np.ndarray:
 
 def design_at(problem: DesignProblem, x: np.ndarray) -> Design:
     """The design (and its derived actuator quantities) at NLP point ``x``."""
-    from ..model import effective
-
     values = problem.layout.values(np.asarray(x, dtype=float))
     technology = problem.technology
-    motor = technology.motor_quantities(values["stator_diameter"], values["stack_length"])
     gear = values["gear_ratio"]
+    joint = technology.joint_quantities(values["stator_diameter"], values["stack_length"], gear)
+    motor = joint.motor
     return Design(
         joint_names=problem.joint_names,
         stator_diameter=values["stator_diameter"],
@@ -467,11 +493,15 @@ def design_at(problem: DesignProblem, x: np.ndarray) -> Design:
         software_stiffness=values["software_stiffness"],
         mechanical_stiffness=technology.joint_mechanical_stiffness(problem.n_joints),
         rotor_inertia=np.asarray(motor.rotor_inertia, dtype=float),
-        reflected_inertia=effective.reflected_inertia(gear, np.asarray(motor.rotor_inertia, dtype=float)),
+        reflected_inertia=np.asarray(joint.reflected_inertia, dtype=float),
         motor_peak_torque=np.asarray(motor.peak_torque, dtype=float),
-        peak_torque=gear * np.asarray(motor.peak_torque, dtype=float),
+        peak_torque=np.asarray(joint.peak_torque, dtype=float),
         motor_mass=np.asarray(motor.mass, dtype=float),
         threshold=float(values["threshold"][0]),
         approach_velocity=float(values["approach_velocity"][0]),
         sensing=technology.sensing,
+        gearbox=joint.gearbox.names,
+        gearbox_mass=joint.gearbox.mass,
+        gearbox_inertia=joint.gearbox.inertia,
+        gearbox_efficiency=joint.gearbox.efficiency,
     )

@@ -4,20 +4,27 @@ They are the reference motor (one for every joint, or one per joint), the scalin
 stiffness, the sensing scheme and the reaction model. A catalogue motor is a joint's reference motor with its
 stator diameter and stack length fixed at its own: its quantities are then its datasheet figures (scale factor
 one), which is how a design is built from catalogue parts.
+
+A joint may also have a gearbox (:attr:`ActuatorTechnology.gearboxes`, catalogue entries): its mass is carried
+at the joint like the motor's, its input-side inertia adds to the rotor's, its efficiency scales the output
+torque that drives the arm, and its torque and speed ratings bound the design (:func:`joint_quantities` is the
+one place these enter).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from .. import _validate
 from ..errors import InvalidParameter
 from ..hardware.actuators import REFLECTED_INERTIA_PLACEMENTS
+from ..hardware.gearboxes import CatalogueGearbox
 from ..hardware.motors import Motor, MotorQuantities, scaled_motor_quantities
+from ..model.effective import reflected_inertia
 from ..model.impulse import REACTION_MODES
 from ..model.sensing import sensing_scheme
 from .space import OPTIMIZED_SENSING_SCHEMES
@@ -39,6 +46,10 @@ class ActuatorTechnology:
         ``"finger"``: also rigidly on the link side, in the finger mass ``m_f`` of the impact phase -- a stiff
         transmission with the compliance at the contact, as the paper measured for its geared A8 actuator
         (fitted finger mass 20 kg against 0.12 kg direct-drive).
+    gearboxes: one gearbox per joint (None at a joint: direct drive, or no gearbox model there), or None for
+        none at all. See :func:`joint_quantities` for what a gearbox changes.
+    gearbox_inertia: count the gearboxes' input-side inertia in the reflected inertia ``N^2 (J_m + J_g)``;
+        False is the paper's choice (gearbox inertia ignored: ``N^2 J_m``).
     """
 
     reference_motor: Motor | tuple[Motor, ...]
@@ -47,6 +58,8 @@ class ActuatorTechnology:
     sensing: str = "force"
     reaction: str = "at_rest"
     reflected_inertia_in: str = "robot"
+    gearboxes: tuple[CatalogueGearbox | None, ...] | None = None
+    gearbox_inertia: bool = True
 
     def __post_init__(self) -> None:
         _validate.positive("mechanical_stiffness", np.asarray(self.mechanical_stiffness, dtype=float))
@@ -60,6 +73,21 @@ class ActuatorTechnology:
         object.__setattr__(self, "sensing", sensing_scheme(self.sensing, OPTIMIZED_SENSING_SCHEMES))
         _validate.choice("reaction", self.reaction, REACTION_MODES)
         _validate.choice("reflected_inertia_in", self.reflected_inertia_in, REFLECTED_INERTIA_PLACEMENTS)
+        if self.gearboxes is not None:
+            gearboxes = tuple(self.gearboxes)
+            if not all(g is None or isinstance(g, CatalogueGearbox) for g in gearboxes):
+                raise InvalidParameter(
+                    "gearboxes", self.gearboxes, "one CatalogueGearbox or None per joint, or None"
+                )
+            for gearbox in gearboxes:
+                if gearbox is not None and gearbox.efficiency is not None:
+                    if not 0 < gearbox.efficiency <= 1:
+                        raise InvalidParameter(
+                            f"gearbox {gearbox.name!r} efficiency", gearbox.efficiency, "a number in (0, 1]"
+                        )
+            object.__setattr__(self, "gearboxes", gearboxes)
+        if not isinstance(self.gearbox_inertia, bool):
+            raise InvalidParameter("gearbox_inertia", self.gearbox_inertia, "True or False")
 
     def joint_mechanical_stiffness(self, n_joints: int) -> np.ndarray:
         """The mechanical stiffness of each of ``n_joints`` joints [N m/rad], shape (n_joints,)."""
@@ -116,6 +144,118 @@ class ActuatorTechnology:
             speeds,
         )
 
+    def joint_gearboxes(self, n_joints: int) -> tuple[CatalogueGearbox | None, ...]:
+        """The gearbox of each of ``n_joints`` joints (None: no gearbox at that joint)."""
+        if self.gearboxes is None:
+            return (None,) * n_joints
+        if len(self.gearboxes) != n_joints:
+            raise InvalidParameter("gearboxes", len(self.gearboxes), f"one gearbox (or None) per joint: {n_joints}")
+        return self.gearboxes
+
+    def gearbox_figures(self, n_joints: int) -> GearboxFigures:
+        """The figures of each joint's gearbox as arrays (n_joints,); see :class:`GearboxFigures`."""
+        gearboxes = self.joint_gearboxes(n_joints)
+
+        def figure(name: str, absent: float) -> np.ndarray:
+            values = [getattr(g, name, None) if g is not None else None for g in gearboxes]
+            return np.array([absent if v is None else float(v) for v in values], dtype=float)
+
+        inertia = figure("inertia", 0.0)
+        return GearboxFigures(
+            names=tuple("" if g is None else g.name for g in gearboxes),
+            mass=figure("mass", 0.0),
+            inertia=inertia,
+            counted_inertia=inertia if self.gearbox_inertia else np.zeros(n_joints),
+            efficiency=figure("efficiency", 1.0),
+            peak_torque=figure("peak_torque", np.inf),
+            rated_torque=figure("rated_torque", np.inf),
+            max_input_speed=figure("max_input_speed", np.inf),
+        )
+
+    def joint_quantities(self, stator_diameter: Any, stack_length: Any, gear_ratio: Any) -> JointQuantities:
+        """Each joint's actuator (motor and gearbox) at its motor size [m] and gear ratio [-], joint side.
+
+        The one place the gearbox enters (NumPy arrays and CasADi columns alike): the mass carried at the joint
+        is the motor's plus the gearbox's [kg]; the reflected inertia ``N^2 (J_m + J_g)`` [kg m^2] (``J_g``
+        zero unless :attr:`gearbox_inertia`); the peak torque ``N tau_p`` [N m] bounds the reaction; the
+        driving torques ``eta N tau_p`` and ``eta N tau_c`` [N m] must cover the torque requirements.
+
+        The efficiency ``eta`` applies to driving torque only, when the motor drives the arm through the
+        gearbox (the static, given and duty-cycle requirements). The collision model's reaction keeps
+        ``N tau_p``: there the contact pushes the link back against a braking motor, the gearbox is backdriven
+        and its friction opposes that motion, so it adds to the motor's braking; leaving it out (as the paper
+        does) can only overestimate the impulse, and keeps the reaction model the paper's.
+        """
+        motor = self.motor_quantities(stator_diameter, stack_length)
+        gearbox = self.gearbox_figures(_rows(gear_ratio))
+        peak = gear_ratio * motor.peak_torque
+        continuous = gear_ratio * motor.continuous_torque
+        if self.gearboxes is None:  # no gearbox anywhere: the motor's quantities, not a term added
+            return JointQuantities(
+                motor, gearbox, motor.mass, reflected_inertia(gear_ratio, motor.rotor_inertia), peak, peak, continuous
+            )
+        mass, counted, efficiency = (
+            _column(v, gear_ratio) for v in (gearbox.mass, gearbox.counted_inertia, gearbox.efficiency)
+        )
+        return JointQuantities(
+            motor=motor,
+            gearbox=gearbox,
+            actuator_mass=motor.mass + mass,
+            reflected_inertia=reflected_inertia(gear_ratio, motor.rotor_inertia + counted),
+            peak_torque=peak,
+            driving_peak_torque=efficiency * peak,
+            driving_continuous_torque=efficiency * continuous,
+        )
+
     def default_stack_lengths(self, n_joints: int) -> list[float]:
         """Each joint's reference motor's stack length [m]: the stack length when the design leaves it out."""
         return [motor.stack_length for motor in self.joint_motors(n_joints)]
+
+
+class GearboxFigures(NamedTuple):
+    """Each joint's gearbox figures, (n_joints,) arrays; a joint without a gearbox has the neutral values.
+
+    names: catalogue names ("" without a gearbox); mass [kg] (0); inertia: input-side inertia ``J_g`` [kg m^2]
+    (0); counted_inertia: ``J_g`` as the reflected inertia counts it (0 unless ``gearbox_inertia``);
+    efficiency [-] (1, also when the catalogue gives none); peak_torque: repeated peak output torque [N m],
+    rated_torque: rated output torque [N m], max_input_speed [rad/s] (inf where not given).
+    """
+
+    names: tuple[str, ...]
+    mass: np.ndarray
+    inertia: np.ndarray
+    counted_inertia: np.ndarray
+    efficiency: np.ndarray
+    peak_torque: np.ndarray
+    rated_torque: np.ndarray
+    max_input_speed: np.ndarray
+
+
+class JointQuantities(NamedTuple):
+    """Each joint's actuator quantities, joint side (see :meth:`ActuatorTechnology.joint_quantities`).
+
+    motor: the motor's own quantities; gearbox: the gearbox figures; actuator_mass: motor plus gearbox mass
+    [kg]; reflected_inertia: ``N^2 (J_m + J_g)`` [kg m^2]; peak_torque: ``N tau_p`` [N m];
+    driving_peak_torque: ``eta N tau_p`` [N m]; driving_continuous_torque: ``eta N tau_c`` [N m].
+    """
+
+    motor: MotorQuantities
+    gearbox: GearboxFigures
+    actuator_mass: Any
+    reflected_inertia: Any
+    peak_torque: Any
+    driving_peak_torque: Any
+    driving_continuous_torque: Any
+
+
+def _rows(values: Any) -> int:
+    """Number of joints of a per-joint column (CasADi or NumPy)."""
+    shape = getattr(values, "shape", None)
+    return int(shape[0]) if shape else int(np.size(values))
+
+
+def _column(values: np.ndarray, like: Any) -> Any:
+    """Per-joint constants shaped as ``like``: a CasADi column (DM) for CasADi, an array for NumPy."""
+    import casadi as ca
+
+    return ca.DM(values) if isinstance(like, (ca.MX, ca.SX, ca.DM)) else values

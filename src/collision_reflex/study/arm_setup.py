@@ -19,7 +19,7 @@ from ..errors import StudyFileError, StudyProblem
 from ..optimize.blas import single_threaded_blas
 from .duty import payload_of, study_duty_cycle
 from .load import LoadedStudy, parse_study
-from .prepare import check_motors, joint_actuators, per_joint_bounds
+from .prepare import check_motors, gearbox_for, joint_actuators, per_joint_bounds
 from .robot import load_arm
 from .samples import configuration_samples, direction_samples
 from .schema import PER_JOINT_DESIGN_VARIABLES, ArmStudy
@@ -27,8 +27,9 @@ from .source import PathKey
 
 if TYPE_CHECKING:
     from ..arm import Arm, DutyCycle
+    from ..hardware.gearboxes import CatalogueGearbox
     from ..hardware.motors import Motor
-    from ..optimize import ActuatorTechnology, Constraints, ContactSamples, DesignProblem, DesignSpace
+    from ..optimize import ActuatorTechnology, Bounds, Constraints, ContactSamples, DesignProblem, DesignSpace
 
 IPOPT_OPTIONS = {"ipopt.max_iter": 400}
 """Options over the optimiser's defaults for study runs (a cap keeps a hopeless Pareto point from stalling a run)."""
@@ -99,6 +100,7 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
         if velocity_spec
         else study.approach_velocity,
     )
+    gearboxes = _joint_gearboxes(loaded, study, joints, space.per_joint("gear_ratio", len(joints)))
     technology = ActuatorTechnology(
         reference_motor=reference,
         mechanical_stiffness=[a.mechanical_stiffness for a in actuators],
@@ -106,6 +108,8 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
         sensing=scheme,
         reaction=study.reaction,
         reflected_inertia_in=study.reflected_inertia_in,
+        gearboxes=gearboxes,
+        gearbox_inertia=study.actuators.gearbox_inertia,
     )
     duty_cycle = study_duty_cycle(loaded, arm)
     if duty_cycle is not None and study.constraints.torque_required is not None:
@@ -166,21 +170,67 @@ def _check_supported(loaded: LoadedStudy, study: ArmStudy) -> None:
                     "reference); override stator_diameter or stack_length only",
                 )
             )
-        if override.gearbox is not None:
-            problems.append(_gearbox_problem(loaded, ("actuators", "joints", joint, "gearbox")))
-    if study.actuators.gearbox is not None:
-        problems.append(_gearbox_problem(loaded, ("actuators", "gearbox")))
     if problems:
         raise StudyFileError(loaded.source.file, problems)
 
 
-def _gearbox_problem(loaded: LoadedStudy, path: PathKey) -> StudyProblem:
-    return loaded.problem(
-        path,
-        "a gearbox in an arm study",
-        "null: the arm optimiser's actuator mass and inertia are the motor's (gear ratio only); "
-        "compare gearboxes in an actuator study (kind: actuator)",
-    )
+def _joint_gearboxes(
+    loaded: LoadedStudy, study: ArmStudy, joints: list[str], ratio_bounds: list[Bounds]
+) -> tuple[CatalogueGearbox | None, ...] | None:
+    """Each joint's gearbox (None: none), or None when no joint has one; every problem located.
+
+    A name is a catalogue entry of ``designs/gearboxes.yaml``; figures (:class:`GearboxSpec`) become an entry
+    whose ratios are the joint's gear-ratio bounds. A gearbox whose ratios miss the joint's gear-ratio bounds
+    is refused here, at the gearbox's line.
+    """
+    from ..hardware.gearboxes import load_gearbox_catalogue
+
+    catalogue: dict[str, CatalogueGearbox] | None = None
+    gearboxes: list[CatalogueGearbox | None] = []
+    problems: list[StudyProblem] = []
+    for joint, bounds in zip(joints, ratio_bounds, strict=True):
+        override = study.actuators.joints.get(joint)
+        path: PathKey = ("actuators", "gearbox")
+        spec = study.actuators.gearbox
+        if override is not None and override.gearbox is not None:
+            path, spec = ("actuators", "joints", joint, "gearbox"), override.gearbox
+        gearbox: CatalogueGearbox | None = None
+        if isinstance(spec, str):
+            catalogue = catalogue if catalogue is not None else load_gearbox_catalogue()
+            gearbox = catalogue.get(spec)
+            if gearbox is None:
+                problems.append(
+                    loaded.problem(
+                        path, repr(spec), "a gearbox of designs/gearboxes.yaml: " + ", ".join(sorted(catalogue))
+                    )
+                )
+                continue
+        elif spec is not None:
+            scaled = gearbox_for(spec)
+            assert scaled is not None  # a spec gives a gearbox
+            gearbox = scaled.catalogue_entry(
+                spec.name or f"{spec.kind} gearbox of {joint}",
+                (bounds.lower, bounds.upper),
+                peak_torque=spec.peak_torque,
+                efficiency=spec.efficiency,
+                max_input_speed=spec.max_input_speed,
+            )
+        if gearbox is not None:
+            low, high = gearbox.ratio_range
+            if max(low, bounds.lower) > min(high, bounds.upper):
+                problems.append(
+                    loaded.problem(
+                        path,
+                        f"{gearbox.name} (ratios {low:g} to {high:g}) at {joint}",
+                        f"a gearbox whose ratios overlap the gear-ratio bounds of {joint}, "
+                        f"{bounds.lower:g} to {bounds.upper:g} (design.gear_ratio, or actuators.gear_ratio "
+                        "when it is fixed); widen them or choose another gearbox",
+                    )
+                )
+        gearboxes.append(gearbox)
+    if problems:
+        raise StudyFileError(loaded.source.file, problems)
+    return tuple(gearboxes) if any(g is not None for g in gearboxes) else None
 
 
 @functools.lru_cache(maxsize=4)

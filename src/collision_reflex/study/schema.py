@@ -117,8 +117,16 @@ class MotorSpec(_Model):
         return {"reference": value} if isinstance(value, str) else value
 
 
+AngularSpeed = quantity_type("rad/s", "an angular speed", "3000 rpm")
+
+
 class GearboxSpec(_Model):
-    """A gearbox with the figures of a real unit (its datasheet): mass and inertia enter the actuator."""
+    """A gearbox with the figures of a real unit (its datasheet): mass and inertia enter the actuator.
+
+    In an arm study the optional ``name``, ``peak_torque``, ``efficiency`` and ``max_input_speed`` complete it
+    as a joint's gearbox (default: a name from its kind, the rated torque as peak, lossless, no speed limit);
+    its ratios are the design's gear-ratio bounds.
+    """
 
     kind: Literal["planetary", "parallel_shaft", "harmonic", "cycloidal", "ball_screw"]
     stages: PositiveInt = 1
@@ -128,13 +136,25 @@ class GearboxSpec(_Model):
     inertia: Inertia = Field(gt=0, description="inertia at the input shaft [kg m^2]")
     rated_torque: Torque = Field(gt=0, description="rated output torque [N m]")
     source: str = Field("", description="where the figures come from")
+    name: str | None = Field(None, min_length=1, description="what reports call it (arm studies)")
+    peak_torque: Torque | None = Field(
+        None, gt=0, description="repeated peak output torque [N m]; null: the rated torque (arm studies)"
+    )
+    efficiency: float | None = Field(
+        None, gt=0, le=1, description="efficiency (0, 1] [-]; null: 1 (arm studies)"
+    )
+    max_input_speed: AngularSpeed | None = Field(
+        None, gt=0, description="maximum input speed [rad/s]; null: none (arm studies)"
+    )
 
 
 class JointActuatorSpec(_Model):
     """Per-joint overrides of the actuator defaults (every field optional)."""
 
     motor: MotorSpec | None = None
-    gearbox: GearboxSpec | None = None
+    gearbox: str | GearboxSpec | None = Field(
+        None, description="catalogue name (designs/gearboxes.yaml) or a gearbox's figures; null: the default"
+    )
     gear_ratio: Ratio | None = Field(None, ge=1)
     mechanical_stiffness: RotaryStiffness | None = Field(None, gt=0)
     software_stiffness: RotaryStiffness | None = Field(None, gt=0)
@@ -144,9 +164,13 @@ class ActuatorsSpec(_Model):
     """The actuator of every joint; ``joints`` overrides fields for named joints."""
 
     motor: MotorSpec = Field(default_factory=MotorSpec)  # type: ignore[arg-type]
-    gearbox: GearboxSpec | None = None
+    gearbox: str | GearboxSpec | None = Field(
+        None,
+        description="every joint's gearbox: a catalogue name (designs/gearboxes.yaml) or a gearbox's figures; "
+        "null: none (the gear ratio alone)",
+    )
     gearbox_inertia: bool = Field(
-        False, description="add the gearbox's reflected inertia (the paper ignores it)"
+        True, description="add the gearbox's input inertia to the reflected inertia; false: the paper's choice"
     )
     gear_ratio: Ratio = Field(1.0, ge=1)
     mechanical_stiffness: RotaryStiffness = Field(gt=0, description="joint mechanical stiffness [N m/rad]")

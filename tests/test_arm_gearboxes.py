@@ -1,0 +1,242 @@
+"""Gearboxes in arm designs: against Pinocchio models with the masses and armature added, and their ratings."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import collision_reflex as cr
+from collision_reflex.arm import Arm
+from collision_reflex.arm.duty_cycle import DutyCycle, Payload
+from collision_reflex.errors import InvalidParameter, SolverFailed, StudyFileError
+from collision_reflex.hardware.gearboxes import CatalogueGearbox
+from collision_reflex.optimize.solve import design_at
+
+ROOT = Path(__file__).resolve().parents[1]
+TWO_LINK = ROOT / "designs" / "planar_two_link.urdf"
+
+
+def _gearbox(name: str, mass: float, inertia: float, peak: float = 1e6, efficiency: float = 1.0, **extra):
+    return CatalogueGearbox(
+        name=name,
+        kind="planetary",
+        ratios=(1.0, 1000.0),
+        continuous_ratio=True,
+        rated_torque=extra.pop("rated", peak),
+        peak_torque=peak,
+        mass=mass,
+        inertia=inertia,
+        source="test figures",
+        efficiency=efficiency,
+        **extra,
+    )
+
+
+def _motor() -> cr.Motor:
+    return cr.reference_motor()
+
+
+@pytest.fixture(scope="module")
+def ur5() -> Arm:
+    return Arm.from_example_robot_data("ur5", "tool0")
+
+
+@pytest.fixture(scope="module")
+def two_link() -> Arm:
+    return Arm.from_urdf(TWO_LINK, "tip")
+
+
+def _two_link_samples(arm: Arm) -> cr.ContactSamples:
+    kin = arm.kinematics(arm.sample_configurations(3, np.random.default_rng(0)))
+    angles = np.linspace(0, 2 * np.pi, 4, endpoint=False) + 0.3
+    return cr.ContactSamples.grid(kin, np.c_[np.cos(angles), np.sin(angles)])
+
+
+TWO_LINK_SPACE = cr.DesignSpace(
+    stator_diameter=(0.02, 0.12),
+    gear_ratio=(1, 30),
+    software_stiffness=(5, 500),
+    threshold=(1, 10),
+    approach_velocity=(0.05, 1.0),
+)
+GIVEN = cr.Constraints(torque_required=[1.3, 1.3])
+
+
+@pytest.mark.parametrize("placement", ["robot", "finger"])
+def test_masses_and_armature_against_pinocchio(ur5, placement):
+    """m_f, m_r, a, the gravity requirement and the actuator mass equal a Pinocchio model with the parts added."""
+    rng = np.random.default_rng(3)
+    q = ur5.sample_configurations(3, rng)
+    directions = rng.normal(size=(4, 3))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    samples = cr.ContactSamples.grid(ur5.kinematics(q), directions)
+    gearboxes = (
+        _gearbox("g1", 2.0, 3e-5),
+        _gearbox("g2", 1.5, 2e-5),
+        None,
+        _gearbox("g4", 0.7, 1e-5, efficiency=0.8),
+        _gearbox("g5", 0.4, 5e-6),
+        _gearbox("g6", 0.3, 4e-6),
+    )
+    technology = cr.ActuatorTechnology(
+        _motor(), mechanical_stiffness=3000.0, gearboxes=gearboxes, reflected_inertia_in=placement
+    )
+    space = cr.DesignSpace(
+        stator_diameter=(0.03, 0.15),
+        gear_ratio=(5, 150),
+        software_stiffness=(50, 5000),
+        threshold=(2, 20),
+        approach_velocity=(0.05, 1.0),
+    )
+    constraints = cr.Constraints(safety_factor=1.5)
+    problem = cr.build_problem(ur5, samples, space, technology, "worst_case_impulse", constraints)
+    x = problem.x0.copy()
+    x[: problem.layout.size] += rng.uniform(-0.3, 0.3, problem.layout.size)  # any design within reach
+    design = design_at(problem, x)
+    gear = design.gear_ratio
+    motor = technology.motor_quantities(design.stator_diameter, design.stack_length)
+    gearbox_mass = np.array([0.0 if g is None else g.mass for g in gearboxes])
+    gearbox_inertia = np.array([0.0 if g is None else g.inertia for g in gearboxes])
+    carried = np.asarray(motor.mass) + gearbox_mass
+    armature = gear**2 * (np.asarray(motor.rotor_inertia) + gearbox_inertia)
+
+    model = ur5.model.copy()
+    for j in range(1, model.njoints):  # each joint's motor and gearbox on its parent link, at the joint
+        point = pin.Inertia(carried[j - 1], model.jointPlacements[j].translation, np.zeros((3, 3)))
+        model.inertias[model.parents[j]] = model.inertias[model.parents[j]] + point
+    model.armature = armature if placement == "finger" else np.zeros(model.nv)
+    data = model.createData()
+    frame = model.getFrameId("tool0")
+    found = problem.sample_parameters(x)
+    gravity = []
+    for s in range(samples.size):
+        config = q[samples.config_index[s]]
+        pin.computeJointJacobians(model, data, config)
+        pin.updateFramePlacements(model, data)
+        jacobian = pin.getFrameJacobian(model, data, frame, pin.LOCAL_WORLD_ALIGNED)[:3]
+        w = jacobian.T @ samples.directions[s]
+        m_f = 1.0 / (w @ np.linalg.solve(pin.crba(model, data, config), w))
+        m_r = 1.0 / (w @ (w / armature))
+        reaction = np.min(design.peak_torque / np.abs(w))  # N tau_p: the reaction is not derated by eta
+        # Sums and one solve of O(1)-conditioned 6x6 systems: agreement to rounding.
+        np.testing.assert_allclose(found["m_f"][s], m_f, rtol=1e-9)
+        np.testing.assert_allclose(found["m_r"][s], m_r, rtol=1e-9)
+        np.testing.assert_allclose(found["a"][s], reaction / m_r, rtol=1e-9)
+    for config in q:
+        gravity.append(pin.computeGeneralizedGravity(model, data, config).copy())
+    required = 1.5 * np.abs(np.array(gravity)).max(axis=0)
+    evaluated = problem.evaluate(problem.exact_point(x))
+    # Joints gravity does not load (base yaw, last wrist) are rounding noise: tolerance relative to the largest.
+    np.testing.assert_allclose(np.asarray(evaluated[4]).ravel(), required, rtol=1e-9, atol=1e-12 * required.max())
+    np.testing.assert_allclose(float(evaluated[1]), carried.sum(), rtol=1e-12)
+    np.testing.assert_allclose(design.reflected_inertia, armature, rtol=1e-12)
+    np.testing.assert_array_equal(design.motor_mass, np.asarray(motor.mass))  # the motor's own
+    np.testing.assert_array_equal(design.gearbox, ("g1", "g2", "", "g4", "g5", "g6"))
+    assert gearbox_mass.sum() > 0.5 * carried.sum() - gearbox_mass.sum()  # the gearboxes weigh in the test
+
+
+def _solve_two_link(arm, gearboxes=None, constraints=GIVEN, **technology):
+    tech = cr.ActuatorTechnology(_motor(), mechanical_stiffness=1000.0, gearboxes=gearboxes, **technology)
+    problem = cr.build_problem(arm, _two_link_samples(arm), TWO_LINK_SPACE, tech, "worst_case_impulse", constraints)
+    return problem, cr.solve(problem)
+
+
+def test_a_neutral_gearbox_reproduces_the_design_without_one(two_link):
+    _, plain = _solve_two_link(two_link)
+    neutral = (_gearbox("none", 0.0, 0.0), _gearbox("none", 0.0, 0.0))
+    _, same = _solve_two_link(two_link, neutral)
+    ignored = (_gearbox("light", 0.0, 1e-3), _gearbox("light", 0.0, 1e-3))
+    _, paper = _solve_two_link(two_link, ignored, gearbox_inertia=False)
+    for result in (same, paper):
+        for name, value in plain.objectives.items():
+            assert result.objectives[name] == pytest.approx(value, rel=1e-9)
+        np.testing.assert_allclose(result.x[: len(plain.x)], plain.x, rtol=1e-9, atol=1e-12)
+    assert paper.design.gearbox_inertia[0] == 1e-3  # reported, though not counted
+
+
+def test_efficiency_half_doubles_the_motor_torque_needed(two_link):
+    _, full = _solve_two_link(two_link, (_gearbox("a", 0.1, 1e-6), _gearbox("b", 0.1, 1e-6)))
+    _, half = _solve_two_link(
+        two_link, (_gearbox("a", 0.1, 1e-6, efficiency=0.5), _gearbox("b", 0.1, 1e-6, efficiency=0.5))
+    )
+    # The given requirement nearly binds at both optima (the impulse grows with the motor's size), so the
+    # output torque N tau_p the motor must give is required / eta: twice as much at eta = 0.5.
+    for result, efficiency in ((full, 1.0), (half, 0.5)):
+        assert np.all(result.torque_margin > -1e-8) and np.all(result.torque_margin < 5e-3)
+        np.testing.assert_allclose(result.design.driving_peak_torque, efficiency * result.design.peak_torque)
+    np.testing.assert_allclose(half.design.peak_torque / full.design.peak_torque, 2.0, rtol=1e-2)
+
+
+def test_a_rating_below_the_requirement_is_refused(two_link):
+    weak = (_gearbox("weak", 0.1, 1e-6, peak=1.0), None)
+    with pytest.raises(InvalidParameter, match=r"gearbox weak of joint1.*1 N\*m.*>= 1.3 N\*m"):
+        _solve_two_link(two_link, weak)
+
+
+@pytest.fixture(scope="module")
+def cycle(two_link):
+    # A loaded, fast cycle: the lightest design's joint 1 is sized by its peak and RMS torque.
+    return DutyCycle.through_via_points(
+        [[0.0, 0.0], [1.2, -1.0], [0.3, 0.6]],
+        two_link.joint_names,
+        [15.0, 20.0],
+        [80.0, 100.0],
+        rate=100.0,
+        dwell=0.05,
+        payload=Payload(2.0),
+    )
+
+
+def _lightest_with_duty(arm, cycle, gearbox):
+    kinematics = arm.kinematics(arm.sample_configurations(2, np.random.default_rng(0)))
+    angles = np.linspace(0, 2 * np.pi, 3, endpoint=False) + 0.3
+    samples = cr.ContactSamples.grid(kinematics, np.c_[np.cos(angles), np.sin(angles)])
+    space = cr.DesignSpace(
+        stator_diameter=(0.02, 0.12),
+        gear_ratio=(1.0, 100.0),
+        software_stiffness=100.0,
+        threshold=5.0,
+        approach_velocity=0.2,
+    )
+    tech = cr.ActuatorTechnology(_motor(), mechanical_stiffness=200.0, gearboxes=(gearbox, None))
+    constraints = cr.Constraints(safety_factor=1.2, duty_cycle=cycle)
+    problem = cr.build_problem(arm, samples, space, tech, "actuator_mass", constraints)
+    return problem, cr.solve(problem)
+
+
+@pytest.mark.parametrize("rating", ["peak", "rms", "speed"])
+def test_a_rating_below_the_lightest_design_moves_the_optimum_onto_it(two_link, cycle, rating):
+    """Capping what the lightest design asks of its gearbox by 5 % gives a heavier design that uses it all."""
+    _, free = _lightest_with_duty(two_link, cycle, _gearbox("g", 0.3, 1e-5))
+    asked = {
+        "peak": ("peak", free.required_torque[0]),
+        "rms": ("rated", free.required_rms_torque[0]),
+        "speed": ("max_input_speed", free.max_motor_speed[0]),
+    }
+    field, value = asked[rating]
+    capped_box = _gearbox("g", 0.3, 1e-5, **{field: 0.95 * value, **({} if field == "peak" else {"peak": 1e6})})
+    problem, capped = _lightest_with_duty(two_link, cycle, capped_box)
+    used = {"peak": capped.required_torque, "rms": capped.required_rms_torque, "speed": capped.max_motor_speed}
+    assert used[rating][0] == pytest.approx(0.95 * value, rel=1e-6)  # on the rating (IPOPT's tolerance)
+    assert capped.objectives["actuator_mass"] > free.objectives["actuator_mass"] * (1 + 1e-3)
+    constraint = ca.Function("g", [problem.nlp["x"], problem.nlp["p"]], [problem.nlp["g"]])
+    g = np.asarray(constraint(problem.exact_point(capped.x), problem.parameters())).ravel()
+    rows = [i for i, label in enumerate(problem.constraint_labels) if label.startswith("gearbox g of joint1")]
+    assert len(rows) >= 3  # peak rows, the RMS row and the cycle's and approach's speed rows
+    slack = np.minimum(g[rows] - problem.lbg[rows], problem.ubg[rows] - g[rows])
+    assert slack.min() == pytest.approx(0.0, abs=1e-6)  # a gearbox row is active, the others met
+
+
+def test_ratio_ranges_are_intersected_and_a_miss_is_named(two_link):
+    box = dataclasses.replace(_gearbox("NPS", 0.1, 1e-6), ratios=(3.0, 10.0))
+    problem, result = _solve_two_link(two_link, (box, box))
+    assert problem.layout.bounds["gear_ratio"][0].lower == 3.0
+    assert np.all((result.design.gear_ratio >= 3 - 1e-9) & (result.design.gear_ratio <= 10 + 1e-9))
+    far = dataclasses.replace(box, ratios=(50.0, 100.0))
+    with pytest.raises(InvalidParameter, match=r"gear_ratio bounds of joint1.*'NPS', 50 to 100"):
+        _solve_two_link(two_link, (far, None))
