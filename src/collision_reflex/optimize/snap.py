@@ -7,8 +7,8 @@ software stiffness, threshold, approach velocity) are re-optimised for that choi
 
 - **Candidates per joint**: among the catalogue motors within the design space's free motor bounds (stator
   diameter, and stack length where it is a design variable) whose peak torque at the largest allowed gear ratio
-  covers the joint's required torque at the continuous optimum (and, with a duty cycle, that state a maximum
-  speed), the ``candidates`` nearest to the continuous optimum's motor in :func:`motor_distance` (log peak
+  covers the joint's required torque at the continuous optimum (and, with a duty cycle, whose continuous torque
+  there covers the cycle's RMS torque and that state a maximum speed), the ``candidates`` nearest to the continuous optimum's motor in :func:`motor_distance` (log peak
   torque and log rotor inertia). A joint whose gearbox offers discrete ratios gets, per motor, the offered
   ratios bracketing the continuous one as fixed gear ratios. A joint with no candidate is reported ("no
   catalogue part within bounds") with the nearest motor and what it misses.
@@ -29,7 +29,7 @@ import itertools
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -40,8 +40,10 @@ from .space import Bounds
 
 if TYPE_CHECKING:
     from ..arm.robot import Arm
+    from ..hardware.gearboxes import CatalogueGearbox
     from ..hardware.motors import Motor
     from .problem import DesignProblem
+    from .technology import ActuatorTechnology
 
 __all__ = [
     "DEFAULT_CANDIDATES",
@@ -59,11 +61,16 @@ __all__ = [
 
 DEFAULT_CANDIDATES = 3
 """Catalogue motors considered per joint by default."""
+DEFAULT_GEARBOX_CANDIDATES = 2
+"""Catalogue gearboxes considered per joint by default, where the study gives a gearbox's own figures."""
 DEFAULT_MAX_COMBINATIONS = 64
 """Largest number of combinations enumerated exactly by default; beyond it the heuristic runs."""
 COVERAGE_MARGIN = 0.1
 """Relative margin of the catalogue's range: a continuous motor within 10 % beyond the catalogue's smallest or
 largest stator diameter and peak torque counts as covered (its nearest part is then at most that far)."""
+REQUIREMENT_PASSES = 4
+"""Passes of :func:`evaluate_parts` raising the gear ratios to the requirement of the parts' own masses (it
+changes little with the ratio: two passes settle it to 1e-6 on the shipped studies)."""
 BOUND_TOLERANCE = 1e-6
 """Relative slack on the motor bounds and the torque screen: a part at a bound is within it, and IPOPT's
 optimum may pass a bound by its relaxation (1e-8 relative)."""
@@ -82,23 +89,26 @@ def motor_distance(motor: Motor, peak_torque: float, rotor_inertia: float) -> fl
 
 @dataclass(frozen=True)
 class CataloguePart:
-    """One joint's catalogue choice: a motor, and the gear-ratio bounds that go with it.
+    """One joint's catalogue choice: a motor, its gearbox (if the joint has one), and the gear-ratio bounds.
 
-    motor: the catalogue motor; gear_ratio: the ratio's bounds for this part (fixed at an offered ratio when
-    the joint's gearbox offers discrete ratios); gearbox: the joint's gearbox name, or None; distance: the
-    motor's :func:`motor_distance` from the continuous optimum's motor [-].
+    motor: the catalogue motor; gear_ratio: the ratio's bounds for this part (fixed at an offered ratio when the
+    gearbox offers discrete ratios); distance: the motor's :func:`motor_distance` from the continuous optimum's
+    motor [-]; gearbox: the joint's gearbox, None without one; gearbox_from_catalogue: whether that gearbox is
+    a catalogue part (False: the study's own figures, kept because no gearbox catalogue was given).
     """
 
     motor: Motor
     gear_ratio: Bounds
     distance: float
-    gearbox: str | None = None
+    gearbox: CatalogueGearbox | None = None
+    gearbox_from_catalogue: bool = True
 
     @property
     def label(self) -> str:
-        """The motor's name, with the fixed gear ratio when the gearbox offers discrete ratios."""
+        """The motor's name, with the gearbox and the fixed gear ratio where there are."""
+        gearbox = "" if self.gearbox is None else f" + {self.gearbox.name}"
         fixed = f" at N = {self.gear_ratio.lower:g}" if self.gear_ratio.is_fixed else ""
-        return f"{self.motor.name}{fixed}"
+        return f"{self.motor.name}{gearbox}{fixed}"
 
 
 @dataclass(frozen=True)
@@ -163,6 +173,8 @@ def joint_candidates(
     optimum: DesignResult,
     motors: Mapping[str, Motor] | Sequence[Motor],
     candidates: int = DEFAULT_CANDIDATES,
+    gearboxes: Mapping[str, CatalogueGearbox] | None = None,
+    gearbox_candidates: int = DEFAULT_GEARBOX_CANDIDATES,
 ) -> tuple[JointCandidates, ...]:
     """Each joint's candidate parts near the continuous ``optimum`` of ``problem`` (module docstring).
 
@@ -172,41 +184,109 @@ def joint_candidates(
     optimum: its solution.
     motors: the catalogue motors, by name or as a sequence.
     candidates: motors kept per joint (>= 1), nearest first.
+    gearboxes: the gearbox catalogue by name; a joint whose gearbox is not one of its entries (the study's own
+        figures) gets its ``gearbox_candidates`` nearest entries of the same kind (:func:`gearbox_options`).
+        None: every joint keeps its gearbox.
+    gearbox_candidates: catalogue gearboxes kept per such joint (>= 1).
     """
     catalogue = _motor_list(motors)
-    if not isinstance(candidates, int) or isinstance(candidates, bool) or candidates < 1:
-        raise InvalidParameter("candidates", candidates, "an integer >= 1")
+    for name, value in (("candidates", candidates), ("gearbox_candidates", gearbox_candidates)):
+        if not isinstance(value, int) or isinstance(value, bool) or value < 1:
+            raise InvalidParameter(name, value, "an integer >= 1")
     design = optimum.design
-    layout = problem.layout
+    bounds = problem.layout.bounds
+    space_ratios = problem.space.per_joint("gear_ratio", problem.n_joints)
+    joint_gearboxes = problem.technology.joint_gearboxes(problem.n_joints)
     out = []
     for j, joint in enumerate(problem.joint_names):
         torque, inertia = float(design.motor_peak_torque[j]), float(design.rotor_inertia[j])
-        ranked = sorted(catalogue, key=lambda m: motor_distance(m, torque, inertia))
         required = float(optimum.required_torque[j])
-        ratio = layout.bounds["gear_ratio"][j]
+        options, gearbox_misses = gearbox_options(
+            joint_gearboxes[j], space_ratios[j], required, gearboxes, gearbox_candidates
+        )
+        largest = max((_ratio_range(space_ratios[j], g)[1] for g, _ in options), default=0.0)
+        ranked = sorted(catalogue, key=lambda m: motor_distance(m, torque, inertia))
+        rms = None if optimum.required_rms_torque is None else float(optimum.required_rms_torque[j])
         misses = {
-            m.name: _misses(m, j, layout.bounds, required, ratio.upper, problem.duty is not None)
-            for m in ranked
+            m.name: _misses(m, j, bounds, required, rms, largest, problem.duty is not None) for m in ranked
         }
         fitting = [m for m in ranked if not misses[m.name]][:candidates]
         parts = tuple(
             part
             for m in fitting
+            for gearbox, listed in options
             for part in _parts_of(
-                m, ratio, _joint_gearbox(problem, j), float(design.gear_ratio[j]), torque, inertia
+                m, space_ratios[j], gearbox, listed, float(design.gear_ratio[j]), torque, inertia
             )
         )
-        nearest = ranked[0].name if ranked else None
+        nearest = ranked[0].name
         out.append(
             JointCandidates(
                 joint,
                 parts,
                 nearest,
-                () if parts or nearest is None else misses[nearest],
+                () if parts else (*gearbox_misses, *misses[nearest]),
                 _coverage_warning(joint, catalogue, float(design.stator_diameter[j]), torque),
             )
         )
     return tuple(out)
+
+
+def gearbox_options(
+    gearbox: CatalogueGearbox | None,
+    ratio: Bounds,
+    required: float,
+    catalogue: Mapping[str, CatalogueGearbox] | None,
+    count: int = DEFAULT_GEARBOX_CANDIDATES,
+) -> tuple[list[tuple[CatalogueGearbox | None, bool]], tuple[str, ...]]:
+    """A joint's gearbox options ``(gearbox, from the catalogue)``, and what the nearest misses if none fits.
+
+    No gearbox: ``[(None, True)]``. A catalogue entry (its name in ``catalogue``, or no catalogue given): kept.
+    The study's own figures with a catalogue given: the ``count`` entries of the same kind nearest to it in
+    (log repeated peak torque, log mass) whose ratios overlap the joint's gear-ratio bounds ``ratio`` and whose
+    repeated peak rating covers the joint's ``required`` torque [N*m].
+    """
+    if gearbox is None:
+        return [(None, True)], ()
+    if catalogue is None or gearbox.name in catalogue:
+        return [(gearbox, catalogue is not None)], ()
+
+    def distance(other: CatalogueGearbox) -> float:
+        return math.hypot(
+            math.log(other.peak_torque / gearbox.peak_torque), math.log(other.mass / gearbox.mass)
+        )
+
+    ranked = sorted((g for g in catalogue.values() if g.kind == gearbox.kind), key=distance)
+    fitting = []
+    for other in ranked:
+        low, high = _ratio_range(ratio, other)
+        if low <= high * (1 + BOUND_TOLERANCE) and other.peak_torque >= required * (1 - BOUND_TOLERANCE):
+            fitting.append((other, True))
+    if fitting:
+        return fitting[:count], ()
+    if not ranked:
+        return [], (f"no {gearbox.kind} gearbox in the gearbox catalogue",)
+    nearest = ranked[0]
+    low, high = nearest.ratio_range
+    found = [f"nearest gearbox {nearest.name}:"]
+    if max(low, ratio.lower) > min(high, ratio.upper):
+        found.append(
+            f"ratios {low:g} to {high:g} outside the gear-ratio bounds {ratio.lower:g} to {ratio.upper:g}"
+        )
+    if nearest.peak_torque < required:
+        found.append(
+            f"repeated peak rating {nearest.peak_torque:.4g} N*m short of the required {required:.4g} N*m by "
+            f"{required - nearest.peak_torque:.3g} N*m"
+        )
+    return [], (" ".join(found),)
+
+
+def _ratio_range(bounds: Bounds, gearbox: CatalogueGearbox | None) -> tuple[float, float]:
+    """The gear-ratio bounds intersected with a gearbox's ratio range (empty when lower > upper)."""
+    if gearbox is None:
+        return bounds.lower, bounds.upper
+    low, high = gearbox.ratio_range
+    return max(bounds.lower, low), min(bounds.upper, high)
 
 
 def _motor_list(motors: Mapping[str, Motor] | Sequence[Motor]) -> list[Motor]:
@@ -224,25 +304,32 @@ def _misses(
     joint: int,
     bounds: Mapping[str, list[Bounds]],
     required: float,
+    required_rms: float | None,
     largest_ratio: float,
     needs_speed: bool,
 ) -> tuple[str, ...]:
-    """What keeps ``motor`` from joint ``joint``: a free motor bound, the torque screen, a missing speed."""
+    """What keeps ``motor`` from joint ``joint``: a free motor bound, the torque screens, a missing speed.
+
+    The screens: the peak torque at the largest gear ratio covers the ``required`` torque [N*m], and with a duty
+    cycle the continuous torque there covers the cycle's RMS torque ``required_rms`` [N*m] (both of the
+    continuous optimum; gearbox losses left to the re-solve).
+    """
     found = []
     for name in ("stator_diameter", "stack_length"):
         b = bounds[name][joint]
         value = getattr(motor, name)
         if b.is_fixed:  # not a design variable: the catalogue motor brings its own size
             continue
+        what = name.replace("_", " ")
         if value < b.lower * (1 - BOUND_TOLERANCE):
             found.append(
-                f"{name.replace('_', ' ')} {value * 1e3:.4g} mm below the lower bound "
-                f"{b.lower * 1e3:.4g} mm by {(b.lower - value) * 1e3:.3g} mm"
+                f"{what} {value * 1e3:.4g} mm below the lower bound {b.lower * 1e3:.4g} mm by "
+                f"{(b.lower - value) * 1e3:.3g} mm"
             )
         elif value > b.upper * (1 + BOUND_TOLERANCE):
             found.append(
-                f"{name.replace('_', ' ')} {value * 1e3:.4g} mm above the upper bound "
-                f"{b.upper * 1e3:.4g} mm by {(value - b.upper) * 1e3:.3g} mm"
+                f"{what} {value * 1e3:.4g} mm above the upper bound {b.upper * 1e3:.4g} mm by "
+                f"{(value - b.upper) * 1e3:.3g} mm"
             )
     reachable = motor.peak_torque * largest_ratio
     if reachable < required * (1 - BOUND_TOLERANCE):
@@ -250,34 +337,46 @@ def _misses(
             f"peak torque {motor.peak_torque:.4g} N*m x the largest gear ratio {largest_ratio:.4g} = "
             f"{reachable:.4g} N*m, short of the required {required:.4g} N*m by {required - reachable:.3g} N*m"
         )
+    if required_rms is not None and motor.continuous_torque * largest_ratio < required_rms * (
+        1 - BOUND_TOLERANCE
+    ):
+        reachable = motor.continuous_torque * largest_ratio
+        found.append(
+            f"continuous torque {motor.continuous_torque:.4g} N*m x the largest gear ratio {largest_ratio:.4g} = "
+            f"{reachable:.4g} N*m, short of the cycle's RMS {required_rms:.4g} N*m by "
+            f"{required_rms - reachable:.3g} N*m"
+        )
     if needs_speed and motor.max_speed is None:
         found.append("no maximum speed in its catalogue entry (the duty cycle's speed limit needs one)")
     return tuple(found)
 
 
-def _joint_gearbox(problem: DesignProblem, joint: int) -> Any:
-    """The joint's catalogue gearbox, or None (no gearbox, or a technology without gearboxes)."""
-    gearboxes = getattr(problem.technology, "gearboxes", None)
-    return None if gearboxes is None else gearboxes[joint]
-
-
 def _parts_of(
-    motor: Motor, ratio: Bounds, gearbox: Any, continuous_ratio: float, torque: float, inertia: float
+    motor: Motor,
+    ratio: Bounds,
+    gearbox: CatalogueGearbox | None,
+    from_catalogue: bool,
+    continuous_ratio: float,
+    torque: float,
+    inertia: float,
 ) -> list[CataloguePart]:
-    """``motor``'s parts: the ratio bounds as they are, or the offered ratios bracketing the continuous one."""
+    """``motor``'s parts with ``gearbox``: the ratio bounds, or the offered ratios bracketing the continuous one.
+
+    ``ratio``: the joint's gear-ratio bounds of the design space (the problem intersects them with the
+    gearbox's range); ``continuous_ratio``, ``torque`` [N*m], ``inertia`` [kg*m^2]: the continuous optimum's.
+    """
     distance = motor_distance(motor, torque, inertia)
-    name = None if gearbox is None else str(gearbox.name)
     if gearbox is None or gearbox.continuous_ratio:
-        return [CataloguePart(motor, ratio, distance, name)]
-    offered = [
-        r
-        for r in gearbox.ratios
-        if ratio.lower * (1 - BOUND_TOLERANCE) <= r <= ratio.upper * (1 + BOUND_TOLERANCE)
-    ]
+        return [CataloguePart(motor, ratio, distance, gearbox, from_catalogue)]
+    low, high = ratio.lower * (1 - BOUND_TOLERANCE), ratio.upper * (1 + BOUND_TOLERANCE)
+    offered = [r for r in gearbox.ratios if low <= r <= high]
     below = [r for r in offered if r <= continuous_ratio]
     above = [r for r in offered if r >= continuous_ratio]
     bracket = sorted({*below[-1:], *above[:1]})
-    return [CataloguePart(motor, Bounds.fixed(float(r), ratio.name), distance, name) for r in bracket]
+    return [
+        CataloguePart(motor, Bounds.fixed(float(r), ratio.name), distance, gearbox, from_catalogue)
+        for r in bracket
+    ]
 
 
 def _coverage_warning(joint: str, catalogue: list[Motor], diameter: float, torque: float) -> str | None:
@@ -308,7 +407,9 @@ def snap_to_catalogue(
     motors: Mapping[str, Motor] | Sequence[Motor],
     *,
     arm: Arm,
+    gearboxes: Mapping[str, CatalogueGearbox] | None = None,
     candidates: int = DEFAULT_CANDIDATES,
+    gearbox_candidates: int = DEFAULT_GEARBOX_CANDIDATES,
     max_combinations: int = DEFAULT_MAX_COMBINATIONS,
     ipopt_options: IpoptOptions | None = None,
     progress: Callable[[int, int], None] | None = None,
@@ -322,7 +423,11 @@ def snap_to_catalogue(
     optimum: the continuous optimum of ``problem`` (:func:`collision_reflex.optimize.solve`).
     motors: the catalogue motors (e.g. :func:`collision_reflex.load_catalogue`), by name or as a sequence.
     arm: the arm ``problem`` was built for (each combination's problem is built for it).
+    gearboxes: the gearbox catalogue by name (e.g. :func:`collision_reflex.hardware.gearboxes.
+        load_gearbox_catalogue`), for joints whose gearbox is the study's own figures; None keeps every joint's
+        gearbox (see :func:`joint_candidates`).
     candidates: motors considered per joint (>= 1), the nearest first.
+    gearbox_candidates: catalogue gearboxes considered per joint with the study's own gearbox figures (>= 1).
     max_combinations: the most combinations enumerated exactly (>= 1); beyond, the heuristic runs.
     ipopt_options: options of every re-solve (see :func:`collision_reflex.optimize.solve`).
     progress: called as ``progress(done, total)`` after each combination solved.
@@ -334,7 +439,7 @@ def snap_to_catalogue(
     """
     if not isinstance(max_combinations, int) or isinstance(max_combinations, bool) or max_combinations < 1:
         raise InvalidParameter("max_combinations", max_combinations, "an integer >= 1")
-    joints = joint_candidates(problem, optimum, motors, candidates)
+    joints = joint_candidates(problem, optimum, motors, candidates, gearboxes, gearbox_candidates)
     warnings = [j.warning for j in joints if j.warning]
     empty = [j for j in joints if not j.parts]
     if empty:
@@ -464,13 +569,13 @@ def catalogue_problem(problem: DesignProblem, parts: Sequence[CataloguePart], ar
     """
     from .problem import build_problem
 
+    technology = _parts_technology(problem, parts)
     space = replace(
         problem.space,
         stator_diameter=[p.motor.stator_diameter for p in parts],
         stack_length=[p.motor.stack_length for p in parts],
         gear_ratio=[p.gear_ratio for p in parts],
     )
-    technology = replace(problem.technology, reference_motor=tuple(p.motor for p in parts))
     return build_problem(
         arm,
         problem.samples,
@@ -482,14 +587,25 @@ def catalogue_problem(problem: DesignProblem, parts: Sequence[CataloguePart], ar
     )
 
 
+def _parts_technology(problem: DesignProblem, parts: Sequence[CataloguePart]) -> ActuatorTechnology:
+    """``problem``'s technology with each joint's motor (and gearbox) the one of ``parts``."""
+    chosen = tuple(p.gearbox for p in parts)
+    return replace(
+        problem.technology,
+        reference_motor=tuple(p.motor for p in parts),
+        gearboxes=chosen if any(g is not None for g in chosen) else None,
+    )
+
+
 def matched_gear_ratio(part: CataloguePart, design: Design, joint: int) -> float:
     """The gear ratio that gives ``part``'s motor the continuous design's peak output torque, within its bounds.
 
     ``N = N_c tau_c / tau_p`` (``N_c tau_c`` the continuous joint's peak torque [N*m]), clipped to the part's
-    gear-ratio bounds: the catalogue design's start, and the ratio of a part evaluated without a re-solve.
+    gear-ratio bounds (within its gearbox's ratios): the catalogue design's start, and the ratio of a part evaluated without a re-solve.
     """
     wanted = float(design.peak_torque[joint]) / part.motor.peak_torque
-    return float(np.clip(wanted, part.gear_ratio.lower, part.gear_ratio.upper))
+    low, high = _ratio_range(part.gear_ratio, part.gearbox)
+    return float(np.clip(wanted, low, high))
 
 
 def solve_parts(
@@ -528,8 +644,8 @@ def solve_parts(
 class PartsEvaluation:
     """A design of catalogue parts evaluated without a re-solve (the quick snap of every Pareto design).
 
-    parts: the part per joint; design: the continuous design with each joint's motor replaced by its part's at
-    :func:`matched_gear_ratio`; objectives: every objective [its unit] (NumPy path); required_torque: per joint
+    parts: the part per joint; design: the continuous design with each joint's motor replaced by its part's
+    (see :func:`evaluate_parts` for the gear ratios); objectives: every objective [its unit] (NumPy path); required_torque: per joint
     [N*m]; shortfalls: the requirements it misses (peak torque, and with a duty cycle RMS torque and motor
     speed), empty when it meets them all.
     """
@@ -547,59 +663,107 @@ class PartsEvaluation:
 
 
 def evaluate_parts(problem: DesignProblem, design: Design, parts: Sequence[CataloguePart]) -> PartsEvaluation:
-    """``design`` with each joint's motor the catalogue motor of ``parts``, evaluated (no re-solve).
+    """``design`` with each joint's motor (and gearbox) the one of ``parts``, evaluated (no re-solve).
 
-    The gear ratios are :func:`matched_gear_ratio`; software stiffness, threshold and approach velocity are
-    ``design``'s. Impulses by the NumPy path (:func:`collision_reflex.optimize.evaluate.evaluate_design`), the
-    requirement by ``problem``'s own torque-requirement function (and duty cycle).
+    The gear ratios are :func:`matched_gear_ratio`, raised (within their bounds) to cover the peak (and with a
+    duty cycle the RMS) requirement of the parts' own masses; software stiffness, threshold and approach velocity are ``design``'s. The actuator quantities come from the technology's one formula
+    (:meth:`~collision_reflex.optimize.technology.ActuatorTechnology.joint_quantities`), the impulses from the
+    NumPy path (:func:`collision_reflex.optimize.evaluate.evaluate_design`), the requirement from ``problem``'s
+    own torque-requirement function (and duty cycle); gearbox ratings are checked as the problem's rows are.
     """
-    from ..model import effective
     from .duty import duty_values
     from .evaluate import evaluate_design
 
     parts = tuple(parts)
+    technology = _parts_technology(problem, parts)
     gear = np.array([matched_gear_ratio(p, design, j) for j, p in enumerate(parts)])
-    inertia = np.array([p.motor.rotor_inertia for p in parts])
-    torque = np.array([p.motor.peak_torque for p in parts])
-    snapped = replace(
-        design,
-        stator_diameter=np.array([p.motor.stator_diameter for p in parts]),
-        stack_length=np.array([p.motor.stack_length for p in parts]),
-        gear_ratio=gear,
-        rotor_inertia=inertia,
-        reflected_inertia=effective.reflected_inertia(gear, inertia),
-        motor_peak_torque=torque,
-        peak_torque=gear * torque,
-        motor_mass=np.array([p.motor.mass for p in parts]),
-    )
+    ranges = np.array([_ratio_range(p.gear_ratio, p.gearbox) for p in parts])
+    for _ in range(REQUIREMENT_PASSES):  # heavier parts need more torque: raise the ratio to cover it
+        snapped = _parts_design(design, parts, technology, gear)
+        required = _required_torque(problem, snapped)
+        efficiency = snapped.gearbox_efficiency
+        wanted = np.maximum(gear, required / (efficiency * snapped.motor_peak_torque))
+        if problem.duty is not None:
+            rms = duty_values(problem.duty, snapped, technology).required_rms_torque
+            continuous = np.array([p.motor.continuous_torque for p in parts])
+            wanted = np.maximum(wanted, rms / (efficiency * continuous))
+        if all(p.gear_ratio.is_fixed for p in parts) or np.allclose(wanted, gear, rtol=BOUND_TOLERANCE):
+            break
+        gear = np.where(
+            [p.gear_ratio.is_fixed for p in parts], gear, np.clip(wanted, ranges[:, 0], ranges[:, 1])
+        )
+    snapped = _parts_design(design, parts, technology, gear)
+    figures = technology.gearbox_figures(len(parts))
     impulses = evaluate_design(problem, snapped)
-    arguments = (
-        (snapped.motor_mass,) if problem.duty is None else (snapped.motor_mass, snapped.reflected_inertia)
-    )
-    required = np.asarray(problem.required_torque_function(*arguments), dtype=float).ravel()
-    shortfalls = [
-        f"{name}: peak torque {snapped.peak_torque[j]:.4g} N*m below the required {required[j]:.4g} N*m"
-        for j, name in enumerate(design.joint_names)
-        if snapped.peak_torque[j] < required[j] * (1 - BOUND_TOLERANCE)
-    ]
+    masses = snapped.actuator_mass
+    required = _required_torque(problem, snapped)
+    names = design.joint_names
+    shortfalls = _below("peak torque", snapped.driving_peak_torque, "the required", required, names)
+    shortfalls += _below("gearbox peak rating", figures.peak_torque, "the required", required, names)
     if problem.duty is not None:
-        technology = replace(problem.technology, reference_motor=tuple(p.motor for p in parts))
         values = duty_values(problem.duty, snapped, technology)
-        for j, name in enumerate(design.joint_names):
-            if values.continuous_torque[j] < values.required_rms_torque[j] * (1 - BOUND_TOLERANCE):
-                shortfalls.append(
-                    f"{name}: continuous torque {values.continuous_torque[j]:.4g} N*m below the cycle's RMS "
-                    f"{values.required_rms_torque[j]:.4g} N*m"
-                )
-            if values.max_motor_speed[j] > values.speed_limit[j] * (1 + BOUND_TOLERANCE):
-                shortfalls.append(
-                    f"{name}: motor speed {values.max_motor_speed[j]:.4g} rad/s above its limit "
-                    f"{values.speed_limit[j]:.4g} rad/s"
-                )
+        rms = values.required_rms_torque
+        shortfalls += _below("continuous torque", values.continuous_torque, "the cycle's RMS", rms, names)
+        shortfalls += _below("gearbox rated torque", figures.rated_torque, "the cycle's RMS", rms, names)
+        speed = values.max_motor_speed
+        shortfalls += _below(
+            "motor speed limit", values.speed_limit, "the motor speed", speed, names, "rad/s"
+        )
+        shortfalls += _below(
+            "gearbox input speed limit", figures.max_input_speed, "the motor speed", speed, names, "rad/s"
+        )
     objectives = {
         "worst_case_impulse": float(impulses.max()),
         "mean_impulse": float(impulses.mean()),
-        "actuator_mass": float(snapped.motor_mass.sum()),
+        "actuator_mass": float(masses.sum()),
         "approach_velocity": float(snapped.approach_velocity),
     }
     return PartsEvaluation(parts, snapped, objectives, required, tuple(shortfalls))
+
+
+def _parts_design(
+    design: Design, parts: tuple[CataloguePart, ...], technology: ActuatorTechnology, gear: np.ndarray
+) -> Design:
+    """``design`` with the motors (and gearboxes) of ``parts`` at gear ratios ``gear`` [-]."""
+    diameter = np.array([p.motor.stator_diameter for p in parts])
+    stack = np.array([p.motor.stack_length for p in parts])
+    joint = technology.joint_quantities(diameter, stack, gear)
+    return replace(
+        design,
+        stator_diameter=diameter,
+        stack_length=stack,
+        gear_ratio=gear,
+        rotor_inertia=np.asarray(joint.motor.rotor_inertia, dtype=float),
+        reflected_inertia=np.asarray(joint.reflected_inertia, dtype=float),
+        motor_peak_torque=np.asarray(joint.motor.peak_torque, dtype=float),
+        peak_torque=np.asarray(joint.peak_torque, dtype=float),
+        motor_mass=np.asarray(joint.motor.mass, dtype=float),
+        gearbox=joint.gearbox.names,
+        gearbox_mass=joint.gearbox.mass,
+        gearbox_inertia=joint.gearbox.inertia,
+        gearbox_efficiency=joint.gearbox.efficiency,
+    )
+
+
+def _required_torque(problem: DesignProblem, design: Design) -> np.ndarray:
+    """Each joint's required peak torque [N*m] for ``design``'s masses (and reflected inertias, with a cycle)."""
+    arguments = (
+        (design.actuator_mass,) if problem.duty is None else (design.actuator_mass, design.reflected_inertia)
+    )
+    return np.asarray(problem.required_torque_function(*arguments), dtype=float).ravel()
+
+
+def _below(
+    capacity_name: str,
+    capacity: np.ndarray,
+    need_name: str,
+    need: np.ndarray,
+    joints: Sequence[str],
+    unit: str = "N*m",
+) -> list[str]:
+    """``joint: <capacity> 1.2 N*m below <need> 1.5 N*m`` for every joint whose capacity is short of its need."""
+    return [
+        f"{joint}: {capacity_name} {capacity[j]:.4g} {unit} below {need_name} {need[j]:.4g} {unit}"
+        for j, joint in enumerate(joints)
+        if capacity[j] < need[j] * (1 - BOUND_TOLERANCE)
+    ]
