@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import json
 import re
@@ -247,3 +248,79 @@ def test_a_study_run_snaps_reports_and_resumes_without_redoing_it(tmp_path, monk
     again = cr.run_study(TWO_LINK_STUDY, folder, quiet=True, smoke=True, executor="serial")
     assert again.resumed and again.computed == 0 and again.reused == first.computed + first.reused
     assert json.loads((folder / "designs.json").read_text())["catalogue"] == catalogue
+
+
+def _harmonic(name: str, ratios: tuple[float, ...], peak: float, mass: float, continuous: bool = False):
+    from collision_reflex.hardware.gearboxes import CatalogueGearbox
+
+    return CatalogueGearbox(
+        name=name,
+        kind="harmonic",
+        ratios=ratios,
+        continuous_ratio=continuous,
+        rated_torque=peak / 2,
+        peak_torque=peak,
+        mass=mass,
+        inertia=1e-6,
+        source="test figures",
+        efficiency=0.8,
+    )
+
+
+def test_a_gearbox_of_discrete_ratios_gets_an_offered_ratio(two_link):
+    arm, problem, _ = two_link
+    geared = cr.ActuatorTechnology(
+        cr.reference_motor(), 1000.0, gearboxes=(_harmonic("HD", (5.0, 10.0, 20.0, 40.0), 100.0, 0.3), None)
+    )
+    # The continuous optimum may use any ratio of the gearbox's range 5-40; the catalogue design an offered one.
+    continuous = dataclasses.replace(geared.gearboxes[0], continuous_ratio=True, ratios=(5.0, 40.0))
+    technology = dataclasses.replace(geared, gearboxes=(continuous, None))
+    built = cr.build_problem(arm, problem.samples, problem.space, technology, OBJECTIVE, problem.constraints)
+    optimum = cr.solve(built, starts=2)
+    ratio = optimum.design.gear_ratio[0]
+    discrete = cr.build_problem(arm, problem.samples, problem.space, geared, OBJECTIVE, problem.constraints)
+    snapped = snap_to_catalogue(discrete, optimum, _catalogue(), arm=arm, candidates=2)
+    offered = np.array([5.0, 10.0, 20.0, 40.0])
+    bracket = {offered[offered <= ratio].max(initial=5.0), offered[offered >= ratio].min(initial=40.0)}
+    for part in snapped.joints[0].parts:
+        assert part.gear_ratio.is_fixed and part.gear_ratio.lower in bracket
+    assert snapped.result.design.gear_ratio[0] in bracket
+    assert snapped.result.design.gearbox[0] == "HD"
+
+
+def test_a_gearbox_given_by_its_figures_snaps_to_catalogue_gearboxes_of_its_kind(two_link):
+    arm, problem, _ = two_link
+    own = _harmonic("study figures", (1.0, 50.0), 40.0, 0.5, continuous=True)
+    technology = cr.ActuatorTechnology(cr.reference_motor(), 1000.0, gearboxes=(own, None))
+    built = cr.build_problem(arm, problem.samples, problem.space, technology, OBJECTIVE, problem.constraints)
+    optimum = cr.solve(built, starts=2)
+    catalogue = {
+        g.name: g
+        for g in (
+            _harmonic("HD-light", (1.0, 50.0), 30.0, 0.3, continuous=True),
+            _harmonic("HD-heavy", (1.0, 50.0), 60.0, 1.2, continuous=True),
+            _harmonic("HD-weak", (1.0, 50.0), 1.0, 0.1, continuous=True),  # below the 2 N*m required
+            dataclasses.replace(
+                _harmonic("planetary", (1.0, 50.0), 40.0, 0.5, continuous=True), kind="planetary"
+            ),
+        )
+    }
+    snapped = snap_to_catalogue(built, optimum, _catalogue(), arm=arm, gearboxes=catalogue, candidates=2)
+    used = {p.gearbox.name for p in snapped.joints[0].parts}
+    assert used == {"HD-light", "HD-heavy"}  # the weak one misses the requirement, the planetary the kind
+    assert all(p.gearbox is None for p in snapped.joints[1].parts)
+    # Lighter gearbox, same motor: less mass at equal torque, so the mass-weighted objective prefers it.
+    assert snapped.parts[0].gearbox.name == "HD-light"
+    without = snap_to_catalogue(built, optimum, _catalogue(), arm=arm, candidates=2)
+    assert {p.gearbox.name for p in without.joints[0].parts} == {"study figures"}
+    assert not without.parts[0].gearbox_from_catalogue
+
+
+def test_a_quick_snap_evaluates_what_a_re_solve_finds(two_link, exact):
+    # Evaluated at the re-solved design's own variables, the parts give its objectives (one model, two paths).
+    _, problem, _ = two_link
+    evaluated = snapping.evaluate_parts(problem, exact.result.design, exact.parts)
+    assert evaluated.feasible
+    for name, value in exact.result.numpy_objectives.items():
+        assert evaluated.objectives[name] == pytest.approx(value, rel=1e-9)
+    np.testing.assert_allclose(evaluated.design.gear_ratio, exact.result.design.gear_ratio, rtol=1e-9)
