@@ -29,7 +29,7 @@ import itertools
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -257,7 +257,7 @@ def gearbox_options(
         )
 
     ranked = sorted((g for g in catalogue.values() if g.kind == gearbox.kind), key=distance)
-    fitting = []
+    fitting: list[tuple[CatalogueGearbox | None, bool]] = []
     for other in ranked:
         low, high = _ratio_range(ratio, other)
         if low <= high * (1 + BOUND_TOLERANCE) and other.peak_torque >= required * (1 - BOUND_TOLERANCE):
@@ -558,7 +558,8 @@ def objective_value(problem: DesignProblem, objectives: Mapping[str, float]) -> 
     The weighted, start-normalised objectives with the tie-break term, scaled as ``problem`` scales them, so
     that designs of different (catalogue) problems compare on one scale.
     """
-    return float(objective_expression(problem.objective, objectives, problem.objective_scale))
+    values: dict[str, Any] = dict(objectives)  # plain numbers: the formula is backend-agnostic arithmetic
+    return float(objective_expression(problem.objective, values, problem.objective_scale))
 
 
 def catalogue_problem(problem: DesignProblem, parts: Sequence[CataloguePart], arm: Arm) -> DesignProblem:
