@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -239,7 +240,8 @@ class CatalogueRecord(TypedDict):
     ``difference`` (catalogue minus continuous), ``relative_difference`` (over the continuous value; None where
     that is zero) [each objective's unit]; ``design``: the catalogue design's record, None when none was found;
     ``tried``: every combination re-solved; ``pareto``: the quick snap of every Pareto design (the chosen
-    design's without a front), see :func:`quick_snap_record`.
+    design's without a front), see :func:`quick_snap_record`; ``solve_time``: the snap's wall time [s] (in
+    ``timings.json``, not ``designs.json``).
     """
 
     key: str
@@ -256,6 +258,7 @@ class CatalogueRecord(TypedDict):
     design: dict[str, Any] | None
     tried: list[dict[str, Any]]
     pareto: list[dict[str, Any]]
+    solve_time: float
 
 
 @dataclass(frozen=True)
@@ -341,6 +344,7 @@ def catalogue_results(
     from ..optimize.snap import snap_to_catalogue
     from .arm_setup import IPOPT_OPTIONS
 
+    started = time.perf_counter()
     problem = built_problem(problems, problems.objective)
     recommendation = recommend(chosen, front, problems.objective)
     snap = snap_to_catalogue(
@@ -397,6 +401,7 @@ def catalogue_results(
         else design_record(problem, snap.result, "catalogue design", catalogue.motors),
         "tried": [{"parts": list(t.parts), "objective": t.objective, "status": t.status} for t in snap.tried],
         "pareto": [quick_snap_record(problem, r, catalogue) for r in results],
+        "solve_time": time.perf_counter() - started,
     }
 
 
