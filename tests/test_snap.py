@@ -324,3 +324,37 @@ def test_a_quick_snap_evaluates_what_a_re_solve_finds(two_link, exact):
     for name, value in exact.result.numpy_objectives.items():
         assert evaluated.objectives[name] == pytest.approx(value, rel=1e-9)
     np.testing.assert_allclose(evaluated.design.gear_ratio, exact.result.design.gear_ratio, rtol=1e-9)
+
+
+def _study_with(tmp_path, catalogue: str) -> Path:
+    text = TWO_LINK_STUDY.read_text().replace("../designs/", f"{ROOT / 'designs'}/")
+    study = tmp_path / "study.yaml"
+    study.write_text(text + f"catalogue: {catalogue}\n")
+    return study
+
+
+def test_a_bad_catalogue_section_is_refused_at_its_line_and_nothing_is_written(tmp_path, capsys):
+    from collision_reflex.cli import main
+
+    study = _study_with(tmp_path, "{candidates: 0}")
+    assert main(["run", str(study), "--out", str(tmp_path / "out"), "--quiet", "--smoke"]) == 2
+    assert re.search(r"study\.yaml:\d+:\d+: catalogue\.candidates: found 0", capsys.readouterr().err)
+    study = _study_with(tmp_path, "{motors: missing.yaml}")
+    assert main(["run", str(study), "--out", str(tmp_path / "out"), "--quiet", "--smoke"]) == 2
+    assert "missing.yaml: cannot read the file" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_changed_catalogue_is_snapped_again_on_resume(tmp_path):
+    motors = tmp_path / "motors.yaml"
+    motors.write_text((ROOT / "designs" / "motors.yaml").read_text())
+    study = _study_with(tmp_path, "{motors: motors.yaml}")
+    folder = tmp_path / "out"
+    cr.run_study(study, folder, quiet=True, smoke=True, executor="serial")
+    first = json.loads((folder / "points" / "catalogue.json").read_text())
+    assert cr.run_study(study, folder, quiet=True, smoke=True, executor="serial").computed == 0
+    motors.write_text(motors.read_text() + "# edited\n")  # the same parts, another file: snapped again
+    again = cr.run_study(study, folder, quiet=True, smoke=True, executor="serial")
+    assert again.computed == 1
+    second = json.loads((folder / "points" / "catalogue.json").read_text())
+    assert second["key"] != first["key"] and second["joints"] == first["joints"]
