@@ -240,6 +240,11 @@ def test_a_study_run_snaps_reports_and_resumes_without_redoing_it(tmp_path, monk
     header = (folder / "pareto.csv").read_text().splitlines()[0]
     assert "catalogue_part[joint1]" in header and "catalogue_worst_case_impulse [N*s]" in header
     assert (folder / "points" / "catalogue.json").exists()
+    (sentence,) = [line for line in designs["verdict"] if line.startswith("Built from catalogue parts")]
+    for joint in catalogue["joints"]:
+        assert f"{joint['joint']} {joint['part']} at N = " in sentence
+    change = 100 * catalogue["relative_difference"]["worst_case_impulse"]
+    assert f"worst case impulse +{change:.3g} %" in sentence and sentence in report
 
     def not_again(*args, **kwargs):
         raise AssertionError("the snap was redone on resume")
