@@ -8,10 +8,12 @@ software stiffness, threshold, approach velocity) are re-optimised for that choi
 - **Candidates per joint**: among the catalogue motors within the design space's free motor bounds (stator
   diameter, and stack length where it is a design variable) whose peak torque at the largest allowed gear ratio
   covers the joint's required torque at the continuous optimum (and, with a duty cycle, whose continuous torque
-  there covers the cycle's RMS torque and that state a maximum speed), the ``candidates`` nearest to the continuous optimum's motor in :func:`motor_distance` (log peak
-  torque and log rotor inertia). A joint whose gearbox offers discrete ratios gets, per motor, the offered
-  ratios bracketing the continuous one as fixed gear ratios. A joint with no candidate is reported ("no
-  catalogue part within bounds") with the nearest motor and what it misses.
+  there covers the cycle's RMS torque and that state a maximum speed), the ``candidates`` nearest to the
+  continuous optimum's motor in :func:`motor_distance` (log peak torque and log rotor inertia). A joint whose
+  gearbox offers discrete ratios gets, per motor, the offered ratios bracketing the continuous one as fixed gear
+  ratios; a gearbox given by its own figures is replaced by the nearest catalogue gearboxes of its kind
+  (:func:`gearbox_options`). A joint with no candidate is reported ("no catalogue part within bounds") with the
+  nearest motor and what it misses.
 - **Exact** when the combinations of candidates number at most ``max_combinations``: every one is re-solved
   (warm started from the continuous optimum's values) and the best feasible by the problem's objective is kept.
 - **Heuristic** beyond that: coordinate descent over joints from the nearest part of every joint; each pass
@@ -19,8 +21,10 @@ software stiffness, threshold, approach velocity) are re-optimised for that choi
   design; it stops when a whole pass improves nothing. It is never worse than the nearest-part design (its
   start); ``benchmarks/snap_gap.py`` measures its gap to enumeration.
 
-A catalogue design is the continuous problem with more constraints, so it is never better than the (global)
-continuous optimum in the optimised objective; a continuous optimum that is only local can be beaten.
+The objective is the problem's own, without the objective bounds of an epsilon-constraint point: a Pareto design
+snapped is the study objective's best design of those parts. A catalogue design is the continuous problem with
+more constraints, so it is never better than the (global) continuous optimum in the optimised objective; a
+continuous optimum that is only local can be beaten.
 """
 
 from __future__ import annotations
@@ -47,16 +51,22 @@ if TYPE_CHECKING:
 
 __all__ = [
     "DEFAULT_CANDIDATES",
+    "DEFAULT_GEARBOX_CANDIDATES",
     "DEFAULT_MAX_COMBINATIONS",
     "CatalogueDesign",
     "CataloguePart",
     "JointCandidates",
     "PartsEvaluation",
     "Trial",
+    "catalogue_problem",
     "evaluate_parts",
+    "gearbox_options",
     "joint_candidates",
+    "matched_gear_ratio",
     "motor_distance",
+    "objective_value",
     "snap_to_catalogue",
+    "solve_parts",
 ]
 
 DEFAULT_CANDIDATES = 3
