@@ -612,7 +612,8 @@ def matched_gear_ratio(part: CataloguePart, design: Design, joint: int) -> float
     """The gear ratio that gives ``part``'s motor the continuous design's peak output torque, within its bounds.
 
     ``N = N_c tau_c / tau_p`` (``N_c tau_c`` the continuous joint's peak torque [N*m]), clipped to the part's
-    gear-ratio bounds (within its gearbox's ratios): the catalogue design's start, and the ratio of a part evaluated without a re-solve.
+    gear-ratio bounds (within its gearbox's ratios): the catalogue design's start, and the ratio of a part
+    evaluated without a re-solve.
     """
     wanted = float(design.peak_torque[joint]) / part.motor.peak_torque
     low, high = _ratio_range(part.gear_ratio, part.gearbox)
@@ -656,8 +657,8 @@ class PartsEvaluation:
     """A design of catalogue parts evaluated without a re-solve (the quick snap of every Pareto design).
 
     parts: the part per joint; design: the continuous design with each joint's motor replaced by its part's
-    (see :func:`evaluate_parts` for the gear ratios); objectives: every objective [its unit] (NumPy path); required_torque: per joint
-    [N*m]; shortfalls: the requirements it misses (peak torque, and with a duty cycle RMS torque and motor
+    (see :func:`evaluate_parts` for the gear ratios); objectives: every objective [its unit] (NumPy path);
+    required_torque: per joint [N*m]; shortfalls: the requirements it misses (peak torque, and with a duty cycle RMS torque and motor
     speed), empty when it meets them all.
     """
 
@@ -677,7 +678,8 @@ def evaluate_parts(problem: DesignProblem, design: Design, parts: Sequence[Catal
     """``design`` with each joint's motor (and gearbox) the one of ``parts``, evaluated (no re-solve).
 
     The gear ratios are :func:`matched_gear_ratio`, raised (within their bounds) to cover the peak (and with a
-    duty cycle the RMS) requirement of the parts' own masses; software stiffness, threshold and approach velocity are ``design``'s. The actuator quantities come from the technology's one formula
+    duty cycle the RMS) requirement of the parts' own masses; software stiffness, threshold and approach
+    velocity are ``design``'s. The actuator quantities come from the technology's one formula
     (:meth:`~collision_reflex.optimize.technology.ActuatorTechnology.joint_quantities`), the impulses from the
     NumPy path (:func:`collision_reflex.optimize.evaluate.evaluate_design`), the requirement from ``problem``'s
     own torque-requirement function (and duty cycle); gearbox ratings are checked as the problem's rows are.

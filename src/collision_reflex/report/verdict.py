@@ -3,8 +3,8 @@
 One place for the HTML report, ``designs.json`` (``verdict``) and ``crx run``'s closing print: the recommended
 design, the bounds and constraints that are active on each joint, how far each objective spans over the front
 (and a plain sentence when the front is flat or degenerate), the lightest design near the best impulse, the kind
-of torque requirement, warnings about oversized joints, and the design built from catalogue parts. Every function reads plain data (the records of
-:func:`collision_reflex.optimize.results.design_record` and the results of
+of torque requirement, warnings about oversized joints, and the design built from catalogue parts. Every
+function reads plain data (the records of :func:`collision_reflex.optimize.results.design_record` and the results of
 :func:`collision_reflex.study.arm_results.arm_results`), so the verdict can be redone from a saved
 ``designs.json``.
 """

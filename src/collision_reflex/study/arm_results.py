@@ -267,7 +267,8 @@ class SnapCatalogue:
 
     motors, gearboxes: the catalogue's motors and gearboxes by name (no gearboxes when no joint has one);
     provenance: per part, each field's source or estimate (as :func:`collision_reflex.hardware.catalogue.
-    read_entries` gives it); files: the catalogue files read; candidates, max_combinations: :func:`collision_reflex.optimize.snap.snap_to_catalogue`'s settings.
+    read_entries` gives it); files: the catalogue files read; candidates, max_combinations:
+    :func:`collision_reflex.optimize.snap.snap_to_catalogue`'s settings.
     """
 
     motors: dict[str, Motor]
