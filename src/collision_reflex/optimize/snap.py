@@ -658,8 +658,8 @@ class PartsEvaluation:
 
     parts: the part per joint; design: the continuous design with each joint's motor replaced by its part's
     (see :func:`evaluate_parts` for the gear ratios); objectives: every objective [its unit] (NumPy path);
-    required_torque: per joint [N*m]; shortfalls: the requirements it misses (peak torque, and with a duty cycle RMS torque and motor
-    speed), empty when it meets them all.
+    required_torque: per joint [N*m]; shortfalls: the requirements it misses (peak torque, the gearbox's
+    ratings, and with a duty cycle RMS torque and motor speed), empty when it meets them all.
     """
 
     parts: tuple[CataloguePart, ...]
