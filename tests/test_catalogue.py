@@ -127,8 +127,18 @@ BAD = {
         "motors.small.construction",
         "'frameless' or 'housed'",
     ),
-    "empty-maker": (GOOD.replace("    source:", "    maker: ''\n    source:"), 9, "motors.small.maker", "empty"),
-    "duplicate-part": (GOOD + GOOD.replace("motors:\n", ""), 10, "motors.small", "given twice (first on line 2)"),
+    "empty-maker": (
+        GOOD.replace("    source:", "    maker: ''\n    source:"),
+        9,
+        "motors.small.maker",
+        "empty",
+    ),
+    "duplicate-part": (
+        GOOD + GOOD.replace("motors:\n", ""),
+        10,
+        "motors.small",
+        "given twice (first on line 2)",
+    ),
     "duplicate-field": (
         GOOD.replace("    source:", "    mass: 0.5 kg\n    source:"),
         9,

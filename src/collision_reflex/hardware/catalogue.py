@@ -367,7 +367,9 @@ def _entry(file: str, kind: str, part: str, key_node: Any, entry_node: Any) -> C
     description = {key: values.pop(key) for key in _DESCRIPTIVE if key in values}
     description = {key: text for key, text in description.items() if text is not None}
     given = [key for key in fields if key not in (*_PROVENANCE, *_DESCRIPTIVE)]
-    return CatalogueEntry(values, _provenance(file, where, fields, entry, given), _line(key_node), description)
+    return CatalogueEntry(
+        values, _provenance(file, where, fields, entry, given), _line(key_node), description
+    )
 
 
 def _check_inertia(values: dict[str, Any], refuse: Any) -> None:
