@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import csv
 import dataclasses
+import json
 from pathlib import Path
 
 import casadi as ca
@@ -13,7 +15,7 @@ import pytest
 import collision_reflex as cr
 from collision_reflex.arm import Arm
 from collision_reflex.arm.duty_cycle import DutyCycle, Payload
-from collision_reflex.errors import InvalidParameter, SolverFailed, StudyFileError
+from collision_reflex.errors import InvalidParameter, StudyFileError
 from collision_reflex.hardware.gearboxes import CatalogueGearbox
 from collision_reflex.optimize.solve import design_at
 
@@ -132,7 +134,9 @@ def test_masses_and_armature_against_pinocchio(ur5, placement):
     required = 1.5 * np.abs(np.array(gravity)).max(axis=0)
     evaluated = problem.evaluate(problem.exact_point(x))
     # Joints gravity does not load (base yaw, last wrist) are rounding noise: tolerance relative to the largest.
-    np.testing.assert_allclose(np.asarray(evaluated[4]).ravel(), required, rtol=1e-9, atol=1e-12 * required.max())
+    np.testing.assert_allclose(
+        np.asarray(evaluated[4]).ravel(), required, rtol=1e-9, atol=1e-12 * required.max()
+    )
     np.testing.assert_allclose(float(evaluated[1]), carried.sum(), rtol=1e-12)
     np.testing.assert_allclose(design.reflected_inertia, armature, rtol=1e-12)
     np.testing.assert_array_equal(design.motor_mass, np.asarray(motor.mass))  # the motor's own
@@ -142,7 +146,9 @@ def test_masses_and_armature_against_pinocchio(ur5, placement):
 
 def _solve_two_link(arm, gearboxes=None, constraints=GIVEN, **technology):
     tech = cr.ActuatorTechnology(_motor(), mechanical_stiffness=1000.0, gearboxes=gearboxes, **technology)
-    problem = cr.build_problem(arm, _two_link_samples(arm), TWO_LINK_SPACE, tech, "worst_case_impulse", constraints)
+    problem = cr.build_problem(
+        arm, _two_link_samples(arm), TWO_LINK_SPACE, tech, "worst_case_impulse", constraints
+    )
     return problem, cr.solve(problem)
 
 
@@ -219,9 +225,15 @@ def test_a_rating_below_the_lightest_design_moves_the_optimum_onto_it(two_link, 
         "speed": ("max_input_speed", free.max_motor_speed[0]),
     }
     field, value = asked[rating]
-    capped_box = _gearbox("g", 0.3, 1e-5, **{field: 0.95 * value, **({} if field == "peak" else {"peak": 1e6})})
+    capped_box = _gearbox(
+        "g", 0.3, 1e-5, **{field: 0.95 * value, **({} if field == "peak" else {"peak": 1e6})}
+    )
     problem, capped = _lightest_with_duty(two_link, cycle, capped_box)
-    used = {"peak": capped.required_torque, "rms": capped.required_rms_torque, "speed": capped.max_motor_speed}
+    used = {
+        "peak": capped.required_torque,
+        "rms": capped.required_rms_torque,
+        "speed": capped.max_motor_speed,
+    }
     assert used[rating][0] == pytest.approx(0.95 * value, rel=1e-6)  # on the rating (IPOPT's tolerance)
     assert capped.objectives["actuator_mass"] > free.objectives["actuator_mass"] * (1 + 1e-3)
     constraint = ca.Function("g", [problem.nlp["x"], problem.nlp["p"]], [problem.nlp["g"]])
@@ -232,11 +244,130 @@ def test_a_rating_below_the_lightest_design_moves_the_optimum_onto_it(two_link, 
     assert slack.min() == pytest.approx(0.0, abs=1e-6)  # a gearbox row is active, the others met
 
 
+def test_a_duty_cycle_beyond_the_gearbox_rating_is_refused_before_solving(two_link, cycle):
+    # The lightest design needs ~53 N*m (safety factor included) at joint 1: a 10 N*m rating is far short.
+    weak = _gearbox("weak", 0.3, 1e-5, peak=10.0)
+    with pytest.raises(
+        InvalidParameter, match=r"joint1.*gearbox weak peak rating: best margin reachable -7\d"
+    ):
+        _lightest_with_duty(two_link, cycle, weak)
+
+
+def test_the_gearbox_fields_survive_the_saved_result(two_link):
+    from collision_reflex.optimize.results import result_from_json, result_to_json
+
+    box = _gearbox("NPS", 0.25, 2e-6, efficiency=0.9)
+    _, result = _solve_two_link(two_link, (box, None))
+    again = result_from_json(json.loads(json.dumps(result_to_json(result)))).design
+    assert again.gearbox == ("NPS", "")
+    for name in (
+        "gearbox_mass",
+        "gearbox_inertia",
+        "gearbox_efficiency",
+        "actuator_mass",
+        "reflected_inertia",
+    ):
+        np.testing.assert_array_equal(getattr(again, name), getattr(result.design, name))
+    np.testing.assert_array_equal(again.gearbox_efficiency, [0.9, 1.0])
+
+
 def test_ratio_ranges_are_intersected_and_a_miss_is_named(two_link):
     box = dataclasses.replace(_gearbox("NPS", 0.1, 1e-6), ratios=(3.0, 10.0))
     problem, result = _solve_two_link(two_link, (box, box))
     assert problem.layout.bounds["gear_ratio"][0].lower == 3.0
-    assert np.all((result.design.gear_ratio >= 3 - 1e-9) & (result.design.gear_ratio <= 10 + 1e-9))
+    ratios = result.design.gear_ratio
+    assert np.all((ratios >= 3 * (1 - 1e-7)) & (ratios <= 10 * (1 + 1e-7)))  # IPOPT relaxes bounds by 1e-8
     far = dataclasses.replace(box, ratios=(50.0, 100.0))
     with pytest.raises(InvalidParameter, match=r"gear_ratio bounds of joint1.*'NPS', 50 to 100"):
         _solve_two_link(two_link, (far, None))
+
+
+STUDY = ROOT / "studies" / "two_link_planetary.yaml"
+
+
+def _study_text(**replacements: str) -> str:
+    text = STUDY.read_text()
+    for old, new in replacements.items():
+        assert old in text
+        text = text.replace(old, new)
+    return text.replace("../designs/", str(ROOT / "designs") + "/")
+
+
+def test_a_catalogue_gearbox_study_runs_and_reports_its_gearboxes(tmp_path):
+    from collision_reflex.study.runner import run_study
+
+    run_study(STUDY, tmp_path / "out", quiet=True, smoke=True, executor="serial", figures=False)
+    rows = list(csv.DictReader((tmp_path / "out" / "pareto.csv").open()))
+    catalogue = cr.hardware.gearboxes.load_gearbox_catalogue()["NPS015-MF-1"]
+    for row in rows:
+        for joint in ("joint1", "joint2"):
+            assert row[f"gearbox[{joint}] [-]"] == "NPS015-MF-1"
+            assert float(row[f"gearbox_mass[{joint}] [kg]"]) == catalogue.mass
+            motor, total = float(row[f"motor_mass[{joint}] [kg]"]), float(row[f"actuator_mass[{joint}] [kg]"])
+            # pareto.csv holds 10 significant digits.
+            assert total == pytest.approx(motor + catalogue.mass, rel=1e-9)
+            # IPOPT may relax a bound by 1e-8 relative.
+            assert 3 * (1 - 1e-7) <= float(row[f"gear_ratio[{joint}] [-]"]) <= 10 * (1 + 1e-7)
+            # The rating holds (safety factor included) and the driving torque covers the requirement.
+            assert float(row[f"required_torque[{joint}] [N*m]"]) <= catalogue.peak_torque * (1 + 1e-6)
+            assert float(row[f"required_rms_torque[{joint}] [N*m]"]) <= catalogue.rated_torque * (1 + 1e-6)
+        masses = sum(float(row[f"actuator_mass[{j}] [kg]"]) for j in ("joint1", "joint2"))
+        assert float(row["actuator_mass [kg]"]) == pytest.approx(masses, rel=1e-9)
+    report = (tmp_path / "out" / "report.html").read_text()
+    assert "gearbox inertia ignored" not in report  # counted here
+
+
+def test_gearbox_inertia_false_is_stated_in_the_report(tmp_path):
+    from collision_reflex.study.runner import run_study
+
+    study = tmp_path / "study.yaml"
+    study.write_text(_study_text(**{"gearbox_inertia: true": "gearbox_inertia: false"}))
+    run_study(study, tmp_path / "out", quiet=True, smoke=True, executor="serial", figures=False)
+    assert "Gearbox inertia ignored, as in the paper" in (tmp_path / "out" / "report.html").read_text()
+
+
+@pytest.mark.parametrize(
+    "old, new, line, message",
+    [
+        (
+            "gearbox: NPS015-MF-1",
+            "gearbox: NPS999",
+            16,
+            r"actuators\.gearbox: found 'NPS999'; expected a gearbox of the catalogue.*'NPS015-MF-1', 'SP100-MF-1'",
+        ),
+        (
+            "  mechanical_stiffness",
+            "  joints: {joint2: {gearbox: SP10}}\n  mechanical_stiffness",
+            19,
+            r"actuators\.joints\.joint2\.gearbox: found 'SP10'",
+        ),
+        ("gear_ratio: {min: 1, max: 10}", "gear_ratio: {min: 20, max: 50}", 16, r"ratios 3 to 10.*20 to 50"),
+    ],
+    ids=["unknown name", "unknown name at a joint", "ratio range missed"],
+)
+def test_bad_gearboxes_are_located(tmp_path, old, new, line, message):
+    from collision_reflex.study.arm_setup import arm_setup
+    from collision_reflex.study.load import parse_study
+
+    with pytest.raises(StudyFileError, match=message) as caught:  # the schema, or the setup with the bounds
+        arm_setup(parse_study(_study_text(**{old: new}), "study.yaml", ROOT / "studies"))
+    assert caught.value.problems[0].line == line
+    assert len({str(p) for p in caught.value.problems}) == len(caught.value.problems)  # each once
+
+
+def test_a_per_joint_gearbox_of_figures_is_scaled_into_a_joint_gearbox():
+    from collision_reflex.study.arm_setup import arm_setup
+    from collision_reflex.study.load import parse_study
+
+    figures = (
+        "  joints:\n    joint2:\n      gearbox: {kind: harmonic, diameter: 50 mm, length: 30 mm, mass: 0.4 kg,"
+        " inertia: 0.02 kg*cm^2, rated_torque: 20 N*m, efficiency: 0.8, name: HD-test}\n"
+        "  mechanical_stiffness"
+    )
+    text = _study_text(**{"  mechanical_stiffness": figures})
+    setup = arm_setup(parse_study(text, "study.yaml", ROOT / "studies"))
+    first, second = setup.technology.gearboxes
+    assert first.name == "NPS015-MF-1"
+    assert (second.name, second.mass, second.peak_torque, second.efficiency) == ("HD-test", 0.4, 20.0, 0.8)
+    assert second.ratio_range == (1.0, 10.0)  # the design's gear-ratio bounds
+    assert second.inertia == pytest.approx(2e-6, rel=1e-12)

@@ -584,7 +584,8 @@ def test_torque_speed_figure_exactly_for_duty_cycle_studies(runs, name):
         # The record's margins are the saved points' (motor side: peak torque over the largest cycle torque).
         factor = results["resolved"]["constraints"]["safety_factor"]
         for entry, joint in zip(saved, recommended["joints"], strict=True):
-            largest = factor * max(abs(t) for t in entry["torque"]) * joint["gear_ratio"]
+            output = joint["gear_ratio"] * joint.get("gearbox_efficiency", 1.0)  # per motor torque
+            largest = factor * max(abs(t) for t in entry["torque"]) * output
             assert largest == pytest.approx(joint["required_torque"], rel=1e-6), joint["joint"]
         assert (folder / "figures" / "torque_speed.png").is_file()
         assert 'id="torque-speed"' in html

@@ -18,7 +18,7 @@ from ..errors import InvalidParameter
 class JointParameters:
     """Per-joint actuation of an arm, arrays of shape (nv,).
 
-    reflected_inertia: rotor (and gearbox) inertia seen at the joint, ``N^2 J_m`` [kg m^2], >= 0.
+    reflected_inertia: rotor (and gearbox) inertia seen at the joint, ``N^2 (J_m + J_g)`` [kg m^2], >= 0.
     torque_limit: largest output torque of the joint [N m], > 0 (``nan`` when unknown).
     stiffness: lumped joint stiffness while sensing, mechanical and software springs in series [N m/rad].
     mechanical_stiffness: joint mechanical stiffness, the spring left during the reaction [N m/rad].

@@ -150,7 +150,7 @@ class Gearbox:
         efficiency: float | None = None,
         max_input_speed: float | None = None,
     ) -> CatalogueGearbox:
-        """This gearbox as a joint's gearbox entry, for the arm optimiser (one mechanism for every gearbox).
+        """Make this gearbox a joint's gearbox entry, for the arm optimiser (one mechanism for every gearbox).
 
         Parameters
         ----------

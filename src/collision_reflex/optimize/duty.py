@@ -48,6 +48,8 @@ if TYPE_CHECKING:
 
 PEAK, RMS, SPEED = "peak torque", "RMS torque", "speed"
 """The duty cycle's constraints, as error messages and labels name them."""
+GEARBOX_RATINGS = ("peak rating", "rated torque (RMS)", "input speed")
+"""A gearbox's ratings the duty cycle's peak, RMS and motor speed must be within, as error messages name them."""
 REACHABLE_TOLERANCE = 0.02
 """Best margin, found on a grid (:func:`check_reachable`), below which a requirement is refused before solving:
 the grid's step in gear ratio (1/240 of the log range) can underestimate the best margin by about this much."""
@@ -325,7 +327,8 @@ def check_reachable(
     other motors' masses are taken at their most favourable within ``[mass_low, mass_high]`` [kg] separately at
     every sample: the margins found are upper bounds of the reachable ones, so a requirement refused here
     cannot be met. The approach speed is taken at the lowest approach velocity allowed. Refused when the best
-    margin is below ``-REACHABLE_TOLERANCE``: one constraint alone, or peak, RMS and speed together.
+    margin is below ``-REACHABLE_TOLERANCE``: one constraint alone (the gearbox's ratings among them), or all
+    of them together.
 
     Raises
     ------
@@ -342,12 +345,13 @@ def check_reachable(
         low = basis[:, 0] + np.minimum(slopes * mass_low, slopes * mass_high).sum(axis=1)
         high = basis[:, 0] + np.maximum(slopes * mass_low, slopes * mass_high).sum(axis=1)
         best = _best_margins(duty, technology, bounds, j, (low, high, basis[:, -1]), weights, speed_need[j])
-        labels = (PEAK, RMS, SPEED)
-        for label, value in zip(labels, best[:3], strict=True):
+        gearbox = technology.gearbox_figures(len(joint_names)).names[j]
+        labels = (PEAK, RMS, SPEED, *(f"gearbox {gearbox} {rating}" for rating in GEARBOX_RATINGS))
+        for label, value in zip(labels, best[:-1], strict=True):
             if value < -REACHABLE_TOLERANCE:
                 _refuse(name, label, value)
-        if best[3] < -REACHABLE_TOLERANCE:
-            _refuse(name, " and ".join(labels) + " together", best[3])
+        if best[-1] < -REACHABLE_TOLERANCE:
+            _refuse(name, " and ".join(labels[: 6 if gearbox else 3]) + " together", best[-1])
 
 
 def _best_margins(
@@ -359,7 +363,11 @@ def _best_margins(
     weights: np.ndarray,
     joint_speed: float,
 ) -> np.ndarray:
-    """Best (peak, RMS, speed, all three) margins of one joint over the grid of its own variables."""
+    """Best margins of one joint over the grid of its own variables.
+
+    They are: peak, RMS and speed, its gearbox's peak, rated torque and input speed (inf without one), all
+    together.
+    """
 
     def grid(name: str, count: int) -> np.ndarray:
         b = bounds[name][joint]
@@ -370,25 +378,29 @@ def _best_margins(
     gearbox = technology.gearbox_figures(n_joints)
     efficiency, gearbox_inertia = gearbox.efficiency[joint], gearbox.counted_inertia[joint]
     gears = grid("gear_ratio", 241)[:, None]
+    ratings = np.ones_like(gears[:, 0])
     low, high, acceleration = demand
-    best = np.full(4, -np.inf)
+    best = np.full(7, -np.inf)
     for length in grid("stack_length", 9):
         for diameter in grid("stator_diameter", 41):
             motor = scaled_motor_quantities(reference, diameter, length, technology.scaling_law)
             rotor = gears**2 * (motor.rotor_inertia + gearbox_inertia) * acceleration  # (gears, n)
             # The smallest |demand| at each sample over the other motors' masses (0 if the interval holds 0).
             least = np.maximum(0.0, np.maximum(low + rotor, -(high + rotor)))
+            peak_need, rms_need = duty.safety_factor * least.max(axis=1), np.sqrt((least**2) @ weights)
+            speed_need = gears[:, 0] * joint_speed
             margins = np.column_stack(
                 [
-                    _margin(
-                        efficiency * gears[:, 0] * motor.peak_torque, duty.safety_factor * least.max(axis=1)
-                    ),
-                    _margin(efficiency * gears[:, 0] * motor.continuous_torque, np.sqrt((least**2) @ weights)),
-                    _margin(np.full(gears.shape[0], motor.max_speed), gears[:, 0] * joint_speed),
+                    _margin(efficiency * gears[:, 0] * motor.peak_torque, peak_need),
+                    _margin(efficiency * gears[:, 0] * motor.continuous_torque, rms_need),
+                    _margin(motor.max_speed * ratings, speed_need),
+                    _margin(gearbox.peak_torque[joint] * ratings, peak_need),
+                    _margin(gearbox.rated_torque[joint] * ratings, rms_need),
+                    _margin(gearbox.max_input_speed[joint] * ratings, speed_need),
                 ]
             )
-            best[:3] = np.maximum(best[:3], margins.max(axis=0))
-            best[3] = max(best[3], float(margins.min(axis=1).max()))
+            best[:-1] = np.maximum(best[:-1], margins.max(axis=0))
+            best[-1] = max(best[-1], float(margins.min(axis=1).max()))
     return best
 
 
@@ -399,9 +411,11 @@ def _margin(capacity: np.ndarray, need: np.ndarray) -> np.ndarray:
 
 
 def _refuse(joint: str, constraint: str, margin: float) -> None:
+    gearbox = constraint.startswith("gearbox")
     raise InvalidParameter(
         f"duty cycle requirement of {joint}",
         f"{constraint}: best margin reachable {margin:+.1%}",
         f"a design within the bounds that meets its {constraint} requirement",
-        "widen the motor-size or gear-ratio bounds, or ask for a gentler cycle (slower, lighter payload)",
+        ("choose a gearbox of higher ratings, " if gearbox else "widen the motor-size or gear-ratio bounds, ")
+        + "or ask for a gentler cycle (slower, lighter payload)",
     )

@@ -92,14 +92,15 @@ def design_layout(
     layout = DesignLayout()
     defaults = {"stack_length": technology.default_stack_lengths(n_joints)}
     for name in PER_JOINT_VARIABLES:
-        bounds = space.per_joint(name, n_joints, defaults.get(name))
+        joint_bounds = space.per_joint(name, n_joints, defaults.get(name))
         if name == "gear_ratio":
             names = joint_names or tuple(f"joint{j + 1}" for j in range(n_joints))
             gearboxes = technology.joint_gearboxes(n_joints)
-            bounds = [
-                _within_ratio_range(b, g, joint) for b, g, joint in zip(bounds, gearboxes, names, strict=True)
+            joint_bounds = [
+                _within_ratio_range(b, g, joint)
+                for b, g, joint in zip(joint_bounds, gearboxes, names, strict=True)
             ]
-        layout.add(name, bounds)
+        layout.add(name, joint_bounds)
     for name in GLOBAL_VARIABLES:
         bounds = space.global_bounds(name)
         if name == "threshold" and technology.sensing == "force":
@@ -179,7 +180,9 @@ def design_quantities(
     stiffness [N m/rad].
     """
     values = layout.expressions(z)
-    joint = technology.joint_quantities(values["stator_diameter"], values["stack_length"], values["gear_ratio"])
+    joint = technology.joint_quantities(
+        values["stator_diameter"], values["stack_length"], values["gear_ratio"]
+    )
     design_column = ca.vertcat(
         joint.actuator_mass,
         joint.reflected_inertia,

@@ -645,8 +645,12 @@ def _duty_required_torque(
     return ca.Function("required_torque", [masses, reflected], [ca.vertcat(*required)])
 
 
-def _start_reflected_inertia(layout: DesignLayout, x0: np.ndarray, technology: ActuatorTechnology) -> np.ndarray:
+def _start_reflected_inertia(
+    layout: DesignLayout, x0: np.ndarray, technology: ActuatorTechnology
+) -> np.ndarray:
     """Reflected inertias ``N^2 (J_m + J_g)`` [kg m^2] of the start design."""
     values = layout.values(x0[: layout.size])
-    joint = technology.joint_quantities(values["stator_diameter"], values["stack_length"], values["gear_ratio"])
+    joint = technology.joint_quantities(
+        values["stator_diameter"], values["stack_length"], values["gear_ratio"]
+    )
     return np.asarray(joint.reflected_inertia, dtype=float)

@@ -143,11 +143,11 @@ class DesignResult:
         :data:`AGREEMENT_TOLERANCE` (relative).
     impulses: (n_samples,) collision impulse per sample [N*s] (NumPy path).
     required_torque, torque_margin: per joint, the required peak torque [N m] (safety factor included) and
-        ``peak_torque / required_torque - 1``.
+        ``eta peak_torque / required_torque - 1`` (``eta`` the gearbox efficiency, 1 without one).
     requirement: what sized the torques (:attr:`collision_reflex.optimize.Constraints.requirement`), e.g.
         ``"static (gravity only)"``.
     required_rms_torque, rms_margin: per joint, the RMS torque over the duty cycle [N m] and
-        ``N tau_c / RMS - 1``; None without a duty cycle.
+        ``eta N tau_c / RMS - 1``; None without a duty cycle.
     max_motor_speed, speed_limit, speed_margin: per joint, the motor speed ``N max |qd|`` over the cycle and
         the approach [rad/s], the motor's maximum speed [rad/s] and ``limit / speed - 1``; None without a duty
         cycle.

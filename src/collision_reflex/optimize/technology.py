@@ -7,8 +7,8 @@ one), which is how a design is built from catalogue parts.
 
 A joint may also have a gearbox (:attr:`ActuatorTechnology.gearboxes`, catalogue entries): its mass is carried
 at the joint like the motor's, its input-side inertia adds to the rotor's, its efficiency scales the output
-torque that drives the arm, and its torque and speed ratings bound the design (:func:`joint_quantities` is the
-one place these enter).
+torque that drives the arm, and its torque and speed ratings bound the design
+(:meth:`ActuatorTechnology.joint_quantities` is the one place these enter).
 """
 
 from __future__ import annotations
@@ -149,7 +149,9 @@ class ActuatorTechnology:
         if self.gearboxes is None:
             return (None,) * n_joints
         if len(self.gearboxes) != n_joints:
-            raise InvalidParameter("gearboxes", len(self.gearboxes), f"one gearbox (or None) per joint: {n_joints}")
+            raise InvalidParameter(
+                "gearboxes", len(self.gearboxes), f"one gearbox (or None) per joint: {n_joints}"
+            )
         return self.gearboxes
 
     def gearbox_figures(self, n_joints: int) -> GearboxFigures:
@@ -180,11 +182,12 @@ class ActuatorTechnology:
         zero unless :attr:`gearbox_inertia`); the peak torque ``N tau_p`` [N m] bounds the reaction; the
         driving torques ``eta N tau_p`` and ``eta N tau_c`` [N m] must cover the torque requirements.
 
-        The efficiency ``eta`` applies to driving torque only, when the motor drives the arm through the
-        gearbox (the static, given and duty-cycle requirements). The collision model's reaction keeps
-        ``N tau_p``: there the contact pushes the link back against a braking motor, the gearbox is backdriven
-        and its friction opposes that motion, so it adds to the motor's braking; leaving it out (as the paper
-        does) can only overestimate the impulse, and keeps the reaction model the paper's.
+        The efficiency ``eta`` applies to driving torque only, where the motor drives the arm through the
+        gearbox (the static, given and duty-cycle requirements). The collision model's reaction (its
+        backdriving) keeps ``N tau_p``: there the motor's torque brakes its own rotor (the reflected inertia
+        ``m_r``, ``a = F_a / m_r``) while the contact pushes the link back through the gearbox, so power flows
+        from the load into the gearbox, whose friction then opposes the motion and adds to the braking.
+        Leaving it out keeps the paper's reaction model and can only overestimate the impulse.
         """
         motor = self.motor_quantities(stator_diameter, stack_length)
         gearbox = self.gearbox_figures(_rows(gear_ratio))
@@ -192,7 +195,13 @@ class ActuatorTechnology:
         continuous = gear_ratio * motor.continuous_torque
         if self.gearboxes is None:  # no gearbox anywhere: the motor's quantities, not a term added
             return JointQuantities(
-                motor, gearbox, motor.mass, reflected_inertia(gear_ratio, motor.rotor_inertia), peak, peak, continuous
+                motor,
+                gearbox,
+                motor.mass,
+                reflected_inertia(gear_ratio, motor.rotor_inertia),
+                peak,
+                peak,
+                continuous,
             )
         mass, counted, efficiency = (
             _column(v, gear_ratio) for v in (gearbox.mass, gearbox.counted_inertia, gearbox.efficiency)

@@ -100,7 +100,7 @@ def torque_speed_record(problem: DesignProblem, result: DesignResult) -> list[Jo
 
     The points are :func:`collision_reflex.optimize.duty.torque_speed_points`; the envelope is the scaled
     motor's (:func:`collision_reflex.hardware.motors.scaled_motor_quantities`); the RMS motor torque is the
-    record's joint-side RMS divided by the gear ratio.
+    record's joint-side RMS divided by the gear ratio and the gearbox efficiency.
     """
     if problem.duty is None or result.required_rms_torque is None:
         return None
@@ -110,7 +110,9 @@ def torque_speed_record(problem: DesignProblem, result: DesignResult) -> list[Jo
     n = len(design.joint_names)
     continuous = np.broadcast_to(np.asarray(motor.continuous_torque, dtype=float), (n,))
     max_speed = None if motor.max_speed is None else np.broadcast_to(np.asarray(motor.max_speed, float), (n,))
-    rms_torque = np.asarray(result.required_rms_torque, dtype=float) / design.gear_ratio
+    rms_torque = np.asarray(result.required_rms_torque, dtype=float) / (
+        design.gearbox_efficiency * design.gear_ratio
+    )
     out: list[JointTorqueSpeed] = []
     for j, (name, points) in enumerate(
         zip(design.joint_names, torque_speed_points(problem, design), strict=True)

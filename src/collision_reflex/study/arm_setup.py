@@ -179,7 +179,7 @@ def _joint_gearboxes(
 ) -> tuple[CatalogueGearbox | None, ...] | None:
     """Each joint's gearbox (None: none), or None when no joint has one; every problem located.
 
-    A name is a catalogue entry of ``designs/gearboxes.yaml``; figures (:class:`GearboxSpec`) become an entry
+    A name is a catalogue entry of ``designs/gearboxes.yaml`` (the schema checks it); figures (:class:`GearboxSpec`) become an entry
     whose ratios are the joint's gear-ratio bounds. A gearbox whose ratios miss the joint's gear-ratio bounds
     is refused here, at the gearbox's line.
     """
@@ -195,16 +195,9 @@ def _joint_gearboxes(
         if override is not None and override.gearbox is not None:
             path, spec = ("actuators", "joints", joint, "gearbox"), override.gearbox
         gearbox: CatalogueGearbox | None = None
-        if isinstance(spec, str):
+        if isinstance(spec, str):  # a catalogue name, checked by the schema
             catalogue = catalogue if catalogue is not None else load_gearbox_catalogue()
-            gearbox = catalogue.get(spec)
-            if gearbox is None:
-                problems.append(
-                    loaded.problem(
-                        path, repr(spec), "a gearbox of designs/gearboxes.yaml: " + ", ".join(sorted(catalogue))
-                    )
-                )
-                continue
+            gearbox = catalogue[spec]
         elif spec is not None:
             scaled = gearbox_for(spec)
             assert scaled is not None  # a spec gives a gearbox

@@ -14,6 +14,7 @@ Every model forbids unknown keys. Quantities are floats in SI units once validat
 from __future__ import annotations
 
 import builtins
+import difflib
 import re
 from typing import Annotated, Any, Literal
 
@@ -143,9 +144,28 @@ class GearboxSpec(_Model):
     efficiency: float | None = Field(
         None, gt=0, le=1, description="efficiency (0, 1] [-]; null: 1 (arm studies)"
     )
-    max_input_speed: AngularSpeed | None = Field(
+    max_input_speed: AngularSpeed | None = Field(  # type: ignore[valid-type]
         None, gt=0, description="maximum input speed [rad/s]; null: none (arm studies)"
     )
+
+
+def _catalogue_gearbox(value: Any) -> Any:
+    """A gearbox name must be one of the packaged catalogue's (figures are checked by :class:`GearboxSpec`)."""
+    if not isinstance(value, str):
+        return value
+    from ..hardware.gearboxes import load_gearbox_catalogue
+
+    names = sorted(load_gearbox_catalogue())
+    if value not in names:
+        close = difflib.get_close_matches(value, names, n=1)
+        raise ValueError(
+            "a gearbox of the catalogue (designs/gearboxes.yaml): "
+            + (f"{close[0]!r}? " if close else "")
+            + "one of "
+            + ", ".join(map(repr, names))
+            + ", or the gearbox's figures"
+        )
+    return value
 
 
 class JointActuatorSpec(_Model):
@@ -159,6 +179,8 @@ class JointActuatorSpec(_Model):
     mechanical_stiffness: RotaryStiffness | None = Field(None, gt=0)
     software_stiffness: RotaryStiffness | None = Field(None, gt=0)
 
+    _known_gearbox = field_validator("gearbox")(_catalogue_gearbox)
+
 
 class ActuatorsSpec(_Model):
     """The actuator of every joint; ``joints`` overrides fields for named joints."""
@@ -170,12 +192,15 @@ class ActuatorsSpec(_Model):
         "null: none (the gear ratio alone)",
     )
     gearbox_inertia: bool = Field(
-        True, description="add the gearbox's input inertia to the reflected inertia; false: the paper's choice"
+        True,
+        description="add the gearbox's input inertia to the reflected inertia; false: the paper's choice",
     )
     gear_ratio: Ratio = Field(1.0, ge=1)
     mechanical_stiffness: RotaryStiffness = Field(gt=0, description="joint mechanical stiffness [N m/rad]")
     software_stiffness: RotaryStiffness = Field(gt=0, description="joint controller stiffness [N m/rad]")
     joints: dict[str, JointActuatorSpec] = Field(default_factory=dict)
+
+    _known_gearbox = field_validator("gearbox")(_catalogue_gearbox)
 
 
 # --- sensing -----------------------------------------------------------------------------------------------------
