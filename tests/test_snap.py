@@ -282,14 +282,20 @@ def test_a_gearbox_of_discrete_ratios_gets_an_offered_ratio(two_link):
     technology = dataclasses.replace(geared, gearboxes=(continuous, None))
     built = cr.build_problem(arm, problem.samples, problem.space, technology, OBJECTIVE, problem.constraints)
     optimum = cr.solve(built, starts=2)
-    ratio = optimum.design.gear_ratio[0]
     discrete = cr.build_problem(arm, problem.samples, problem.space, geared, OBJECTIVE, problem.constraints)
     snapped = snap_to_catalogue(discrete, optimum, _catalogue(), arm=arm, candidates=2)
     offered = np.array([5.0, 10.0, 20.0, 40.0])
-    bracket = {offered[offered <= ratio].max(initial=5.0), offered[offered >= ratio].min(initial=40.0)}
+    chosen = set()
     for part in snapped.joints[0].parts:
+        # The offered ratios around the one that gives this motor the continuous peak output torque.
+        matched = optimum.design.peak_torque[0] / part.motor.peak_torque
+        bracket = {
+            offered[offered <= matched].max(initial=5.0),
+            offered[offered >= matched].min(initial=40.0),
+        }
         assert part.gear_ratio.is_fixed and part.gear_ratio.lower in bracket
-    assert snapped.result.design.gear_ratio[0] in bracket
+        chosen.add(part.gear_ratio.lower)
+    assert snapped.result.design.gear_ratio[0] in chosen
     assert snapped.result.design.gearbox[0] == "HD"
 
 

@@ -11,7 +11,7 @@ software stiffness, threshold, approach velocity) are re-optimised for that choi
   there covers the cycle's RMS torque and that state a maximum speed), the ``candidates`` nearest to the
   continuous optimum's motor in :func:`motor_distance` (log peak torque and log rotor inertia). A joint whose
   gearbox offers discrete ratios gets, per motor, the offered ratios bracketing the continuous one as fixed gear
-  ratios; a gearbox given by its own figures is replaced by the nearest catalogue gearboxes of its kind
+  ratios (those that give the motor the continuous peak output torque); a gearbox given by its own figures is replaced by the nearest catalogue gearboxes of its kind
   (:func:`gearbox_options`). A joint with no candidate is reported ("no catalogue part within bounds") with the
   nearest motor and what it misses.
 - **Exact** when the combinations of candidates number at most ``max_combinations``: every one is re-solved
@@ -65,6 +65,7 @@ __all__ = [
     "matched_gear_ratio",
     "motor_distance",
     "objective_value",
+    "quick_parts",
     "snap_to_catalogue",
     "solve_parts",
 ]
@@ -140,7 +141,10 @@ class JointCandidates:
 
 @dataclass(frozen=True)
 class Trial:
-    """One combination tried: a part label per joint, its objective value (None: no feasible design) and status."""
+    """One combination tried: a part label per joint, its objective value (None: no feasible design) and status.
+
+    The status is IPOPT's, or ``"refused: ..."`` when the problem of these parts was refused before solving.
+    """
 
     parts: tuple[str, ...]
     objective: float | None
@@ -226,7 +230,7 @@ def joint_candidates(
             for m in fitting
             for gearbox, listed in options
             for part in _parts_of(
-                m, space_ratios[j], gearbox, listed, float(design.gear_ratio[j]), torque, inertia
+                m, space_ratios[j], gearbox, listed, float(design.peak_torque[j]), torque, inertia
             )
         )
         nearest = ranked[0].name
@@ -366,22 +370,24 @@ def _parts_of(
     ratio: Bounds,
     gearbox: CatalogueGearbox | None,
     from_catalogue: bool,
-    continuous_ratio: float,
+    output_torque: float,
     torque: float,
     inertia: float,
 ) -> list[CataloguePart]:
-    """``motor``'s parts with ``gearbox``: the ratio bounds, or the offered ratios bracketing the continuous one.
+    """``motor``'s parts with ``gearbox``: the ratio bounds, or the offered ratios bracketing the matched one.
 
-    ``ratio``: the joint's gear-ratio bounds of the design space (the problem intersects them with the
-    gearbox's range); ``continuous_ratio``, ``torque`` [N*m], ``inertia`` [kg*m^2]: the continuous optimum's.
+    The matched ratio gives ``motor`` the continuous optimum's peak output torque ``output_torque`` [N*m]
+    (:func:`matched_gear_ratio`). ``ratio``: the joint's gear-ratio bounds of the design space (the problem
+    intersects them with the gearbox's range); ``torque`` [N*m], ``inertia`` [kg*m^2]: the continuous motor's.
     """
+    matched = output_torque / motor.peak_torque
     distance = motor_distance(motor, torque, inertia)
     if gearbox is None or gearbox.continuous_ratio:
         return [CataloguePart(motor, ratio, distance, gearbox, from_catalogue)]
     low, high = ratio.lower * (1 - BOUND_TOLERANCE), ratio.upper * (1 + BOUND_TOLERANCE)
     offered = [r for r in gearbox.ratios if low <= r <= high]
-    below = [r for r in offered if r <= continuous_ratio]
-    above = [r for r in offered if r >= continuous_ratio]
+    below = [r for r in offered if r <= matched]
+    above = [r for r in offered if r >= matched]
     bracket = sorted({*below[-1:], *above[:1]})
     return [
         CataloguePart(motor, Bounds.fixed(float(r), ratio.name), distance, gearbox, from_catalogue)
@@ -531,6 +537,9 @@ class _Search:
         except SolverFailed as error:
             self.values[combination] = math.inf
             self.tried[combination] = Trial(labels, None, error.status)
+        except InvalidParameter as error:  # refused before solving: no design of these parts can meet it
+            self.values[combination] = math.inf
+            self.tried[combination] = Trial(labels, None, f"refused: {error}")
         else:
             value = objective_value(self.problem, result.numpy_objectives)
             self.values[combination], self.results[combination] = value, result
@@ -598,6 +607,25 @@ def catalogue_problem(problem: DesignProblem, parts: Sequence[CataloguePart], ar
     )
 
 
+def quick_parts(joints: Sequence[JointCandidates], design: Design) -> tuple[CataloguePart, ...] | None:
+    """Each joint's nearest part for a quick snap, None when a joint has none.
+
+    The nearest motor's, and of its offered gear ratios (a gearbox of discrete ratios) the smallest that keeps
+    ``design``'s peak output torque, else the largest.
+    """
+    chosen = []
+    for j, joint in enumerate(joints):
+        if not joint.parts:
+            return None
+        motor = joint.parts[0].motor
+        own = [p for p in joint.parts if p.motor is motor]
+        wanted = float(design.peak_torque[j]) / motor.peak_torque * (1 - BOUND_TOLERANCE)
+        chosen.append(
+            next((p for p in own if not p.gear_ratio.is_fixed or p.gear_ratio.lower >= wanted), own[-1])
+        )
+    return tuple(chosen)
+
+
 def _parts_technology(problem: DesignProblem, parts: Sequence[CataloguePart]) -> ActuatorTechnology:
     """``problem``'s technology with each joint's motor (and gearbox) the one of ``parts``."""
     chosen = tuple(p.gearbox for p in parts)
@@ -635,6 +663,8 @@ def solve_parts(
     Raises
     ------
     SolverFailed: no design of these parts meets the constraints (or the solver did not converge).
+    InvalidParameter: the problem of these parts is refused before solving (a duty-cycle requirement or a
+        gearbox rating that no design within the bounds can meet).
     """
     built = catalogue_problem(problem, parts, arm)
     design = optimum.design

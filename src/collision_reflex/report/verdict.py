@@ -308,7 +308,12 @@ def catalogue_sentences(catalogue: Mapping[str, Any]) -> list[str]:
             f"No design built from catalogue parts meets the requirements ({catalogue['method']}).",
             *warnings,
         ]
-    parts = ", ".join(f"{j['joint']} {j['part']} at N = {_g(j['gear_ratio'])}" for j in catalogue["joints"])
+    parts = ", ".join(
+        f"{j['joint']} {j['motor']}"
+        + (f" + {j['gearbox']}" if j["gearbox"] else "")
+        + f" at N = {_g(j['gear_ratio'])}"
+        for j in catalogue["joints"]
+    )
     costs = ", ".join(
         f"{_words(name)} {'+' if change >= 0 else '−'}{_percent(abs(change) * 100)} %"
         for name in ("worst_case_impulse", "mean_impulse", "actuator_mass")

@@ -413,7 +413,7 @@ def quick_snap_record(
 ) -> dict[str, Any]:
     """A design's quick catalogue snap: the nearest candidate per joint, evaluated without a re-solve.
 
-    Each joint's nearest part within bounds (:func:`collision_reflex.optimize.snap.joint_candidates`) at the
+    Each joint's nearest part within bounds (:func:`collision_reflex.optimize.snap.quick_parts`) at the
     gear ratio that keeps the joint's peak torque, raised where the parts' own masses need more
     (:func:`collision_reflex.optimize.snap.evaluate_parts`), the other variables the design's. Measured on the
     full Panda study: 8 ms per design, where re-solving it (build and IPOPT) takes about 0.8 s. ``parts``: the
@@ -422,14 +422,17 @@ def quick_snap_record(
     ``objectives``, ``difference``, ``relative_difference``: as in :class:`CatalogueRecord` (empty without
     parts).
     """
-    from ..optimize.snap import evaluate_parts, joint_candidates
+    from ..optimize.snap import evaluate_parts, joint_candidates, quick_parts
 
     joints = joint_candidates(problem, result, catalogue.motors, 1, catalogue.gearboxes or None, 1)
     missing = [
         {"joint": j.joint, "nearest": j.nearest, "misses": list(j.misses)} for j in joints if not j.parts
     ]
+    parts = quick_parts(joints, result.design)
     record: dict[str, Any] = {
-        "parts": [j.parts[0].label if j.parts else None for j in joints],
+        "parts": [j.parts[0].label if j.parts else None for j in joints]
+        if parts is None
+        else [p.label for p in parts],
         "missing": missing,
         "feasible": False,
         "shortfalls": [],
@@ -437,9 +440,9 @@ def quick_snap_record(
         "difference": {},
         "relative_difference": {},
     }
-    if missing:
+    if parts is None:
         return record
-    evaluated = evaluate_parts(problem, result.design, [j.parts[0] for j in joints])
+    evaluated = evaluate_parts(problem, result.design, parts)
     continuous = result.numpy_objectives
     difference = {k: v - continuous[k] for k, v in evaluated.objectives.items()}
     record.update(
