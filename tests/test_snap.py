@@ -369,3 +369,40 @@ def test_a_changed_catalogue_is_snapped_again_on_resume(tmp_path):
     assert again.computed == 1
     second = json.loads((folder / "points" / "catalogue.json").read_text())
     assert second["key"] != first["key"] and second["joints"] == first["joints"]
+
+
+def test_a_catalogue_with_no_part_within_bounds_is_reported_in_the_files(tmp_path):
+    motors = tmp_path / "tiny.yaml"
+    motors.write_text(
+        "motors:\n"
+        "  tiny:\n"
+        "    stator_diameter: 20 mm\n"
+        "    stack_length: 5 mm\n"
+        "    rotor_inertia: 1.0e-7 kg*m^2\n"
+        "    peak_torque: 0.01 N*m\n"
+        "    continuous_torque: 0.004 N*m\n"
+        "    mass: 0.01 kg\n"
+        "    source: a test motor\n"
+        "    estimates: {mass: a guess for the test}\n"
+    )
+    folder = tmp_path / "out"
+    cr.run_study(
+        _study_with(tmp_path, "{motors: tiny.yaml}"), folder, quiet=True, smoke=True, executor="serial"
+    )
+    catalogue = json.loads((folder / "designs.json").read_text())["catalogue"]
+    # 0.01 N*m x the largest ratio 100 = 1 N*m of the 1.3 N*m every joint must give: 0.3 N*m short.
+    assert catalogue["design"] is None and catalogue["method"].startswith("none: joint1: no catalogue part")
+    for joint in catalogue["joints"]:
+        assert joint["part"] is None and joint["nearest"] == "tiny"
+        assert joint["misses"] == [
+            "peak torque 0.01 N*m x the largest gear ratio 100 = 1 N*m, short of the required 1.3 N*m by 0.3 N*m"
+        ]
+    report = (folder / "report.html").read_text()
+    assert (
+        'id="catalogue-none"' in report and "no catalogue part within bounds; nearest tiny misses" in report
+    )
+    import pandas as pd
+
+    table = pd.read_csv(folder / "pareto.csv")
+    assert set(table["catalogue_part[joint1]"]) == {"none within bounds"}
+    assert not table["catalogue_feasible"].any()
