@@ -29,7 +29,7 @@ if TYPE_CHECKING:
     from ..hardware.gearboxes import CatalogueGearbox
     from ..hardware.motors import Motor
     from ..optimize import DesignProblem, DesignResult, ParetoSet
-    from ..optimize.snap import CataloguePart
+    from ..optimize.snap import CatalogueDesign, CataloguePart
     from .load import LoadedStudy
 
 SAVED_DIGITS = 7
@@ -361,31 +361,7 @@ def catalogue_results(
         ipopt_options=IPOPT_OPTIONS,
         progress=progress,
     )
-    joints = []
-    for j, candidates in enumerate(snap.joints):
-        part = snap.parts[j] if snap.parts is not None else None
-        joints.append(
-            {
-                "joint": candidates.joint,
-                "part": None if part is None else part.label,
-                "motor": None if part is None else part.motor.name,
-                "gearbox": None if part is None or part.gearbox is None else part.gearbox.name,
-                "gearbox_from_catalogue": None if part is None else part.gearbox_from_catalogue,
-                "gearbox_source": None if part is None or part.gearbox is None else part.gearbox.source,
-                "gearbox_estimates": {}
-                if part is None or part.gearbox is None
-                else _estimates(catalogue.provenance.get(part.gearbox.name, {})),
-                "gear_ratio": None if snap.result is None else float(snap.result.design.gear_ratio[j]),
-                "continuous_gear_ratio": float(recommendation.result.design.gear_ratio[j]),
-                "stator_diameter": None if part is None else part.motor.stator_diameter,
-                "continuous_stator_diameter": float(recommendation.result.design.stator_diameter[j]),
-                **_provenance(part, catalogue),
-                "candidates": [p.label for p in candidates.parts],
-                "nearest": candidates.nearest,
-                "misses": list(candidates.misses),
-                "warning": candidates.warning,
-            }
-        )
+    joints = [_joint_record(snap, j, catalogue) for j in range(len(snap.joints))]
     results = front.points if front is not None and front.points else (chosen,)
     return {
         "key": catalogue.key,
@@ -405,6 +381,34 @@ def catalogue_results(
         "tried": [{"parts": list(t.parts), "objective": t.objective, "status": t.status} for t in snap.tried],
         "pareto": [quick_snap_record(problem, r, catalogue) for r in results],
         "solve_time": time.perf_counter() - started,
+    }
+
+
+def _joint_record(snap: CatalogueDesign, j: int, catalogue: SnapCatalogue) -> dict[str, Any]:
+    """Joint ``j`` of a catalogue snap as plain data: its part and provenance, next to the continuous design."""
+    candidates = snap.joints[j]
+    part = snap.parts[j] if snap.parts is not None else None
+    gearbox = None if part is None else part.gearbox
+    continuous = snap.continuous.design
+    return {
+        "joint": candidates.joint,
+        "part": None if part is None else part.label,
+        "motor": None if part is None else part.motor.name,
+        "gearbox": None if gearbox is None else gearbox.name,
+        "gearbox_from_catalogue": None if part is None else part.gearbox_from_catalogue,
+        "gearbox_source": None if gearbox is None else gearbox.source,
+        "gearbox_estimates": {}
+        if gearbox is None
+        else _estimates(catalogue.provenance.get(gearbox.name, {})),
+        "gear_ratio": None if snap.result is None else float(snap.result.design.gear_ratio[j]),
+        "continuous_gear_ratio": float(continuous.gear_ratio[j]),
+        "stator_diameter": None if part is None else part.motor.stator_diameter,
+        "continuous_stator_diameter": float(continuous.stator_diameter[j]),
+        **_provenance(part, catalogue),
+        "candidates": [p.label for p in candidates.parts],
+        "nearest": candidates.nearest,
+        "misses": list(candidates.misses),
+        "warning": candidates.warning,
     }
 
 
