@@ -406,3 +406,11 @@ def test_a_catalogue_with_no_part_within_bounds_is_reported_in_the_files(tmp_pat
     table = pd.read_csv(folder / "pareto.csv")
     assert set(table["catalogue_part[joint1]"]) == {"none within bounds"}
     assert not table["catalogue_feasible"].any()
+
+
+def test_the_snap_gives_the_same_catalogue_design_through_a_process_pool(tmp_path):
+    serial, pool = tmp_path / "serial", tmp_path / "pool"
+    cr.run_study(TWO_LINK_STUDY, serial, quiet=True, smoke=True, executor="serial")
+    cr.run_study(TWO_LINK_STUDY, pool, quiet=True, smoke=True, executor="processes", workers=2)
+    entries = [json.loads((folder / "designs.json").read_text())["catalogue"] for folder in (serial, pool)]
+    assert entries[0] == entries[1]

@@ -57,6 +57,7 @@ __all__ = [
     "CataloguePart",
     "JointCandidates",
     "PartsEvaluation",
+    "PartsSolver",
     "Trial",
     "catalogue_problem",
     "evaluate_parts",
@@ -68,7 +69,13 @@ __all__ = [
     "quick_parts",
     "snap_to_catalogue",
     "solve_parts",
+    "solved_or_status",
 ]
+
+PartsSolver = Callable[[Sequence[tuple["CataloguePart", ...]]], list["DesignResult | str"]]
+"""``solve_many(combinations)``: each combination (one part per joint) re-optimised, in any order or place (an
+executor's workers), as its :class:`DesignResult`, or the status that says why it has none (IPOPT's, or
+``"refused: ..."`` for a problem refused before solving). Default: :func:`solve_parts` in this process."""
 
 DEFAULT_CANDIDATES = 3
 """Catalogue motors considered per joint by default."""
@@ -429,6 +436,7 @@ def snap_to_catalogue(
     max_combinations: int = DEFAULT_MAX_COMBINATIONS,
     ipopt_options: IpoptOptions | None = None,
     progress: Callable[[int, int], None] | None = None,
+    solve_many: PartsSolver | None = None,
 ) -> CatalogueDesign:
     """The best design built from catalogue motors near ``optimum``, re-optimised (module docstring).
 
@@ -446,7 +454,10 @@ def snap_to_catalogue(
     gearbox_candidates: catalogue gearboxes considered per joint with the study's own gearbox figures (>= 1).
     max_combinations: the most combinations enumerated exactly (>= 1); beyond, the heuristic runs.
     ipopt_options: options of every re-solve (see :func:`collision_reflex.optimize.solve`).
-    progress: called as ``progress(done, total)`` after each combination solved.
+    progress: called as ``progress(done, total)`` after each batch of combinations solved.
+    solve_many: how combinations are solved (:data:`PartsSolver`), e.g. through an executor; default in this
+        process. The combinations of a batch (every one when enumerating; a joint's candidates in a step of the
+        heuristic) are independent, and the answer does not depend on where they run.
 
     Raises
     ------
@@ -465,12 +476,13 @@ def snap_to_catalogue(
             for j in empty
         ]
         return _design(joints, None, None, optimum, (), "none: " + " / ".join(reasons), [*warnings, *reasons])
-    search = _Search(problem, optimum, arm, [j.parts for j in joints], ipopt_options, progress)
+    if solve_many is None:
+        solve_many = _InProcess(problem, optimum, arm, ipopt_options)
+    search = _Search(problem, [j.parts for j in joints], solve_many, progress)
     total = math.prod(len(j.parts) for j in joints)
     if total <= max_combinations:
         search.total = total
-        for combination in itertools.product(*(range(len(j.parts)) for j in joints)):
-            search.value(combination)
+        search.values_of(list(itertools.product(*(range(len(j.parts)) for j in joints))))
         method = f"exact: enumerated {total} combinations"
     else:
         passes = search.descend()
@@ -507,58 +519,88 @@ def _design(
     )
 
 
+@dataclass(frozen=True)
+class _InProcess:
+    """The default :data:`PartsSolver`: :func:`solve_parts` for each combination, here, one after the other."""
+
+    problem: DesignProblem
+    optimum: DesignResult
+    arm: Arm
+    ipopt_options: IpoptOptions | None
+
+    def __call__(self, combinations: Sequence[tuple[CataloguePart, ...]]) -> list[DesignResult | str]:
+        return [
+            solved_or_status(self.problem, self.optimum, parts, self.arm, self.ipopt_options)
+            for parts in combinations
+        ]
+
+
+def solved_or_status(
+    problem: DesignProblem,
+    optimum: DesignResult,
+    parts: Sequence[CataloguePart],
+    arm: Arm,
+    ipopt_options: IpoptOptions | None = None,
+) -> DesignResult | str:
+    """:func:`solve_parts`, or the status that says why these parts have no design (see :data:`PartsSolver`)."""
+    try:
+        return solve_parts(problem, optimum, parts, arm, ipopt_options)
+    except SolverFailed as error:
+        return error.status
+    except InvalidParameter as error:  # refused before solving: no design of these parts can meet it
+        return f"refused: {error}"
+
+
 class _Search:
     """Solves combinations of candidate parts (by index per joint) once each, and keeps their values."""
 
     def __init__(
         self,
         problem: DesignProblem,
-        optimum: DesignResult,
-        arm: Arm,
         parts: list[tuple[CataloguePart, ...]],
-        ipopt_options: IpoptOptions | None,
+        solve_many: PartsSolver,
         progress: Callable[[int, int], None] | None,
     ) -> None:
-        self.problem, self.optimum, self.arm, self.parts = problem, optimum, arm, parts
-        self.ipopt_options, self.progress = ipopt_options, progress
+        self.problem, self.parts, self.solve_many, self.progress = problem, parts, solve_many, progress
         self.values: dict[tuple[int, ...], float] = {}
         self.results: dict[tuple[int, ...], DesignResult] = {}
         self.tried: dict[tuple[int, ...], Trial] = {}
         self.total = 0
 
-    def value(self, combination: tuple[int, ...]) -> float:
-        """The problem's objective of the combination re-optimised; inf when it has no feasible design."""
-        if combination in self.values:
-            return self.values[combination]
-        chosen = tuple(self.parts[j][c] for j, c in enumerate(combination))
-        labels = tuple(p.label for p in chosen)
-        try:
-            result = solve_parts(self.problem, self.optimum, chosen, self.arm, self.ipopt_options)
-        except SolverFailed as error:
-            self.values[combination] = math.inf
-            self.tried[combination] = Trial(labels, None, error.status)
-        except InvalidParameter as error:  # refused before solving: no design of these parts can meet it
-            self.values[combination] = math.inf
-            self.tried[combination] = Trial(labels, None, f"refused: {error}")
-        else:
-            value = objective_value(self.problem, result.numpy_objectives)
-            self.values[combination], self.results[combination] = value, result
-            self.tried[combination] = Trial(labels, value, result.status)
-        if self.progress is not None:
+    def values_of(self, combinations: list[tuple[int, ...]]) -> list[float]:
+        """The problem's objective of each combination re-optimised (inf: no feasible design); new ones solved."""
+        new = [c for c in dict.fromkeys(combinations) if c not in self.values]
+        chosen = [tuple(self.parts[j][i] for j, i in enumerate(c)) for c in new]
+        for combination, parts, solved in zip(new, chosen, self.solve_many(chosen), strict=True):
+            labels = tuple(p.label for p in parts)
+            if isinstance(solved, str):
+                self.values[combination] = math.inf
+                self.tried[combination] = Trial(labels, None, solved)
+            else:
+                value = objective_value(self.problem, solved.numpy_objectives)
+                self.values[combination], self.results[combination] = value, solved
+                self.tried[combination] = Trial(labels, value, solved.status)
+        if new and self.progress is not None:
             self.progress(len(self.tried), max(self.total, len(self.tried)))
-        return self.values[combination]
+        return [self.values[c] for c in combinations]
 
     def descend(self) -> int:
-        """Coordinate descent from the nearest parts until a pass improves nothing; the number of passes."""
+        """Coordinate descent from the nearest parts until a pass improves nothing; the number of passes.
+
+        A step solves every candidate of one joint with the others held (one batch) and moves to the best, if
+        it is better than the current design (the first among equals).
+        """
         current = (0,) * len(self.parts)
-        value, passes, improved = self.value(current), 0, True
+        (value,) = self.values_of([current])
+        passes, improved = 0, True
         while improved:
             improved, passes = False, passes + 1
             for j, joint_parts in enumerate(self.parts):
-                for c in range(len(joint_parts)):
-                    trial = (*current[:j], c, *current[j + 1 :])
-                    if trial != current and self.value(trial) < value:
-                        current, value, improved = trial, self.values[trial], True
+                options = [(*current[:j], c, *current[j + 1 :]) for c in range(len(joint_parts))]
+                values = self.values_of(options)
+                best = min(range(len(options)), key=lambda i: values[i])
+                if values[best] < value:
+                    current, value, improved = options[best], values[best], True
         return passes
 
     def best(self) -> tuple[int, ...] | None:

@@ -10,8 +10,10 @@ from __future__ import annotations
 
 import hashlib
 import math
+import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from concurrent.futures import Executor
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NotRequired, TypedDict
@@ -338,11 +340,13 @@ def catalogue_results(
     front: ParetoSet | None,
     catalogue: SnapCatalogue,
     progress: Callable[[int, int], None] | None = None,
+    executor: Executor | None = None,
 ) -> CatalogueRecord:
     """The recommended design snapped to ``catalogue`` (re-solved), and every Pareto design's quick snap.
 
     The recommended design is snapped by :func:`collision_reflex.optimize.snap.snap_to_catalogue` (exact or
-    heuristic); each Pareto design (the chosen one without a front) by :func:`quick_snap_record`.
+    heuristic), its combinations solved through ``executor`` (default in this process: the same numbers
+    either way); each Pareto design (the chosen one without a front) by :func:`quick_snap_record`.
     """
     from ..optimize.snap import snap_to_catalogue
     from .arm_setup import IPOPT_OPTIONS
@@ -360,6 +364,7 @@ def catalogue_results(
         max_combinations=catalogue.max_combinations,
         ipopt_options=IPOPT_OPTIONS,
         progress=progress,
+        solve_many=None if executor is None else _ThroughExecutor(problems, recommendation.result, executor),
     )
     joints = [_joint_record(snap, j, catalogue) for j in range(len(snap.joints))]
     results = front.points if front is not None and front.points else (chosen,)
@@ -382,6 +387,48 @@ def catalogue_results(
         "pareto": [quick_snap_record(problem, r, catalogue) for r in results],
         "solve_time": time.perf_counter() - started,
     }
+
+
+_SNAP_LOCK = threading.RLock()
+"""CasADi and IPOPT are not thread-safe: a process (a Dask worker with several threads) solves one combination
+at a time; the snap runs after the sweep, so its pieces never meet the sweep's."""
+
+
+@dataclass(frozen=True)
+class _ThroughExecutor:
+    """A :data:`collision_reflex.optimize.snap.PartsSolver` that solves each combination as a piece of work."""
+
+    problems: StudyProblems
+    optimum: DesignResult
+    executor: Executor
+
+    def __call__(self, combinations: Sequence[tuple[CataloguePart, ...]]) -> list[DesignResult | str]:
+        futures = [
+            self.executor.submit(solve_study_parts, self.problems, self.optimum, c) for c in combinations
+        ]
+        try:
+            return [future.result() for future in futures]
+        except BaseException:
+            for future in futures:
+                future.cancel()
+            raise
+
+
+def solve_study_parts(
+    problems: StudyProblems, optimum: DesignResult, parts: tuple[CataloguePart, ...]
+) -> DesignResult | str:
+    """One combination of a study's catalogue snap, in any process (its problem built there once).
+
+    One solve at a time per process with single-threaded BLAS, as every piece of a sweep, so that the numbers
+    are the same on every executor.
+    """
+    from ..optimize.blas import single_threaded_blas
+    from ..optimize.snap import solved_or_status
+    from .arm_setup import IPOPT_OPTIONS
+
+    with _SNAP_LOCK, single_threaded_blas():
+        problem = built_problem(problems, problems.objective)
+        return solved_or_status(problem, optimum, parts, problems.setup.arm, IPOPT_OPTIONS)
 
 
 def _joint_record(snap: CatalogueDesign, j: int, catalogue: SnapCatalogue) -> dict[str, Any]:

@@ -308,7 +308,7 @@ def _run_arm(
             snapped, reused = cast("CatalogueRecord", saved), reused + 1
         else:
             snapped = catalogue_results(
-                problems, optimum, front, catalogue, progress.counter("catalogue snap")
+                problems, optimum, front, catalogue, progress.counter("catalogue snap"), pool
             )
             folder.save("catalogue", dict(snapped))
             computed += 1
