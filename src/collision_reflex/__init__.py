@@ -94,6 +94,7 @@ if TYPE_CHECKING:  # the names as type checkers and IDEs see them; at run time `
         OBJECTIVES,
         ActuatorTechnology,
         Bounds,
+        CatalogueDesign,
         Constraints,
         ContactSamples,
         Design,
@@ -104,6 +105,7 @@ if TYPE_CHECKING:  # the names as type checkers and IDEs see them; at run time `
         build_problem,
         hypervolume,
         pareto_front,
+        snap_to_catalogue,
     )
     from .optimize.results import result_from_json, result_to_json
     from .optimize.solve import solve  # from its module: mypy confuses it with `optimize.solve`
@@ -222,6 +224,7 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
         "OBJECTIVES",
         "ActuatorTechnology",
         "Bounds",
+        "CatalogueDesign",
         "Constraints",
         "ContactSamples",
         "Design",
@@ -232,6 +235,7 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
         "build_problem",
         "hypervolume",
         "pareto_front",
+        "snap_to_catalogue",
         "solve",
     ),
     ".optimize.results": (
@@ -284,6 +288,7 @@ __all__ = [
     "ArmCollision",
     "ArmSamples",
     "Bounds",
+    "CatalogueDesign",
     "CatalogueError",
     "CollisionImpulses",
     "CollisionParameters",
@@ -365,6 +370,7 @@ __all__ = [
     "simulate_arm_collision",
     "simulate_collision",
     "simulation_sweep",
+    "snap_to_catalogue",
     "solve",
     "sphere_directions",
     "study_json_schema",

@@ -5,7 +5,8 @@ CasADi + IPOPT choose motor size, gear ratio, stiffness, threshold and approach 
 Build and solve are separate: :func:`build_problem` returns an inspectable :class:`DesignProblem`,
 :func:`solve` runs IPOPT and returns a :class:`DesignResult`; :func:`pareto_front` sweeps objectives into a
 :class:`ParetoSet` (in-process or through any executor); :mod:`.results` makes the one result record and table
-row of a design; :mod:`.duty` turns a duty cycle into peak, RMS and speed constraints.
+row of a design; :mod:`.duty` turns a duty cycle into peak, RMS and speed constraints; :func:`snap_to_catalogue` builds the best design
+from catalogue parts near a continuous optimum (:class:`CatalogueDesign`).
 """
 
 from .constraints import Constraints
@@ -13,6 +14,7 @@ from .objectives import OBJECTIVES
 from .pareto import ParetoSet, hypervolume, pareto_front
 from .problem import DesignProblem, build_problem
 from .samples import ContactSamples
+from .snap import CatalogueDesign, snap_to_catalogue
 from .solve import Design, DesignResult, design_at, solve
 from .space import Bounds, DesignSpace
 from .technology import ActuatorTechnology
@@ -21,6 +23,7 @@ __all__ = [
     "OBJECTIVES",
     "ActuatorTechnology",
     "Bounds",
+    "CatalogueDesign",
     "Constraints",
     "ContactSamples",
     "Design",
@@ -32,5 +35,6 @@ __all__ = [
     "design_at",
     "hypervolume",
     "pareto_front",
+    "snap_to_catalogue",
     "solve",
 ]

@@ -354,11 +354,11 @@ def nearest_catalogue_motor(catalogue: Mapping[str, Motor], peak_torque: float, 
 
     Closest in (log peak torque, log rotor inertia): the off-the-shelf part a designer would start from.
     """
+    from .snap import motor_distance
+
     best, best_distance = "", math.inf
     for name, motor in catalogue.items():
-        distance = math.hypot(
-            math.log(motor.peak_torque / peak_torque), math.log(motor.rotor_inertia / rotor_inertia)
-        )
+        distance = motor_distance(motor, peak_torque, rotor_inertia)
         if distance < best_distance:
             best, best_distance = name, distance
     return best
@@ -382,7 +382,31 @@ def record_row(record: Mapping[str, Any], index: int) -> dict[str, Any]:
         for joint in record["joints"]:
             row[f"{key}[{joint['joint']}] [{unit}]"] = joint[key]
     row[f"threshold [{threshold_unit(record['sensing'])}]"] = record["threshold"]
+    row.update(catalogue_columns(record))
     row["status"] = record["solver"]["status"]
     row["iterations"] = record["solver"]["iterations"]
     row["solve_time [s]"] = record["solver"]["solve_time"]
+    return row
+
+
+NO_PART = "none within bounds"
+"""A catalogue-part cell of a joint with no catalogue part within the design's bounds."""
+
+
+def catalogue_columns(record: Mapping[str, Any]) -> dict[str, Any]:
+    """A design's catalogue snap as table columns (none when the record has no snap).
+
+    Per joint the catalogue part (``catalogue_part[joint1]``, :data:`NO_PART` when none is within bounds), then
+    whether the catalogue design meets every requirement as snapped and its objectives [their units], empty
+    without parts (:func:`collision_reflex.study.arm_results.quick_snap_record`).
+    """
+    snapped = record.get("catalogue")
+    if snapped is None:
+        return {}
+    row: dict[str, Any] = {}
+    for joint, part in zip(record["joints"], snapped["parts"], strict=True):
+        row[f"catalogue_part[{joint['joint']}]"] = NO_PART if part is None else part
+    row["catalogue_feasible"] = snapped["feasible"]
+    for name, (_, unit, _) in OBJECTIVES.items():
+        row[f"catalogue_{name} [{unit}]"] = snapped["objectives"].get(name)
     return row

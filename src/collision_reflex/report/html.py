@@ -134,6 +134,13 @@ def _velocity_summary(record: dict[str, Any]) -> dict[str, float]:
     }
 
 
+def _objective_units() -> dict[str, str]:
+    """Each optimiser objective's unit, by name (the catalogue section's columns)."""
+    from ..optimize import OBJECTIVES
+
+    return {name: unit for name, (_, unit, _) in OBJECTIVES.items()}
+
+
 def render_html(results: dict[str, Any], rows: list[dict[str, Any]], svgs: dict[str, str]) -> str:
     """The report page for a run's results; ``rows`` are the rows of ``pareto.csv``."""
     import jinja2
@@ -164,6 +171,7 @@ def render_html(results: dict[str, Any], rows: list[dict[str, Any]], svgs: dict[
         # re-rendered from an edited designs.json says what its numbers say.
         context["verdict"] = verdict(results)
         context["duty_cycle"] = has_duty_cycle(results)
+        context["objective_units"] = _objective_units()
         context["velocity"] = {
             "chosen": _velocity_summary(results["chosen"]),
             **{str(i): _velocity_summary(p) for i, p in enumerate(results["pareto"]["points"])},

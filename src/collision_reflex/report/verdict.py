@@ -3,8 +3,8 @@
 One place for the HTML report, ``designs.json`` (``verdict``) and ``crx run``'s closing print: the recommended
 design, the bounds and constraints that are active on each joint, how far each objective spans over the front
 (and a plain sentence when the front is flat or degenerate), the lightest design near the best impulse, the kind
-of torque requirement, and warnings about oversized joints. Every function reads plain data (the records of
-:func:`collision_reflex.optimize.results.design_record` and the results of
+of torque requirement, warnings about oversized joints, and the design built from catalogue parts. Every
+function reads plain data (the records of :func:`collision_reflex.optimize.results.design_record` and the results of
 :func:`collision_reflex.study.arm_results.arm_results`), so the verdict can be redone from a saved
 ``designs.json``.
 """
@@ -291,11 +291,43 @@ def verdict(results: Mapping[str, Any]) -> list[str]:
         lines.append(near[1])
     if bounds is not None:
         lines += oversized_warnings(recommended, bounds)
+    if results.get("catalogue"):
+        lines += catalogue_sentences(results["catalogue"])
     return lines
+
+
+def catalogue_sentences(catalogue: Mapping[str, Any]) -> list[str]:
+    """The catalogue design in one sentence, what it costs against the continuous one, and its warnings.
+
+    ``catalogue``: the ``catalogue`` entry of the results (:class:`collision_reflex.study.arm_results.
+    CatalogueRecord`).
+    """
+    warnings = [f"Warning: {text}." for text in catalogue["warnings"]]
+    if catalogue["design"] is None:
+        return [
+            f"No design built from catalogue parts meets the requirements ({catalogue['method']}).",
+            *warnings,
+        ]
+    parts = ", ".join(
+        f"{j['joint']} {j['motor']}"
+        + (f" + {j['gearbox']}" if j["gearbox"] else "")
+        + f" at N = {_g(j['gear_ratio'])}"
+        for j in catalogue["joints"]
+    )
+    costs = ", ".join(
+        f"{_words(name)} {'+' if change >= 0 else '−'}{_percent(abs(change) * 100)} %"
+        for name in ("worst_case_impulse", "mean_impulse", "actuator_mass")
+        if (change := catalogue["relative_difference"].get(name)) is not None
+    )
+    return [
+        f"Built from catalogue parts ({catalogue['method']}): {parts}; against the continuous design {costs}.",
+        *warnings,
+    ]
 
 
 __all__ = [
     "bound_position",
+    "catalogue_sentences",
     "design_sentence",
     "front_sentences",
     "joint_limits",

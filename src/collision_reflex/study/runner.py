@@ -17,9 +17,9 @@ from collections.abc import Callable
 from concurrent.futures import Executor
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
-from .arm_results import arm_results
+from .arm_results import CatalogueRecord, SnapCatalogue, arm_results, catalogue_results, study_catalogue
 from .executors import open_executor
 from .load import LoadedStudy, load_study, parse_study
 from .resolve import fingerprint, resolved_study, resolved_yaml
@@ -137,6 +137,7 @@ def run_study(
     # Robot, motors, samples and the problem build: every problem is raised here, located in the file as
     # written, before any output.
     _prepare(as_written, text)
+    catalogue = study_catalogue(loaded) if isinstance(loaded.study, ArmStudy) else None
     folder = RunFolder(Path(out) if out is not None else default_output_folder(loaded, smoke))
     execution = resolved.get("execution", {})
     kind = executor or execution.get("executor", "serial")
@@ -161,7 +162,7 @@ def run_study(
         window = 1 if kind == "serial" and scheduler is None else (10**6 if scheduler else 2 * n_workers)
         with open_executor(kind, n_workers, scheduler) as pool:
             if isinstance(loaded.study, ArmStudy):
-                results, counts = _run_arm(loaded.study, text, folder, pool, progress, window)
+                results, counts = _run_arm(loaded.study, text, folder, pool, progress, window, catalogue)
             else:
                 results, counts = _run_actuators(loaded, folder, progress)
         progress.stop()
@@ -254,10 +255,13 @@ def _run_arm(
     pool: Executor,
     progress: _Progress,
     window: int,
+    catalogue: SnapCatalogue | None = None,
 ) -> tuple[dict[str, Any], tuple[int, int]]:
     """The study's optimum (multi-started), its Pareto front by the optimiser's one sweep, and the verdict.
 
-    Each piece is saved as it finishes and found again when the run resumes.
+    Then, with a ``catalogue``, the recommended design and every Pareto design snapped to it
+    (:func:`.arm_results.catalogue_results`). Each piece is saved as it finishes and found again when the run
+    resumes (the snap as ``catalogue``, reused while the catalogue file and the settings are the same).
     """
     from ..errors import SolverFailed, StudyRunFailed
     from ..optimize.pareto import OPTIMUM_STARTS, pareto_front, single_optimum
@@ -297,12 +301,23 @@ def _run_arm(
         except SolverFailed as error:
             raise StudyRunFailed(str(error.args[0]), "anchor", error.status) from None
         computed, reused = computed + front.computed, reused + front.reused
+    snapped = None
+    if catalogue is not None:
+        saved = folder.finished("catalogue")
+        if saved is not None and saved.get("key") == catalogue.key:
+            snapped, reused = cast("CatalogueRecord", saved), reused + 1
+        else:
+            snapped = catalogue_results(
+                problems, optimum, front, catalogue, progress.counter("catalogue snap"), pool
+            )
+            folder.save("catalogue", dict(snapped))
+            computed += 1
     results = {
         "kind": "arm",
         "study": study.name,
         "description": study.description,
         "resolved": resolved_study(parse_study(text, "resolved study")),
-        **arm_results(problems, optimum, front),
+        **arm_results(problems, optimum, front, snapped),
     }
     results["verdict"] = verdict(results)
     return results, (computed, reused)

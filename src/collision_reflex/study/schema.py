@@ -642,6 +642,28 @@ class ParetoSpec(_Model):
         return value
 
 
+class CatalogueSpec(_Model):
+    """The catalogue the recommended design (and every Pareto design) is snapped to after the front.
+
+    See :mod:`collision_reflex.optimize.snap`: per joint the ``candidates`` nearest catalogue motors within
+    bounds; every combination re-solved when there are at most ``max_combinations``, else coordinate descent.
+    """
+
+    snap: bool = Field(True, description="snap the recommended and the Pareto designs to catalogue parts")
+    motors: str | None = Field(
+        None, description="motor catalogue file, relative to the study file; null: the packaged catalogue"
+    )
+    gearboxes: str | None = Field(
+        None, description="gearbox catalogue file, relative to the study file; null: the packaged catalogue"
+    )
+    candidates: Annotated[int, Field(ge=1, le=20, strict=True)] = Field(
+        3, description="catalogue motors considered per joint, the nearest to the continuous optimum first"
+    )
+    max_combinations: Annotated[int, Field(ge=1, le=10000, strict=True)] = Field(
+        64, description="the most combinations re-solved exactly; beyond, a coordinate-descent heuristic"
+    )
+
+
 class OutputsSpec(_Model):
     """Which files a run writes besides the results: figure formats and the PDF report."""
 
@@ -710,6 +732,7 @@ class ArmStudy(_Model):
     ] = Field(default_factory=lambda: {"worst_case_impulse": 1.0}, min_length=1)  # type: ignore[arg-type]
     constraints: ConstraintsSpec = Field(default_factory=ConstraintsSpec)  # type: ignore[arg-type]
     pareto: ParetoSpec | None = None
+    catalogue: CatalogueSpec = Field(default_factory=CatalogueSpec)  # type: ignore[arg-type]
     outputs: OutputsSpec = Field(default_factory=OutputsSpec)  # type: ignore[arg-type]
     execution: ExecutionSpec = Field(default_factory=ExecutionSpec)  # type: ignore[arg-type]
 

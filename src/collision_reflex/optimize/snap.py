@@ -1,0 +1,854 @@
+"""Snap a continuous optimum to catalogue parts: the best design built from motors one can buy.
+
+A continuous optimum sizes each joint's motor freely ("a 41.7 mm motor at N = 200"). Here each joint gets a
+catalogue motor instead (a joint's reference motor with its stator diameter and stack length fixed at its own,
+so that its quantities are its datasheet figures), and the continuous variables that remain (gear ratio,
+software stiffness, threshold, approach velocity) are re-optimised for that choice.
+
+- **Candidates per joint**: among the catalogue motors within the design space's free motor bounds (stator
+  diameter, and stack length where it is a design variable) whose peak torque at the largest allowed gear ratio
+  covers the joint's required torque at the continuous optimum (and, with a duty cycle, whose continuous torque
+  there covers the cycle's RMS torque and that state a maximum speed), the ``candidates`` nearest to the
+  continuous optimum's motor in :func:`motor_distance` (log peak torque and log rotor inertia). A joint whose
+  gearbox offers discrete ratios gets, per motor, the offered ratios bracketing the continuous one as fixed gear
+  ratios (those that give the motor the continuous peak output torque); a gearbox given by its own figures is replaced by the nearest catalogue gearboxes of its kind
+  (:func:`gearbox_options`). A joint with no candidate is reported ("no catalogue part within bounds") with the
+  nearest motor and what it misses.
+- **Exact** when the combinations of candidates number at most ``max_combinations``: every one is re-solved
+  (warm started from the continuous optimum's values) and the best feasible by the problem's objective is kept.
+- **Heuristic** beyond that: coordinate descent over joints from the nearest part of every joint; each pass
+  tries, joint by joint, every other candidate of that joint with the rest held, and moves to any better
+  design; it stops when a whole pass improves nothing. It is never worse than the nearest-part design (its
+  start); ``benchmarks/snap_gap.py`` measures its gap to enumeration.
+
+The objective is the problem's own, without the objective bounds of an epsilon-constraint point: a Pareto design
+snapped is the study objective's best design of those parts. A catalogue design is the continuous problem with
+more constraints, so it is never better than the (global) continuous optimum in the optimised objective; a
+continuous optimum that is only local can be beaten.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import InvalidParameter, SolverFailed
+from .objectives import objective_expression
+from .solve import Design, DesignResult, IpoptOptions, solve
+from .space import Bounds
+
+if TYPE_CHECKING:
+    from ..arm.robot import Arm
+    from ..hardware.gearboxes import CatalogueGearbox
+    from ..hardware.motors import Motor
+    from .problem import DesignProblem
+    from .technology import ActuatorTechnology
+
+__all__ = [
+    "DEFAULT_CANDIDATES",
+    "DEFAULT_GEARBOX_CANDIDATES",
+    "DEFAULT_MAX_COMBINATIONS",
+    "CatalogueDesign",
+    "CataloguePart",
+    "JointCandidates",
+    "PartsEvaluation",
+    "PartsSolver",
+    "Trial",
+    "catalogue_problem",
+    "evaluate_parts",
+    "gearbox_options",
+    "joint_candidates",
+    "matched_gear_ratio",
+    "motor_distance",
+    "objective_value",
+    "quick_parts",
+    "snap_to_catalogue",
+    "solve_parts",
+    "solved_or_status",
+]
+
+PartsSolver = Callable[[Sequence[tuple["CataloguePart", ...]]], list["DesignResult | str"]]
+"""``solve_many(combinations)``: each combination (one part per joint) re-optimised, in any order or place (an
+executor's workers), as its :class:`DesignResult`, or the status that says why it has none (IPOPT's, or
+``"refused: ..."`` for a problem refused before solving). Default: :func:`solve_parts` in this process."""
+
+DEFAULT_CANDIDATES = 3
+"""Catalogue motors considered per joint by default."""
+DEFAULT_GEARBOX_CANDIDATES = 2
+"""Catalogue gearboxes considered per joint by default, where the study gives a gearbox's own figures."""
+DEFAULT_MAX_COMBINATIONS = 64
+"""Largest number of combinations enumerated exactly by default; beyond it the heuristic runs."""
+COVERAGE_MARGIN = 0.1
+"""Relative margin of the catalogue's range: a continuous motor within 10 % beyond the catalogue's smallest or
+largest stator diameter and peak torque counts as covered (its nearest part is then at most that far)."""
+REQUIREMENT_PASSES = 4
+"""Passes of :func:`evaluate_parts` raising the gear ratios to the requirement of the parts' own masses (it
+changes little with the ratio: two passes settle it to 1e-6 on the shipped studies)."""
+BOUND_TOLERANCE = 1e-6
+"""Relative slack on the motor bounds and the torque screen: a part at a bound is within it, and IPOPT's
+optimum may pass a bound by its relaxation (1e-8 relative)."""
+
+
+def motor_distance(motor: Motor, peak_torque: float, rotor_inertia: float) -> float:
+    """Distance of a catalogue motor from a sized one (peak torque [N*m], rotor inertia [kg*m^2]) [-].
+
+    The Euclidean distance in (log peak torque, log rotor inertia): the two figures that, with the gear ratio,
+    set a joint's output torque and reflected inertia. A factor of e in one of them is a distance of 1.
+    """
+    return math.hypot(
+        math.log(motor.peak_torque / peak_torque), math.log(motor.rotor_inertia / rotor_inertia)
+    )
+
+
+@dataclass(frozen=True)
+class CataloguePart:
+    """One joint's catalogue choice: a motor, its gearbox (if the joint has one), and the gear-ratio bounds.
+
+    motor: the catalogue motor; gear_ratio: the ratio's bounds for this part (fixed at an offered ratio when the
+    gearbox offers discrete ratios); distance: the motor's :func:`motor_distance` from the continuous optimum's
+    motor [-]; gearbox: the joint's gearbox, None without one; gearbox_from_catalogue: whether that gearbox is
+    a catalogue part (False: the study's own figures, kept because no gearbox catalogue was given).
+    """
+
+    motor: Motor
+    gear_ratio: Bounds
+    distance: float
+    gearbox: CatalogueGearbox | None = None
+    gearbox_from_catalogue: bool = True
+
+    @property
+    def label(self) -> str:
+        """The motor's name, with the gearbox and the fixed gear ratio where there are."""
+        gearbox = "" if self.gearbox is None else f" + {self.gearbox.name}"
+        fixed = f" at N = {self.gear_ratio.lower:g}" if self.gear_ratio.is_fixed else ""
+        return f"{self.motor.name}{gearbox}{fixed}"
+
+
+@dataclass(frozen=True)
+class JointCandidates:
+    """One joint's candidate parts, nearest first, and what the catalogue offers around its optimum.
+
+    joint: the joint's name; parts: the candidates (empty: no catalogue part within bounds); nearest: the
+    nearest catalogue motor of all, within bounds or not; misses: what ``nearest`` misses when ``parts`` is
+    empty (which bound, by how much); warning: set when the continuous optimum's motor lies outside the range
+    the catalogue covers (its nearest part is then far away).
+    """
+
+    joint: str
+    parts: tuple[CataloguePart, ...]
+    nearest: str | None
+    misses: tuple[str, ...] = ()
+    warning: str | None = None
+
+
+@dataclass(frozen=True)
+class Trial:
+    """One combination tried: a part label per joint, its objective value (None: no feasible design) and status.
+
+    The status is IPOPT's, or ``"refused: ..."`` when the problem of these parts was refused before solving.
+    """
+
+    parts: tuple[str, ...]
+    objective: float | None
+    status: str
+
+
+@dataclass(frozen=True)
+class CatalogueDesign:
+    """The best design built from catalogue parts, next to the continuous optimum it was snapped from.
+
+    joints: per joint the candidates and catalogue coverage (:class:`JointCandidates`); parts: the chosen part
+    per joint, None when no combination gave a feasible design; result: the re-optimised design (None with
+    ``parts``); continuous: the continuous optimum; objectives, continuous_objectives: every objective of each
+    [its unit] (NumPy path; empty without a result); difference: catalogue minus continuous [its unit];
+    relative_difference: the same over the continuous value [-]; tried: every combination solved; method: how
+    the answer was found (``"exact: enumerated 9 combinations"`` or ``"heuristic: ..."``); warnings: the
+    joints' catalogue-coverage warnings and why no design was found, if none was.
+    """
+
+    joints: tuple[JointCandidates, ...]
+    parts: tuple[CataloguePart, ...] | None
+    result: DesignResult | None
+    continuous: DesignResult
+    objectives: dict[str, float]
+    continuous_objectives: dict[str, float]
+    difference: dict[str, float]
+    relative_difference: dict[str, float]
+    tried: tuple[Trial, ...]
+    method: str
+    warnings: tuple[str, ...] = field(default=())
+
+    @property
+    def found(self) -> bool:
+        """Whether a feasible catalogue design was found."""
+        return self.result is not None
+
+
+def joint_candidates(
+    problem: DesignProblem,
+    optimum: DesignResult,
+    motors: Mapping[str, Motor] | Sequence[Motor],
+    candidates: int = DEFAULT_CANDIDATES,
+    gearboxes: Mapping[str, CatalogueGearbox] | None = None,
+    gearbox_candidates: int = DEFAULT_GEARBOX_CANDIDATES,
+) -> tuple[JointCandidates, ...]:
+    """Each joint's candidate parts near the continuous ``optimum`` of ``problem`` (module docstring).
+
+    Parameters
+    ----------
+    problem: the continuous design problem (its bounds, requirement and gearboxes).
+    optimum: its solution.
+    motors: the catalogue motors, by name or as a sequence.
+    candidates: motors kept per joint (>= 1), nearest first.
+    gearboxes: the gearbox catalogue by name; a joint whose gearbox is not one of its entries (the study's own
+        figures) gets its ``gearbox_candidates`` nearest entries of the same kind (:func:`gearbox_options`).
+        None: every joint keeps its gearbox.
+    gearbox_candidates: catalogue gearboxes kept per such joint (>= 1).
+    """
+    catalogue = _motor_list(motors)
+    for name, value in (("candidates", candidates), ("gearbox_candidates", gearbox_candidates)):
+        if not isinstance(value, int) or isinstance(value, bool) or value < 1:
+            raise InvalidParameter(name, value, "an integer >= 1")
+    design = optimum.design
+    bounds = problem.layout.bounds
+    space_ratios = problem.space.per_joint("gear_ratio", problem.n_joints)
+    joint_gearboxes = problem.technology.joint_gearboxes(problem.n_joints)
+    out = []
+    for j, joint in enumerate(problem.joint_names):
+        torque, inertia = float(design.motor_peak_torque[j]), float(design.rotor_inertia[j])
+        required = float(optimum.required_torque[j])
+        options, gearbox_misses = gearbox_options(
+            joint_gearboxes[j], space_ratios[j], required, gearboxes, gearbox_candidates
+        )
+        largest = max((_ratio_range(space_ratios[j], g)[1] for g, _ in options), default=0.0)
+        ranked = sorted(catalogue, key=lambda m: motor_distance(m, torque, inertia))
+        rms = None if optimum.required_rms_torque is None else float(optimum.required_rms_torque[j])
+        misses = {
+            m.name: _misses(m, j, bounds, required, rms, largest, problem.duty is not None) for m in ranked
+        }
+        fitting = [m for m in ranked if not misses[m.name]][:candidates]
+        parts = tuple(
+            part
+            for m in fitting
+            for gearbox, listed in options
+            for part in _parts_of(
+                m, space_ratios[j], gearbox, listed, float(design.peak_torque[j]), torque, inertia
+            )
+        )
+        nearest = ranked[0].name
+        out.append(
+            JointCandidates(
+                joint,
+                parts,
+                nearest,
+                () if parts else (*gearbox_misses, *misses[nearest]),
+                _coverage_warning(joint, catalogue, float(design.stator_diameter[j]), torque),
+            )
+        )
+    return tuple(out)
+
+
+def gearbox_options(
+    gearbox: CatalogueGearbox | None,
+    ratio: Bounds,
+    required: float,
+    catalogue: Mapping[str, CatalogueGearbox] | None,
+    count: int = DEFAULT_GEARBOX_CANDIDATES,
+) -> tuple[list[tuple[CatalogueGearbox | None, bool]], tuple[str, ...]]:
+    """A joint's gearbox options ``(gearbox, from the catalogue)``, and what the nearest misses if none fits.
+
+    No gearbox: ``[(None, True)]``. A catalogue entry (its name in ``catalogue``, or no catalogue given): kept.
+    The study's own figures with a catalogue given: the ``count`` entries of the same kind nearest to it in
+    (log repeated peak torque, log mass) whose ratios overlap the joint's gear-ratio bounds ``ratio`` and whose
+    repeated peak rating covers the joint's ``required`` torque [N*m].
+    """
+    if gearbox is None:
+        return [(None, True)], ()
+    if catalogue is None or gearbox.name in catalogue:
+        return [(gearbox, catalogue is not None)], ()
+
+    def distance(other: CatalogueGearbox) -> float:
+        return math.hypot(
+            math.log(other.peak_torque / gearbox.peak_torque), math.log(other.mass / gearbox.mass)
+        )
+
+    ranked = sorted((g for g in catalogue.values() if g.kind == gearbox.kind), key=distance)
+    fitting: list[tuple[CatalogueGearbox | None, bool]] = []
+    for other in ranked:
+        low, high = _ratio_range(ratio, other)
+        if low <= high * (1 + BOUND_TOLERANCE) and other.peak_torque >= required * (1 - BOUND_TOLERANCE):
+            fitting.append((other, True))
+    if fitting:
+        return fitting[:count], ()
+    if not ranked:
+        return [], (f"no {gearbox.kind} gearbox in the gearbox catalogue",)
+    nearest = ranked[0]
+    low, high = nearest.ratio_range
+    found = [f"nearest gearbox {nearest.name}:"]
+    if max(low, ratio.lower) > min(high, ratio.upper):
+        found.append(
+            f"ratios {low:g} to {high:g} outside the gear-ratio bounds {ratio.lower:g} to {ratio.upper:g}"
+        )
+    if nearest.peak_torque < required:
+        found.append(
+            f"repeated peak rating {nearest.peak_torque:.4g} N*m short of the required {required:.4g} N*m by "
+            f"{required - nearest.peak_torque:.3g} N*m"
+        )
+    return [], (" ".join(found),)
+
+
+def _ratio_range(bounds: Bounds, gearbox: CatalogueGearbox | None) -> tuple[float, float]:
+    """The gear-ratio bounds intersected with a gearbox's ratio range (empty when lower > upper)."""
+    if gearbox is None:
+        return bounds.lower, bounds.upper
+    low, high = gearbox.ratio_range
+    return max(bounds.lower, low), min(bounds.upper, high)
+
+
+def _motor_list(motors: Mapping[str, Motor] | Sequence[Motor]) -> list[Motor]:
+    """The catalogue as a list of motors (a mapping's values), refused when empty or not motors."""
+    from ..hardware.motors import Motor
+
+    listed = list(motors.values()) if isinstance(motors, Mapping) else list(motors)
+    if not listed or not all(isinstance(m, Motor) for m in listed):
+        raise InvalidParameter("motors", motors, "a non-empty catalogue of Motors (a mapping or a sequence)")
+    return listed
+
+
+def _misses(
+    motor: Motor,
+    joint: int,
+    bounds: Mapping[str, list[Bounds]],
+    required: float,
+    required_rms: float | None,
+    largest_ratio: float,
+    needs_speed: bool,
+) -> tuple[str, ...]:
+    """What keeps ``motor`` from joint ``joint``: a free motor bound, the torque screens, a missing speed.
+
+    The screens: the peak torque at the largest gear ratio covers the ``required`` torque [N*m], and with a duty
+    cycle the continuous torque there covers the cycle's RMS torque ``required_rms`` [N*m] (both of the
+    continuous optimum; gearbox losses left to the re-solve).
+    """
+    found = []
+    for name in ("stator_diameter", "stack_length"):
+        b = bounds[name][joint]
+        value = getattr(motor, name)
+        if b.is_fixed:  # not a design variable: the catalogue motor brings its own size
+            continue
+        what = name.replace("_", " ")
+        if value < b.lower * (1 - BOUND_TOLERANCE):
+            found.append(
+                f"{what} {value * 1e3:.4g} mm below the lower bound {b.lower * 1e3:.4g} mm by "
+                f"{(b.lower - value) * 1e3:.3g} mm"
+            )
+        elif value > b.upper * (1 + BOUND_TOLERANCE):
+            found.append(
+                f"{what} {value * 1e3:.4g} mm above the upper bound {b.upper * 1e3:.4g} mm by "
+                f"{(value - b.upper) * 1e3:.3g} mm"
+            )
+    reachable = motor.peak_torque * largest_ratio
+    if reachable < required * (1 - BOUND_TOLERANCE):
+        found.append(
+            f"peak torque {motor.peak_torque:.4g} N*m x the largest gear ratio {largest_ratio:.4g} = "
+            f"{reachable:.4g} N*m, short of the required {required:.4g} N*m by {required - reachable:.3g} N*m"
+        )
+    if required_rms is not None and motor.continuous_torque * largest_ratio < required_rms * (
+        1 - BOUND_TOLERANCE
+    ):
+        reachable = motor.continuous_torque * largest_ratio
+        found.append(
+            f"continuous torque {motor.continuous_torque:.4g} N*m x the largest gear ratio {largest_ratio:.4g} = "
+            f"{reachable:.4g} N*m, short of the cycle's RMS {required_rms:.4g} N*m by "
+            f"{required_rms - reachable:.3g} N*m"
+        )
+    if needs_speed and motor.max_speed is None:
+        found.append("no maximum speed in its catalogue entry (the duty cycle's speed limit needs one)")
+    return tuple(found)
+
+
+def _parts_of(
+    motor: Motor,
+    ratio: Bounds,
+    gearbox: CatalogueGearbox | None,
+    from_catalogue: bool,
+    output_torque: float,
+    torque: float,
+    inertia: float,
+) -> list[CataloguePart]:
+    """``motor``'s parts with ``gearbox``: the ratio bounds, or the offered ratios bracketing the matched one.
+
+    The matched ratio gives ``motor`` the continuous optimum's peak output torque ``output_torque`` [N*m]
+    (:func:`matched_gear_ratio`). ``ratio``: the joint's gear-ratio bounds of the design space (the problem
+    intersects them with the gearbox's range); ``torque`` [N*m], ``inertia`` [kg*m^2]: the continuous motor's.
+    """
+    matched = output_torque / motor.peak_torque
+    distance = motor_distance(motor, torque, inertia)
+    if gearbox is None or gearbox.continuous_ratio:
+        return [CataloguePart(motor, ratio, distance, gearbox, from_catalogue)]
+    low, high = ratio.lower * (1 - BOUND_TOLERANCE), ratio.upper * (1 + BOUND_TOLERANCE)
+    offered = [r for r in gearbox.ratios if low <= r <= high]
+    below = [r for r in offered if r <= matched]
+    above = [r for r in offered if r >= matched]
+    bracket = sorted({*below[-1:], *above[:1]})
+    return [
+        CataloguePart(motor, Bounds.fixed(float(r), ratio.name), distance, gearbox, from_catalogue)
+        for r in bracket
+    ]
+
+
+def _coverage_warning(joint: str, catalogue: list[Motor], diameter: float, torque: float) -> str | None:
+    """A warning when the continuous motor (stator diameter [m], peak torque [N*m]) is outside the catalogue."""
+    diameters = [m.stator_diameter for m in catalogue]
+    torques = [m.peak_torque for m in catalogue]
+    outside = []
+    low, high = 1 / (1 + COVERAGE_MARGIN), 1 + COVERAGE_MARGIN
+    if not min(diameters) * low <= diameter <= max(diameters) * high:
+        outside.append(
+            f"stator diameter {diameter * 1e3:.4g} mm (catalogue {min(diameters) * 1e3:.4g}–"
+            f"{max(diameters) * 1e3:.4g} mm)"
+        )
+    if not min(torques) * low <= torque <= max(torques) * high:
+        outside.append(f"peak torque {torque:.4g} N*m (catalogue {min(torques):.4g}–{max(torques):.4g} N*m)")
+    if not outside:
+        return None
+    return (
+        f"{joint}: the continuous optimum lies outside the range the catalogue covers, "
+        + " and ".join(outside)
+        + ": the nearest part is far from it"
+    )
+
+
+def snap_to_catalogue(
+    problem: DesignProblem,
+    optimum: DesignResult,
+    motors: Mapping[str, Motor] | Sequence[Motor],
+    *,
+    arm: Arm,
+    gearboxes: Mapping[str, CatalogueGearbox] | None = None,
+    candidates: int = DEFAULT_CANDIDATES,
+    gearbox_candidates: int = DEFAULT_GEARBOX_CANDIDATES,
+    max_combinations: int = DEFAULT_MAX_COMBINATIONS,
+    ipopt_options: IpoptOptions | None = None,
+    progress: Callable[[int, int], None] | None = None,
+    solve_many: PartsSolver | None = None,
+) -> CatalogueDesign:
+    """The best design built from catalogue motors near ``optimum``, re-optimised (module docstring).
+
+    Parameters
+    ----------
+    problem: the continuous design problem (:func:`collision_reflex.optimize.build_problem`); each combination
+        is this problem with every joint's motor fixed at a catalogue motor, its objective and constraints.
+    optimum: the continuous optimum of ``problem`` (:func:`collision_reflex.optimize.solve`).
+    motors: the catalogue motors (e.g. :func:`collision_reflex.load_catalogue`), by name or as a sequence.
+    arm: the arm ``problem`` was built for (each combination's problem is built for it).
+    gearboxes: the gearbox catalogue by name (e.g. :func:`collision_reflex.hardware.gearboxes.
+        load_gearbox_catalogue`), for joints whose gearbox is the study's own figures; None keeps every joint's
+        gearbox (see :func:`joint_candidates`).
+    candidates: motors considered per joint (>= 1), the nearest first.
+    gearbox_candidates: catalogue gearboxes considered per joint with the study's own gearbox figures (>= 1).
+    max_combinations: the most combinations enumerated exactly (>= 1); beyond, the heuristic runs.
+    ipopt_options: options of every re-solve (see :func:`collision_reflex.optimize.solve`).
+    progress: called as ``progress(done, total)`` after each batch of combinations solved.
+    solve_many: how combinations are solved (:data:`PartsSolver`), e.g. through an executor; default in this
+        process. The combinations of a batch (every one when enumerating; a joint's candidates in a step of the
+        heuristic) are independent, and the answer does not depend on where they run.
+
+    Raises
+    ------
+    InvalidParameter: an empty catalogue, ``candidates`` or ``max_combinations`` not an integer >= 1.
+    KeyboardInterrupt: Ctrl-C, from any re-solve (nothing is returned).
+    """
+    if not isinstance(max_combinations, int) or isinstance(max_combinations, bool) or max_combinations < 1:
+        raise InvalidParameter("max_combinations", max_combinations, "an integer >= 1")
+    joints = joint_candidates(problem, optimum, motors, candidates, gearboxes, gearbox_candidates)
+    warnings = [j.warning for j in joints if j.warning]
+    empty = [j for j in joints if not j.parts]
+    if empty:
+        reasons = [
+            f"{j.joint}: no catalogue part within bounds; the nearest, {j.nearest}, misses: "
+            + "; ".join(j.misses)
+            for j in empty
+        ]
+        return _design(joints, None, None, optimum, (), "none: " + " / ".join(reasons), [*warnings, *reasons])
+    if solve_many is None:
+        solve_many = _InProcess(problem, optimum, arm, ipopt_options)
+    search = _Search(problem, [j.parts for j in joints], solve_many, progress)
+    total = math.prod(len(j.parts) for j in joints)
+    if total <= max_combinations:
+        search.total = total
+        search.values_of(list(itertools.product(*(range(len(j.parts)) for j in joints))))
+        method = f"exact: enumerated {total} combinations"
+    else:
+        passes = search.descend()
+        method = (
+            f"heuristic: coordinate descent over joints from the nearest parts, {len(search.tried)} of {total} "
+            f"combinations solved in {passes} passes (more than max_combinations = {max_combinations})"
+        )
+    best = search.best()
+    if best is None:
+        reason = "no combination of candidates gives a feasible design (every re-solve failed)"
+        return _design(joints, None, None, optimum, search.trials(), method, [*warnings, reason])
+    parts = tuple(j.parts[c] for j, c in zip(joints, best, strict=True))
+    return _design(joints, parts, search.results[best], optimum, search.trials(), method, warnings)
+
+
+def _design(
+    joints: tuple[JointCandidates, ...],
+    parts: tuple[CataloguePart, ...] | None,
+    result: DesignResult | None,
+    optimum: DesignResult,
+    tried: tuple[Trial, ...],
+    method: str,
+    warnings: list[str],
+) -> CatalogueDesign:
+    """The :class:`CatalogueDesign` with its objectives compared to the continuous optimum's."""
+    continuous = dict(optimum.numpy_objectives)
+    mine = dict(result.numpy_objectives) if result is not None else {}
+    difference = {name: mine[name] - continuous[name] for name in mine}
+    relative = {
+        name: difference[name] / continuous[name] if continuous[name] != 0 else math.inf for name in mine
+    }
+    return CatalogueDesign(
+        joints, parts, result, optimum, mine, continuous, difference, relative, tried, method, tuple(warnings)
+    )
+
+
+@dataclass(frozen=True)
+class _InProcess:
+    """The default :data:`PartsSolver`: :func:`solve_parts` for each combination, here, one after the other."""
+
+    problem: DesignProblem
+    optimum: DesignResult
+    arm: Arm
+    ipopt_options: IpoptOptions | None
+
+    def __call__(self, combinations: Sequence[tuple[CataloguePart, ...]]) -> list[DesignResult | str]:
+        return [
+            solved_or_status(self.problem, self.optimum, parts, self.arm, self.ipopt_options)
+            for parts in combinations
+        ]
+
+
+def solved_or_status(
+    problem: DesignProblem,
+    optimum: DesignResult,
+    parts: Sequence[CataloguePart],
+    arm: Arm,
+    ipopt_options: IpoptOptions | None = None,
+) -> DesignResult | str:
+    """:func:`solve_parts`, or the status that says why these parts have no design (see :data:`PartsSolver`)."""
+    try:
+        return solve_parts(problem, optimum, parts, arm, ipopt_options)
+    except SolverFailed as error:
+        return error.status
+    except InvalidParameter as error:  # refused before solving: no design of these parts can meet it
+        return f"refused: {error}"
+
+
+class _Search:
+    """Solves combinations of candidate parts (by index per joint) once each, and keeps their values."""
+
+    def __init__(
+        self,
+        problem: DesignProblem,
+        parts: list[tuple[CataloguePart, ...]],
+        solve_many: PartsSolver,
+        progress: Callable[[int, int], None] | None,
+    ) -> None:
+        self.problem, self.parts, self.solve_many, self.progress = problem, parts, solve_many, progress
+        self.values: dict[tuple[int, ...], float] = {}
+        self.results: dict[tuple[int, ...], DesignResult] = {}
+        self.tried: dict[tuple[int, ...], Trial] = {}
+        self.total = 0
+
+    def values_of(self, combinations: list[tuple[int, ...]]) -> list[float]:
+        """The problem's objective of each combination re-optimised (inf: no feasible design); new ones solved."""
+        new = [c for c in dict.fromkeys(combinations) if c not in self.values]
+        chosen = [tuple(self.parts[j][i] for j, i in enumerate(c)) for c in new]
+        for combination, parts, solved in zip(new, chosen, self.solve_many(chosen), strict=True):
+            labels = tuple(p.label for p in parts)
+            if isinstance(solved, str):
+                self.values[combination] = math.inf
+                self.tried[combination] = Trial(labels, None, solved)
+            else:
+                value = objective_value(self.problem, solved.numpy_objectives)
+                self.values[combination], self.results[combination] = value, solved
+                self.tried[combination] = Trial(labels, value, solved.status)
+        if new and self.progress is not None:
+            self.progress(len(self.tried), max(self.total, len(self.tried)))
+        return [self.values[c] for c in combinations]
+
+    def descend(self) -> int:
+        """Coordinate descent from the nearest parts until a pass improves nothing; the number of passes.
+
+        A step solves every candidate of one joint with the others held (one batch) and moves to the best, if
+        it is better than the current design (the first among equals).
+        """
+        current = (0,) * len(self.parts)
+        (value,) = self.values_of([current])
+        passes, improved = 0, True
+        while improved:
+            improved, passes = False, passes + 1
+            for j, joint_parts in enumerate(self.parts):
+                options = [(*current[:j], c, *current[j + 1 :]) for c in range(len(joint_parts))]
+                values = self.values_of(options)
+                best = min(range(len(options)), key=lambda i: values[i])
+                if values[best] < value:
+                    current, value, improved = options[best], values[best], True
+        return passes
+
+    def best(self) -> tuple[int, ...] | None:
+        """The feasible combination of least value (the first tried among equals), or None."""
+        feasible = [c for c in self.tried if math.isfinite(self.values[c])]
+        return min(feasible, key=lambda c: self.values[c]) if feasible else None
+
+    def trials(self) -> tuple[Trial, ...]:
+        """Every combination tried, in the order tried."""
+        return tuple(self.tried.values())
+
+
+def objective_value(problem: DesignProblem, objectives: Mapping[str, float]) -> float:
+    """``problem``'s objective for a design's objective values [their units]: the NLP's, at its scale.
+
+    The weighted, start-normalised objectives with the tie-break term, scaled as ``problem`` scales them, so
+    that designs of different (catalogue) problems compare on one scale.
+    """
+    values: dict[str, Any] = dict(objectives)  # plain numbers: the formula is backend-agnostic arithmetic
+    return float(objective_expression(problem.objective, values, problem.objective_scale))
+
+
+def catalogue_problem(problem: DesignProblem, parts: Sequence[CataloguePart], arm: Arm) -> DesignProblem:
+    """``problem`` with each joint's motor the catalogue motor of ``parts`` at its own size.
+
+    Each joint's stator diameter and stack length are fixed at its part's, its gear ratio within the part's
+    bounds; the objective, constraints and the other bounds are ``problem``'s.
+    """
+    from .problem import build_problem
+
+    technology = _parts_technology(problem, parts)
+    space = replace(
+        problem.space,
+        stator_diameter=[p.motor.stator_diameter for p in parts],
+        stack_length=[p.motor.stack_length for p in parts],
+        gear_ratio=[p.gear_ratio for p in parts],
+    )
+    return build_problem(
+        arm,
+        problem.samples,
+        space,
+        technology,
+        problem.objective,
+        problem.constraints,
+        problem.bounded_objectives,
+    )
+
+
+def quick_parts(joints: Sequence[JointCandidates], design: Design) -> tuple[CataloguePart, ...] | None:
+    """Each joint's nearest part for a quick snap, None when a joint has none.
+
+    The nearest motor's, and of its offered gear ratios (a gearbox of discrete ratios) the smallest that keeps
+    ``design``'s peak output torque, else the largest.
+    """
+    chosen = []
+    for j, joint in enumerate(joints):
+        if not joint.parts:
+            return None
+        motor = joint.parts[0].motor
+        own = [p for p in joint.parts if p.motor is motor]
+        wanted = float(design.peak_torque[j]) / motor.peak_torque * (1 - BOUND_TOLERANCE)
+        chosen.append(
+            next((p for p in own if not p.gear_ratio.is_fixed or p.gear_ratio.lower >= wanted), own[-1])
+        )
+    return tuple(chosen)
+
+
+def _parts_technology(problem: DesignProblem, parts: Sequence[CataloguePart]) -> ActuatorTechnology:
+    """``problem``'s technology with each joint's motor (and gearbox) the one of ``parts``."""
+    chosen = tuple(p.gearbox for p in parts)
+    return replace(
+        problem.technology,
+        reference_motor=tuple(p.motor for p in parts),
+        gearboxes=chosen if any(g is not None for g in chosen) else None,
+    )
+
+
+def matched_gear_ratio(part: CataloguePart, design: Design, joint: int) -> float:
+    """The gear ratio that gives ``part``'s motor the continuous design's peak output torque, within its bounds.
+
+    ``N = N_c tau_c / tau_p`` (``N_c tau_c`` the continuous joint's peak torque [N*m]), clipped to the part's
+    gear-ratio bounds (within its gearbox's ratios): the catalogue design's start, and the ratio of a part
+    evaluated without a re-solve.
+    """
+    wanted = float(design.peak_torque[joint]) / part.motor.peak_torque
+    low, high = _ratio_range(part.gear_ratio, part.gearbox)
+    return float(np.clip(wanted, low, high))
+
+
+def solve_parts(
+    problem: DesignProblem,
+    optimum: DesignResult,
+    parts: Sequence[CataloguePart],
+    arm: Arm,
+    ipopt_options: IpoptOptions | None = None,
+) -> DesignResult:
+    """The design of ``parts`` with the remaining continuous variables re-optimised.
+
+    Started from ``optimum``'s values of those variables (clipped to their bounds), the gear ratios at
+    :func:`matched_gear_ratio`.
+
+    Raises
+    ------
+    SolverFailed: no design of these parts meets the constraints (or the solver did not converge).
+    InvalidParameter: the problem of these parts is refused before solving (a duty-cycle requirement or a
+        gearbox rating that no design within the bounds can meet).
+    """
+    built = catalogue_problem(problem, parts, arm)
+    design = optimum.design
+    known: dict[str, np.ndarray] = {
+        "gear_ratio": np.array([matched_gear_ratio(p, design, j) for j, p in enumerate(parts)]),
+        "software_stiffness": design.software_stiffness,
+        "threshold": np.array([design.threshold]),
+        "approach_velocity": np.array([design.approach_velocity]),
+    }
+    start = built.x0.copy()
+    for name, values in known.items():
+        for i, b, value in zip(built.layout.slices[name], built.layout.bounds[name], values, strict=True):
+            if i is not None:
+                start[i] = math.log(min(max(float(value), b.lower), b.upper))
+    return solve(built, x0=built.exact_point(start), ipopt_options=ipopt_options)
+
+
+@dataclass(frozen=True)
+class PartsEvaluation:
+    """A design of catalogue parts evaluated without a re-solve (the quick snap of every Pareto design).
+
+    parts: the part per joint; design: the continuous design with each joint's motor replaced by its part's
+    (see :func:`evaluate_parts` for the gear ratios); objectives: every objective [its unit] (NumPy path);
+    required_torque: per joint [N*m]; shortfalls: the requirements it misses (peak torque, the gearbox's
+    ratings, and with a duty cycle RMS torque and motor speed), empty when it meets them all.
+    """
+
+    parts: tuple[CataloguePart, ...]
+    design: Design
+    objectives: dict[str, float]
+    required_torque: np.ndarray
+    shortfalls: tuple[str, ...]
+
+    @property
+    def feasible(self) -> bool:
+        """Whether the design meets every torque and speed requirement."""
+        return not self.shortfalls
+
+
+def evaluate_parts(problem: DesignProblem, design: Design, parts: Sequence[CataloguePart]) -> PartsEvaluation:
+    """``design`` with each joint's motor (and gearbox) the one of ``parts``, evaluated (no re-solve).
+
+    The gear ratios are :func:`matched_gear_ratio`, raised (within their bounds) to cover the peak (and with a
+    duty cycle the RMS) requirement of the parts' own masses; software stiffness, threshold and approach
+    velocity are ``design``'s. The actuator quantities come from the technology's one formula
+    (:meth:`~collision_reflex.optimize.technology.ActuatorTechnology.joint_quantities`), the impulses from the
+    NumPy path (:func:`collision_reflex.optimize.evaluate.evaluate_design`), the requirement from ``problem``'s
+    own torque-requirement function (and duty cycle); gearbox ratings are checked as the problem's rows are.
+    """
+    from .duty import duty_values
+    from .evaluate import evaluate_design
+
+    parts = tuple(parts)
+    technology = _parts_technology(problem, parts)
+    gear = np.array([matched_gear_ratio(p, design, j) for j, p in enumerate(parts)])
+    ranges = np.array([_ratio_range(p.gear_ratio, p.gearbox) for p in parts])
+    for _ in range(REQUIREMENT_PASSES):  # heavier parts need more torque: raise the ratio to cover it
+        snapped = _parts_design(design, parts, technology, gear)
+        required = _required_torque(problem, snapped)
+        efficiency = snapped.gearbox_efficiency
+        wanted = np.maximum(gear, required / (efficiency * snapped.motor_peak_torque))
+        if problem.duty is not None:
+            rms = duty_values(problem.duty, snapped, technology).required_rms_torque
+            continuous = np.array([p.motor.continuous_torque for p in parts])
+            wanted = np.maximum(wanted, rms / (efficiency * continuous))
+        if all(p.gear_ratio.is_fixed for p in parts) or np.allclose(wanted, gear, rtol=BOUND_TOLERANCE):
+            break
+        gear = np.where(
+            [p.gear_ratio.is_fixed for p in parts], gear, np.clip(wanted, ranges[:, 0], ranges[:, 1])
+        )
+    snapped = _parts_design(design, parts, technology, gear)
+    figures = technology.gearbox_figures(len(parts))
+    impulses = evaluate_design(problem, snapped)
+    masses = snapped.actuator_mass
+    required = _required_torque(problem, snapped)
+    names = design.joint_names
+    shortfalls = _below("peak torque", snapped.driving_peak_torque, "the required", required, names)
+    shortfalls += _below("gearbox peak rating", figures.peak_torque, "the required", required, names)
+    if problem.duty is not None:
+        values = duty_values(problem.duty, snapped, technology)
+        rms = values.required_rms_torque
+        shortfalls += _below("continuous torque", values.continuous_torque, "the cycle's RMS", rms, names)
+        shortfalls += _below("gearbox rated torque", figures.rated_torque, "the cycle's RMS", rms, names)
+        speed = values.max_motor_speed
+        shortfalls += _below(
+            "motor speed limit", values.speed_limit, "the motor speed", speed, names, "rad/s"
+        )
+        shortfalls += _below(
+            "gearbox input speed limit", figures.max_input_speed, "the motor speed", speed, names, "rad/s"
+        )
+    objectives = {
+        "worst_case_impulse": float(impulses.max()),
+        "mean_impulse": float(impulses.mean()),
+        "actuator_mass": float(masses.sum()),
+        "approach_velocity": float(snapped.approach_velocity),
+    }
+    return PartsEvaluation(parts, snapped, objectives, required, tuple(shortfalls))
+
+
+def _parts_design(
+    design: Design, parts: tuple[CataloguePart, ...], technology: ActuatorTechnology, gear: np.ndarray
+) -> Design:
+    """``design`` with the motors (and gearboxes) of ``parts`` at gear ratios ``gear`` [-]."""
+    diameter = np.array([p.motor.stator_diameter for p in parts])
+    stack = np.array([p.motor.stack_length for p in parts])
+    joint = technology.joint_quantities(diameter, stack, gear)
+    return replace(
+        design,
+        stator_diameter=diameter,
+        stack_length=stack,
+        gear_ratio=gear,
+        rotor_inertia=np.asarray(joint.motor.rotor_inertia, dtype=float),
+        reflected_inertia=np.asarray(joint.reflected_inertia, dtype=float),
+        motor_peak_torque=np.asarray(joint.motor.peak_torque, dtype=float),
+        peak_torque=np.asarray(joint.peak_torque, dtype=float),
+        motor_mass=np.asarray(joint.motor.mass, dtype=float),
+        gearbox=joint.gearbox.names,
+        gearbox_mass=joint.gearbox.mass,
+        gearbox_inertia=joint.gearbox.inertia,
+        gearbox_efficiency=joint.gearbox.efficiency,
+    )
+
+
+def _required_torque(problem: DesignProblem, design: Design) -> np.ndarray:
+    """Each joint's required peak torque [N*m] for ``design``'s masses (and reflected inertias, with a cycle)."""
+    arguments = (
+        (design.actuator_mass,) if problem.duty is None else (design.actuator_mass, design.reflected_inertia)
+    )
+    return np.asarray(problem.required_torque_function(*arguments), dtype=float).ravel()
+
+
+def _below(
+    capacity_name: str,
+    capacity: np.ndarray,
+    need_name: str,
+    need: np.ndarray,
+    joints: Sequence[str],
+    unit: str = "N*m",
+) -> list[str]:
+    """``joint: <capacity> 1.2 N*m below <need> 1.5 N*m`` for every joint whose capacity is short of its need."""
+    return [
+        f"{joint}: {capacity_name} {capacity[j]:.4g} {unit} below {need_name} {need[j]:.4g} {unit}"
+        for j, joint in enumerate(joints)
+        if capacity[j] < need[j] * (1 - BOUND_TOLERANCE)
+    ]

@@ -1,0 +1,416 @@
+"""Snapping a continuous optimum to catalogue motors: against brute-force enumeration, and in a study run."""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import json
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import collision_reflex as cr
+from collision_reflex.arm import Arm
+from collision_reflex.optimize import snap as snapping
+from collision_reflex.optimize.pareto import MERGE_TOLERANCE
+from collision_reflex.optimize.snap import objective_value, snap_to_catalogue, solve_parts
+
+ROOT = Path(__file__).resolve().parents[1]
+TWO_LINK = ROOT / "designs" / "planar_two_link.urdf"
+TWO_LINK_STUDY = ROOT / "studies" / "two_link_paper.yaml"
+SOLVER_TOLERANCE = MERGE_TOLERANCE
+"""Two solves of one problem from different starts agree to ~1e-7 relative (IPOPT tol 1e-8); 1e-5 is ten
+times the anchor slack, the tolerance the Pareto sweep uses for "the same design"."""
+
+
+OBJECTIVE = {"worst_case_impulse": 1.0, "actuator_mass": 0.05}
+"""The worst case with the motors' mass: every joint's part then matters (the worst case alone hardly depends
+on the proximal motor, and its pairs tie)."""
+
+
+def _catalogue() -> list[cr.Motor]:
+    """Six motors of different sizes, not on one scaling law (rotor inertia and mass perturbed)."""
+    reference = cr.reference_motor()
+    sizes = [(0.03, 0.010), (0.04, 0.012), (0.05, 0.015), (0.07, 0.012), (0.09, 0.020), (0.11, 0.030)]
+    motors = []
+    for i, (diameter, stack) in enumerate(sizes):
+        scaled = reference.scaled(diameter, stack)
+        motors.append(
+            cr.Motor(
+                f"M{i}",
+                diameter,
+                stack,
+                scaled.rotor_inertia * (1 + 0.15 * i),
+                scaled.peak_torque,
+                scaled.continuous_torque,
+                scaled.mass * (1 - 0.06 * i),
+                source="test motor",
+            )
+        )
+    return motors
+
+
+@pytest.fixture(scope="module")
+def two_link():
+    arm = Arm.from_urdf(TWO_LINK, "tip")
+    kinematics = arm.kinematics(arm.sample_configurations(3, np.random.default_rng(0)))
+    angles = np.linspace(0, 2 * np.pi, 6, endpoint=False) + 0.3
+    samples = cr.ContactSamples.grid(kinematics, np.c_[np.cos(angles), np.sin(angles)])
+    space = cr.DesignSpace(
+        stator_diameter=(0.02, 0.12),
+        gear_ratio=(1, 50),
+        software_stiffness=(5, 500),
+        threshold=(1, 10),
+        approach_velocity=(0.05, 1.0),
+    )
+    technology = cr.ActuatorTechnology(cr.reference_motor(), 1000.0)
+    constraints = cr.Constraints(torque_required=[2.0, 1.0], threshold_floor=0.5)
+    problem = cr.build_problem(arm, samples, space, technology, OBJECTIVE, constraints)
+    optimum = cr.solve(problem, starts=4)
+    return arm, problem, optimum
+
+
+@pytest.fixture(scope="module")
+def brute_force(two_link):
+    """Every pair of the catalogue solved on its own: built directly, multi-started from the default start."""
+    arm, problem, _ = two_link
+    values = {}
+    for first, second in itertools.product(_catalogue(), repeat=2):
+        space = cr.DesignSpace(
+            stator_diameter=[first.stator_diameter, second.stator_diameter],
+            stack_length=[first.stack_length, second.stack_length],
+            gear_ratio=(1, 50),
+            software_stiffness=(5, 500),
+            threshold=(1, 10),
+            approach_velocity=(0.05, 1.0),
+        )
+        technology = cr.ActuatorTechnology((first, second), 1000.0)
+        built = cr.build_problem(arm, problem.samples, space, technology, OBJECTIVE, problem.constraints)
+        result = cr.solve(built, starts=3)
+        values[(first.name, second.name)] = objective_value(problem, result.numpy_objectives)
+    return values
+
+
+@pytest.fixture(scope="module")
+def exact(two_link):
+    arm, problem, optimum = two_link
+    return snap_to_catalogue(problem, optimum, _catalogue(), arm=arm, candidates=6, max_combinations=64)
+
+
+def _chosen_value(problem, design) -> float:
+    return objective_value(problem, design.result.numpy_objectives)
+
+
+def test_snapping_a_two_joint_problem_equals_full_enumeration(two_link, brute_force, exact):
+    _, problem, _ = two_link
+    assert exact.method == "exact: enumerated 36 combinations"
+    assert len(exact.tried) == 36
+    best = min(brute_force.values())
+    assert _chosen_value(problem, exact) == pytest.approx(best, rel=SOLVER_TOLERANCE)
+    # The pair found is one of the best pairs (pairs within the solver tolerance are ties).
+    ties = {pair for pair, value in brute_force.items() if value <= best * (1 + SOLVER_TOLERANCE)}
+    assert tuple(p.motor.name for p in exact.parts) in ties
+    # The worst pair is far worse: the enumeration distinguishes the parts.
+    assert max(brute_force.values()) > 1.5 * best
+
+
+def test_the_catalogue_design_is_the_continuous_optimum_with_more_constraints(two_link, exact):
+    _, problem, optimum = two_link
+    continuous = objective_value(problem, optimum.numpy_objectives)
+    assert _chosen_value(problem, exact) >= continuous * (1 - SOLVER_TOLERANCE)
+    for trial in exact.tried:
+        assert trial.objective is None or trial.objective >= continuous * (1 - SOLVER_TOLERANCE)
+    # Every objective compared, absolute and relative, against the continuous optimum's own numbers.
+    for name, value in exact.objectives.items():
+        assert exact.difference[name] == pytest.approx(value - optimum.numpy_objectives[name], abs=1e-15)
+        assert exact.relative_difference[name] == pytest.approx(
+            exact.difference[name] / optimum.numpy_objectives[name]
+        )
+
+
+def test_a_catalogue_motor_at_the_optimum_size_reproduces_the_continuous_optimum(two_link):
+    # The optimum's own (scaled) motors, as catalogue parts: fixing them changes nothing.
+    arm, problem, optimum = two_link
+    design = optimum.design
+    own = [
+        problem.technology.motors[0].scaled(d, s)
+        for d, s in zip(design.stator_diameter, design.stack_length, strict=True)
+    ]
+    snapped = snap_to_catalogue(problem, optimum, [*own, *_catalogue()], arm=arm, candidates=1)
+    assert [p.motor.name for p in snapped.parts] == [m.name for m in own]
+    assert _chosen_value(problem, snapped) == pytest.approx(
+        objective_value(problem, optimum.numpy_objectives), rel=1e-6
+    )
+
+
+def test_the_heuristic_is_never_worse_than_the_nearest_parts(two_link, exact):
+    arm, problem, optimum = two_link
+    heuristic = snap_to_catalogue(problem, optimum, _catalogue(), arm=arm, candidates=6, max_combinations=1)
+    assert heuristic.method.startswith("heuristic: coordinate descent")
+    assert len(heuristic.tried) < 36
+    nearest = solve_parts(problem, optimum, [j.parts[0] for j in heuristic.joints], arm)
+    assert _chosen_value(problem, heuristic) <= objective_value(problem, nearest.numpy_objectives) * (
+        1 + SOLVER_TOLERANCE
+    )
+    # On two joints, each pass tries every part of each joint: it finds the enumeration's best here.
+    assert _chosen_value(problem, heuristic) == pytest.approx(
+        _chosen_value(problem, exact), rel=SOLVER_TOLERANCE
+    )
+
+
+def test_candidates_are_the_nearest_within_bounds(two_link):
+    _, problem, optimum = two_link
+    joints = snapping.joint_candidates(problem, optimum, _catalogue(), candidates=2)
+    design = optimum.design
+    for j, joint in enumerate(joints):
+        distances = sorted(
+            snapping.motor_distance(m, design.motor_peak_torque[j], design.rotor_inertia[j])
+            for m in _catalogue()
+        )
+        assert [p.distance for p in joint.parts] == pytest.approx(distances[:2])
+
+
+def test_a_catalogue_of_small_motors_for_a_big_joint_says_what_the_nearest_misses(two_link):
+    arm, problem, _ = two_link
+    big = cr.Constraints(torque_required=[20.0, 1.0], threshold_floor=0.5)
+    needy = cr.build_problem(arm, problem.samples, problem.space, problem.technology, OBJECTIVE, big)
+    optimum = cr.solve(needy, starts=2)
+    small = [
+        cr.Motor("tiny", 0.022, 0.01, 1e-7, 0.05, 0.02, 0.02, source="test motor"),
+        cr.Motor("small", 0.025, 0.01, 2e-7, 0.08, 0.03, 0.03, source="test motor"),
+    ]
+    snapped = snap_to_catalogue(needy, optimum, small, arm=arm)
+    assert not snapped.found and snapped.parts is None and snapped.result is None
+    joint1 = snapped.joints[0]
+    assert joint1.parts == () and joint1.nearest == "small"
+    # 0.08 N*m x the largest ratio 50 = 4 N*m of the 20 N*m required: 16 N*m short.
+    assert re.search(r"= 4 N\*m, short of the required 20 N\*m by 16 N\*m", " ".join(joint1.misses))
+    assert any("joint1: no catalogue part within bounds; the nearest, small," in w for w in snapped.warnings)
+    # The optimum's motor is far beyond the catalogue's small motors: warned.
+    assert optimum.design.motor_peak_torque[0] > 1.1 * 0.08
+    assert joint1.warning is not None and "outside the range the catalogue covers" in joint1.warning
+    # The second joint (1 N*m) is covered by the small motors: no warning of its own.
+    assert snapped.joints[1].parts
+
+
+def test_a_motor_beyond_the_diameter_bound_is_reported_with_the_excess(two_link):
+    arm, problem, optimum = two_link
+    wide = [cr.Motor("too wide", 0.15, 0.03, 5e-4, 9.0, 4.0, 1.5, source="test motor")]
+    snapped = snap_to_catalogue(problem, optimum, wide, arm=arm)
+    for joint in snapped.joints:
+        assert joint.nearest == "too wide"
+        assert joint.misses == ("stator diameter 150 mm above the upper bound 120 mm by 30 mm",)
+
+
+def test_bad_settings_are_refused(two_link):
+    arm, problem, optimum = two_link
+    with pytest.raises(cr.InvalidParameter, match="candidates"):
+        snap_to_catalogue(problem, optimum, _catalogue(), arm=arm, candidates=0)
+    with pytest.raises(cr.InvalidParameter, match="max_combinations"):
+        snap_to_catalogue(problem, optimum, _catalogue(), arm=arm, max_combinations=0)
+    with pytest.raises(cr.InvalidParameter, match="motors"):
+        snap_to_catalogue(problem, optimum, [], arm=arm)
+
+
+def test_ctrl_c_interrupts_the_snap(two_link, monkeypatch):
+    arm, problem, optimum = two_link
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(snapping, "solve_parts", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        snap_to_catalogue(problem, optimum, _catalogue(), arm=arm)
+
+
+def test_a_study_run_snaps_reports_and_resumes_without_redoing_it(tmp_path, monkeypatch):
+    folder = tmp_path / "out"
+    first = cr.run_study(TWO_LINK_STUDY, folder, quiet=True, smoke=True, executor="serial")
+    designs = json.loads((folder / "designs.json").read_text())
+    catalogue = designs["catalogue"]
+    assert catalogue["method"].startswith("exact: enumerated")
+    assert catalogue["design"] is not None and catalogue["snapped"] == designs["recommended"]["source"]
+    for joint in catalogue["joints"]:
+        assert joint["part"] in cr.load_catalogue() and joint["source"]
+    assert len(catalogue["pareto"]) == len(designs["pareto"]["points"])
+    report = (folder / "report.html").read_text()
+    assert 'id="catalogue"' in report and 'id="catalogue-objectives"' in report
+    header = (folder / "pareto.csv").read_text().splitlines()[0]
+    assert "catalogue_part[joint1]" in header and "catalogue_worst_case_impulse [N*s]" in header
+    assert (folder / "points" / "catalogue.json").exists()
+    (sentence,) = [line for line in designs["verdict"] if line.startswith("Built from catalogue parts")]
+    for joint in catalogue["joints"]:
+        assert f"{joint['joint']} {joint['part']} at N = " in sentence
+    change = 100 * catalogue["relative_difference"]["worst_case_impulse"]
+    assert f"worst case impulse +{change:.3g} %" in sentence and sentence in report
+
+    def not_again(*args, **kwargs):
+        raise AssertionError("the snap was redone on resume")
+
+    monkeypatch.setattr(snapping, "snap_to_catalogue", not_again)
+    again = cr.run_study(TWO_LINK_STUDY, folder, quiet=True, smoke=True, executor="serial")
+    assert again.resumed and again.computed == 0 and again.reused == first.computed + first.reused
+    assert json.loads((folder / "designs.json").read_text())["catalogue"] == catalogue
+
+
+def _harmonic(name: str, ratios: tuple[float, ...], peak: float, mass: float, continuous: bool = False):
+    from collision_reflex.hardware.gearboxes import CatalogueGearbox
+
+    return CatalogueGearbox(
+        name=name,
+        kind="harmonic",
+        ratios=ratios,
+        continuous_ratio=continuous,
+        rated_torque=peak / 2,
+        peak_torque=peak,
+        mass=mass,
+        inertia=1e-6,
+        source="test figures",
+        efficiency=0.8,
+    )
+
+
+def test_a_gearbox_of_discrete_ratios_gets_an_offered_ratio(two_link):
+    arm, problem, _ = two_link
+    geared = cr.ActuatorTechnology(
+        cr.reference_motor(), 1000.0, gearboxes=(_harmonic("HD", (5.0, 10.0, 20.0, 40.0), 100.0, 0.3), None)
+    )
+    # The continuous optimum may use any ratio of the gearbox's range 5-40; the catalogue design an offered one.
+    continuous = dataclasses.replace(geared.gearboxes[0], continuous_ratio=True, ratios=(5.0, 40.0))
+    technology = dataclasses.replace(geared, gearboxes=(continuous, None))
+    built = cr.build_problem(arm, problem.samples, problem.space, technology, OBJECTIVE, problem.constraints)
+    optimum = cr.solve(built, starts=2)
+    discrete = cr.build_problem(arm, problem.samples, problem.space, geared, OBJECTIVE, problem.constraints)
+    snapped = snap_to_catalogue(discrete, optimum, _catalogue(), arm=arm, candidates=2)
+    offered = np.array([5.0, 10.0, 20.0, 40.0])
+    chosen = set()
+    for part in snapped.joints[0].parts:
+        # The offered ratios around the one that gives this motor the continuous peak output torque.
+        matched = optimum.design.peak_torque[0] / part.motor.peak_torque
+        bracket = {
+            offered[offered <= matched].max(initial=5.0),
+            offered[offered >= matched].min(initial=40.0),
+        }
+        assert part.gear_ratio.is_fixed and part.gear_ratio.lower in bracket
+        chosen.add(part.gear_ratio.lower)
+    assert snapped.result.design.gear_ratio[0] in chosen
+    assert snapped.result.design.gearbox[0] == "HD"
+
+
+def test_a_gearbox_given_by_its_figures_snaps_to_catalogue_gearboxes_of_its_kind(two_link):
+    arm, problem, _ = two_link
+    own = _harmonic("study figures", (1.0, 50.0), 40.0, 0.5, continuous=True)
+    technology = cr.ActuatorTechnology(cr.reference_motor(), 1000.0, gearboxes=(own, None))
+    built = cr.build_problem(arm, problem.samples, problem.space, technology, OBJECTIVE, problem.constraints)
+    optimum = cr.solve(built, starts=2)
+    catalogue = {
+        g.name: g
+        for g in (
+            _harmonic("HD-light", (1.0, 50.0), 30.0, 0.3, continuous=True),
+            _harmonic("HD-heavy", (1.0, 50.0), 60.0, 1.2, continuous=True),
+            _harmonic("HD-weak", (1.0, 50.0), 1.0, 0.1, continuous=True),  # below the 2 N*m required
+            dataclasses.replace(
+                _harmonic("planetary", (1.0, 50.0), 40.0, 0.5, continuous=True), kind="planetary"
+            ),
+        )
+    }
+    snapped = snap_to_catalogue(built, optimum, _catalogue(), arm=arm, gearboxes=catalogue, candidates=2)
+    used = {p.gearbox.name for p in snapped.joints[0].parts}
+    assert used == {"HD-light", "HD-heavy"}  # the weak one misses the requirement, the planetary the kind
+    assert all(p.gearbox is None for p in snapped.joints[1].parts)
+    # Lighter gearbox, same motor: less mass at equal torque, so the mass-weighted objective prefers it.
+    assert snapped.parts[0].gearbox.name == "HD-light"
+    without = snap_to_catalogue(built, optimum, _catalogue(), arm=arm, candidates=2)
+    assert {p.gearbox.name for p in without.joints[0].parts} == {"study figures"}
+    assert not without.parts[0].gearbox_from_catalogue
+
+
+def test_a_quick_snap_evaluates_what_a_re_solve_finds(two_link, exact):
+    # Evaluated at the re-solved design's own variables, the parts give its objectives (one model, two paths).
+    _, problem, _ = two_link
+    evaluated = snapping.evaluate_parts(problem, exact.result.design, exact.parts)
+    assert evaluated.feasible
+    for name, value in exact.result.numpy_objectives.items():
+        assert evaluated.objectives[name] == pytest.approx(value, rel=1e-9)
+    np.testing.assert_allclose(evaluated.design.gear_ratio, exact.result.design.gear_ratio, rtol=1e-9)
+
+
+def _study_with(tmp_path, catalogue: str) -> Path:
+    text = TWO_LINK_STUDY.read_text().replace("../designs/", f"{ROOT / 'designs'}/")
+    study = tmp_path / "study.yaml"
+    study.write_text(text + f"catalogue: {catalogue}\n")
+    return study
+
+
+def test_a_bad_catalogue_section_is_refused_at_its_line_and_nothing_is_written(tmp_path, capsys):
+    from collision_reflex.cli import main
+
+    study = _study_with(tmp_path, "{candidates: 0}")
+    assert main(["run", str(study), "--out", str(tmp_path / "out"), "--quiet", "--smoke"]) == 2
+    assert re.search(r"study\.yaml:\d+:\d+: catalogue\.candidates: found 0", capsys.readouterr().err)
+    study = _study_with(tmp_path, "{motors: missing.yaml}")
+    assert main(["run", str(study), "--out", str(tmp_path / "out"), "--quiet", "--smoke"]) == 2
+    assert "missing.yaml: cannot read the file" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_changed_catalogue_is_snapped_again_on_resume(tmp_path):
+    motors = tmp_path / "motors.yaml"
+    motors.write_text((ROOT / "designs" / "motors.yaml").read_text())
+    study = _study_with(tmp_path, "{motors: motors.yaml}")
+    folder = tmp_path / "out"
+    cr.run_study(study, folder, quiet=True, smoke=True, executor="serial")
+    first = json.loads((folder / "points" / "catalogue.json").read_text())
+    assert cr.run_study(study, folder, quiet=True, smoke=True, executor="serial").computed == 0
+    motors.write_text(motors.read_text() + "# edited\n")  # the same parts, another file: snapped again
+    again = cr.run_study(study, folder, quiet=True, smoke=True, executor="serial")
+    assert again.computed == 1
+    second = json.loads((folder / "points" / "catalogue.json").read_text())
+    assert second["key"] != first["key"] and second["joints"] == first["joints"]
+
+
+def test_a_catalogue_with_no_part_within_bounds_is_reported_in_the_files(tmp_path):
+    motors = tmp_path / "tiny.yaml"
+    motors.write_text(
+        "motors:\n"
+        "  tiny:\n"
+        "    stator_diameter: 20 mm\n"
+        "    stack_length: 5 mm\n"
+        "    rotor_inertia: 1.0e-7 kg*m^2\n"
+        "    peak_torque: 0.01 N*m\n"
+        "    continuous_torque: 0.004 N*m\n"
+        "    mass: 0.01 kg\n"
+        "    source: a test motor\n"
+        "    estimates: {mass: a guess for the test}\n"
+    )
+    folder = tmp_path / "out"
+    cr.run_study(
+        _study_with(tmp_path, "{motors: tiny.yaml}"), folder, quiet=True, smoke=True, executor="serial"
+    )
+    catalogue = json.loads((folder / "designs.json").read_text())["catalogue"]
+    # 0.01 N*m x the largest ratio 100 = 1 N*m of the 1.3 N*m every joint must give: 0.3 N*m short.
+    assert catalogue["design"] is None and catalogue["method"].startswith("none: joint1: no catalogue part")
+    for joint in catalogue["joints"]:
+        assert joint["part"] is None and joint["nearest"] == "tiny"
+        assert joint["misses"] == [
+            "peak torque 0.01 N*m x the largest gear ratio 100 = 1 N*m, short of the required 1.3 N*m by 0.3 N*m"
+        ]
+    report = (folder / "report.html").read_text()
+    assert (
+        'id="catalogue-none"' in report and "no catalogue part within bounds; nearest tiny misses" in report
+    )
+    import pandas as pd
+
+    table = pd.read_csv(folder / "pareto.csv")
+    assert set(table["catalogue_part[joint1]"]) == {"none within bounds"}
+    assert not table["catalogue_feasible"].any()
+
+
+def test_the_snap_gives_the_same_catalogue_design_through_a_process_pool(tmp_path):
+    serial, pool = tmp_path / "serial", tmp_path / "pool"
+    cr.run_study(TWO_LINK_STUDY, serial, quiet=True, smoke=True, executor="serial")
+    cr.run_study(TWO_LINK_STUDY, pool, quiet=True, smoke=True, executor="processes", workers=2)
+    entries = [json.loads((folder / "designs.json").read_text())["catalogue"] for folder in (serial, pool)]
+    assert entries[0] == entries[1]
