@@ -141,6 +141,18 @@ def _objective_units() -> dict[str, str]:
     return {name: unit for name, (_, unit, _) in OBJECTIVES.items()}
 
 
+# A number with an exponent ("9.25e-06", "2e7") in prose: the browser may break a line after its minus sign.
+_PROSE_NUMBER = re.compile(r"\d+(?:\.\d+)?e[+-]?\d+")
+
+
+def whole_numbers(text: str) -> Any:
+    """``text`` escaped for HTML, each number with an exponent kept on one line (a citation's figures)."""
+    import markupsafe
+
+    escaped = str(markupsafe.escape(text))
+    return markupsafe.Markup(_PROSE_NUMBER.sub(lambda m: f'<span class="nowrap">{m.group(0)}</span>', escaped))
+
+
 def render_html(results: dict[str, Any], rows: list[dict[str, Any]], svgs: dict[str, str]) -> str:
     """The report page for a run's results; ``rows`` are the rows of ``pareto.csv``."""
     import jinja2
@@ -154,6 +166,7 @@ def render_html(results: dict[str, Any], rows: list[dict[str, Any]], svgs: dict[
     )
     environment.filters["n"] = number
     environment.filters["settled"] = settled
+    environment.filters["whole_numbers"] = whole_numbers
     template = environment.get_template(f"{results['kind']}_report.html.j2")
     context: dict[str, Any] = {
         "results": results,
