@@ -1,0 +1,438 @@
+"""Where the arm-level closed form holds: the time-domain arm collision against the closed form, swept.
+
+For an arm and a design's joint parameters, :func:`validity_map` simulates the collision
+(:func:`collision_reflex.simulate.simulate_arm_collision`) over configurations x directions x approach
+velocities (multiples of the closed form's optimum ``v*``) x the ratio of the contact stiffness to the joint
+stiffness along ``u``, for each detection scheme the simulator offers, and compares each simulated impulse with
+the closed form for both placements of the reflected inertia (``robot``: behind the joint springs, the paper's
+arm model; ``finger``: rigidly on the link side, a stiff transmission). A row is *valid* where the two agree
+within the tolerance (5 % by default).
+
+The closed form compared is the one a study uses, with the object hit as a spring in series with the joints
+(as the actuator study does): ``k`` and ``k_m`` along ``u`` are each in series with the contact stiffness
+``k_c``. Every simulation is checked against a work budget first (:func:`check_arm_work`): a setting whose step
+would collapse (a very stiff wall) or whose approach would last very long is refused at once, and recorded as a
+failed row, never run for hours.
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from .. import _validate
+from ..errors import CollisionReflexError, InvalidParameter, SimulationError
+from ..model.impulse import collision_times, optimal_velocity, series_stiffness, total_impulse
+from . import arm as arm_simulation
+from .budget import STEP_PER_PERIOD
+from .dynamics import admittance_share
+from .setup import oscillation_period
+
+VELOCITY_RATIOS: tuple[float, ...] = (0.1, 0.3, 1.0, 3.0, 10.0)
+"""Approach velocities swept, as multiples of the closed form's optimum ``v* = F_s / sqrt(2 k m_f)``."""
+
+STIFFNESS_RATIOS: tuple[float, ...] = (0.1, 10.0)
+"""Contact stiffness over the joints' mechanical stiffness along ``u``: 0.1 is a stiff transmission hitting a
+compliant object, 10 compliant joints hitting a stiff one."""
+
+PLACEMENTS: tuple[str, ...] = ("robot", "finger")
+"""Where the closed form puts the reflected inertia ``N^2 J_m`` (see :data:`REFLECTED_INERTIA_PLACEMENTS`)."""
+
+TOLERANCE = 0.05
+"""Agreement that counts as valid: ``|I_sim / I_closed - 1| <= 5 %``."""
+
+MAX_STEPS = 400_000
+"""Default work budget of one arm simulation, in integrator steps (about a minute on a loaded machine)."""
+
+TORQUE_DETECTION = "joint_torque"
+"""The simulator's own detection when it offers no choice: the contact force estimated from the joint spring
+torques."""
+
+WATCH_PERIODS = 2  # periods of the finger on its springs the simulator watches for a rebound
+
+
+@dataclass(frozen=True)
+class JointDesign:
+    """A design's joint parameters, one value per joint or one for all, and its detection threshold.
+
+    Attributes
+    ----------
+    mechanical_stiffness: joint spring between link and motor [N m/rad], finite.
+    reflected_inertia: ``N^2 J_m`` per joint [kg m^2].
+    torque_limit: output torque limit per joint [N m].
+    threshold: contact-force threshold of the detector ``F_s`` [N].
+    software_stiffness: joint software stiffness [N m/rad]; ``inf`` for ideally velocity-controlled motors.
+    """
+
+    mechanical_stiffness: Any
+    reflected_inertia: Any
+    torque_limit: Any
+    threshold: float
+    software_stiffness: Any = math.inf
+
+    def simulator_keywords(self) -> dict[str, Any]:
+        """The keywords of :func:`simulate_arm_collision` that carry the joint parameters."""
+        return {
+            "mechanical_stiffness": self.mechanical_stiffness,
+            "reflected_inertia": self.reflected_inertia,
+            "torque_limit": self.torque_limit,
+            "software_stiffness": self.software_stiffness,
+        }
+
+
+def available_detections() -> tuple[str, ...]:
+    """The detection schemes the arm simulator offers (its ``ARM_DETECTIONS``), or its one torque-based scheme."""
+    return tuple(getattr(arm_simulation, "ARM_DETECTIONS", (TORQUE_DETECTION,)))
+
+
+@dataclass(frozen=True)
+class ArmClosedForm:
+    """The arm closed form at one configuration and direction, against a contact of given stiffness.
+
+    Attributes
+    ----------
+    m_f, m_r: effective finger and robot masses along ``u`` [kg]; k, k_m: lumped and mechanical stiffness along
+    ``u``, each in series with the contact [N/m]; a: reaction acceleration [m/s^2]; v_r: robot velocity at
+    detection along ``u`` per unit approach velocity [-]; impulse: ``I(v0)`` [N*s] for ``v0`` [m/s].
+    """
+
+    m_f: float
+    m_r: float
+    k: float
+    k_m: float
+    a: float
+    v_r: float
+    threshold: float
+    reaction: str
+
+    def impulse(self, approach_velocity: float) -> float:
+        """The closed form's impulse [N*s] at the approach velocity [m/s]."""
+        v0 = float(approach_velocity)
+        robot_velocity = self.v_r * v0 if self.reaction == "moving" else None
+        return float(
+            total_impulse(
+                self.m_f, self.k, self.k_m, self.threshold, self.a, v0, self.reaction, robot_velocity
+            )
+        )
+
+
+def arm_closed_form(
+    arm: Any,
+    q: npt.ArrayLike,
+    direction: npt.ArrayLike,
+    joints: JointDesign,
+    placement: str = "robot",
+    contact_stiffness: float = math.inf,
+    reaction: str = "moving",
+) -> ArmClosedForm:
+    """The arm closed form of a design at configuration ``q`` [rad] along ``direction``.
+
+    Parameters
+    ----------
+    arm: a :class:`collision_reflex.Arm`.
+    q: configuration (nq,) [rad]; direction: collision direction in task coordinates, normalised here.
+    joints: the design's joint parameters.
+    placement: ``"robot"`` or ``"finger"`` (reflected inertia also in ``m_f``).
+    contact_stiffness: stiffness of the object hit [N/m], in series with ``k`` and ``k_m``; ``inf``: rigid.
+    reaction: ``"moving"`` (robot still moving at detection, as the simulation) or ``"at_rest"``.
+    """
+    from ..arm import effective_parameters
+
+    _validate.choice("placement", placement, PLACEMENTS)
+    _validate.choice("reaction", reaction, arm_simulation.ARM_REACTIONS)
+    _validate.positive("contact_stiffness", contact_stiffness, allow_inf=True)
+    nv = int(arm.nv)
+    inertia = np.broadcast_to(np.asarray(joints.reflected_inertia, dtype=float), (nv,))
+    k_m = np.broadcast_to(np.asarray(joints.mechanical_stiffness, dtype=float), (nv,))
+    k_s = np.broadcast_to(np.asarray(joints.software_stiffness, dtype=float), (nv,))
+    u = np.asarray(direction, dtype=float).reshape(-1)
+    u = u / np.linalg.norm(u)
+    samples = arm.kinematics(np.asarray(q, dtype=float)[None])
+    motor_mass = np.asarray(arm.joint_parameters.motor_mass, dtype=float)
+    effective = effective_parameters(
+        samples,
+        u[None],
+        inertia,
+        series_stiffness(k_m, k_s),
+        k_m,
+        joints.torque_limit,
+        motor_mass=motor_mass if np.any(motor_mass > 0) else None,
+        finger_joint_inertia=inertia if placement == "finger" else None,
+    )
+    if bool(effective.singular[0, 0]):
+        raise InvalidParameter(
+            "direction", direction, "a direction the arm can move along at q", "q is singular"
+        )
+    jac = samples.jacobian[0]
+    v_r = float(u @ jac @ (admittance_share(k_m, k_s) * (np.linalg.pinv(jac) @ u)))
+    value = {name: float(getattr(effective, name)[0, 0]) for name in ("m_f", "m_r", "k", "k_m", "a")}
+    return ArmClosedForm(
+        m_f=value["m_f"],
+        m_r=value["m_r"],
+        k=float(series_stiffness(value["k"], contact_stiffness)),
+        k_m=float(series_stiffness(value["k_m"], contact_stiffness)),
+        a=value["a"],
+        v_r=v_r,
+        threshold=float(joints.threshold),
+        reaction=reaction,
+    )
+
+
+def check_arm_work(
+    arm: Any,
+    closed: ArmClosedForm,
+    joints: JointDesign,
+    approach_velocity: float,
+    contact_stiffness: float,
+    max_steps: float = MAX_STEPS,
+) -> float:
+    """Estimated integrator steps of an arm simulation; raise :class:`SimulationError` beyond ``max_steps``.
+
+    The step is a sixteenth of the shortest period in play (the finger on the wall and on the joint springs,
+    the robot mass and each rotor on its spring), as the simulator chooses it; the span is the closed form's
+    contact (detection and reaction) and the watch after it. ``closed`` is the ``robot`` placement's closed
+    form with a rigid contact; ``approach_velocity`` [m/s], ``contact_stiffness`` [N/m].
+    """
+    nv = int(arm.nv)
+    inertia = np.broadcast_to(np.asarray(joints.reflected_inertia, dtype=float), (nv,))
+    k_m = np.broadcast_to(np.asarray(joints.mechanical_stiffness, dtype=float), (nv,))
+    periods = {
+        "the finger on the wall contact (lower the contact stiffness)": oscillation_period(
+            closed.m_f, contact_stiffness
+        ),
+        "the finger on the joint springs": oscillation_period(closed.m_f, closed.k_m),
+        "the robot mass on the joint springs": oscillation_period(closed.m_r, closed.k_m),
+        "a rotor on its joint spring": min(oscillation_period(b, k) for b, k in zip(inertia, k_m, strict=True)),
+    }
+    scale = min(periods, key=lambda name: periods[name])
+    step = periods[scale] / STEP_PER_PERIOD
+    robot_velocity = closed.v_r * approach_velocity if closed.reaction == "moving" else None
+    try:
+        _, t2 = collision_times(
+            closed.m_f,
+            closed.k,
+            closed.k_m,
+            closed.threshold,
+            closed.a,
+            approach_velocity,
+            closed.reaction,
+            robot_velocity,
+        )
+    except CollisionReflexError as error:
+        raise SimulationError(f"the closed form has no finite contact here: {error}") from None
+    span = float(t2) + WATCH_PERIODS * periods["the finger on the joint springs"]
+    steps = span / step
+    if not steps <= max_steps:  # NaN and inf refused too
+        raise SimulationError(
+            f"this arm collision needs about {steps:.2g} integrator steps, beyond the budget {max_steps:g}: the "
+            f"contact lasts {span:.3g} s while {scale} limits the step to {step:.3g} s"
+        )
+    return steps
+
+
+def simulator_detection_keywords(detection: str) -> dict[str, Any]:
+    """The keyword that selects ``detection`` in the simulator (none for its only, torque-based scheme)."""
+    if "detection" in inspect.signature(arm_simulation.simulate_arm_collision).parameters:
+        return {"detection": detection}
+    if detection != TORQUE_DETECTION:
+        raise InvalidParameter("detection", detection, f"one of {available_detections()}")
+    return {}
+
+
+@dataclass(frozen=True)
+class ValidityCase:
+    """One simulated collision of the map: where, how fast, against what, detected how.
+
+    Attributes
+    ----------
+    configuration, direction: indices into the map's configurations and directions.
+    velocity_ratio: ``v0 / v*``; stiffness_ratio: contact over joint stiffness along ``u``; detection: scheme.
+    """
+
+    configuration: int
+    direction: int
+    velocity_ratio: float
+    stiffness_ratio: float
+    detection: str
+
+
+def validity_map(
+    arm: Any,
+    joints: JointDesign,
+    configurations: npt.ArrayLike,
+    directions: npt.ArrayLike,
+    *,
+    velocity_ratios: Sequence[float] = VELOCITY_RATIOS,
+    stiffness_ratios: Sequence[float] = STIFFNESS_RATIOS,
+    detections: Sequence[str] | None = None,
+    placements: Sequence[str] = PLACEMENTS,
+    tolerance: float = TOLERANCE,
+    reaction: str = "moving",
+    max_steps: float = MAX_STEPS,
+) -> Any:
+    """Where the arm closed form agrees with the time-domain simulation, as a :class:`pandas.DataFrame`.
+
+    Parameters
+    ----------
+    arm: a :class:`collision_reflex.Arm`.
+    joints: the design's joint parameters and threshold.
+    configurations: (n, nq) impact configurations [rad]; directions: (d, task_dim) collision directions.
+    velocity_ratios: approach velocities as multiples of ``v*`` (robot placement, rigid contact) [-].
+    stiffness_ratios: contact stiffness over the joints' mechanical stiffness along ``u`` [-].
+    detections: detection schemes to simulate; default every scheme the simulator offers.
+    placements: closed-form placements of the reflected inertia compared with each simulation.
+    tolerance: relative agreement that counts as valid [-].
+    reaction: the closed form's reaction variant (``"moving"``: the robot's velocity at detection).
+    max_steps: work budget of one simulation [integrator steps]; a case beyond it is refused and recorded.
+
+    Returns
+    -------
+    One row per case and placement: ``configuration``, ``direction`` (indices), ``q``, ``u`` (as lists),
+    ``velocity_ratio``, ``v0`` [m/s], ``stiffness_ratio``, ``contact_stiffness`` [N/m], ``detection``,
+    ``placement``, ``simulated`` and ``closed_form`` [N*s], ``difference`` (``I_sim / I_closed - 1``),
+    ``valid`` (within ``tolerance``), ``error`` (why a case was refused or failed, else ``""``) and
+    ``seconds`` (the simulation's wall time).
+    """
+    import pandas as pd
+
+    qs = np.atleast_2d(np.asarray(configurations, dtype=float))
+    us = np.atleast_2d(np.asarray(directions, dtype=float))
+    for name, values in (("velocity_ratios", velocity_ratios), ("stiffness_ratios", stiffness_ratios)):
+        _validate.positive(name, np.asarray(values, dtype=float))
+    _validate.positive("tolerance", tolerance)
+    schemes = tuple(available_detections() if detections is None else detections)
+    for placement in placements:
+        _validate.choice("placement", placement, PLACEMENTS)
+    rows: list[dict[str, Any]] = []
+    for i, q in enumerate(qs):
+        for j, u in enumerate(us):
+            reference = arm_closed_form(arm, q, u, joints, "robot", math.inf, reaction)
+            v_star = float(optimal_velocity(reference.m_f, reference.k, joints.threshold))
+            for ratio_k in stiffness_ratios:
+                k_c = float(ratio_k) * reference.k_m
+                closed = {p: arm_closed_form(arm, q, u, joints, p, k_c, reaction) for p in placements}
+                for ratio_v in velocity_ratios:
+                    for detection in schemes:
+                        case = ValidityCase(i, j, float(ratio_v), float(ratio_k), detection)
+                        simulated, error, seconds = _simulated(
+                            arm, q, u, joints, reference, case, v_star, k_c, reaction, max_steps
+                        )
+                        for placement, form in closed.items():
+                            rows.append(
+                                _row(
+                                    case,
+                                    q,
+                                    u,
+                                    v_star,
+                                    k_c,
+                                    placement,
+                                    form,
+                                    simulated,
+                                    error,
+                                    seconds,
+                                    tolerance,
+                                )
+                            )
+    return pd.DataFrame(rows)
+
+
+def _simulated(
+    arm: Any,
+    q: np.ndarray,
+    u: np.ndarray,
+    joints: JointDesign,
+    reference: ArmClosedForm,
+    case: ValidityCase,
+    v_star: float,
+    contact_stiffness: float,
+    reaction: str,
+    max_steps: float,
+) -> tuple[float, str, float]:
+    """The simulated impulse [N*s] of a case (NaN if refused or failed), why not (or ``""``), its seconds."""
+    v0 = case.velocity_ratio * v_star
+    start = time.perf_counter()
+    try:
+        check_arm_work(arm, reference, joints, v0, contact_stiffness, max_steps)
+        result = arm_simulation.simulate_arm_collision(
+            arm,
+            q,
+            u,
+            v0,
+            joints.threshold,
+            contact_stiffness=contact_stiffness,
+            reaction=reaction,
+            **joints.simulator_keywords(),
+            **simulator_detection_keywords(case.detection),
+        )
+    except (SimulationError, InvalidParameter) as error:
+        return math.nan, str(error), time.perf_counter() - start
+    return float(result.impulse), "", time.perf_counter() - start
+
+
+def _row(
+    case: ValidityCase,
+    q: np.ndarray,
+    u: np.ndarray,
+    v_star: float,
+    contact_stiffness: float,
+    placement: str,
+    closed: ArmClosedForm,
+    simulated: float,
+    error: str,
+    seconds: float,
+    tolerance: float,
+) -> dict[str, Any]:
+    """One row of the map: a case against one placement's closed form."""
+    v0 = case.velocity_ratio * v_star
+    closed_form = closed.impulse(v0)
+    difference = simulated / closed_form - 1
+    return {
+        "configuration": case.configuration,
+        "direction": case.direction,
+        "q": [float(x) for x in q],
+        "u": [float(x) for x in u / np.linalg.norm(u)],
+        "velocity_ratio": case.velocity_ratio,
+        "v0": v0,
+        "stiffness_ratio": case.stiffness_ratio,
+        "contact_stiffness": contact_stiffness,
+        "detection": case.detection,
+        "placement": placement,
+        "simulated": simulated,
+        "closed_form": closed_form,
+        "difference": difference,
+        "valid": bool(abs(difference) <= tolerance),
+        "error": error,
+        "seconds": seconds,
+    }
+
+
+def validity_summary(table: Any) -> Any:
+    """Share of valid cases per detection, placement, stiffness ratio and velocity ratio (a pivot table).
+
+    Rows: ``(detection, placement, stiffness_ratio)``; columns: ``velocity_ratio``; values: the fraction of the
+    configurations x directions where the closed form holds (failed cases count as not valid).
+    """
+    return table.pivot_table(
+        index=["detection", "placement", "stiffness_ratio"],
+        columns="velocity_ratio",
+        values="valid",
+        aggfunc="mean",
+    )
+
+
+def worst_difference(table: Any) -> Any:
+    """Largest ``|I_sim / I_closed - 1|`` per detection, placement, stiffness ratio and velocity ratio."""
+    frame = table.assign(magnitude=table["difference"].abs())
+    return frame.pivot_table(
+        index=["detection", "placement", "stiffness_ratio"],
+        columns="velocity_ratio",
+        values="magnitude",
+        aggfunc="max",
+    )
