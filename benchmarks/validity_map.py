@@ -67,7 +67,9 @@ ARMS = {"planar two-link": _planar, "UR5": _ur5, "Panda": _panda}
 
 def main(figure_path: str | None) -> None:
     tables = {}
-    print(f"machine load (1, 5, 15 min): {', '.join(f'{x:.1f}' for x in os.getloadavg())} on {os.cpu_count()} cores")
+    print(
+        f"machine load (1, 5, 15 min): {', '.join(f'{x:.1f}' for x in os.getloadavg())} on {os.cpu_count()} cores"
+    )
     for name, build in ARMS.items():
         arm, joints, configurations, directions = build()
         start = time.perf_counter()
@@ -97,7 +99,8 @@ def _figure(tables: dict[str, Any], path: str) -> Path:
     for ax, (name, table) in zip(np.atleast_1d(axes), tables.items(), strict=True):
         worst = 100 * worst_difference(table)
         labels = [
-            f"{detection}, {placement}, k_c/k_m={ratio:g}" if len(table["detection"].unique()) > 1
+            f"{detection}, {placement}, k_c/k_m={ratio:g}"
+            if len(table["detection"].unique()) > 1
             else f"{placement}, k_c/k_m = {ratio:g}"
             for detection, placement, ratio in worst.index
         ]

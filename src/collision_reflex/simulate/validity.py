@@ -17,6 +17,8 @@ failed row, never run for hours.
 
 from __future__ import annotations
 
+import copy
+import dataclasses
 import inspect
 import math
 import time
@@ -69,6 +71,7 @@ class JointDesign:
     torque_limit: output torque limit per joint [N m].
     threshold: contact-force threshold of the detector ``F_s`` [N].
     software_stiffness: joint software stiffness [N m/rad]; ``inf`` for ideally velocity-controlled motors.
+    motor_mass: motor (and gearbox) mass per joint [kg], carried by the parent link; None: the arm's.
     """
 
     mechanical_stiffness: Any
@@ -76,6 +79,18 @@ class JointDesign:
     torque_limit: Any
     threshold: float
     software_stiffness: Any = math.inf
+    motor_mass: Any = None
+
+    def on(self, arm: Any) -> Any:
+        """``arm`` with this design's motor masses (the arm itself when they are the arm's)."""
+        if self.motor_mass is None:
+            return arm
+        params = arm.joint_parameters
+        mass = np.broadcast_to(np.asarray(self.motor_mass, dtype=float), params.motor_mass.shape)
+        _validate.non_negative("motor_mass", mass)
+        out = copy.copy(arm)
+        out.joint_parameters = dataclasses.replace(params, motor_mass=mass.copy())
+        return out
 
     def simulator_keywords(self) -> dict[str, Any]:
         """The keywords of :func:`simulate_arm_collision` that carry the joint parameters."""
@@ -145,6 +160,7 @@ def arm_closed_form(
     """
     from ..arm import effective_parameters
 
+    arm = joints.on(arm)
     _validate.choice("placement", placement, PLACEMENTS)
     _validate.choice("reaction", reaction, arm_simulation.ARM_REACTIONS)
     _validate.positive("contact_stiffness", contact_stiffness, allow_inf=True)
@@ -209,7 +225,9 @@ def check_arm_work(
         ),
         "the finger on the joint springs": oscillation_period(closed.m_f, closed.k_m),
         "the robot mass on the joint springs": oscillation_period(closed.m_r, closed.k_m),
-        "a rotor on its joint spring": min(oscillation_period(b, k) for b, k in zip(inertia, k_m, strict=True)),
+        "a rotor on its joint spring": min(
+            oscillation_period(b, k) for b, k in zip(inertia, k_m, strict=True)
+        ),
     }
     scale = min(periods, key=lambda name: periods[name])
     step = periods[scale] / STEP_PER_PERIOD
@@ -361,7 +379,7 @@ def _simulated(
     try:
         check_arm_work(arm, reference, joints, v0, contact_stiffness, max_steps)
         result = arm_simulation.simulate_arm_collision(
-            arm,
+            joints.on(arm),
             q,
             u,
             v0,
