@@ -326,6 +326,8 @@ def validity_map(
         _validate.positive(name, np.asarray(values, dtype=float))
     _validate.positive("tolerance", tolerance)
     schemes = tuple(available_detections() if detections is None else detections)
+    for scheme in schemes:
+        _validate.choice("detection", scheme, available_detections())
     for placement in placements:
         _validate.choice("placement", placement, PLACEMENTS)
     rows: list[dict[str, Any]] = []
