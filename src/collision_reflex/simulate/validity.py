@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import importlib
 import inspect
 import math
 import time
@@ -53,9 +54,8 @@ TOLERANCE = 0.05
 MAX_STEPS = 400_000
 """Default work budget of one arm simulation, in integrator steps (about a minute on a loaded machine)."""
 
-TORQUE_DETECTION = "joint_torque"
-"""The simulator's own detection when it offers no choice: the contact force estimated from the joint spring
-torques."""
+TORQUE_DETECTION = "spring_torque"
+"""The simulator's default detection: the contact force estimated from the joint spring torques."""
 
 WATCH_PERIODS = 2  # periods of the finger on its springs the simulator watches for a rebound
 
@@ -103,8 +103,12 @@ class JointDesign:
 
 
 def available_detections() -> tuple[str, ...]:
-    """The detection schemes the arm simulator offers (its ``ARM_DETECTIONS``), or its one torque-based scheme."""
-    return tuple(getattr(arm_simulation, "ARM_DETECTIONS", (TORQUE_DETECTION,)))
+    """The detection schemes the arm simulator offers, its default first."""
+    try:
+        schemes = importlib.import_module(f"{__package__}.arm_detection").DETECTIONS
+    except ModuleNotFoundError:  # a simulator with its one torque-based scheme
+        return (TORQUE_DETECTION,)
+    return (TORQUE_DETECTION, *(s for s in schemes if s != TORQUE_DETECTION))
 
 
 @dataclass(frozen=True)
