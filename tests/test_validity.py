@@ -123,6 +123,16 @@ def test_unknown_detection_and_placement_are_refused(arm):
         arm_closed_form(arm, Q, U, JOINTS, "gearbox")
 
 
+def test_bad_samples_are_clear_errors(arm):
+    """A stretched arm pushed along itself cannot move into the wall; malformed samples are named."""
+    with pytest.raises(cr.errors.InvalidParameter, match="singular"):
+        validity_map(arm, JOINTS, [[0.0, 0.0]], [[1.0, 0.0]], velocity_ratios=(0.1,))
+    with pytest.raises(cr.errors.InvalidParameter, match="configurations"):
+        validity_map(arm, JOINTS, [[0.3, 1.2, 0.0]], [U])
+    with pytest.raises(cr.errors.InvalidParameter, match="directions"):
+        validity_map(arm, JOINTS, [Q], [[0.0, 0.0]])
+
+
 # ---------------------------------------------------------------------------------- the study option
 def _study(tmp_path: Path, simulate: dict | None) -> Path:
     data = yaml.safe_load((ROOT / "studies" / "two_link_paper.yaml").read_text())

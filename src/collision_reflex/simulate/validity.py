@@ -326,6 +326,13 @@ def validity_map(
 
     qs = np.atleast_2d(np.asarray(configurations, dtype=float))
     us = np.atleast_2d(np.asarray(directions, dtype=float))
+    if qs.ndim != 2 or qs.shape[1] != arm.nq or not np.all(np.isfinite(qs)):
+        raise InvalidParameter(
+            "configurations", configurations, f"rows of {arm.nq} finite joint angles [rad]"
+        )
+    norms = np.linalg.norm(us, axis=-1) if us.ndim == 2 else np.zeros(1)
+    if us.ndim != 2 or us.shape[1] != arm.task_dim or not np.all(np.isfinite(norms) & (norms > 0)):
+        raise InvalidParameter("directions", directions, f"nonzero rows of {arm.task_dim} task coordinates")
     for name, values in (("velocity_ratios", velocity_ratios), ("stiffness_ratios", stiffness_ratios)):
         _validate.positive(name, np.asarray(values, dtype=float))
     _validate.positive("tolerance", tolerance)

@@ -661,7 +661,8 @@ class SimulateSpec(_Model):
         3, description="contact samples per design: those with the largest closed-form impulse"
     )
     detection: str | None = Field(
-        None, description="the simulator's detection scheme; null: its default (spring_torque, the joint spring torques' force estimate)"
+        None,
+        description="the simulator's detection scheme; null: its default (spring_torque, the joint spring torques' force estimate)",
     )
     contact_stiffness_ratio: float = Field(
         100.0, ge=1, le=1e4, description="the wall's stiffness over the joints' stiffness along u [-]"
