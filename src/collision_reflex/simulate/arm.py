@@ -37,12 +37,18 @@ import numpy as np
 from .. import _validate
 from .._compat import renamed_keywords
 from ..errors import InvalidParameter, SimulationError
-from ..model.impulse import collision_times, series_stiffness, total_impulse
+from ..model.impulse import collision_times, phase_impulses, series_stiffness, sprung_reaction, total_impulse
+from .arm_detection import DETECTIONS, detection_margin, next_sample
+from .budget import EVALUATIONS_PER_STEP, check_arm_work
 from .contact import damping_from_ratio
 from .dynamics import admittance_share
 from .setup import oscillation_period
 
 ARM_REACTIONS: tuple[str, ...] = ("at_rest", "moving")
+RETREATS: tuple[str, ...] = ("along_u", "saturated")
+"""``"along_u"``: the motors push with ``tau = -F_a J^T n``, each joint at most at its limit and the first at
+it, the closed form's reaction. ``"saturated"``: a retreat command saturates every joint, ``tau_i = -tau_max,i
+sign((J^T n)_i)`` (a real controller's reaction: more force along ``-n``, and a push off it)."""
 _MAX_REBOUNDS = 50  # contacts after the reaction before the finger is taken to keep hitting the wall
 _RENAMED_KEYWORDS = {
     "velocity": "approach_velocity",
@@ -68,6 +74,12 @@ class ArmCollision:
         ``S = diag(k_s / (k_s + k_m))`` [m/s] (``v0`` for ideally velocity-controlled motors).
     closed_form: the closed form's impulse [N*s] with ``reaction`` (and ``robot_velocity`` if moving).
     reaction: the closed form's reaction variant.
+    detection: the detection scheme (:data:`collision_reflex.simulate.arm_detection.DETECTIONS`).
+    retreat: the reaction's motor torques (:data:`RETREATS`).
+    detected_impulse: the simulated impulse on the wall until detection [N*s] (impact and sensing phases).
+    closed_form_sprung: the closed form with :func:`collision_reflex.model.impulse.sprung_reaction` in place
+        of the constant-acceleration reaction [N*s] (the spring's push on the robot mass kept).
+    closed_form_detected: the closed form's impact and sensing impulses, ``m_f v0 + F_s^2 / (2 k v0)`` [N*s].
     """
 
     q: np.ndarray
@@ -83,6 +95,11 @@ class ArmCollision:
     robot_velocity: float
     closed_form: float
     reaction: str
+    detection: str = "spring_torque"
+    retreat: str = "along_u"
+    detected_impulse: float = math.nan
+    closed_form_sprung: float = math.nan
+    closed_form_detected: float = math.nan
 
     @property
     def relative_difference(self) -> float:
@@ -111,6 +128,13 @@ def simulate_arm_collision(
     delay: float = 0.0,
     reaction: str = "moving",
     rtol: float = 1e-9,
+    detection: str = "spring_torque",
+    observer_gain: float = 200.0,
+    sample_rate: float | None = None,
+    current_threshold: Any = None,
+    retreat: str = "along_u",
+    max_steps: float = 2e5,
+    blanking: float | None = None,
 ) -> ArmCollision:
     """Simulate the collision of the arm's contact point with a wall.
 
@@ -138,8 +162,35 @@ def simulate_arm_collision(
     reaction: the closed form's variant to compare with, ``"moving"`` (with the robot velocity at detection)
         or ``"at_rest"``.
     rtol: the integrator's relative tolerance.
+    detection: the detection scheme, ``"spring_torque"`` (default, the joint spring torques projected on
+        ``u``), ``"force"`` (a sensor at the contact: the closed form's meaning), ``"observer"`` (a
+        generalized-momentum observer), ``"position"`` (contact-point position error, ``F_s = k e``) or
+        ``"current"`` (motor torque per joint); see :mod:`collision_reflex.simulate.arm_detection`.
+    observer_gain: the momentum observer's gain ``K`` [1/s], > 0 (``"observer"`` only).
+    sample_rate: the detector's sample rate [Hz], > 0; None (default) for a continuous detector.
+    current_threshold: per-joint motor-torque thresholds [N m] (output side), ``"current"`` only; default
+        ``threshold |J(q)^T u|``.
+    retreat: the reaction's motor torques, ``"along_u"`` (default: the closed form's, each joint at most at
+        its limit along the escape direction) or ``"saturated"`` (every joint at its limit); see
+        :data:`RETREATS`.
+    blanking: the longest time after the impact the detector stays unarmed [s], >= 0: it arms when its
+        signal first falls below the threshold after the impact, or at ``blanking`` at the latest. None
+        (default): twenty periods of the finger on the wall for ``"force"`` (the impact pulse, ``m_f v0``
+        over about half a period, would trip a contact sensor at once: the closed form's threshold means the
+        force after it), 0 for the other schemes (their signal passes through the joints or a filter; an
+        observer with ``K m_f v0 > F_s`` does detect the impact itself).
+    max_steps: the work budget [integrator steps]: a setting expected to need more is refused at once, and a
+        run that takes four times as many right-hand-side evaluations as the budget allows is stopped.
     """
     _validate.choice("reaction", reaction, ARM_REACTIONS)
+    _validate.choice("detection", detection, DETECTIONS)
+    _validate.choice("retreat", retreat, RETREATS)
+    _validate.positive("observer_gain", observer_gain)
+    _validate.positive("max_steps", max_steps)
+    if sample_rate is not None:
+        _validate.positive("sample_rate", sample_rate)
+    if blanking is not None:
+        _validate.non_negative("blanking", blanking)
     for name, value in (
         ("approach_velocity", approach_velocity),
         ("threshold", threshold),
@@ -152,8 +203,16 @@ def simulate_arm_collision(
         arm, q, direction, software_stiffness, mechanical_stiffness, reflected_inertia, torque_limit
     )
     closed = _closed_form(arm, joints, float(approach_velocity), float(threshold), reaction)
-    dynamics = _ArmDynamics(arm, joints, closed, contact_stiffness, contact_damping_ratio)
-    trace = _integrate(dynamics, closed, float(approach_velocity), float(threshold), delay, rtol)
+    sensing = _Sensing(
+        detection,
+        float(observer_gain),
+        None if sample_rate is None else float(sample_rate),
+        _current_threshold(arm, joints, float(threshold), current_threshold),
+        retreat,
+        blanking,
+    )
+    dynamics = _ArmDynamics(arm, joints, closed, contact_stiffness, contact_damping_ratio, sensing)
+    trace = _integrate(dynamics, closed, float(approach_velocity), float(threshold), delay, rtol, max_steps)
     return ArmCollision(
         q=joints.q0,
         direction=joints.u,
@@ -168,7 +227,36 @@ def simulate_arm_collision(
         robot_velocity=closed.robot_velocity,
         closed_form=closed.impulse,
         reaction=reaction,
+        detection=detection,
+        retreat=retreat,
+        detected_impulse=trace.detected_impulse,
+        closed_form_sprung=closed.sprung_impulse,
+        closed_form_detected=closed.detected_impulse,
     )
+
+
+@dataclass(frozen=True)
+class _Sensing:
+    """The detector and the reaction's torques.
+
+    Scheme, observer gain [1/s], sample rate [Hz] (or None), per-joint current thresholds [N m] (nv,), the
+    retreat and the blanking after the impact [s] (None: the scheme's default).
+    """
+
+    detection: str
+    observer_gain: float
+    sample_rate: float | None
+    current_threshold: np.ndarray
+    retreat: str
+    blanking: float | None
+
+
+def _current_threshold(arm: Any, joints: _Joints, threshold: float, given: Any) -> np.ndarray:
+    """Per-joint motor-torque thresholds [N m]: ``given``, or ``threshold |J(q0)^T u|``."""
+    if given is not None:
+        return _joint("current_threshold", given, joints.q0.size)
+    lever = arm.kinematics(joints.q0[None]).jacobian[0].T @ joints.u
+    return np.maximum(threshold * np.abs(lever), 1e-12 * threshold * float(np.max(np.abs(lever))))
 
 
 @dataclass(frozen=True)
@@ -234,6 +322,10 @@ def _joints(
     u = np.asarray(direction, dtype=float).reshape(-1)
     if u.shape != (arm.task_dim,) or not np.all(np.isfinite(u)) or np.linalg.norm(u) == 0:
         raise InvalidParameter("direction", direction, f"a nonzero vector of {arm.task_dim} task coordinates")
+    space = arm.configuration_space
+    lower, upper = space.lower_position_limit, space.upper_position_limit
+    if np.any(q0 <= lower) or np.any(q0 >= upper):
+        raise InvalidParameter("q", q, "a configuration strictly inside the joint limits", "q is at or past one")
     u = u / np.linalg.norm(u)
     return _Joints(q0, u, k_m, k_s, inertia, tau_max, np.asarray(params.motor_mass, dtype=float))
 
@@ -260,6 +352,8 @@ class _ClosedForm:
     reference_rate: the motors' reference velocity ``J(q0)^+ u v0`` (nv,) [rad/s].
     robot_velocity: the robot velocity at detection along ``u`` [m/s].
     impulse: the closed form's impulse [N*s].
+    sprung_impulse: the same with the spring's push on the robot mass in the reaction [N*s].
+    detected_impulse: its impact and sensing impulses [N*s].
     """
 
     effective: dict[str, float]
@@ -267,6 +361,8 @@ class _ClosedForm:
     reference_rate: np.ndarray
     robot_velocity: float
     impulse: float
+    sprung_impulse: float
+    detected_impulse: float
 
 
 def _closed_form(
@@ -292,6 +388,9 @@ def _closed_form(
             "direction", u, "a direction the arm can move along at q", "q is singular there"
         )
     jac0 = samples.jacobian[0]
+    reachable = jac0 @ (np.linalg.pinv(jac0) @ u)
+    if np.linalg.norm(reachable - u) > 1e-6:
+        raise InvalidParameter("direction", u, "a direction the contact point can move along at q")
     share = admittance_share(joints.k_m, joints.k_s)
     reference_rate = np.linalg.pinv(jac0) @ u * approach_velocity  # theta_ref' [rad/s]
     robot_velocity = float(u @ jac0 @ (share * reference_rate))
@@ -305,7 +404,13 @@ def _closed_form(
         reaction,
         robot_velocity if reaction == "moving" else None,
     )
-    return _ClosedForm(eff, share, reference_rate, robot_velocity, float(impulse))
+    v_r = robot_velocity if reaction == "moving" else None
+    phases = phase_impulses(
+        eff["m_f"], eff["k"], eff["k_m"], threshold, eff["a"], approach_velocity, reaction, v_r
+    )
+    detected = float(phases.initial + phases.sensing)
+    _, sprung = sprung_reaction(threshold, eff["k_m"], eff["F_a"], eff["m_r"], max(v_r or 0.0, 0.0))
+    return _ClosedForm(eff, share, reference_rate, robot_velocity, float(impulse), detected + sprung, detected)
 
 
 def _link_model(arm: Any) -> tuple[Any, Any, int]:
@@ -342,9 +447,10 @@ def _link_model(arm: Any) -> tuple[Any, Any, int]:
 
 
 class _ArmDynamics:
-    """Links, motors and wall: the right-hand side of the state ``(q, q', theta, theta', impulse)``.
+    """Links, motors, wall and observer: the right-hand side of the state ``(q, q', theta, theta', s, impulse)``.
 
-    It also gives the estimated contact force. Before the reaction ``theta`` is algebraic (ideal admittance).
+    ``s`` is the momentum observer's integral (zero unless it detects). It also gives the detectors'
+    estimates. Before the reaction ``theta`` is algebraic (ideal admittance).
     """
 
     def __init__(
@@ -354,6 +460,7 @@ class _ArmDynamics:
         closed: _ClosedForm,
         contact_stiffness: float,
         contact_damping_ratio: float,
+        sensing: _Sensing,
     ) -> None:
         import pinocchio as pin
 
@@ -370,6 +477,17 @@ class _ArmDynamics:
             contact_damping_ratio, closed.effective["m_f"], contact_stiffness
         )
         self.tau_max = joints.tau_max
+        self.detection, self.retreat = sensing.detection, sensing.retreat
+        self.observer_gain, self.current_threshold = sensing.observer_gain, sensing.current_threshold
+        self.sample_rate = sensing.sample_rate
+        wall_period = oscillation_period(closed.effective["m_f"], contact_stiffness)
+        default_blanking = 20 * wall_period if sensing.detection == "force" else 0.0
+        self.blanking = default_blanking if sensing.blanking is None else sensing.blanking
+        _, jac0 = self.contact_kinematics(joints.q0)
+        self.approach_velocity = float(self.normal @ (jac0 @ self.v_ref))  # v0 [m/s]
+        self.initial_momentum = self.mass_matrix(joints.q0) @ self.v_ref  # p(0) [N m s]
+        self.lumped_stiffness = closed.effective["k"]
+        self.evaluations, self.max_evaluations = 0, math.inf
         self.reacting = False
         self.torque = np.zeros(self.nv)  # motor torques of the reaction [N m]
         self.push = self.torque  # the reaction's torques, kept for a rebound
@@ -412,7 +530,13 @@ class _ArmDynamics:
         return max(self.contact_stiffness * depth + self.contact_damping * rate, 0.0)
 
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
-        """Time derivative of the state at ``t`` [s]: link and motor accelerations, the wall force."""
+        """Time derivative of the state at ``t`` [s]: link and motor accelerations, observer, wall force."""
+        self.evaluations += 1
+        if self.evaluations > self.max_evaluations:
+            raise SimulationError(
+                f"the arm collision needed more than {self.max_evaluations:.3g} right-hand-side evaluations "
+                "(the work budget); stiffen nothing, raise max_steps, or lower contact_stiffness"
+            )
         nv = self.nv
         qs, dq = y[:nv], y[nv : 2 * nv]
         theta, dtheta = self.motor_state(t, y)
@@ -420,13 +544,38 @@ class _ArmDynamics:
         force = self.wall_force(position, jac, dq)
         spring = self.k_m * (theta - qs)
         ddq = self.pin.aba(self.model, self.data, qs, dq, spring - jac.T @ self.normal * force)
-        out = np.empty_like(y)
+        out = np.zeros_like(y)
         out[:nv] = dq
         out[nv : 2 * nv] = ddq
         out[2 * nv : 3 * nv] = dtheta
         out[3 * nv : 4 * nv] = (self.torque - spring) / self.inertia if self.reacting else 0.0
+        if self.detection == "observer":
+            coriolis = self.pin.computeCoriolisMatrix(self.model, self.data, qs, dq)
+            out[4 * nv : 5 * nv] = spring + coriolis.T @ dq + self.observer_residual(y)  # no gravity here
         out[-1] = force
         return out
+
+    def mass_matrix(self, qs: np.ndarray) -> np.ndarray:
+        """The links' joint-space mass matrix ``M(q)`` (nv, nv) [kg m^2]."""
+        upper = np.asarray(self.pin.crba(self.model, self.data, qs))
+        return np.triu(upper) + np.triu(upper, 1).T
+
+    def observer_residual(self, y: np.ndarray) -> np.ndarray:
+        """The momentum observer's residual ``r = K (M(q) q' - p(0) - s)`` (nv,) [N m]: ``-J^T n f`` lagged."""
+        nv = self.nv
+        momentum = self.mass_matrix(y[:nv]) @ y[nv : 2 * nv]
+        return self.observer_gain * (momentum - self.initial_momentum - y[4 * nv : 5 * nv])
+
+    def motor_torque(self, t: float, y: np.ndarray) -> np.ndarray:
+        """Output-side motor torques ``B theta'' + K_m (theta - q)`` (nv,) [N m] (current times torque constant)."""
+        if self.reacting:
+            return self.torque.copy()
+        nv = self.nv
+        theta, _ = self.motor_state(t, y)
+        spring = self.k_m * (theta - y[:nv])
+        # The admittance's motor acceleration (1 - share) q'': zero for an ideal velocity drive.
+        ddq = self.rhs(t, y)[nv : 2 * nv]
+        return self.inertia * (1 - self.share) * ddq + spring
 
     def force_estimate(self, t: float, y: np.ndarray) -> float:
         """Contact force along ``u`` estimated from the joint spring torques [N]."""
@@ -456,9 +605,12 @@ class _ArmDynamics:
         y = y.copy()
         y[2 * nv : 3 * nv], y[3 * nv : 4 * nv] = self.motors(t, y[:nv], y[nv : 2 * nv])
         lever = self.contact_kinematics(y[:nv])[1].T @ self.normal
-        F_a = float(np.min(self.tau_max / np.maximum(np.abs(lever), 1e-300)))
+        if self.retreat == "saturated":
+            self.push = -self.tau_max * np.sign(lever)
+        else:
+            F_a = float(np.min(self.tau_max / np.maximum(np.abs(lever), 1e-300)))
+            self.push = -F_a * lever
         self.reacting = True
-        self.push = -F_a * lever
         self.torque = self.push
         return y
 
@@ -470,6 +622,7 @@ class _ArmTrace:
     times: list[np.ndarray]
     forces: list[np.ndarray]
     detection_time: float = math.nan
+    detected_impulse: float = math.nan
     reaction_time: float = math.nan
     contact_end: float = math.nan
     impulse: float = math.nan
@@ -491,11 +644,22 @@ def _time_scales(
         oscillation_period(eff["m_r"], eff["k_m"]),
         min(oscillation_period(b, k) for b, k in zip(dynamics.inertia, dynamics.k_m, strict=True)),
     ]
+    if dynamics.detection == "observer":
+        periods.append(2 * math.pi / dynamics.observer_gain)  # the observer's time constant, as a period
     max_step = min(periods) / 16  # a sixteenth of the shortest period in play
     # Fifty closed-form contacts (paper's reaction) and delays, and twenty of the longest periods.
     _, t2 = collision_times(eff["m_f"], eff["k"], eff["k_m"], threshold, eff["a"], approach_velocity)
     duration = 50 * (t2 + delay) + 20 * max(periods)
     return max_step, float(duration), finger_period
+
+
+def _expected_span(
+    closed: _ClosedForm, approach_velocity: float, threshold: float, delay: float, finger_period: float
+) -> float:
+    """The run's expected simulated time [s]: the closed form's contact, the delay and the watch after it."""
+    eff = closed.effective
+    _, t2 = collision_times(eff["m_f"], eff["k"], eff["k_m"], threshold, eff["a"], approach_velocity)
+    return float(t2 + delay + 2 * finger_period)
 
 
 def _integrate(
@@ -505,6 +669,7 @@ def _integrate(
     threshold: float,
     delay: float,
     rtol: float,
+    max_steps: float,
 ) -> _ArmTrace:
     """Integrate the arm's collision, phase by phase.
 
@@ -514,37 +679,82 @@ def _integrate(
     from scipy.integrate import solve_ivp  # here: SciPy's import time is paid only by a simulation
 
     max_step, duration, finger_period = _time_scales(dynamics, closed, approach_velocity, threshold, delay)
+    span = _expected_span(closed, approach_velocity, threshold, delay, finger_period)
+    check_arm_work(span, max_step, max_steps)
+    dynamics.max_evaluations = 4 * max_steps * EVALUATIONS_PER_STEP
     nv = dynamics.nv
-    y = np.zeros(4 * nv + 1)
+    y = np.zeros(5 * nv + 1)
     y[:nv] = dynamics.q0
     y[nv : 2 * nv] = dynamics.v_ref  # the links move with the motors before the impact
     options: dict[str, Any] = {"method": "DOP853", "rtol": rtol, "atol": 1e-12, "max_step": max_step}
     trace = _ArmTrace([np.array([0.0])], [np.array([0.0])])
 
     def detected(t: float, y: np.ndarray) -> float:
-        return dynamics.force_estimate(t, y) - threshold
+        return detection_margin(dynamics, t, y, threshold)
 
     detected.terminal, detected.direction = True, 1  # type: ignore[attr-defined]
 
-    # 1. Impact and sensing until the estimated force reaches the threshold.
-    solution = solve_ivp(dynamics.rhs, (0.0, duration), y, events=detected, **options)
-    trace.add(solution, dynamics)
-    if solution.status != 1:
-        raise SimulationError(
-            f"the contact force never reached the threshold {threshold:g} N within {duration:.3g} s; lower it"
-        )
-    t = trace.detection_time = float(solution.t[-1])
-    y = solution.y[:, -1].copy()
-    # 2. The delay, still tracking the reference.
-    if delay > 0:
-        solution = solve_ivp(dynamics.rhs, (t, t + delay), y, **options)
+    # 1. Impact and sensing until the estimated force reaches the threshold, once armed.
+    t, y, fell = _arm(dynamics, trace, y, threshold, options)
+    if fell or detection_margin(dynamics, t, y, threshold) < 0:
+        solution = solve_ivp(dynamics.rhs, (t, duration), y, events=detected, **options)
         trace.add(solution, dynamics)
-        y, t = solution.y[:, -1].copy(), t + delay
+        if solution.status != 1:
+            raise SimulationError(
+                f"the detector never reached the threshold {threshold:g} N within {duration:.3g} s; lower it"
+            )
+        t = float(solution.t[-1])
+        y = solution.y[:, -1].copy()
+    # A sampled detector sees the crossing at its next sample.
+    t, y = _advance(dynamics, trace, t, y, next_sample(t, dynamics.sample_rate) - t, options)
+    trace.detection_time, trace.detected_impulse = t, float(y[-1])
+    # 2. The delay, still tracking the reference.
+    t, y = _advance(dynamics, trace, t, y, delay, options)
     trace.reaction_time = t
     # 3. The reaction: admittance off, the motors push at the force limit along -u.
     y = dynamics.start_reaction(t, y)
     _react(dynamics, trace, t, y, duration, 2 * finger_period, options)
     return trace
+
+
+def _arm(
+    dynamics: _ArmDynamics, trace: _ArmTrace, y: np.ndarray, threshold: float, options: dict[str, Any]
+) -> tuple[float, np.ndarray, bool]:
+    """Integrate from the impact until the detector arms.
+
+    It arms when its signal falls below the threshold, or when the blanking time is over. Returns the time
+    [s], the state then and whether the signal fell below the threshold.
+    """
+    from scipy.integrate import solve_ivp
+
+    if dynamics.blanking <= 0:
+        return 0.0, y, False
+
+    def fallen(t: float, y: np.ndarray) -> float:
+        return detection_margin(dynamics, t, y, threshold)
+
+    fallen.terminal, fallen.direction = True, -1  # type: ignore[attr-defined]
+    solution = solve_ivp(dynamics.rhs, (0.0, dynamics.blanking), y, events=fallen, **options)
+    trace.add(solution, dynamics)
+    return float(solution.t[-1]), solution.y[:, -1].copy(), solution.status == 1
+
+
+def _advance(
+    dynamics: _ArmDynamics,
+    trace: _ArmTrace,
+    t: float,
+    y: np.ndarray,
+    span: float,
+    options: dict[str, Any],
+) -> tuple[float, np.ndarray]:
+    """Integrate ``span`` [s] on from ``t`` [s] without a mode change; the new time and state."""
+    from scipy.integrate import solve_ivp
+
+    if span <= 0:
+        return t, y
+    solution = solve_ivp(dynamics.rhs, (t, t + span), y, **options)
+    trace.add(solution, dynamics)
+    return t + span, solution.y[:, -1].copy()
 
 
 def _react(
@@ -559,14 +769,19 @@ def _react(
     """Push until the finger leaves the wall; then the reflex is over: the motors stop pushing and coast away.
 
     Watch ``watch`` [s] for a rebound into the wall before stopping (a constant torque kept on would spin the
-    arm round into the wall again, which is no part of the reflex), and push again if there is one.
+    arm round into the wall again, which is no part of the reflex), and push again from the moment it touches
+    again, until it leaves again.
     """
     from scipy.integrate import solve_ivp
 
     def separated(t: float, y: np.ndarray) -> float:
         return dynamics.penetration(y)
 
+    def touched(t: float, y: np.ndarray) -> float:
+        return dynamics.penetration(y)
+
     separated.terminal, separated.direction = True, -1  # type: ignore[attr-defined]
+    touched.terminal, touched.direction = True, 1  # type: ignore[attr-defined]
 
     for _ in range(_MAX_REBOUNDS):
         solution = solve_ivp(dynamics.rhs, (t, duration), y, events=separated, **options)
@@ -576,11 +791,10 @@ def _react(
             raise SimulationError(f"the contact had not ended after {duration:.3g} s; lengthen it")
         trace.contact_end = t
         dynamics.torque = np.zeros(dynamics.nv)
-        coast = solve_ivp(dynamics.rhs, (t, t + watch), y, **options)
+        coast = solve_ivp(dynamics.rhs, (t, t + watch), y, events=touched, **options)
         trace.add(coast, dynamics)
-        rebound = coast.y[-1, -1] > y[-1]
         y, t = coast.y[:, -1].copy(), float(coast.t[-1])
-        if not rebound:
+        if coast.status != 1:  # no new touch within the watch
             break
         dynamics.torque = dynamics.push
     else:

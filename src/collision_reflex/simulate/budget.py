@@ -205,3 +205,22 @@ def _fastest(setup: CollisionSetup, scales: dict[str, float]) -> tuple[float, st
         return math.inf, ""
     name = min(scales, key=lambda key: scales[key])
     return scales[name] / STEP_PER_PERIOD, name
+
+
+def check_arm_work(span: float, step: float, max_steps: float) -> None:
+    """Refuse an arm collision expected to need more than ``max_steps`` integrator steps.
+
+    Parameters
+    ----------
+    span: the expected simulated time [s] (the closed form's contact, the delay and the watch after it).
+    step: the largest step the fastest time scale allows [s] (a sixteenth of the shortest period in play).
+    max_steps: the budget [steps].
+    """
+    steps = _MIN_STEPS_PER_PHASE + span / step
+    if steps <= max_steps:  # (an inf or NaN estimate, from extreme settings, is refused)
+        return
+    raise SimulationError(
+        f"the arm collision would need about {steps:.3g} integrator steps ({span:.3g} s at steps of "
+        f"{step:.3g} s), more than the budget of {max_steps:.3g}: lower contact_stiffness, raise the joints' "
+        "reflected_inertia or the approach velocity, or raise max_steps"
+    )

@@ -1,0 +1,72 @@
+"""How the simulated arm detects the contact: the schemes and the quantity each compares with its threshold.
+
+Each scheme gives a force-equivalent along the wall normal ``n`` that is compared with the force threshold
+``F_s`` [N], so that one threshold means the same contact force for all of them in the quasi-static limit:
+
+- ``"force"``: a force sensor at the contact (the closed form's meaning of ``F_s``). Like the 1D simulator's,
+  it measures its own deflection: the contact's elastic force ``k_c d`` (depth ``d``), without the damper's
+  part, which jumps at each touch of a sliding, chattering finger.
+- ``"observer"``: the external-force estimate of a generalized-momentum observer from the joint torques, as
+  collaborative arms use it: ``r = K (p(t) - p(0) - int (tau + C^T q' - g + r) dt)`` with ``p = M(q) q'`` and
+  ``tau`` the joint spring torques; ``r' = K (tau_ext - r)``, a first-order lag of the external joint torque
+  ``tau_ext = -J^T n f`` with the gain ``K`` [1/s]. The force is ``f_est = -(J^T n) . r / |J^T n|^2``.
+- ``"spring_torque"``: the same projection of the joint spring torques themselves (an ideal joint-torque
+  sensor without the inertia correction: it carries the links' inertial torques).
+- ``"position"``: the contact point's position error along ``n``, ``e = n . (p0 + n v0 t - p(q))`` against the
+  commanded path, times the closed form's lumped stiffness: ``F = k e`` (``F_s = k e_th``).
+- ``"current"``: the motor torques ``B theta'' + K_m (theta - q)`` (current times torque constant, output
+  side), each against its own threshold torque; the first joint to reach it detects. The default thresholds
+  are ``F_s |J(q0)^T n|``: every joint reaches its threshold at the contact force ``F_s`` statically.
+
+A detector may be sampled at ``sample_rate`` [Hz]: it detects at the first sample at or after the continuous
+crossing (exact while the estimate rises monotonically across the threshold within a sample period).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from .arm import _ArmDynamics
+
+DETECTIONS: tuple[str, ...] = ("spring_torque", "force", "observer", "position", "current")
+"""The arm simulator's detection schemes (see the module docstring)."""
+
+
+def detection_margin(dynamics: _ArmDynamics, t: float, y: np.ndarray, threshold: float) -> float:
+    """The detector's force-equivalent minus the threshold [N]: it detects where this crosses zero upward.
+
+    Parameters
+    ----------
+    dynamics: the arm collision's dynamics (its ``detection`` names the scheme).
+    t: time since the impact [s].
+    y: the state ``(q, q', theta, theta', s, impulse)``.
+    threshold: the force threshold ``F_s`` [N].
+    """
+    scheme = dynamics.detection
+    nv = dynamics.nv
+    qs, dq = y[:nv], y[nv : 2 * nv]
+    if scheme == "force":
+        return dynamics.contact_stiffness * max(dynamics.penetration(y), 0.0) - threshold
+    if scheme == "spring_torque":
+        return dynamics.force_estimate(t, y) - threshold
+    if scheme == "observer":
+        _, jac = dynamics.contact_kinematics(qs)
+        lever = jac.T @ dynamics.normal
+        return float(-(lever @ dynamics.observer_residual(y)) / (lever @ lever)) - threshold
+    if scheme == "position":
+        error = dynamics.approach_velocity * t - dynamics.penetration(y)
+        return dynamics.lumped_stiffness * error - threshold
+    # "current": the first joint at its threshold torque, scaled to a force so that the margin is in N.
+    ratio = np.abs(dynamics.motor_torque(t, y)) / dynamics.current_threshold
+    return threshold * (float(np.max(ratio)) - 1.0)
+
+
+def next_sample(t: float, sample_rate: float | None) -> float:
+    """The first detector sample at or after ``t`` [s] (``t`` itself for a continuous detector)."""
+    if sample_rate is None:
+        return t
+    return math.ceil(t * sample_rate - 1e-9) / sample_rate
