@@ -19,8 +19,6 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import importlib
-import inspect
 import math
 import time
 from collections.abc import Sequence
@@ -31,10 +29,10 @@ import numpy as np
 import numpy.typing as npt
 
 from .. import _validate
-from ..errors import CollisionReflexError, InvalidParameter, SimulationError
-from ..model.impulse import collision_times, optimal_velocity, series_stiffness, total_impulse
+from ..errors import InvalidParameter, SimulationError
+from ..model.impulse import optimal_velocity, phase_impulses, series_stiffness, sprung_reaction
 from . import arm as arm_simulation
-from .budget import STEP_PER_PERIOD
+from .arm_detection import DETECTIONS
 from .dynamics import admittance_share
 from .setup import oscillation_period
 
@@ -51,13 +49,16 @@ PLACEMENTS: tuple[str, ...] = ("robot", "finger")
 TOLERANCE = 0.05
 """Agreement that counts as valid: ``|I_sim / I_closed - 1| <= 5 %``."""
 
-MAX_STEPS = 400_000
-"""Default work budget of one arm simulation, in integrator steps (about a minute on a loaded machine)."""
+MAX_STEPS = 200_000
+"""Default work budget of one arm simulation [integrator steps] (the simulator's; tens of seconds at most)."""
+
+REACTION_MODELS: tuple[str, ...] = ("constant", "sprung")
+"""The closed form's reaction: ``"constant"``, the paper's constant acceleration ``a = F_a / m_r``;
+``"sprung"``, :func:`collision_reflex.model.impulse.sprung_reaction` (the compressed spring also pushes the
+robot mass away, the term the constant acceleration leaves out)."""
 
 TORQUE_DETECTION = "spring_torque"
 """The simulator's default detection: the contact force estimated from the joint spring torques."""
-
-WATCH_PERIODS = 2  # periods of the finger on its springs the simulator watches for a rebound
 
 
 @dataclass(frozen=True)
@@ -103,12 +104,8 @@ class JointDesign:
 
 
 def available_detections() -> tuple[str, ...]:
-    """The detection schemes the arm simulator offers, its default first."""
-    try:
-        schemes = importlib.import_module(f"{__package__}.arm_detection").DETECTIONS
-    except ModuleNotFoundError:  # a simulator with its one torque-based scheme
-        return (TORQUE_DETECTION,)
-    return (TORQUE_DETECTION, *(s for s in schemes if s != TORQUE_DETECTION))
+    """The detection schemes of the arm simulator, its default first."""
+    return (TORQUE_DETECTION, *(s for s in DETECTIONS if s != TORQUE_DETECTION))
 
 
 @dataclass(frozen=True)
@@ -118,28 +115,33 @@ class ArmClosedForm:
     Attributes
     ----------
     m_f, m_r: effective finger and robot masses along ``u`` [kg]; k, k_m: lumped and mechanical stiffness along
-    ``u``, each in series with the contact [N/m]; a: reaction acceleration [m/s^2]; v_r: robot velocity at
-    detection along ``u`` per unit approach velocity [-]; impulse: ``I(v0)`` [N*s] for ``v0`` [m/s].
+    ``u``, each in series with the contact [N/m]; F_a: the motors' force along ``-u`` [N]; a: reaction
+    acceleration ``F_a / m_r`` [m/s^2]; v_r: robot velocity at detection along ``u`` per unit approach velocity
+    [-]; threshold: ``F_s`` [N]; reaction: ``"moving"`` or ``"at_rest"``.
     """
 
     m_f: float
     m_r: float
     k: float
     k_m: float
+    F_a: float
     a: float
     v_r: float
     threshold: float
     reaction: str
 
-    def impulse(self, approach_velocity: float) -> float:
-        """The closed form's impulse [N*s] at the approach velocity [m/s]."""
+    def impulse(self, approach_velocity: float, model: str = "constant") -> float:
+        """The closed form's impulse [N*s] at the approach velocity [m/s] with a reaction of :data:`REACTION_MODELS`."""
+        _validate.choice("model", model, REACTION_MODELS)
         v0 = float(approach_velocity)
         robot_velocity = self.v_r * v0 if self.reaction == "moving" else None
-        return float(
-            total_impulse(
-                self.m_f, self.k, self.k_m, self.threshold, self.a, v0, self.reaction, robot_velocity
-            )
+        phases = phase_impulses(
+            self.m_f, self.k, self.k_m, self.threshold, self.a, v0, self.reaction, robot_velocity
         )
+        if model == "constant":
+            return float(phases.total)
+        _, reaction = sprung_reaction(self.threshold, self.k_m, self.F_a, self.m_r, robot_velocity or 0.0)
+        return float(phases.initial + phases.sensing + reaction)
 
 
 def arm_closed_form(
@@ -192,80 +194,18 @@ def arm_closed_form(
         )
     jac = samples.jacobian[0]
     v_r = float(u @ jac @ (admittance_share(k_m, k_s) * (np.linalg.pinv(jac) @ u)))
-    value = {name: float(getattr(effective, name)[0, 0]) for name in ("m_f", "m_r", "k", "k_m", "a")}
+    value = {name: float(getattr(effective, name)[0, 0]) for name in ("m_f", "m_r", "k", "k_m", "F_a", "a")}
     return ArmClosedForm(
         m_f=value["m_f"],
         m_r=value["m_r"],
         k=float(series_stiffness(value["k"], contact_stiffness)),
         k_m=float(series_stiffness(value["k_m"], contact_stiffness)),
+        F_a=value["F_a"],
         a=value["a"],
         v_r=v_r,
         threshold=float(joints.threshold),
         reaction=reaction,
     )
-
-
-def check_arm_work(
-    arm: Any,
-    closed: ArmClosedForm,
-    joints: JointDesign,
-    approach_velocity: float,
-    contact_stiffness: float,
-    max_steps: float = MAX_STEPS,
-) -> float:
-    """Estimated integrator steps of an arm simulation; raise :class:`SimulationError` beyond ``max_steps``.
-
-    The step is a sixteenth of the shortest period in play (the finger on the wall and on the joint springs,
-    the robot mass and each rotor on its spring), as the simulator chooses it; the span is the closed form's
-    contact (detection and reaction) and the watch after it. ``closed`` is the ``robot`` placement's closed
-    form with a rigid contact; ``approach_velocity`` [m/s], ``contact_stiffness`` [N/m].
-    """
-    nv = int(arm.nv)
-    inertia = np.broadcast_to(np.asarray(joints.reflected_inertia, dtype=float), (nv,))
-    k_m = np.broadcast_to(np.asarray(joints.mechanical_stiffness, dtype=float), (nv,))
-    periods = {
-        "the finger on the wall contact (lower the contact stiffness)": oscillation_period(
-            closed.m_f, contact_stiffness
-        ),
-        "the finger on the joint springs": oscillation_period(closed.m_f, closed.k_m),
-        "the robot mass on the joint springs": oscillation_period(closed.m_r, closed.k_m),
-        "a rotor on its joint spring": min(
-            oscillation_period(b, k) for b, k in zip(inertia, k_m, strict=True)
-        ),
-    }
-    scale = min(periods, key=lambda name: periods[name])
-    step = periods[scale] / STEP_PER_PERIOD
-    robot_velocity = closed.v_r * approach_velocity if closed.reaction == "moving" else None
-    try:
-        _, t2 = collision_times(
-            closed.m_f,
-            closed.k,
-            closed.k_m,
-            closed.threshold,
-            closed.a,
-            approach_velocity,
-            closed.reaction,
-            robot_velocity,
-        )
-    except CollisionReflexError as error:
-        raise SimulationError(f"the closed form has no finite contact here: {error}") from None
-    span = float(t2) + WATCH_PERIODS * periods["the finger on the joint springs"]
-    steps = span / step
-    if not steps <= max_steps:  # NaN and inf refused too
-        raise SimulationError(
-            f"this arm collision needs about {steps:.2g} integrator steps, beyond the budget {max_steps:g}: the "
-            f"contact lasts {span:.3g} s while {scale} limits the step to {step:.3g} s"
-        )
-    return steps
-
-
-def simulator_detection_keywords(detection: str) -> dict[str, Any]:
-    """The keyword that selects ``detection`` in the simulator (none for its only, torque-based scheme)."""
-    if "detection" in inspect.signature(arm_simulation.simulate_arm_collision).parameters:
-        return {"detection": detection}
-    if detection != TORQUE_DETECTION:
-        raise InvalidParameter("detection", detection, f"one of {available_detections()}")
-    return {}
 
 
 @dataclass(frozen=True)
@@ -316,9 +256,9 @@ def validity_map(
 
     Returns
     -------
-    One row per case and placement: ``configuration``, ``direction`` (indices), ``q``, ``u`` (as lists),
-    ``velocity_ratio``, ``v0`` [m/s], ``stiffness_ratio``, ``contact_stiffness`` [N/m], ``detection``,
-    ``placement``, ``simulated`` and ``closed_form`` [N*s], ``difference`` (``I_sim / I_closed - 1``),
+    One row per case, placement and reaction model (:data:`REACTION_MODELS`): ``configuration``,
+    ``direction`` (indices), ``q``, ``u`` (as lists), ``velocity_ratio``, ``v0`` [m/s], ``stiffness_ratio``,
+    ``contact_stiffness`` [N/m], ``detection``, ``placement``, ``reaction_model``, ``simulated`` and ``closed_form`` [N*s], ``difference`` (``I_sim / I_closed - 1``),
     ``valid`` (within ``tolerance``), ``error`` (why a case was refused or failed, else ``""``) and
     ``seconds`` (the simulation's wall time).
     """
@@ -352,26 +292,26 @@ def validity_map(
                 for ratio_v in velocity_ratios:
                     for detection in schemes:
                         case = ValidityCase(i, j, float(ratio_v), float(ratio_k), detection)
-                        simulated, error, seconds = _simulated(
-                            arm, q, u, joints, reference, case, v_star, k_c, reaction, max_steps
+                        v0 = case.velocity_ratio * v_star
+                        blanking = _blanking(detection, reference.m_f, k_c)
+                        simulated = _simulated(
+                            arm, q, u, joints, v0, k_c, detection, reaction, max_steps, blanking
                         )
-                        for placement, form in closed.items():
-                            rows.append(
-                                _row(
-                                    case,
-                                    q,
-                                    u,
-                                    v_star,
-                                    k_c,
-                                    placement,
-                                    form,
-                                    simulated,
-                                    error,
-                                    seconds,
-                                    tolerance,
-                                )
-                            )
+                        rows.extend(
+                            _row(case, q, u, v0, k_c, placement, model, form, simulated, tolerance)
+                            for placement, form in closed.items()
+                            for model in REACTION_MODELS
+                        )
     return pd.DataFrame(rows)
+
+
+@dataclass(frozen=True)
+class _Simulated:
+    """A simulation's impulse [N*s] (NaN if refused or failed), why not (``""`` if run) and its wall time [s]."""
+
+    impulse: float
+    error: str
+    seconds: float
 
 
 def _simulated(
@@ -379,18 +319,16 @@ def _simulated(
     q: np.ndarray,
     u: np.ndarray,
     joints: JointDesign,
-    reference: ArmClosedForm,
-    case: ValidityCase,
-    v_star: float,
+    v0: float,
     contact_stiffness: float,
+    detection: str,
     reaction: str,
     max_steps: float,
-) -> tuple[float, str, float]:
-    """The simulated impulse [N*s] of a case (NaN if refused or failed), why not (or ``""``), its seconds."""
-    v0 = case.velocity_ratio * v_star
+    blanking: float | None,
+) -> _Simulated:
+    """Simulate one case at ``v0`` [m/s] against a wall of ``contact_stiffness`` [N/m]."""
     start = time.perf_counter()
     try:
-        check_arm_work(arm, reference, joints, v0, contact_stiffness, max_steps)
         result = arm_simulation.simulate_arm_collision(
             joints.on(arm),
             q,
@@ -399,31 +337,41 @@ def _simulated(
             joints.threshold,
             contact_stiffness=contact_stiffness,
             reaction=reaction,
+            detection=detection,
+            max_steps=max_steps,
+            blanking=blanking,
             **joints.simulator_keywords(),
-            **simulator_detection_keywords(case.detection),
         )
     except (SimulationError, InvalidParameter) as error:
-        return math.nan, str(error), time.perf_counter() - start
-    return float(result.impulse), "", time.perf_counter() - start
+        return _Simulated(math.nan, str(error), time.perf_counter() - start)
+    return _Simulated(float(result.impulse), "", time.perf_counter() - start)
+
+
+def _blanking(detection: str, m_f: float, contact_stiffness: float) -> float | None:
+    """How long a contact-force detector stays unarmed after the impact [s]; None: the simulator's default.
+
+    One period of the finger on the wall: it arms when the impact pulse (half a period) is over, or, against a
+    soft wall whose force only ramps up and never falls back below the threshold, then at the latest (the
+    simulator's twenty periods would then delay the detection far beyond the closed form's).
+    """
+    return oscillation_period(m_f, contact_stiffness) if detection == "force" else None
 
 
 def _row(
     case: ValidityCase,
     q: np.ndarray,
     u: np.ndarray,
-    v_star: float,
+    v0: float,
     contact_stiffness: float,
     placement: str,
+    model: str,
     closed: ArmClosedForm,
-    simulated: float,
-    error: str,
-    seconds: float,
+    simulated: _Simulated,
     tolerance: float,
 ) -> dict[str, Any]:
-    """One row of the map: a case against one placement's closed form."""
-    v0 = case.velocity_ratio * v_star
-    closed_form = closed.impulse(v0)
-    difference = simulated / closed_form - 1
+    """One row of the map: a case against one placement's and reaction model's closed form."""
+    closed_form = closed.impulse(v0, model)
+    difference = simulated.impulse / closed_form - 1
     return {
         "configuration": case.configuration,
         "direction": case.direction,
@@ -435,23 +383,28 @@ def _row(
         "contact_stiffness": contact_stiffness,
         "detection": case.detection,
         "placement": placement,
-        "simulated": simulated,
+        "reaction_model": model,
+        "simulated": simulated.impulse,
         "closed_form": closed_form,
         "difference": difference,
         "valid": bool(abs(difference) <= tolerance),
-        "error": error,
-        "seconds": seconds,
+        "error": simulated.error,
+        "seconds": simulated.seconds,
     }
+
+
+MAP_INDEX: tuple[str, ...] = ("detection", "reaction_model", "placement", "stiffness_ratio")
+"""The rows of the map's pivot tables; their columns are the velocity ratios."""
 
 
 def validity_summary(table: Any) -> Any:
     """Share of valid cases per detection, placement, stiffness ratio and velocity ratio (a pivot table).
 
-    Rows: ``(detection, placement, stiffness_ratio)``; columns: ``velocity_ratio``; values: the fraction of the
-    configurations x directions where the closed form holds (failed cases count as not valid).
+    Rows: :data:`MAP_INDEX`; columns: ``velocity_ratio``; values: the fraction of the configurations x
+    directions where the closed form holds (failed cases count as not valid).
     """
     return table.pivot_table(
-        index=["detection", "placement", "stiffness_ratio"],
+        index=list(MAP_INDEX),
         columns="velocity_ratio",
         values="valid",
         aggfunc="mean",
@@ -459,10 +412,10 @@ def validity_summary(table: Any) -> Any:
 
 
 def worst_difference(table: Any) -> Any:
-    """Largest ``|I_sim / I_closed - 1|`` per detection, placement, stiffness ratio and velocity ratio."""
-    frame = table.assign(magnitude=table["difference"].abs())
+    """Largest ``|I_sim / I_closed - 1|`` per :data:`MAP_INDEX` row and velocity ratio (``inf`` where one failed)."""
+    frame = table.assign(magnitude=table["difference"].abs().fillna(math.inf))
     return frame.pivot_table(
-        index=["detection", "placement", "stiffness_ratio"],
+        index=list(MAP_INDEX),
         columns="velocity_ratio",
         values="magnitude",
         aggfunc="max",

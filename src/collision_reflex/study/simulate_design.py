@@ -145,7 +145,7 @@ def _sample(
     from ..errors import InvalidParameter, SimulationError
     from ..model.impulse import optimal_velocity
     from ..simulate import arm as arm_simulation
-    from ..simulate.validity import arm_closed_form, check_arm_work, simulator_detection_keywords
+    from ..simulate.validity import MAX_STEPS, arm_closed_form
 
     config = int(setup.samples.config_index[s])
     q = np.asarray(setup.configurations[config], dtype=float)
@@ -155,7 +155,6 @@ def _sample(
     simulated: float | None = None
     error = ""
     try:
-        check_arm_work(setup.arm, reference, joints, approach_velocity, contact_stiffness)
         simulated = float(
             arm_simulation.simulate_arm_collision(
                 joints.on(setup.arm),
@@ -165,8 +164,9 @@ def _sample(
                 joints.threshold,
                 contact_stiffness=contact_stiffness,
                 reaction=reaction,
+                detection=detection,
+                max_steps=MAX_STEPS,
                 **joints.simulator_keywords(),
-                **simulator_detection_keywords(detection),
             ).impulse
         )
     except (SimulationError, InvalidParameter) as failure:
