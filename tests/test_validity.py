@@ -190,7 +190,7 @@ def _study(tmp_path: Path, simulate: dict | None) -> Path:
 @pytest.fixture(scope="module")
 def simulated_run(tmp_path_factory):
     folder = tmp_path_factory.mktemp("simulated")
-    study = _study(folder, {"samples": 2})
+    study = _study(folder, {"samples": 2, "detection": "force"})
     return study, run_study(study, folder / "out", quiet=True, figures=False)
 
 
@@ -199,6 +199,7 @@ def test_study_simulates_the_recommended_design_on_its_worst_samples(simulated_r
     designs = json.loads((run.folder / "designs.json").read_text())
     simulation = designs["simulation"]
     assert simulation["pareto"] == []
+    assert simulation["recommended"]["detection"] == "force"
     rows = simulation["recommended"]["samples"]
     assert len(rows) == 2
     # The closed form beside each simulation is the optimiser's: the record's phases, summed, at that sample;

@@ -293,9 +293,8 @@ def validity_map(
                     for detection in schemes:
                         case = ValidityCase(i, j, float(ratio_v), float(ratio_k), detection)
                         v0 = case.velocity_ratio * v_star
-                        blanking = _blanking(detection, reference.m_f, k_c)
-                        simulated = _simulated(
-                            arm, q, u, joints, v0, k_c, detection, reaction, max_steps, blanking
+                        simulated = simulated_impulse(
+                            arm, q, u, joints, v0, k_c, detection, reaction, max_steps, reference.m_f
                         )
                         rows.extend(
                             _row(case, q, u, v0, k_c, placement, model, form, simulated, tolerance)
@@ -306,34 +305,59 @@ def validity_map(
 
 
 @dataclass(frozen=True)
-class _Simulated:
-    """A simulation's impulse [N*s] (NaN if refused or failed), why not (``""`` if run) and its wall time [s]."""
+class SimulatedImpulse:
+    """A simulation's impulse [N*s] (NaN if refused or failed), why not (``""`` if run) and its wall time [s].
+
+    Attributes
+    ----------
+    impulse: [N*s]; error: the refusal's or failure's message, ``""`` if it ran; seconds: wall time [s].
+    """
 
     impulse: float
     error: str
     seconds: float
 
 
-def _simulated(
+def simulated_impulse(
     arm: Any,
-    q: np.ndarray,
-    u: np.ndarray,
+    q: npt.ArrayLike,
+    u: npt.ArrayLike,
     joints: JointDesign,
-    v0: float,
+    approach_velocity: float,
     contact_stiffness: float,
-    detection: str,
-    reaction: str,
-    max_steps: float,
-    blanking: float | None,
-) -> _Simulated:
-    """Simulate one case at ``v0`` [m/s] against a wall of ``contact_stiffness`` [N/m]."""
+    detection: str = TORQUE_DETECTION,
+    reaction: str = "moving",
+    max_steps: float = MAX_STEPS,
+    finger_mass: float | None = None,
+) -> SimulatedImpulse:
+    """Simulate one collision of a design; a refusal (work budget) or failure is returned, not raised.
+
+    Parameters
+    ----------
+    arm: a :class:`collision_reflex.Arm`; q: configuration [rad]; u: collision direction (task coordinates).
+    joints: the design's joint parameters and threshold.
+    approach_velocity: [m/s]; contact_stiffness: the wall's stiffness [N/m].
+    detection: a scheme of :func:`available_detections`; reaction: the closed-form variant the simulator
+        reports beside (``"moving"`` or ``"at_rest"``); max_steps: the work budget [integrator steps].
+    finger_mass: the effective finger mass along ``u`` [kg] (robot placement) if known, else computed: it
+        sets how long a contact-force detector stays unarmed after the impact.
+
+    A contact-force detector stays unarmed for one period of the finger on the wall: it arms when the impact
+    pulse (half a period) is over or, against a soft wall whose force only ramps up and never falls back below
+    the threshold, then at the latest (the simulator's default, twenty periods, would then delay the detection
+    far beyond the closed form's).
+    """
     start = time.perf_counter()
     try:
+        blanking = None
+        if detection == "force":
+            m_f = finger_mass or arm_closed_form(arm, q, u, joints, "robot", math.inf, reaction).m_f
+            blanking = oscillation_period(m_f, contact_stiffness)
         result = arm_simulation.simulate_arm_collision(
             joints.on(arm),
             q,
             u,
-            v0,
+            approach_velocity,
             joints.threshold,
             contact_stiffness=contact_stiffness,
             reaction=reaction,
@@ -343,18 +367,8 @@ def _simulated(
             **joints.simulator_keywords(),
         )
     except (SimulationError, InvalidParameter) as error:
-        return _Simulated(math.nan, str(error), time.perf_counter() - start)
-    return _Simulated(float(result.impulse), "", time.perf_counter() - start)
-
-
-def _blanking(detection: str, m_f: float, contact_stiffness: float) -> float | None:
-    """How long a contact-force detector stays unarmed after the impact [s]; None: the simulator's default.
-
-    One period of the finger on the wall: it arms when the impact pulse (half a period) is over, or, against a
-    soft wall whose force only ramps up and never falls back below the threshold, then at the latest (the
-    simulator's twenty periods would then delay the detection far beyond the closed form's).
-    """
-    return oscillation_period(m_f, contact_stiffness) if detection == "force" else None
+        return SimulatedImpulse(math.nan, str(error), time.perf_counter() - start)
+    return SimulatedImpulse(float(result.impulse), "", time.perf_counter() - start)
 
 
 def _row(
@@ -366,7 +380,7 @@ def _row(
     placement: str,
     model: str,
     closed: ArmClosedForm,
-    simulated: _Simulated,
+    simulated: SimulatedImpulse,
     tolerance: float,
 ) -> dict[str, Any]:
     """One row of the map: a case against one placement's and reaction model's closed form."""

@@ -142,35 +142,28 @@ def _sample(
     reaction: str,
 ) -> SimulatedSample:
     """Simulate sample ``s`` of the study; the closed form [N*s] is the optimiser's."""
-    from ..errors import InvalidParameter, SimulationError
     from ..model.impulse import optimal_velocity
-    from ..simulate import arm as arm_simulation
-    from ..simulate.validity import MAX_STEPS, arm_closed_form
+    from ..simulate.validity import MAX_STEPS, arm_closed_form, simulated_impulse
 
     config = int(setup.samples.config_index[s])
     q = np.asarray(setup.configurations[config], dtype=float)
     u = np.asarray(setup.samples.directions[s], dtype=float)
     reference = arm_closed_form(setup.arm, q, u, joints, "robot", math.inf, "moving")
     v_star = float(optimal_velocity(reference.m_f, reference.k, joints.threshold))
-    simulated: float | None = None
-    error = ""
-    try:
-        simulated = float(
-            arm_simulation.simulate_arm_collision(
-                joints.on(setup.arm),
-                q,
-                u,
-                approach_velocity,
-                joints.threshold,
-                contact_stiffness=contact_stiffness,
-                reaction=reaction,
-                detection=detection,
-                max_steps=MAX_STEPS,
-                **joints.simulator_keywords(),
-            ).impulse
-        )
-    except (SimulationError, InvalidParameter) as failure:
-        error = str(failure)
+    run = simulated_impulse(
+        setup.arm,
+        q,
+        u,
+        joints,
+        approach_velocity,
+        contact_stiffness,
+        detection,
+        reaction,
+        MAX_STEPS,
+        reference.m_f,
+    )
+    simulated = None if run.error else run.impulse
+    error = run.error
     difference = None if simulated is None else simulated / closed_form - 1
     return {
         "sample": s,
