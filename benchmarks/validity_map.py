@@ -1,8 +1,8 @@
 """Where the arm closed form holds: the validity map of the planar arm, the UR5 and the Panda.
 
 For each arm, a few configurations x directions x v0 in {0.1, 0.3, 1, 3, 10} v* x a compliant contact (0.1 of
-the joints' stiffness along u: a stiff transmission hitting a soft object) and a stiff one (10 times: compliant
-joints hitting a hard object), it simulates the collision in the time domain
+the joints' stiffness along u: a stiff transmission hitting a soft object), a stiff one (10 times: compliant
+joints hitting a hard object) and a rigid one (1000 times, the study's closed form), it simulates the collision in the time domain
 (:func:`collision_reflex.simulate.simulate_arm_collision`) and compares it with the arm closed form for both
 placements of the reflected inertia; it prints the largest |I_sim / I_closed - 1| and the share of cases within
 5 %, per detection scheme, placement and stiffness ratio, with the timings and the machine's load.
@@ -25,6 +25,7 @@ import collision_reflex as cr
 from collision_reflex.plots import new_figure, save_figure
 from collision_reflex.simulate.validity import (
     PLACEMENTS,
+    REACTION_MODELS,
     JointDesign,
     validity_map,
     worst_difference,
@@ -62,6 +63,8 @@ def _panda() -> tuple[Any, JointDesign, list[list[float]], list[list[float]]]:
     return arm, joints, [list(arm.reference_configuration)], [[1, 0, 0], [0, 0, -1]]
 
 
+# The issue's two regimes and the study's: an object 1000 times stiffer than the joints (a rigid one).
+STIFFNESS_RATIOS = (0.1, 10.0, 1000.0)
 ARMS = {"planar two-link": _planar, "UR5": _ur5, "Panda": _panda}
 
 
@@ -73,18 +76,20 @@ def main(figure_path: str | None) -> None:
     for name, build in ARMS.items():
         arm, joints, configurations, directions = build()
         start = time.perf_counter()
-        table = validity_map(arm, joints, configurations, directions)
+        table = validity_map(arm, joints, configurations, directions, stiffness_ratios=STIFFNESS_RATIOS)
         elapsed = time.perf_counter() - start
         tables[name] = table
-        simulations = len(table) // len(PLACEMENTS)
-        failed = int((table["error"] != "").sum()) // len(PLACEMENTS)
+        simulations = len(table) // (len(PLACEMENTS) * len(REACTION_MODELS))
+        failed = int((table["error"] != "").sum()) // (len(PLACEMENTS) * len(REACTION_MODELS))
         print(
             f"\n{name}: {len(configurations)} configuration(s) x {len(directions)} directions, {simulations} "
             f"simulations ({failed} refused or failed) in {elapsed:.1f} s ({1e3 * elapsed / simulations:.0f} ms each)"
         )
         worst = 100 * worst_difference(table)
         worst.columns = [f"{ratio:g} v*" for ratio in worst.columns]
-        print("largest |I_sim / I_closed - 1| [%] (rows: detection, placement, k_contact / k_joint):")
+        print(
+            "largest |I_sim / I_closed - 1| [%] (rows: detection, reaction model, placement, k_contact / k_joint):"
+        )
         print(worst.round(1).to_string())
         print(f"within 5 %: {100 * table['valid'].mean():.0f} % of the cases")
     print(f"\nmachine load (1, 5, 15 min): {', '.join(f'{x:.1f}' for x in os.getloadavg())}")
@@ -92,31 +97,35 @@ def main(figure_path: str | None) -> None:
         print(f"figure: {_figure(tables, figure_path)}")
 
 
+FIGURE_DETECTIONS = ("spring_torque", "force")
+"""The detections drawn: the simulator's default and the contact-force sensor (the closed form's meaning)."""
+
+
 def _figure(tables: dict[str, Any], path: str) -> Path:
-    """One panel per arm: the largest |difference| per placement x stiffness ratio (rows) and v0 / v* (columns)."""
-    figure, axes = new_figure(1, len(tables), figsize=(4.2 * len(tables), 3.2), constrained_layout=True)
+    """A panel per detection (rows) and arm (columns): the largest |difference| per reaction model x placement x
+    stiffness ratio (rows) and v0 / v* (columns)."""
+    shape = (len(FIGURE_DETECTIONS), len(tables))
+    figure, axes = new_figure(*shape, figsize=(5.0 * shape[1], 4.0 * shape[0]), constrained_layout=True)
     image = None
-    for ax, (name, table) in zip(np.atleast_1d(axes), tables.items(), strict=True):
-        worst = 100 * worst_difference(table)
-        labels = [
-            f"{detection}, {placement}, k_c/k_m={ratio:g}"
-            if len(table["detection"].unique()) > 1
-            else f"{placement}, k_c/k_m = {ratio:g}"
-            for detection, placement, ratio in worst.index
-        ]
-        values = worst.to_numpy()
-        image = ax.imshow(np.minimum(values, 50), cmap="RdYlGn_r", vmin=0, vmax=50, aspect="auto")
-        for (row, column), value in np.ndenumerate(values):
-            text = "fail" if not np.isfinite(value) else f"{value:.0f}" if value >= 10 else f"{value:.1f}"
-            weight = "bold" if np.isfinite(value) and value <= 5 else "normal"
-            ax.text(column, row, text, ha="center", va="center", fontsize=8, weight=weight)
-        ax.set_xticks(range(values.shape[1]), [f"{r:g}" for r in worst.columns])
-        ax.set_yticks(range(values.shape[0]), labels, fontsize=8)
-        ax.set_xlabel("approach velocity v0 / v*")
-        ax.set_title(name)
+    for row, detection in enumerate(FIGURE_DETECTIONS):
+        for column, (name, table) in enumerate(tables.items()):
+            ax = np.atleast_2d(axes)[row, column]
+            worst = 100 * worst_difference(table[table["detection"] == detection]).droplevel("detection")
+            values = worst.to_numpy()
+            image = ax.imshow(np.minimum(values, 50), cmap="RdYlGn_r", vmin=0, vmax=50, aspect="auto")
+            for (i, j), value in np.ndenumerate(values):
+                text = "fail" if not np.isfinite(value) else f"{value:.0f}" if value >= 10 else f"{value:.1f}"
+                weight = "bold" if np.isfinite(value) and value <= 5 else "normal"
+                ax.text(j, i, text, ha="center", va="center", fontsize=7, weight=weight)
+            ax.set_xticks(range(values.shape[1]), [f"{r:g}" for r in worst.columns])
+            labels = [f"{model}, {placement}, {ratio:g}" for model, placement, ratio in worst.index]
+            ax.set_yticks(range(values.shape[0]), labels if column == 0 else [], fontsize=7)
+            ax.set_xlabel("approach velocity v0 / v*")
+            ax.set_title(f"{name}, detection: {detection}", fontsize=9)
+    np.atleast_2d(axes)[0, 0].set_ylabel("reaction model, placement, k_contact / k_joint", fontsize=8)
     if image is not None:
-        figure.colorbar(image, ax=axes, label="largest |I_sim / I_closed - 1| [%], bold: <= 5 %")
-    return save_figure(figure, path)
+        figure.colorbar(image, ax=axes, label="largest |I_sim / I_closed - 1| [%], bold: <= 5 %", shrink=0.6)
+    return save_figure(figure, path, dpi=110)
 
 
 if __name__ == "__main__":
