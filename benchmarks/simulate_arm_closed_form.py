@@ -55,7 +55,9 @@ def finger_closed_form(arm: cr.Arm, result: ArmCollision) -> float:
 
 def main() -> None:
     arm = cr.Arm.from_urdf(URDF, "tip")
-    print(f"planar two-link arm, joint springs 50 N m/rad, rotor 2.2e-3 kg m^2, 1.3 N m, threshold {THRESHOLD} N")
+    print(
+        f"planar two-link arm, joint springs 50 N m/rad, rotor 2.2e-3 kg m^2, 1.3 N m, threshold {THRESHOLD} N"
+    )
     print("I_sim / I_closed - 1 [%] for the closed forms robot / robot+spring / finger")
     header = f"{'q [rad]':>12}{'u':>5}{'detection':>15}" + "".join(f"{f'{r} v*':>22}" for r in RATIOS)
     print(header)

@@ -25,6 +25,7 @@ URDF = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
 # 1.3 N m effort limits; ideally velocity-controlled motors (k_s = inf), a 3 N threshold.
 JOINTS = dict(mechanical_stiffness=50.0, reflected_inertia=2.2e-3, torque_limit=1.3)
 
+
 @pytest.fixture(scope="module")
 def arm():
     return Arm.from_urdf(URDF, "tip")
@@ -117,7 +118,14 @@ def test_constant_acceleration_reaction_overestimates(honest_runs):
     eff, runs = honest_runs
     result = runs[0.1]
     phases = cr.phase_impulses(
-        eff["m_f"], eff["k"], eff["k_m"], 3.0, eff["a"], result.approach_velocity, "moving", result.robot_velocity
+        eff["m_f"],
+        eff["k"],
+        eff["k_m"],
+        3.0,
+        eff["a"],
+        result.approach_velocity,
+        "moving",
+        result.robot_velocity,
     )
     simulated_reaction = result.impulse - result.detected_impulse
     assert simulated_reaction / float(phases.reaction) - 1 == pytest.approx(-0.18, abs=0.04)
@@ -233,7 +241,33 @@ def test_saturated_retreat_pushes_harder(arm, honest_runs):
     """Every joint at its limit gives at least the force of the limit along u: a smaller reaction impulse."""
     along_u = honest_runs[1][1.0]
     saturated = simulate_arm_collision(
-        arm, HONEST_Q, HONEST_U, along_u.approach_velocity, 3.0, detection="force", retreat="saturated", **JOINTS
+        arm,
+        HONEST_Q,
+        HONEST_U,
+        along_u.approach_velocity,
+        3.0,
+        detection="force",
+        retreat="saturated",
+        **JOINTS,
     )
     assert saturated.detected_impulse == pytest.approx(along_u.detected_impulse, rel=1e-9)
     assert saturated.impulse < along_u.impulse
+
+
+def test_impedance_drive_approaches_the_admittance_slowly(arm, slow_v0):
+    """At 0.1 v* the impedance drive is quasi-static: the ideal admittance's impulse, less the rotor dynamics.
+
+    Software springs of 200 N m/rad in series with the 50 N m/rad joints. Measured 0.06 % apart; a wrong
+    impedance law (its stiffness off by 10 %, so k by 2 %) moves the sensing phase, 90 % of the impulse, by
+    about 2 %, so 0.5 % guards it.
+    """
+    common = dict(detection="force", software_stiffness=200.0, **JOINTS)
+    ideal = simulate_arm_collision(arm, HONEST_Q, HONEST_U, slow_v0, 3.0, **common)
+    impedance = simulate_arm_collision(arm, HONEST_Q, HONEST_U, slow_v0, 3.0, drive="impedance", **common)
+    assert impedance.impulse == pytest.approx(ideal.impulse, rel=0.005)
+    assert impedance.closed_form == ideal.closed_form
+
+
+def test_impedance_drive_needs_a_finite_software_stiffness(arm):
+    with pytest.raises(InvalidParameter, match="impedance drive"):
+        simulate_arm_collision(arm, HONEST_Q, HONEST_U, 0.05, 3.0, drive="impedance", **JOINTS)

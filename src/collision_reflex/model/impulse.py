@@ -313,7 +313,9 @@ def sprung_reaction(F_s: Any, k_m: Any, F_a: Any, m_r: Any, v_r: Any = 0.0) -> t
     x1, push = F_s / k_m, F_a / k_m
     phase = np.arctan2(v_r / w, x1 + push)
     tau_e = (phase + np.arccos(push / np.hypot(x1 + push, v_r / w))) / w
-    impulse = k_m * (-push * tau_e + (x1 + push) * np.sin(w * tau_e) / w + v_r * (1 - np.cos(w * tau_e)) / w**2)
+    impulse = k_m * (
+        -push * tau_e + (x1 + push) * np.sin(w * tau_e) / w + v_r * (1 - np.cos(w * tau_e)) / w**2
+    )
     return (tau_e if tau_e.ndim else float(tau_e)), (impulse if impulse.ndim else float(impulse))
 
 

@@ -12,18 +12,36 @@ Each joint is a link side and a motor side coupled by the joint's mechanical spr
 ``f`` the wall force, a stiff Kelvin-Voigt contact that cannot pull (the wall is frictionless: the contact point
 may slide along it). Gravity is left out, as in the closed form.
 
-Approach and sensing follow the 1D ideal drive (:mod:`collision_reflex.simulate`) joint by joint: each motor is
-ideally velocity-controlled along ``theta_ref' = J(q0)^+ u v0`` (the contact point approaches along ``u`` at
-``v0``) and its software stiffness ``k_s,i`` acts as an admittance, so that the joint springs are the series
-``K = K_m K_s / (K_m + K_s)`` of the closed form. Detection is on the contact force estimated from the joint
-spring torques (a joint-torque sensor or observer): ``f_est = (J^T u) . tau_spring / |J^T u|^2``. At
-detection (plus an optional delay) the admittance is switched off and the motors push with
-``tau = -F_a J^T u``, ``F_a = min_i tau_max,i / |(J^T u)_i|``: the largest force along ``-u`` before the first
-joint saturates, as the closed form's ``a = F_a / m_r`` assumes.
+Approach follows the 1D ideal drive (:mod:`collision_reflex.simulate`) joint by joint: each motor is ideally
+velocity-controlled along ``theta_ref' = J(q0)^+ u v0`` (the contact point approaches along ``u`` at ``v0``)
+and its software stiffness ``k_s,i`` acts as an admittance, so that the joint springs are the series ``K = K_m
+K_s / (K_m + K_s)`` of the closed form. Detection (``detection=``, :mod:`.arm_detection`): a contact-force
+sensor (``"force"``, the closed form's meaning of ``F_s``), a generalized-momentum observer (``"observer"``),
+the joint spring torques projected on ``u`` (``"spring_torque"``, the default, kept from the first version),
+the contact point's position error (``"position"``) or the motor torques (``"current"``), optionally sampled.
+At detection (plus an optional delay) the admittance is switched off and the motors push (``retreat=``) with
+``tau = -F_a J^T u``, ``F_a = min_i tau_max,i / |(J^T u)_i|``, the largest force along ``-u`` before the first
+joint saturates, as the closed form's ``a = F_a / m_r`` assumes, or every joint saturated (``"saturated"``).
 
 What the closed form leaves out and this model keeps: the links' motion along the wall after the impact (the
 finger's momentum is only removed along ``u``), the motors' acceleration off the direction ``u`` during the
-reaction, the wall's compliance and rebound, and the change of ``J`` during the contact.
+reaction, the spring's push on the motors during the reaction, the wall's compliance and rebound, and the
+change of ``J`` during the contact.
+
+Why ``a/2`` matched the first test better than ``a`` (0.1 v*, spring-torque detection; elbow-up-x,
+elbow-up-oblique, folded-x of ``tests/test_simulate_arm.py``): two errors of opposite sign, not a factor in
+``a``. (1) The closed form's reaction moves the robot mass at the constant ``a``; the spring compressed by
+``F_s`` pushes it away as well, ``m_r x'' = -F_a - k_m x``, and with ``F_s / F_a = 0.6-1`` the simulated
+reaction impulse is 37 %, 26 % and 18 % *below* the closed form's;
+:func:`collision_reflex.model.impulse.sprung_reaction` (derived there, an option beside the paper's reaction:
+``ArmCollision.closed_form_sprung``) matches it within 1.3 %, 1.4 % and 0.5 %. A smaller ``a`` moves the reaction the wrong way. (2) The
+spring-torque detector fires late: the impulse until detection is 5.1 %, 3.2 % and 0.9 % above ``m_f v0 +
+F_s^2 / (2 k v0)`` (the contact force at detection is 2.6 N, not 3 N, on elbow-up-x: the joint torques carry
+the links' inertia as they oscillate along the wall). ``a/2`` adds ``(sqrt(2) - 1) I3``, 2-3 % of the impulse,
+which cancels (2) less (1). With the contact-force sensor the sensing phase matches on folded-x (-0.2 %), and
+the total with the sprung reaction is within 0.1 %; on the elbow-up configurations the contact force itself
+ramps up slower than ``k v0 t`` (impulse until detection +4 % and +21 %): the operational-space inertia couples
+the wall normal to the tangent, and the 1D reduction has no term for it.
 """
 
 from __future__ import annotations
@@ -39,12 +57,16 @@ from .._compat import renamed_keywords
 from ..errors import InvalidParameter, SimulationError
 from ..model.impulse import collision_times, phase_impulses, series_stiffness, sprung_reaction, total_impulse
 from .arm_detection import DETECTIONS, detection_margin, next_sample
+from .arm_dynamics import ArmDynamics
 from .budget import EVALUATIONS_PER_STEP, check_arm_work
-from .contact import damping_from_ratio
 from .dynamics import admittance_share
 from .setup import oscillation_period
 
 ARM_REACTIONS: tuple[str, ...] = ("at_rest", "moving")
+ARM_DRIVES: tuple[str, ...] = ("ideal", "impedance")
+"""``"ideal"``: velocity-controlled motors with the software stiffness as an ideal admittance (massless).
+``"impedance"``: the 1D simulator's impedance drive per joint, motor torque ``k_s (theta_ref - theta) + d_s
+(theta_ref' - theta')`` saturated at the torque limit, the rotor inertia integrated."""
 RETREATS: tuple[str, ...] = ("along_u", "saturated")
 """``"along_u"``: the motors push with ``tau = -F_a J^T n``, each joint at most at its limit and the first at
 it, the closed form's reaction. ``"saturated"``: a retreat command saturates every joint, ``tau_i = -tau_max,i
@@ -135,6 +157,8 @@ def simulate_arm_collision(
     retreat: str = "along_u",
     max_steps: float = 2e5,
     blanking: float | None = None,
+    drive: str = "ideal",
+    software_damping: Any = 0.0,
 ) -> ArmCollision:
     """Simulate the collision of the arm's contact point with a wall.
 
@@ -179,12 +203,16 @@ def simulate_arm_collision(
         over about half a period, would trip a contact sensor at once: the closed form's threshold means the
         force after it), 0 for the other schemes (their signal passes through the joints or a filter; an
         observer with ``K m_f v0 > F_s`` does detect the impact itself).
+    drive: ``"ideal"`` (default) or ``"impedance"`` (finite ``software_stiffness`` needed), see
+        :data:`ARM_DRIVES`.
+    software_damping: the impedance drive's joint damping ``d_s`` [N m s/rad], >= 0 (scalar or (nv,)).
     max_steps: the work budget [integrator steps]: a setting expected to need more is refused at once, and a
         run that takes four times as many right-hand-side evaluations as the budget allows is stopped.
     """
     _validate.choice("reaction", reaction, ARM_REACTIONS)
     _validate.choice("detection", detection, DETECTIONS)
     _validate.choice("retreat", retreat, RETREATS)
+    _validate.choice("drive", drive, ARM_DRIVES)
     _validate.positive("observer_gain", observer_gain)
     _validate.positive("max_steps", max_steps)
     if sample_rate is not None:
@@ -210,8 +238,10 @@ def simulate_arm_collision(
         _current_threshold(arm, joints, float(threshold), current_threshold),
         retreat,
         blanking,
+        drive,
+        _impedance_damping(joints, drive, software_damping),
     )
-    dynamics = _ArmDynamics(arm, joints, closed, contact_stiffness, contact_damping_ratio, sensing)
+    dynamics = ArmDynamics(arm, joints, closed, contact_stiffness, contact_damping_ratio, sensing)
     trace = _integrate(dynamics, closed, float(approach_velocity), float(threshold), delay, rtol, max_steps)
     return ArmCollision(
         q=joints.q0,
@@ -237,10 +267,11 @@ def simulate_arm_collision(
 
 @dataclass(frozen=True)
 class _Sensing:
-    """The detector and the reaction's torques.
+    """The controller: detector, reaction and drive.
 
     Scheme, observer gain [1/s], sample rate [Hz] (or None), per-joint current thresholds [N m] (nv,), the
-    retreat and the blanking after the impact [s] (None: the scheme's default).
+    retreat, the blanking after the impact [s] (None: the scheme's default), the drive and its joint damping
+    [N m s/rad] (nv,).
     """
 
     detection: str
@@ -249,6 +280,23 @@ class _Sensing:
     current_threshold: np.ndarray
     retreat: str
     blanking: float | None
+    drive: str
+    software_damping: np.ndarray
+
+
+def _impedance_damping(joints: _Joints, drive: str, software_damping: Any) -> np.ndarray:
+    """The impedance drive's joint damping (nv,) [N m s/rad]; its software stiffness must be finite."""
+    nv = joints.q0.size
+    damping = np.broadcast_to(np.asarray(software_damping, dtype=float), (nv,)).copy()
+    _validate.non_negative("software_damping", damping)
+    if drive == "impedance" and not np.all(np.isfinite(joints.k_s)):
+        raise InvalidParameter(
+            "software_stiffness",
+            joints.k_s,
+            "finite joint stiffnesses [N m/rad]",
+            "the impedance drive needs them",
+        )
+    return damping
 
 
 def _current_threshold(arm: Any, joints: _Joints, threshold: float, given: Any) -> np.ndarray:
@@ -325,7 +373,9 @@ def _joints(
     space = arm.configuration_space
     lower, upper = space.lower_position_limit, space.upper_position_limit
     if np.any(q0 <= lower) or np.any(q0 >= upper):
-        raise InvalidParameter("q", q, "a configuration strictly inside the joint limits", "q is at or past one")
+        raise InvalidParameter(
+            "q", q, "a configuration strictly inside the joint limits", "q is at or past one"
+        )
     u = u / np.linalg.norm(u)
     return _Joints(q0, u, k_m, k_s, inertia, tau_max, np.asarray(params.motor_mass, dtype=float))
 
@@ -410,209 +460,9 @@ def _closed_form(
     )
     detected = float(phases.initial + phases.sensing)
     _, sprung = sprung_reaction(threshold, eff["k_m"], eff["F_a"], eff["m_r"], max(v_r or 0.0, 0.0))
-    return _ClosedForm(eff, share, reference_rate, robot_velocity, float(impulse), detected + sprung, detected)
-
-
-def _link_model(arm: Any) -> tuple[Any, Any, int]:
-    """Pinocchio's link-side model of ``arm``.
-
-    Structure only (no armature), no gravity, motor masses carried by the parent links, and a frame at the
-    contact point. Returns ``(model, data, contact frame id)``.
-    """
-    import pinocchio as pin
-
-    params = arm.joint_parameters
-    model = arm.model.copy()
-    model.armature = np.zeros(model.nv)
-    model.gravity.linear = np.zeros(3)
-    for joint_id in range(1, model.njoints):
-        mass = float(params.motor_mass[joint_id - 1])
-        parent = int(model.parents[joint_id])
-        if mass > 0 and parent > 0:
-            placement = model.jointPlacements[joint_id]
-            model.inertias[parent] = model.inertias[parent] + pin.Inertia(
-                mass, np.asarray(placement.translation), np.zeros((3, 3))
-            )
-    frame = model.frames[model.getFrameId(arm.contact_frame)]
-    local = np.asarray(frame.placement.act(np.asarray(arm.contact_offset, dtype=float)))
-    contact_id = model.addFrame(
-        pin.Frame(
-            "collision_reflex_wall_contact",
-            frame.parentJoint,
-            pin.SE3(np.eye(3), local),
-            pin.FrameType.OP_FRAME,
-        )
+    return _ClosedForm(
+        eff, share, reference_rate, robot_velocity, float(impulse), detected + sprung, detected
     )
-    return model, model.createData(), contact_id
-
-
-class _ArmDynamics:
-    """Links, motors, wall and observer: the right-hand side of the state ``(q, q', theta, theta', s, impulse)``.
-
-    ``s`` is the momentum observer's integral (zero unless it detects). It also gives the detectors'
-    estimates. Before the reaction ``theta`` is algebraic (ideal admittance).
-    """
-
-    def __init__(
-        self,
-        arm: Any,
-        joints: _Joints,
-        closed: _ClosedForm,
-        contact_stiffness: float,
-        contact_damping_ratio: float,
-        sensing: _Sensing,
-    ) -> None:
-        import pinocchio as pin
-
-        self.pin = pin
-        self.model, self.data, self.contact_id = _link_model(arm)
-        self.nv = joints.q0.size
-        self.q0, self.k_m, self.k_s, self.inertia = joints.q0, joints.k_m, joints.k_s, joints.inertia
-        self.share, self.v_ref = closed.share, closed.reference_rate
-        plane = arm.plane  # (3, 2) orthonormal basis of a planar arm's plane (columns), or None
-        self.normal = plane @ joints.u if plane is not None else joints.u  # world-aligned wall normal
-        self.p0, _ = self.contact_kinematics(joints.q0)
-        self.contact_stiffness = contact_stiffness
-        self.contact_damping = damping_from_ratio(
-            contact_damping_ratio, closed.effective["m_f"], contact_stiffness
-        )
-        self.tau_max = joints.tau_max
-        self.detection, self.retreat = sensing.detection, sensing.retreat
-        self.observer_gain, self.current_threshold = sensing.observer_gain, sensing.current_threshold
-        self.sample_rate = sensing.sample_rate
-        wall_period = oscillation_period(closed.effective["m_f"], contact_stiffness)
-        default_blanking = 20 * wall_period if sensing.detection == "force" else 0.0
-        self.blanking = default_blanking if sensing.blanking is None else sensing.blanking
-        _, jac0 = self.contact_kinematics(joints.q0)
-        self.approach_velocity = float(self.normal @ (jac0 @ self.v_ref))  # v0 [m/s]
-        self.initial_momentum = self.mass_matrix(joints.q0) @ self.v_ref  # p(0) [N m s]
-        self.lumped_stiffness = closed.effective["k"]
-        self.evaluations, self.max_evaluations = 0, math.inf
-        self.reacting = False
-        self.torque = np.zeros(self.nv)  # motor torques of the reaction [N m]
-        self.push = self.torque  # the reaction's torques, kept for a rebound
-
-    def contact_kinematics(self, qs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Contact point position [m] (3,) and translational Jacobian (3, nv), world-aligned."""
-        pin, model, data = self.pin, self.model, self.data
-        pin.forwardKinematics(model, data, qs)
-        pin.updateFramePlacement(model, data, self.contact_id)
-        position = np.asarray(data.oMf[self.contact_id].translation).copy()
-        jac = pin.computeFrameJacobian(model, data, qs, self.contact_id, pin.LOCAL_WORLD_ALIGNED)[:3]
-        return position, np.asarray(jac)
-
-    def motors(self, t: float, qs: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Motor angles [rad] and velocities [rad/s] of the ideal admittance drive at ``t`` [s]."""
-        k_s, k_m = self.k_s, self.k_m
-        reference = self.q0 + self.v_ref * t
-        infinite = np.isinf(k_s)
-        theta = np.where(
-            infinite,
-            reference,
-            (np.where(infinite, 0, k_s) * reference + k_m * qs) / np.where(infinite, 1, k_s + k_m),
-        )
-        dtheta = self.share * self.v_ref + (1 - self.share) * dq
-        return theta, dtheta
-
-    def motor_state(self, t: float, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Motor angles and velocities: integrated during the reaction, the admittance's before."""
-        nv = self.nv
-        if self.reacting:
-            return y[2 * nv : 3 * nv], y[3 * nv : 4 * nv]
-        return self.motors(t, y[:nv], y[nv : 2 * nv])
-
-    def wall_force(self, position: np.ndarray, jac: np.ndarray, dq: np.ndarray) -> float:
-        """Kelvin-Voigt wall force [N], zero out of contact and never pulling."""
-        depth = float(self.normal @ (position - self.p0))
-        if depth <= 0:
-            return 0.0
-        rate = float(self.normal @ (jac @ dq))
-        return max(self.contact_stiffness * depth + self.contact_damping * rate, 0.0)
-
-    def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
-        """Time derivative of the state at ``t`` [s]: link and motor accelerations, observer, wall force."""
-        self.evaluations += 1
-        if self.evaluations > self.max_evaluations:
-            raise SimulationError(
-                f"the arm collision needed more than {self.max_evaluations:.3g} right-hand-side evaluations "
-                "(the work budget); stiffen nothing, raise max_steps, or lower contact_stiffness"
-            )
-        nv = self.nv
-        qs, dq = y[:nv], y[nv : 2 * nv]
-        theta, dtheta = self.motor_state(t, y)
-        position, jac = self.contact_kinematics(qs)
-        force = self.wall_force(position, jac, dq)
-        spring = self.k_m * (theta - qs)
-        ddq = self.pin.aba(self.model, self.data, qs, dq, spring - jac.T @ self.normal * force)
-        out = np.zeros_like(y)
-        out[:nv] = dq
-        out[nv : 2 * nv] = ddq
-        out[2 * nv : 3 * nv] = dtheta
-        out[3 * nv : 4 * nv] = (self.torque - spring) / self.inertia if self.reacting else 0.0
-        if self.detection == "observer":
-            coriolis = self.pin.computeCoriolisMatrix(self.model, self.data, qs, dq)
-            out[4 * nv : 5 * nv] = spring + coriolis.T @ dq + self.observer_residual(y)  # no gravity here
-        out[-1] = force
-        return out
-
-    def mass_matrix(self, qs: np.ndarray) -> np.ndarray:
-        """The links' joint-space mass matrix ``M(q)`` (nv, nv) [kg m^2]."""
-        upper = np.asarray(self.pin.crba(self.model, self.data, qs))
-        return np.triu(upper) + np.triu(upper, 1).T
-
-    def observer_residual(self, y: np.ndarray) -> np.ndarray:
-        """The momentum observer's residual ``r = K (M(q) q' - p(0) - s)`` (nv,) [N m]: ``-J^T n f`` lagged."""
-        nv = self.nv
-        momentum = self.mass_matrix(y[:nv]) @ y[nv : 2 * nv]
-        return self.observer_gain * (momentum - self.initial_momentum - y[4 * nv : 5 * nv])
-
-    def motor_torque(self, t: float, y: np.ndarray) -> np.ndarray:
-        """Output-side motor torques ``B theta'' + K_m (theta - q)`` (nv,) [N m] (current times torque constant)."""
-        if self.reacting:
-            return self.torque.copy()
-        nv = self.nv
-        theta, _ = self.motor_state(t, y)
-        spring = self.k_m * (theta - y[:nv])
-        # The admittance's motor acceleration (1 - share) q'': zero for an ideal velocity drive.
-        ddq = self.rhs(t, y)[nv : 2 * nv]
-        return self.inertia * (1 - self.share) * ddq + spring
-
-    def force_estimate(self, t: float, y: np.ndarray) -> float:
-        """Contact force along ``u`` estimated from the joint spring torques [N]."""
-        qs = y[: self.nv]
-        theta, _ = self.motor_state(t, y)
-        _, jac = self.contact_kinematics(qs)
-        lever = jac.T @ self.normal
-        return float(lever @ (self.k_m * (theta - qs)) / (lever @ lever))
-
-    def penetration(self, y: np.ndarray) -> float:
-        """Depth of the contact point beyond the wall [m]."""
-        position, _ = self.contact_kinematics(y[: self.nv])
-        return float(self.normal @ (position - self.p0))
-
-    def wall_forces(self, solution: Any) -> np.ndarray:
-        """Wall force [N] at each step of a solution but the first."""
-        nv = self.nv
-        columns = solution.y.T[1:]
-        return np.array([self.wall_force(*self.contact_kinematics(c[:nv]), c[nv : 2 * nv]) for c in columns])
-
-    def start_reaction(self, t: float, y: np.ndarray) -> np.ndarray:
-        """Switch the admittance off: the motors take over its state (returned) and push at the force limit.
-
-        They push along -u, ``F_a = min_i tau_max,i / |(J^T u)_i|`` at the current configuration.
-        """
-        nv = self.nv
-        y = y.copy()
-        y[2 * nv : 3 * nv], y[3 * nv : 4 * nv] = self.motors(t, y[:nv], y[nv : 2 * nv])
-        lever = self.contact_kinematics(y[:nv])[1].T @ self.normal
-        if self.retreat == "saturated":
-            self.push = -self.tau_max * np.sign(lever)
-        else:
-            F_a = float(np.min(self.tau_max / np.maximum(np.abs(lever), 1e-300)))
-            self.push = -F_a * lever
-        self.reacting = True
-        self.torque = self.push
-        return y
 
 
 @dataclass
@@ -627,13 +477,13 @@ class _ArmTrace:
     contact_end: float = math.nan
     impulse: float = math.nan
 
-    def add(self, solution: Any, dynamics: _ArmDynamics) -> None:
+    def add(self, solution: Any, dynamics: ArmDynamics) -> None:
         self.times.append(solution.t[1:])
         self.forces.append(dynamics.wall_forces(solution))
 
 
 def _time_scales(
-    dynamics: _ArmDynamics, closed: _ClosedForm, approach_velocity: float, threshold: float, delay: float
+    dynamics: ArmDynamics, closed: _ClosedForm, approach_velocity: float, threshold: float, delay: float
 ) -> tuple[float, float, float]:
     """Largest step, simulated time limit and the finger's period on the joint springs [s]."""
     eff = closed.effective
@@ -644,6 +494,13 @@ def _time_scales(
         oscillation_period(eff["m_r"], eff["k_m"]),
         min(oscillation_period(b, k) for b, k in zip(dynamics.inertia, dynamics.k_m, strict=True)),
     ]
+    if dynamics.drive == "impedance":  # the rotors on the software and joint springs
+        periods.append(
+            min(
+                oscillation_period(b, k)
+                for b, k in zip(dynamics.inertia, dynamics.k_s + dynamics.k_m, strict=True)
+            )
+        )
     if dynamics.detection == "observer":
         periods.append(2 * math.pi / dynamics.observer_gain)  # the observer's time constant, as a period
     max_step = min(periods) / 16  # a sixteenth of the shortest period in play
@@ -663,7 +520,7 @@ def _expected_span(
 
 
 def _integrate(
-    dynamics: _ArmDynamics,
+    dynamics: ArmDynamics,
     closed: _ClosedForm,
     approach_velocity: float,
     threshold: float,
@@ -686,6 +543,7 @@ def _integrate(
     y = np.zeros(5 * nv + 1)
     y[:nv] = dynamics.q0
     y[nv : 2 * nv] = dynamics.v_ref  # the links move with the motors before the impact
+    y[2 * nv : 3 * nv], y[3 * nv : 4 * nv] = dynamics.q0, dynamics.v_ref  # unloaded springs
     options: dict[str, Any] = {"method": "DOP853", "rtol": rtol, "atol": 1e-12, "max_step": max_step}
     trace = _ArmTrace([np.array([0.0])], [np.array([0.0])])
 
@@ -718,7 +576,7 @@ def _integrate(
 
 
 def _arm(
-    dynamics: _ArmDynamics, trace: _ArmTrace, y: np.ndarray, threshold: float, options: dict[str, Any]
+    dynamics: ArmDynamics, trace: _ArmTrace, y: np.ndarray, threshold: float, options: dict[str, Any]
 ) -> tuple[float, np.ndarray, bool]:
     """Integrate from the impact until the detector arms.
 
@@ -740,7 +598,7 @@ def _arm(
 
 
 def _advance(
-    dynamics: _ArmDynamics,
+    dynamics: ArmDynamics,
     trace: _ArmTrace,
     t: float,
     y: np.ndarray,
@@ -758,7 +616,7 @@ def _advance(
 
 
 def _react(
-    dynamics: _ArmDynamics,
+    dynamics: ArmDynamics,
     trace: _ArmTrace,
     t: float,
     y: np.ndarray,

@@ -30,13 +30,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from .arm import _ArmDynamics
+    from .arm_dynamics import ArmDynamics
 
 DETECTIONS: tuple[str, ...] = ("spring_torque", "force", "observer", "position", "current")
 """The arm simulator's detection schemes (see the module docstring)."""
 
 
-def detection_margin(dynamics: _ArmDynamics, t: float, y: np.ndarray, threshold: float) -> float:
+def detection_margin(dynamics: ArmDynamics, t: float, y: np.ndarray, threshold: float) -> float:
     """The detector's force-equivalent minus the threshold [N]: it detects where this crosses zero upward.
 
     Parameters
@@ -47,8 +47,7 @@ def detection_margin(dynamics: _ArmDynamics, t: float, y: np.ndarray, threshold:
     threshold: the force threshold ``F_s`` [N].
     """
     scheme = dynamics.detection
-    nv = dynamics.nv
-    qs, dq = y[:nv], y[nv : 2 * nv]
+    qs = y[: dynamics.nv]
     if scheme == "force":
         return dynamics.contact_stiffness * max(dynamics.penetration(y), 0.0) - threshold
     if scheme == "spring_torque":
