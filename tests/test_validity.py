@@ -212,7 +212,7 @@ def test_study_simulates_the_recommended_design_on_its_worst_samples(simulated_r
         assert row["error"] == "" and row["simulated"] > 0
         assert row["difference"] == pytest.approx(row["simulated"] / row["closed_form"] - 1, rel=1e-12)
         assert row["valid"] == (abs(row["difference"]) <= 0.05)
-    assert (run.folder / "points" / "simulation-recommended.json").exists()
+    assert len(list((run.folder / "points").glob("simulation-recommended-*.json"))) == 1
     report = (run.folder / "report.html").read_text()
     assert 'id="simulation"' in report
     assert f"{rows[0]['simulated']:.4g}" in report and f"{rows[0]['closed_form']:.4g}" in report
@@ -229,6 +229,18 @@ def test_resumed_run_does_not_simulate_again(simulated_run, monkeypatch):
     again = run_study(study, run.folder, quiet=True, figures=False)
     assert again.resumed
     assert json.loads((again.folder / "designs.json").read_text())["simulation"] == before
+
+
+def test_a_finished_run_is_simulated_afterwards_without_solving_again(tmp_path, monkeypatch):
+    """The ``simulate`` section is no part of the fingerprint: added to a finished run, only it is computed."""
+    plain = run_study(_study(tmp_path, None), tmp_path / "out", quiet=True, figures=False)
+    assert "simulation" not in json.loads((plain.folder / "designs.json").read_text())
+    again = run_study(_study(tmp_path, {"samples": 1}), tmp_path / "out", quiet=True, figures=False)
+    assert again.resumed and again.computed == 0
+    assert (
+        len(json.loads((again.folder / "designs.json").read_text())["simulation"]["recommended"]["samples"])
+        == 1
+    )
 
 
 def test_smoke_run_and_default_do_not_simulate(tmp_path, monkeypatch):

@@ -8,12 +8,15 @@ impulses differ by more than ``tolerance`` lies outside the closed form's validi
 optimiser's number for it is not to be trusted as it stands (see the validity map,
 :mod:`collision_reflex.simulate.validity`).
 
-Each design's simulations are one piece of work of the run folder (``simulation-recommended``,
-``simulation-pareto-<i>``): a resumed run finds them and does not simulate again.
+Each design's simulations are one piece of work of the run folder (``simulation-recommended-<settings>``,
+``simulation-pareto-<i>-<settings>``, keyed by a hash of the ``simulate`` section): a resumed run finds them
+and does not simulate again; the section is no part of the run's fingerprint, so that a finished run can be
+simulated afterwards without solving again.
 """
 
 from __future__ import annotations
 
+import hashlib
 import math
 from typing import TYPE_CHECKING, Any, TypedDict
 
@@ -78,8 +81,10 @@ def simulate_designs(
         jobs.append(("recommended", recommended))
     if spec.pareto and front is not None:
         jobs.extend((f"pareto-{i}", result) for i, result in enumerate(front.points))
+    # Keyed by the settings too: a run resumed with other ones simulates again, and keeps the solved designs.
+    settings = hashlib.sha256(spec.model_dump_json().encode()).hexdigest()[:8]
     for name, result in jobs:
-        key = f"simulation-{name}"
+        key = f"simulation-{name}-{settings}"
         saved = folder.finished(key)
         if saved is None:
             saved = dict(simulate_design(problems, problem, result, spec, name))
