@@ -42,9 +42,13 @@ def resolved_yaml(loaded: LoadedStudy) -> str:
 
 
 def fingerprint(
-    resolved: dict[str, Any], ignore: tuple[str, ...] = ("execution", "outputs", "description")
+    resolved: dict[str, Any], ignore: tuple[str, ...] = ("execution", "outputs", "description", "simulate")
 ) -> str:
-    """A hash of what determines a run's numbers (execution settings and outputs do not)."""
+    """A hash of what determines a run's numbers (execution settings and outputs do not).
+
+    ``simulate`` does not either: its pieces are keyed by their own settings, so that a finished run can be
+    simulated afterwards without solving again.
+    """
     relevant = {key: value for key, value in resolved.items() if key not in ignore}
     text = json.dumps(relevant, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()[:16]

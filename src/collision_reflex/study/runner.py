@@ -84,6 +84,7 @@ def smoke_study(data: dict[str, Any]) -> dict[str, Any]:
         if directions.get(key):
             directions[key] = directions[key][:4]
     data["samples"] = {"configurations": configurations, "directions": directions}
+    data.pop("simulate", None)  # the time-domain simulation is no quick check
     if data.get("pareto"):
         data["pareto"] = {**data["pareto"], "points": min(data["pareto"]["points"], 4)}
     return data
@@ -319,6 +320,12 @@ def _run_arm(
         "resolved": resolved_study(parse_study(text, "resolved study")),
         **arm_results(problems, optimum, front, snapped),
     }
+    if study.simulate is not None:
+        from ..optimize.pareto import recommend
+        from .simulate_design import simulate_designs
+
+        recommended = recommend(optimum, front, problems.objective).result
+        results["simulation"] = simulate_designs(problems, recommended, front, study.simulate, folder)
     results["verdict"] = verdict(results)
     return results, (computed, reused)
 

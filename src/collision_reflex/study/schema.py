@@ -671,6 +671,38 @@ class OutputsSpec(_Model):
     pdf: bool = Field(False, description="also write report.pdf (needs Chromium)")
 
 
+class SimulateSpec(_Model):
+    """Simulate the recommended (and optionally each Pareto) design on its worst contact samples.
+
+    The time-domain arm simulation beside the closed form, samples outside its validity region flagged.
+    """
+
+    recommended: bool = Field(True, description="simulate the recommended design")
+    pareto: bool = Field(False, description="also simulate each Pareto design")
+    samples: Annotated[int, Field(ge=1, le=50, strict=True)] = Field(
+        3, description="contact samples per design: those with the largest closed-form impulse"
+    )
+    detection: str | None = Field(
+        None,
+        description="the simulator's detection scheme; null: its default (spring_torque, the joint spring torques' force estimate)",
+    )
+    contact_stiffness_ratio: float = Field(
+        100.0, ge=1, le=1e4, description="the wall's stiffness over the joints' stiffness along u [-]"
+    )
+    tolerance: float = Field(
+        0.05, gt=0, le=1, description="relative difference beyond which a sample is flagged [-]"
+    )
+
+    @field_validator("detection")
+    @classmethod
+    def _known_detection(cls, value: str | None) -> str | None:
+        from ..simulate.validity import available_detections
+
+        if value is not None and value not in available_detections():
+            raise ValueError(f"one of {', '.join(available_detections())} (found {value!r})")
+        return value
+
+
 class ExecutionSpec(_Model):
     """Where the independent work runs: in-process, a local process pool, or a Dask cluster."""
 
@@ -735,6 +767,9 @@ class ArmStudy(_Model):
     catalogue: CatalogueSpec = Field(default_factory=CatalogueSpec)  # type: ignore[arg-type]
     outputs: OutputsSpec = Field(default_factory=OutputsSpec)  # type: ignore[arg-type]
     execution: ExecutionSpec = Field(default_factory=ExecutionSpec)  # type: ignore[arg-type]
+    simulate: SimulateSpec | None = Field(
+        None, description="simulate the recommended design in the time domain; null: no simulation"
+    )
 
     @field_validator("objective", mode="before")
     @classmethod

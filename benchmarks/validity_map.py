@@ -1,0 +1,132 @@
+"""Where the arm closed form holds: the validity map of the planar arm, the UR5 and the Panda.
+
+For each arm, a few configurations x directions x v0 in {0.1, 0.3, 1, 3, 10} v* x a compliant contact (0.1 of
+the joints' stiffness along u: a stiff transmission hitting a soft object), a stiff one (10 times: compliant
+joints hitting a hard object) and a rigid one (1000 times, the study's closed form), it simulates the collision in the time domain
+(:func:`collision_reflex.simulate.simulate_arm_collision`) and compares it with the arm closed form for both
+placements of the reflected inertia; it prints the largest |I_sim / I_closed - 1| and the share of cases within
+5 %, per detection scheme, placement and stiffness ratio, with the timings and the machine's load.
+
+Run: ``PYTHONPATH=src python benchmarks/validity_map.py [FIGURE.png]`` (about a minute on an idle machine).
+The joint parameters of the UR5 and the Panda are representative harmonic-drive joints, not the makers' data.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import collision_reflex as cr
+from collision_reflex.plots import new_figure, save_figure
+from collision_reflex.simulate.validity import (
+    PLACEMENTS,
+    REACTION_MODELS,
+    JointDesign,
+    validity_map,
+    worst_difference,
+)
+
+URDF = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
+
+
+def _planar() -> tuple[Any, JointDesign, list[list[float]], list[list[float]]]:
+    arm = cr.Arm.from_urdf(URDF, "tip")
+    joints = JointDesign(mechanical_stiffness=50.0, reflected_inertia=2.2e-3, torque_limit=1.3, threshold=3.0)
+    directions = [[np.cos(angle), np.sin(angle)] for angle in (0.0, 2.0)]
+    return arm, joints, [[0.3, 1.2], [-0.5, 2.0]], directions
+
+
+def _ur5() -> tuple[Any, JointDesign, list[list[float]], list[list[float]]]:
+    arm = cr.Arm.from_example_robot_data("ur5")
+    joints = JointDesign(
+        mechanical_stiffness=[5000, 5000, 3000, 800, 800, 800],
+        reflected_inertia=[0.2, 0.2, 0.1, 0.03, 0.03, 0.03],
+        torque_limit=[150, 150, 150, 28, 28, 28],
+        threshold=20.0,
+    )
+    return arm, joints, [[0.0, -1.2, 1.5, -1.9, -1.57, 0.0]], [[1, 0, 0], [0, 0, -1]]
+
+
+def _panda() -> tuple[Any, JointDesign, list[list[float]], list[list[float]]]:
+    arm = cr.Arm.from_example_robot_data("panda")
+    joints = JointDesign(
+        mechanical_stiffness=[4000] * 4 + [1000] * 3,
+        reflected_inertia=[0.1] * 4 + [0.02] * 3,
+        torque_limit=[87] * 4 + [12] * 3,
+        threshold=20.0,
+    )
+    return arm, joints, [list(arm.reference_configuration)], [[1, 0, 0], [0, 0, -1]]
+
+
+# The issue's two regimes and the study's: an object 1000 times stiffer than the joints (a rigid one).
+STIFFNESS_RATIOS = (0.1, 10.0, 1000.0)
+ARMS = {"planar two-link": _planar, "UR5": _ur5, "Panda": _panda}
+
+
+def main(figure_path: str | None) -> None:
+    tables = {}
+    print(
+        f"machine load (1, 5, 15 min): {', '.join(f'{x:.1f}' for x in os.getloadavg())} on {os.cpu_count()} cores"
+    )
+    for name, build in ARMS.items():
+        arm, joints, configurations, directions = build()
+        start = time.perf_counter()
+        table = validity_map(arm, joints, configurations, directions, stiffness_ratios=STIFFNESS_RATIOS)
+        elapsed = time.perf_counter() - start
+        tables[name] = table
+        simulations = len(table) // (len(PLACEMENTS) * len(REACTION_MODELS))
+        failed = int((table["error"] != "").sum()) // (len(PLACEMENTS) * len(REACTION_MODELS))
+        print(
+            f"\n{name}: {len(configurations)} configuration(s) x {len(directions)} directions, {simulations} "
+            f"simulations ({failed} refused or failed) in {elapsed:.1f} s ({1e3 * elapsed / simulations:.0f} ms each)"
+        )
+        worst = 100 * worst_difference(table)
+        worst.columns = [f"{ratio:g} v*" for ratio in worst.columns]
+        print(
+            "largest |I_sim / I_closed - 1| [%] (rows: detection, reaction model, placement, k_contact / k_joint):"
+        )
+        print(worst.round(1).to_string())
+        print(f"within 5 %: {100 * table['valid'].mean():.0f} % of the cases")
+    print(f"\nmachine load (1, 5, 15 min): {', '.join(f'{x:.1f}' for x in os.getloadavg())}")
+    if figure_path:
+        print(f"figure: {_figure(tables, figure_path)}")
+
+
+FIGURE_DETECTIONS = ("spring_torque", "force")
+"""The detections drawn: the simulator's default and the contact-force sensor (the closed form's meaning)."""
+
+
+def _figure(tables: dict[str, Any], path: str) -> Path:
+    """A panel per detection (rows) and arm (columns): the largest |difference| per reaction model x placement x
+    stiffness ratio (rows) and v0 / v* (columns)."""
+    shape = (len(FIGURE_DETECTIONS), len(tables))
+    figure, axes = new_figure(*shape, figsize=(5.0 * shape[1], 4.0 * shape[0]), constrained_layout=True)
+    image = None
+    for row, detection in enumerate(FIGURE_DETECTIONS):
+        for column, (name, table) in enumerate(tables.items()):
+            ax = np.atleast_2d(axes)[row, column]
+            worst = 100 * worst_difference(table[table["detection"] == detection]).droplevel("detection")
+            values = worst.to_numpy()
+            image = ax.imshow(np.minimum(values, 50), cmap="RdYlGn_r", vmin=0, vmax=50, aspect="auto")
+            for (i, j), value in np.ndenumerate(values):
+                text = "fail" if not np.isfinite(value) else f"{value:.0f}" if value >= 10 else f"{value:.1f}"
+                weight = "bold" if np.isfinite(value) and value <= 5 else "normal"
+                ax.text(j, i, text, ha="center", va="center", fontsize=7, weight=weight)
+            ax.set_xticks(range(values.shape[1]), [f"{r:g}" for r in worst.columns])
+            labels = [f"{model}, {placement}, {ratio:g}" for model, placement, ratio in worst.index]
+            ax.set_yticks(range(values.shape[0]), labels if column == 0 else [], fontsize=7)
+            ax.set_xlabel("approach velocity v0 / v*")
+            ax.set_title(f"{name}, detection: {detection}", fontsize=9)
+    np.atleast_2d(axes)[0, 0].set_ylabel("reaction model, placement, k_contact / k_joint", fontsize=8)
+    if image is not None:
+        figure.colorbar(image, ax=axes, label="largest |I_sim / I_closed - 1| [%], bold: <= 5 %", shrink=0.6)
+    return save_figure(figure, path, dpi=110)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1] if len(sys.argv) > 1 else None)
