@@ -14,6 +14,7 @@ import pytest
 from collision_reflex.cli import main
 from collision_reflex.optimize.duty import torque_speed_points
 from collision_reflex.optimize.pareto import built_problem
+from collision_reflex.optimize.results import _DESIGN_ARRAYS
 from collision_reflex.optimize.solve import Design
 from collision_reflex.plots.torque_speed import JointOperatingPoints
 from collision_reflex.study.arm_results import SAVED_DIGITS, JointTorqueSpeed
@@ -65,21 +66,9 @@ def _recorded_design(record: dict) -> Design:
     def per_joint(key: str) -> np.ndarray:
         return np.array([j[key] for j in joints], dtype=float)
 
-    keys = (
-        "stator_diameter",
-        "stack_length",
-        "gear_ratio",
-        "software_stiffness",
-        "mechanical_stiffness",
-        "rotor_inertia",
-        "reflected_inertia",
-        "motor_peak_torque",
-        "peak_torque",
-        "motor_mass",
-    )
     return Design(
         joint_names=tuple(j["joint"] for j in joints),
-        **{key: per_joint(key) for key in keys},
+        **{key: per_joint(key) for key in _DESIGN_ARRAYS},
         threshold=record["threshold"],
         approach_velocity=record["approach_velocity"],
         sensing=record["sensing"],
