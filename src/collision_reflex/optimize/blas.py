@@ -20,8 +20,22 @@ def single_threaded_blas() -> contextlib.AbstractContextManager[object]:
 
     if not _CASADI_BLAS_REGISTERED:
         threadpoolctl.register(_casadi_openblas_controller())
+        _load_casadi_openblas()
         _CASADI_BLAS_REGISTERED.append(True)
     return threadpoolctl.threadpool_limits(limits=1)
+
+
+def _load_casadi_openblas() -> None:
+    """Load IPOPT with its OpenBLAS now: threadpoolctl limits only the libraries already loaded.
+
+    CasADi loads them with the first solver; without this, a first solve spins two BLAS threads (measured:
+    the kernel took as much time as the solve itself).
+    """
+    import casadi
+    import threadpoolctl
+
+    if all(info["internal_api"] != "casadi_openblas" for info in threadpoolctl.threadpool_info()):
+        casadi.load_nlpsol("ipopt")  # not loaded yet (it links that OpenBLAS), so no "already in use" warning
 
 
 def _casadi_openblas_controller() -> type:

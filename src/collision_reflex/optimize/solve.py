@@ -12,6 +12,7 @@ import numpy as np
 
 from .. import _validate
 from ..errors import InvalidParameter, SolverFailed, Violation
+from .blas import single_threaded_blas
 from .constraints import STATIC_REQUIREMENT
 from .duty import duty_values
 from .evaluate import evaluate_design
@@ -306,15 +307,16 @@ class _Attempts:
             else {}
         )
         started = time.perf_counter()
-        solution = solver(
-            x0=start,
-            lbx=problem.lbx,
-            ubx=problem.ubx,
-            lbg=problem.lbg,
-            ubg=problem.ubg,
-            p=self.parameters,
-            **multipliers,
-        )
+        with single_threaded_blas():
+            solution = solver(
+                x0=start,
+                lbx=problem.lbx,
+                ubx=problem.ubx,
+                lbg=problem.lbg,
+                ubg=problem.ubg,
+                p=self.parameters,
+                **multipliers,
+            )
         stats = dict(solver.stats())
         status = str(stats.get("return_status", "unknown"))
         if status == INTERRUPTED:
