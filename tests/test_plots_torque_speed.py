@@ -144,3 +144,19 @@ def test_no_joints_or_bad_path_raise(tmp_path):
     with pytest.raises(InvalidParameter, match="joint"):
         JointOperatingPoints("", [1.0], [1.0])
     assert list(tmp_path.iterdir()) == []
+
+
+def test_one_drawing_for_several_files_gives_the_pixels_of_each_drawn_alone(tmp_path):
+    """A figure saved to its SVG and PNG at once is laid out once; its PNG is the one matplotlib crops alone."""
+    from PIL import Image
+
+    joints = [_shoulder(), _wrist_unknown_limits()]
+    alone = plot_torque_speed(tmp_path / "alone.png", joints)
+    first = plot_torque_speed((tmp_path / "both.svg", tmp_path / "both.png"), joints)
+    assert first == tmp_path / "both.svg" and (tmp_path / "both.svg").read_text().startswith("<?xml")
+    with Image.open(alone) as a, Image.open(tmp_path / "both.png") as b:
+        assert a.size == b.size and a.tobytes() == b.tobytes()
+    with pytest.raises(InvalidParameter, match="figure file"):
+        plot_torque_speed((tmp_path / "ok.png", tmp_path / "bad.txt"), joints)
+    with pytest.raises(InvalidParameter, match="at least one file"):
+        plot_torque_speed((), joints)

@@ -59,6 +59,20 @@ def test_every_example_study_runs(runs, name):
     assert (numbers == numbers).all()  # no NaN anywhere in the results
 
 
+@pytest.mark.parametrize("name", [p.stem for p in STUDIES], ids=[p.stem for p in STUDIES])
+def test_timings_hold_every_stage_of_the_run_within_its_wall_time(runs, name):
+    folder = runs[name]
+    timings = json.loads((folder / "timings.json").read_text())
+    stages = {k.split("/")[1] for k in timings if k.startswith("stages/")}
+    expected = {"load", "prepare", "result files", "figures", "report"}
+    expected |= {"actuators"} if name == ACTUATORS.stem else {"optimum", "results"}
+    assert expected <= stages
+    walls = [v for k, v in timings.items() if k.startswith("stages/") and k.endswith("/wall")]
+    assert all(v >= 0 for v in walls)
+    # The stages do not overlap: together they fit in the run's wall time (the manifest's, taken after them).
+    assert sum(walls) <= json.loads((folder / "run.json").read_text())["elapsed"]
+
+
 class _Tables(HTMLParser):
     """The text of every cell of the table with a given id."""
 

@@ -4,12 +4,15 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeAlias
 
 from .._io import atomic_path
 from ..errors import InvalidParameter
 
 FIGURE_FORMATS = (".png", ".svg", ".pdf")
+
+FigurePath: TypeAlias = str | os.PathLike[str] | tuple[str | os.PathLike[str], ...]
+"""A figure file, or several files of one figure (its PNG and SVG, say): the figure is drawn and laid out once."""
 
 
 def check_figure_path(path: str | os.PathLike[str]) -> Path:
@@ -20,17 +23,48 @@ def check_figure_path(path: str | os.PathLike[str]) -> Path:
     return target
 
 
-def save_figure(figure: Any, path: str | os.PathLike[str], dpi: int = 150) -> Path:
-    """Write a matplotlib figure atomically (format from the suffix) and close it."""
+def figure_paths(path: FigurePath) -> tuple[Path, ...]:
+    """The files of a :data:`FigurePath`, each checked by :func:`check_figure_path`."""
+    paths = path if isinstance(path, tuple) else (path,)
+    if not paths:
+        raise InvalidParameter("figure file", "no file", "at least one file name")
+    return tuple(check_figure_path(p) for p in paths)
+
+
+def save_figure(figure: Any, path: FigurePath, dpi: int = 150) -> Path:
+    """Write a matplotlib figure atomically to each file of ``path`` (format from the suffix), close it.
+
+    Cropped to the figure's tight bounding box, found once at ``dpi`` (a second file costs one more drawing,
+    not another layout pass). Returns the first file.
+    """
     import matplotlib.pyplot as plt
 
-    target = check_figure_path(path)
+    targets = figure_paths(path)
     try:
-        with atomic_path(target) as tmp:
-            figure.savefig(tmp, dpi=dpi, bbox_inches="tight")
+        bbox = _tight_bbox(figure, dpi) if len(targets) > 1 else "tight"
+        for target in targets:
+            with atomic_path(target) as tmp:
+                figure.savefig(tmp, dpi=dpi, bbox_inches=bbox)
     finally:
         plt.close(figure)
-    return target
+    return targets[0]
+
+
+def _tight_bbox(figure: Any, dpi: int) -> Any:
+    """The bounding box [in] that ``savefig(bbox_inches="tight")`` crops to at ``dpi`` (its padding included).
+
+    Measured with the Agg renderer at ``dpi`` as a PNG's ``savefig`` measures it, without its extra drawing
+    pass: the figures are laid out before they are saved (the report's PNGs are the same pixels).
+    """
+    import matplotlib
+
+    saved = figure.dpi
+    figure.set_dpi(dpi)
+    try:
+        bbox = figure.get_tightbbox(figure.canvas.get_renderer())
+    finally:
+        figure.set_dpi(saved)
+    return bbox.padded(matplotlib.rcParams["savefig.pad_inches"])
 
 
 def new_figure(*args: Any, **kwargs: Any) -> Any:

@@ -2,17 +2,16 @@
 
 from __future__ import annotations
 
-import os
 from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
-from . import new_figure, save_figure
+from . import FigurePath, new_figure, save_figure
 
 
 def plot_design_front(
-    path: str | os.PathLike[str],
+    path: FigurePath,
     names: Sequence[str],
     units: Sequence[str],
     values: np.ndarray,

@@ -6,16 +6,15 @@ a spatial one.
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import numpy as np
 
-from . import new_figure, save_figure
+from . import FigurePath, new_figure, save_figure
 
 
 def plot_impulse_directions(
-    path: str | os.PathLike[str],
+    path: FigurePath,
     directions: np.ndarray,
     config_index: np.ndarray,
     impulses: np.ndarray,

@@ -5,19 +5,18 @@ There is one bar per design or actuator.
 
 from __future__ import annotations
 
-import os
 from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
-from . import new_figure, save_figure
+from . import FigurePath, new_figure, save_figure
 
 PHASES = (("initial", "I impact"), ("sensing", "II sensing"), ("reaction", "III reaction"))
 
 
 def plot_phase_breakdown(
-    path: str | os.PathLike[str],
+    path: FigurePath,
     labels: Sequence[str],
     initial: Sequence[float],
     sensing: Sequence[float],

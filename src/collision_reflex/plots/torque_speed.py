@@ -15,7 +15,6 @@ the RMS torque is compared with it.
 from __future__ import annotations
 
 import math
-import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -25,7 +24,7 @@ import numpy as np
 
 from .._validate import non_negative, positive
 from ..errors import InvalidParameter
-from . import check_figure_path, new_figure, save_figure
+from . import FigurePath, figure_paths, new_figure, save_figure
 
 RAD_PER_S_TO_RPM = 60.0 / (2.0 * math.pi)
 INSIDE_COLOUR = "tab:blue"
@@ -156,13 +155,13 @@ def margins(point: JointOperatingPoints) -> dict[str, float | None]:
     return out
 
 
-def plot_torque_speed(path: str | os.PathLike[str], joints: Sequence[JointOperatingPoints]) -> Path:
+def plot_torque_speed(path: FigurePath, joints: Sequence[JointOperatingPoints]) -> Path:
     """Draw one torque–speed subplot per joint (a grid of up to 3 columns) and save it.
 
     Parameters
     ----------
-    path : str or os.PathLike
-        The figure file (.png, .svg or .pdf).
+    path : FigurePath
+        The figure file (.png, .svg or .pdf), or a tuple of files of the same figure.
     joints : sequence of JointOperatingPoints
         One entry per joint, in the order drawn.
 
@@ -171,7 +170,7 @@ def plot_torque_speed(path: str | os.PathLike[str], joints: Sequence[JointOperat
     pathlib.Path
         The written file.
     """
-    check_figure_path(path)
+    figure_paths(path)
     joints = list(joints)
     if not joints:
         raise InvalidParameter("joints", joints, "at least one joint's operating points")

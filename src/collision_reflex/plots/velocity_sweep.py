@@ -2,17 +2,16 @@
 
 from __future__ import annotations
 
-import os
 from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
-from . import new_figure, save_figure
+from . import FigurePath, new_figure, save_figure
 
 
 def plot_velocity_sweep(
-    path: str | os.PathLike[str],
+    path: FigurePath,
     velocities: Sequence[float],
     totals: dict[str, Sequence[float]],
     optimal: dict[str, tuple[float, float]],

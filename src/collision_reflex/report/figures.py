@@ -21,6 +21,7 @@ from .files import ResultsDamaged
 from .outputs import objective_unit
 
 if TYPE_CHECKING:
+    from ..plots import FigurePath
     from ..plots.torque_speed import JointOperatingPoints
 
 TORQUE_SPEED_FIELD = "recommended.torque_speed"
@@ -40,15 +41,15 @@ def _unique_svg_ids(name: str) -> Iterator[None]:
         yield
 
 
-def _draw(directory: Path, name: str, formats: list[str], draw: Callable[[Path], Path]) -> str:
+def _draw(directory: Path, name: str, formats: list[str], draw: Callable[[FigurePath], Path]) -> str:
+    """Draw one figure once into its SVG (always: the report inlines it) and, if asked, its PNG."""
     directory.mkdir(parents=True, exist_ok=True)
+    svg_path = directory / f"{name}.svg"
     with _unique_svg_ids(name):
-        svg_path = draw(directory / f"{name}.svg")
-        text = Path(svg_path).read_text(encoding="utf-8")
-        if "png" in formats:
-            draw(directory / f"{name}.png")
+        draw((svg_path, directory / f"{name}.png") if "png" in formats else svg_path)
+    text = svg_path.read_text(encoding="utf-8")
     if "svg" not in formats:
-        Path(svg_path).unlink()
+        svg_path.unlink()
     # Inline: from the <svg> element on, without the metadata block (it only records the drawing time, which
     # would make otherwise identical reports differ).
     return re.sub(r"<metadata>.*?</metadata>\s*", "", text[text.index("<svg") :], count=1, flags=re.S)
@@ -180,7 +181,7 @@ def _words(name: str) -> str:
 
 
 def _surface(
-    path: Path, directions: np.ndarray, config_index: np.ndarray, impulses: np.ndarray, title: str
+    path: FigurePath, directions: np.ndarray, config_index: np.ndarray, impulses: np.ndarray, title: str
 ) -> Path:
     from ..plots.impulse_directions import plot_impulse_directions
 

@@ -7,8 +7,11 @@ alone.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
+import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -76,14 +79,53 @@ TIMING_KEYS = frozenset({"solve_time", "build_time"})
 for the same study on every executor and machine load."""
 
 
-def write_outputs(folder: str | os.PathLike[str], results: dict[str, Any], figures: bool = True) -> Path:
-    """Write ``designs.json``, ``pareto.csv``, ``timings.json`` and the report (with its figures) into ``folder``."""
+STAGES = "stages"
+"""The prefix of the stage times in ``timings.json``: ``stages/<stage>/wall`` and ``stages/<stage>/cpu`` [s]."""
+
+
+class StageTimes:
+    """The wall and CPU time of each stage of a run [s], for ``timings.json`` (see :data:`STAGES`).
+
+    CPU time is this process's (the work a pool's workers do is not in it); on a loaded machine it is steadier
+    than wall time. A stage timed twice adds up.
+    """
+
+    def __init__(self) -> None:
+        self.times: dict[str, float] = {}
+
+    @contextlib.contextmanager
+    def stage(self, name: str) -> Iterator[None]:
+        """Time the body of the ``with`` block as stage ``name``."""
+        wall, cpu = time.perf_counter(), time.process_time()
+        try:
+            yield
+        finally:
+            for kind, spent in (("wall", time.perf_counter() - wall), ("cpu", time.process_time() - cpu)):
+                key = f"{STAGES}/{name}/{kind}"
+                self.times[key] = self.times.get(key, 0.0) + spent
+
+
+def write_outputs(
+    folder: str | os.PathLike[str],
+    results: dict[str, Any],
+    figures: bool = True,
+    stages: StageTimes | None = None,
+) -> Path:
+    """Write ``designs.json``, ``pareto.csv``, ``timings.json`` and the report (with its figures) into ``folder``.
+
+    ``timings.json`` holds the solver times and, last, the times of ``stages`` with those of writing the
+    result files, drawing the figures and writing the report.
+    """
     folder = Path(folder)
+    stages = stages if stages is not None else StageTimes()
     numbers, timings = split_timings(results)
-    write_json(folder / DESIGNS, numbers)
-    write_json(folder / TIMINGS, timings)
-    _write_csv(folder / PARETO, pareto_rows(results))
-    return render_report(folder, results, figures=figures)
+    with stages.stage("result files"):
+        write_json(folder / DESIGNS, numbers)
+        write_json(folder / TIMINGS, timings)
+        _write_csv(folder / PARETO, pareto_rows(results))
+    report = render_report(folder, results, figures=figures, stages=stages)
+    write_json(folder / TIMINGS, {**timings, **stages.times})
+    return report
 
 
 def split_timings(data: Any, at: str = "") -> tuple[Any, dict[str, float]]:
@@ -152,11 +194,15 @@ def _unknown_timings(data: Any) -> None:
 
 
 def render_report(
-    folder: str | os.PathLike[str], results: dict[str, Any] | None = None, figures: bool = True
+    folder: str | os.PathLike[str],
+    results: dict[str, Any] | None = None,
+    figures: bool = True,
+    stages: StageTimes | None = None,
 ) -> Path:
     """Redraw the figures and rewrite the report from the results saved in ``folder``.
 
-    Writes ``report.html`` (and ``report.pdf`` if the study asks).
+    Writes ``report.html`` (and ``report.pdf`` if the study asks); ``stages`` gets the times of the figures,
+    the HTML and the PDF.
 
     Raises
     ------
@@ -170,11 +216,15 @@ def render_report(
     from .html import render_html
 
     folder = Path(folder)
+    stages = stages if stages is not None else StageTimes()
     saved = results is None
     if results is None:
         results = _read_results(folder)
     try:
-        html = render_html(results, pareto_rows(results), _figures(folder, results, figures))
+        with stages.stage("figures"):
+            svgs = _figures(folder, results, figures)
+        with stages.stage("report"):
+            html = render_html(results, pareto_rows(results), svgs)
         pdf = bool(results["resolved"]["outputs"]["pdf"])
     except ResultsDamaged as error:
         raise ResultsDamaged(f"{folder / DESIGNS}: {error}; run the study again") from None
@@ -194,7 +244,8 @@ def render_report(
         from .pdf import html_to_pdf
 
         try:
-            html_to_pdf(folder / REPORT, folder / "report.pdf")
+            with stages.stage("pdf"):
+                html_to_pdf(folder / REPORT, folder / "report.pdf")
         except CollisionReflexError as error:
             import warnings
 

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, cast
 
+from ..report.outputs import StageTimes
 from .arm_results import CatalogueRecord, SnapCatalogue, arm_results, catalogue_results, study_catalogue
 from .executors import open_executor
 from .load import LoadedStudy, load_study, parse_study
@@ -127,18 +128,21 @@ def run_study(
     from .. import __version__
 
     started = time.perf_counter()
-    loaded = load_study(path)
-    smoke = bool(os.environ.get(SMOKE_ENVIRONMENT, "")) if smoke is None else smoke
-    resolved = resolved_study(loaded)
-    as_written = loaded
-    if smoke:
-        resolved = smoke_study(resolved)
-        loaded = parse_study(_dump(resolved), str(path), loaded.directory)
-    text = resolved_yaml(loaded)
+    stages = StageTimes()
+    with stages.stage("load"):
+        loaded = load_study(path)
+        smoke = bool(os.environ.get(SMOKE_ENVIRONMENT, "")) if smoke is None else smoke
+        resolved = resolved_study(loaded)
+        as_written = loaded
+        if smoke:
+            resolved = smoke_study(resolved)
+            loaded = parse_study(_dump(resolved), str(path), loaded.directory)
+        text = resolved_yaml(loaded)
     # Robot, motors, samples and the problem build: every problem is raised here, located in the file as
     # written, before any output.
-    _prepare(as_written, text)
-    catalogue = study_catalogue(loaded) if isinstance(loaded.study, ArmStudy) else None
+    with stages.stage("prepare"):
+        _prepare(as_written, text)
+        catalogue = study_catalogue(loaded) if isinstance(loaded.study, ArmStudy) else None
     folder = RunFolder(Path(out) if out is not None else default_output_folder(loaded, smoke))
     execution = resolved.get("execution", {})
     kind = executor or execution.get("executor", "serial")
@@ -163,13 +167,16 @@ def run_study(
         window = 1 if kind == "serial" and scheduler is None else (10**6 if scheduler else 2 * n_workers)
         with open_executor(kind, n_workers, scheduler) as pool:
             if isinstance(loaded.study, ArmStudy):
-                results, counts = _run_arm(loaded.study, text, folder, pool, progress, window, catalogue)
+                results, counts = _run_arm(
+                    loaded.study, text, folder, pool, progress, window, stages, catalogue
+                )
             else:
-                results, counts = _run_actuators(loaded, folder, progress)
+                with stages.stage("actuators"):
+                    results, counts = _run_actuators(loaded, folder, progress)
         progress.stop()
         from ..report import write_outputs
 
-        write_outputs(folder.path, results, figures=figures)
+        write_outputs(folder.path, results, figures=figures, stages=stages)
     except OSError as error:  # a full disk, a folder made read-only meanwhile: finished pieces are kept
         progress.stop()
         with contextlib.suppress(OSError):
@@ -256,9 +263,12 @@ def _run_arm(
     pool: Executor,
     progress: _Progress,
     window: int,
+    stages: StageTimes,
     catalogue: SnapCatalogue | None = None,
 ) -> tuple[dict[str, Any], tuple[int, int]]:
     """The study's optimum (multi-started), its Pareto front by the optimiser's one sweep, and the verdict.
+
+    Each stage is timed into ``stages``.
 
     Then, with a ``catalogue``, the recommended design and every Pareto design snapped to it
     (:func:`.arm_results.catalogue_results`). Each piece is saved as it finishes and found again when the run
@@ -271,34 +281,36 @@ def _run_arm(
 
     problems = StudyProblems(text)
     try:
-        optimum, found = single_optimum(
-            problems,
-            problems.objective,
-            IPOPT_OPTIONS,
-            progress.counter("optimum of the study's objective"),
-            executor=pool,
-            finished=folder.finished,
-            save=folder.save,
-            starts=OPTIMUM_STARTS,
-        )
+        with stages.stage("optimum"):
+            optimum, found = single_optimum(
+                problems,
+                problems.objective,
+                IPOPT_OPTIONS,
+                progress.counter("optimum of the study's objective"),
+                executor=pool,
+                finished=folder.finished,
+                save=folder.save,
+                starts=OPTIMUM_STARTS,
+            )
     except SolverFailed as error:
         raise StudyRunFailed(f"the optimum solve failed: {error.args[0]}", "optimum", error.status) from None
     computed, reused = (0, 1) if found else (1, 0)
     front = None
     if study.pareto is not None:
         try:
-            front = pareto_front(
-                problems,
-                tuple(study.pareto.objectives),
-                study.pareto.points,
-                IPOPT_OPTIONS,
-                progress=progress.counter("Pareto sweep"),
-                anchor_starts=study.pareto.anchor_starts,
-                executor=pool,
-                in_flight=window,
-                finished=folder.finished,
-                save=folder.save,
-            )
+            with stages.stage("pareto"):
+                front = pareto_front(
+                    problems,
+                    tuple(study.pareto.objectives),
+                    study.pareto.points,
+                    IPOPT_OPTIONS,
+                    progress=progress.counter("Pareto sweep"),
+                    anchor_starts=study.pareto.anchor_starts,
+                    executor=pool,
+                    in_flight=window,
+                    finished=folder.finished,
+                    save=folder.save,
+                )
         except SolverFailed as error:
             raise StudyRunFailed(str(error.args[0]), "anchor", error.status) from None
         computed, reused = computed + front.computed, reused + front.reused
@@ -308,25 +320,29 @@ def _run_arm(
         if saved is not None and saved.get("key") == catalogue.key:
             snapped, reused = cast("CatalogueRecord", saved), reused + 1
         else:
-            snapped = catalogue_results(
-                problems, optimum, front, catalogue, progress.counter("catalogue snap"), pool
-            )
+            with stages.stage("catalogue snap"):
+                snapped = catalogue_results(
+                    problems, optimum, front, catalogue, progress.counter("catalogue snap"), pool
+                )
             folder.save("catalogue", dict(snapped))
             computed += 1
-    results = {
-        "kind": "arm",
-        "study": study.name,
-        "description": study.description,
-        "resolved": resolved_study(parse_study(text, "resolved study")),
-        **arm_results(problems, optimum, front, snapped),
-    }
+    with stages.stage("results"):
+        results = {
+            "kind": "arm",
+            "study": study.name,
+            "description": study.description,
+            "resolved": resolved_study(parse_study(text, "resolved study")),
+            **arm_results(problems, optimum, front, snapped),
+        }
     if study.simulate is not None:
         from ..optimize.pareto import recommend
         from .simulate_design import simulate_designs
 
-        recommended = recommend(optimum, front, problems.objective).result
-        results["simulation"] = simulate_designs(problems, recommended, front, study.simulate, folder)
-    results["verdict"] = verdict(results)
+        with stages.stage("simulation"):
+            recommended = recommend(optimum, front, problems.objective).result
+            results["simulation"] = simulate_designs(problems, recommended, front, study.simulate, folder)
+    with stages.stage("results"):
+        results["verdict"] = verdict(results)
     return results, (computed, reused)
 
 
