@@ -11,9 +11,9 @@ import contextlib
 import os
 import re
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 from ..errors import CollisionReflexError
 from .files import (
@@ -79,6 +79,8 @@ TIMING_KEYS = frozenset({"solve_time", "build_time"})
 for the same study on every executor and machine load."""
 
 
+T = TypeVar("T")
+
 STAGES = "stages"
 """The prefix of the stage times in ``timings.json``: ``stages/<stage>/wall`` and ``stages/<stage>/cpu`` [s]."""
 
@@ -103,6 +105,15 @@ class StageTimes:
             for kind, spent in (("wall", time.perf_counter() - wall), ("cpu", time.process_time() - cpu)):
                 key = f"{STAGES}/{name}/{kind}"
                 self.times[key] = self.times.get(key, 0.0) + spent
+
+    def timed(self, name: str, function: Callable[..., T]) -> Callable[..., T]:
+        """``function``, each call timed as stage ``name``."""
+
+        def call(*args: Any, **kwargs: Any) -> T:
+            with self.stage(name):
+                return function(*args, **kwargs)
+
+        return call
 
 
 def write_outputs(

@@ -281,36 +281,34 @@ def _run_arm(
 
     problems = StudyProblems(text)
     try:
-        with stages.stage("optimum"):
-            optimum, found = single_optimum(
-                problems,
-                problems.objective,
-                IPOPT_OPTIONS,
-                progress.counter("optimum of the study's objective"),
-                executor=pool,
-                finished=folder.finished,
-                save=folder.save,
-                starts=OPTIMUM_STARTS,
-            )
+        optimum, found = stages.timed("optimum", single_optimum)(
+            problems,
+            problems.objective,
+            IPOPT_OPTIONS,
+            progress.counter("optimum of the study's objective"),
+            executor=pool,
+            finished=folder.finished,
+            save=folder.save,
+            starts=OPTIMUM_STARTS,
+        )
     except SolverFailed as error:
         raise StudyRunFailed(f"the optimum solve failed: {error.args[0]}", "optimum", error.status) from None
     computed, reused = (0, 1) if found else (1, 0)
     front = None
     if study.pareto is not None:
         try:
-            with stages.stage("pareto"):
-                front = pareto_front(
-                    problems,
-                    tuple(study.pareto.objectives),
-                    study.pareto.points,
-                    IPOPT_OPTIONS,
-                    progress=progress.counter("Pareto sweep"),
-                    anchor_starts=study.pareto.anchor_starts,
-                    executor=pool,
-                    in_flight=window,
-                    finished=folder.finished,
-                    save=folder.save,
-                )
+            front = stages.timed("pareto", pareto_front)(
+                problems,
+                tuple(study.pareto.objectives),
+                study.pareto.points,
+                IPOPT_OPTIONS,
+                progress=progress.counter("Pareto sweep"),
+                anchor_starts=study.pareto.anchor_starts,
+                executor=pool,
+                in_flight=window,
+                finished=folder.finished,
+                save=folder.save,
+            )
         except SolverFailed as error:
             raise StudyRunFailed(str(error.args[0]), "anchor", error.status) from None
         computed, reused = computed + front.computed, reused + front.reused
@@ -320,29 +318,27 @@ def _run_arm(
         if saved is not None and saved.get("key") == catalogue.key:
             snapped, reused = cast("CatalogueRecord", saved), reused + 1
         else:
-            with stages.stage("catalogue snap"):
-                snapped = catalogue_results(
-                    problems, optimum, front, catalogue, progress.counter("catalogue snap"), pool
-                )
+            snapped = stages.timed("catalogue snap", catalogue_results)(
+                problems, optimum, front, catalogue, progress.counter("catalogue snap"), pool
+            )
             folder.save("catalogue", dict(snapped))
             computed += 1
-    with stages.stage("results"):
-        results = {
-            "kind": "arm",
-            "study": study.name,
-            "description": study.description,
-            "resolved": resolved_study(parse_study(text, "resolved study")),
-            **arm_results(problems, optimum, front, snapped),
-        }
+    results = {
+        "kind": "arm",
+        "study": study.name,
+        "description": study.description,
+        "resolved": resolved_study(parse_study(text, "resolved study")),
+        **stages.timed("results", arm_results)(problems, optimum, front, snapped),
+    }
     if study.simulate is not None:
         from ..optimize.pareto import recommend
         from .simulate_design import simulate_designs
 
-        with stages.stage("simulation"):
-            recommended = recommend(optimum, front, problems.objective).result
-            results["simulation"] = simulate_designs(problems, recommended, front, study.simulate, folder)
-    with stages.stage("results"):
-        results["verdict"] = verdict(results)
+        recommended = recommend(optimum, front, problems.objective).result
+        results["simulation"] = stages.timed("simulation", simulate_designs)(
+            problems, recommended, front, study.simulate, folder
+        )
+    results["verdict"] = stages.timed("results", verdict)(results)
     return results, (computed, reused)
 
 
