@@ -1,0 +1,351 @@
+"""The arm's collision in joint space: the 1D model's three phases with the links free to slide along the wall.
+
+The arm-level closed form reduces the arm to a 1D finger mass ``m_f``, robot mass ``m_r``, spring ``k`` and force
+``F_a`` along ``u``. What it leaves out is the links' motion *along* the wall. A frictionless wall removes the
+finger's momentum along ``u`` only; the links keep the rest of it and, with the joint springs, oscillate in the
+``nv - 1`` directions that keep the contact point on the wall. The contact force, the wall's reaction that holds
+the point on it, then carries that oscillation: it rises as ``k v0 t`` *plus* a sum of sinusoids, reaches the
+threshold earlier or later than ``t1 = F_s / (k v0)``, and the reaction starts from a spring compression other
+than ``F_s / k``. This module derives it, linearised at the impact configuration (``M``, ``J`` frozen), with the
+closed form's other assumptions kept: a rigid, plastic, frictionless contact and force-threshold detection.
+
+Derivation. Links ``q = q0 + xi``, motors ``theta``, contact lever ``c = J^T u`` (nv,), joint springs ``K``::
+
+    M xi'' = K (theta - q) - c f,   c^T xi = 0   (the contact point stays on the wall)
+
+so ``f = m_f c^T M^-1 K (theta - q)`` with ``m_f = 1 / (c^T M^-1 c)``, and with ``xi = N eta`` (``N`` an
+orthonormal basis of the directions with ``c^T xi = 0``) the links move as ``N^T M N eta'' = N^T K (theta - q0 -
+N eta)``: undamped modes ``zeta_j'' + w_j^2 zeta_j = forcing``, solved exactly (no integration).
+
+1. Impact (plastic, instantaneous): ``I1 = m_f v0``; the links keep ``q'+ = q'- - M^-1 c m_f v0`` (along the
+   wall).
+2. Sensing: the motors follow the reference ``q0 + J^+ u v0 t`` through the admittance, the joints see the
+   series stiffness ``K_l`` of ``K_m`` and ``K_s``; ``f(t) = k v0 t - sum_j h_j A_j sin(w_j t) / w_j`` (``k`` the
+   compliance-form stiffness along ``u``); detection at its first crossing of ``F_s``; ``I2`` its integral.
+3. Reaction: the software spring is zeroed, the rotors ``B = diag(N^2 J_m)`` integrated with the motors' push
+   (``tau = -F_a c``, the closed form's; or each joint saturated), against ``K_m``, with the links: modes of
+   ``(theta, eta)``; among them ``nv - 1`` free ones (motors and links sliding together along the wall, which
+   carry no contact force). ``I3`` is the integral of ``f`` until it first returns to zero.
+
+Limits that are tests: one joint (no directions along the wall) gives the 1D model exactly, ``m_f v0 + F_s^2 /
+(2 k v0)`` and :func:`collision_reflex.model.impulse.sprung_reaction`; links without mass on the wall (all
+modes fast) give the sprung reaction with the arm's ``m_r`` and ``F_a`` (the motors alone, ``B theta'' = tau -
+c f``, ``f = k c^T (theta - q0)``, project onto ``u``); a push far above ``F_s`` gives the paper's
+constant-acceleration reaction.
+
+Not modelled: the change of ``M`` and ``J`` while the links slide (the linearisation: it grows with the
+sliding distance), a compliant or damped contact, friction, and the contact after the force first returns to
+zero (a finger that leaves the wall and comes back). If the force falls to zero *before* detection (the finger
+lifts off the wall) the result says so (``lifted_off``): the model then does not hold.
+
+Numeric only (NumPy and SciPy): detection and the contact's end are first crossings of a sum of sinusoids, found
+by sampling at a 32nd of the shortest period and refining with Brent's method. That is no smooth function of
+the design, which is why the optimiser keeps the 1D closed form and this model serves to check it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from .. import _validate
+from ..errors import InvalidParameter
+from .impulse import PhaseImpulses
+
+RETREATS: tuple[str, ...] = ("along_u", "saturated")
+"""The motors' push in the reaction: ``"along_u"``, ``tau = -F_a J^T u`` with ``F_a = min_i tau_max,i /
+|(J^T u)_i|`` (the closed form's: each joint at most at its limit); ``"saturated"``, ``tau_i = -tau_max,i
+sign((J^T u)_i)`` (every joint at its limit)."""
+
+_SAMPLES_PER_PERIOD = 32
+_MAX_SAMPLES = 20_000_000
+"""A crossing search longer than this many samples is refused (widely separated time scales): bounded run time."""
+_FREE_MODE = 1e-9
+"""A mode with ``w^2`` below this fraction of the largest is free (``w = 0``): rounding of a zero eigenvalue."""
+
+
+@dataclass(frozen=True)
+class JointSpaceCollision:
+    """The joint-space collision's phases (:func:`joint_space_collision`).
+
+    Attributes
+    ----------
+    phases: impulses of the impact, sensing (until detection) and reaction phases [N*s].
+    detection_time: ``t_d`` after the impact [s] (the 1D model's ``t1 = F_s / (k v0)``).
+    reaction_duration: from detection until the contact force first returns to zero [s].
+    lifted_off: the contact force fell to zero between the impact and the detection: the finger left the wall,
+        which the model leaves out (its result is then not to be trusted).
+    m_f, k: the effective finger mass and lumped stiffness along ``u`` [kg, N/m] (the 1D model's).
+    """
+
+    phases: PhaseImpulses
+    detection_time: float
+    reaction_duration: float
+    lifted_off: bool
+    m_f: float
+    k: float
+
+    @property
+    def total(self) -> float:
+        """The collision's impulse on the wall [N*s]."""
+        return float(self.phases.total)
+
+
+@dataclass(frozen=True)
+class _Modes:
+    """Undamped modes ``zeta_j'' + w_j^2 zeta_j = p_j + p1_j t``, ``zeta(0) = z0``, ``zeta'(0) = dz0``.
+
+    The contact force is ``h0 + h1 t + h . zeta(t)`` [N]. A mode with ``w = 0`` moves freely.
+    """
+
+    w: np.ndarray
+    z0: np.ndarray
+    dz0: np.ndarray
+    p: np.ndarray
+    p1: np.ndarray
+    h: np.ndarray
+    h1: float = 0.0
+
+    def _parts(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        tt = np.asarray(t, dtype=float)[..., None]
+        free = self.w == 0
+        w = np.where(free, 1.0, self.w)
+        mean = np.where(free, 0.0, self.p / w**2)
+        slope = np.where(free, 0.0, self.p1 / w**2)
+        return tt, w, self.z0 - mean, self.dz0 - slope
+
+    def state(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """``zeta(t)`` and ``zeta'(t)``."""
+        tt, w, c, s = self._parts(np.asarray(t))
+        free = self.w == 0
+        wt = w * tt
+        osc = (self.p + self.p1 * tt) / w**2 + c * np.cos(wt) + s * np.sin(wt) / w
+        dosc = self.p1 / w**2 - c * w * np.sin(wt) + s * np.cos(wt)
+        poly = self.z0 + self.dz0 * tt + self.p * tt**2 / 2 + self.p1 * tt**3 / 6
+        dpoly = self.dz0 + self.p * tt + self.p1 * tt**2 / 2
+        return np.where(free, poly, osc), np.where(free, dpoly, dosc)
+
+    def force(self, t: Any) -> Any:
+        """The contact force at ``t`` [N] (array in, array out)."""
+        tt, w, c, s = self._parts(t)
+        free = self.w == 0
+        wt = w * tt
+        osc = (self.p + self.p1 * tt) / w**2 + c * np.cos(wt) + s * np.sin(wt) / w
+        poly = self.z0 + self.dz0 * tt + self.p * tt**2 / 2 + self.p1 * tt**3 / 6
+        return self.h1 * tt[..., 0] + np.where(free, poly, osc) @ self.h
+
+    def impulse(self, t: float) -> float:
+        """``integral_0^t force`` [N*s], exact."""
+        tt, w, c, s = self._parts(np.asarray(t))
+        free = self.w == 0
+        wt = w * tt
+        osc = (self.p * tt + self.p1 * tt**2 / 2) / w**2 + c * np.sin(wt) / w + s * (1 - np.cos(wt)) / w**2
+        poly = self.z0 * tt + self.dz0 * tt**2 / 2 + self.p * tt**3 / 6 + self.p1 * tt**4 / 24
+        return float(self.h1 * t**2 / 2 + np.where(free, poly, osc) @ self.h)
+
+    def shortest_period(self) -> float:
+        moving = self.w[self.w > 0]
+        return float(2 * np.pi / moving.max()) if moving.size else math.inf
+
+    def longest_period(self) -> float:
+        moving = self.w[(self.w > 0) & (np.abs(self.h) > 0)]
+        return float(2 * np.pi / moving.min()) if moving.size else 0.0
+
+
+def _modes(mass: np.ndarray, stiffness: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Frequencies [rad/s] and mass-normalised mode shapes (``Phi^T mass Phi = I``) of ``mass, stiffness``."""
+    from scipy.linalg import eigh
+
+    if mass.shape[0] == 0:
+        return np.zeros(0), np.zeros((0, 0))
+    w2, shapes = eigh(stiffness, mass)
+    w2 = np.where(w2 <= _FREE_MODE * max(float(np.max(np.abs(w2))), 1e-300), 0.0, w2)
+    return np.sqrt(w2), shapes
+
+
+def _first_crossing(modes: _Modes, level: float, horizon: float, rising: bool, what: str) -> float:
+    """The first time in ``(0, horizon]`` [s] where the force crosses ``level`` [N] (upward if ``rising``)."""
+    from scipy.optimize import brentq
+
+    step = min(modes.shortest_period(), horizon) / _SAMPLES_PER_PERIOD
+    count = int(math.ceil(horizon / step))
+    if count > _MAX_SAMPLES:
+        raise InvalidParameter(
+            what,
+            f"{count:.3g} samples",
+            f"at most {_MAX_SAMPLES:.3g} samples of the shortest period",
+            "the arm's periods and the collision's duration are too far apart for this model",
+        )
+    chunk = 8192
+    for start in range(0, count, chunk):
+        times = np.arange(start, min(start + chunk, count) + 1) * step
+        margin = modes.force(times) - level
+        hits = (margin[:-1] < 0) & (margin[1:] >= 0) if rising else (margin[:-1] > 0) & (margin[1:] <= 0)
+        found = np.flatnonzero(hits)
+        if found.size:
+            i = int(found[0])
+            return float(
+                brentq(lambda t: float(modes.force(np.array([t]))[0]) - level, times[i], times[i + 1], xtol=1e-16)
+            )
+    raise InvalidParameter(what, horizon, "a crossing within the searched horizon [s]")
+
+
+def joint_space_collision(
+    mass_matrix: npt.ArrayLike,
+    jacobian: npt.ArrayLike,
+    direction: npt.ArrayLike,
+    mechanical_stiffness: npt.ArrayLike,
+    reflected_inertia: npt.ArrayLike,
+    torque_limit: npt.ArrayLike,
+    threshold: float,
+    approach_velocity: float,
+    *,
+    software_stiffness: npt.ArrayLike = math.inf,
+    retreat: str = "along_u",
+) -> JointSpaceCollision:
+    """The arm's collision with the links' motion along the wall, linearised at the impact configuration.
+
+    See the module's docstring for the derivation and its assumptions.
+
+    Parameters
+    ----------
+    mass_matrix: the links' joint-space mass matrix ``M(q0)`` (nv, nv) [kg m^2], with the motor masses, without
+        the reflected inertia (it sits behind the joint springs).
+    jacobian: the contact point's translational Jacobian ``J(q0)`` (task_dim, nv) [m/rad].
+    direction: the collision direction, the wall's inward normal (task_dim,), normalised here.
+    mechanical_stiffness: joint springs ``K_m`` [N m/rad], finite, > 0 (scalar or (nv,)).
+    reflected_inertia: rotor inertia behind each spring ``N^2 J_m`` [kg m^2], > 0.
+    torque_limit: output torque limit per joint [N m], > 0 (``inf`` allowed for all but the first to saturate).
+    threshold: the contact force at which the reaction starts ``F_s`` [N], > 0.
+    approach_velocity: ``v0`` of the contact point along ``direction`` [m/s], > 0.
+    software_stiffness: joint software stiffness ``K_s`` [N m/rad], > 0, ``inf`` (default) for ideally
+        velocity-controlled motors; in series with ``K_m`` until detection, zeroed at it.
+    retreat: the reaction's motor torques, :data:`RETREATS`.
+    """
+    _validate.choice("retreat", retreat, RETREATS)
+    mass = _validate.real("mass_matrix", mass_matrix, "a square matrix of real numbers [kg m^2]")
+    if mass.ndim != 2 or mass.shape[0] != mass.shape[1] or mass.shape[0] == 0:
+        raise InvalidParameter("mass_matrix", mass.shape, "a square (nv, nv) matrix")
+    nv = mass.shape[0]
+    jac = _validate.real("jacobian", jacobian, "a (task_dim, nv) matrix of real numbers [m/rad]")
+    if jac.ndim != 2 or jac.shape[1] != nv or not np.all(np.isfinite(jac)):
+        raise InvalidParameter("jacobian", jac.shape, f"a finite (task_dim, {nv}) matrix")
+    u = _validate.real("direction", direction, "a vector of real numbers").reshape(-1)
+    if u.shape != (jac.shape[0],) or not np.all(np.isfinite(u)) or np.linalg.norm(u) == 0:
+        raise InvalidParameter("direction", direction, f"a nonzero vector of {jac.shape[0]} task coordinates")
+    u = u / np.linalg.norm(u)
+    k_m = _per_joint("mechanical_stiffness", mechanical_stiffness, nv, allow_inf=False)
+    k_s = _per_joint("software_stiffness", software_stiffness, nv, allow_inf=True)
+    rotor = _per_joint("reflected_inertia", reflected_inertia, nv, allow_inf=False)
+    tau_max = _per_joint("torque_limit", torque_limit, nv, allow_inf=True)
+    F_s = float(_validate.positive("threshold", threshold))
+    v0 = float(_validate.positive("approach_velocity", approach_velocity))
+    if not np.all(np.isfinite(mass)) or not np.allclose(mass, mass.T, rtol=1e-9, atol=0):
+        raise InvalidParameter("mass_matrix", mass, "a finite symmetric matrix")
+    try:
+        np.linalg.cholesky(mass)
+    except np.linalg.LinAlgError:
+        raise InvalidParameter("mass_matrix", mass, "a positive definite matrix") from None
+
+    lever = jac.T @ u  # c = J^T u
+    reference = np.linalg.pinv(jac) @ u  # J^+ u: the motors' reference rate per unit v0
+    if np.linalg.norm(jac @ reference - u) > 1e-6 or not np.any(lever):
+        raise InvalidParameter(
+            "direction", u, "a direction the contact point can move along", "the Jacobian is singular along it"
+        )
+    m_inv_c = np.linalg.solve(mass, lever)
+    m_f = 1 / float(lever @ m_inv_c)
+    series = np.where(np.isinf(k_s), k_m, k_m * k_s / np.where(np.isinf(k_s), 1.0, k_m + k_s))
+    share = np.where(np.isinf(k_s), 1.0, k_s / np.where(np.isinf(k_s), 1.0, k_m + k_s))  # of theta_ref
+    k = 1 / float(lever @ (lever / series))
+    v_ref = reference * v0
+    along_wall = _wall_basis(lever)  # N (nv, nv - 1)
+
+    # 1. Impact: the wall takes m_f v0 along u; the links keep their velocity along the wall.
+    dq_impact = v_ref - m_inv_c * m_f * float(lever @ v_ref)
+
+    # 2. Sensing: N^T M N eta'' + N^T K_l N eta = N^T K_l v_ref t;  f = g . (v_ref t - N eta).
+    mass_t = along_wall.T @ mass @ along_wall
+    gain = m_f * series * m_inv_c  # f = g . (theta_ref - q)
+    w, shapes = _modes(mass_t, along_wall.T @ (series[:, None] * along_wall))
+    sensing = _Modes(
+        w=w,
+        z0=np.zeros(w.size),
+        dz0=shapes.T @ mass_t @ (along_wall.T @ dq_impact),
+        p=np.zeros(w.size),
+        p1=shapes.T @ along_wall.T @ (series * v_ref),
+        h=-(shapes.T @ along_wall.T @ gain),
+        h1=float(gain @ v_ref),
+    )
+    swing = float(np.sum(np.abs(sensing.h * (sensing.dz0 - sensing.p1 / np.where(w > 0, w, 1) ** 2)) / np.where(w > 0, w, 1)))
+    horizon = (F_s + swing) / (k * v0) * (1 + 1e-9) + 1e-300
+    t_d = _first_crossing(sensing, F_s, horizon, True, "the detection time")
+    lifted = _lifts_off(sensing, t_d)
+    zeta, dzeta = sensing.state(t_d)
+    xi, dxi = along_wall @ (shapes @ zeta), along_wall @ (shapes @ dzeta)
+    theta_ref = v_ref * t_d
+    theta = np.where(np.isinf(k_s), theta_ref, share * theta_ref + (1 - share) * xi)  # admittance (minus q0)
+    dtheta = share * v_ref + (1 - share) * dxi
+
+    # 3. Reaction: coordinates x = (theta - q0, eta), mass diag(B, N^T M N), springs K_m (theta - q0 - N eta).
+    if retreat == "along_u":
+        push = -float(np.min(tau_max / np.where(lever != 0, np.abs(lever), np.inf))) * lever
+    else:
+        push = -tau_max * np.sign(lever)
+    if not np.all(np.isfinite(push)):
+        raise InvalidParameter("torque_limit", tau_max, "finite limits on the joints that push the contact")
+    coupling = k_m[:, None] * along_wall
+    mass_r = np.block([[np.diag(rotor), np.zeros((nv, nv - 1))], [np.zeros((nv - 1, nv)), mass_t]])
+    stiff_r = np.block([[np.diag(k_m), -coupling], [-coupling.T, along_wall.T @ coupling]])
+    w_r, shapes_r = _modes(mass_r, stiff_r)
+    x0 = np.concatenate([theta, along_wall.T @ xi])
+    dx0 = np.concatenate([dtheta, along_wall.T @ dxi])
+    gain_m = m_f * k_m * m_inv_c  # f = g_m . (theta - q0 - N eta)
+    reaction = _Modes(
+        w=w_r,
+        z0=shapes_r.T @ mass_r @ x0,
+        dz0=shapes_r.T @ mass_r @ dx0,
+        p=shapes_r.T @ np.concatenate([push, np.zeros(nv - 1)]),
+        p1=np.zeros(w_r.size),
+        h=shapes_r.T @ np.concatenate([gain_m, -(along_wall.T @ gain_m)]),
+    )
+    free = w_r == 0
+    mean_force = float(np.sum(reaction.h[~free] * reaction.p[~free] / w_r[~free] ** 2))
+    if mean_force >= 0:
+        raise InvalidParameter(
+            "torque_limit", tau_max, "a push that unloads the contact", "the motors' push does not pull the finger off"
+        )
+    duration = _first_crossing(
+        reaction, 0.0, 100 * max(reaction.longest_period(), reaction.shortest_period()), False, "the reaction time"
+    )
+    phases = PhaseImpulses(m_f * v0, sensing.impulse(t_d), reaction.impulse(duration))
+    return JointSpaceCollision(phases, t_d, duration, lifted, m_f, k)
+
+
+def _wall_basis(lever: np.ndarray) -> np.ndarray:
+    """An orthonormal basis (nv, nv - 1) of the joint motions that keep the contact point on the wall."""
+    _, _, vt = np.linalg.svd(lever[None, :])
+    return vt[1:].T
+
+
+def _lifts_off(sensing: _Modes, t_d: float) -> bool:
+    """Whether the contact force falls to zero or below between the impact and detection (sampled)."""
+    step = sensing.shortest_period() / _SAMPLES_PER_PERIOD
+    count = min(int(math.ceil(t_d / step)), _MAX_SAMPLES) if math.isfinite(step) else 1
+    times = np.linspace(0.0, t_d, count + 1)[1:]
+    return bool(np.any(sensing.force(times) <= 0))
+
+
+def _per_joint(name: str, value: Any, nv: int, *, allow_inf: bool) -> np.ndarray:
+    """One value per joint (nv,), a scalar broadcast, each > 0."""
+    array = np.asarray(_validate.positive(name, value, allow_inf=allow_inf), dtype=float)
+    if array.ndim == 0:
+        return np.full(nv, float(array))
+    array = array.reshape(-1)
+    if array.shape != (nv,):
+        raise InvalidParameter(name, value, f"one value or {nv} values, one per joint")
+    return array
