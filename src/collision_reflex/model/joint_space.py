@@ -74,18 +74,27 @@ class JointSpaceCollision:
 
     Attributes
     ----------
-    phases: impulses of the impact, sensing (until detection) and reaction phases [N*s].
-    detection_time: ``t_d`` after the impact [s] (the 1D model's ``t1 = F_s / (k v0)``).
-    reaction_duration: from detection until the contact force first returns to zero [s].
+    phases: impulses of the impact, sensing (until the reaction starts) and reaction phases [N*s].
+    detection_time: the contact force's first crossing of ``F_s`` after the impact [s] (the 1D model's
+        ``t1 = F_s / (k v0)``).
+    delay: from it to the reaction's start [s].
+    reaction_duration: from the reaction's start until the contact force first returns to zero [s].
     lifted_off: the contact force fell to zero between the impact and the detection: the finger left the wall,
         which the model leaves out (its result is then not to be trusted).
+    threshold_margin: the smallest relative change of ``F_s`` that moves the detection to another swing of the
+        oscillating force [-] (``inf`` if none): an earlier peak ``p < F_s`` (lower ``F_s`` by ``1 - p/F_s``),
+        or the crossing's own peak ``p`` if the force falls back below ``F_s`` after it (raise it by ``p/F_s -
+        1``). A small margin (a few %) means the impulse jumps with a small change of the threshold or of the
+        arm: the detection is ill-conditioned there, in the model and in the arm alike.
     m_f, k: the effective finger mass and lumped stiffness along ``u`` [kg, N/m] (the 1D model's).
     """
 
     phases: PhaseImpulses
     detection_time: float
+    delay: float
     reaction_duration: float
     lifted_off: bool
+    threshold_margin: float
     m_f: float
     k: float
 
@@ -172,7 +181,7 @@ def _first_crossing(modes: _Modes, level: float, horizon: float, rising: bool, w
     from scipy.optimize import brentq
 
     step = min(modes.shortest_period(), horizon) / _SAMPLES_PER_PERIOD
-    count = int(math.ceil(horizon / step))
+    count = math.ceil(horizon / step)
     if count > _MAX_SAMPLES:
         raise InvalidParameter(
             what,
@@ -189,7 +198,9 @@ def _first_crossing(modes: _Modes, level: float, horizon: float, rising: bool, w
         if found.size:
             i = int(found[0])
             return float(
-                brentq(lambda t: float(modes.force(np.array([t]))[0]) - level, times[i], times[i + 1], xtol=1e-16)
+                brentq(
+                    lambda t: float(modes.force(np.array([t]))[0]) - level, times[i], times[i + 1], xtol=1e-16
+                )
             )
     raise InvalidParameter(what, horizon, "a crossing within the searched horizon [s]")
 
@@ -206,6 +217,7 @@ def joint_space_collision(
     *,
     software_stiffness: npt.ArrayLike = math.inf,
     retreat: str = "along_u",
+    delay: float = 0.0,
 ) -> JointSpaceCollision:
     """The arm's collision with the links' motion along the wall, linearised at the impact configuration.
 
@@ -225,6 +237,9 @@ def joint_space_collision(
     software_stiffness: joint software stiffness ``K_s`` [N m/rad], > 0, ``inf`` (default) for ideally
         velocity-controlled motors; in series with ``K_m`` until detection, zeroed at it.
     retreat: the reaction's motor torques, :data:`RETREATS`.
+    delay: from the threshold crossing to the reaction [s], >= 0; the motors keep tracking the reference
+        meanwhile, and its impulse counts in the sensing phase (a sensor's lag: a contact-force sensor that
+        reads a spring ``k_c`` in parallel with a damper ``c`` lags the force by ``c / k_c`` on a ramp).
     """
     _validate.choice("retreat", retreat, RETREATS)
     mass = _validate.real("mass_matrix", mass_matrix, "a square matrix of real numbers [kg m^2]")
@@ -244,6 +259,7 @@ def joint_space_collision(
     tau_max = _per_joint("torque_limit", torque_limit, nv, allow_inf=True)
     F_s = float(_validate.positive("threshold", threshold))
     v0 = float(_validate.positive("approach_velocity", approach_velocity))
+    delay = float(_validate.non_negative("delay", delay))
     if not np.all(np.isfinite(mass)) or not np.allclose(mass, mass.T, rtol=1e-9, atol=0):
         raise InvalidParameter("mass_matrix", mass, "a finite symmetric matrix")
     try:
@@ -255,7 +271,10 @@ def joint_space_collision(
     reference = np.linalg.pinv(jac) @ u  # J^+ u: the motors' reference rate per unit v0
     if np.linalg.norm(jac @ reference - u) > 1e-6 or not np.any(lever):
         raise InvalidParameter(
-            "direction", u, "a direction the contact point can move along", "the Jacobian is singular along it"
+            "direction",
+            u,
+            "a direction the contact point can move along",
+            "the Jacobian is singular along it",
         )
     m_inv_c = np.linalg.solve(mass, lever)
     m_f = 1 / float(lever @ m_inv_c)
@@ -281,10 +300,12 @@ def joint_space_collision(
         h=-(shapes.T @ along_wall.T @ gain),
         h1=float(gain @ v_ref),
     )
-    swing = float(np.sum(np.abs(sensing.h * (sensing.dz0 - sensing.p1 / np.where(w > 0, w, 1) ** 2)) / np.where(w > 0, w, 1)))
-    horizon = (F_s + swing) / (k * v0) * (1 + 1e-9) + 1e-300
-    t_d = _first_crossing(sensing, F_s, horizon, True, "the detection time")
-    lifted = _lifts_off(sensing, t_d)
+    # f = k v0 t + oscillations no larger than `swing`: it reaches F_s by (F_s + swing) / (k v0).
+    swing = float(np.sum(np.abs(sensing.h * (sensing.dz0 - sensing.p1 / w**2) / w)))  # w > 0 here
+    horizon = (F_s + swing) / (k * v0) * (1 + 1e-9)
+    t_c = _first_crossing(sensing, F_s, horizon, True, "the detection time")
+    t_d = t_c + delay  # the reaction's start
+    lifted, margin = _around_detection(sensing, t_c, t_d, F_s)
     zeta, dzeta = sensing.state(t_d)
     xi, dxi = along_wall @ (shapes @ zeta), along_wall @ (shapes @ dzeta)
     theta_ref = v_ref * t_d
@@ -317,13 +338,16 @@ def joint_space_collision(
     mean_force = float(np.sum(reaction.h[~free] * reaction.p[~free] / w_r[~free] ** 2))
     if mean_force >= 0:
         raise InvalidParameter(
-            "torque_limit", tau_max, "a push that unloads the contact", "the motors' push does not pull the finger off"
+            "torque_limit",
+            tau_max,
+            "a push that unloads the contact",
+            "the motors' push does not pull the finger off",
         )
-    duration = _first_crossing(
-        reaction, 0.0, 100 * max(reaction.longest_period(), reaction.shortest_period()), False, "the reaction time"
-    )
+    # Oscillations about a negative mean force: it returns to zero within a few of the longest periods.
+    horizon = 100 * max(reaction.longest_period(), reaction.shortest_period())
+    duration = _first_crossing(reaction, 0.0, horizon, False, "the reaction time")
     phases = PhaseImpulses(m_f * v0, sensing.impulse(t_d), reaction.impulse(duration))
-    return JointSpaceCollision(phases, t_d, duration, lifted, m_f, k)
+    return JointSpaceCollision(phases, t_c, delay, duration, lifted, margin, m_f, k)
 
 
 def _wall_basis(lever: np.ndarray) -> np.ndarray:
@@ -332,12 +356,29 @@ def _wall_basis(lever: np.ndarray) -> np.ndarray:
     return vt[1:].T
 
 
-def _lifts_off(sensing: _Modes, t_d: float) -> bool:
-    """Whether the contact force falls to zero or below between the impact and detection (sampled)."""
+def _around_detection(sensing: _Modes, t_c: float, t_d: float, F_s: float) -> tuple[bool, float]:
+    """Whether the force falls to zero before the reaction starts at ``t_d``; the threshold margin.
+
+    See :class:`JointSpaceCollision`. Sampled at a 32nd of the shortest period (peaks to 0.5 %) up to one
+    longest period after the crossing ``t_c``.
+    """
     step = sensing.shortest_period() / _SAMPLES_PER_PERIOD
-    count = min(int(math.ceil(t_d / step)), _MAX_SAMPLES) if math.isfinite(step) else 1
-    times = np.linspace(0.0, t_d, count + 1)[1:]
-    return bool(np.any(sensing.force(times) <= 0))
+    if not math.isfinite(step):  # one joint: the force is the ramp k v0 t
+        return False, math.inf
+    end = max(t_d, t_c + sensing.longest_period())
+    times = np.arange(1, min(math.ceil(end / step), _MAX_SAMPLES) + 1) * step
+    force = sensing.force(times)
+    lifted = bool(np.any(force[times <= t_d] <= 0))
+    inner = force[1:-1]
+    peaks = (inner > force[:-2]) & (inner >= force[2:])
+    earlier = inner[peaks & (times[1:-1] < t_c)]
+    margins = [1 - float(earlier.max()) / F_s] if earlier.size else []
+    after = times > t_c
+    fallen = np.flatnonzero(after & (force < F_s))
+    if fallen.size:  # the crossing's swing falls back below F_s: its peak decides
+        swing = force[after & (times < times[fallen[0]])]
+        margins.append(float(swing.max(initial=F_s)) / F_s - 1)
+    return lifted, min(margins, default=math.inf)
 
 
 def _per_joint(name: str, value: Any, nv: int, *, allow_inf: bool) -> np.ndarray:
