@@ -350,6 +350,37 @@ def joint_space_collision(
     return JointSpaceCollision(phases, t_c, delay, duration, lifted, margin, m_f, k)
 
 
+@dataclass(frozen=True)
+class JointSpaceArm:
+    """An arm at its impact configuration, as :func:`joint_space_collision` takes it (see there for units)."""
+
+    mass_matrix: np.ndarray
+    jacobian: np.ndarray
+    direction: np.ndarray
+    mechanical_stiffness: Any
+    reflected_inertia: Any
+    torque_limit: Any
+    software_stiffness: Any = math.inf
+
+    def collision(
+        self, threshold: float, approach_velocity: float, retreat: str = "along_u", delay: float = 0.0
+    ) -> JointSpaceCollision:
+        """:func:`joint_space_collision` of this arm at ``threshold`` [N] and ``approach_velocity`` [m/s]."""
+        return joint_space_collision(
+            self.mass_matrix,
+            self.jacobian,
+            self.direction,
+            self.mechanical_stiffness,
+            self.reflected_inertia,
+            self.torque_limit,
+            threshold,
+            approach_velocity,
+            software_stiffness=self.software_stiffness,
+            retreat=retreat,
+            delay=delay,
+        )
+
+
 def _wall_basis(lever: np.ndarray) -> np.ndarray:
     """An orthonormal basis (nv, nv - 1) of the joint motions that keep the contact point on the wall."""
     _, _, vt = np.linalg.svd(lever[None, :])
