@@ -270,3 +270,35 @@ def test_a_wrong_model_fails(arm, simulated, q, mass_scale, torque_scale):
         or abs(simulated_reaction / model.phases.reaction - 1) > ARM_TOLERANCE
     )
     assert misses
+
+
+def test_sliding_pull_is_the_curvature_of_the_contact_path(arm):
+    """``sliding_pull`` at the impact is ``-m_f a_n / F_s``, ``a_n`` the normal acceleration of the contact point
+    moving at the links' post-impact velocity: here from a second difference of its position (no Jacobian).
+
+    Elbow up, oblique, 1.05 m/s: the links slide at 0.9 m/s and pull 14 % of ``F_s`` off the wall (the
+    simulated finger leaves it for most of the sensing phase); H = 0 pulls nothing.
+    """
+    q, u, v0 = np.array([0.3, 1.2]), np.array([np.cos(2.0), np.sin(2.0)]), 1.05
+    mass, jac = _at(arm, q)
+    step = 1e-6
+    hessian = np.array(
+        [u @ (_at(arm, q + step * e)[1] - _at(arm, q - step * e)[1]) / (2 * step) for e in np.eye(2)]
+    )
+    result = joint_space_collision(mass, jac, u, K_M, ROTOR, TAU, F_S, v0, normal_curvature=hessian)
+    c = jac.T @ u
+    m_f = 1 / float(c @ np.linalg.solve(mass, c))
+    rate = np.linalg.pinv(jac) @ u * v0 - np.linalg.solve(mass, c) * m_f * v0  # q' after the impact
+    h = 1e-4
+
+    def normal(s):
+        position = arm.kinematics((q + s * rate)[None]).contact_position[0]
+        return float(u @ (arm.plane.T @ position))
+
+    accel = (normal(h) - 2 * normal(0.0) + normal(-h)) / h**2
+    # The largest pull is at the impact here (the sliding slows down after it): equal to 0.2 %.
+    assert result.sliding_pull == pytest.approx(-m_f * accel / F_S, rel=2e-3)
+    assert result.sliding_pull == pytest.approx(0.145, abs=0.01)
+    flat = joint_space_collision(mass, jac, u, K_M, ROTOR, TAU, F_S, v0, normal_curvature=np.zeros((2, 2)))
+    assert flat.sliding_pull == 0.0
+    assert joint_space_collision(mass, jac, u, K_M, ROTOR, TAU, F_S, v0).sliding_pull is None

@@ -86,6 +86,10 @@ class JointSpaceCollision:
         or the crossing's own peak ``p`` if the force falls back below ``F_s`` after it (raise it by ``p/F_s -
         1``). A small margin (a few %) means the impulse jumps with a small change of the threshold or of the
         arm: the detection is ill-conditioned there, in the model and in the arm alike.
+    sliding_pull: the largest pull of the sliding links off the wall until the reaction, over ``F_s`` [-]:
+        ``-m_f q'^T H q'`` with ``H`` the curvature of the contact point's path (``normal_curvature``), 0 if it
+        curves into the wall; None without ``H``. Right after the impact the springs push with nothing yet,
+        so a pull of a few % or more lifts the finger off the wall, which the model leaves out.
     m_f, k: the effective finger mass and lumped stiffness along ``u`` [kg, N/m] (the 1D model's).
     """
 
@@ -95,6 +99,7 @@ class JointSpaceCollision:
     reaction_duration: float
     lifted_off: bool
     threshold_margin: float
+    sliding_pull: float | None
     m_f: float
     k: float
 
@@ -218,6 +223,7 @@ def joint_space_collision(
     software_stiffness: npt.ArrayLike = math.inf,
     retreat: str = "along_u",
     delay: float = 0.0,
+    normal_curvature: npt.ArrayLike | None = None,
 ) -> JointSpaceCollision:
     """The arm's collision with the links' motion along the wall, linearised at the impact configuration.
 
@@ -240,6 +246,9 @@ def joint_space_collision(
     delay: from the threshold crossing to the reaction [s], >= 0; the motors keep tracking the reference
         meanwhile, and its impulse counts in the sensing phase (a sensor's lag: a contact-force sensor that
         reads a spring ``k_c`` in parallel with a damper ``c`` lags the force by ``c / k_c`` on a ramp).
+    normal_curvature: the Hessian ``H`` (nv, nv) [m/rad^2] of the contact point's position along ``u`` at
+        ``q0``, ``u^T J'(q) q' = q'^T H q'``; if given, ``sliding_pull`` reports how much the links' sliding
+        unloads the contact (the model's force leaves that second-order term out).
     """
     _validate.choice("retreat", retreat, RETREATS)
     mass = _validate.real("mass_matrix", mass_matrix, "a square matrix of real numbers [kg m^2]")
@@ -306,6 +315,9 @@ def joint_space_collision(
     t_c = _first_crossing(sensing, F_s, horizon, True, "the detection time")
     t_d = t_c + delay  # the reaction's start
     lifted, margin = _around_detection(sensing, t_c, t_d, F_s)
+    pull = None
+    if normal_curvature is not None:
+        pull = _sliding_pull(normal_curvature, along_wall @ shapes, sensing, t_d, m_f, F_s)
     zeta, dzeta = sensing.state(t_d)
     xi, dxi = along_wall @ (shapes @ zeta), along_wall @ (shapes @ dzeta)
     theta_ref = v_ref * t_d
@@ -347,7 +359,7 @@ def joint_space_collision(
     horizon = 100 * max(reaction.longest_period(), reaction.shortest_period())
     duration = _first_crossing(reaction, 0.0, horizon, False, "the reaction time")
     phases = PhaseImpulses(m_f * v0, sensing.impulse(t_d), reaction.impulse(duration))
-    return JointSpaceCollision(phases, t_c, delay, duration, lifted, margin, m_f, k)
+    return JointSpaceCollision(phases, t_c, delay, duration, lifted, margin, pull, m_f, k)
 
 
 @dataclass(frozen=True)
@@ -361,6 +373,7 @@ class JointSpaceArm:
     reflected_inertia: Any
     torque_limit: Any
     software_stiffness: Any = math.inf
+    normal_curvature: Any = None
 
     def collision(
         self, threshold: float, approach_velocity: float, retreat: str = "along_u", delay: float = 0.0
@@ -378,6 +391,7 @@ class JointSpaceArm:
             software_stiffness=self.software_stiffness,
             retreat=retreat,
             delay=delay,
+            normal_curvature=self.normal_curvature,
         )
 
 
@@ -410,6 +424,25 @@ def _around_detection(sensing: _Modes, t_c: float, t_d: float, F_s: float) -> tu
         swing = force[after & (times < times[fallen[0]])]
         margins.append(float(swing.max(initial=F_s)) / F_s - 1)
     return lifted, min(margins, default=math.inf)
+
+
+def _sliding_pull(
+    curvature: Any, to_joints: np.ndarray, sensing: _Modes, t_d: float, m_f: float, F_s: float
+) -> float:
+    """``max(-m_f q'^T H q') / F_s`` over the sensing phase, ``q' = to_joints zeta'`` (sampled).
+
+    Sampled as the threshold margin, at a 32nd of the shortest period.
+    """
+    nv = to_joints.shape[0]
+    hessian = _validate.real("normal_curvature", curvature, "a (nv, nv) matrix of real numbers [m/rad^2]")
+    if hessian.shape != (nv, nv) or not np.all(np.isfinite(hessian)):
+        raise InvalidParameter("normal_curvature", hessian.shape, f"a finite ({nv}, {nv}) matrix")
+    step = min(sensing.shortest_period() / _SAMPLES_PER_PERIOD, t_d)
+    times = np.linspace(0.0, t_d, min(math.ceil(t_d / step), _MAX_SAMPLES) + 1)
+    _, rates = sensing.state(times)
+    velocities = rates @ to_joints.T  # q' (samples, nv)
+    pull = -m_f * np.einsum("si,ij,sj->s", velocities, (hessian + hessian.T) / 2, velocities)
+    return max(float(pull.max()) / F_s, 0.0)
 
 
 def _per_joint(name: str, value: Any, nv: int, *, allow_inf: bool) -> np.ndarray:
