@@ -13,8 +13,9 @@ of the total, for
   d``, which lags the contact force by ``c / k_c`` on a ramp).
 
 Then, per case, the model's threshold margin (a few % or less: the detection sits on a peak of the oscillating
-force, ill-conditioned) and whether the finger lifts off before detection, both retreats, and the model's
-CPU time (median of repeats) with the machine's load.
+force, ill-conditioned), the sliding links' pull off the wall over ``F_s`` (a few % or more: the finger leaves
+the wall after the impact, which the model leaves out) and whether its linear force falls to zero before
+detection; for both retreats; and the model's CPU time (median) with the machine's load.
 Run: ``PYTHONPATH=src python benchmarks/arm_reaction.py`` (about a minute).
 """
 
@@ -48,6 +49,15 @@ def _percent(simulated: float, model: float) -> str:
     return f"{100 * (simulated / model - 1):+7.1f}"
 
 
+def _normal_curvature(arm: cr.Arm, q: np.ndarray, u: np.ndarray, step: float = 1e-6) -> np.ndarray:
+    """The Hessian of the contact point's position along ``u`` [m/rad^2], central differences of ``u^T J``."""
+    rows = []
+    for e in np.eye(q.size):
+        ahead, behind = (arm.kinematics((q + s * step * e)[None]).jacobian[0] for s in (1, -1))
+        rows.append(u @ (ahead - behind) / (2 * step))
+    return np.array(rows)
+
+
 def main() -> None:
     print(
         f"machine load (1, 5, 15 min): {', '.join(f'{x:.1f}' for x in os.getloadavg())} on {os.cpu_count()} cores"
@@ -66,6 +76,7 @@ def main() -> None:
             u = np.array([np.cos(angle), np.sin(angle)])
             samples = arm.kinematics(np.asarray(q, dtype=float)[None])
             mass, jac = samples.mass_matrix[0], samples.jacobian[0]
+            curvature = _normal_curvature(arm, np.asarray(q, dtype=float), u)
             eff = simulate_arm_collision(arm, q, u, 0.1, F_S, detection="force", **JOINTS).effective
             v_star = float(cr.optimal_velocity(eff["m_f"], eff["k"], F_S))
             lag = damping_from_ratio(2.0, eff["m_f"], K_C) / K_C
@@ -85,7 +96,17 @@ def main() -> None:
                 for delay in (0.0, lag):
                     start = time.process_time()
                     joint = joint_space_collision(
-                        mass, jac, u, K_M, ROTOR, TAU, F_S, v0, retreat=retreat, delay=delay
+                        mass,
+                        jac,
+                        u,
+                        K_M,
+                        ROTOR,
+                        TAU,
+                        F_S,
+                        v0,
+                        retreat=retreat,
+                        delay=delay,
+                        normal_curvature=curvature,
                     )
                     cpu.append(time.process_time() - start)
                     models.append(
@@ -96,7 +117,8 @@ def main() -> None:
                     for model in models
                 )
                 print(
-                    f"{name:>17}{ratio:>5g}*{cells}   {100 * joint.threshold_margin:5.1f} %  {joint.lifted_off}"
+                    f"{name:>17}{ratio:>5g}*{cells}   {100 * joint.threshold_margin:5.1f} %"
+                    f"  {100 * (joint.sliding_pull or 0.0):5.1f} %  {joint.lifted_off}"
                 )
     print(
         f"\njoint_space_collision: median {1e3 * statistics.median(cpu):.1f} ms CPU per call ({len(cpu)} calls);"
