@@ -132,8 +132,8 @@ class _Modes:
         slope = np.where(free, 0.0, self.p1 / w**2)
         return tt, w, self.z0 - mean, self.dz0 - slope
 
-    def state(self, t: float) -> tuple[np.ndarray, np.ndarray]:
-        """``zeta(t)`` and ``zeta'(t)``."""
+    def state(self, t: Any) -> tuple[np.ndarray, np.ndarray]:
+        """``zeta(t)`` and ``zeta'(t)`` at a time [s] or an array of times (modes last)."""
         tt, w, c, s = self._parts(np.asarray(t))
         free = self.w == 0
         wt = w * tt
