@@ -302,3 +302,18 @@ def test_sliding_pull_is_the_curvature_of_the_contact_path(arm):
     flat = joint_space_collision(mass, jac, u, K_M, ROTOR, TAU, F_S, v0, normal_curvature=np.zeros((2, 2)))
     assert flat.sliding_pull == 0.0
     assert joint_space_collision(mass, jac, u, K_M, ROTOR, TAU, F_S, v0).sliding_pull is None
+
+
+def test_the_validity_map_evaluates_the_model(arm):
+    """The map's ``joint_space`` reaction model is this model at the configuration, both placements alike."""
+    from collision_reflex.simulate.validity import REACTION_MODELS, JointDesign, arm_closed_form
+
+    assert "joint_space" in REACTION_MODELS
+    joints = JointDesign(mechanical_stiffness=K_M, reflected_inertia=ROTOR, torque_limit=TAU, threshold=F_S)
+    q, u = [0.3, 1.2], np.array([1.0, 0.0])
+    mass, jac = _at(arm, q)
+    expected = joint_space_collision(mass, jac, u, K_M, ROTOR, TAU, F_S, 0.5).total
+    for placement in ("robot", "finger"):
+        closed = arm_closed_form(arm, q, u, joints, placement)
+        assert closed.impulse(0.5, "joint_space") == pytest.approx(expected, rel=1e-12)
+    assert closed.impulse(0.5, "constant") != pytest.approx(expected, rel=0.05)
