@@ -317,3 +317,27 @@ def test_the_validity_map_evaluates_the_model(arm):
         closed = arm_closed_form(arm, q, u, joints, placement)
         assert closed.impulse(0.5, "joint_space") == pytest.approx(expected, rel=1e-12)
     assert closed.impulse(0.5, "constant") != pytest.approx(expected, rel=0.05)
+
+
+def test_detection_signals(arm):
+    """The position error against a rigid wall is ``k v0 t``: detection at ``t1`` exactly, whatever the links do.
+
+    The projected spring torque ``c . K (theta - q) / |c|^2`` misses the links' oscillation along the wall when
+    the joints are equally stiff (``c^T K N = k c^T N = 0``): the same detection; with unequal joints it sees it.
+    """
+    mass, jac = _at(arm, [0.3, 1.2])
+    u, v0 = np.array([1.0, 0.0]), 0.57
+
+    def run(detection, stiffness=K_M):
+        return joint_space_collision(mass, jac, u, stiffness, ROTOR, TAU, F_S, v0, detection=detection)
+
+    force, position, torque = run("force"), run("position"), run("spring_torque")
+    assert position.detection_time == pytest.approx(F_S / (position.k * v0), rel=1e-12)
+    assert torque.detection_time == pytest.approx(position.detection_time, rel=1e-9)
+    assert abs(force.detection_time / position.detection_time - 1) > 0.5  # elbow up: the force rises early
+    unequal = [K_M, 3 * K_M]
+    assert (
+        abs(run("spring_torque", unequal).detection_time / run("position", unequal).detection_time - 1) > 0.01
+    )
+    with pytest.raises(InvalidParameter, match="detection"):
+        run("observer")

@@ -46,7 +46,7 @@ the design, which is why the optimiser keeps the 1D closed form and this model s
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -60,6 +60,13 @@ RETREATS: tuple[str, ...] = ("along_u", "saturated")
 """The motors' push in the reaction: ``"along_u"``, ``tau = -F_a J^T u`` with ``F_a = min_i tau_max,i /
 |(J^T u)_i|`` (the closed form's: each joint at most at its limit); ``"saturated"``, ``tau_i = -tau_max,i
 sign((J^T u)_i)`` (every joint at its limit)."""
+
+DETECTIONS: tuple[str, ...] = ("force", "spring_torque", "position")
+"""What crosses ``F_s`` at detection: ``"force"``, the contact force (a sensor at the contact: the closed form's
+meaning); ``"spring_torque"``, the joint spring torques projected on ``u``, ``(J^T u) . K (theta - q) / |J^T
+u|^2`` (joint-torque sensing without the links' inertia: it carries their oscillation differently); and
+``"position"``, the contact point's position error times ``k``, which against the rigid wall is ``k v0 t``: the
+1D model's ``t1`` exactly."""
 
 _SAMPLES_PER_PERIOD = 32
 _MAX_SAMPLES = 20_000_000
@@ -224,6 +231,7 @@ def joint_space_collision(
     retreat: str = "along_u",
     delay: float = 0.0,
     normal_curvature: npt.ArrayLike | None = None,
+    detection: str = "force",
 ) -> JointSpaceCollision:
     """The arm's collision with the links' motion along the wall, linearised at the impact configuration.
 
@@ -249,8 +257,10 @@ def joint_space_collision(
     normal_curvature: the Hessian ``H`` (nv, nv) [m/rad^2] of the contact point's position along ``u`` at
         ``q0``, ``u^T J'(q) q' = q'^T H q'``; if given, ``sliding_pull`` reports how much the links' sliding
         unloads the contact (the model's force leaves that second-order term out).
+    detection: what crosses the threshold, :data:`DETECTIONS`.
     """
     _validate.choice("retreat", retreat, RETREATS)
+    _validate.choice("detection", detection, DETECTIONS)
     mass = _validate.real("mass_matrix", mass_matrix, "a square matrix of real numbers [kg m^2]")
     if mass.ndim != 2 or mass.shape[0] != mass.shape[1] or mass.shape[0] == 0:
         raise InvalidParameter("mass_matrix", mass.shape, "a square (nv, nv) matrix")
@@ -309,10 +319,11 @@ def joint_space_collision(
         h=-(shapes.T @ along_wall.T @ gain),
         h1=float(gain @ v_ref),
     )
-    # f = k v0 t + oscillations no larger than `swing`: it reaches F_s by (F_s + swing) / (k v0).
-    swing = float(np.sum(np.abs(sensing.h * (sensing.dz0 - sensing.p1 / w**2) / w)))  # w > 0 here
+    signal = _detection_signal(sensing, detection, shapes.T @ along_wall.T, series, lever, v_ref, k * v0)
+    # The signal is k v0 t + oscillations no larger than `swing`: it reaches F_s by (F_s + swing) / (k v0).
+    swing = float(np.sum(np.abs(signal.h * (signal.dz0 - signal.p1 / w**2) / w)))  # w > 0 here
     horizon = (F_s + swing) / (k * v0) * (1 + 1e-9)
-    t_c = _first_crossing(sensing, F_s, horizon, True, "the detection time")
+    t_c = _first_crossing(signal, F_s, horizon, True, "the detection time")
     t_d = t_c + delay  # the reaction's start
     lifted, margin = _around_detection(sensing, t_c, t_d, F_s)
     pull = None
@@ -376,7 +387,12 @@ class JointSpaceArm:
     normal_curvature: Any = None
 
     def collision(
-        self, threshold: float, approach_velocity: float, retreat: str = "along_u", delay: float = 0.0
+        self,
+        threshold: float,
+        approach_velocity: float,
+        retreat: str = "along_u",
+        delay: float = 0.0,
+        detection: str = "force",
     ) -> JointSpaceCollision:
         """:func:`joint_space_collision` of this arm at ``threshold`` [N] and ``approach_velocity`` [m/s]."""
         return joint_space_collision(
@@ -392,7 +408,30 @@ class JointSpaceArm:
             retreat=retreat,
             delay=delay,
             normal_curvature=self.normal_curvature,
+            detection=detection,
         )
+
+
+def _detection_signal(
+    force: _Modes,
+    detection: str,
+    to_modes: np.ndarray,
+    series: np.ndarray,
+    lever: np.ndarray,
+    v_ref: np.ndarray,
+    ramp: float,
+) -> _Modes:
+    """The detector's signal during sensing [N], as the contact force's modes with other gains.
+
+    ``to_modes`` maps joint vectors to modal forces (``Phi^T N^T``); ``ramp`` is ``k v0`` [N/s].
+    """
+    if detection == "force":
+        return force
+    if detection == "position":  # k (v0 t - penetration), no penetration into a rigid wall
+        return replace(force, h=np.zeros(force.h.size), h1=ramp)
+    # spring_torque: c . K_l (theta_ref - q) / |c|^2 with q - q0 = N eta.
+    gain = series * lever / float(lever @ lever)
+    return replace(force, h=-(to_modes @ gain), h1=float(gain @ v_ref))
 
 
 def _wall_basis(lever: np.ndarray) -> np.ndarray:

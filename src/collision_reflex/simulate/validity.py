@@ -31,6 +31,7 @@ import numpy.typing as npt
 from .. import _validate
 from ..errors import InvalidParameter, SimulationError
 from ..model.impulse import optimal_velocity, phase_impulses, series_stiffness, sprung_reaction
+from ..model.joint_space import DETECTIONS as JOINT_SPACE_DETECTIONS
 from ..model.joint_space import JointSpaceArm
 from . import arm as arm_simulation
 from .arm_detection import DETECTIONS
@@ -135,14 +136,20 @@ class ArmClosedForm:
     reaction: str
     joint_space: JointSpaceArm | None = None
 
-    def impulse(self, approach_velocity: float, model: str = "constant") -> float:
-        """The closed form's impulse [N*s] at the approach velocity [m/s] with a reaction of :data:`REACTION_MODELS`."""
+    def impulse(self, approach_velocity: float, model: str = "constant", detection: str = "force") -> float:
+        """The closed form's impulse [N*s] at the approach velocity [m/s] with a reaction of :data:`REACTION_MODELS`.
+
+        ``detection`` (a scheme of the simulator) matters to ``"joint_space"`` only, which models the contact
+        force, spring-torque and position signals (:data:`collision_reflex.model.joint_space.DETECTIONS`) and
+        takes the contact force for the others (the observer estimates it, lagged).
+        """
         _validate.choice("model", model, REACTION_MODELS)
         v0 = float(approach_velocity)
         if model == "joint_space":
             if self.joint_space is None:
                 raise InvalidParameter("model", model, "a closed form made by arm_closed_form")
-            return self.joint_space.collision(self.threshold, v0).total
+            scheme = detection if detection in JOINT_SPACE_DETECTIONS else "force"
+            return self.joint_space.collision(self.threshold, v0, detection=scheme).total
         robot_velocity = self.v_r * v0 if self.reaction == "moving" else None
         phases = phase_impulses(
             self.m_f, self.k, self.k_m, self.threshold, self.a, v0, self.reaction, robot_velocity
@@ -402,7 +409,7 @@ def _row(
     tolerance: float,
 ) -> dict[str, Any]:
     """One row of the map: a case against one placement's and reaction model's closed form."""
-    closed_form = closed.impulse(v0, model)
+    closed_form = closed.impulse(v0, model, case.detection)
     difference = simulated.impulse / closed_form - 1
     return {
         "configuration": case.configuration,
