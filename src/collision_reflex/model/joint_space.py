@@ -7,7 +7,8 @@ finger's momentum along ``u`` only; the links keep the rest of it and, with the 
 the point on it, then carries that oscillation: it rises as ``k v0 t`` *plus* a sum of sinusoids, reaches the
 threshold earlier or later than ``t1 = F_s / (k v0)``, and the reaction starts from a spring compression other
 than ``F_s / k``. This module derives it, linearised at the impact configuration (``M``, ``J`` frozen), with the
-closed form's other assumptions kept: a rigid, plastic, frictionless contact and force-threshold detection.
+closed form's other assumptions kept: a rigid, plastic, frictionless contact and a threshold on a force
+(:data:`DETECTIONS`: the contact force, the projected spring torques or the position error).
 
 Derivation. Links ``q = q0 + xi``, motors ``theta``, contact lever ``c = J^T u`` (nv,), joint springs ``K``::
 
@@ -35,8 +36,11 @@ constant-acceleration reaction.
 
 Not modelled: the change of ``M`` and ``J`` while the links slide (the linearisation: it grows with the
 sliding distance), a compliant or damped contact, friction, and the contact after the force first returns to
-zero (a finger that leaves the wall and comes back). If the force falls to zero *before* detection (the finger
-lifts off the wall) the result says so (``lifted_off``): the model then does not hold.
+zero (a finger that leaves the wall and comes back). A contact with a little restitution ``e`` lets the finger
+fly off after the impact for about ``sqrt(6 m_f e / k)`` (the springs push with ``k v0 t``, from nothing: a 1D
+estimate), independent of ``v0``: once that is comparable with ``t1`` (near 3 ``v*`` on the planar arm) the
+detection fires on the second impact, which no plastic model describes. If the force falls to zero *before*
+detection (the finger lifts off the wall) the result says so (``lifted_off``): the model then does not hold.
 
 Numeric only (NumPy and SciPy): detection and the contact's end are first crossings of a sum of sinusoids, found
 by sampling at a 32nd of the shortest period and refining with Brent's method. That is no smooth function of
