@@ -341,3 +341,15 @@ def test_detection_signals(arm):
     )
     with pytest.raises(InvalidParameter, match="detection"):
         run("observer")
+
+
+@pytest.mark.parametrize("retreat", ["along_u", "saturated"])
+def test_a_joint_without_lever_does_not_limit_the_push(retreat):
+    """A joint that cannot move the contact along u (``(J^T u)_i = 0``), decoupled from the other: the collision
+    of the other joint alone (a zero lever once made the push zero and the model refuse the arm)."""
+    two = joint_space_collision(
+        np.diag([0.03, 0.01]), np.eye(2), [1.0, 0.0], K_M, ROTOR, TAU, F_S, 0.3, retreat=retreat
+    )
+    one = joint_space_collision([[0.03]], [[1.0]], [1.0], K_M, ROTOR, TAU, F_S, 0.3, retreat=retreat)
+    assert two.total == pytest.approx(one.total, rel=1e-9)
+    assert two.phases.reaction == pytest.approx(one.phases.reaction, rel=1e-9)

@@ -341,7 +341,9 @@ def joint_space_collision(
 
     # 3. Reaction: coordinates x = (theta - q0, eta), mass diag(B, N^T M N), springs K_m (theta - q0 - N eta).
     if retreat == "along_u":
-        push = -float(np.min(tau_max / np.where(lever != 0, np.abs(lever), np.inf))) * lever
+        # A joint without lever (c_i = 0) does not limit the force along u.
+        limits = np.where(lever != 0, tau_max / np.where(lever != 0, np.abs(lever), 1.0), np.inf)
+        push = -float(np.min(limits)) * lever
     else:
         push = -tau_max * np.sign(lever)
     if not np.all(np.isfinite(push)):
