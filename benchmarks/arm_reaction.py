@@ -70,7 +70,7 @@ def main() -> None:
     for retreat in ("along_u", "saturated"):
         print(f"\nretreat: {retreat}")
         print(
-            f"{'case':>17}{'v0':>6}{'1D':>24}{'sprung':>24}{'joint':>24}{'joint+lag':>24}   margin  lift-off"
+            f"{'case':>17}{'v0':>6}{'1D':>24}{'sprung':>24}{'joint':>24}{'joint+lag':>24}   margin     pull  lift-off"
         )
         for name, (q, angle) in CASES.items():
             u = np.array([np.cos(angle), np.sin(angle)])
