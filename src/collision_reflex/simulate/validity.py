@@ -31,6 +31,8 @@ import numpy.typing as npt
 from .. import _validate
 from ..errors import InvalidParameter, SimulationError
 from ..model.impulse import optimal_velocity, phase_impulses, series_stiffness, sprung_reaction
+from ..model.joint_space import DETECTIONS as JOINT_SPACE_DETECTIONS
+from ..model.joint_space import JointSpaceArm
 from . import arm as arm_simulation
 from .arm_detection import DETECTIONS
 from .dynamics import admittance_share
@@ -52,10 +54,13 @@ TOLERANCE = 0.05
 MAX_STEPS = 200_000
 """Default work budget of one arm simulation [integrator steps] (the simulator's; tens of seconds at most)."""
 
-REACTION_MODELS: tuple[str, ...] = ("constant", "sprung")
+REACTION_MODELS: tuple[str, ...] = ("constant", "sprung", "joint_space")
 """The closed form's reaction: ``"constant"``, the paper's constant acceleration ``a = F_a / m_r``;
 ``"sprung"``, :func:`collision_reflex.model.impulse.sprung_reaction` (the compressed spring also pushes the
-robot mass away, the term the constant acceleration leaves out)."""
+robot mass away, the term the constant acceleration leaves out); ``"joint_space"``,
+:func:`collision_reflex.model.joint_space.joint_space_collision` (all three phases with the links' motion along
+the wall, linearised at ``q``; it places each inertia where the arm has it, so it is the same under both
+placements, and it takes the contact as rigid: against a compliant object it leaves the object out)."""
 
 TORQUE_DETECTION = "spring_torque"
 """The simulator's default detection: the contact force estimated from the joint spring torques."""
@@ -129,11 +134,22 @@ class ArmClosedForm:
     v_r: float
     threshold: float
     reaction: str
+    joint_space: JointSpaceArm | None = None
 
-    def impulse(self, approach_velocity: float, model: str = "constant") -> float:
-        """The closed form's impulse [N*s] at the approach velocity [m/s] with a reaction of :data:`REACTION_MODELS`."""
+    def impulse(self, approach_velocity: float, model: str = "constant", detection: str = "force") -> float:
+        """The closed form's impulse [N*s] at the approach velocity [m/s] with a reaction of :data:`REACTION_MODELS`.
+
+        ``detection`` (a scheme of the simulator) matters to ``"joint_space"`` only, which models the contact
+        force, spring-torque and position signals (:data:`collision_reflex.model.joint_space.DETECTIONS`) and
+        takes the contact force for the others (the observer estimates it, lagged).
+        """
         _validate.choice("model", model, REACTION_MODELS)
         v0 = float(approach_velocity)
+        if model == "joint_space":
+            if self.joint_space is None:
+                raise InvalidParameter("model", model, "a closed form made by arm_closed_form")
+            scheme = detection if detection in JOINT_SPACE_DETECTIONS else "force"
+            return self.joint_space.collision(self.threshold, v0, detection=scheme).total
         robot_velocity = self.v_r * v0 if self.reaction == "moving" else None
         phases = phase_impulses(
             self.m_f, self.k, self.k_m, self.threshold, self.a, v0, self.reaction, robot_velocity
@@ -205,6 +221,15 @@ def arm_closed_form(
         v_r=v_r,
         threshold=float(joints.threshold),
         reaction=reaction,
+        joint_space=JointSpaceArm(
+            samples.structure_mass_matrix(motor_mass if np.any(motor_mass > 0) else None)[0],
+            jac,
+            u,
+            k_m,
+            inertia,
+            joints.torque_limit,
+            k_s,
+        ),
     )
 
 
@@ -384,7 +409,7 @@ def _row(
     tolerance: float,
 ) -> dict[str, Any]:
     """One row of the map: a case against one placement's and reaction model's closed form."""
-    closed_form = closed.impulse(v0, model)
+    closed_form = closed.impulse(v0, model, case.detection)
     difference = simulated.impulse / closed_form - 1
     return {
         "configuration": case.configuration,
