@@ -150,9 +150,7 @@ def whole_numbers(text: str) -> Any:
     import markupsafe
 
     escaped = str(markupsafe.escape(text))
-    return markupsafe.Markup(
-        _PROSE_NUMBER.sub(lambda m: f'<span class="nowrap">{m.group(0)}</span>', escaped)
-    )
+    return markupsafe.Markup(_PROSE_NUMBER.sub(lambda m: f'<span class="nowrap">{m.group(0)}</span>', escaped))
 
 
 def render_html(results: dict[str, Any], rows: list[dict[str, Any]], svgs: dict[str, str]) -> str:
