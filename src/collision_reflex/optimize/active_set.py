@@ -223,9 +223,9 @@ def solve_active_set(
     retry: as :func:`collision_reflex.optimize.solve` for every round (False: a failed round raises).
     full: ``build(samples)`` when it is already built (it is not built again).
     warm: an earlier result of a problem with the same variables and rows (e.g. a Pareto anchor's, for the
-        epsilon points of its sweep): when the first active set is its ``active_samples``, the first round
-        starts from its ``last_round`` (point and multipliers, as :func:`collision_reflex.optimize.solve`
-        warm-starts a neighbouring result) instead of ``x0``.
+        epsilon points of its sweep): the first start's first round is on its ``active_samples`` (``initial``
+        ignored) from its ``last_round`` (point and multipliers, as :func:`collision_reflex.optimize.solve`
+        warm-starts a neighbouring result); its design replaces ``x0``.
 
     Raises
     ------
@@ -256,15 +256,22 @@ def solve_active_set(
     n_design = full.layout.size
     generator = rng or np.random.default_rng(0)
     first = full.x0 if x0 is None else np.asarray(x0, dtype=float)
+    if warm is not None:
+        first = warm.x
     designs = [first[:n_design]] + [
         generator.uniform(full.lbx[:n_design], full.ubx[:n_design]) for _ in range(starts - 1)
     ]
     best: _Settled | None = None
     failure: SolverFailed | None = None
-    for design in designs:
-        active = _first_active_set(full, start_samples, initial, design)
+    for index, design in enumerate(designs):
+        # A warm start's samples were settled at its design (every row of the full NLP checked): kept as they are.
+        resumed = warm is not None and warm.last_round is not None and index == 0
+        active = (
+            warm.active_samples
+            if resumed and warm is not None
+            else _first_active_set(full, start_samples, initial, design)
+        )
         try:
-            same = warm is not None and np.array_equal(active, warm.active_samples)
             settled = _settle(
                 build,
                 full,
@@ -275,7 +282,7 @@ def solve_active_set(
                 tolerance,
                 max_rounds,
                 retry,
-                warm.last_round if same and warm is not None else None,
+                warm.last_round if resumed and warm is not None else None,
             )
         except SolverFailed as error:
             if starts == 1 or error.confirmed_infeasible:
