@@ -196,3 +196,21 @@ def test_a_study_with_many_samples_runs_on_active_sets_and_resumes(tmp_path):
     again = run_study(study, folder, quiet=True, executor="serial")
     assert again.resumed and again.computed == 0
     assert _designs(folder) == designs
+
+
+def test_an_unknown_active_set_choice_is_located_in_the_study_file(tmp_path, capsys):
+    from collision_reflex.cli import main
+
+    study = _study(tmp_path, "sometimes")
+    assert main(["validate", str(study)]) == 2
+    err = capsys.readouterr().err
+    line = MANY_SAMPLES_STUDY.splitlines().index("optimizer: {{active_set: {choice}}}") + 1
+    assert f"{study}:{line}:" in err and "'auto'" in err and "'never'" in err, err
+    assert "Traceback" not in err
+
+
+def test_the_study_json_schema_documents_the_choice():
+    from collision_reflex.study.jsonschema import study_json_schema
+
+    text = json.dumps(study_json_schema())
+    assert '"OptimizerSpec"' in text and "active sets of the contact samples" in text
