@@ -155,7 +155,7 @@ actuators:
 sensing: {{scheme: force, threshold: 3 N}}
 approach_velocity: 0.5 m/s
 samples:
-  configurations: {{random: {{count: 160, seed: 3}}}}
+  configurations: {{random: {{count: {count}, seed: 3}}}}
   directions: {{circle: 8}}
 design:
   stator_diameter: {{min: 10 mm, max: 100 mm}}
@@ -170,10 +170,11 @@ outputs: {{figures: [png], pdf: false}}
 """
 
 
-def _study(tmp_path: Path, choice: str) -> Path:
+def _study(tmp_path: Path, choice: str, count: int = 160) -> Path:
+    """The study with ``count`` configurations x 8 directions, solved as ``choice`` says."""
     path = tmp_path / f"many-{choice}.yaml"
     urdf = (ROOT / "designs" / "planar_two_link.urdf").as_posix()
-    path.write_text(MANY_SAMPLES_STUDY.format(urdf=urdf, choice=choice))
+    path.write_text(MANY_SAMPLES_STUDY.format(urdf=urdf, choice=choice, count=count))
     return path
 
 
@@ -214,3 +215,21 @@ def test_the_study_json_schema_documents_the_choice():
 
     text = json.dumps(study_json_schema())
     assert '"OptimizerSpec"' in text and "active sets of the contact samples" in text
+
+
+def _without_times(value):
+    """A record with its wall times dropped (they differ between runs; every number else must not)."""
+    if isinstance(value, dict):
+        return {k: _without_times(v) for k, v in value.items() if k not in ("solve_time", "build_time")}
+    if isinstance(value, list):
+        return [_without_times(v) for v in value]
+    return value
+
+
+def test_a_study_on_active_sets_gives_the_serial_numbers_through_a_process_pool(tmp_path):
+    study = _study(tmp_path, "always", count=40)  # 320 samples: the executors' agreement, not the scale
+    run_study(study, tmp_path / "serial", quiet=True, executor="serial")
+    run_study(study, tmp_path / "pool", quiet=True, executor="processes")
+    serial, pool = _designs(tmp_path / "serial"), _designs(tmp_path / "pool")
+    assert all(d["solver"]["method"] == "active set" for d in serial)
+    assert _without_times(pool) == _without_times(serial)

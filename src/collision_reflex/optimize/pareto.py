@@ -9,7 +9,9 @@ point and multipliers (:data:`collision_reflex.optimize.solve.WARM_START_OPTIONS
 the approach velocity is bounded (:func:`warm_started_points`). A point's result is then a
 pure function of the problem and its bounds, whatever the executor and the order in which the points finish;
 the points run in parallel. Chaining each point from its neighbour instead leaves no parallelism and was not
-faster even in series.
+faster even in series. On active sets of the samples (``active_set``, :func:`solve_with`) the same holds: every
+epsilon point starts from the first anchor's active set and its last NLP (point and multipliers), and each
+lexicographic step from its anchor's active set.
 
 Barrier strategy per kind of solve (measured on the Panda benchmark, 256 samples): a cold anchor with IPOPT's
 monotone barrier from ``mu = 1e-2`` (77 iterations; adaptive: 122, each dearer); an epsilon point warm-started
@@ -474,7 +476,7 @@ def warm_started_points(names: Sequence[str]) -> bool:
 
 SUBSET_PROBLEMS = 4
 """Problems on subsets of the samples kept per process (with their solvers): every epsilon point's first
-active set is the same (the anchors'), so its problem is built once per process."""
+active set is the first anchor's, so its problem is built once per process."""
 _SUBSETS: OrderedDict[tuple[Hashable, ...], DesignProblem] = OrderedDict()
 
 
