@@ -558,7 +558,7 @@ def solve_with(
             full=problem,
             warm=x0 if isinstance(x0, ActiveSetResult) else None,
         )
-    return solve(problem, epsilon, x0, ipopt_options, starts, retry=retry)
+    return solve(problem, epsilon, x0, ipopt_options, starts=starts, retry=retry)
 
 
 def _others(names: Sequence[str], name: str) -> tuple[str, ...]:
