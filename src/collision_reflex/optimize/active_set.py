@@ -16,6 +16,10 @@ configuration of the largest demand at the start). With a duty cycle, the sample
 approach rate, which sets the motor-speed row, is in every active set. A last check evaluates every constraint
 row of the full NLP at the design found.
 
+Sweeps, optima and studies solve on active sets through :func:`collision_reflex.optimize.pareto.solve_with`
+(``active_set="auto"`` from :data:`ACTIVE_SET_THRESHOLD` samples, ``"always"``, ``"never"``; a study's
+``optimizer.active_set``); a result says how it was solved (:func:`solve_method`).
+
 Two things depend on all samples and are handled as follows, never silently:
 
 - A mean-impulse objective or bound needs every sample: the problem is then solved on all samples
@@ -55,7 +59,9 @@ __all__ = [
     "ActiveSetRound",
     "sample_subset",
     "solve_active_set",
+    "solve_method",
     "uses_active_set",
+    "with_active_set",
 ]
 
 ACTIVE_SET_THRESHOLD = 512
