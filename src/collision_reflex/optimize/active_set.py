@@ -16,6 +16,10 @@ configuration of the largest demand at the start). With a duty cycle, the sample
 approach rate, which sets the motor-speed row, is in every active set. A last check evaluates every constraint
 row of the full NLP at the design found.
 
+Sweeps, optima and studies solve on active sets through :func:`collision_reflex.optimize.pareto.solve_with`
+(``active_set="auto"`` from :data:`ACTIVE_SET_THRESHOLD` samples, ``"always"``, ``"never"``; a study's
+``optimizer.active_set``); a result says how it was solved (:func:`solve_method`).
+
 Two things depend on all samples and are handled as follows, never silently:
 
 - A mean-impulse objective or bound needs every sample: the problem is then solved on all samples
@@ -48,12 +52,33 @@ if TYPE_CHECKING:
     from .problem import DesignProblem
     from .solve import Design
 
-__all__ = ["ACTIVE_SET_THRESHOLD", "ActiveSetResult", "ActiveSetRound", "sample_subset", "solve_active_set"]
+__all__ = [
+    "ACTIVE_SET_CHOICES",
+    "ACTIVE_SET_THRESHOLD",
+    "ActiveSetResult",
+    "ActiveSetRound",
+    "sample_subset",
+    "solve_active_set",
+    "solve_method",
+    "uses_active_set",
+    "with_active_set",
+]
 
-ACTIVE_SET_THRESHOLD = 1024
-"""Number of samples from which a problem should be solved on an active set (``benchmarks/
-optimize_samples_scaling.py``: on the Panda the full NLP solves 256 samples in seconds, and the multi-start and
-Pareto machinery of :mod:`.solve` and :mod:`.pareto` apply; 1,024 did not finish in 400 s)."""
+ACTIVE_SET_THRESHOLD = 512
+"""Number of samples from which ``active_set="auto"`` solves a problem on active sets.
+
+Measured on 2 cores under a load average of 6-14 (wall times). One solve each in a fresh process
+(``benchmarks/optimize_samples_scaling.py --threshold``): the Panda benchmark problem at 256 / 512 / 1,024
+samples, full NLP 5.5 / 29 / over 150 s against 4.2 / 2.3 / 5.4 s on active sets; ``studies/ur5.yaml`` (duty
+cycle, weighted objective) at 252 / 504 / 1,022 samples, 17.6 / 37 / 100 s against 10.8 / 13.2 / 23 s. But the
+whole UR5 study at its 336 samples (``crx run``, serial) spent 307 s solving on active sets against 199 s as one
+NLP, its 4-start optimum 74 s against 28 s: each random start settles its own active set, and the duty cycle's
+rows, which do not shrink with the samples, carry much of the cost. From about 500 samples the active set was
+2.8-12 times faster in every case measured; below, the gain is small or negative and the full NLP is kept."""
+
+ACTIVE_SET_CHOICES = ("auto", "always", "never")
+"""How a problem's samples are solved: ``auto`` on an active set from :data:`ACTIVE_SET_THRESHOLD` samples,
+``always`` on an active set, ``never`` all at once (the full NLP)."""
 
 FULL_PROBLEM_TOLERANCE = 1e-6
 """Largest violation of a row of the full NLP (rows are scaled to order one) allowed at the design found."""
@@ -90,11 +115,75 @@ class ActiveSetResult(DesignResult):
     active_samples: indices (into all samples) of the samples in the last NLP.
     rounds: every NLP solved (:class:`ActiveSetRound`), in order.
     method: ``"active set"``, or why all samples were solved at once.
+    last_round: the last NLP's own result (its point and multipliers), which warm-starts a solve of a problem
+        of the same variables and rows on the same samples (``solve_active_set(warm=...)``); None when all
+        samples were solved at once.
     """
 
     active_samples: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=int))
     rounds: tuple[ActiveSetRound, ...] = ()
     method: str = "active set"
+    last_round: DesignResult | None = None
+
+    def active_set_json(self) -> dict[str, object]:
+        """What the active set adds to a result, as JSON types (:func:`with_active_set` reads it back)."""
+        return {
+            "method": self.method,
+            "active_samples": [int(i) for i in self.active_samples],
+            "rounds": [
+                {
+                    "samples": r.samples,
+                    "added": [int(i) for i in r.added],
+                    "iterations": r.iterations,
+                    "solve_time": r.solve_time,
+                    "worst_active": r.worst_active,
+                    "worst_all": r.worst_all,
+                }
+                for r in self.rounds
+            ],
+        }
+
+
+def with_active_set(
+    result: DesignResult, data: Mapping[str, object], last_round: DesignResult | None = None
+) -> ActiveSetResult:
+    """``result`` with the active set written by :meth:`ActiveSetResult.active_set_json` (and its last NLP's)."""
+    rounds = data["rounds"]
+    assert isinstance(rounds, list)
+    return ActiveSetResult(
+        **_replace(result),  # type: ignore[arg-type]
+        active_samples=np.asarray(data["active_samples"], dtype=int),
+        rounds=tuple(
+            ActiveSetRound(
+                int(r["samples"]),
+                np.asarray(r["added"], dtype=int),
+                int(r["iterations"]),
+                float(r["solve_time"]),
+                float(r["worst_active"]),
+                float(r["worst_all"]),
+            )
+            for r in rounds
+        ),
+        method=str(data["method"]),
+        last_round=last_round,
+    )
+
+
+def solve_method(result: DesignResult) -> tuple[str, int]:
+    """How ``result`` was solved and on how many samples its last NLP was: ``("active set", 72)``."""
+    if isinstance(result, ActiveSetResult):
+        return result.method, int(result.active_samples.size)
+    return "full NLP", int(np.asarray(result.impulses).size)
+
+
+def uses_active_set(n_samples: int, choice: str) -> bool:
+    """Whether a problem of ``n_samples`` samples is solved on an active set under ``choice``.
+
+    ``choice``: one of :data:`ACTIVE_SET_CHOICES`.
+    """
+    if choice not in ACTIVE_SET_CHOICES:
+        raise InvalidParameter("active_set", choice, "one of " + ", ".join(map(repr, ACTIVE_SET_CHOICES)))
+    return choice == "always" or (choice == "auto" and n_samples >= ACTIVE_SET_THRESHOLD)
 
 
 def sample_subset(samples: ContactSamples, index: np.ndarray) -> ContactSamples:
@@ -115,6 +204,11 @@ def solve_active_set(
     initial: np.ndarray | None = None,
     starts: int = 1,
     rng: np.random.Generator | None = None,
+    *,
+    x0: np.ndarray | None = None,
+    retry: bool = True,
+    full: DesignProblem | None = None,
+    warm: ActiveSetResult | None = None,
 ) -> ActiveSetResult:
     """Solve the problem ``build(samples)`` on an active set of its samples (see the module's description).
 
@@ -137,6 +231,14 @@ def solve_active_set(
         ``starts - 1`` drawn log-uniformly within the bounds by ``rng`` (default
         ``numpy.random.default_rng(0)``); each settles its own active set, the best on the full NLP's
         objective is returned (its rounds).
+    x0: start point of the full problem (its design variables are used: the per-sample auxiliaries of a subset
+        start at their exact values); default the problem's start.
+    retry: as :func:`collision_reflex.optimize.solve` for every round (False: a failed round raises).
+    full: ``build(samples)`` when it is already built (it is not built again).
+    warm: an earlier result of a problem with the same variables and rows (e.g. a Pareto anchor's, for the
+        epsilon points of its sweep): the first start's first round is on its ``active_samples`` (``initial``
+        ignored) from its ``last_round`` (point and multipliers, as :func:`collision_reflex.optimize.solve`
+        warm-starts a neighbouring result); its design replaces ``x0``.
 
     Raises
     ------
@@ -147,14 +249,14 @@ def solve_active_set(
     """
     _check_settings(start_samples, tolerance, max_rounds, starts)
     started = time.perf_counter()
-    full = build(samples)
+    full = build(samples) if full is None else full
     if full.samples.size != samples.size:
         raise InvalidParameter(
             "build", f"a problem on {full.samples.size} samples", f"{samples.size} samples"
         )
     needs_all = _needs_every_sample(full)
     if needs_all is not None:
-        result = solve(full, epsilon, ipopt_options=ipopt_options, starts=starts, rng=rng)
+        result = solve(full, epsilon, x0, ipopt_options, starts, rng, retry=retry)
         record = ActiveSetRound(
             samples.size,
             np.empty(0, dtype=int),
@@ -166,15 +268,35 @@ def solve_active_set(
 
     n_design = full.layout.size
     generator = rng or np.random.default_rng(0)
-    designs = [full.x0[:n_design]] + [
+    first = full.x0 if x0 is None else np.asarray(x0, dtype=float)
+    if warm is not None:
+        first = warm.x
+    designs = [first[:n_design]] + [
         generator.uniform(full.lbx[:n_design], full.ubx[:n_design]) for _ in range(starts - 1)
     ]
     best: _Settled | None = None
     failure: SolverFailed | None = None
-    for design in designs:
-        active = _first_active_set(full, start_samples, initial, design)
+    for index, design in enumerate(designs):
+        # A warm start's samples were settled at its design (every row of the full NLP checked): kept as they are.
+        resumed = warm is not None and warm.last_round is not None and index == 0
+        active = (
+            warm.active_samples
+            if resumed and warm is not None
+            else _first_active_set(full, start_samples, initial, design)
+        )
         try:
-            settled = _settle(build, full, active, design, epsilon, ipopt_options, tolerance, max_rounds)
+            settled = _settle(
+                build,
+                full,
+                active,
+                design,
+                epsilon,
+                ipopt_options,
+                tolerance,
+                max_rounds,
+                retry,
+                warm.last_round if resumed and warm is not None else None,
+            )
         except SolverFailed as error:
             if starts == 1 or error.confirmed_infeasible:
                 raise
@@ -187,7 +309,13 @@ def solve_active_set(
         raise failure
     final = _full_result(full, best.result, best.x, best.impulses)
     return _with_rounds(
-        final, best.impulses, best.active, best.rounds, "active set", time.perf_counter() - started
+        final,
+        best.impulses,
+        best.active,
+        best.rounds,
+        "active set",
+        time.perf_counter() - started,
+        best.result,
     )
 
 
@@ -215,8 +343,12 @@ def _settle(
     ipopt_options: IpoptOptions | None,
     tolerance: float,
     max_rounds: int,
+    retry: bool,
+    warm: DesignResult | None = None,
 ) -> _Settled:
     """Solve on ``active`` from the design ``x_design`` (log values), add the violated samples, repeat.
+
+    ``warm``: a result of the first round's NLP (same samples) to start it from, point and multipliers.
 
     Raises
     ------
@@ -228,8 +360,12 @@ def _settle(
     while True:
         round_started = time.perf_counter()
         problem = build(sample_subset(full.samples, active))
-        start = problem.exact_point(np.concatenate([x_design, problem.x0[n_design:]]))
-        result = solve(problem, epsilon, start, ipopt_options)
+        start: np.ndarray | DesignResult = problem.exact_point(
+            np.concatenate([x_design, problem.x0[n_design:]])
+        )
+        if warm is not None and not rounds and warm.x.size == problem.x0.size:
+            start = warm
+        result = solve(problem, epsilon, start, ipopt_options, retry=retry)
         impulses = evaluate_design(full, result.design)
         added = _violated(full, result.design, impulses, active, epsilon, tolerance)
         rounds.append(
@@ -457,6 +593,7 @@ def _with_rounds(
     rounds: tuple[ActiveSetRound, ...],
     method: str,
     total_time: float | None = None,
+    last_round: DesignResult | None = None,
 ) -> ActiveSetResult:
     """The :class:`ActiveSetResult` of ``result`` (a result or its fields) with the rounds' totals."""
     values = result if isinstance(result, dict) else _replace(result)
@@ -465,4 +602,10 @@ def _with_rounds(
         iterations=sum(r.iterations for r in rounds),
         solve_time=sum(r.solve_time for r in rounds) if total_time is None else total_time,
     )
-    return ActiveSetResult(**values, active_samples=active, rounds=rounds, method=method)  # type: ignore[arg-type]
+    return ActiveSetResult(
+        **values,  # type: ignore[arg-type]
+        active_samples=active,
+        rounds=rounds,
+        method=method,
+        last_round=last_round,
+    )

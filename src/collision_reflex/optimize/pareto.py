@@ -9,7 +9,9 @@ point and multipliers (:data:`collision_reflex.optimize.solve.WARM_START_OPTIONS
 the approach velocity is bounded (:func:`warm_started_points`). A point's result is then a
 pure function of the problem and its bounds, whatever the executor and the order in which the points finish;
 the points run in parallel. Chaining each point from its neighbour instead leaves no parallelism and was not
-faster even in series.
+faster even in series. On active sets of the samples (``active_set``, :func:`solve_with`) the same holds: every
+epsilon point starts from the first anchor's active set and its last NLP (point and multipliers), and each
+lexicographic step from its anchor's active set.
 
 Barrier strategy per kind of solve (measured on the Panda benchmark, 256 samples): a cold anchor with IPOPT's
 monotone barrier from ``mu = 1e-2`` (77 iterations; adaptive: 122, each dearer); an epsilon point warm-started
@@ -23,10 +25,13 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import inspect
 import itertools
 import os
 import threading
 import time
+import warnings
+from collections import OrderedDict
 from collections.abc import Callable, Hashable, Iterable, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Executor, Future, wait
 from dataclasses import dataclass
@@ -36,6 +41,7 @@ import numpy as np
 
 from .. import _validate
 from ..errors import InvalidParameter, SolverFailed
+from .active_set import ACTIVE_SET_CHOICES, ActiveSetResult, solve_active_set, uses_active_set
 from .blas import single_threaded_blas
 from .objectives import OBJECTIVES
 from .problem import DesignProblem
@@ -47,6 +53,8 @@ if TYPE_CHECKING:
     from pathlib import Path
 
     import pandas as pd
+
+    from .samples import ContactSamples
 
 _P = ParamSpec("_P")
 
@@ -83,10 +91,13 @@ OPTIMUM_STARTS = 4
 
 
 class ProblemBuilder(Protocol):
-    """``build(objective, bounded_objectives) -> DesignProblem``.
+    """``build(objective, bounded_objectives[, samples]) -> DesignProblem``.
 
     Hashable (the problems are cached per process by builder); picklable (a module-level function, or a frozen
-    dataclass) to run through a process pool.
+    dataclass) to run through a process pool. A builder that also takes ``samples`` (a
+    :class:`collision_reflex.optimize.ContactSamples`, default all of its own) can be solved on active sets
+    (:mod:`collision_reflex.optimize.active_set`): ``lambda obj, bounded, s=samples: build_problem(arm, s,
+    ...)``.
     """
 
     def __call__(self, objective: Hashable, bounded: tuple[str, ...], /) -> DesignProblem:
@@ -211,6 +222,7 @@ def pareto_front(
     in_flight: int | None = None,
     finished: FinishedHook | None = None,
     save: SaveHook | None = None,
+    active_set: str = "auto",
 ) -> ParetoSet:
     """Pareto set of two or three objectives by epsilon-constraint sweeps.
 
@@ -232,6 +244,10 @@ def pareto_front(
         while the others run.
     finished, save: keep each finished piece (``save(name, json)``) and find it again (``finished(name)``), so
         that a sweep resumed after an interruption redoes only the rest.
+    active_set: ``"auto"`` solves every anchor and point on active sets of the samples when the problem has
+        at least :data:`collision_reflex.optimize.active_set.ACTIVE_SET_THRESHOLD` of them, ``"always"`` does
+        so whatever their number, ``"never"`` solves the full NLP (see :func:`solve_with`); each result says
+        which (``method``, and ``active_samples`` in its record).
 
     Anchors first: each objective is minimised, then (lexicographically) the others are minimised with it held
     at its optimum, so every anchor is non-dominated. The bounds on the other objectives are then spread
@@ -247,6 +263,7 @@ def pareto_front(
         raise InvalidParameter("objectives", names, "2 or 3 different objective names")
     for name in names:
         _validate.choice("objective", name, tuple(OBJECTIVES))
+    _check_active_set(build, active_set)
     if not isinstance(points, int) or isinstance(points, bool) or points < 2:
         raise InvalidParameter("points", points, "an integer >= 2")
     for name, value in (
@@ -264,7 +281,8 @@ def pareto_front(
         points,
     )
     anchor_tasks = {
-        f"anchor-{name}": (solve_anchor, (build, name, names, ipopt_options, anchor_starts)) for name in names
+        f"anchor-{name}": (solve_anchor, (build, name, names, ipopt_options, anchor_starts, active_set))
+        for name in names
     }
     anchors = sweep.run(anchor_tasks)
     by_objective: dict[str, DesignResult] = {}
@@ -278,10 +296,12 @@ def pareto_front(
         by_objective[name] = anchor.result
     grid = epsilon_grid(by_objective, names[1:], points - len(names))
     first = anchors[f"anchor-{names[0]}"].start
-    start = first if first is not None and warm_started_points(names) else by_objective[names[0]].x
+    origin = first if first is not None and warm_started_points(names) else by_objective[names[0]]
+    start = origin if origin is first else origin.x
+    initial = origin.active_samples if isinstance(origin, ActiveSetResult) else None
     sweep.total = len(names) + len(grid)
     point_tasks = {
-        f"point-{i:03d}": (solve_point, (build, names, epsilon, start, ipopt_options))
+        f"point-{i:03d}": (solve_point, (build, names, epsilon, start, ipopt_options, active_set, initial))
         for i, epsilon in enumerate(grid)
     }
     pieces = [*anchors.values(), *sweep.run(point_tasks).values()]
@@ -313,12 +333,14 @@ def single_optimum(
     finished: FinishedHook | None = None,
     save: SaveHook | None = None,
     starts: int = OPTIMUM_STARTS,
+    active_set: str = "auto",
 ) -> tuple[DesignResult, bool]:
     """The optimum of one objective (a name, or what ``build`` takes for a weighted one).
 
     It is run, saved and found again like a piece of :func:`pareto_front` (its name: ``optimum``, or
     ``optimum-<starts>-starts``). ``starts``: start points of the solve (multi-start, seeded: see
-    :func:`collision_reflex.optimize.solve.solve`). Returns the result and whether it was found finished.
+    :func:`collision_reflex.optimize.solve.solve`; on an active set each start settles its own);
+    ``active_set``: as :func:`pareto_front`. Returns the result and whether it was found finished.
 
     Raises
     ------
@@ -326,9 +348,12 @@ def single_optimum(
     """
     if not isinstance(starts, int) or isinstance(starts, bool) or starts < 1:
         raise InvalidParameter("starts", starts, "an integer >= 1")
+    _check_active_set(build, active_set)
     name = "optimum" if starts == 1 else f"optimum-{starts}-starts"
     pieces = _Sweep(executor or SerialExecutor(), 1, finished, save, progress, 1)
-    (point,) = pieces.run({name: (solve_alone, (build, objective, ipopt_options, starts))}).values()
+    (point,) = pieces.run(
+        {name: (solve_alone, (build, objective, ipopt_options, starts, active_set))}
+    ).values()
     if point.result is None:
         failure = point.failures[0]
         raise SolverFailed(failure.message, failure.status, {}, [])
@@ -449,6 +474,93 @@ def warm_started_points(names: Sequence[str]) -> bool:
     return "approach_velocity" not in names[1:]
 
 
+SUBSET_PROBLEMS = 4
+"""Problems on subsets of the samples kept per process (with their solvers): every epsilon point's first
+active set is the first anchor's, so its problem is built once per process."""
+_SUBSETS: OrderedDict[tuple[Hashable, ...], DesignProblem] = OrderedDict()
+
+
+def takes_samples(build: Hashable) -> bool:
+    """Whether ``build`` accepts ``build(objective, bounded, samples)`` (it can build on active sets)."""
+    try:
+        inspect.signature(build).bind(None, (), None)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        return False
+    return True
+
+
+def _check_active_set(build: Hashable, active_set: str) -> None:
+    """Refuse an unknown choice, and ``"always"`` with a builder that cannot build on a subset of samples."""
+    _validate.choice("active_set", active_set, ACTIVE_SET_CHOICES)
+    if active_set == "always" and not takes_samples(build):
+        raise InvalidParameter(
+            "active_set",
+            active_set,
+            "a builder taking the samples, build(objective, bounded, samples), to solve on active sets",
+        )
+
+
+def subset_problem(
+    build: Hashable, objective: Hashable, bounded: tuple[str, ...], samples: ContactSamples
+) -> DesignProblem:
+    """``build(objective, bounded, samples)``, the last :data:`SUBSET_PROBLEMS` kept per process."""
+    key = (build, objective, bounded, samples.config_index.tobytes(), samples.directions.tobytes())
+    problem = _SUBSETS.get(key)
+    if problem is None:
+        problem = build(objective, bounded, samples)  # type: ignore[operator]
+        _SUBSETS[key] = problem
+        while len(_SUBSETS) > SUBSET_PROBLEMS:
+            _SUBSETS.popitem(last=False)
+    _SUBSETS.move_to_end(key)
+    return problem
+
+
+def solve_with(
+    build: ProblemBuilder,
+    objective: Hashable,
+    bounded: tuple[str, ...],
+    active_set: str,
+    epsilon: Mapping[str, float] | None = None,
+    x0: np.ndarray | DesignResult | None = None,
+    ipopt_options: IpoptOptions | None = None,
+    starts: int = 1,
+    *,
+    retry: bool = True,
+    initial: np.ndarray | None = None,
+) -> DesignResult:
+    """Solve ``build(objective, bounded)`` on all samples or on active sets of them, as ``active_set`` says.
+
+    On active sets (:func:`collision_reflex.optimize.active_set.solve_active_set`) the solve starts from the
+    design of ``x0`` and from the samples ``initial`` (indices; default its own first choice); an
+    active-set result ``x0`` of the same problem also warm-starts the first round from its last NLP when that
+    round has its samples. ``"auto"`` with a builder that does not take samples solves the full NLP, with a
+    warning, whatever the number of samples.
+    """
+    problem = built_problem(build, objective, bounded)
+    n_samples = problem.samples.size
+    if uses_active_set(n_samples, active_set) and not takes_samples(build):
+        warnings.warn(
+            f"{n_samples} contact samples solved as one NLP: the problem builder does not take the samples "
+            "(build(objective, bounded, samples)), so it cannot be solved on active sets",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+    elif uses_active_set(n_samples, active_set):
+        return solve_active_set(
+            functools.partial(subset_problem, build, objective, bounded),
+            problem.samples,
+            epsilon,
+            ipopt_options,
+            initial=initial,
+            starts=starts,
+            x0=x0.x if isinstance(x0, DesignResult) else x0,
+            retry=retry,
+            full=problem,
+            warm=x0 if isinstance(x0, ActiveSetResult) else None,
+        )
+    return solve(problem, epsilon, x0, ipopt_options, starts=starts, retry=retry)
+
+
 def _others(names: Sequence[str], name: str) -> tuple[str, ...]:
     return tuple(other for other in names if other != name)
 
@@ -460,18 +572,23 @@ def solve_anchor(
     objectives: tuple[str, ...],
     ipopt_options: IpoptOptions | None,
     starts: int = 1,
+    active_set: str = "auto",
 ) -> SweepPoint:
     """A Pareto anchor: ``objective`` minimised, then each other objective with it held at its optimum.
 
     The first solve runs from ``starts`` start points; the lexicographic steps make the anchor non-dominated.
     A lexicographic step runs without retries, within :data:`LEXICOGRAPHIC_MAX_ITER` iterations; one that
     fails or stops early keeps the anchor found so far and is recorded among the failures. The first
-    objective's anchor keeps its first solve as the start of the epsilon points (``SweepPoint.start``).
+    objective's anchor keeps its first solve as the start of the epsilon points (``SweepPoint.start``). On
+    active sets (``active_set``, :func:`solve_with`) each step starts from the active samples of the last.
     """
     label = f"anchor: {objective}"
     try:
-        result = solve(
-            built_problem(build, objective, _others(objectives, objective)),
+        result = solve_with(
+            build,
+            objective,
+            _others(objectives, objective),
+            active_set,
             ipopt_options=ipopt_options,
             starts=starts,
         )
@@ -482,12 +599,16 @@ def solve_anchor(
     failures = []
     for other in _others(objectives, objective):
         try:
-            result = solve(
-                built_problem(build, other, _others(objectives, other)),
+            result = solve_with(
+                build,
+                other,
+                _others(objectives, other),
+                active_set,
                 epsilon=held,
                 x0=result.x,
                 ipopt_options={**(ipopt_options or {}), **LEXICOGRAPHIC_OPTIONS},
                 retry=False,
+                initial=result.active_samples if isinstance(result, ActiveSetResult) else None,
             )
         except SolverFailed as error:
             failures.append(PointFailure(other, dict(held), error.status, str(error.args[0])))
@@ -501,17 +622,28 @@ def solve_point(
     epsilon: dict[str, float],
     start: np.ndarray | DesignResult,
     ipopt_options: IpoptOptions | None,
+    active_set: str = "auto",
+    initial: np.ndarray | None = None,
 ) -> SweepPoint:
     """One epsilon-constraint point: the first objective minimised with the others bounded by ``epsilon``.
 
     The bounds are in the objectives' units; the solve starts from ``start``: a point of the NLP's variables,
-    or a result of the same problem, whose multipliers then warm-start IPOPT.
+    or a result of the same problem, whose multipliers then warm-start IPOPT. On active sets
+    (``active_set``, :func:`solve_with`) it starts from the samples ``initial``.
     """
     label = "epsilon: " + ", ".join(_bound_text(k, v) for k, v in epsilon.items())
-    problem = built_problem(build, objectives[0], objectives[1:])
     x0 = start if isinstance(start, DesignResult) else np.asarray(start)
     try:
-        result = solve(problem, epsilon=epsilon, x0=x0, ipopt_options=ipopt_options)
+        result = solve_with(
+            build,
+            objectives[0],
+            objectives[1:],
+            active_set,
+            epsilon=epsilon,
+            x0=x0,
+            ipopt_options=ipopt_options,
+            initial=initial,
+        )
     except SolverFailed as error:
         return SweepPoint(
             label, None, (PointFailure(objectives[0], epsilon, error.status, str(error.args[0])),)
@@ -521,14 +653,19 @@ def solve_point(
 
 @_one_at_a_time
 def solve_alone(
-    build: ProblemBuilder, objective: Hashable, ipopt_options: IpoptOptions | None, starts: int = 1
+    build: ProblemBuilder,
+    objective: Hashable,
+    ipopt_options: IpoptOptions | None,
+    starts: int = 1,
+    active_set: str = "auto",
 ) -> SweepPoint:
     """A single-objective optimum as a piece run like the sweep's.
 
-    ``objective``: a name, or what ``build`` takes for a weighted one; ``starts``: start points (multi-start).
+    ``objective``: a name, or what ``build`` takes for a weighted one; ``starts``: start points (multi-start);
+    ``active_set``: see :func:`solve_with`.
     """
     try:
-        result = solve(built_problem(build, objective), ipopt_options=ipopt_options, starts=starts)
+        result = solve_with(build, objective, (), active_set, ipopt_options=ipopt_options, starts=starts)
     except SolverFailed as error:
         return SweepPoint(
             "optimum", None, (PointFailure(str(objective), {}, error.status, str(error.args[0])),)

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..model.impulse import optimal_velocity, phase_impulses, series_stiffness
+from .active_set import ActiveSetResult, solve_method, with_active_set
 from .constraints import DUTY_REQUIREMENT, STATIC_REQUIREMENT
 from .objectives import OBJECTIVES
 from .solve import Attempt, Design, DesignResult
@@ -169,6 +170,7 @@ def result_to_json(result: DesignResult) -> dict[str, Any]:
         "multipliers": None
         if multipliers is None
         else [np.asarray(m, dtype=float).tolist() for m in multipliers],
+        **({"active_set": _active_set_json(result)} if isinstance(result, ActiveSetResult) else {}),
     }
 
 
@@ -202,6 +204,21 @@ def _optional_array(values: list[float | None] | None) -> np.ndarray | None:
 def result_from_json(data: Mapping[str, Any]) -> DesignResult:
     """The :class:`DesignResult` written by :func:`result_to_json` (bitwise the same numbers)."""
     saved = data["design"]
+    result = _result_from_json(data, saved)
+    active = data.get("active_set")
+    if active is None:
+        return result
+    last = active.get("last_round")
+    return with_active_set(result, active, None if last is None else result_from_json(last))
+
+
+def _active_set_json(result: ActiveSetResult) -> dict[str, Any]:
+    """The active set of a result as JSON types, with its last NLP's result (a warm start of the next)."""
+    last = result.last_round
+    return {**result.active_set_json(), "last_round": None if last is None else result_to_json(last)}
+
+
+def _result_from_json(data: Mapping[str, Any], saved: Mapping[str, Any]) -> DesignResult:
     design = Design(
         joint_names=tuple(saved["joint_names"]),
         **{name: np.asarray(saved[name], dtype=float) for name in _DESIGN_ARRAYS},
@@ -249,6 +266,7 @@ def result_from_json(data: Mapping[str, Any]) -> DesignResult:
 def result_record(result: DesignResult, label: str) -> dict[str, Any]:
     """A design and its solve as plain data: objectives, per-joint quantities and margins, solver status."""
     design = result.design
+    method, active = solve_method(result)
     joints = []
     for i, name in enumerate(design.joint_names):
         duty = {key: _finite_entry(getattr(result, key), i) for key in DUTY_ARRAYS}
@@ -300,6 +318,8 @@ def result_record(result: DesignResult, label: str) -> dict[str, Any]:
             "build_time": float(result.build_time),
             "epsilon": {k: float(v) for k, v in result.epsilon.items()},
             "attempts": attempt_records(result.attempts),
+            "method": method,
+            "active_samples": active,
         },
     }
 

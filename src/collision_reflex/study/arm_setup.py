@@ -248,13 +248,16 @@ class StudyProblems:
     """The design problems of a resolved study, built from its text in any process.
 
     Called as :func:`collision_reflex.optimize.pareto.pareto_front` builds them:
-    ``StudyProblems(text)(objective, bounded)``. Plain text inside, so it crosses process boundaries.
+    ``StudyProblems(text)(objective, bounded)``, or on some of the samples (an active set)
+    ``StudyProblems(text)(objective, bounded, samples)``. Plain text inside, so it crosses process boundaries.
     """
 
     resolved_text: str
 
-    def __call__(self, objective: Hashable, bounded: tuple[str, ...] = ()) -> DesignProblem:
-        """The design problem for ``objective`` (an :func:`objective_key`).
+    def __call__(
+        self, objective: Hashable, bounded: tuple[str, ...] = (), samples: ContactSamples | None = None
+    ) -> DesignProblem:
+        """The design problem for ``objective`` (an :func:`objective_key`), on ``samples`` (default all).
 
         The objectives named in ``bounded`` can be bounded per solve (epsilon-constraint Pareto sweeps).
         """
@@ -263,7 +266,13 @@ class StudyProblems:
         setup = setup_from_text(self.resolved_text)
         weighted: Any = objective if isinstance(objective, str) else dict(objective)  # type: ignore[call-overload]
         return build_problem(
-            setup.arm, setup.samples, setup.space, setup.technology, weighted, setup.constraints, bounded
+            setup.arm,
+            setup.samples if samples is None else samples,
+            setup.space,
+            setup.technology,
+            weighted,
+            setup.constraints,
+            bounded,
         )
 
     @property
@@ -275,6 +284,11 @@ class StudyProblems:
     def objective(self) -> Hashable:
         """The study's own objective (for :func:`collision_reflex.optimize.pareto.built_problem`)."""
         return objective_key(self.setup.study.objective)
+
+    @property
+    def active_set(self) -> str:
+        """How the study's problems are solved: on active sets of the samples or not (``optimizer.active_set``)."""
+        return self.setup.study.optimizer.active_set
 
 
 class SampleLayout(TypedDict):

@@ -290,6 +290,7 @@ def _run_arm(
             finished=folder.finished,
             save=folder.save,
             starts=OPTIMUM_STARTS,
+            active_set=problems.active_set,
         )
     except SolverFailed as error:
         raise StudyRunFailed(f"the optimum solve failed: {error.args[0]}", "optimum", error.status) from None
@@ -308,6 +309,7 @@ def _run_arm(
                 in_flight=window,
                 finished=folder.finished,
                 save=folder.save,
+                active_set=problems.active_set,
             )
         except SolverFailed as error:
             raise StudyRunFailed(str(error.args[0]), "anchor", error.status) from None

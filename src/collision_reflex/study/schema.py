@@ -703,6 +703,17 @@ class SimulateSpec(_Model):
         return value
 
 
+class OptimizerSpec(_Model):
+    """How the optimiser solves the study's problems (the numbers agree within the solver's tolerance)."""
+
+    active_set: Literal["auto", "always", "never"] = Field(
+        "auto",
+        description="solve the optimum and every Pareto point on active sets of the contact samples (a subset, "
+        "grown by the samples found above its worst case until none is: exact for worst-case objectives): "
+        "'auto' from 512 samples (ACTIVE_SET_THRESHOLD), 'always', or 'never' (all samples in one NLP)",
+    )
+
+
 class ExecutionSpec(_Model):
     """Where the independent work runs: in-process, a local process pool, or a Dask cluster."""
 
@@ -764,6 +775,7 @@ class ArmStudy(_Model):
     ] = Field(default_factory=lambda: {"worst_case_impulse": 1.0}, min_length=1)  # type: ignore[arg-type]
     constraints: ConstraintsSpec = Field(default_factory=ConstraintsSpec)  # type: ignore[arg-type]
     pareto: ParetoSpec | None = None
+    optimizer: OptimizerSpec = Field(default_factory=OptimizerSpec)  # type: ignore[arg-type]
     catalogue: CatalogueSpec = Field(default_factory=CatalogueSpec)  # type: ignore[arg-type]
     outputs: OutputsSpec = Field(default_factory=OutputsSpec)  # type: ignore[arg-type]
     execution: ExecutionSpec = Field(default_factory=ExecutionSpec)  # type: ignore[arg-type]
