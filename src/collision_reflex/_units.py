@@ -14,6 +14,8 @@ from __future__ import annotations
 import functools
 import math
 import re
+import sys
+from importlib import resources
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
@@ -51,13 +53,125 @@ class QuantityError(ValueError):
         self.dimension = dimension
 
 
+# The registry holds the part of pint's own definitions file (``default_en.txt``) that datasheets and studies
+# use; building pint's whole registry takes ~5x as long (0.14 s of a 0.9 s ``crx validate``; pint's on-disk
+# cache would avoid it, but the package writes nothing outside the folders it is given). The definitions are
+# pint's lines, picked by name here, never copied. Kept: SI base and derived units with every prefix, angles
+# (deg, rev, arcmin), rpm and rps, time, temperature, the international inch/foot/yard/mile, the avoirdupois
+# pound and ounce with their forces (lbf, ozf) and kgf/gf, and the power, pressure and electrical units of motor
+# datasheets. Also kept: every unit whose name the smaller registry would otherwise read as a prefix and another
+# unit ("kt" would be kilo-tonne without the knot, "pt" pico-tonne without the pint, "pc" pico-c without the
+# parsec): a unit pint's default registry knows is read identically here or refused, never read as another
+# (tests/test_study_units.py checks every name and prefix of pint's default registry).
+_KEPT_BLOCKS = frozenset(
+    {
+        "@defaults",
+        "@group USCSLengthInternational",
+        "@group Avoirdupois",
+        "@system mks using international",
+        # Only for the names above: pt, qt, dpi, rd, ppi, Tt.
+        "@group USCSLiquidVolume",
+        "@group USCSDryVolume",
+        "@group USCSLengthSurvey",
+        "@group Printer",
+        "@group Textile",
+    }
+)
+_KEPT_UNITS = frozenset(
+    """
+    meter second ampere candela gram mole kelvin radian bit count pi standard_gravity standard_atmosphere
+    turn degree arcminute arcsecond steradian percent permille ppm micron metric_ton grain carat
+    minute hour day degree_Celsius degree_Fahrenheit degree_Rankine liter cubic_centimeter
+    hertz revolutions_per_minute revolutions_per_second counts_per_second
+    mile_per_hour kilometer_per_hour meter_per_second foot_per_second meter_per_second_squared
+    newton dyne force_kilogram force_gram force_metric_ton joule erg watt_hour
+    watt volt_ampere horsepower metric_horsepower electrical_horsepower
+    pascal bar torr pound_force_per_square_inch kip_per_square_inch foot_pound
+    coulomb ampere_hour volt ohm siemens farad weber henry tesla
+    """.split()
+) | frozenset(  # only for their names: Eh, Rd, Td, at, hbar, kt, nmi, rads, bps, kat, pc, fm, mil
+    """
+    hartree rydberg planck_constant speed_of_light rydberg_constant dirac_constant rutherford becquerel
+    townsend technical_atmosphere knot nautical_mile rads gray baud katal parsec tansec astronomical_unit
+    fermi mil
+    """.split()
+)
+
+# pint.compat imports Dask, SciPy and Babel when they are installed, for integrations the package never uses
+# (Quantity-wrapped Dask arrays, `to_preferred`, locale formatting): 0.09 s of `crx validate`. The `crx`
+# command's own process imports pint without them (:func:`hide_pint_extras`); library users keep all of pint.
+_PINT_EXTRAS = ("dask", "scipy", "babel")
+_hide_extras = False
+
+
+def hide_pint_extras() -> None:
+    """Import pint, when it is first needed, without its optional integrations (for the ``crx`` command)."""
+    global _hide_extras
+    _hide_extras = True
+
+
+def import_pint() -> Any:
+    """pint, imported (without the extras after :func:`hide_pint_extras`, if pint is not imported yet)."""
+    if not _hide_extras or "pint" in sys.modules:
+        import pint
+
+        return pint
+    hidden = [name for name in _PINT_EXTRAS if name not in sys.modules]
+    for name in hidden:
+        sys.modules[name] = None  # type: ignore[assignment]  # `import dask` fails, find_spec gives None
+    try:
+        import pint
+    finally:
+        for name in hidden:  # importable again for the code that uses them
+            if name in sys.modules and sys.modules[name] is None:
+                del sys.modules[name]
+    return pint
+
+
+def registry_definitions() -> list[str] | None:
+    """The lines of pint's definitions file the registry is built from (None if one of the kept names is
+    missing from the installed pint's file: the registry is then pint's whole default one)."""
+    folder = resources.files("pint")
+
+    def lines(name: str) -> Any:
+        for line in folder.joinpath(name).read_text(encoding="utf-8").splitlines():
+            text = line.split("#", 1)[0].rstrip()
+            if text.strip().startswith("@import"):
+                yield from lines(text.split()[1])
+            elif text.strip():
+                yield text
+
+    kept: list[str] = []
+    found: set[str] = set()
+    block = None
+    for line in lines("default_en.txt"):
+        text = line.strip()
+        if block is not None:  # inside a @group, @context, @system or @defaults block: kept whole or not at all
+            if block in _KEPT_BLOCKS:
+                kept.append(line)
+                found.add(block)
+            if text == "@end":
+                block = None
+        elif text.startswith("@"):
+            block = " ".join(text.split())
+            if block in _KEPT_BLOCKS:
+                kept.append(line)
+        elif (name := text.split("=", 1)[0].strip()).endswith("-") or name.startswith("["):
+            kept.append(line)  # prefixes and dimensions: every one
+        elif name in _KEPT_UNITS:
+            kept.append(line)
+            found.add(name)
+    return kept if found == _KEPT_UNITS | _KEPT_BLOCKS else None
+
+
 @functools.cache
 def unit_registry() -> pint.UnitRegistry:
     """The registry every unit string of the package is read with: study files, catalogues, traces."""
-    import pint
-
-    # Not pint's on-disk cache (0.1 s faster): the package writes nothing outside the folders it is given.
-    return pint.UnitRegistry()
+    pint = import_pint()
+    definitions = registry_definitions()
+    registry = pint.UnitRegistry() if definitions is None else pint.UnitRegistry(definitions)
+    registry.define("@alias turn = rev")  # datasheets' "counts/rev", "mm/rev"; not a name of pint's own
+    return registry
 
 
 @functools.lru_cache(maxsize=4096)  # files repeat their units; a pint conversion costs ~0.2 ms
@@ -106,8 +220,7 @@ def si_scale(unit: str) -> float:
 
 def _converted(number: float, text: str, unit: str, angle_explicit: bool) -> float:
     """``number`` in the unit ``text`` (already of the bounded grammar), converted to ``unit``."""
-    import pint
-
+    pint = import_pint()
     registry = unit_registry()
     try:
         given = registry.Quantity(1.0, text.replace("^", "**"))
