@@ -227,9 +227,8 @@ def test_every_name_of_pints_default_registry_is_read_identically_or_refused(reg
     package's registry reads, the default one reads as the same unit (or one of the same value), so a dropped
     unit ("ct", "kt", "pt") is refused, never taken for a prefix and another unit ("c"+"t", "k"+"t")."""
     ours, default = registries
-    prefixes = [""] + sorted(
-        {name for p in default._prefixes.values() for name in (p.name, p.symbol, *p.aliases) if name}
-    )
+    spellings = {name for p in default._prefixes.values() for name in (p.name, p.symbol, *p.aliases) if name}
+    prefixes = ["", *sorted(spellings)]
     read = 0
     for prefix in prefixes:
         for name in default._units:

@@ -129,8 +129,11 @@ def import_pint() -> Any:
 
 
 def registry_definitions() -> list[str] | None:
-    """The lines of pint's definitions file the registry is built from (None if one of the kept names is
-    missing from the installed pint's file: the registry is then pint's whole default one)."""
+    """The lines of pint's definitions file the registry is built from.
+
+    None if one of the kept names is missing from the installed pint's file: the registry is then pint's
+    whole default one.
+    """
     folder = resources.files("pint")
 
     def lines(name: str) -> Any:
@@ -146,7 +149,8 @@ def registry_definitions() -> list[str] | None:
     block = None
     for line in lines("default_en.txt"):
         text = line.strip()
-        if block is not None:  # inside a @group, @context, @system or @defaults block: kept whole or not at all
+        # Inside a @group, @context, @system or @defaults block: kept whole or not at all.
+        if block is not None:
             if block in _KEPT_BLOCKS:
                 kept.append(line)
                 found.add(block)
