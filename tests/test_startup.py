@@ -51,15 +51,27 @@ def test_crx_help_loads_no_heavy_library():
     assert not loaded & {*HEAVY, "pint", "pydantic"}, sorted(loaded & {*HEAVY, "pint", "pydantic"})
 
 
-def test_crx_validate_schema_only_loads_no_solver_or_plotting_library():
-    code = "from collision_reflex.cli import main\nmain(['validate', '--schema-only', 'studies/two_link_paper.yaml'])"
-    loaded = imported_after(code, submodules=True)
-    assert {"pydantic", "pint"} <= loaded  # it did check the study and its units
-    # pint imports the bare scipy package (its private modules and version) when it is installed; none of
-    # SciPy's public subpackages (integrate, optimize, linalg, ...) may follow.
-    pint_probe = {"scipy", "scipy.version"} | {name for name in loaded if name.startswith("scipy._")}
-    heavy = {name for name in loaded if name.split(".")[0] in HEAVY} - pint_probe
-    assert not heavy, sorted(heavy)
+@pytest.mark.parametrize("flags", [["--schema-only"], []], ids=["schema-only", "with-robot"])
+def test_crx_validate_loads_only_what_it_checks_with(flags):
+    code = f"from collision_reflex.cli import main\nmain(['validate', *{flags!r}, 'studies/two_link_paper.yaml'])"
+    loaded = imported_after(code)
+    assert {"pydantic", "pint", "yaml"} <= loaded  # it did check the study and its units
+    # pint imports Dask, SciPy and Babel when installed (pint.compat); crx hides them, and needs no solver,
+    # plotting, table or template library.
+    unused = {*HEAVY, "dask", "babel", "jinja2"} - ({"pinocchio"} if not flags else set())
+    assert not loaded & unused, sorted(loaded & unused)
+    assert ("pinocchio" in loaded) == (not flags)  # the robot is loaded only without --schema-only
+
+
+def test_pint_without_its_extras_leaves_them_importable():
+    # After crx's pint import the hidden libraries import normally, and pint works with NumPy arrays.
+    code = (
+        "from collision_reflex import _units\n_units.hide_pint_extras()\n"
+        "import numpy as np\nq = _units.unit_registry().Quantity(np.array([1.0, 2.0]), 'mm')\n"
+        "assert list(q.to('m').magnitude) == [0.001, 0.002]\n"
+        "import pint.compat, scipy, dask\nassert not pint.compat.HAS_DASK"
+    )
+    assert {"scipy", "dask"} <= imported_after(code)
 
 
 def test_every_public_name_resolves_and_dir_lists_it():
