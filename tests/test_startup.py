@@ -81,9 +81,11 @@ def test_every_public_name_resolves_and_dir_lists_it():
     assert set(cr.__all__) <= set(dir(cr))
 
 
-def _type_checking_imports() -> dict[str, tuple[str, str]]:
-    """The names the ``if TYPE_CHECKING:`` block of the package root imports: name -> (module, attribute)."""
-    tree = ast.parse((ROOT / "src" / "collision_reflex" / "__init__.py").read_text(encoding="utf-8"))
+def _type_checking_imports(package: str) -> dict[str, tuple[str, str]]:
+    """The names the ``if TYPE_CHECKING:`` block of ``package`` (``collision_reflex``, ``...experiments``)
+    imports: name -> (module, attribute)."""
+    init = ROOT / "src" / Path(*package.split(".")) / "__init__.py"
+    tree = ast.parse(init.read_text(encoding="utf-8"))
     block = next(n for n in tree.body if isinstance(n, ast.If) and ast.unparse(n.test) == "TYPE_CHECKING")
     names: dict[str, tuple[str, str]] = {}
     for node in block.body:
@@ -93,13 +95,21 @@ def _type_checking_imports() -> dict[str, tuple[str, str]]:
     return names
 
 
-def test_the_type_checkers_names_are_the_run_time_names():
+@pytest.mark.parametrize("package", ["collision_reflex", "collision_reflex.experiments"])
+def test_the_type_checkers_names_are_the_run_time_names(package):
     # The TYPE_CHECKING imports (what mypy and IDEs see) and the lazy table must name the same objects.
-    declared = _type_checking_imports()
-    assert set(declared) == set(cr.__all__) - {"__version__"}
+    lazy = importlib.import_module(package)
+    declared = _type_checking_imports(package)
+    assert set(declared) == set(lazy.__all__) - {"__version__"}
     for name, (module, attribute) in declared.items():
-        where = importlib.import_module(f"collision_reflex.{module}" if module else "collision_reflex")
-        assert getattr(where, attribute) is getattr(cr, name), name
+        where = importlib.import_module(f"{package}.{module}" if module else package)
+        assert getattr(where, attribute) is getattr(lazy, name), name
+
+
+def test_the_duty_cycles_trace_units_do_not_load_the_experiment_fits():
+    loaded = imported_after("import collision_reflex.arm.duty_cycle", submodules=True)
+    assert "collision_reflex.experiments.traces" in loaded
+    assert not {"collision_reflex.experiments.fit", "collision_reflex.experiments.analysis"} & loaded
 
 
 def test_from_import_and_star_import_work():
