@@ -56,29 +56,23 @@ class QuantityError(ValueError):
 # The registry holds the part of pint's own definitions file (``default_en.txt``) that datasheets and studies
 # use; building pint's whole registry takes ~5x as long (0.14 s of a 0.9 s ``crx validate``; pint's on-disk
 # cache would avoid it, but the package writes nothing outside the folders it is given). The definitions are
-# pint's lines, picked by name here, never copied. Kept: SI base and derived units with every prefix, angles
-# (deg, rev, arcmin), rpm and rps, time, temperature, the international inch/foot/yard/mile, the avoirdupois
-# pound and ounce with their forces (lbf, ozf) and kgf/gf, and the power, pressure and electrical units of motor
-# datasheets. Also kept: every unit whose name the smaller registry would otherwise read as a prefix and another
-# unit ("kt" would be kilo-tonne without the knot, "pt" pico-tonne without the pint, "pc" pico-c without the
-# parsec): a unit pint's default registry knows is read identically here or refused, never read as another
-# (tests/test_study_units.py checks every name and prefix of pint's default registry).
+# pint's lines, picked by name here (two groups and the mks system whole), never copied. Kept: SI base and
+# derived units with every prefix, angles (deg, turn, arcmin), rpm and rps, time, temperature, the
+# international inch/foot/yard/mile, the avoirdupois pound and ounce with their forces (lbf, ozf), kgf and gf,
+# and the power, pressure and electrical units of motor datasheets. Also kept: every unit whose name the
+# smaller registry would otherwise read as a prefix and another unit ("kt" would be kilo-tonne without the
+# knot, "pt" pico-tonne without the pint, "pc" pico-c without the parsec): a unit pint's default registry
+# knows is read identically here or refused, never read as another (tests/test_study_units.py checks every
+# name, plural and prefix of pint's default registry).
 _KEPT_BLOCKS = frozenset(
     {
         "@defaults",
         "@group USCSLengthInternational",
         "@group Avoirdupois",
         "@system mks using international",
-        # Only for the names above: pt, qt, dpi, rd, ppi, Tt.
-        "@group USCSLiquidVolume",
-        "@group USCSDryVolume",
-        "@group USCSLengthSurvey",
-        "@group Printer",
-        "@group Textile",
     }
 )
-_KEPT_UNITS = frozenset(
-    """
+_DATASHEET_UNITS = """
     meter second ampere candela gram mole kelvin radian bit count pi standard_gravity standard_atmosphere
     turn degree arcminute arcsecond steradian percent permille ppm micron metric_ton grain carat
     minute hour day degree_Celsius degree_Fahrenheit degree_Rankine liter cubic_centimeter
@@ -88,14 +82,16 @@ _KEPT_UNITS = frozenset(
     watt volt_ampere horsepower metric_horsepower electrical_horsepower
     pascal bar torr pound_force_per_square_inch kip_per_square_inch foot_pound
     coulomb ampere_hour volt ohm siemens farad weber henry tesla
-    """.split()
-) | frozenset(  # only for their names: Eh, Rd, Td, at, hbar, kt, nmi, rads, bps, kat, pc, fm, mil
-    """
+"""
+# Kept only for their names (and what they are defined with): Eh, Rd, Td, at, hbar, kt, nmi, rads, bps, kat,
+# pc, fm, mil, pt, qt, dpi, dqt, dgal, rd, ppi, Tt.
+_UNITS_FOR_THEIR_NAMES = """
     hartree rydberg planck_constant speed_of_light rydberg_constant dirac_constant rutherford becquerel
     townsend technical_atmosphere knot nautical_mile rads gray baud katal parsec tansec astronomical_unit
-    fermi mil
-    """.split()
-)
+    fermi mil pint quart gallon dry_pint dry_quart dry_gallon bushel rod survey_foot pixels_per_inch pixel
+    tex
+"""
+_KEPT_UNITS = frozenset(_DATASHEET_UNITS.split() + _UNITS_FOR_THEIR_NAMES.split())
 
 # pint.compat imports Dask, SciPy and Babel when they are installed, for integrations the package never uses
 # (Quantity-wrapped Dask arrays, `to_preferred`, locale formatting): 0.09 s of `crx validate`. The `crx`
@@ -146,25 +142,26 @@ def registry_definitions() -> list[str] | None:
 
     kept: list[str] = []
     found: set[str] = set()
-    block = None
+    block = ""  # the block a line is in: "" outside any, else its first line ("@group Avoirdupois")
     for line in lines("default_en.txt"):
         text = line.strip()
-        # Inside a @group, @context, @system or @defaults block: kept whole or not at all.
-        if block is not None:
-            if block in _KEPT_BLOCKS:
+        if text.startswith("@"):
+            block = block if text == "@end" else " ".join(text.split())
+            if block in _KEPT_BLOCKS:  # its first and last lines
                 kept.append(line)
                 found.add(block)
-            if text == "@end":
-                block = None
-        elif text.startswith("@"):
-            block = " ".join(text.split())
-            if block in _KEPT_BLOCKS:
-                kept.append(line)
-        elif (name := text.split("=", 1)[0].strip()).endswith("-") or name.startswith("["):
-            kept.append(line)  # prefixes and dimensions: every one
-        elif name in _KEPT_UNITS:
+            block = "" if text == "@end" else block
+            continue
+        name = text.split("=", 1)[0].strip()
+        if block in _KEPT_BLOCKS:  # @defaults, a @group or a @system kept whole
             kept.append(line)
+        elif name.endswith("-") and not block:
+            kept.append(line)  # every prefix
+        elif name in _KEPT_UNITS and (not block or block.startswith("@group")):
+            kept.append(text)  # a unit of a group not kept whole goes to the default group
             found.add(name)
+        # Left out: the named dimensions ("[force] = ..."), which no quantity of the bounded grammar names,
+        # and the conversions of every @context.
     return kept if found == _KEPT_UNITS | _KEPT_BLOCKS else None
 
 
