@@ -153,3 +153,28 @@ def test_crx_help_lists_every_subcommand(capsys):
         "report",
     ):
         assert f"    {command} " in shown, command
+
+
+def test_a_subcommand_is_parsed_without_importing_the_others():
+    code = "from collision_reflex.cli import main\nmain(['validate', '--schema-only', 'studies/two_link_paper.yaml'])"
+    loaded = imported_after(code, submodules=True)
+    assert "collision_reflex.cli.validate" in loaded
+    others = {
+        "collision_reflex.cli.impulse",
+        "collision_reflex.cli.sweep",
+        "collision_reflex.hardware.sweeps",
+    }
+    assert not loaded & others, sorted(loaded & others)
+
+
+@pytest.mark.parametrize("command", ["validate", "sweep", "run"])
+def test_a_subcommands_help_is_the_same_alone(command, capsys):
+    # `crx COMMAND --help` as parsed with that subcommand alone, and with every subcommand.
+    from collision_reflex.cli import build_parser, main
+
+    assert main([command, "--help"]) == 0
+    alone = capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        build_parser().parse_args([command, "--help"])
+    assert capsys.readouterr().out == alone
+    assert alone.startswith(f"usage: crx {command}")
