@@ -341,3 +341,16 @@ def test_a_dropped_unit_is_refused_as_unknown(text):
     with pytest.raises(QuantityError) as caught:
         parse_quantity(text, "kg")
     assert caught.value.kind == "unit"
+
+
+@pytest.mark.parametrize(("text", "unit", "si"), DATASHEET_UNITS, ids=[t for t, _, _ in DATASHEET_UNITS])
+def test_a_number_converts_to_the_bit_as_pint_converts_it(registries, text, unit, si):
+    # The package multiplies by the unit's cached factor (an offset unit, degC, goes through pint each time):
+    # the same float as pint's conversion of the number, for numbers of any size and sign.
+    from collision_reflex._units import parse_quantity
+
+    _, default = registries
+    name = text.split(" ", 1)[1]
+    for value in np.random.default_rng(7).normal(0.0, 1.0, 20) * 10.0 ** np.arange(-9, 11):
+        expected = float(default.Quantity(float(value), name.replace("^", "**")).to(unit or "").magnitude)
+        assert parse_quantity(f"{float(value)!r} {name}", unit) == expected, (value, name)

@@ -221,6 +221,19 @@ def si_scale(unit: str) -> float:
 
 def _converted(number: float, text: str, unit: str, angle_explicit: bool) -> float:
     """``number`` in the unit ``text`` (already of the bounded grammar), converted to ``unit``."""
+    factor = _factor(text, unit, angle_explicit)
+    if factor is not None:
+        return number * factor  # as pint converts: the magnitude times the units' factor
+    pint = import_pint()
+    try:  # an offset unit (degC): pint's own conversion of the number
+        return float(unit_registry().Quantity(number, text.replace("^", "**")).to(unit).magnitude)
+    except (pint.PintError, OverflowError, ValueError, TypeError):
+        raise QuantityError("unit", f"a unit that cannot be converted to {unit}") from None
+
+
+@functools.lru_cache(maxsize=1024)  # a catalogue gives 100 numbers in a dozen units
+def _factor(text: str, unit: str, angle_explicit: bool) -> float | None:
+    """The factor from the unit ``text`` to ``unit``, once its dimension is checked (None for an offset unit)."""
     pint = import_pint()
     registry = unit_registry()
     try:
@@ -240,10 +253,11 @@ def _converted(number: float, text: str, unit: str, angle_explicit: bool) -> flo
             "angle", f"no angle unit; give an angle per time, e.g. '3000 rpm' or '314 {unit}'"
         )
     try:
-        with_number = registry.Quantity(number, text.replace("^", "**"))
-        return float(with_number.to(unit).magnitude)
+        zero = registry.Quantity(0.0, text.replace("^", "**")).to(unit).magnitude
+        factor = float(given.to(unit).magnitude)
     except (pint.PintError, OverflowError, ValueError, TypeError):  # offset units (degC) in a product, ...
         raise QuantityError("unit", f"a unit that cannot be converted to {unit}") from None
+    return factor if zero == 0 else None
 
 
 def _dimension(quantity: pint.Quantity) -> str:
