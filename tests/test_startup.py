@@ -65,6 +65,8 @@ def test_crx_validate_loads_only_what_it_checks_with(flags):
 
 def test_pint_without_its_extras_leaves_them_importable():
     # After crx's pint import the hidden libraries import normally, and pint works with NumPy arrays.
+    pytest.importorskip("dask")
+    pytest.importorskip("scipy")
     code = (
         "from collision_reflex import _units\n_units.hide_pint_extras()\n"
         "import numpy as np\nq = _units.unit_registry().Quantity(np.array([1.0, 2.0]), 'mm')\n"
