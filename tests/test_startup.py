@@ -51,15 +51,29 @@ def test_crx_help_loads_no_heavy_library():
     assert not loaded & {*HEAVY, "pint", "pydantic"}, sorted(loaded & {*HEAVY, "pint", "pydantic"})
 
 
-def test_crx_validate_schema_only_loads_no_solver_or_plotting_library():
-    code = "from collision_reflex.cli import main\nmain(['validate', '--schema-only', 'studies/two_link_paper.yaml'])"
-    loaded = imported_after(code, submodules=True)
-    assert {"pydantic", "pint"} <= loaded  # it did check the study and its units
-    # pint imports the bare scipy package (its private modules and version) when it is installed; none of
-    # SciPy's public subpackages (integrate, optimize, linalg, ...) may follow.
-    pint_probe = {"scipy", "scipy.version"} | {name for name in loaded if name.startswith("scipy._")}
-    heavy = {name for name in loaded if name.split(".")[0] in HEAVY} - pint_probe
-    assert not heavy, sorted(heavy)
+@pytest.mark.parametrize("flags", [["--schema-only"], []], ids=["schema-only", "with-robot"])
+def test_crx_validate_loads_only_what_it_checks_with(flags):
+    code = f"from collision_reflex.cli import main\nmain(['validate', *{flags!r}, 'studies/two_link_paper.yaml'])"
+    loaded = imported_after(code)
+    assert {"pydantic", "pint", "yaml"} <= loaded  # it did check the study and its units
+    # pint imports Dask, SciPy and Babel when installed (pint.compat); crx hides them, and needs no solver,
+    # plotting, table or template library.
+    unused = {*HEAVY, "dask", "babel", "jinja2"} - ({"pinocchio"} if not flags else set())
+    assert not loaded & unused, sorted(loaded & unused)
+    assert ("pinocchio" in loaded) == (not flags)  # the robot is loaded only without --schema-only
+
+
+def test_pint_without_its_extras_leaves_them_importable():
+    # After crx's pint import the hidden libraries import normally, and pint works with NumPy arrays.
+    pytest.importorskip("dask")
+    pytest.importorskip("scipy")
+    code = (
+        "from collision_reflex import _units\n_units.hide_pint_extras()\n"
+        "import numpy as np\nq = _units.unit_registry().Quantity(np.array([1.0, 2.0]), 'mm')\n"
+        "assert list(q.to('m').magnitude) == [0.001, 0.002]\n"
+        "import pint.compat, scipy, dask\nassert not pint.compat.HAS_DASK"
+    )
+    assert {"scipy", "dask"} <= imported_after(code)
 
 
 def test_every_public_name_resolves_and_dir_lists_it():
@@ -69,9 +83,11 @@ def test_every_public_name_resolves_and_dir_lists_it():
     assert set(cr.__all__) <= set(dir(cr))
 
 
-def _type_checking_imports() -> dict[str, tuple[str, str]]:
-    """The names the ``if TYPE_CHECKING:`` block of the package root imports: name -> (module, attribute)."""
-    tree = ast.parse((ROOT / "src" / "collision_reflex" / "__init__.py").read_text(encoding="utf-8"))
+def _type_checking_imports(package: str) -> dict[str, tuple[str, str]]:
+    """The names the ``if TYPE_CHECKING:`` block of ``package`` (``collision_reflex``, ``...experiments``)
+    imports: name -> (module, attribute)."""
+    init = ROOT / "src" / Path(*package.split(".")) / "__init__.py"
+    tree = ast.parse(init.read_text(encoding="utf-8"))
     block = next(n for n in tree.body if isinstance(n, ast.If) and ast.unparse(n.test) == "TYPE_CHECKING")
     names: dict[str, tuple[str, str]] = {}
     for node in block.body:
@@ -81,13 +97,21 @@ def _type_checking_imports() -> dict[str, tuple[str, str]]:
     return names
 
 
-def test_the_type_checkers_names_are_the_run_time_names():
+@pytest.mark.parametrize("package", ["collision_reflex", "collision_reflex.experiments"])
+def test_the_type_checkers_names_are_the_run_time_names(package):
     # The TYPE_CHECKING imports (what mypy and IDEs see) and the lazy table must name the same objects.
-    declared = _type_checking_imports()
-    assert set(declared) == set(cr.__all__) - {"__version__"}
+    lazy = importlib.import_module(package)
+    declared = _type_checking_imports(package)
+    assert set(declared) == set(lazy.__all__) - {"__version__"}
     for name, (module, attribute) in declared.items():
-        where = importlib.import_module(f"collision_reflex.{module}" if module else "collision_reflex")
-        assert getattr(where, attribute) is getattr(cr, name), name
+        where = importlib.import_module(f"{package}.{module}" if module else package)
+        assert getattr(where, attribute) is getattr(lazy, name), name
+
+
+def test_the_duty_cycles_trace_units_do_not_load_the_experiment_fits():
+    loaded = imported_after("import collision_reflex.arm.duty_cycle", submodules=True)
+    assert "collision_reflex.experiments.traces" in loaded
+    assert not {"collision_reflex.experiments.fit", "collision_reflex.experiments.analysis"} & loaded
 
 
 def test_from_import_and_star_import_work():
@@ -131,3 +155,28 @@ def test_crx_help_lists_every_subcommand(capsys):
         "report",
     ):
         assert f"    {command} " in shown, command
+
+
+def test_a_subcommand_is_parsed_without_importing_the_others():
+    code = "from collision_reflex.cli import main\nmain(['validate', '--schema-only', 'studies/two_link_paper.yaml'])"
+    loaded = imported_after(code, submodules=True)
+    assert "collision_reflex.cli.validate" in loaded
+    others = {
+        "collision_reflex.cli.impulse",
+        "collision_reflex.cli.sweep",
+        "collision_reflex.hardware.sweeps",
+    }
+    assert not loaded & others, sorted(loaded & others)
+
+
+@pytest.mark.parametrize("command", ["validate", "sweep", "run"])
+def test_a_subcommands_help_is_the_same_alone(command, capsys):
+    # `crx COMMAND --help` as parsed with that subcommand alone, and with every subcommand.
+    from collision_reflex.cli import build_parser, main
+
+    assert main([command, "--help"]) == 0
+    alone = capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        build_parser().parse_args([command, "--help"])
+    assert capsys.readouterr().out == alone
+    assert alone.startswith(f"usage: crx {command}")

@@ -199,3 +199,158 @@ def test_wrong_dimension_message_names_the_value():
     with pytest.raises(PydanticCustomError) as caught:
         to_si("3 N", "kg", "a mass", "0.5 kg")
     assert "'3 N' is [mass] * [length] / [time] ** 2, not [mass]" in str(caught.value)
+
+
+# --- the unit registry: the part of pint's definitions datasheets use ------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def registries():
+    """The package's registry and pint's whole default one."""
+    import pint
+
+    from collision_reflex._units import unit_registry
+
+    return unit_registry(), pint.UnitRegistry()
+
+
+def test_the_registry_is_the_smaller_one(registries):
+    from collision_reflex._units import registry_definitions
+
+    ours, default = registries
+    assert registry_definitions() is not None  # the installed pint's file holds every kept name
+    assert len(ours._units) < len(default._units) / 2
+
+
+def test_every_name_of_pints_default_registry_is_read_identically_or_refused(registries):
+    """Every unit name, symbol and alias of pint's default registry, bare, plural and with every prefix: what the
+    package's registry reads, the default one reads as the same unit (or one of the same value), so a dropped
+    unit ("ct", "kt", "pt") is refused, never taken for a prefix and another unit ("c"+"t", "k"+"t")."""
+    ours, default = registries
+    spellings = {name for p in default._prefixes.values() for name in (p.name, p.symbol, *p.aliases) if name}
+    prefixes = ["", *sorted(spellings)]
+    read = 0
+    for prefix in prefixes:
+        for name in default._units:
+            for text in (prefix + name, prefix + name + "s"):
+                candidates = ours.parse_unit_name(text)
+                if not candidates:
+                    continue
+                read += 1
+                expected = default.parse_unit_name(text)
+                assert expected, f"{text!r} is read here but not by pint's default registry"
+                if candidates[0] != expected[0]:  # another spelling of one unit (fm: femto-meter, fermi)?
+                    mine, theirs = ours.Quantity(1.0, text), default.Quantity(1.0, text)
+                    assert mine.dimensionality == theirs.dimensionality, text
+                    assert mine.to_root_units().magnitude == pytest.approx(
+                        theirs.to_root_units().magnitude, rel=1e-12
+                    ), text
+    assert read > 10_000  # SI with its prefixes, at least
+
+
+# Datasheet units with their SI values from their definitions: the inch is 0.0254 m and the pound
+# 0.45359237 kg exactly (international yard and pound agreement, 1959), standard gravity 9.80665 m/s^2 (3rd
+# CGPM, 1901), the mechanical horsepower 550 ft*lbf/s.
+_IN, _LB, _G0 = 0.0254, 0.45359237, 9.80665
+DATASHEET_UNITS = [
+    ("1 mm", "m", 1e-3),
+    ("1 µm", "m", 1e-6),
+    ("1 um", "m", 1e-6),
+    ("1 in", "m", _IN),
+    ("1 inch", "m", _IN),
+    ("1 ft", "m", 12 * _IN),
+    ("1 thou", "m", 1e-3 * _IN),
+    ("1 mi", "m", 63360 * _IN),
+    ("1 g", "kg", 1e-3),
+    ("1 lb", "kg", _LB),
+    ("1 oz", "kg", _LB / 16),
+    ("1 t", "kg", 1e3),
+    ("1 lbf", "N", _LB * _G0),
+    ("1 ozf", "N", _LB / 16 * _G0),
+    ("1 kgf", "N", _G0),
+    ("1 gf", "N", 1e-3 * _G0),
+    ("1 kN", "N", 1e3),
+    ("1 mN*m", "N*m", 1e-3),
+    ("1 ozf*in", "N*m", _LB / 16 * _G0 * _IN),
+    ("1 lbf*ft", "N*m", _LB * _G0 * 12 * _IN),
+    ("1 lbf*in", "N*m", _LB * _G0 * _IN),
+    ("1 kgf*cm", "N*m", _G0 * 1e-2),
+    ("1 ft_lb", "N*m", _LB * _G0 * 12 * _IN),
+    ("1 oz*in^2", "kg*m^2", _LB / 16 * _IN**2),
+    ("1 lb*ft^2", "kg*m^2", _LB * (12 * _IN) ** 2),
+    ("1 g*cm^2", "kg*m^2", 1e-7),
+    ("1 kg*cm^2", "kg*m^2", 1e-4),
+    ("1 lbf/in", "N/m", _LB * _G0 / _IN),
+    ("1 N*m/deg", "N*m/rad", 180 / math.pi),
+    ("1 rpm", "rad/s", 2 * math.pi / 60),
+    ("1 krpm", "rad/s", 2e3 * math.pi / 60),
+    ("1 rps", "rad/s", 2 * math.pi),
+    ("1 deg/s", "rad/s", math.pi / 180),
+    ("1 turn", "rad", 2 * math.pi),
+    ("1 deg", "rad", math.pi / 180),
+    ("1 °", "rad", math.pi / 180),
+    ("1 arcmin", "rad", math.pi / 180 / 60),
+    ("1 V/krpm", "V*s/rad", 60 / (2e3 * math.pi)),
+    ("1 N*m/A", "N*m/A", 1.0),
+    ("1 mH", "H", 1e-3),
+    ("1 mΩ", "ohm", 1e-3),
+    ("1 mohm", "ohm", 1e-3),
+    ("1 kW", "W", 1e3),
+    ("1 hp", "W", 550 * 12 * _IN * _LB * _G0),
+    ("1 psi", "Pa", _LB * _G0 / _IN**2),
+    ("1 bar", "Pa", 1e5),
+    ("1 K/W", "K/W", 1.0),
+    ("20 degC", "K", 293.15),
+    ("68 degF", "K", 293.15),
+    ("1 ms", "s", 1e-3),
+    ("1 min", "s", 60.0),
+    ("1 h", "s", 3600.0),
+    ("1 kHz", "Hz", 1e3),
+    ("1 mph", "m/s", 63360 * _IN / 3600),
+    ("1 km/h", "m/s", 1 / 3.6),
+    ("1 ft/s", "m/s", 12 * _IN),
+    ("1 mA", "A", 1e-3),
+    ("1 A*h", "C", 3600.0),
+    ("1 percent", "", 0.01),
+]
+
+
+@pytest.mark.parametrize(("text", "unit", "si"), DATASHEET_UNITS, ids=[t for t, _, _ in DATASHEET_UNITS])
+def test_datasheet_units_read_their_defined_value_as_pints_default_registry_does(registries, text, unit, si):
+    from collision_reflex._units import parse_quantity
+
+    _, default = registries
+    assert parse_quantity(text, unit) == pytest.approx(si, rel=1e-12)
+    number, name = text.split(" ", 1)
+    in_default = default.Quantity(float(number), name.replace("^", "**")).to(unit or "dimensionless")
+    assert parse_quantity(text, unit) == pytest.approx(float(in_default.magnitude), rel=1e-14)
+
+
+def test_rev_is_a_turn():
+    # Not a name of pint's own registry; datasheets write it ("4096 counts/rev", "5 mm/rev").
+    from collision_reflex._units import parse_quantity
+
+    assert parse_quantity("1 rev", "rad") == pytest.approx(2 * math.pi, rel=1e-15)
+    assert parse_quantity("5 mm/rev", "m/rad") == pytest.approx(5e-3 / (2 * math.pi), rel=1e-15)
+
+
+@pytest.mark.parametrize("text", ["1 statvolt", "1 kcal", "1 Btu", "1 ly", "1 eV", "1 gauss"])
+def test_a_dropped_unit_is_refused_as_unknown(text):
+    from collision_reflex._units import QuantityError, parse_quantity
+
+    with pytest.raises(QuantityError) as caught:
+        parse_quantity(text, "kg")
+    assert caught.value.kind == "unit"
+
+
+@pytest.mark.parametrize(("text", "unit", "si"), DATASHEET_UNITS, ids=[t for t, _, _ in DATASHEET_UNITS])
+def test_a_number_converts_to_the_bit_as_pint_converts_it(registries, text, unit, si):
+    # The package multiplies by the unit's cached factor (an offset unit, degC, goes through pint each time):
+    # the same float as pint's conversion of the number, for numbers of any size and sign.
+    from collision_reflex._units import parse_quantity
+
+    _, default = registries
+    name = text.split(" ", 1)[1]
+    for value in np.random.default_rng(7).normal(0.0, 1.0, 20) * 10.0 ** np.arange(-9, 11):
+        expected = float(default.Quantity(float(value), name.replace("^", "**")).to(unit or "").magnitude)
+        assert parse_quantity(f"{float(value)!r} {name}", unit) == expected, (value, name)

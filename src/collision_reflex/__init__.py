@@ -11,8 +11,9 @@ start without loading CasADi, SciPy, Pinocchio or Matplotlib.
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING
+
+from ._lazy import lazy_attributes
 
 if TYPE_CHECKING:  # the names as type checkers and IDEs see them; at run time `__getattr__` imports them
     from . import experiments
@@ -381,25 +382,4 @@ __all__ = [
 ]
 
 if not TYPE_CHECKING:  # hidden from type checkers, so that a misspelt name is still an error for them
-
-    def __getattr__(name: str) -> object:
-        """Import the public name ``name`` (or the subpackage ``name``) on first access."""
-        if name in _WHERE:
-            module, attribute = _WHERE[name]
-            value = getattr(importlib.import_module(module, __name__), attribute)
-        elif name.startswith("__") or not name.isidentifier():
-            raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-        else:  # a subpackage, bound as an attribute only once something imports it
-            try:
-                value = importlib.import_module(f".{name}", __name__)
-            except ModuleNotFoundError as missing:
-                if missing.name != f"{__name__}.{name}":
-                    raise
-                raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None
-        globals()[name] = value  # later accesses find it without calling __getattr__
-        return value
-
-
-def __dir__() -> list[str]:
-    """The module's attributes and every public name, imported or not."""
-    return sorted(set(globals()) | set(__all__))
+    __getattr__, __dir__ = lazy_attributes(globals(), _WHERE, __all__)

@@ -14,6 +14,8 @@ from __future__ import annotations
 import functools
 import math
 import re
+import sys
+from importlib import resources
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
@@ -51,13 +53,126 @@ class QuantityError(ValueError):
         self.dimension = dimension
 
 
+# The registry holds the part of pint's own definitions file (``default_en.txt``) that datasheets and studies
+# use; building pint's whole registry takes ~5x as long (0.14 s of a 0.9 s ``crx validate``; pint's on-disk
+# cache would avoid it, but the package writes nothing outside the folders it is given). The definitions are
+# pint's lines, picked by name here (two groups and the mks system whole), never copied. Kept: SI base and
+# derived units with every prefix, angles (deg, turn, arcmin), rpm and rps, time, temperature, the
+# international inch/foot/yard/mile, the avoirdupois pound and ounce with their forces (lbf, ozf), kgf and gf,
+# and the power, pressure and electrical units of motor datasheets. Also kept: every unit whose name the
+# smaller registry would otherwise read as a prefix and another unit ("kt" would be kilo-tonne without the
+# knot, "pt" pico-tonne without the pint, "pc" pico-c without the parsec): a unit pint's default registry
+# knows is read identically here or refused, never read as another (tests/test_study_units.py checks every
+# name, plural and prefix of pint's default registry).
+_KEPT_BLOCKS = frozenset(
+    {
+        "@defaults",
+        "@group USCSLengthInternational",
+        "@group Avoirdupois",
+        "@system mks using international",
+    }
+)
+_DATASHEET_UNITS = """
+    meter second ampere candela gram mole kelvin radian bit count pi standard_gravity standard_atmosphere
+    turn degree arcminute arcsecond steradian percent permille ppm micron metric_ton grain carat
+    minute hour day degree_Celsius degree_Fahrenheit degree_Rankine liter cubic_centimeter
+    hertz revolutions_per_minute revolutions_per_second counts_per_second
+    mile_per_hour kilometer_per_hour meter_per_second foot_per_second meter_per_second_squared
+    newton dyne force_kilogram force_gram force_metric_ton joule erg watt_hour
+    watt volt_ampere horsepower metric_horsepower electrical_horsepower
+    pascal bar torr pound_force_per_square_inch kip_per_square_inch foot_pound
+    coulomb ampere_hour volt ohm siemens farad weber henry tesla
+"""
+# Kept only for their names (and what they are defined with): Eh, Rd, Td, at, hbar, kt, nmi, rads, bps, kat,
+# pc, fm, mil, pt, qt, dpi, dqt, dgal, rd, ppi, Tt.
+_UNITS_FOR_THEIR_NAMES = """
+    hartree rydberg planck_constant speed_of_light rydberg_constant dirac_constant rutherford becquerel
+    townsend technical_atmosphere knot nautical_mile rads gray baud katal parsec tansec astronomical_unit
+    fermi mil pint quart gallon dry_pint dry_quart dry_gallon bushel rod survey_foot pixels_per_inch pixel
+    tex
+"""
+_KEPT_UNITS = frozenset(_DATASHEET_UNITS.split() + _UNITS_FOR_THEIR_NAMES.split())
+
+# pint.compat imports Dask, SciPy and Babel when they are installed, for integrations the package never uses
+# (Quantity-wrapped Dask arrays, `to_preferred`, locale formatting): 0.09 s of `crx validate`. The `crx`
+# command's own process imports pint without them (:func:`hide_pint_extras`); library users keep all of pint.
+_PINT_EXTRAS = ("dask", "scipy", "babel")
+_hide_extras = False
+
+
+def hide_pint_extras() -> None:
+    """Import pint, when it is first needed, without its optional integrations (for the ``crx`` command)."""
+    global _hide_extras
+    _hide_extras = True
+
+
+def import_pint() -> Any:
+    """pint, imported (without the extras after :func:`hide_pint_extras`, if pint is not imported yet)."""
+    if not _hide_extras or "pint" in sys.modules:
+        import pint
+
+        return pint
+    hidden = [name for name in _PINT_EXTRAS if name not in sys.modules]
+    for name in hidden:
+        sys.modules[name] = None  # type: ignore[assignment]  # `import dask` fails, find_spec gives None
+    try:
+        import pint
+    finally:
+        for name in hidden:  # importable again for the code that uses them
+            if name in sys.modules and sys.modules[name] is None:
+                del sys.modules[name]
+    return pint
+
+
+def registry_definitions() -> list[str] | None:
+    """The lines of pint's definitions file the registry is built from.
+
+    None if one of the kept names is missing from the installed pint's file: the registry is then pint's
+    whole default one.
+    """
+    folder = resources.files("pint")
+
+    def lines(name: str) -> Any:
+        for line in folder.joinpath(name).read_text(encoding="utf-8").splitlines():
+            text = line.split("#", 1)[0].rstrip()
+            if text.strip().startswith("@import"):
+                yield from lines(text.split()[1])
+            elif text.strip():
+                yield text
+
+    kept: list[str] = []
+    found: set[str] = set()
+    block = ""  # the block a line is in: "" outside any, else its first line ("@group Avoirdupois")
+    for line in lines("default_en.txt"):
+        text = line.strip()
+        if text.startswith("@"):
+            block = block if text == "@end" else " ".join(text.split())
+            if block in _KEPT_BLOCKS:  # its first and last lines
+                kept.append(line)
+                found.add(block)
+            block = "" if text == "@end" else block
+            continue
+        name = text.split("=", 1)[0].strip()
+        if block in _KEPT_BLOCKS:  # @defaults, a @group or a @system kept whole
+            kept.append(line)
+        elif name.endswith("-") and not block:
+            kept.append(line)  # every prefix
+        elif name in _KEPT_UNITS and (not block or block.startswith("@group")):
+            kept.append(text)  # a unit of a group not kept whole goes to the default group
+            found.add(name)
+        # Left out: the named dimensions ("[force] = ..."), which no quantity of the bounded grammar names,
+        # and the conversions of every @context.
+    return kept if found == _KEPT_UNITS | _KEPT_BLOCKS else None
+
+
 @functools.cache
 def unit_registry() -> pint.UnitRegistry:
     """The registry every unit string of the package is read with: study files, catalogues, traces."""
-    import pint
-
-    # Not pint's on-disk cache (0.1 s faster): the package writes nothing outside the folders it is given.
-    return pint.UnitRegistry()
+    pint = import_pint()
+    definitions = registry_definitions()
+    registry = pint.UnitRegistry() if definitions is None else pint.UnitRegistry(definitions)
+    registry.define("@alias turn = rev")  # datasheets' "counts/rev", "mm/rev"; not a name of pint's own
+    return registry
 
 
 @functools.lru_cache(maxsize=4096)  # files repeat their units; a pint conversion costs ~0.2 ms
@@ -106,8 +221,20 @@ def si_scale(unit: str) -> float:
 
 def _converted(number: float, text: str, unit: str, angle_explicit: bool) -> float:
     """``number`` in the unit ``text`` (already of the bounded grammar), converted to ``unit``."""
-    import pint
+    factor = _factor(text, unit, angle_explicit)
+    if factor is not None:
+        return number * factor  # as pint converts: the magnitude times the units' factor
+    pint = import_pint()
+    try:  # an offset unit (degC): pint's own conversion of the number
+        return float(unit_registry().Quantity(number, text.replace("^", "**")).to(unit).magnitude)
+    except (pint.PintError, OverflowError, ValueError, TypeError):
+        raise QuantityError("unit", f"a unit that cannot be converted to {unit}") from None
 
+
+@functools.lru_cache(maxsize=1024)  # a catalogue gives 100 numbers in a dozen units
+def _factor(text: str, unit: str, angle_explicit: bool) -> float | None:
+    """The factor from the unit ``text`` to ``unit``, once its dimension is checked (None for an offset unit)."""
+    pint = import_pint()
     registry = unit_registry()
     try:
         given = registry.Quantity(1.0, text.replace("^", "**"))
@@ -126,10 +253,11 @@ def _converted(number: float, text: str, unit: str, angle_explicit: bool) -> flo
             "angle", f"no angle unit; give an angle per time, e.g. '3000 rpm' or '314 {unit}'"
         )
     try:
-        with_number = registry.Quantity(number, text.replace("^", "**"))
-        return float(with_number.to(unit).magnitude)
+        zero = registry.Quantity(0.0, text.replace("^", "**")).to(unit).magnitude
+        factor = float(given.to(unit).magnitude)
     except (pint.PintError, OverflowError, ValueError, TypeError):  # offset units (degC) in a product, ...
         raise QuantityError("unit", f"a unit that cannot be converted to {unit}") from None
+    return factor if zero == 0 else None
 
 
 def _dimension(quantity: pint.Quantity) -> str:

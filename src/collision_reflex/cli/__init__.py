@@ -8,43 +8,37 @@ exit with status 2 (or the error's ``exit_status``: 1 for a failure after work s
 from __future__ import annotations
 
 import argparse
+import importlib
 import os
 import sys
 from collections.abc import Sequence
 
-from .. import __version__
+from .. import __version__, _units
 from ..errors import CollisionReflexError
-from . import export as _export
-from . import fit as _fit
-from . import impulse as _impulse
-from . import motors as _motors
 from . import options
-from . import report as _report
-from . import run as _run
-from . import schema as _schema
-from . import simulate as _simulate
-from . import surface as _surface
-from . import sweep as _sweep
-from . import validate as _validate
 
-# Subcommand modules, in the order `crx --help` lists them.
-_SUBCOMMANDS = [
-    _impulse,
-    _motors,
-    _sweep,
-    _surface,
-    _fit,
-    _simulate,
-    _validate,
-    _schema,
-    _run,
-    _report,
-    _export,
-]
+# Subcommands, in the order `crx --help` lists them; each is the module of its name, with `register(subparsers)`.
+SUBCOMMANDS = (
+    "impulse",
+    "motors",
+    "sweep",
+    "surface",
+    "fit",
+    "simulate",
+    "validate",
+    "schema",
+    "run",
+    "report",
+    "export",
+)
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The ``crx`` parser with every subcommand."""
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The ``crx`` parser with every subcommand, or with ``command``'s alone.
+
+    A subcommand's module imports what its options need (the model's constants, the catalogues); parsing
+    ``crx validate ...`` with the validate subcommand alone keeps the others' imports out of its start-up.
+    """
     parser = options.Parser(
         prog="crx",
         description=(
@@ -55,18 +49,21 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for module in _SUBCOMMANDS:
-        module.register(subparsers)
+    for name in SUBCOMMANDS if command is None else (command,):
+        importlib.import_module(f".{name}", __name__).register(subparsers)
     return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run ``crx`` with ``argv`` (default: the process's arguments) and return its exit status."""
-    parser = build_parser()
+    arguments = sys.argv[1:] if argv is None else list(argv)
+    # The command is the first argument (the options before it are --help and --version, which need them all).
+    parser = build_parser(arguments[0] if arguments and arguments[0] in SUBCOMMANDS else None)
     try:
-        args = parser.parse_args(argv)
+        args = parser.parse_args(arguments)
     except SystemExit as done:  # --help, --version, or a usage error already printed as one line
         return done.code if isinstance(done.code, int) else 0 if done.code is None else 2
+    _units.hide_pint_extras()
     try:
         status = int(args.run(args) or 0)
         sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's exit flush
