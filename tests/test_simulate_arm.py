@@ -228,7 +228,7 @@ def test_force_sensor_is_armed_when_the_pulse_stays_below_the_threshold(arm):
 
     The first version armed only when its signal *fell* below the threshold, or at the window's end (by
     default twenty periods of the finger on the contact): a signal that never rose stayed blind to the
-    window's end. Put back as that window, the detection comes there, 14 times as late.
+    window's end. Put back as that window, the detection comes 14 times as late.
     """
     from collision_reflex.simulate.setup import oscillation_period
 
@@ -243,8 +243,8 @@ def test_force_sensor_is_armed_when_the_pulse_stays_below_the_threshold(arm):
     assert default.impulse == pytest.approx(unblanked.impulse, rel=1e-6)
     old_window = 20 * oscillation_period(eff["m_f"], soft)
     old = simulate_arm_collision(arm, HONEST_Q, HONEST_U, v_star, 3.0, blanking=old_window, **common)
-    assert old.detection_time == pytest.approx(old_window, rel=1e-6)
     assert old.detection_time > 10 * default.detection_time
+    assert old.impulse > 2 * default.impulse
 
 
 def test_force_sensor_lags_a_damped_contact_by_the_derived_share(arm):

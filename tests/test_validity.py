@@ -84,8 +84,8 @@ def test_map_reproduces_the_known_cases(tiny_map):
         soft = _cell(tiny_map, 1, "force", 0.1, placement)
         assert 0.06 < soft.difference < 0.26 and not soft.valid
     summary = validity_summary(tiny_map[tiny_map["configuration"] == 0])
-    assert summary.loc[("spring_torque", "constant"), 0.1].tolist() == [1.0, 1.0]
-    assert summary.loc[("spring_torque", "constant"), 1.0].tolist() == [0.0, 0.0]
+    assert summary.loc[("spring_torque", "ideal", "constant"), 0.1].tolist() == [1.0, 1.0]
+    assert summary.loc[("spring_torque", "ideal", "constant"), 1.0].tolist() == [0.0, 0.0]
 
 
 def test_sprung_reaction_model_is_the_simulators(arm, tiny_map):
@@ -129,10 +129,11 @@ def test_map_rows_are_the_simulation_and_the_closed_form(arm, tiny_map):
 def test_map_has_the_impedance_drive(arm):
     """``drives`` adds the impedance drive: rows for both, the quasi-static case the admittance's impulse.
 
-    Software springs of 200 N m/rad behind the 50 N m/rad joints, 0.1 v*: the impedance loop's rotor dynamics
-    are fast against the sensing, so the two drives agree within 0.5 % (measured 0.1 %; the software
-    stiffness off by 10 % moves the 90 % sensing share by about 2 %). An infinite software stiffness is refused
-    at once for the impedance drive.
+    Software springs of 200 N m/rad behind the 50 N m/rad joints, 0.1 v*, a contact-force sensor: the
+    impedance loop's rotor dynamics are fast against the sensing, so the two drives agree within 1.5 %
+    (measured -0.8 %, the undamped rotor's ringing; the software stiffness off by 10 % moves ``k`` by 2 %
+    and the 90 % sensing share by about 1.8 % more). They are different simulations, not one run twice. An
+    infinite software stiffness is refused at once for the impedance drive.
     """
     design = dataclasses.replace(JOINTS, software_stiffness=200.0)
     table = validity_map(
@@ -142,13 +143,14 @@ def test_map_has_the_impedance_drive(arm):
         [U],
         velocity_ratios=(0.1,),
         stiffness_ratios=(1000.0,),
-        detections=("spring_torque",),
+        detections=("force",),
         drives=("ideal", "impedance"),
     )
     assert set(table["drive"]) == {"ideal", "impedance"} and set(table["error"]) == {""}
     ideal = table[table["drive"] == "ideal"]["simulated"].to_numpy()
     impedance = table[table["drive"] == "impedance"]["simulated"].to_numpy()
-    np.testing.assert_allclose(impedance, ideal, rtol=0.005)
+    np.testing.assert_allclose(impedance, ideal, rtol=0.015)
+    assert np.all(impedance != ideal)
     assert table.loc[table["drive"] == "ideal", "closed_form"].tolist() == (
         table.loc[table["drive"] == "impedance", "closed_form"].tolist()
     )
