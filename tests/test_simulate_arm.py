@@ -365,3 +365,20 @@ def test_impedance_drive_approaches_the_admittance_slowly(arm, slow_v0):
 def test_impedance_drive_needs_a_finite_software_stiffness(arm):
     with pytest.raises(InvalidParameter, match="impedance drive"):
         simulate_arm_collision(arm, HONEST_Q, HONEST_U, 0.05, 3.0, drive="impedance", **JOINTS)
+
+
+def test_a_detector_that_never_fires_is_a_clear_error(arm):
+    """No joint watched (every current threshold infinite): the run ends after its bounded simulated time
+    with an error that says what happened, never a hang or a silent result."""
+    with pytest.raises(SimulationError, match="never reached the threshold"):
+        simulate_arm_collision(
+            arm,
+            HONEST_Q,
+            HONEST_U,
+            0.05,
+            3.0,
+            detection="current",
+            current_threshold=[np.inf, np.inf],
+            contact_stiffness=1e4,
+            **JOINTS,
+        )
