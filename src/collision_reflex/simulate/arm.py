@@ -18,7 +18,8 @@ and its software stiffness ``k_s,i`` acts as an admittance, so that the joint sp
 K_s / (K_m + K_s)`` of the closed form. Detection (``detection=``, :mod:`.arm_detection`): a contact-force
 sensor (``"force"``, the closed form's meaning of ``F_s``), a generalized-momentum observer (``"observer"``),
 the joint spring torques projected on ``u`` (``"spring_torque"``, the default, kept from the first version),
-the contact point's position error (``"position"``) or the motor torques (``"current"``), optionally sampled.
+the contact point's position error against the commanded path (``"position"``) or the residual motor
+torques over the model's (``"current"``), optionally sampled.
 At detection (plus an optional delay) the admittance is switched off and the motors push (``retreat=``) with
 ``tau = -F_a J^T u``, ``F_a = min_i tau_max,i / |(J^T u)_i|``, the largest force along ``-u`` before the first
 joint saturates, as the closed form's ``a = F_a / m_r`` assumes, or every joint saturated (``"saturated"``).
