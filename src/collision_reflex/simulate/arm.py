@@ -18,7 +18,8 @@ and its software stiffness ``k_s,i`` acts as an admittance, so that the joint sp
 K_s / (K_m + K_s)`` of the closed form. Detection (``detection=``, :mod:`.arm_detection`): a contact-force
 sensor (``"force"``, the closed form's meaning of ``F_s``), a generalized-momentum observer (``"observer"``),
 the joint spring torques projected on ``u`` (``"spring_torque"``, the default, kept from the first version),
-the contact point's position error (``"position"``) or the motor torques (``"current"``), optionally sampled.
+the contact point's position error against the commanded path (``"position"``) or the residual motor
+torques over the model's (``"current"``), optionally sampled.
 At detection (plus an optional delay) the admittance is switched off and the motors push (``retreat=``) with
 ``tau = -F_a J^T u``, ``F_a = min_i tau_max,i / |(J^T u)_i|``, the largest force along ``-u`` before the first
 joint saturates, as the closed form's ``a = F_a / m_r`` assumes, or every joint saturated (``"saturated"``).
@@ -71,6 +72,7 @@ RETREATS: tuple[str, ...] = ("along_u", "saturated")
 """``"along_u"``: the motors push with ``tau = -F_a J^T n``, each joint at most at its limit and the first at
 it, the closed form's reaction. ``"saturated"``: a retreat command saturates every joint, ``tau_i = -tau_max,i
 sign((J^T n)_i)`` (a real controller's reaction: more force along ``-n``, and a push off it)."""
+_CURRENT_LEVER_SHARE = 0.1  # joints with a smaller share of the largest lever sense no current by default
 _MAX_REBOUNDS = 50  # contacts after the reaction before the finger is taken to keep hitting the wall
 _RENAMED_KEYWORDS = {
     "velocity": "approach_velocity",
@@ -192,17 +194,21 @@ def simulate_arm_collision(
         ``"current"`` (motor torque per joint); see :mod:`collision_reflex.simulate.arm_detection`.
     observer_gain: the momentum observer's gain ``K`` [1/s], > 0 (``"observer"`` only).
     sample_rate: the detector's sample rate [Hz], > 0; None (default) for a continuous detector.
-    current_threshold: per-joint motor-torque thresholds [N m] (output side), ``"current"`` only; default
-        ``threshold |J(q)^T u|``.
+    current_threshold: per-joint thresholds on the residual motor torque [N m] (output side, ``inf``: the
+        joint is not watched), ``"current"`` only; default ``threshold |J(q)^T u|`` on the joints with at
+        least a tenth of the largest lever.
     retreat: the reaction's motor torques, ``"along_u"`` (default: the closed form's, each joint at most at
         its limit along the escape direction) or ``"saturated"`` (every joint at its limit); see
         :data:`RETREATS`.
-    blanking: the longest time after the impact the detector stays unarmed [s], >= 0: it arms when its
-        signal first falls below the threshold after the impact, or at ``blanking`` at the latest. None
-        (default): twenty periods of the finger on the wall for ``"force"`` (the impact pulse, ``m_f v0``
-        over about half a period, would trip a contact sensor at once: the closed form's threshold means the
-        force after it), 0 for the other schemes (their signal passes through the joints or a filter; an
-        observer with ``K m_f v0 > F_s`` does detect the impact itself).
+    blanking: how long after the impact the detector takes a crossing of its threshold for the impact
+        pulse [s], >= 0. A signal that rises above the threshold within it is blanked until it falls below
+        again; if it has not by the end, the contact force holds above the threshold and it detects then; a
+        signal still below the threshold at the end was armed all along. None (default): for ``"force"`` the
+        impact pulse of the finger on the contact and the joint springs
+        (:func:`collision_reflex.simulate.arm_dynamics.impact_pulse_duration`; the pulse, ``m_f v0``, would trip
+        a contact sensor at once: the closed form's threshold means the force after it), 0 for the other
+        schemes (their signal passes through the joints or a filter; an observer with ``K m_f v0 > F_s`` does
+        detect the impact itself).
     drive: ``"ideal"`` (default) or ``"impedance"`` (finite ``software_stiffness`` needed), see
         :data:`ARM_DRIVES`.
     software_damping: the impedance drive's joint damping ``d_s`` [N m s/rad], >= 0 (scalar or (nv,)).
@@ -240,6 +246,7 @@ def simulate_arm_collision(
         blanking,
         drive,
         _impedance_damping(joints, drive, software_damping),
+        float(threshold),
     )
     dynamics = ArmDynamics(arm, joints, closed, contact_stiffness, contact_damping_ratio, sensing)
     trace = _integrate(dynamics, closed, float(approach_velocity), float(threshold), delay, rtol, max_steps)
@@ -271,7 +278,7 @@ class _Sensing:
 
     Scheme, observer gain [1/s], sample rate [Hz] (or None), per-joint current thresholds [N m] (nv,), the
     retreat, the blanking after the impact [s] (None: the scheme's default), the drive and its joint damping
-    [N m s/rad] (nv,).
+    [N m s/rad] (nv,), the force threshold [N].
     """
 
     detection: str
@@ -282,6 +289,7 @@ class _Sensing:
     blanking: float | None
     drive: str
     software_damping: np.ndarray
+    threshold: float
 
 
 def _impedance_damping(joints: _Joints, drive: str, software_damping: Any) -> np.ndarray:
@@ -300,11 +308,15 @@ def _impedance_damping(joints: _Joints, drive: str, software_damping: Any) -> np
 
 
 def _current_threshold(arm: Any, joints: _Joints, threshold: float, given: Any) -> np.ndarray:
-    """Per-joint motor-torque thresholds [N m]: ``given``, or ``threshold |J(q0)^T u|``."""
+    """Per-joint motor-torque thresholds [N m]: ``given``, or ``threshold |J(q0)^T u|``.
+
+    By default a joint whose lever is below a tenth of the largest is left out (an infinite threshold): it
+    barely feels the contact, and a threshold that small would trip on the links' inertial torques.
+    """
     if given is not None:
-        return _joint("current_threshold", given, joints.q0.size)
-    lever = arm.kinematics(joints.q0[None]).jacobian[0].T @ joints.u
-    return np.maximum(threshold * np.abs(lever), 1e-12 * threshold * float(np.max(np.abs(lever))))
+        return _joint("current_threshold", given, joints.q0.size, allow_inf=True)
+    lever = np.abs(arm.kinematics(joints.q0[None]).jacobian[0].T @ joints.u)
+    return np.where(lever >= _CURRENT_LEVER_SHARE * float(np.max(lever)), threshold * lever, math.inf)
 
 
 @dataclass(frozen=True)
@@ -553,8 +565,8 @@ def _integrate(
     detected.terminal, detected.direction = True, 1  # type: ignore[attr-defined]
 
     # 1. Impact and sensing until the estimated force reaches the threshold, once armed.
-    t, y, fell = _arm(dynamics, trace, y, threshold, options)
-    if fell or detection_margin(dynamics, t, y, threshold) < 0:
+    t, y, armed = _blank(dynamics, trace, y, threshold, options)
+    if armed and detection_margin(dynamics, t, y, threshold) < 0:  # at or above it: it fires at once
         solution = solve_ivp(dynamics.rhs, (t, duration), y, events=detected, **options)
         trace.add(solution, dynamics)
         if solution.status != 1:
@@ -575,26 +587,44 @@ def _integrate(
     return trace
 
 
-def _arm(
+def _blank(
     dynamics: ArmDynamics, trace: _ArmTrace, y: np.ndarray, threshold: float, options: dict[str, Any]
 ) -> tuple[float, np.ndarray, bool]:
-    """Integrate from the impact until the detector arms.
+    """Integrate through the blanking window after the impact.
 
-    It arms when its signal falls below the threshold, or when the blanking time is over. Returns the time
-    [s], the state then and whether the signal fell below the threshold.
+    A rise above the threshold within the window is the impact pulse: the detector waits until the signal
+    falls below again, and is armed from there. If it does not fall by the window's end, the force holds
+    above the threshold and the detector fires there. A signal that stays below was armed all along (a first
+    version waited for a fall in any case, and against a soft object, whose pulse never reaches the
+    threshold, stayed blind for the whole window). Returns the time [s], the state then and whether the
+    detector is armed (False: it fires at that time).
     """
     from scipy.integrate import solve_ivp
 
-    if dynamics.blanking <= 0:
-        return 0.0, y, False
+    window = dynamics.blanking
+    if window <= 0:
+        return 0.0, y, True
 
-    def fallen(t: float, y: np.ndarray) -> float:
+    def margin(t: float, y: np.ndarray) -> float:
         return detection_margin(dynamics, t, y, threshold)
 
-    fallen.terminal, fallen.direction = True, -1  # type: ignore[attr-defined]
-    solution = solve_ivp(dynamics.rhs, (0.0, dynamics.blanking), y, events=fallen, **options)
+    def rose(t: float, y: np.ndarray) -> float:
+        return margin(t, y)
+
+    def fell(t: float, y: np.ndarray) -> float:
+        return margin(t, y)
+
+    rose.terminal, rose.direction = True, 1  # type: ignore[attr-defined]
+    fell.terminal, fell.direction = True, -1  # type: ignore[attr-defined]
+    solution = solve_ivp(dynamics.rhs, (0.0, window), y, events=rose, **options)
     trace.add(solution, dynamics)
-    return float(solution.t[-1]), solution.y[:, -1].copy(), solution.status == 1
+    t, y = float(solution.t[-1]), solution.y[:, -1].copy()
+    if solution.status != 1:  # no rise within the window: armed all along, nothing crossed yet
+        return t, y, True
+    solution = solve_ivp(dynamics.rhs, (t, window), y, events=fell, **options)
+    trace.add(solution, dynamics)
+    t, y = float(solution.t[-1]), solution.y[:, -1].copy()
+    return t, y, solution.status == 1
 
 
 def _advance(

@@ -15,7 +15,6 @@ import numpy as np
 
 from ..errors import SimulationError
 from .contact import damping_from_ratio
-from .setup import oscillation_period
 
 if TYPE_CHECKING:
     from .arm import _ClosedForm, _Joints, _Sensing
@@ -54,6 +53,37 @@ def _link_model(arm: Any) -> tuple[Any, Any, int]:
     return model, model.createData(), contact_id
 
 
+def impact_pulse_duration(
+    finger_mass: float,
+    contact_stiffness: float,
+    contact_damping: float,
+    joint_stiffness: float,
+    approach_velocity: float,
+    threshold: float,
+) -> float:
+    """How long the impact pulse can hold a contact-force sensor above its threshold [s].
+
+    During the impact the finger (mass ``m_f``) sits between the contact (``k_c``, damper ``c``) and the joint
+    springs along ``u`` (``k_m``), in parallel: ``K = k_c + k_m``, ``omega = sqrt(K / m_f)``, damping ratio
+    ``zeta = c / (2 sqrt(K m_f))``. Its free motion from ``v0`` decays at ``sigma = zeta omega`` (underdamped)
+    or at the slow root ``omega (zeta - sqrt(zeta^2 - 1))`` (overdamped), from an elastic force of at most
+    ``A = k_c v0 / omega``. The pulse is over after half a period, or when ``A exp(-sigma t)`` has fallen to
+    half the threshold, whichever is later.
+
+    Parameters
+    ----------
+    finger_mass: ``m_f`` [kg]; contact_stiffness: ``k_c`` [N/m]; contact_damping: ``c`` [N s/m];
+    joint_stiffness: ``k_m`` along ``u`` [N/m]; approach_velocity: ``v0`` [m/s]; threshold: ``F_s`` [N].
+    """
+    stiffness = contact_stiffness + joint_stiffness
+    omega = math.sqrt(stiffness / finger_mass)
+    zeta = contact_damping / (2 * math.sqrt(stiffness * finger_mass))
+    decay = omega * (zeta - math.sqrt(zeta**2 - 1)) if zeta > 1 else omega * zeta
+    amplitude = contact_stiffness * approach_velocity / omega
+    fall = math.log(max(2 * amplitude / threshold, 1.0)) / decay if decay > 0 else math.inf
+    return max(math.pi / omega, fall)
+
+
 class ArmDynamics:
     """Links, motors, wall and observer: the right-hand side of the state ``(q, q', theta, theta', s, impulse)``.
 
@@ -89,11 +119,18 @@ class ArmDynamics:
         self.observer_gain, self.current_threshold = sensing.observer_gain, sensing.current_threshold
         self.sample_rate = sensing.sample_rate
         self.drive, self.software_damping = sensing.drive, sensing.software_damping
-        wall_period = oscillation_period(closed.effective["m_f"], contact_stiffness)
-        default_blanking = 20 * wall_period if sensing.detection == "force" else 0.0
-        self.blanking = default_blanking if sensing.blanking is None else sensing.blanking
         _, jac0 = self.contact_kinematics(joints.q0)
         self.approach_velocity = float(self.normal @ (jac0 @ self.v_ref))  # v0 [m/s]
+        pulse = impact_pulse_duration(
+            closed.effective["m_f"],
+            contact_stiffness,
+            self.contact_damping,
+            closed.effective["k_m"],
+            self.approach_velocity,
+            sensing.threshold,
+        )
+        default_blanking = pulse if sensing.detection == "force" else 0.0
+        self.blanking = default_blanking if sensing.blanking is None else sensing.blanking
         self.initial_momentum = self.mass_matrix(joints.q0) @ self.v_ref  # p(0) [N m s]
         self.lumped_stiffness = closed.effective["k"]
         self.evaluations, self.max_evaluations = 0, math.inf
@@ -194,6 +231,27 @@ class ArmDynamics:
         # The admittance's motor acceleration (1 - share) q'': zero for an ideal velocity drive.
         ddq = self.rhs(t, y)[nv : 2 * nv]
         return self.inertia * (1 - self.share) * ddq + spring
+
+    def residual_motor_torque(self, t: float, y: np.ndarray) -> np.ndarray:
+        """Motor torques less the model's expectation for the motion, ``C(q, q') q'`` (nv,) [N m].
+
+        The reference runs at constant joint rates (no commanded acceleration) and gravity is left out, so
+        the model's torque is the links' Coriolis and centrifugal torque at the measured ``q, q'``.
+        """
+        nv = self.nv
+        qs, dq = y[:nv], y[nv : 2 * nv]
+        expected = np.asarray(self.pin.rnea(self.model, self.data, qs, dq, np.zeros(nv)))
+        return self.motor_torque(t, y) - expected
+
+    def position_error(self, t: float, y: np.ndarray) -> float:
+        """The contact point's error along ``n`` against the motors' commanded path [m].
+
+        ``n . (p(theta_ref(t)) - p(q))``: the reference joint angles ``q0 + theta_ref' t`` through the forward
+        kinematics, less the contact point's position.
+        """
+        commanded, _ = self.contact_kinematics(self.q0 + self.v_ref * t)
+        position, _ = self.contact_kinematics(y[: self.nv])
+        return float(self.normal @ (commanded - position))
 
     def force_estimate(self, t: float, y: np.ndarray) -> float:
         """Contact force along ``u`` estimated from the joint spring torques [N]."""

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import itertools
 import math
 import time
 from collections.abc import Sequence
@@ -35,8 +36,8 @@ from ..model.joint_space import DETECTIONS as JOINT_SPACE_DETECTIONS
 from ..model.joint_space import JointSpaceArm
 from . import arm as arm_simulation
 from .arm_detection import DETECTIONS
+from .contact import damping_from_ratio
 from .dynamics import admittance_share
-from .setup import oscillation_period
 
 VELOCITY_RATIOS: tuple[float, ...] = (0.1, 0.3, 1.0, 3.0, 10.0)
 """Approach velocities swept, as multiples of the closed form's optimum ``v* = F_s / sqrt(2 k m_f)``."""
@@ -62,6 +63,14 @@ robot mass away, the term the constant acceleration leaves out); ``"joint_space"
 the wall, linearised at ``q``; it places each inertia where the arm has it, so it is the same under both
 placements, and it takes the contact as rigid: against a compliant object it leaves the object out)."""
 
+DRIVES: tuple[str, ...] = arm_simulation.ARM_DRIVES
+"""The simulated drives: ``"ideal"`` (an ideal admittance) and ``"impedance"`` (the physical impedance loop
+with the rotor inertia; a finite software stiffness needed)."""
+
+CONTACT_DAMPING_RATIO = 2.0
+"""The simulated contact's damping, as a ratio of critical for the finger mass (the simulator's default: a
+plastic impact, restitution 0.02)."""
+
 TORQUE_DETECTION = "spring_torque"
 """The simulator's default detection: the contact force estimated from the joint spring torques."""
 
@@ -78,6 +87,7 @@ class JointDesign:
     threshold: contact-force threshold of the detector ``F_s`` [N].
     software_stiffness: joint software stiffness [N m/rad]; ``inf`` for ideally velocity-controlled motors.
     motor_mass: motor (and gearbox) mass per joint [kg], carried by the parent link; None: the arm's.
+    software_damping: the impedance drive's joint damping [N m s/rad] (``drive="impedance"`` only).
     """
 
     mechanical_stiffness: Any
@@ -86,6 +96,7 @@ class JointDesign:
     threshold: float
     software_stiffness: Any = math.inf
     motor_mass: Any = None
+    software_damping: Any = 0.0
 
     def on(self, arm: Any) -> Any:
         """``arm`` with this design's motor masses (the arm itself when they are the arm's)."""
@@ -105,6 +116,7 @@ class JointDesign:
             "reflected_inertia": self.reflected_inertia,
             "torque_limit": self.torque_limit,
             "software_stiffness": self.software_stiffness,
+            "software_damping": self.software_damping,
         }
 
 
@@ -240,7 +252,8 @@ class ValidityCase:
     Attributes
     ----------
     configuration, direction: indices into the map's configurations and directions.
-    velocity_ratio: ``v0 / v*``; stiffness_ratio: contact over joint stiffness along ``u``; detection: scheme.
+    velocity_ratio: ``v0 / v*``; stiffness_ratio: contact over joint stiffness along ``u``; detection: scheme;
+    drive: :data:`DRIVES`.
     """
 
     configuration: int
@@ -248,6 +261,7 @@ class ValidityCase:
     velocity_ratio: float
     stiffness_ratio: float
     detection: str
+    drive: str = "ideal"
 
 
 def validity_map(
@@ -263,6 +277,8 @@ def validity_map(
     tolerance: float = TOLERANCE,
     reaction: str = "moving",
     max_steps: float = MAX_STEPS,
+    drives: Sequence[str] = ("ideal",),
+    contact_damping_ratio: float = CONTACT_DAMPING_RATIO,
 ) -> Any:
     """Where the arm closed form agrees with the time-domain simulation, as a :class:`pandas.DataFrame`.
 
@@ -278,14 +294,20 @@ def validity_map(
     tolerance: relative agreement that counts as valid [-].
     reaction: the closed form's reaction variant (``"moving"``: the robot's velocity at detection).
     max_steps: work budget of one simulation [integrator steps]; a case beyond it is refused and recorded.
+    drives: the simulated drives (:data:`DRIVES`); ``"impedance"`` needs a finite software stiffness.
+    contact_damping_ratio: the contact's damping as a ratio of critical for the finger mass (dimensionless).
 
     Returns
     -------
     One row per case, placement and reaction model (:data:`REACTION_MODELS`): ``configuration``,
     ``direction`` (indices), ``q``, ``u`` (as lists), ``velocity_ratio``, ``v0`` [m/s], ``stiffness_ratio``,
-    ``contact_stiffness`` [N/m], ``detection``, ``placement``, ``reaction_model``, ``simulated`` and ``closed_form`` [N*s], ``difference`` (``I_sim / I_closed - 1``),
-    ``valid`` (within ``tolerance``), ``error`` (why a case was refused or failed, else ``""``) and
-    ``seconds`` (the simulation's wall time).
+    ``contact_stiffness`` [N/m], ``detection``, ``drive``, ``placement``, ``reaction_model``, ``simulated``
+    and ``closed_form`` [N*s], ``difference`` (``I_sim / I_closed - 1``), ``valid`` (within ``tolerance``),
+    ``damper_share`` (:func:`damper_share`: the contact's viscous force in the sensing ramp over ``F_s``, a
+    force the closed form's elastic object has not), ``object_deflection`` (``F_s / k_c`` [m], the contact
+    point's travel into the object until detection, over which the closed form keeps the configuration
+    fixed), ``error`` (why a case was refused or failed, else ``""``) and ``seconds`` (the simulation's
+    wall time).
     """
     import pandas as pd
 
@@ -304,6 +326,16 @@ def validity_map(
     schemes = tuple(available_detections() if detections is None else detections)
     for scheme in schemes:
         _validate.choice("detection", scheme, available_detections())
+    for drive in drives:
+        _validate.choice("drive", drive, DRIVES)
+    if "impedance" in drives and not np.all(np.isfinite(np.asarray(joints.software_stiffness, dtype=float))):
+        raise InvalidParameter(
+            "joints.software_stiffness",
+            joints.software_stiffness,
+            "finite joint stiffnesses [N m/rad]",
+            "the impedance drive needs them",
+        )
+    _validate.positive("contact_damping_ratio", contact_damping_ratio)
     for placement in placements:
         _validate.choice("placement", placement, PLACEMENTS)
     rows: list[dict[str, Any]] = []
@@ -314,18 +346,28 @@ def validity_map(
             for ratio_k in stiffness_ratios:
                 k_c = float(ratio_k) * reference.k_m
                 closed = {p: arm_closed_form(arm, q, u, joints, p, k_c, reaction) for p in placements}
-                for ratio_v in velocity_ratios:
-                    for detection in schemes:
-                        case = ValidityCase(i, j, float(ratio_v), float(ratio_k), detection)
-                        v0 = case.velocity_ratio * v_star
-                        simulated = simulated_impulse(
-                            arm, q, u, joints, v0, k_c, detection, reaction, max_steps, reference.m_f
-                        )
-                        rows.extend(
-                            _row(case, q, u, v0, k_c, placement, model, form, simulated, tolerance)
-                            for placement, form in closed.items()
-                            for model in REACTION_MODELS
-                        )
+                for ratio_v, detection, drive in itertools.product(velocity_ratios, schemes, drives):
+                    case = ValidityCase(i, j, float(ratio_v), float(ratio_k), detection, drive)
+                    v0 = case.velocity_ratio * v_star
+                    simulated = simulated_impulse(
+                        arm,
+                        q,
+                        u,
+                        joints,
+                        v0,
+                        k_c,
+                        detection,
+                        reaction,
+                        max_steps,
+                        drive=drive,
+                        contact_damping_ratio=contact_damping_ratio,
+                    )
+                    share = damper_share(reference, v0, k_c, contact_damping_ratio)
+                    rows.extend(
+                        _row(case, q, u, v0, k_c, placement, model, form, simulated, tolerance, share)
+                        for placement, form in closed.items()
+                        for model in REACTION_MODELS
+                    )
     return pd.DataFrame(rows)
 
 
@@ -354,6 +396,9 @@ def simulated_impulse(
     reaction: str = "moving",
     max_steps: float = MAX_STEPS,
     finger_mass: float | None = None,
+    *,
+    drive: str = "ideal",
+    contact_damping_ratio: float = CONTACT_DAMPING_RATIO,
 ) -> SimulatedImpulse:
     """Simulate one collision of a design; a refusal (work budget) or failure is returned, not raised.
 
@@ -364,20 +409,12 @@ def simulated_impulse(
     approach_velocity: [m/s]; contact_stiffness: the wall's stiffness [N/m].
     detection: a scheme of :func:`available_detections`; reaction: the closed-form variant the simulator
         reports beside (``"moving"`` or ``"at_rest"``); max_steps: the work budget [integrator steps].
-    finger_mass: the effective finger mass along ``u`` [kg] (robot placement) if known, else computed: it
-        sets how long a contact-force detector stays unarmed after the impact.
-
-    A contact-force detector stays unarmed for one period of the finger on the wall: it arms when the impact
-    pulse (half a period) is over or, against a soft wall whose force only ramps up and never falls back below
-    the threshold, then at the latest (the simulator's default, twenty periods, would then delay the detection
-    far beyond the closed form's).
+    finger_mass: ignored, kept for callers: the simulator now blanks a contact-force sensor for the impact
+        pulse it derives itself (:func:`collision_reflex.simulate.arm_dynamics.impact_pulse_duration`).
+    drive: :data:`DRIVES`; contact_damping_ratio: the contact's damping, a ratio of critical for the finger.
     """
     start = time.perf_counter()
     try:
-        blanking = None
-        if detection == "force":
-            m_f = finger_mass or arm_closed_form(arm, q, u, joints, "robot", math.inf, reaction).m_f
-            blanking = oscillation_period(m_f, contact_stiffness)
         result = arm_simulation.simulate_arm_collision(
             joints.on(arm),
             q,
@@ -385,15 +422,39 @@ def simulated_impulse(
             approach_velocity,
             joints.threshold,
             contact_stiffness=contact_stiffness,
+            contact_damping_ratio=contact_damping_ratio,
             reaction=reaction,
+            drive=drive,
             detection=detection,
             max_steps=max_steps,
-            blanking=blanking,
             **joints.simulator_keywords(),
         )
     except (SimulationError, InvalidParameter) as error:
         return SimulatedImpulse(math.nan, str(error), time.perf_counter() - start)
     return SimulatedImpulse(float(result.impulse), "", time.perf_counter() - start)
+
+
+def damper_share(
+    closed: ArmClosedForm, approach_velocity: float, contact_stiffness: float, damping_ratio: float
+) -> float:
+    """The contact's viscous force during the sensing ramp over the threshold [-].
+
+    In the ramp the chain's force rises as ``k v0 t`` (``k``: the joints' ``k_j`` in series with the contact)
+    and the object is compressed at ``d' = k v0 / k_c``; its damper ``c = 2 zeta sqrt(m_f k_c)`` carries ``c
+    d'`` of the force, which the closed form's elastic object has not, and which a contact sensor reading the
+    elastic force ``k_c d`` misses (it detects when the wall's force is ``F_s`` plus this share of it). With
+    ``v0 = r v*`` (``v*`` of the rigid contact) it is ``zeta r sqrt(2) k / sqrt(k_c k_j)``, symmetric in
+    ``k_c`` and ``k_j``: 8.1 % at 0.1 ``v*`` with ``zeta = 2`` against an object 10 or 0.1 times the joints'
+    stiffness, 81 % at ``v*``; 8.9 % at ``v*`` against one 1000 times as stiff (where the sensing phase is a small share of the impulse).
+
+    Parameters
+    ----------
+    closed: the closed form at the rigid contact (robot placement): ``m_f`` [kg], the joints' ``k`` [N/m].
+    approach_velocity: [m/s]; contact_stiffness: ``k_c`` [N/m]; damping_ratio: ``zeta`` (the simulator's).
+    """
+    k = float(series_stiffness(closed.k, contact_stiffness))
+    damping = damping_from_ratio(damping_ratio, closed.m_f, contact_stiffness)
+    return float(damping * k * approach_velocity / contact_stiffness / closed.threshold)
 
 
 def _row(
@@ -407,6 +468,7 @@ def _row(
     closed: ArmClosedForm,
     simulated: SimulatedImpulse,
     tolerance: float,
+    damper: float,
 ) -> dict[str, Any]:
     """One row of the map: a case against one placement's and reaction model's closed form."""
     closed_form = closed.impulse(v0, model, case.detection)
@@ -421,18 +483,21 @@ def _row(
         "stiffness_ratio": case.stiffness_ratio,
         "contact_stiffness": contact_stiffness,
         "detection": case.detection,
+        "drive": case.drive,
         "placement": placement,
         "reaction_model": model,
         "simulated": simulated.impulse,
         "closed_form": closed_form,
         "difference": difference,
         "valid": bool(abs(difference) <= tolerance),
+        "damper_share": damper,
+        "object_deflection": closed.threshold / contact_stiffness,
         "error": simulated.error,
         "seconds": simulated.seconds,
     }
 
 
-MAP_INDEX: tuple[str, ...] = ("detection", "reaction_model", "placement", "stiffness_ratio")
+MAP_INDEX: tuple[str, ...] = ("detection", "drive", "reaction_model", "placement", "stiffness_ratio")
 """The rows of the map's pivot tables; their columns are the velocity ratios."""
 
 
