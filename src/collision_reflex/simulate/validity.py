@@ -395,7 +395,6 @@ def simulated_impulse(
     detection: str = TORQUE_DETECTION,
     reaction: str = "moving",
     max_steps: float = MAX_STEPS,
-    finger_mass: float | None = None,
     *,
     drive: str = "ideal",
     contact_damping_ratio: float = CONTACT_DAMPING_RATIO,
@@ -409,8 +408,6 @@ def simulated_impulse(
     approach_velocity: [m/s]; contact_stiffness: the wall's stiffness [N/m].
     detection: a scheme of :func:`available_detections`; reaction: the closed-form variant the simulator
         reports beside (``"moving"`` or ``"at_rest"``); max_steps: the work budget [integrator steps].
-    finger_mass: ignored, kept for callers: the simulator now blanks a contact-force sensor for the impact
-        pulse it derives itself (:func:`collision_reflex.simulate.arm_dynamics.impact_pulse_duration`).
     drive: :data:`DRIVES`; contact_damping_ratio: the contact's damping, a ratio of critical for the finger.
     """
     start = time.perf_counter()

@@ -165,7 +165,6 @@ def _sample(
         detection,
         reaction,
         MAX_STEPS,
-        reference.m_f,
     )
     simulated = None if run.error else run.impulse
     error = run.error
