@@ -239,6 +239,11 @@ def test_a_study_run_snaps_reports_and_resumes_without_redoing_it(tmp_path, monk
     assert len(catalogue["pareto"]) == len(designs["pareto"]["points"])
     report = (folder / "report.html").read_text()
     assert 'id="catalogue"' in report and 'id="catalogue-objectives"' in report
+    # The solver table says how each design was solved (the two-link study is small: all samples at once).
+    samples = len(designs["chosen"]["impulses"])
+    solved = f'<td class="text">full NLP: all {samples} samples</td>'
+    assert f'<td class="text">catalogue design</td>{solved}' in report
+    assert report.count(solved) == 2 + len(designs["pareto"]["points"])  # chosen, Pareto designs, catalogue
     header = (folder / "pareto.csv").read_text().splitlines()[0]
     assert "catalogue_part[joint1]" in header and "catalogue_worst_case_impulse [N*s]" in header
     assert (folder / "points" / "catalogue.json").exists()
