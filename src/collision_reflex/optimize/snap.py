@@ -153,12 +153,14 @@ class JointCandidates:
 class Trial:
     """One combination tried: a part label per joint, its objective value (None: no feasible design) and status.
 
-    The status is IPOPT's, or ``"refused: ..."`` when the problem of these parts was refused before solving.
+    The status is IPOPT's, or ``"refused: ..."`` when the problem of these parts was refused before solving;
+    iterations: IPOPT's iterations of the design found (None without one).
     """
 
     parts: tuple[str, ...]
     objective: float | None
     status: str
+    iterations: int | None = None
 
 
 @dataclass(frozen=True)
@@ -591,7 +593,7 @@ class _Search:
             else:
                 value = objective_value(self.problem, solved.numpy_objectives)
                 self.values[combination], self.results[combination] = value, solved
-                self.tried[combination] = Trial(labels, value, solved.status)
+                self.tried[combination] = Trial(labels, value, solved.status, solved.iterations)
         if new and self.progress is not None:
             self.progress(len(self.tried), max(self.total, len(self.tried)))
         return [self.values[c] for c in combinations]

@@ -385,7 +385,10 @@ def catalogue_results(
         "design": None
         if snap.result is None
         else design_record(problem, snap.result, "catalogue design", catalogue.motors),
-        "tried": [{"parts": list(t.parts), "objective": t.objective, "status": t.status} for t in snap.tried],
+        "tried": [
+            {"parts": list(t.parts), "objective": t.objective, "status": t.status, "iterations": t.iterations}
+            for t in snap.tried
+        ],
         "pareto": [quick_snap_record(problem, r, catalogue) for r in results],
         "solve_time": time.perf_counter() - started,
     }
