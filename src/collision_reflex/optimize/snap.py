@@ -21,6 +21,12 @@ software stiffness, threshold, approach velocity) are re-optimised for that choi
   design; it stops when a whole pass improves nothing. It is never worse than the nearest-part design (its
   start); ``benchmarks/snap_gap.py`` measures its gap to enumeration.
 
+Each combination is solved on all samples or on an active set of them by the sweep's rule (``active_set``,
+:func:`collision_reflex.optimize.active_set.uses_active_set`), the first round on the continuous optimum's active
+samples. A combination may have more than one local optimum (measured on the UR5 study: two of 17 with optima
+1.5e-4 apart); which one is found depends on its start, so the start (the continuous optimum's values) is the
+same for every combination.
+
 The objective is the problem's own, without the objective bounds of an epsilon-constraint point: a Pareto design
 snapped is the study objective's best design of those parts. A catalogue design is the continuous problem with
 more constraints, so it is never better than the (global) continuous optimum in the optimised objective; a
