@@ -483,3 +483,17 @@ def test_a_bad_active_set_choice_is_refused(two_link):
     arm, problem, optimum = two_link
     with pytest.raises(cr.InvalidParameter, match="active_set"):
         snap_to_catalogue(problem, optimum, _catalogue(), arm=arm, active_set="sometimes")
+
+
+def test_a_study_on_active_sets_snaps_on_them_and_through_a_process_pool_alike(tmp_path):
+    text = TWO_LINK_STUDY.read_text().replace("../designs/", f"{ROOT / 'designs'}/")
+    study = tmp_path / "study.yaml"
+    study.write_text(text + "optimizer: {active_set: always}\n")
+    serial, pool = tmp_path / "serial", tmp_path / "pool"
+    cr.run_study(study, serial, quiet=True, smoke=True, executor="serial")
+    cr.run_study(study, pool, quiet=True, smoke=True, executor="processes", workers=2)
+    entries = [json.loads((folder / "designs.json").read_text())["catalogue"] for folder in (serial, pool)]
+    assert entries[0] == entries[1]
+    solver = entries[0]["design"]["solver"]
+    assert solver["method"] == "active set"
+    assert 0 < solver["active_samples"] <= len(entries[0]["design"]["impulses"])
