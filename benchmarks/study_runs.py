@@ -12,6 +12,11 @@ report). CPU time is the run's process's, steadier than wall time on a loaded ma
 largest single solve and any solve that stopped at the iteration cap (a run reports such a point as failed).
 
 ``--keep DIR``: keep each run's output folder under DIR (default: a temporary folder, removed after).
+
+``--snap-only``: after each study's first run, redo its catalogue snap alone ``--repeats`` times (the run resumed
+with its saved snap removed: every other piece is reused) and print the snap stage's median wall and CPU time,
+its re-solves and their IPOPT iterations, with the load; ``--from DIR`` takes the first runs from DIR (folders
+``<study>-0`` of an earlier ``--keep``) instead of running them.
 """
 
 from __future__ import annotations
@@ -19,6 +24,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import shutil
 import statistics
 import subprocess
 import sys
@@ -37,9 +43,17 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--smoke", action="store_true", help="small sample counts (a quick check)")
     parser.add_argument("--keep", metavar="DIR", help="keep the runs' output folders under DIR")
+    parser.add_argument("--snap-only", action="store_true", help="time the catalogue snap stage alone")
+    parser.add_argument(
+        "--from", dest="source", metavar="DIR", help="with --snap-only: earlier runs' folders"
+    )
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as scratch:
         base = Path(args.keep) if args.keep else Path(scratch)
+        if args.snap_only:
+            for study in args.studies:
+                snap_only(study, base, Path(args.source) if args.source else None, args.repeats, args.smoke)
+            return
         runs: dict[str, list[dict]] = {study: [] for study in args.studies}
         for repeat in range(args.repeats):
             for study in args.studies:
@@ -73,6 +87,33 @@ def run_once(study: str, out: Path, smoke: bool) -> dict:
         "timings": timings,
         "capped": capped_solves(designs),
     }
+
+
+def snap_only(study: str, base: Path, source: Path | None, repeats: int, smoke: bool) -> None:
+    """The catalogue snap stage of ``study`` alone, ``repeats`` times, on one finished run (see the docstring)."""
+    name = Path(study).stem
+    first = base / f"{name}-0"
+    if source is not None:
+        shutil.copytree(source / f"{name}-0", first, dirs_exist_ok=True)
+    else:
+        run_once(study, first, smoke)
+    walls, cpus, loads = [], [], []
+    for _ in range(repeats):
+        (first / "points" / "catalogue.json").unlink(missing_ok=True)
+        record = run_once(study, first, smoke)
+        walls.append(record["timings"]["stages/catalogue snap/wall"])
+        cpus.append(record["timings"]["stages/catalogue snap/cpu"])
+        loads.append(f"{record['load_before']:.2f}->{record['load_after']:.2f}")
+    catalogue = json.loads((first / "designs.json").read_text(encoding="utf-8"))["catalogue"]
+    solved = [t for t in catalogue["tried"] if t["objective"] is not None]
+    print(
+        f"{Path(study).name} catalogue snap alone: median wall {statistics.median(walls):.2f} s, CPU "
+        f"{statistics.median(cpus):.2f} s over {repeats} (each wall {', '.join(f'{w:.2f}' for w in walls)}; CPU "
+        f"{', '.join(f'{c:.2f}' for c in cpus)}; load {', '.join(loads)}); {len(catalogue['tried'])} "
+        f"combinations re-solved ({len(solved)} feasible, {sum(t.get('iterations') or 0 for t in solved)} IPOPT "
+        f"iterations), {catalogue['method']}; chosen: {' + '.join(j['part'] or '-' for j in catalogue['joints'])}",
+        flush=True,
+    )
 
 
 def capped_solves(designs: dict) -> list[str]:

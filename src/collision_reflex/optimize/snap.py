@@ -21,6 +21,12 @@ software stiffness, threshold, approach velocity) are re-optimised for that choi
   design; it stops when a whole pass improves nothing. It is never worse than the nearest-part design (its
   start); ``benchmarks/snap_gap.py`` measures its gap to enumeration.
 
+Each combination is solved on all samples or on an active set of them by the sweep's rule (``active_set``,
+:func:`collision_reflex.optimize.active_set.uses_active_set`), the first round on the continuous optimum's active
+samples. A combination may have more than one local optimum (measured on the UR5 study: two of 17 with optima
+1.5e-4 apart); which one is found depends on its start, so the start (the continuous optimum's values) is the
+same for every combination.
+
 The objective is the problem's own, without the objective bounds of an epsilon-constraint point: a Pareto design
 snapped is the study objective's best design of those parts. A catalogue design is the continuous problem with
 more constraints, so it is never better than the (global) continuous optimum in the optimised objective; a
@@ -29,6 +35,7 @@ continuous optimum that is only local can be beaten.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from collections.abc import Callable, Mapping, Sequence
@@ -38,6 +45,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import InvalidParameter, SolverFailed
+from .active_set import ACTIVE_SET_CHOICES, ActiveSetResult, solve_active_set, uses_active_set
 from .objectives import objective_expression
 from .solve import Design, DesignResult, IpoptOptions, solve
 from .space import Bounds
@@ -47,6 +55,7 @@ if TYPE_CHECKING:
     from ..hardware.gearboxes import CatalogueGearbox
     from ..hardware.motors import Motor
     from .problem import DesignProblem
+    from .samples import ContactSamples
     from .technology import ActuatorTechnology
 
 __all__ = [
@@ -150,12 +159,14 @@ class JointCandidates:
 class Trial:
     """One combination tried: a part label per joint, its objective value (None: no feasible design) and status.
 
-    The status is IPOPT's, or ``"refused: ..."`` when the problem of these parts was refused before solving.
+    The status is IPOPT's, or ``"refused: ..."`` when the problem of these parts was refused before solving;
+    iterations: IPOPT's iterations of the design found (None without one).
     """
 
     parts: tuple[str, ...]
     objective: float | None
     status: str
+    iterations: int | None = None
 
 
 @dataclass(frozen=True)
@@ -437,6 +448,7 @@ def snap_to_catalogue(
     ipopt_options: IpoptOptions | None = None,
     progress: Callable[[int, int], None] | None = None,
     solve_many: PartsSolver | None = None,
+    active_set: str = "auto",
 ) -> CatalogueDesign:
     """The best design built from catalogue motors near ``optimum``, re-optimised (module docstring).
 
@@ -458,14 +470,20 @@ def snap_to_catalogue(
     solve_many: how combinations are solved (:data:`PartsSolver`), e.g. through an executor; default in this
         process. The combinations of a batch (every one when enumerating; a joint's candidates in a step of the
         heuristic) are independent, and the answer does not depend on where they run.
+    active_set: how the default ``solve_many`` solves each combination's samples (:func:`solve_parts`): on an
+        active set from :data:`collision_reflex.optimize.active_set.ACTIVE_SET_THRESHOLD` samples (``"auto"``,
+        the sweep's rule), always or never; a given ``solve_many`` decides for itself.
 
     Raises
     ------
-    InvalidParameter: an empty catalogue, ``candidates`` or ``max_combinations`` not an integer >= 1.
+    InvalidParameter: an empty catalogue, ``candidates`` or ``max_combinations`` not an integer >= 1, an
+        ``active_set`` not one of :data:`collision_reflex.optimize.active_set.ACTIVE_SET_CHOICES`.
     KeyboardInterrupt: Ctrl-C, from any re-solve (nothing is returned).
     """
     if not isinstance(max_combinations, int) or isinstance(max_combinations, bool) or max_combinations < 1:
         raise InvalidParameter("max_combinations", max_combinations, "an integer >= 1")
+    if active_set not in ACTIVE_SET_CHOICES:
+        raise InvalidParameter("active_set", active_set, "one of " + ", ".join(map(repr, ACTIVE_SET_CHOICES)))
     joints = joint_candidates(problem, optimum, motors, candidates, gearboxes, gearbox_candidates)
     warnings = [j.warning for j in joints if j.warning]
     empty = [j for j in joints if not j.parts]
@@ -477,7 +495,7 @@ def snap_to_catalogue(
         ]
         return _design(joints, None, None, optimum, (), "none: " + " / ".join(reasons), [*warnings, *reasons])
     if solve_many is None:
-        solve_many = _InProcess(problem, optimum, arm, ipopt_options)
+        solve_many = _InProcess(problem, optimum, arm, ipopt_options, active_set)
     search = _Search(problem, [j.parts for j in joints], solve_many, progress)
     total = math.prod(len(j.parts) for j in joints)
     if total <= max_combinations:
@@ -527,10 +545,11 @@ class _InProcess:
     optimum: DesignResult
     arm: Arm
     ipopt_options: IpoptOptions | None
+    active_set: str = "auto"
 
     def __call__(self, combinations: Sequence[tuple[CataloguePart, ...]]) -> list[DesignResult | str]:
         return [
-            solved_or_status(self.problem, self.optimum, parts, self.arm, self.ipopt_options)
+            solved_or_status(self.problem, self.optimum, parts, self.arm, self.ipopt_options, self.active_set)
             for parts in combinations
         ]
 
@@ -541,10 +560,11 @@ def solved_or_status(
     parts: Sequence[CataloguePart],
     arm: Arm,
     ipopt_options: IpoptOptions | None = None,
+    active_set: str = "auto",
 ) -> DesignResult | str:
     """:func:`solve_parts`, or the status that says why these parts have no design (see :data:`PartsSolver`)."""
     try:
-        return solve_parts(problem, optimum, parts, arm, ipopt_options)
+        return solve_parts(problem, optimum, parts, arm, ipopt_options, active_set)
     except SolverFailed as error:
         return error.status
     except InvalidParameter as error:  # refused before solving: no design of these parts can meet it
@@ -579,7 +599,7 @@ class _Search:
             else:
                 value = objective_value(self.problem, solved.numpy_objectives)
                 self.values[combination], self.results[combination] = value, solved
-                self.tried[combination] = Trial(labels, value, solved.status)
+                self.tried[combination] = Trial(labels, value, solved.status, solved.iterations)
         if new and self.progress is not None:
             self.progress(len(self.tried), max(self.total, len(self.tried)))
         return [self.values[c] for c in combinations]
@@ -623,11 +643,17 @@ def objective_value(problem: DesignProblem, objectives: Mapping[str, float]) -> 
     return float(objective_expression(problem.objective, values, problem.objective_scale))
 
 
-def catalogue_problem(problem: DesignProblem, parts: Sequence[CataloguePart], arm: Arm) -> DesignProblem:
+def catalogue_problem(
+    problem: DesignProblem,
+    parts: Sequence[CataloguePart],
+    arm: Arm,
+    samples: ContactSamples | None = None,
+) -> DesignProblem:
     """``problem`` with each joint's motor the catalogue motor of ``parts`` at its own size.
 
     Each joint's stator diameter and stack length are fixed at its part's, its gear ratio within the part's
-    bounds; the objective, constraints and the other bounds are ``problem``'s.
+    bounds; the objective, constraints and the other bounds are ``problem``'s, and so are the samples unless
+    ``samples`` are given (a subset of them, for an active-set round).
     """
     from .problem import build_problem
 
@@ -640,7 +666,7 @@ def catalogue_problem(problem: DesignProblem, parts: Sequence[CataloguePart], ar
     )
     return build_problem(
         arm,
-        problem.samples,
+        problem.samples if samples is None else samples,
         space,
         technology,
         problem.objective,
@@ -696,11 +722,16 @@ def solve_parts(
     parts: Sequence[CataloguePart],
     arm: Arm,
     ipopt_options: IpoptOptions | None = None,
+    active_set: str = "auto",
 ) -> DesignResult:
     """The design of ``parts`` with the remaining continuous variables re-optimised.
 
     Started from ``optimum``'s values of those variables (clipped to their bounds), the gear ratios at
-    :func:`matched_gear_ratio`.
+    :func:`matched_gear_ratio`. ``active_set`` (one of
+    :data:`collision_reflex.optimize.active_set.ACTIVE_SET_CHOICES`) says whether the samples are solved on an
+    active set, by the sweep's rule (:func:`collision_reflex.optimize.active_set.uses_active_set`); on an
+    active set the first round holds ``optimum``'s last active samples when it has them (the samples that bound
+    the continuous optimum, most likely those that bound a catalogue design near it).
 
     Raises
     ------
@@ -721,7 +752,24 @@ def solve_parts(
         for i, b, value in zip(built.layout.slices[name], built.layout.bounds[name], values, strict=True):
             if i is not None:
                 start[i] = math.log(min(max(float(value), b.lower), b.upper))
-    return solve(built, x0=built.exact_point(start), ipopt_options=ipopt_options)
+    x0 = built.exact_point(start)
+    if not uses_active_set(built.samples.size, active_set):
+        return solve(built, x0=x0, ipopt_options=ipopt_options)
+    initial = None
+    if (
+        isinstance(optimum, ActiveSetResult)
+        and optimum.active_samples.size
+        and optimum.impulses.size == built.samples.size
+    ):
+        initial = optimum.active_samples
+    return solve_active_set(
+        functools.partial(catalogue_problem, problem, parts, arm),
+        built.samples,
+        ipopt_options=ipopt_options,
+        initial=initial,
+        x0=x0,
+        full=built,
+    )
 
 
 @dataclass(frozen=True)

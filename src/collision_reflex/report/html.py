@@ -141,6 +141,24 @@ def _objective_units() -> dict[str, str]:
     return {name: unit for name, (_, unit, _) in OBJECTIVES.items()}
 
 
+def solved_by(record: dict[str, Any]) -> str:
+    """How a design record's solve treated the samples: ``full NLP: all 336 samples``, or an active set.
+
+    ``active set: 72 of 4096 samples``, from its ``solver`` record's ``method`` and ``active_samples``; "–"
+    for a record written without them.
+    """
+    solver = record.get("solver") or {}
+    method, active = solver.get("method"), solver.get("active_samples")
+    if method is None or active is None:
+        return "–"
+    total = len(record.get("impulses") or ()) or active
+    if method == "active set":
+        return f"active set: {active} of {total} samples"
+    if method == "full NLP":
+        return f"full NLP: all {total} samples"
+    return f"full NLP: {method} ({total})"  # e.g. "all samples: the mean impulse ... needs every sample"
+
+
 # A number with an exponent ("9.25e-06", "2e7") in prose: the browser may break a line after its minus sign.
 _PROSE_NUMBER = re.compile(r"\d+(?:\.\d+)?e[+-]?\d+")
 
@@ -150,7 +168,9 @@ def whole_numbers(text: str) -> Any:
     import markupsafe
 
     escaped = str(markupsafe.escape(text))
-    return markupsafe.Markup(_PROSE_NUMBER.sub(lambda m: f'<span class="nowrap">{m.group(0)}</span>', escaped))
+    return markupsafe.Markup(
+        _PROSE_NUMBER.sub(lambda m: f'<span class="nowrap">{m.group(0)}</span>', escaped)
+    )
 
 
 def render_html(results: dict[str, Any], rows: list[dict[str, Any]], svgs: dict[str, str]) -> str:
@@ -167,6 +187,7 @@ def render_html(results: dict[str, Any], rows: list[dict[str, Any]], svgs: dict[
     environment.filters["n"] = number
     environment.filters["settled"] = settled
     environment.filters["whole_numbers"] = whole_numbers
+    environment.filters["solved_by"] = solved_by
     template = environment.get_template(f"{results['kind']}_report.html.j2")
     context: dict[str, Any] = {
         "results": results,

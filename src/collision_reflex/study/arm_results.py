@@ -346,7 +346,8 @@ def catalogue_results(
 
     The recommended design is snapped by :func:`collision_reflex.optimize.snap.snap_to_catalogue` (exact or
     heuristic), its combinations solved through ``executor`` (default in this process: the same numbers
-    either way); each Pareto design (the chosen one without a front) by :func:`quick_snap_record`.
+    either way), on active sets of the samples as the study's ``optimizer.active_set`` says (the sweep's
+    rule); each Pareto design (the chosen one without a front) by :func:`quick_snap_record`.
     """
     from ..optimize.snap import snap_to_catalogue
     from .arm_setup import IPOPT_OPTIONS
@@ -365,6 +366,7 @@ def catalogue_results(
         ipopt_options=IPOPT_OPTIONS,
         progress=progress,
         solve_many=None if executor is None else _ThroughExecutor(problems, recommendation.result, executor),
+        active_set=problems.active_set,
     )
     joints = [_joint_record(snap, j, catalogue) for j in range(len(snap.joints))]
     results = front.points if front is not None and front.points else (chosen,)
@@ -383,7 +385,10 @@ def catalogue_results(
         "design": None
         if snap.result is None
         else design_record(problem, snap.result, "catalogue design", catalogue.motors),
-        "tried": [{"parts": list(t.parts), "objective": t.objective, "status": t.status} for t in snap.tried],
+        "tried": [
+            {"parts": list(t.parts), "objective": t.objective, "status": t.status, "iterations": t.iterations}
+            for t in snap.tried
+        ],
         "pareto": [quick_snap_record(problem, r, catalogue) for r in results],
         "solve_time": time.perf_counter() - started,
     }
@@ -428,7 +433,9 @@ def solve_study_parts(
 
     with _SNAP_LOCK, single_threaded_blas():
         problem = built_problem(problems, problems.objective)
-        return solved_or_status(problem, optimum, parts, problems.setup.arm, IPOPT_OPTIONS)
+        return solved_or_status(
+            problem, optimum, parts, problems.setup.arm, IPOPT_OPTIONS, problems.active_set
+        )
 
 
 def _joint_record(snap: CatalogueDesign, j: int, catalogue: SnapCatalogue) -> dict[str, Any]:
