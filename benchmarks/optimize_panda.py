@@ -152,6 +152,7 @@ def timed_front(build, points: int, repeats: int = 3) -> cr.ParetoSet:
 
 def compare_construction(build, repeats: int = 3) -> None:
     """Solver construction and one IPOPT run, derivatives per sample against the whole NLP's; medians."""
+    from collision_reflex.optimize.blas import single_threaded_blas
     from collision_reflex.optimize.solve import DEFAULT_IPOPT_OPTIONS
 
     load = os.getloadavg()[0]
@@ -163,9 +164,10 @@ def compare_construction(build, repeats: int = 3) -> None:
             solver = problem.solver(DEFAULT_IPOPT_OPTIONS, structural=structural)
             constructed = time.perf_counter() - started
             started = time.perf_counter()
-            solution = solver(
-                x0=problem.x0, lbx=problem.lbx, ubx=problem.ubx, lbg=problem.lbg, ubg=problem.ubg, p=[]
-            )
+            with single_threaded_blas():  # as solve() runs IPOPT
+                solution = solver(
+                    x0=problem.x0, lbx=problem.lbx, ubx=problem.ubx, lbg=problem.lbg, ubg=problem.ubg, p=[]
+                )
             solved = time.perf_counter() - started
             iterations = int(solver.stats()["iter_count"])
             figures[structural].append((constructed, solved, iterations, float(solution["f"])))

@@ -127,7 +127,7 @@ def test_casadi_derivatives_match_numpy_finite_differences(arm, technology):
 def test_per_sample_derivatives_equal_casadis_of_the_whole_nlp(arm, technology, objective, bounded):
     import casadi as ca
 
-    from collision_reflex.optimize.derivatives import derivative_functions
+    from collision_reflex.optimize.derivatives import derivative_functions, structured_nlp
 
     space = FREE_SPACE
     if technology.get("sensing") == "position":
@@ -154,10 +154,17 @@ def test_per_sample_derivatives_equal_casadis_of_the_whole_nlp(arm, technology, 
         ],
     )
     ours = derivative_functions(problem._structure)
+    split = structured_nlp(problem._structure)
+    values = ca.Function("values", [split["x"], split["p"]], [split["f"], split["g"]])
+    original = ca.Function("original", [nlp["x"], nlp["p"]], [nlp["f"], nlp["g"]])
     for _ in range(3):  # random points: off the start, and random multipliers
         x = problem.exact_point(problem.x0) + rng.normal(0.0, 0.1, problem.x0.size)
         p = rng.uniform(0.5, 2.0, problem.parameters().size)
         weights = (rng.uniform(0.5, 2.0), rng.normal(size=problem.lbg.size))
+        # The NLP's values as the per-sample map and the outer part: the same operations, so to rounding.
+        for mine, theirs in zip(values(x, p), original(x, p), strict=True):
+            theirs = np.asarray(theirs)
+            np.testing.assert_allclose(np.asarray(mine), theirs, rtol=0, atol=1e-12 * np.abs(theirs).max())
         grad, jac, hess = (np.asarray(ca.DM(v)) for v in whole(x, p, *weights))
         # Both are exact derivatives of the same expressions, in another order of operations: they agree to
         # rounding, ~1e-15 relative to the largest entry; 1e-10 leaves room without hiding a wrong term.

@@ -53,20 +53,22 @@ def build():
     return build
 
 
-def test_solvers_share_one_expansion_and_match_casadis_own(build):
+def test_solvers_share_one_structured_nlp_and_match_casadis_own(build):
     problem = build("worst_case_impulse", ("actuator_mass",))
     shared = problem.solver(DEFAULT_IPOPT_OPTIONS)
-    expanded = problem._expanded
+    structured = problem._structured
     problem.solver({**DEFAULT_IPOPT_OPTIONS, "ipopt.mu_strategy": "adaptive"})
-    assert problem._expanded is expanded and len(problem._solvers) == 2
-    # Independent: CasADi expanding the NLP itself, with the same derivative functions.
+    assert problem._structured is structured and len(problem._solvers) == 2
+    # Independent: CasADi expanding the NLP as built, with the same derivative functions.
     own = ca.nlpsol(
         "own", "ipopt", problem.nlp, {**DEFAULT_IPOPT_OPTIONS, **derivative_functions(problem._structure)}
     )
     bounds = dict(lbx=problem.lbx, ubx=problem.ubx, lbg=problem.lbg, ubg=problem.ubg, p=problem.parameters())
     a, b = shared(x0=problem.x0, **bounds), own(x0=problem.x0, **bounds)
+    # The same values up to rounding (~1e-16, another order of operations), grown along the iterations to
+    # ~1e-12 here: far below IPOPT's tol 1e-8, which a wrong value or derivative would exceed.
     assert shared.stats()["iter_count"] == own.stats()["iter_count"]
-    np.testing.assert_allclose(np.asarray(a["x"]), np.asarray(b["x"]), rtol=1e-12, atol=1e-14)
+    np.testing.assert_allclose(np.asarray(a["x"]), np.asarray(b["x"]), rtol=1e-10, atol=1e-12)
 
 
 def test_epsilon_points_start_from_the_anchor_and_match_cold_solves(build):
