@@ -228,7 +228,10 @@ class DesignProblem:
                 solver = ca.nlpsol("actuator_design", "ipopt", self.nlp, dict(options))
             else:
                 if self._structured is None:
-                    self._structured = (structured_nlp(self._structure), derivative_functions(self._structure))
+                    self._structured = (
+                        structured_nlp(self._structure),
+                        derivative_functions(self._structure),
+                    )
                 nlp, derivatives = self._structured
                 solver = ca.nlpsol(
                     "actuator_design", "ipopt", nlp, {**options, **derivatives, "expand": False}

@@ -24,8 +24,9 @@ IpoptOptions = Mapping[str, str | float]
 """Options of CasADi's ``nlpsol`` with IPOPT (``"ipopt.<option>"`` and CasADi's own): strings, numbers, flags."""
 
 DEFAULT_IPOPT_OPTIONS: dict[str, str | float] = {
-    # Expanding the MX graph (mapped per-sample functions) to SX once makes every derivative evaluation an
-    # order of magnitude cheaper; the solver is built once per problem and reused across Pareto points.
+    # For an NLP that CasADi differentiates itself (the feasibility solve): expanding its MX graph (mapped
+    # per-sample functions) to SX makes every derivative evaluation an order of magnitude cheaper. The
+    # design solvers get SX functions assembled per sample (DesignProblem.solver), nothing to expand.
     "expand": True,
     "ipopt.print_level": 0,
     "ipopt.sb": "yes",
