@@ -12,8 +12,9 @@ NSGA-II's), and the sweep's warm start of its epsilon points (the first anchor's
 a start from the anchor's point alone. Run: ``python benchmarks/optimize_panda.py`` (``--quick`` for 5 Pareto points and a short GA).
 
 It first prints the solver construction with the derivatives assembled per sample against CasADi's
-differentiation of the whole NLP (median of 3 repeats, fresh problems, with the load average before and after;
-target: construction <= 0.8 s, one solve including construction <= 1.5 s, the same optimum to 1e-8);
+differentiation of the whole NLP (median of 3 repeats, fresh problems, with the load average before and after,
+and the CPU time of construction and IPOPT, steadier under load; target: construction <= 0.8 s, one solve
+including construction <= 1.5 s, the same optimum to 1e-8);
 ``--construction`` prints only that, ``--front`` only the front.
 
 With ``--duty`` it prints only the problem size (variables, constraint rows, peak-torque rows kept) and the build
@@ -156,11 +157,11 @@ def compare_construction(build, repeats: int = 3) -> None:
     from collision_reflex.optimize.solve import DEFAULT_IPOPT_OPTIONS
 
     load = os.getloadavg()[0]
-    figures: dict[bool, list[tuple[float, float, int, float]]] = {True: [], False: []}
+    figures: dict[bool, list[tuple[float, float, int, float, float]]] = {True: [], False: []}
     for _ in range(repeats):
         for structural in (True, False):
             problem = build("worst_case_impulse", ())
-            started = time.perf_counter()
+            started, cpu = time.perf_counter(), time.process_time()
             solver = problem.solver(DEFAULT_IPOPT_OPTIONS, structural=structural)
             constructed = time.perf_counter() - started
             started = time.perf_counter()
@@ -168,16 +169,16 @@ def compare_construction(build, repeats: int = 3) -> None:
                 solution = solver(
                     x0=problem.x0, lbx=problem.lbx, ubx=problem.ubx, lbg=problem.lbg, ubg=problem.ubg, p=[]
                 )
-            solved = time.perf_counter() - started
+            solved, cpu = time.perf_counter() - started, time.process_time() - cpu
             iterations = int(solver.stats()["iter_count"])
-            figures[structural].append((constructed, solved, iterations, float(solution["f"])))
+            figures[structural].append((constructed, solved, iterations, float(solution["f"]), cpu))
     medians = {key: np.median(np.array(rows), axis=0) for key, rows in figures.items()}
     objectives = {key: figures[key][0][3] for key in figures}
     for structural, label in ((False, "whole NLP differentiated"), (True, "per-sample derivatives")):
-        constructed, solved, iterations, _ = medians[structural]
+        constructed, solved, iterations, _, cpu = medians[structural]
         print(
             f"{label}: construction {constructed:.2f} s, IPOPT {solved:.2f} s, one solve "
-            f"{constructed + solved:.2f} s ({int(iterations)} iterations; median of {repeats})"
+            f"{constructed + solved:.2f} s ({int(iterations)} iterations; median of {repeats}; CPU {cpu:.2f} s)"
         )
     difference = abs(objectives[True] - objectives[False]) / abs(objectives[False])
     print(
