@@ -133,10 +133,9 @@ def derivative_functions(structure: SampleStructure) -> dict[str, ca.Function]:
 
     # The Hessian needs Y only through the outer part, and then the outputs alone: an outer part linear in Y
     # (the usual case) needs no per-sample evaluation besides the Hessians (a fifth of their cost saved).
+    y_second: ca.MX | ca.DM = ca.DM.zeros(n_y, n_samples)
     if any(ca.depends_on(e, ca.vec(yo)) for e in (ybar_expression, hess_expression)):
         y_second = sample.map(n_samples)(variables, *constants)
-    else:
-        y_second = ca.DM.zeros(n_y, n_samples)
     ybar, hess = outer_second(x, y_second, p, lam_f, lam_g)
     hess_blocks = second.map(n_samples)(variables, *constants, ca.reshape(ybar, n_y, n_samples))
     if np.all(np.array(outer_second.sparsity_out(1).get_triplet()) < n_x):
