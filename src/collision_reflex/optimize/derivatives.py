@@ -11,8 +11,8 @@ by the chain rule::
     hess L = T^T hess(outer L) T + sum_s P_s^T (sum_k ybar_sk hess y_sk) P_s,   T = [I; J],
 
 with ``J = dY/dx`` (block-sparse), ``ybar = sigma f_Y + g_Y^T lambda`` and ``P_s`` the selection of ``v_s``.
-IPOPT gets the NLP's values the same way (:func:`structured_nlp`): expanding the whole NLP to SX and building a
-solver on it took twice as long as the rest of the construction.
+IPOPT gets the NLP's values the same way (:func:`structured_nlp`): on the Panda benchmark, expanding the whole NLP
+to SX and building a solver on it took 0.2-0.3 s CPU, three times the per-sample differentiation.
 """
 
 from __future__ import annotations
