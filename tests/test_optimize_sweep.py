@@ -68,7 +68,8 @@ def test_solvers_share_one_structured_nlp_and_match_casadis_own(build):
     # The same values up to rounding (~1e-16, another order of operations), so the same path and optimum: the
     # objective to 3e-15 here (1e-12 allowed); a variable to within IPOPT's tol 1e-8 scaled by how weakly it
     # is pinned (a sample's auxiliary that does not set the worst case only by the 1e-3 tie-break pull: 4e-8
-    # here; AGREEMENT allowed). A wrong value or derivative changes the path and the optimum.
+    # here without IPOPT's residual checks; AGREEMENT allowed). A wrong value or derivative changes the path
+    # and the optimum.
     assert shared.stats()["iter_count"] == own.stats()["iter_count"]
     assert float(a["f"]) == pytest.approx(float(b["f"]), rel=1e-12)
     np.testing.assert_allclose(np.asarray(a["x"]), np.asarray(b["x"]), rtol=AGREEMENT, atol=1e-12)

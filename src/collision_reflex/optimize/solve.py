@@ -42,12 +42,12 @@ DEFAULT_IPOPT_OPTIONS: dict[str, str | float] = {
     # of the UR5 study's fast points needed delayed pivots, 8x MUMPS's memory estimate and ~0.5 s per
     # iteration (a 100 s solve); scaled so, the same optimum in 10 s.
     "ipopt.mumps_scaling": 8,
-    # METIS ordering, and no residual check of each step (MUMPS's factors are accurate here): on the Panda
-    # benchmark the same 61 iterations and optimum with 16 % less IPOPT time (median of 7 interleaved runs,
-    # CPU 1.22 s against 1.49 s; the two apart: 1.33 s, 1.44 s), most of the rest being MUMPS's
-    # factorizations (114 for 61 iterations: the inertia correction refactorizes).
+    # METIS ordering (MUMPS chose QAMD): on the Panda benchmark the same 61 iterations and optimum with 10 %
+    # less IPOPT time (CPU median of 7 interleaved runs 1.33 s against 1.49 s, load 8-10), most of which is
+    # MUMPS's factorizations (114 for 61 iterations: the inertia correction refactorizes); the UR5 study's
+    # sweep 1,067 iterations against 1,072 (CPU 78 s against 82 s). Skipping the residual check of each
+    # step (fast_step_computation) saved another 8 % on the Panda but cost the UR5 sweep 1,132 iterations.
     "ipopt.mumps_pivot_order": 5,
-    "ipopt.fast_step_computation": "yes",
 }
 WARM_START_OPTIONS: dict[str, str | float] = {
     # Start from a neighbouring solution's primal and dual point, close to the central path.
