@@ -156,22 +156,26 @@ def compare_construction(build, repeats: int = 3) -> None:
     from collision_reflex.optimize.blas import single_threaded_blas
     from collision_reflex.optimize.solve import DEFAULT_IPOPT_OPTIONS
 
+    def timed(structural: bool) -> tuple[float, float, int, float, float]:
+        """Construction and IPOPT wall times, iterations, objective, CPU time; everything freed on return, so
+        that no earlier solver is destroyed inside the timed part (a whole-NLP solver takes a while)."""
+        problem = build("worst_case_impulse", ())
+        started, cpu = time.perf_counter(), time.process_time()
+        solver = problem.solver(DEFAULT_IPOPT_OPTIONS, structural=structural)
+        constructed = time.perf_counter() - started
+        started = time.perf_counter()
+        with single_threaded_blas():  # as solve() runs IPOPT
+            solution = solver(
+                x0=problem.x0, lbx=problem.lbx, ubx=problem.ubx, lbg=problem.lbg, ubg=problem.ubg, p=[]
+            )
+        solved, cpu = time.perf_counter() - started, time.process_time() - cpu
+        return constructed, solved, int(solver.stats()["iter_count"]), float(solution["f"]), cpu
+
     load = os.getloadavg()[0]
     figures: dict[bool, list[tuple[float, float, int, float, float]]] = {True: [], False: []}
     for _ in range(repeats):
         for structural in (True, False):
-            problem = build("worst_case_impulse", ())
-            started, cpu = time.perf_counter(), time.process_time()
-            solver = problem.solver(DEFAULT_IPOPT_OPTIONS, structural=structural)
-            constructed = time.perf_counter() - started
-            started = time.perf_counter()
-            with single_threaded_blas():  # as solve() runs IPOPT
-                solution = solver(
-                    x0=problem.x0, lbx=problem.lbx, ubx=problem.ubx, lbg=problem.lbg, ubg=problem.ubg, p=[]
-                )
-            solved, cpu = time.perf_counter() - started, time.process_time() - cpu
-            iterations = int(solver.stats()["iter_count"])
-            figures[structural].append((constructed, solved, iterations, float(solution["f"]), cpu))
+            figures[structural].append(timed(structural))
     medians = {key: np.median(np.array(rows), axis=0) for key, rows in figures.items()}
     objectives = {key: figures[key][0][3] for key in figures}
     for structural, label in ((False, "whole NLP differentiated"), (True, "per-sample derivatives")):
