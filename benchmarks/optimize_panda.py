@@ -12,8 +12,9 @@ NSGA-II's), and the sweep's warm start of its epsilon points (the first anchor's
 a start from the anchor's point alone. Run: ``python benchmarks/optimize_panda.py`` (``--quick`` for 5 Pareto points and a short GA).
 
 It first prints the solver construction with the derivatives assembled per sample against CasADi's
-differentiation of the whole NLP (median of 3 repeats, fresh problems, with the load average before and after;
-target: construction <= 0.8 s, one solve including construction <= 1.5 s, the same optimum to 1e-8);
+differentiation of the whole NLP (median of 3 repeats, fresh problems, with the load average before and after,
+and the CPU time of construction and IPOPT, steadier under load; target: construction <= 0.8 s, one solve
+including construction <= 1.5 s, the same optimum to 1e-8);
 ``--construction`` prints only that, ``--front`` only the front.
 
 With ``--duty`` it prints only the problem size (variables, constraint rows, peak-torque rows kept) and the build
@@ -152,30 +153,36 @@ def timed_front(build, points: int, repeats: int = 3) -> cr.ParetoSet:
 
 def compare_construction(build, repeats: int = 3) -> None:
     """Solver construction and one IPOPT run, derivatives per sample against the whole NLP's; medians."""
+    from collision_reflex.optimize.blas import single_threaded_blas
     from collision_reflex.optimize.solve import DEFAULT_IPOPT_OPTIONS
 
-    load = os.getloadavg()[0]
-    figures: dict[bool, list[tuple[float, float, int, float]]] = {True: [], False: []}
-    for _ in range(repeats):
-        for structural in (True, False):
-            problem = build("worst_case_impulse", ())
-            started = time.perf_counter()
-            solver = problem.solver(DEFAULT_IPOPT_OPTIONS, structural=structural)
-            constructed = time.perf_counter() - started
-            started = time.perf_counter()
+    def timed(structural: bool) -> tuple[float, float, int, float, float]:
+        """Construction and IPOPT wall times, iterations, objective, CPU time; everything freed on return, so
+        that no earlier solver is destroyed inside the timed part (a whole-NLP solver takes a while)."""
+        problem = build("worst_case_impulse", ())
+        started, cpu = time.perf_counter(), time.process_time()
+        solver = problem.solver(DEFAULT_IPOPT_OPTIONS, structural=structural)
+        constructed = time.perf_counter() - started
+        started = time.perf_counter()
+        with single_threaded_blas():  # as solve() runs IPOPT
             solution = solver(
                 x0=problem.x0, lbx=problem.lbx, ubx=problem.ubx, lbg=problem.lbg, ubg=problem.ubg, p=[]
             )
-            solved = time.perf_counter() - started
-            iterations = int(solver.stats()["iter_count"])
-            figures[structural].append((constructed, solved, iterations, float(solution["f"])))
+        solved, cpu = time.perf_counter() - started, time.process_time() - cpu
+        return constructed, solved, int(solver.stats()["iter_count"]), float(solution["f"]), cpu
+
+    load = os.getloadavg()[0]
+    figures: dict[bool, list[tuple[float, float, int, float, float]]] = {True: [], False: []}
+    for _ in range(repeats):
+        for structural in (True, False):
+            figures[structural].append(timed(structural))
     medians = {key: np.median(np.array(rows), axis=0) for key, rows in figures.items()}
     objectives = {key: figures[key][0][3] for key in figures}
     for structural, label in ((False, "whole NLP differentiated"), (True, "per-sample derivatives")):
-        constructed, solved, iterations, _ = medians[structural]
+        constructed, solved, iterations, _, cpu = medians[structural]
         print(
             f"{label}: construction {constructed:.2f} s, IPOPT {solved:.2f} s, one solve "
-            f"{constructed + solved:.2f} s ({int(iterations)} iterations; median of {repeats})"
+            f"{constructed + solved:.2f} s ({int(iterations)} iterations; median of {repeats}; CPU {cpu:.2f} s)"
         )
     difference = abs(objectives[True] - objectives[False]) / abs(objectives[False])
     print(

@@ -127,7 +127,7 @@ def test_casadi_derivatives_match_numpy_finite_differences(arm, technology):
 def test_per_sample_derivatives_equal_casadis_of_the_whole_nlp(arm, technology, objective, bounded):
     import casadi as ca
 
-    from collision_reflex.optimize.derivatives import derivative_functions
+    from collision_reflex.optimize.derivatives import derivative_functions, structured_nlp
 
     space = FREE_SPACE
     if technology.get("sensing") == "position":
@@ -154,10 +154,17 @@ def test_per_sample_derivatives_equal_casadis_of_the_whole_nlp(arm, technology, 
         ],
     )
     ours = derivative_functions(problem._structure)
+    split = structured_nlp(problem._structure)
+    values = ca.Function("values", [split["x"], split["p"]], [split["f"], split["g"]])
+    original = ca.Function("original", [nlp["x"], nlp["p"]], [nlp["f"], nlp["g"]])
     for _ in range(3):  # random points: off the start, and random multipliers
         x = problem.exact_point(problem.x0) + rng.normal(0.0, 0.1, problem.x0.size)
         p = rng.uniform(0.5, 2.0, problem.parameters().size)
         weights = (rng.uniform(0.5, 2.0), rng.normal(size=problem.lbg.size))
+        # The NLP's values as the per-sample map and the outer part: the same operations, so to rounding.
+        for mine, theirs in zip(values(x, p), original(x, p), strict=True):
+            theirs = np.asarray(theirs)
+            np.testing.assert_allclose(np.asarray(mine), theirs, rtol=0, atol=1e-12 * np.abs(theirs).max())
         grad, jac, hess = (np.asarray(ca.DM(v)) for v in whole(x, p, *weights))
         # Both are exact derivatives of the same expressions, in another order of operations: they agree to
         # rounding, ~1e-15 relative to the largest entry; 1e-10 leaves room without hiding a wrong term.
@@ -169,6 +176,64 @@ def test_per_sample_derivatives_equal_casadis_of_the_whole_nlp(arm, technology, 
             mine = np.asarray(ca.DM(mine))
             np.testing.assert_allclose(mine, theirs, rtol=0, atol=1e-10 * np.abs(theirs).max())
     assert np.abs(np.tril(np.asarray(ca.DM(ours["hess_lag"](x, p, *weights))), -1)).max() == 0.0
+
+
+def test_per_sample_derivatives_of_an_outer_part_nonlinear_in_the_sample_outputs():
+    """The chain rule's general case, which the model's outer part (linear in Y) does not reach: weights on Y
+    that depend on Y, and an outer Hessian with Y-terms, against CasADi differentiating the whole NLP."""
+    import casadi as ca
+
+    from collision_reflex.optimize.derivatives import (
+        SampleStructure,
+        derivative_functions,
+        structured_nlp,
+    )
+
+    n_x, n_samples = 5, 4
+    v, data, scale = ca.SX.sym("v", 3), ca.SX.sym("data", 1), ca.SX.sym("scale", 1)
+    outputs = ca.vertcat(ca.sin(v[0]) * ca.exp(v[1] * data) + scale * v[2] ** 2, v[0] * v[1] * v[2])
+    sample = ca.Function("sample", [v, data, scale], [outputs])
+    xo, yo, po = ca.SX.sym("x", n_x), ca.SX.sym("Y", 2, n_samples), ca.SX.sym("p", 1)
+    fo = ca.sumsqr(yo[0, :]) + xo[0] * ca.sum2(yo[1, :]) + po * xo[1] ** 2
+    go = ca.vertcat(ca.transpose(yo[0, :] * yo[1, :]), xo[0] + yo[1, 0] ** 3)
+    outer = ca.Function("outer", [xo, yo, po], [fo, go])
+    # Every sample shares x0 and x1 (as the design variables) and has one of x2..x4 (as its auxiliaries).
+    variables = np.array([[0] * n_samples, [1] * n_samples, [2, 3, 4, 2]])
+    rng = np.random.default_rng(2)
+    structure = SampleStructure(
+        outer, sample, variables, rng.uniform(0.5, 1.5, (1, n_samples)), rng.uniform(0.5, 1.5, (1, n_samples))
+    )
+
+    x, p = ca.MX.sym("x", n_x), ca.MX.sym("p", 1)
+    columns = ca.horzcat(
+        *[
+            sample(x[variables[:, s].tolist()], structure.data[:, s], structure.direction_scale[:, s])
+            for s in range(n_samples)
+        ]
+    )
+    f, g = outer(x, columns, p)
+    sigma, lam = ca.MX.sym("sigma"), ca.MX.sym("lam", g.shape[0])
+    whole = ca.Function(
+        "whole",
+        [x, p, sigma, lam],
+        [f, g, ca.gradient(f, x), ca.jacobian(g, x), ca.hessian(sigma * f + ca.dot(lam, g), x)[0]],
+    )
+    ours = derivative_functions(structure)
+    split = structured_nlp(structure)
+    values = ca.Function("values", [split["x"], split["p"]], [split["f"], split["g"]])
+    point, parameter = rng.normal(size=n_x), [0.7]
+    weights = (1.3, rng.normal(size=g.shape[0]))
+    f_value, g_value, grad, jac, hess = (np.asarray(ca.DM(e)) for e in whole(point, parameter, *weights))
+    # The same derivatives in another order of operations: they agree to rounding.
+    for mine, theirs in [
+        (values(point, parameter)[0], f_value),
+        (values(point, parameter)[1], g_value),
+        (ours["grad_f"](point, parameter)[1], grad),
+        (ours["jac_g"](point, parameter)[1], jac),
+        (ours["hess_lag"](point, parameter, *weights), np.triu(hess)),
+    ]:
+        theirs = np.asarray(theirs)
+        np.testing.assert_allclose(np.asarray(ca.DM(mine)), theirs, rtol=0, atol=1e-12 * np.abs(theirs).max())
 
 
 def test_every_solver_of_a_problem_shares_one_set_of_derivatives_and_the_optimum_is_unchanged(

@@ -11,6 +11,8 @@ by the chain rule::
     hess L = T^T hess(outer L) T + sum_s P_s^T (sum_k ybar_sk hess y_sk) P_s,   T = [I; J],
 
 with ``J = dY/dx`` (block-sparse), ``ybar = sigma f_Y + g_Y^T lambda`` and ``P_s`` the selection of ``v_s``.
+IPOPT gets the NLP's values the same way (:func:`structured_nlp`): on the Panda benchmark, expanding the whole NLP
+to SX and building a solver on it took 0.2-0.3 s CPU, three times the per-sample differentiation.
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-__all__ = ["SampleStructure", "derivative_functions"]
+__all__ = ["SampleStructure", "derivative_functions", "structured_nlp"]
 
 
 @dataclass(frozen=True)
@@ -57,6 +59,31 @@ def _nonzeros(matrix: ca.SX) -> ca.SX:
     return ca.sparsity_cast(matrix, ca.Sparsity.dense(matrix.nnz(), 1))
 
 
+def _sample_inputs(structure: SampleStructure, x: ca.MX) -> tuple[ca.MX, tuple[ca.DM, ca.DM]]:
+    """Every sample's variables ``v_s`` taken from ``x`` (n_local, n_samples), and its data and direction scale."""
+    n_local, n_samples = structure.variables.shape
+    variables = ca.reshape(x[structure.variables.ravel(order="F").tolist()], n_local, n_samples)
+    return variables, (ca.DM(structure.data), ca.DM(structure.direction_scale))
+
+
+def structured_nlp(structure: SampleStructure) -> dict[str, ca.MX]:
+    """The NLP ``{"x", "p", "f", "g"}`` as the per-sample function mapped over the samples and the outer part.
+
+    The same values as the NLP it was split from, as a few calls of SX functions: nothing to expand, and
+    ``f`` and ``g`` each evaluate only what they need.
+    """
+    outer = structure.outer
+    x, p = ca.MX.sym("x", outer.size1_in(0)), ca.MX.sym("p", outer.size1_in(2))
+    xo, yo, po = (ca.SX.sym(name, outer.sparsity_in(i)) for i, name in enumerate(("x", "Y", "p")))
+    fo, go = outer(xo, yo, po)
+    n_samples = structure.variables.shape[1]
+    variables, constants = _sample_inputs(structure, x)
+    y = structure.sample.map(n_samples)(variables, *constants)
+    f = ca.Function("outer_value_f", [xo, yo, po], [fo])(x, y, p)
+    g = ca.Function("outer_value_g", [xo, yo, po], [go])(x, y, p)
+    return {"x": x, "p": p, "f": f, "g": g}
+
+
 def derivative_functions(structure: SampleStructure) -> dict[str, ca.Function]:
     """IPOPT's ``grad_f``, ``jac_g`` and ``hess_lag`` functions for CasADi's ``nlpsol``, assembled per sample."""
     outer, sample = structure.outer, structure.sample
@@ -74,16 +101,13 @@ def derivative_functions(structure: SampleStructure) -> dict[str, ca.Function]:
     y = sample(v, data, scale)
     jacobian = ca.jacobian(y, v)
     hessian = ca.triu(ca.hessian(ca.dot(weights, y), v)[0])
-    first = ca.Function("sample_jacobian", [v, data, scale], [y, _nonzeros(jacobian)])
-    second = ca.Function("sample_hessian", [v, data, scale, weights], [_nonzeros(hessian)])
+    # Common subexpressions merged: 4 % fewer operations in the Hessian, the same values.
+    first = ca.Function("sample_jacobian", [v, data, scale], [y, _nonzeros(jacobian)], {"cse": True})
+    second = ca.Function("sample_hessian", [v, data, scale, weights], [_nonzeros(hessian)], {"cse": True})
 
-    x = ca.MX.sym("x", n_x)
-    p = ca.MX.sym("p", n_p)
-    lam_f = ca.MX.sym("lam_f")
-    lam_g = ca.MX.sym("lam_g", n_g)
-    flat_index = structure.variables.ravel(order="F")
-    variables = ca.reshape(x[flat_index.tolist()], n_local, n_samples)
-    constants = (ca.DM(structure.data), ca.DM(structure.direction_scale))
+    x, p = ca.MX.sym("x", n_x), ca.MX.sym("p", n_p)
+    lam_f, lam_g = ca.MX.sym("lam_f"), ca.MX.sym("lam_g", n_g)
+    variables, constants = _sample_inputs(structure, x)
     y_values, jac_blocks = first.map(n_samples)(variables, *constants)
     # J = dY/dx: sample s's block sits in rows n_y*s..n_y*s+n_y-1 and the columns of its variables.
     local_rows, local_cols = (np.array(i) for i in jacobian.sparsity().get_triplet())
@@ -99,20 +123,22 @@ def derivative_functions(structure: SampleStructure) -> dict[str, ca.Function]:
     fo, go = outer(xo, yo, po)
     both = ca.vertcat(xo, ca.vec(yo))
     lagrangian = so * fo + ca.dot(lo, go)
-    outer_first = ca.Function(
-        "outer_first", [xo, yo, po], [fo, go, ca.gradient(fo, both), ca.jacobian(go, both)]
-    )
-    outer_second = ca.Function(
-        "outer_second",
-        [xo, yo, po, so, lo],
-        [ca.gradient(lagrangian, ca.vec(yo)), ca.hessian(lagrangian, both)[0]],
-    )
+    outer_f = ca.Function("outer_f", [xo, yo, po], [fo, ca.gradient(fo, both)])
+    outer_g = ca.Function("outer_g", [xo, yo, po], [go, ca.jacobian(go, both)])
+    ybar_expression, hess_expression = ca.gradient(lagrangian, ca.vec(yo)), ca.hessian(lagrangian, both)[0]
+    outer_second = ca.Function("outer_second", [xo, yo, po, so, lo], [ybar_expression, hess_expression])
 
-    f, g, grad, jac = outer_first(x, y_values, p)
+    f, grad = outer_f(x, y_values, p)
     grad_f = grad[:n_x] + ca.mtimes(ca.transpose(jac_y), grad[n_x:])
+    g, jac = outer_g(x, y_values, p)
     jac_g = jac[:, :n_x] + ca.mtimes(jac[:, n_x:], jac_y)
 
-    ybar, hess = outer_second(x, y_values, p, lam_f, lam_g)
+    # The Hessian needs Y only through the outer part, and then the outputs alone: an outer part linear in Y
+    # (the usual case) needs no per-sample evaluation besides the Hessians (a fifth of their cost saved).
+    y_second: ca.MX | ca.DM = ca.DM.zeros(n_y, n_samples)
+    if any(ca.depends_on(e, ca.vec(yo)) for e in (ybar_expression, hess_expression)):
+        y_second = sample.map(n_samples)(variables, *constants)
+    ybar, hess = outer_second(x, y_second, p, lam_f, lam_g)
     hess_blocks = second.map(n_samples)(variables, *constants, ca.reshape(ybar, n_y, n_samples))
     if np.all(np.array(outer_second.sparsity_out(1).get_triplet()) < n_x):
         outer_part = hess[:n_x, :n_x]  # the outer part is linear in Y (the usual case): no product needed

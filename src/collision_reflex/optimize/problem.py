@@ -24,8 +24,8 @@ Structure (see the README's "Design optimisation" section):
 - Objectives (:mod:`.objectives`) can be bounded (``f_k <= eps_k``) through NLP parameters, so one solver serves
   a whole epsilon-constraint Pareto sweep.
 - The constraint rows (:mod:`.constraints`) each carry a label.
-- IPOPT gets the NLP's gradient, Jacobian and Hessian assembled per sample (:mod:`.derivatives`), which
-  :meth:`DesignProblem.solver` builds once and shares between all the problem's solvers.
+- IPOPT gets the NLP's values, gradient, Jacobian and Hessian assembled per sample (:mod:`.derivatives`),
+  which :meth:`DesignProblem.solver` builds once and shares between all the problem's solvers.
 """
 
 from __future__ import annotations
@@ -52,7 +52,7 @@ from .constraints import (
     required_torque_function,
     torque_requirement_rows,
 )
-from .derivatives import SampleStructure, derivative_functions
+from .derivatives import SampleStructure, derivative_functions, structured_nlp
 from .duty import (
     DutyRequirement,
     add_duty_constraints,
@@ -136,8 +136,7 @@ class DesignProblem:
     _sample_data: np.ndarray = field(repr=False)
     _structure: SampleStructure = field(repr=False)
     _solvers: dict[str, ca.Function] = field(default_factory=dict, repr=False)
-    _derivatives: dict[str, ca.Function] | None = field(default=None, repr=False)
-    _expanded: dict[str, ca.MX] | None = field(default=None, repr=False)
+    _structured: tuple[dict[str, ca.MX], dict[str, ca.Function]] | None = field(default=None, repr=False)
     _objective: ca.Function | None = field(default=None, repr=False)
 
     @property
@@ -216,37 +215,29 @@ class DesignProblem:
     def solver(self, options: Mapping[str, str | float | bool], structural: bool = True) -> ca.Function:
         """IPOPT for this NLP with ``options`` (CasADi's ``nlpsol`` options), built once per option set.
 
-        Every solver of the problem shares the same derivative functions, assembled per sample
-        (:mod:`.derivatives`): differentiating the whole NLP instead is most of a solver's construction. With
-        ``"expand"`` they also share the NLP expanded to SX once, so that a solver for another option set (a
-        warm start, another barrier strategy) costs about a fifth of the first.
+        Every solver of the problem shares the same NLP functions, assembled per sample (:mod:`.derivatives`):
+        the per-sample function mapped over the samples and the outer part, their values and derivatives.
+        Differentiating the whole NLP instead is most of a solver's construction, and expanding it to SX
+        most of the rest; these are SX functions already, so ``"expand"`` has nothing to do.
         ``structural=False`` lets CasADi differentiate the whole NLP (for comparison).
         """
         key = repr((sorted(options.items()), structural))
         solver = self._solvers.get(key)
         if solver is None:
-            if structural and self._derivatives is None:
-                self._derivatives = derivative_functions(self._structure)
-            derivatives = self._derivatives if structural else None
-            shared = bool(derivatives) and bool(options.get("expand", False))
-            solver = ca.nlpsol(
-                "actuator_design",
-                "ipopt",
-                self._expanded_nlp() if shared else self.nlp,
-                {**options, **(derivatives or {}), **({"expand": False} if shared else {})},
-            )
+            if not structural:
+                solver = ca.nlpsol("actuator_design", "ipopt", self.nlp, dict(options))
+            else:
+                if self._structured is None:
+                    self._structured = (
+                        structured_nlp(self._structure),
+                        derivative_functions(self._structure),
+                    )
+                nlp, derivatives = self._structured
+                solver = ca.nlpsol(
+                    "actuator_design", "ipopt", nlp, {**options, **derivatives, "expand": False}
+                )
             self._solvers[key] = solver
         return solver
-
-    def _expanded_nlp(self) -> dict[str, ca.MX]:
-        """The NLP with its objective and constraints one SX function, expanded once for every solver."""
-        if self._expanded is None:
-            x, p = self.nlp["x"], self.nlp["p"]
-            both = ca.Function("nlp_fg", [x, p], [self.nlp["f"], self.nlp["g"]]).expand()
-            x_sym, p_sym = ca.MX.sym("x", x.shape[0]), ca.MX.sym("p", p.shape[0])
-            f, g = both(x_sym, p_sym)
-            self._expanded = {"x": x_sym, "p": p_sym, "f": f, "g": g}
-        return self._expanded
 
     def objective_value(self, x: np.ndarray) -> float:
         """The NLP's (scaled) objective at ``x``, auxiliaries at their exact values: for comparing results."""
