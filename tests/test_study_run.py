@@ -233,6 +233,15 @@ def test_dask_cluster_gives_the_serial_result(runs, tmp_path):
     )
 
 
+def test_local_dask_cluster_gives_the_serial_result(runs, tmp_path):
+    """A local cluster's workers (started without Dask's malloc trimming and profiler, warmed at once)."""
+    pytest.importorskip("distributed")
+    run_study(TWO_LINK, tmp_path / "dask", quiet=True, smoke=True, executor="dask", workers=2)
+    pd.testing.assert_frame_equal(
+        _numbers(tmp_path / "dask"), _numbers(runs["two_link_paper"]), check_exact=True
+    )
+
+
 def test_process_pool_gives_the_serial_result(runs, tmp_path):
     assert (
         main(

@@ -31,6 +31,22 @@ def test_executors_run_tasks(kind):
         assert list(pool.map(_square, range(5))) == [0, 1, 4, 9, 16]
 
 
+def _imported(module: str) -> bool:
+    import sys
+
+    return module in sys.modules
+
+
+def test_a_pool_starts_every_worker_at_once_and_warms_it():
+    """Both workers exist before any piece is submitted, and each has imported the robot models' library
+    (which nothing a piece's unpickling imports) before its first piece."""
+    import multiprocessing
+
+    with open_executor("processes", workers=2) as pool:
+        assert len(multiprocessing.active_children()) >= 2
+        assert all(pool.map(_imported, ["pinocchio"] * 4))
+
+
 def test_serial_executor_delivers_errors_through_the_future():
     future: Future = SerialExecutor().submit(math.sqrt, -1.0)
     with pytest.raises(ValueError):
