@@ -9,8 +9,8 @@ placements of the reflected inertia and both reaction models; it prints the larg
 and the share of cases within 5 %, the contact damper's share of the force, the failures, the timings (wall
 and CPU) and the machine's load. The arms run in parallel processes.
 
-Run: ``PYTHONPATH=src python benchmarks/validity_map.py [FIGURE.png]`` (1,200 simulations: 476 s of CPU
-time, measured at a load of 8-10 on two cores, 20 minutes of wall time there). The joint parameters of the UR5 and the Panda are
+Run: ``PYTHONPATH=src python benchmarks/validity_map.py [FIGURE.png]`` (1,200 simulations: 501 s of CPU
+time, measured at a load of 2.5-8 on two cores, 10 minutes of wall time there). The joint parameters of the UR5 and the Panda are
 representative harmonic-drive joints, not the makers' data.
 """
 
