@@ -199,7 +199,8 @@ def test_interrupted_run_resumes_from_finished_points(runs, tmp_path, monkeypatc
     assert json.loads((folder / "run.json").read_text())["status"] == "interrupted"
     assert not (folder / "pareto.csv").exists()  # no results until the run has finished
     finished = sorted(p.name for p in (folder / "points").iterdir())
-    assert "point-000.json" in finished and "point-001.json" not in finished
+    # The first point solved is kept, the interrupted one is not (points go out from the far end of the grid).
+    assert len([name for name in finished if name.startswith("point-")]) == 1, finished
 
     monkeypatch.setattr(sweep, "solve_point", original)
     result = run_study(TWO_LINK, folder, quiet=True, smoke=True, executor="serial")
