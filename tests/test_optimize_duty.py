@@ -263,3 +263,25 @@ def test_torque_speed_points_are_the_motor_side_cycle(lightest, cycle):
         fastest = max(np.abs(joint.cycle_speed).max(), np.abs(joint.approach_speed).max())
         assert fastest == pytest.approx(result.max_motor_speed[j], rel=1e-12)
         assert math.isfinite(fastest)
+
+
+def test_peak_rows_give_the_unreduced_peak_everywhere_in_the_box(arm, samples, cycle):
+    # The kept rows' maximum against every row's: the peak requirement SF max_t |d_j(t)| at random x_j in the
+    # box and at its corners (a linear function's extremes over a box are at corners).
+    from collision_reflex.optimize.duty import duty_requirement, peak_rows
+
+    duty = duty_requirement(arm, samples, cycle, _technology(), SAFETY)
+    nv = duty.torques.nv
+    low = np.array([1.0, *np.full(nv, 0.05), 1e-6])
+    high = np.array([1.0, *np.full(nv, 1.5), 0.5])
+    kept = peak_rows(duty, np.tile(low, (nv, 1)), np.tile(high, (nv, 1)))
+    rng = np.random.default_rng(2)
+    pick = (np.arange(2 ** (nv + 1))[:, None] >> np.arange(nv + 1)[None, :]) & 1
+    corners = np.column_stack([np.ones(pick.shape[0]), np.where(pick == 1, high[1:], low[1:])])
+    points = np.vstack([corners, rng.uniform(low, high, size=(500, nv + 2))])
+    for j, (rows, index, sign) in enumerate(kept):
+        basis = duty.torques.demand_basis(j)
+        assert rows.shape[0] < basis.shape[0] / 10  # most rows go
+        np.testing.assert_array_equal(rows, SAFETY * sign[:, None] * basis[index])
+        expected = SAFETY * np.abs(points @ basis.T).max(axis=1)
+        np.testing.assert_allclose((points @ rows.T).max(axis=1), expected, rtol=1e-12, atol=0)

@@ -18,6 +18,7 @@ import pytest
 import collision_reflex as cr
 from collision_reflex.arm import Arm
 from collision_reflex.optimize.constraints import (
+    binding_rows,
     binding_torque_demands,
     required_torque_function,
     torque_requirement_rows,
@@ -80,3 +81,38 @@ def test_binding_torque_demands_drop_only_demands_that_never_bind():
         ]
         expected = constraints.safety_factor * np.max(np.abs(gravity), axis=0)
         np.testing.assert_allclose(np.asarray(required(masses)).ravel(), expected, rtol=RTOL)
+
+
+def _box_corners(low: np.ndarray, high: np.ndarray) -> np.ndarray:
+    """All 2^k corners of the box ``[low, high]``, (2^k, k)."""
+    pick = (np.arange(2**low.size)[:, None] >> np.arange(low.size)[None, :]) & 1
+    return np.where(pick == 1, high, low)
+
+
+def test_binding_rows_keep_the_maximum_and_drop_only_covered_rows():
+    # A sampled smooth motion's rows: neighbours nearly equal, a few cross over the box (the duty-cycle case).
+    rng = np.random.default_rng(11)
+    k, n = 4, 400
+    time = np.linspace(0.0, 1.0, n)[:, None]
+    slopes = np.sin(2 * np.pi * time * rng.uniform(0.5, 3.0, k) + rng.uniform(0, 6, k)) * rng.uniform(1, 5, k)
+    bases = 3.0 * np.cos(2 * np.pi * time[:, 0] + 0.4)
+    bases, slopes = np.concatenate([bases, -bases]), np.vstack([slopes, -slopes])
+    bases[7], slopes[7] = bases[3], slopes[3]  # an exact duplicate: one of the pair must stay
+    low, high = np.full(k, 0.1), np.array([2.0, 1.0, 3.0, 0.5])
+    keep = binding_rows(bases, slopes, low, high)
+    smallest = bases + np.minimum(slopes * low, slopes * high).sum(axis=1)
+    largest = bases + np.maximum(slopes * low, slopes * high).sum(axis=1)
+    box_test = largest >= smallest.max()
+    assert 0 < keep.sum() < box_test.sum() / 3  # pairwise dominance removes most of what the box test keeps
+    assert keep[3] != keep[7] or not keep[3]
+    # Independent check: a linear function is >= 0 on a box iff it is at every corner, so at each corner and
+    # at random points the kept rows' maximum is the maximum of all rows.
+    points = np.vstack([_box_corners(low, high), rng.uniform(low, high, size=(2000, k))])
+    every = (bases[None, :] + points @ slopes.T).max(axis=1)
+    kept = (bases[keep][None, :] + points @ slopes[keep].T).max(axis=1)
+    np.testing.assert_allclose(kept, every, rtol=RTOL, atol=0)
+    # and each dropped row is covered at every corner by one kept row (dominance, not just the maximum).
+    corner_values = bases[None, :] + _box_corners(low, high) @ slopes.T
+    for row in np.flatnonzero(~keep):
+        margin = corner_values[:, keep] - corner_values[:, [row]]
+        assert np.any(np.all(margin >= -1e-12 * np.abs(corner_values).max(), axis=0))

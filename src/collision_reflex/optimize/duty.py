@@ -7,8 +7,8 @@ must meet, over the cycle's samples ``t``:
   (J_m,j + J_g,j) qdd_j(t)`` (:func:`collision_reflex.arm.dynamics.joint_side_torque`; ``eta``, ``J_g`` the
   gearbox's efficiency and input inertia, 1 and 0 without one). It is affine in ``x_j = [1, m_0, ...,
   m_{nv-1}, N_j^2 (J_m,j + J_g,j)]`` (actuator masses, motor and gearbox [kg], reflected inertia [kg m^2]):
-  ``d_j = B_j x_j``, so the peak is the linear rows ``+-SF B_j(t) x_j <= eta_j N_j tau_p,j``; rows that can
-  never be the largest within the variable bounds are dropped exactly
+  ``d_j = B_j x_j``, so the peak is the linear rows ``+-SF B_j(t) x_j <= eta_j N_j tau_p,j``; rows another
+  row covers everywhere within the variable bounds are dropped exactly
   (:func:`collision_reflex.optimize.constraints.binding_rows`);
 - continuous (thermal): ``eta_j N_j tau_c,j >= RMS_t d_j`` as ``x_j^T Q_j x_j / (eta_j N_j tau_c,j)^2 <= 1``
   (smooth, of order one); no safety factor: the RMS is a thermal average, the safety factor covers the peak;
@@ -160,7 +160,7 @@ def peak_rows(
     """Per joint the peak demands that can bind: ``(rows (R, nv + 2), sample index (R,), sign (R,))``.
 
     Row ``r`` is ``sign SF B_j(t)`` so that ``rows @ x_j <= N tau_p`` is the peak requirement. ``x_low`` and
-    ``x_high`` (nv, nv + 2) bound ``x_j`` per joint (its first entry is 1); rows that can never be the largest
+    ``x_high`` (nv, nv + 2) bound ``x_j`` per joint (its first entry is 1); rows another row covers everywhere
     within them are dropped (exact, :func:`collision_reflex.optimize.constraints.binding_rows`).
     """
     kept = []
