@@ -160,3 +160,42 @@ def test_one_drawing_for_several_files_gives_the_pixels_of_each_drawn_alone(tmp_
         plot_torque_speed((tmp_path / "ok.png", tmp_path / "bad.txt"), joints)
     with pytest.raises(InvalidParameter, match="at least one file"):
         plot_torque_speed((), joints)
+
+
+def test_each_file_is_drawn_once_with_the_layout_tight_layout_gives(tmp_path, monkeypatch):
+    """Saving the figure to its SVG and PNG draws it once per file, laid out as ``fig.tight_layout()`` lays it.
+
+    A figure left with a layout engine (``fig.tight_layout()`` leaves a placeholder) is drawn once more before
+    each file by ``savefig``: four drawings instead of two.
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
+
+    import collision_reflex.plots.torque_speed as module
+
+    joints = [_shoulder(), _wrist_unknown_limits(), JointOperatingPoints("elbow", [1.0], [0.1])]
+    drawn: list[Figure] = []
+    draw = Figure.draw
+    monkeypatch.setattr(Figure, "draw", lambda self, renderer: (drawn.append(self), draw(self, renderer))[1])
+    laid_out: list[tuple[float, ...]] = []
+    save = module.save_figure
+
+    def keep_layout(fig, path):
+        params = fig.subplotpars
+        laid_out.append((params.left, params.right, params.bottom, params.top, params.wspace, params.hspace))
+        assert fig.get_layout_engine() is None
+        return save(fig, path)
+
+    monkeypatch.setattr(module, "save_figure", keep_layout)
+    plot_torque_speed((tmp_path / "f.svg", tmp_path / "f.png"), joints)
+    assert len(drawn) == 2
+
+    # The same figure laid out by matplotlib's own call, for comparison.
+    monkeypatch.setattr(module, "_tight_layout", lambda fig: fig.tight_layout())
+    captured: list[Figure] = []
+    monkeypatch.setattr(module, "save_figure", lambda fig, path: captured.append(fig))
+    plot_torque_speed(tmp_path / "g.png", joints)
+    params = captured[0].subplotpars
+    expected = (params.left, params.right, params.bottom, params.top, params.wspace, params.hspace)
+    plt.close(captured[0])
+    assert laid_out[0] == expected

@@ -187,8 +187,19 @@ def plot_torque_speed(path: FigurePath, joints: Sequence[JointOperatingPoints]) 
     fig.suptitle(
         "Motor operating points over the motor envelope (|speed|, |torque|, motor side)", fontsize=11
     )
-    fig.tight_layout()
+    _tight_layout(fig)
     return save_figure(fig, path)
+
+
+def _tight_layout(fig: Any) -> None:
+    """Lay the subplots out as ``fig.tight_layout()`` does, leaving the figure without a layout engine.
+
+    ``fig.tight_layout()`` leaves a placeholder engine behind, and with any engine set ``savefig`` draws the
+    whole figure once more before each file, to no effect here (the layout is done).
+    """
+    from matplotlib.layout_engine import TightLayoutEngine
+
+    TightLayoutEngine().execute(fig)
 
 
 def _draw_joint(ax: Any, point: JointOperatingPoints) -> None:
