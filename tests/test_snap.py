@@ -497,3 +497,101 @@ def test_a_study_on_active_sets_snaps_on_them_and_through_a_process_pool_alike(t
     solver = entries[0]["design"]["solver"]
     assert solver["method"] == "active set"
     assert 0 < solver["active_samples"] <= len(entries[0]["design"]["impulses"])
+
+
+@pytest.fixture(scope="module")
+def cycle_sized(two_link):
+    """The two-link problem sized by a loaded duty cycle (peak and RMS torques grow with the motors' masses and
+    inertias), its optimum, and the test catalogue with maximum speeds (the cycle's speed rows need them)."""
+    from collision_reflex.arm.duty_cycle import DutyCycle, Payload
+
+    arm, problem, _ = two_link
+    cycle = DutyCycle.through_via_points(
+        [[0.0, 0.0], [1.2, -1.0], [0.3, 0.6]],
+        arm.joint_names,
+        [15.0, 20.0],
+        [80.0, 100.0],
+        rate=100.0,
+        dwell=0.05,
+        payload=Payload(2.0),
+    )
+    constraints = cr.Constraints(safety_factor=1.2, duty_cycle=cycle)
+    built = cr.build_problem(arm, problem.samples, problem.space, problem.technology, OBJECTIVE, constraints)
+    reference = cr.reference_motor()
+    catalogue = [
+        dataclasses.replace(m, max_speed=reference.scaled(m.stator_diameter, m.stack_length).max_speed)
+        for m in _catalogue()
+    ]
+    return arm, built, cr.solve(built, starts=2), catalogue
+
+
+def _torque_shortfalls(problem, x):
+    """How far each peak- and RMS-torque row of ``problem`` at ``x`` is outside its bounds (0 when within)."""
+    import casadi as ca
+
+    g = ca.Function("g", [problem.nlp["x"], problem.nlp["p"]], [problem.nlp["g"]])(x, problem.parameters())
+    rows = [i for i, label in enumerate(problem.constraint_labels) if label.startswith(("peak", "RMS"))]
+    values = np.asarray(g).ravel()[rows]
+    return np.maximum(np.maximum(problem.lbg[rows] - values, values - problem.ubg[rows]), 0.0)
+
+
+def test_the_warm_start_meets_the_torque_requirement_of_the_parts_own_masses(cycle_sized):
+    # The heaviest motor at both joints: at the matched ratios (the continuous peak torques) its mass is not
+    # covered; at the covering ratios every peak-torque row of the parts' own problem holds, as CasADi builds it.
+    arm, problem, optimum, catalogue = cycle_sized
+    heavy = catalogue[-1]
+    joints = snapping.joint_candidates(problem, optimum, [heavy], candidates=1)
+    parts = [j.parts[0] for j in joints]
+    built = snapping.catalogue_problem(problem, parts, arm)
+    cold = snapping._parts_start(problem, optimum, parts, built, raised=False)
+    warm = snapping._parts_start(problem, optimum, parts, built, raised=True)
+    assert _torque_shortfalls(built, cold).max() > 1e-2  # the guarded case: the matched ratios fall short
+    # Within what REQUIREMENT_PASSES fixed-point passes settle (the RMS row grows with N^2 J: 2e-5 here).
+    assert _torque_shortfalls(built, warm).max() <= 1e-4
+    matched = [snapping.matched_gear_ratio(p, optimum.design, j) for j, p in enumerate(parts)]
+    assert np.all(snapping.covering_gear_ratios(problem, optimum.design, parts) >= np.array(matched))
+
+
+def test_the_warm_start_carries_the_multipliers_over_by_variable_and_row(cycle_sized):
+    arm, problem, optimum, catalogue = cycle_sized
+    joints = snapping.joint_candidates(problem, optimum, catalogue, candidates=2)
+    parts = [j.parts[1] for j in joints]
+    built = snapping.catalogue_problem(problem, parts, arm)
+    x0 = snapping._parts_start(problem, optimum, parts, built, raised=True)
+    start = snapping.warm_start(problem, built, optimum, x0)
+    lam_x, lam_g = start.multipliers
+    np.testing.assert_array_equal(start.x, x0)
+    bounds, rows = optimum.multipliers
+    for name, indices in built.layout.slices.items():  # every variable free in both keeps its multiplier
+        for i, k in zip(indices, problem.layout.slices[name], strict=True):
+            if i is not None:
+                assert lam_x[i] == (bounds[k] if k is not None else 0.0)
+    np.testing.assert_array_equal(lam_x[built.layout.size :], bounds[problem.layout.size :])
+    own = dict(zip(problem.constraint_labels, rows, strict=True))
+    assert set(built.constraint_labels) <= set(own)  # the catalogue problem drops rows, never adds one
+    assert list(lam_g) == [own[label] for label in built.constraint_labels]
+
+
+def test_a_warm_re_solve_finds_the_cold_one_in_fewer_iterations(cycle_sized):
+    # Every combination of two candidates per joint: the warm start reaches the cold start's optimum (or a
+    # better one) in fewer iterations in total.
+    arm, problem, optimum, catalogue = cycle_sized
+    joints = snapping.joint_candidates(problem, optimum, catalogue, candidates=2)
+    warm_iterations = cold_iterations = 0
+    for parts in itertools.product(*(j.parts for j in joints)):
+        warm = solve_parts(problem, optimum, parts, arm)
+        cold = solve_parts(problem, optimum, parts, arm, warm=False)
+        assert objective_value(problem, warm.numpy_objectives) <= objective_value(
+            problem, cold.numpy_objectives
+        ) * (1 + SOLVER_TOLERANCE)
+        warm_iterations, cold_iterations = (
+            warm_iterations + warm.iterations,
+            cold_iterations + cold.iterations,
+        )
+    assert warm_iterations < cold_iterations
+
+
+def test_the_chosen_parts_are_never_worse_than_their_cold_re_solve(two_link, exact):
+    arm, problem, optimum = two_link
+    cold = solve_parts(problem, optimum, exact.parts, arm, warm=False)
+    assert _chosen_value(problem, exact) <= objective_value(problem, cold.numpy_objectives)

@@ -407,9 +407,12 @@ class _ThroughExecutor:
     optimum: DesignResult
     executor: Executor
 
-    def __call__(self, combinations: Sequence[tuple[CataloguePart, ...]]) -> list[DesignResult | str]:
+    def __call__(
+        self, combinations: Sequence[tuple[CataloguePart, ...]], warm: bool = True
+    ) -> list[DesignResult | str]:
         futures = [
-            self.executor.submit(solve_study_parts, self.problems, self.optimum, c) for c in combinations
+            self.executor.submit(solve_study_parts, self.problems, self.optimum, c, warm)
+            for c in combinations
         ]
         try:
             return [future.result() for future in futures]
@@ -420,9 +423,11 @@ class _ThroughExecutor:
 
 
 def solve_study_parts(
-    problems: StudyProblems, optimum: DesignResult, parts: tuple[CataloguePart, ...]
+    problems: StudyProblems, optimum: DesignResult, parts: tuple[CataloguePart, ...], warm: bool = True
 ) -> DesignResult | str:
     """One combination of a study's catalogue snap, in any process (its problem built there once).
+
+    ``warm``: as :func:`collision_reflex.optimize.snap.solve_parts` says.
 
     One solve at a time per process with single-threaded BLAS, as every piece of a sweep, so that the numbers
     are the same on every executor.
@@ -434,7 +439,7 @@ def solve_study_parts(
     with _SNAP_LOCK, single_threaded_blas():
         problem = built_problem(problems, problems.objective)
         return solved_or_status(
-            problem, optimum, parts, problems.setup.arm, IPOPT_OPTIONS, problems.active_set
+            problem, optimum, parts, problems.setup.arm, IPOPT_OPTIONS, problems.active_set, warm
         )
 
 
