@@ -619,6 +619,33 @@ def solve_anchor(
     return SweepPoint(label, result, tuple(failures), start)
 
 
+POINT_START_OPTIONS: dict[str, str | float] = {"ipopt.mu_init": 1e-4}
+"""IPOPT options, under the sweep's, of an epsilon point started from the anchor's point alone (monotone barrier
+from a smaller ``mu`` than a cold solve's 1e-2: the anchor's point is near the front). Measured on the UR5 study's
+8 points, each started at the anchor's design with the approach velocity raised to its bound
+(:func:`velocity_within_bound`): 658 iterations (76-95 a point) against 751 from ``mu = 1e-2``, 719 from 1e-3;
+from 1e-6, 820 with two points retried; the same objectives to 1e-7 relative."""
+
+
+def velocity_within_bound(
+    problem: DesignProblem, start: np.ndarray, epsilon: Mapping[str, float]
+) -> np.ndarray:
+    """``start`` (NLP variables) with its approach velocity raised to the point's lower bound in ``epsilon``.
+
+    The anchor of the worst-case impulse sits at the slowest approach; an epsilon point demands a faster one,
+    which the start then meets, its auxiliaries (epigraph, reaction) set at their exact values for it. On the
+    UR5 study's 8 points: 751 iterations against 931 from the anchor's point as it is (CPU 19 s against 30 s),
+    the same objectives to 1e-7 relative. A start without a velocity bound, or with a fixed velocity, is kept.
+    """
+    start = np.array(start, dtype=float)
+    bound = epsilon.get("approach_velocity")
+    slot = problem.layout.slices.get("approach_velocity", [None])[0]
+    if bound is None or slot is None or bound <= 0 or start[slot] >= np.log(bound):
+        return start
+    start[slot] = min(np.log(bound) + 1e-6, problem.ubx[slot])  # 1 ppm inside the bound
+    return problem.exact_point(start)
+
+
 @_one_at_a_time
 def solve_point(
     build: ProblemBuilder,
@@ -636,7 +663,12 @@ def solve_point(
     (``active_set``, :func:`solve_with`) it starts from the samples ``initial``.
     """
     label = "epsilon: " + ", ".join(_bound_text(k, v) for k, v in epsilon.items())
-    x0 = start if isinstance(start, DesignResult) else np.asarray(start)
+    options = ipopt_options
+    if isinstance(start, DesignResult):
+        x0: np.ndarray | DesignResult = start
+    else:
+        x0 = velocity_within_bound(built_problem(build, objectives[0], objectives[1:]), start, epsilon)
+        options = {**POINT_START_OPTIONS, **(ipopt_options or {})}
     try:
         result = solve_with(
             build,
@@ -645,7 +677,7 @@ def solve_point(
             active_set,
             epsilon=epsilon,
             x0=x0,
-            ipopt_options=ipopt_options,
+            ipopt_options=options,
             initial=initial,
         )
     except SolverFailed as error:
