@@ -638,8 +638,9 @@ def velocity_within_bound(
 
     The anchor of the worst-case impulse sits at the slowest approach; an epsilon point demands a faster one,
     which the start then meets, its auxiliaries (epigraph, reaction) set at their exact values for it. On the
-    UR5 study's 8 points: 751 iterations against 931 from the anchor's point as it is (CPU 19 s against 30 s),
-    the same objectives to 1e-7 relative. A start without a velocity bound, or with a fixed velocity, is kept.
+    UR5 study's 8 points, with :data:`POINT_START_OPTIONS`: 658 iterations against 931 from the anchor's point as
+    it is (CPU 19 s against 30 s), every objective within 1e-7 relative of the old one; from ``mu = 1e-2`` (751
+    iterations) one point stopped 9e-6 worse. A start without a velocity bound, or with a fixed velocity, is kept.
     """
     start = np.array(start, dtype=float)
     bound = epsilon.get("approach_velocity")
@@ -663,7 +664,8 @@ def solve_point(
     """One epsilon-constraint point: the first objective minimised with the others bounded by ``epsilon``.
 
     The bounds are in the objectives' units; the solve starts from ``start``: a point of the NLP's variables,
-    or a result of the same problem, whose multipliers then warm-start IPOPT. On active sets
+    or a result of the same problem, whose multipliers then warm-start IPOPT; a point alone starts at the point's
+    velocity bound (:func:`velocity_within_bound`, :data:`POINT_START_OPTIONS`). On active sets
     (``active_set``, :func:`solve_with`) it starts from the samples ``initial``.
     """
     label = "epsilon: " + ", ".join(_bound_text(k, v) for k, v in epsilon.items())
