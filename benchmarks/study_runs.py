@@ -8,7 +8,9 @@ fresh Python process (the package imported, the robot loaded and every problem b
 the studies interleaved. It prints, per study, the median wall time with the load average before and after
 each run, and per stage the median wall and CPU time read back from the run's ``timings.json``
 (``stages/<stage>/wall|cpu``: load, prepare, optimum, pareto, catalogue snap, results, result files, figures,
-report). CPU time is the run's process's, steadier than wall time on a loaded machine. It also prints the
+report). CPU time is the run's process's, steadier than wall time on a loaded machine. Bytecode is compiled
+before the runs and read as an installed package's is (``PYTHONDONTWRITEBYTECODE`` is dropped from the runs'
+environment), so that no run counts compiling the package's sources. It also prints the
 largest single solve and any solve that stopped at the iteration cap (a run reports such a point as failed).
 
 ``--keep DIR``: keep each run's output folder under DIR (default: a temporary folder, removed after).
@@ -35,6 +37,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_STUDIES = (ROOT / "studies" / "panda.yaml", ROOT / "studies" / "ur5.yaml")
 STAGE_PREFIX = "stages/"
+# Bytecode written and read as for an installed package: a shell with PYTHONDONTWRITEBYTECODE set would make every
+# run compile the package's sources again (measured: 0.06-0.09 s for 40 modules, at load 3).
+ENV = {name: value for name, value in os.environ.items() if name != "PYTHONDONTWRITEBYTECODE"}
 
 
 def main() -> None:
@@ -48,6 +53,8 @@ def main() -> None:
         "--from", dest="source", metavar="DIR", help="with --snap-only: earlier runs' folders"
     )
     args = parser.parse_args()
+    package = ROOT / "src" / "collision_reflex"
+    subprocess.run([sys.executable, "-m", "compileall", "-q", str(package)], env=ENV, check=True)
     with tempfile.TemporaryDirectory() as scratch:
         base = Path(args.keep) if args.keep else Path(scratch)
         if args.snap_only:
@@ -75,7 +82,7 @@ def run_once(study: str, out: Path, smoke: bool) -> dict:
     command += ["--executor", "serial"] + (["--smoke"] if smoke else [])
     load_before = os.getloadavg()[0]
     started = time.perf_counter()
-    subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
+    subprocess.run(command, env=ENV, check=True, stdout=subprocess.DEVNULL)
     wall = time.perf_counter() - started
     load_after = os.getloadavg()[0]
     timings = json.loads((out / "timings.json").read_text(encoding="utf-8"))
