@@ -236,6 +236,35 @@ def test_per_sample_derivatives_of_an_outer_part_nonlinear_in_the_sample_outputs
         np.testing.assert_allclose(np.asarray(ca.DM(mine)), theirs, rtol=0, atol=1e-12 * np.abs(theirs).max())
 
 
+def test_scattered_sample_entries_sum_into_the_nlp_matrix_as_a_dense_accumulation():
+    """The per-sample entries' pattern and summing matrix against a brute-force dense sum, repeated entries
+    (shared design variables) and empty columns included; and the sample data converted to CasADi unchanged."""
+    import casadi as ca
+
+    from collision_reflex.optimize.derivatives import _scatter, dense_dm
+
+    rng = np.random.default_rng(5)
+    shape = (7, 9)
+    rows, cols = rng.integers(0, shape[0], 60), rng.integers(0, 6, 60)  # columns 6..8 stay empty
+    values = rng.normal(size=rows.size)
+    pattern, summing = _scatter(rows, cols, shape)
+    expected = np.zeros(shape)
+    np.add.at(expected, (rows, cols), values)
+    summed = ca.DM(pattern, ca.mtimes(summing, ca.DM(values)))
+    np.testing.assert_allclose(np.asarray(summed), expected, rtol=0, atol=1e-12 * np.abs(expected).max())
+    entries = set(zip(rows.tolist(), cols.tolist(), strict=True))
+    assert pattern.nnz() == len(entries)
+    assert set(zip(*pattern.get_triplet(), strict=True)) == entries
+    assert summing.shape == (len(entries), rows.size) and np.all(np.asarray(ca.sum1(summing)) == 1)
+
+    data = rng.normal(size=(4, 3))
+    data[1] = 0.0  # zeros stay structural entries, as in ca.DM(array)
+    for array in (data, data[:, 0]):
+        converted, reference = dense_dm(array), ca.DM(array)
+        assert converted.sparsity() == reference.sparsity()
+        assert np.array_equal(np.asarray(converted), np.asarray(reference))
+
+
 def test_every_solver_of_a_problem_shares_one_set_of_derivatives_and_the_optimum_is_unchanged(
     arm, monkeypatch
 ):

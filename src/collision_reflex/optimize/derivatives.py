@@ -17,12 +17,13 @@ to SX and building a solver on it took 0.2-0.3 s CPU, three times the per-sample
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
 
-__all__ = ["SampleStructure", "derivative_functions", "structured_nlp"]
+__all__ = ["SampleStructure", "dense_dm", "derivative_functions", "structured_nlp"]
 
 
 @dataclass(frozen=True)
@@ -40,18 +41,41 @@ class SampleStructure:
     data: np.ndarray
     direction_scale: np.ndarray
 
+    @functools.cached_property
+    def constants(self) -> tuple[ca.DM, ca.DM]:
+        """``data`` and ``direction_scale`` as CasADi matrices, converted once for all the NLP's functions."""
+        return dense_dm(self.data), dense_dm(self.direction_scale)
+
 
 def _scatter(rows: np.ndarray, cols: np.ndarray, shape: tuple[int, int]) -> tuple[ca.Sparsity, ca.DM]:
     """Sparsity of the entries ``(rows, cols)`` and the 0/1 matrix summing values given in that order into it."""
     keys = cols.astype(np.int64) * shape[0] + rows
     unique, position = np.unique(keys, return_inverse=True)
-    pattern = ca.Sparsity.triplet(
-        shape[0], shape[1], (unique % shape[0]).tolist(), (unique // shape[0]).tolist()
+    # Built column-compressed: the sorted keys are already in CasADi's (column-major) order and the summing
+    # matrix has one entry per column, so nothing is sorted again (the UR5 study's two scatters: 9.6 ms CPU
+    # against 12.3 ms from triplets, measured, medians of 31 at load 2.6).
+    pattern = ca.Sparsity(
+        shape[0],
+        shape[1],
+        np.searchsorted(unique // shape[0], np.arange(shape[1] + 1)).tolist(),
+        (unique % shape[0]).tolist(),
     )
-    summing = ca.DM.triplet(
-        position.tolist(), list(range(keys.size)), ca.DM.ones(keys.size), unique.size, keys.size
+    summing = ca.DM(
+        ca.Sparsity(unique.size, keys.size, list(range(keys.size + 1)), position.ravel().tolist()), 1.0
     )
     return pattern, summing
+
+
+def dense_dm(values: np.ndarray) -> ca.DM:
+    """``ca.DM(values)`` for a 2-D array, every entry a structural nonzero, built from a flat list.
+
+    The same matrix, faster than CasADi's conversion of a NumPy array: 3.7 ms CPU against 6.9 ms for the UR5
+    study's 259 x 336 sample data (measured, medians of 31 at load 2.6).
+    """
+    values = np.asarray(values, dtype=float)
+    if values.ndim == 1:
+        values = values[:, None]
+    return ca.DM(ca.Sparsity.dense(*values.shape), values.ravel(order="F").tolist())
 
 
 def _nonzeros(matrix: ca.SX) -> ca.SX:
@@ -63,7 +87,7 @@ def _sample_inputs(structure: SampleStructure, x: ca.MX) -> tuple[ca.MX, tuple[c
     """Every sample's variables ``v_s`` taken from ``x`` (n_local, n_samples), and its data and direction scale."""
     n_local, n_samples = structure.variables.shape
     variables = ca.reshape(x[structure.variables.ravel(order="F").tolist()], n_local, n_samples)
-    return variables, (ca.DM(structure.data), ca.DM(structure.direction_scale))
+    return variables, structure.constants
 
 
 def structured_nlp(structure: SampleStructure) -> dict[str, ca.MX]:
@@ -125,7 +149,9 @@ def derivative_functions(structure: SampleStructure) -> dict[str, ca.Function]:
     lagrangian = so * fo + ca.dot(lo, go)
     outer_f = ca.Function("outer_f", [xo, yo, po], [fo, ca.gradient(fo, both)])
     outer_g = ca.Function("outer_g", [xo, yo, po], [go, ca.jacobian(go, both)])
-    ybar_expression, hess_expression = ca.gradient(lagrangian, ca.vec(yo)), ca.hessian(lagrangian, both)[0]
+    # The Hessian comes with the gradient it differentiates: its Y part is ybar (not differentiated again).
+    hess_expression, gradient = ca.hessian(lagrangian, both)
+    ybar_expression = gradient[n_x:]
     outer_second = ca.Function("outer_second", [xo, yo, po, so, lo], [ybar_expression, hess_expression])
 
     f, grad = outer_f(x, y_values, p)

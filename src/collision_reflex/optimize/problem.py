@@ -52,7 +52,7 @@ from .constraints import (
     required_torque_function,
     torque_requirement_rows,
 )
-from .derivatives import SampleStructure, derivative_functions, structured_nlp
+from .derivatives import SampleStructure, dense_dm, derivative_functions, structured_nlp
 from .duty import (
     DutyRequirement,
     add_duty_constraints,
@@ -399,7 +399,7 @@ def build_problem(
         _joint_numbers=joint_numbers,
         _sample_function=per_sample.function,
         _sample_data=per_sample.data,
-        _structure=_sample_structure(nlp, layout, technology, per_sample, compliance_index, direction_index),
+        _structure=_sample_structure(nlp, layout, design, per_sample, compliance_index, direction_index),
     )
 
 
@@ -438,18 +438,18 @@ def _sample_terms(
     )
     start_directions = finger_mass_directions(samples, start_mass, start_finger)
     direction_scale = np.maximum(np.abs(start_directions).max(axis=1), 1e-300)
-    directions = ca.reshape(scaled_directions, n_joints, n_samples) * ca.DM(
+    directions = ca.reshape(scaled_directions, n_joints, n_samples) * dense_dm(
         np.tile(direction_scale, (n_joints, 1))
     )
     compliance = ca.exp(ca.transpose(log_compliance))
-    outputs = function.map(n_samples)(design.design_column, directions, compliance, ca.DM(data))
+    outputs = function.map(n_samples)(design.design_column, directions, compliance, dense_dm(data))
     return _SampleTerms(function, data, start_directions, direction_scale, *outputs)
 
 
 def _sample_structure(
     nlp: dict[str, ca.MX],
     layout: DesignLayout,
-    technology: ActuatorTechnology,
+    design: DesignQuantities,
     per_sample: _SampleTerms,
     compliance_index: slice,
     direction_index: slice,
@@ -458,12 +458,12 @@ def _sample_structure(
 
     A sample's variables are the design's log values, its ``log(1/F_a)`` and its scaled finger-mass direction;
     its outputs the impulse, the force threshold and ``w^T x``, the per-sample terms ``f`` and ``g`` use.
+    ``design`` holds the NLP's design quantities (functions of the design part of ``nlp["x"]``).
     """
     n_design, n_samples = layout.size, per_sample.data.shape[1]
     n_joints = (direction_index.stop - direction_index.start) // n_samples
-    z = ca.MX.sym("z", n_design)
-    design = design_quantities(layout, z, technology, technology.joint_mechanical_stiffness(n_joints))
-    design_column = ca.Function("design_column", [z], [design.design_column]).expand()
+    # The NLP's own design column, taken as a function of x (only its design part enters): not built again.
+    design_column = ca.Function("design_column", [nlp["x"]], [design.design_column]).expand()
     local = ca.SX.sym("v", n_design + 1 + n_joints)
     # Data the same for every sample (most motor-mass influence entries are zero) become constants: a third
     # fewer operations in the per-sample Hessian.
@@ -473,7 +473,7 @@ def _sample_structure(
     for position, row in enumerate(varying):
         column_data[int(row)] = data[position]
     scale = ca.SX.sym("scale", n_joints)
-    column = design_column(local[:n_design])
+    column = design_column(ca.vertcat(local[:n_design], ca.SX.zeros(nlp["x"].numel() - n_design)))
     outputs = per_sample.function(column, local[n_design + 1 :] * scale, ca.exp(local[n_design]), column_data)
     sample = ca.Function("sample", [local, data, scale], [ca.vertcat(*outputs[:3])])
 
