@@ -464,7 +464,8 @@ def _multi_start(
 
     Every start first runs to :data:`SCREENING_TOLERANCE`. Starts that stop within
     :data:`SAME_PATH_DISTANCE` of a better screened start's design are on its central path and are not run
-    further; every other one is finished to the full tolerance from its screened point and multipliers (warm
+    further unless the finish from that better start fails (then the next of its path is finished); every
+    other one is finished to the full tolerance from its screened point and multipliers (warm
     start), and the best finished one is returned. So the result is the best of the distinct optima the starts
     lead to, each solved to the full tolerance; two optima whose designs differ by less than 2 % count as one.
     """
@@ -488,22 +489,34 @@ def _multi_start(
             continue
         screened.append((problem.objective_value(result.x), result))
     screened.sort(key=lambda pair: pair[0])  # stable: a tie keeps the earlier start
-    distinct: list[DesignResult] = []
+    paths: list[list[DesignResult]] = []  # each path's starts, the best screened first
     for _, result in screened:
-        if all(np.max(np.abs(result.x[:n_design] - d.x[:n_design])) > SAME_PATH_DISTANCE for d in distinct):
-            distinct.append(result)
+        path = next(
+            (
+                p
+                for p in paths
+                if np.max(np.abs(result.x[:n_design] - p[0].x[:n_design])) <= SAME_PATH_DISTANCE
+            ),
+            None,
+        )
+        if path is None:
+            paths.append([result])
+        else:
+            path.append(result)
     best: DesignResult | None = None
     best_value = np.inf
-    for result in distinct:
-        if requested_tol < SCREENING_TOLERANCE:
-            try:
-                result = solve(problem, epsilon, result, ipopt_options, retry=retry)
-            except SolverFailed as error:
-                failure = error
-                continue
-        value = problem.objective_value(result.x)
-        if value < best_value:
-            best, best_value = result, value
+    for path in paths:
+        for result in path:  # the path's other starts only if the finish from its best one fails
+            if requested_tol < SCREENING_TOLERANCE:
+                try:
+                    result = solve(problem, epsilon, result, ipopt_options, retry=retry)
+                except SolverFailed as error:
+                    failure = error
+                    continue
+            value = problem.objective_value(result.x)
+            if value < best_value:
+                best, best_value = result, value
+            break
     if best is None:
         assert failure is not None  # every start failed
         raise failure
