@@ -442,13 +442,20 @@ def _start_point(problem: DesignProblem, x0: np.ndarray | DesignResult | None) -
 
 SCREENING_TOLERANCE = 1e-4
 """IPOPT's ``tol`` for the first run of every start of a multi-start (:func:`_multi_start`): the run stops on the
-central path, before the barrier's last decreases, which are most of a full solve's iterations. Measured on the
-4 starts of each study's optimum (``studies/panda.yaml``, ``studies/ur5.yaml``): 35-87 iterations against
-84-133 to ``tol = 1e-8``; 1e-3 stops at the same points, 1e-5 about 10 iterations later."""
+central path, before the barrier's last decreases. Measured on the 4 starts of each study's optimum
+(``studies/panda.yaml``, ``studies/ur5.yaml``): 42-67 (Panda) and 34-88 (UR5) iterations against 110-168 and
+63-130 for each start solved alone to ``tol = 1e-8``; a finish from a screened point takes 53-91 (Panda) and
+31-42 (UR5) more. A looser ``tol`` changes little, as IPOPT also waits for its absolute complementarity and
+constraint-violation tolerances (1e-4 by default): in all, screening and finishes, 1e-3 and 1e-2 took 463 and
+443 iterations against 489 (Panda) and 300 against 298 (UR5, whose optimum then moved by 7e-7). IPOPT's
+acceptable level at 1e-2, or a cap of 20-40 iterations, saved 5-19 % of the Panda's iterations but split the
+UR5's merged paths (3-4 finishes instead of 2: 324-362 iterations)."""
 SAME_PATH_DISTANCE = 2e-2
 """Largest difference of any log design variable (2 % of the variable) at which two screened starts count as one
-central path, so one optimum: measured on both studies' 4 starts (each reaching one optimum), at most 4.7e-3
-(Panda) and 4.5e-4 (UR5)."""
+central path, so one optimum. Measured on both studies' 4 starts: the UR5's screened starts are two pairs, each
+within 7.6e-5, the pairs 2.1e-2 apart and leading to different optima (1.4 apart in a log design variable);
+the Panda's are 4.4e-2 to 2.6 apart (none merged), two of them 4.4e-2 apart leading to optima 2.5 apart. So
+screened designs a few 1e-2 apart can be on different paths: the distance is not to be raised."""
 
 
 def _multi_start(
