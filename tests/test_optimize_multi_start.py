@@ -85,18 +85,19 @@ def test_starts_screened_on_different_optima_are_both_finished(monkeypatch):
 
 def test_a_failed_finish_is_retried_from_the_next_start_on_its_path(monkeypatch):
     # Three starts screen within the same-path distance of each other, in the better optimum's basin; the
-    # finish from the best screened one (-0.995) fails, so the next best (-0.99) is finished, and no further one.
-    screened = {-1.5: -0.99, -0.5: -0.995, -0.3: -0.985}
+    # finish from the best screened one (-0.9998) fails, so the next best (-0.9996) is finished, and no further one.
+    screened = {-1.5: -0.9996, -0.5: -0.9998, -0.3: -0.9994}
     assert max(screened.values()) - min(screened.values()) < solve_module.SAME_PATH_DISTANCE
-    finished_from = _stand_in_solver(monkeypatch, screened.__getitem__, fails_from={-0.995})
+    finished_from = _stand_in_solver(monkeypatch, screened.__getitem__, fails_from={-0.9998})
     result = solve_module._multi_start(_problem(-1.5), None, None, None, 3, _Draws(-0.5, -0.3))
-    assert finished_from == [-0.995, -0.99]
+    assert finished_from == [-0.9998, -0.9996]
     assert float(result.x[0]) == BETTER
 
 
 def test_every_finish_of_a_path_failing_raises(monkeypatch):
-    screened = {-1.5: -0.99, -0.5: -0.995}
-    finished_from = _stand_in_solver(monkeypatch, screened.__getitem__, fails_from={-0.99, -0.995})
+    screened = {-1.5: -0.9996, -0.5: -0.9998}
+    assert max(screened.values()) - min(screened.values()) < solve_module.SAME_PATH_DISTANCE
+    finished_from = _stand_in_solver(monkeypatch, screened.__getitem__, fails_from={-0.9996, -0.9998})
     with pytest.raises(SolverFailed, match="stand-in finish failed"):
         solve_module._multi_start(_problem(-1.5), None, None, None, 2, _Draws(-0.5))
-    assert finished_from == [-0.995, -0.99]
+    assert finished_from == [-0.9998, -0.9996]

@@ -450,12 +450,13 @@ constraint-violation tolerances (1e-4 by default): in all, screening and finishe
 443 iterations against 489 (Panda) and 300 against 298 (UR5, whose optimum then moved by 7e-7). IPOPT's
 acceptable level at 1e-2, or a cap of 20-40 iterations, saved 5-19 % of the Panda's iterations but split the
 UR5's merged paths (3-4 finishes instead of 2: 324-362 iterations)."""
-SAME_PATH_DISTANCE = 2e-2
-"""Largest difference of any log design variable (2 % of the variable) at which two screened starts count as one
-central path, so one optimum. Measured on both studies' 4 starts: the UR5's screened starts are two pairs, each
+SAME_PATH_DISTANCE = 1e-3
+"""Largest difference of any log design variable (0.1 % of the variable) at which two screened starts count as
+one central path, so one optimum. Measured on both studies' 4 starts: the UR5's screened starts are two pairs, each
 within 7.6e-5, the pairs 2.1e-2 apart and leading to different optima (1.4 apart in a log design variable);
 the Panda's are 4.4e-2 to 2.6 apart (none merged), two of them 4.4e-2 apart leading to optima 2.5 apart. So
-screened designs a few 1e-2 apart can be on different paths: the distance is not to be raised."""
+screened designs a few 1e-2 apart can be on different paths: 1e-3 merges the same pairs as 2e-2 did on both
+studies, with a margin of 20x to the closest split seen."""
 
 
 def _multi_start(
@@ -474,7 +475,7 @@ def _multi_start(
     further unless the finish from that better start fails (then the next of its path is finished); every
     other one is finished to the full tolerance from its screened point and multipliers (warm
     start), and the best finished one is returned. So the result is the best of the distinct optima the starts
-    lead to, each solved to the full tolerance; two optima whose designs differ by less than 2 % count as one.
+    lead to, each solved to the full tolerance; two optima whose designs differ by less than 0.1 % count as one.
     """
     n_design = problem.layout.size
     points: list[np.ndarray | DesignResult | None] = [x0]
