@@ -5,7 +5,8 @@ quadrant, because the envelope of a motor and drive is symmetric in the sign of 
 motors and brakes alike in both directions), so folding the four quadrants onto one shows every point
 against the same limits and doubles the resolution. Torques and speeds are motor-side (joint torque divided
 by the gear ratio, joint speed times the gear ratio). Speed is in rad/s on the bottom axis and in rpm on the
-top axis.
+top axis. Each subplot's title states the joint's margins, limits and RMS torque; one legend for the figure
+(in an empty grid cell, else below the grid) names the kinds of lines and points, which every subplot shares.
 
 The envelope is the rectangle the catalogue can state: the peak torque up to the maximum speed. The
 continuous (thermal) torque bounds the cycle's RMS torque, not single points, so it is drawn as a line and
