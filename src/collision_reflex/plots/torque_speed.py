@@ -197,17 +197,17 @@ def plot_torque_speed(path: FigurePath, joints: Sequence[JointOperatingPoints]) 
     )
     _tight_layout(fig)
     if legend:
-        _shared_legend(fig, legend, empty[0] if empty else None)
+        _shared_legend(fig, legend, empty[0] if empty else None, columns)
     return save_figure(fig, path)
 
 
-def _shared_legend(fig: Any, legend: dict[str, Any], empty_cell: Any | None) -> None:
-    """The figure's legend: centred in ``empty_cell`` (an unused subplot), else in a row below the grid."""
+def _shared_legend(fig: Any, legend: dict[str, Any], empty_cell: Any | None, columns: int) -> None:
+    """The figure's legend: centred in ``empty_cell`` (an unused subplot), else below the grid of ``columns``."""
     if empty_cell is not None:
         where = {"loc": "center", "bbox_to_anchor": (0.5, 0.5), "bbox_transform": empty_cell.transAxes}
     else:
-        # Below the figure's bottom edge: the saved file is cropped to include it.
-        where = {"loc": "upper center", "bbox_to_anchor": (0.5, 0.0), "ncols": min(6, len(legend))}
+        # Below the figure's bottom edge (the saved file is cropped to include it), two legend columns per subplot column.
+        where = {"loc": "upper center", "bbox_to_anchor": (0.5, 0.0), "ncols": min(2 * columns, len(legend))}
     fig.legend(list(legend.values()), list(legend.keys()), fontsize=9, **where)
 
 
