@@ -199,3 +199,37 @@ def test_each_file_is_drawn_once_with_the_layout_tight_layout_gives(tmp_path, mo
     expected = (params.left, params.right, params.bottom, params.top, params.wspace, params.hspace)
     plt.close(captured[0])
     assert laid_out[0] == expected
+
+
+@pytest.mark.parametrize("count", [2, 3])
+def test_one_shared_legend_of_the_kinds_drawn_outside_every_subplot(tmp_path, monkeypatch, count):
+    """One figure legend lists each kind drawn once and covers no subplot (an empty cell, or below the grid)."""
+    import matplotlib.pyplot as plt
+
+    import collision_reflex.plots.torque_speed as module
+
+    captured = []
+    monkeypatch.setattr(module, "save_figure", lambda fig, path: captured.append(fig))
+    joints = [_shoulder(), _wrist_unknown_limits(), JointOperatingPoints("elbow", [1.0], [0.1])][:count]
+    plot_torque_speed(tmp_path / "f.png", joints)
+    fig = captured[0]
+    try:
+        renderer = fig.canvas.get_renderer()
+        assert [ax.get_legend() for ax in fig.axes] == [None] * len(fig.axes)
+        (legend,) = fig.legends
+        # The shoulder draws every kind (its RMS torque 1.06 N*m is over its continuous 1 N*m); the others none.
+        assert [text.get_text() for text in legend.get_texts()] == [
+            "peak torque, max speed",
+            "continuous torque",
+            "duty cycle",
+            "outside the envelope",
+            "approach",
+            "approach, too fast",
+            "RMS torque above continuous",
+        ]
+        box = legend.get_window_extent(renderer)
+        for ax in fig.axes:
+            if ax.get_visible():
+                assert not box.overlaps(ax.get_window_extent(renderer))
+    finally:
+        plt.close(fig)

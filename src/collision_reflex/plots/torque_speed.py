@@ -5,7 +5,8 @@ quadrant, because the envelope of a motor and drive is symmetric in the sign of 
 motors and brakes alike in both directions), so folding the four quadrants onto one shows every point
 against the same limits and doubles the resolution. Torques and speeds are motor-side (joint torque divided
 by the gear ratio, joint speed times the gear ratio). Speed is in rad/s on the bottom axis and in rpm on the
-top axis.
+top axis. Each subplot's title states the joint's margins, limits and RMS torque; one legend for the figure
+(in an empty grid cell, else below the grid) names the kinds of lines and points, which every subplot shares.
 
 The envelope is the rectangle the catalogue can state: the peak torque up to the maximum speed. The
 continuous (thermal) torque bounds the cycle's RMS torque, not single points, so it is drawn as a line and
@@ -31,6 +32,8 @@ INSIDE_COLOUR = "tab:blue"
 APPROACH_COLOUR = "tab:green"
 WARNING_COLOUR = "tab:red"
 COLUMNS = 3
+RPM_LABEL_SIZE = 8
+ENVELOPE_LABEL = "peak torque, max speed"
 
 
 @dataclass(frozen=True)
@@ -180,15 +183,32 @@ def plot_torque_speed(path: FigurePath, joints: Sequence[JointOperatingPoints]) 
     columns = min(COLUMNS, len(joints))
     rows = math.ceil(len(joints) / columns)
     fig, axes = new_figure(rows, columns, figsize=(4.6 * columns, 3.9 * rows), squeeze=False)
+    # One legend for the figure: every subplot draws the same kinds of lines and points, and each joint's
+    # numbers are in its title. Placed outside the data (an empty grid cell, else below the grid), so it
+    # never hides a point and needs no search for a free place.
+    legend: dict[str, Any] = {}
     for ax, point in zip(axes.flat, joints, strict=False):
-        _draw_joint(ax, point)
-    for ax in list(axes.flat)[len(joints) :]:
+        _draw_joint(ax, point, legend)
+    empty = list(axes.flat)[len(joints) :]
+    for ax in empty:
         ax.set_visible(False)
     fig.suptitle(
         "Motor operating points over the motor envelope (|speed|, |torque|, motor side)", fontsize=11
     )
     _tight_layout(fig)
+    if legend:
+        _shared_legend(fig, legend, empty[0] if empty else None, columns)
     return save_figure(fig, path)
+
+
+def _shared_legend(fig: Any, legend: dict[str, Any], empty_cell: Any | None, columns: int) -> None:
+    """The figure's legend: centred in ``empty_cell`` (an unused subplot), else below the grid of ``columns``."""
+    if empty_cell is not None:
+        where = {"loc": "center", "bbox_to_anchor": (0.5, 0.5), "bbox_transform": empty_cell.transAxes}
+    else:
+        # Below the figure's bottom edge (the saved file is cropped to include it), two legend columns per subplot column.
+        where = {"loc": "upper center", "bbox_to_anchor": (0.5, 0.0), "ncols": min(2 * columns, len(legend))}
+    fig.legend(list(legend.values()), list(legend.keys()), fontsize=9, **where)
 
 
 def _tight_layout(fig: Any) -> None:
@@ -202,8 +222,11 @@ def _tight_layout(fig: Any) -> None:
     TightLayoutEngine().execute(fig)
 
 
-def _draw_joint(ax: Any, point: JointOperatingPoints) -> None:
-    """One joint's subplot: envelope lines, cycle points, approach speeds, RMS torque; title with margins."""
+def _draw_joint(ax: Any, point: JointOperatingPoints, legend: dict[str, Any]) -> None:
+    """One joint's subplot: envelope lines, cycle points, approach speeds, RMS torque; title with the numbers.
+
+    Each kind of artist drawn is added to ``legend`` (label to artist) for the figure's shared legend.
+    """
     speed, torque = np.abs(point.speed), np.abs(point.torque)
     approach = np.abs(point.approach_speed)
     # Room above the largest point or limit; a unit range when there is nothing to scale by.
@@ -213,12 +236,13 @@ def _draw_joint(ax: Any, point: JointOperatingPoints) -> None:
         * max([*torque, point.peak_torque or 0.0, point.continuous_torque or 0.0, point.rms_torque or 0.0])
         or 1.0
     )
-    _draw_envelope(ax, point)
+    _draw_envelope(ax, point, legend)
     outside = outside_envelope(speed, torque, point.peak_torque, point.max_speed)
-    ax.plot(speed[~outside], torque[~outside], ".", ms=4, color=INSIDE_COLOUR, label="duty cycle")
+    if np.any(~outside):
+        (legend["duty cycle"],) = ax.plot(speed[~outside], torque[~outside], ".", ms=4, color=INSIDE_COLOUR)
     if np.any(outside):
-        ax.plot(
-            speed[outside], torque[outside], ".", ms=6, color=WARNING_COLOUR, label="outside the envelope"
+        (legend["outside the envelope"],) = ax.plot(
+            speed[outside], torque[outside], ".", ms=6, color=WARNING_COLOUR
         )
     # The approach runs at constant speed: its torque is drawn at zero, on the speed axis (not clipped).
     fast = outside_envelope(approach, np.zeros_like(approach), None, point.max_speed)
@@ -227,70 +251,82 @@ def _draw_joint(ax: Any, point: JointOperatingPoints) -> None:
         (fast, WARNING_COLOUR, "approach, too fast"),
     ):
         if np.any(selected):
-            ax.plot(
-                approach[selected],
-                np.zeros(int(np.sum(selected))),
-                "^",
-                ms=7,
-                color=colour,
-                clip_on=False,
-                label=label,
+            (legend[label],) = ax.plot(
+                approach[selected], np.zeros(int(np.sum(selected))), "^", ms=7, color=colour, clip_on=False
             )
     if point.rms_torque is not None:
         too_hot = point.continuous_torque is not None and point.rms_torque > point.continuous_torque
-        ax.axhline(
-            point.rms_torque,
-            color=WARNING_COLOUR if too_hot else "black",
-            ls=":",
-            lw=1.2,
-            label=f"RMS torque {point.rms_torque:.3g} N·m",
+        legend["RMS torque above continuous" if too_hot else "RMS torque"] = ax.axhline(
+            point.rms_torque, color=WARNING_COLOUR if too_hot else "black", ls=":", lw=1.2
         )
     ax.set_xlim(0.0, x_top)
     ax.set_ylim(0.0, y_top)
     ax.set_xlabel("motor speed |ω| [rad/s]")
     ax.set_ylabel("motor torque |τ| = joint torque / N [N·m]", fontsize=8)
     top = ax.secondary_xaxis("top", functions=(_to_rpm, _from_rpm))
-    top.set_xlabel("motor speed [rpm]", fontsize=8)
+    top.set_xlabel("motor speed [rpm]", fontsize=RPM_LABEL_SIZE)
     short = any(value is not None and value < 0 for value in margins(point).values())
+    # Placed at a fixed offset above the rpm axis: an automatic title position is measured again at every
+    # drawing from the rpm axis's tick labels, which costs as much as drawing them.
     ax.set_title(
-        f"{point.joint}\n{_margin_text(point)}", fontsize=9, color=WARNING_COLOUR if short else "black"
+        f"{point.joint}\n{_margin_text(point)}\n{_limits_text(point)}",
+        fontsize=8,
+        color=WARNING_COLOUR if short else "black",
+        y=1.0,
+        pad=_rpm_axis_height(),
     )
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=6.5, loc="best", framealpha=0.85)
 
 
-def _draw_envelope(ax: Any, point: JointOperatingPoints) -> None:
-    """Peak torque (up to the maximum speed), continuous torque and maximum speed; "unknown" in the legend."""
+def _rpm_axis_height() -> float:
+    """Height [pt] of the rpm axis above a subplot (ticks, tick labels, label) plus the usual title pad."""
+    import matplotlib
+    from matplotlib.font_manager import FontProperties
+
+    rc = matplotlib.rcParams
+    tick_label = FontProperties(size=rc["xtick.labelsize"]).get_size_in_points()
+    # A line of text is about 1.2 font sizes high (ascent and descent).
+    return (
+        rc["xtick.major.size"]
+        + rc["xtick.major.pad"]
+        + 1.2 * tick_label
+        + rc["axes.labelpad"]
+        + 1.2 * RPM_LABEL_SIZE
+        + rc["axes.titlepad"]
+    )
+
+
+def _draw_envelope(ax: Any, point: JointOperatingPoints, legend: dict[str, Any]) -> None:
+    """Peak torque (up to the maximum speed), continuous torque and maximum speed, those that are known."""
     x_end = point.max_speed if point.max_speed is not None else 1.0
     transform = ax.transData if point.max_speed is not None else ax.get_yaxis_transform()
     for value, name, style in (
-        (point.peak_torque, "peak torque", "-"),
+        (point.peak_torque, ENVELOPE_LABEL, "-"),
         (point.continuous_torque, "continuous torque", "--"),
     ):
-        if value is None:
-            ax.plot([], [], " ", label=f"{name}: unknown")
-        else:
-            ax.plot(
-                [0.0, x_end],
-                [value, value],
-                style,
-                color="dimgray",
-                lw=1.4,
-                transform=transform,
-                label=f"{name} {value:.3g} N·m",
+        if value is not None:
+            (legend[name],) = ax.plot(
+                [0.0, x_end], [value, value], style, color="dimgray", lw=1.4, transform=transform
             )
     if point.peak_torque is not None:
         # The region the motor can reach, lightly shaded.
         ax.fill_between([0.0, x_end], 0.0, point.peak_torque, color="0.92", transform=transform, zorder=0)
-    if point.max_speed is None:
-        ax.plot([], [], " ", label="max speed: unknown")
-    else:
-        ax.axvline(
-            point.max_speed,
-            color="dimgray",
-            lw=1.4,
-            label=f"max speed {point.max_speed:.3g} rad/s ({point.max_speed * RAD_PER_S_TO_RPM:.0f} rpm)",
-        )
+    if point.max_speed is not None:
+        legend[ENVELOPE_LABEL] = ax.axvline(point.max_speed, color="dimgray", lw=1.4)
+
+
+def _limits_text(point: JointOperatingPoints) -> str:
+    """The joint's limits and RMS torque in two lines; "unknown" for a limit the catalogue does not state."""
+    torques = []
+    for value, name in ((point.peak_torque, "peak torque"), (point.continuous_torque, "continuous torque")):
+        torques.append(f"{name}: unknown" if value is None else f"{name} {value:.3g} N·m")
+    speed = (
+        "max speed: unknown"
+        if point.max_speed is None
+        else f"max speed {point.max_speed:.3g} rad/s ({point.max_speed * RAD_PER_S_TO_RPM:.0f} rpm)"
+    )
+    rms = [] if point.rms_torque is None else [f"RMS torque {point.rms_torque:.3g} N·m"]
+    return ", ".join(torques) + "\n" + ", ".join([speed, *rms])
 
 
 def _margin_text(point: JointOperatingPoints) -> str:
