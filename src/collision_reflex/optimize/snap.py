@@ -519,11 +519,7 @@ def snap_to_catalogue(
             f"combinations solved in {passes} passes (more than max_combinations = {max_combinations})"
         )
     best = search.best()
-    if (
-        best is not None
-        and optimum.multipliers is not None
-        and not uses_active_set(problem.samples.size, active_set)
-    ):
+    if best is not None and _warm_startable(problem, optimum, active_set):
         search.confirm(best)
     if best is None:
         reason = "no combination of candidates gives a feasible design (every re-solve failed)"
@@ -754,6 +750,19 @@ def matched_gear_ratio(part: CataloguePart, design: Design, joint: int) -> float
     return float(np.clip(wanted, low, high))
 
 
+def _warm_startable(problem: DesignProblem, optimum: DesignResult, active_set: str) -> bool:
+    """Whether a combination of parts is re-solved warm from ``optimum`` (:func:`solve_parts`).
+
+    On all samples only, and from a solution of ``problem`` itself with its multipliers (not of an active set's
+    subset, whose auxiliaries are others): a catalogue problem has the same samples, so the same auxiliaries.
+    """
+    return (
+        not uses_active_set(problem.samples.size, active_set)
+        and optimum.multipliers is not None
+        and optimum.x.size == problem.x0.size
+    )
+
+
 def _parts_start(
     problem: DesignProblem,
     optimum: DesignResult,
@@ -838,14 +847,7 @@ def solve_parts(
     """
     built = catalogue_problem(problem, parts, arm)
     full = not uses_active_set(built.samples.size, active_set)
-    # Warm only from a solution of ``problem`` itself with the same auxiliaries (not of an active set's subset).
-    warm = (
-        warm
-        and full
-        and optimum.multipliers is not None
-        and optimum.x.size == problem.x0.size
-        and built.x0.size - built.layout.size == problem.x0.size - problem.layout.size
-    )
+    warm = warm and _warm_startable(problem, optimum, active_set)
     x0 = _parts_start(problem, optimum, parts, built, raised=warm)
     if full:
         return solve(
