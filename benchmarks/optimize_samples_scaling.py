@@ -17,7 +17,7 @@ Targets (issue 14, item 6): a 4,096-sample solve <= 20 s (aim 10 s) and <= 1 GB.
 with a 60 s budget).
 
 ``--threshold`` measures where the active set starts to pay (``ACTIVE_SET_THRESHOLD``): one solve of each
-method at 256, 512 and 1,024 samples, on this Panda problem and on ``studies/ur5.yaml`` (its duty cycle and
+method at 64 to 1,024 samples, on this Panda problem and on ``studies/ur5.yaml`` (its duty cycle and
 weighted objective) with the study's configuration count scaled (14 directions each), in fresh processes.
 
 ``--front`` prints a 20-point Pareto front (worst-case impulse against actuator mass) of the Panda at 4,096
@@ -167,7 +167,7 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="256 and 1,024 samples, one repeat, 60 s budget")
     parser.add_argument("--repeats", type=int, default=3, help="runs per size and method (median)")
     parser.add_argument("--budget", type=float, default=300.0, help="time limit of one full-NLP run [s]")
-    parser.add_argument("--threshold", action="store_true", help="only: 256/512/1,024 samples, Panda and UR5")
+    parser.add_argument("--threshold", action="store_true", help="only: 64 to 1,024 samples, Panda and UR5")
     parser.add_argument("--front", action="store_true", help="only: a 20-point front at 4,096 samples")
     parser.add_argument("--points", type=int, default=20, help="points of the --front front")
     parser.add_argument("--case", nargs=3, metavar=("N_CONFIG", "METHOD", "ROBOT"), help=argparse.SUPPRESS)
@@ -223,10 +223,10 @@ def main() -> None:
 
 
 def threshold(budget: float) -> None:
-    """One solve per method at about 256, 512 and 1,024 samples, Panda and UR5 study, fresh processes."""
+    """One solve per method at about 64 to 1,024 samples, Panda and UR5 study, fresh processes."""
     print(f"Where the active set pays: one solve per method and size (full NLP budget {budget:.0f} s)")
-    cases = [("panda", n, DIRECTIONS) for n in (64, 128, 256)]
-    cases += [("ur5", n, UR5_DIRECTIONS) for n in (18, 36, 73)]
+    cases = [("panda", n, DIRECTIONS) for n in (16, 32, 64, 128, 256)]
+    cases += [("ur5", n, UR5_DIRECTIONS) for n in (5, 9, 18, 24, 36, 73)]
     for robot, n_config, directions in cases:
         load = os.getloadavg()[0]
         line = []

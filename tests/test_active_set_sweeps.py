@@ -121,10 +121,18 @@ def test_an_active_set_result_round_trips_and_its_record_says_how_it_was_solved(
 
 def test_the_full_nlp_below_the_threshold_and_bad_choices_refused(panda):
     samples, build = panda
-    assert samples.size < active_set.ACTIVE_SET_THRESHOLD
-    result, _ = pareto.single_optimum(build, "worst_case_impulse", starts=1)  # auto: the full NLP
+    few = active_set.sample_subset(samples, np.arange(active_set.ACTIVE_SET_THRESHOLD // 2))
+
+    def build_few(objective, bounded, chosen=few):
+        return build(objective, bounded, chosen)
+
+    result, _ = pareto.single_optimum(build_few, "worst_case_impulse", starts=1)  # auto: the full NLP
     assert not isinstance(result, ActiveSetResult)
     assert result_record(result, "p")["solver"]["method"] == "full NLP"
+    # From the threshold on, auto solves on active sets.
+    assert samples.size >= active_set.ACTIVE_SET_THRESHOLD
+    result, _ = pareto.single_optimum(build, "worst_case_impulse", starts=1)
+    assert isinstance(result, ActiveSetResult) and result.method == "active set"
     with pytest.raises(InvalidParameter, match="active_set"):
         cr.pareto_front(build, NAMES, active_set="sometimes")
 

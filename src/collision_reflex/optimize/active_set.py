@@ -64,17 +64,18 @@ __all__ = [
     "with_active_set",
 ]
 
-ACTIVE_SET_THRESHOLD = 512
+ACTIVE_SET_THRESHOLD = 128
 """Number of samples from which ``active_set="auto"`` solves a problem on active sets.
 
-Measured on 2 cores under a load average of 6-14 (wall times). One solve each in a fresh process
-(``benchmarks/optimize_samples_scaling.py --threshold``): the Panda benchmark problem at 256 / 512 / 1,024
-samples, full NLP 5.5 / 29 / over 150 s against 4.2 / 2.3 / 5.4 s on active sets; ``studies/ur5.yaml`` (duty
-cycle, weighted objective) at 252 / 504 / 1,022 samples, 17.6 / 37 / 100 s against 10.8 / 13.2 / 23 s. But the
-whole UR5 study at its 336 samples (``crx run``, serial) spent 307 s solving on active sets against 199 s as one
-NLP, its 4-start optimum 74 s against 28 s: each random start settles its own active set, and the duty cycle's
-rows, which do not shrink with the samples, carry much of the cost. From about 500 samples the active set was
-2.8-12 times faster in every case measured; below, the gain is small or negative and the full NLP is kept."""
+Measured on 2 cores at a load average of 0.6-1.4 (wall times), one solve each in a fresh process
+(``benchmarks/optimize_samples_scaling.py --threshold``). The Panda benchmark problem at 64 / 128 / 256 / 512 /
+1,024 samples: full NLP 0.56 / 1.08 / 1.91 / 6.68 / 73 s against 0.62 / 0.55 / 0.77 / 0.69 / 0.68 s on active sets;
+``studies/ur5.yaml`` (duty cycle, weighted objective) at 70 / 126 / 252 / 336 / 504 samples: 0.69 / 0.70 / 1.20 /
+1.64 / 2.49 s against 0.76 / 0.62 / 0.73 / 0.88 / 0.61 s. Below about 100 samples the two are alike (the active
+set then holds most samples); from 126 samples the active set was faster in every case. The whole UR5 study at
+its 336 samples (``crx run``, serial, ``benchmarks/study_runs.py``): 18.9 s on active sets against 35.4 s as one
+NLP, the same front within 3e-5 relative (the active set's equal or lower). An earlier measurement (512) predates
+the duty cycle's row reduction and the screened multi-start, which had made each start's active set expensive."""
 
 ACTIVE_SET_CHOICES = ("auto", "always", "never")
 """How a problem's samples are solved: ``auto`` on an active set from :data:`ACTIVE_SET_THRESHOLD` samples,

@@ -711,7 +711,7 @@ class OptimizerSpec(_Model):
         "auto",
         description="solve the optimum and every Pareto point on active sets of the contact samples (a subset, "
         "grown by the samples found above its worst case until none is: exact for worst-case objectives): "
-        "'auto' from 512 samples (ACTIVE_SET_THRESHOLD), 'always', or 'never' (all samples in one NLP)",
+        "'auto' from 128 samples (ACTIVE_SET_THRESHOLD), 'always', or 'never' (all samples in one NLP)",
     )
 
 
