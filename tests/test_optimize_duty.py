@@ -18,6 +18,7 @@ from collision_reflex.arm.duty_cycle import DutyCycle, Payload
 from collision_reflex.arm.dynamics import peak, rms
 from collision_reflex.errors import InvalidParameter
 from collision_reflex.hardware.motors import scaled_motor_quantities
+from collision_reflex.optimize import duty as duty_module
 from collision_reflex.optimize.duty import approach_joint_rates, torque_speed_points
 from collision_reflex.optimize.results import record_row, result_from_json, result_record, result_to_json
 
@@ -285,3 +286,22 @@ def test_peak_rows_give_the_unreduced_peak_everywhere_in_the_box(arm, samples, c
         np.testing.assert_array_equal(rows, SAFETY * sign[:, None] * basis[index])
         expected = SAFETY * np.abs(points @ basis.T).max(axis=1)
         np.testing.assert_allclose((points @ rows.T).max(axis=1), expected, rtol=1e-12, atol=0)
+
+
+def test_reachability_memo_answers_only_the_same_question(arm, samples):
+    # The check's grids are kept per joint (the problems of one study repeat them); the memo must give the
+    # same refusal again, and a changed bound must be checked anew, not answered from the memo.
+    constraints = cr.Constraints(duty_cycle=_out_and_back(arm, 20.0, 450.0))
+    refused = _space(stator_diameter=[(0.02, 0.25), 0.06], gear_ratio=[(1.0, 100.0), (30.0, 40.0)])
+    duty_module._CHECKED.clear()
+    messages = []
+    for _ in range(2):
+        with pytest.raises(InvalidParameter, match="joint2") as raised:
+            cr.build_problem(arm, samples, refused, _technology(), constraints=constraints)
+        messages.append(str(raised.value))
+    assert messages[0] == messages[1] and len(duty_module._CHECKED) == 2  # one grid per joint, found again
+    # Joint 2's gear ratio may now go down to 1: 20 rad/s x 20 = 400 rad/s is within the motor's 492.6.
+    allowed = _space(stator_diameter=[(0.02, 0.25), 0.06], gear_ratio=[(1.0, 100.0), (1.0, 40.0)])
+    cr.build_problem(arm, samples, allowed, _technology(), constraints=constraints)
+    assert len(duty_module._CHECKED) == 3  # joint 1's grid reused, joint 2's computed for its new bounds
+    assert list(duty_module._CHECKED.values())[-1][2] > 0  # joint 2's best speed margin, now reachable

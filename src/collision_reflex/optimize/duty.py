@@ -26,6 +26,7 @@ motor speeds of a design, for a torque-speed figure.
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, NamedTuple
 
@@ -349,7 +350,14 @@ def check_reachable(
         slopes = basis[:, 1:-1]
         low = basis[:, 0] + np.minimum(slopes * mass_low, slopes * mass_high).sum(axis=1)
         high = basis[:, 0] + np.maximum(slopes * mass_low, slopes * mass_high).sum(axis=1)
-        best = _best_margins(duty, technology, bounds, j, (low, high, basis[:, -1]), weights, speed_need[j])
+        demand = (low, high, basis[:, -1])
+        key = _margins_key(duty, technology, bounds, j, demand, weights, speed_need[j])
+        best = _CHECKED.get(key)
+        if best is None:
+            best = _best_margins(duty, technology, bounds, j, demand, weights, speed_need[j])
+            _CHECKED[key] = best
+            while len(_CHECKED) > _CHECKED_SIZE:
+                del _CHECKED[next(iter(_CHECKED))]  # the oldest first
         gearbox = technology.gearbox_figures(len(joint_names)).names[j]
         labels = (PEAK, RMS, SPEED, *(f"gearbox {gearbox} {rating}" for rating in GEARBOX_RATINGS))
         for label, value in zip(labels, best[:-1], strict=True):
@@ -357,6 +365,43 @@ def check_reachable(
                 _refuse(name, label, value)
         if best[-1] < -REACHABLE_TOLERANCE:
             _refuse(name, " and ".join(labels[: 6 if gearbox else 3]) + " together", best[-1])
+
+
+_CHECKED: dict[bytes, np.ndarray] = {}
+"""Best margins found by :func:`_best_margins`, by :func:`_margins_key`: the problems of one study (an objective's,
+its Pareto anchors', every active-set round's) repeat the same joints' grids, 0.1-0.3 s each per build on the
+shipped studies (measured)."""
+_CHECKED_SIZE = 256
+
+
+def _margins_key(
+    duty: DutyRequirement,
+    technology: ActuatorTechnology,
+    bounds: dict,
+    joint: int,
+    demand: tuple[np.ndarray, np.ndarray, np.ndarray],
+    weights: np.ndarray,
+    joint_speed: float,
+) -> bytes:
+    """A digest of everything :func:`_best_margins` reads for ``joint`` (its numbers, exactly)."""
+    n_joints = len(bounds["gear_ratio"])
+    gearbox = technology.gearbox_figures(n_joints)
+    scalars = (
+        duty.safety_factor,
+        float(joint_speed),
+        technology.joint_motors(n_joints)[joint],
+        technology.scaling_law,
+        *(float(getattr(gearbox, name)[joint]) for name in _GEARBOX_FIELDS),
+        *(bounds[name][joint] for name in ("gear_ratio", "stator_diameter", "stack_length")),
+    )
+    digest = hashlib.blake2b(repr(scalars).encode(), digest_size=20)
+    for array in (*demand, weights):
+        digest.update(np.ascontiguousarray(array, dtype=float).tobytes())
+    return digest.digest()
+
+
+_GEARBOX_FIELDS = ("efficiency", "counted_inertia", "peak_torque", "rated_torque", "max_input_speed")
+"""The gearbox figures :func:`_best_margins` reads."""
 
 
 def _best_margins(
