@@ -273,19 +273,22 @@ def test_peak_rows_give_the_unreduced_peak_everywhere_in_the_box(arm, samples, c
 
     duty = duty_requirement(arm, samples, cycle, _technology(), SAFETY)
     nv = duty.torques.nv
-    low = np.array([1.0, *np.full(nv, 0.05), 1e-6])
-    high = np.array([1.0, *np.full(nv, 1.5), 0.5])
-    kept = peak_rows(duty, np.tile(low, (nv, 1)), np.tile(high, (nv, 1)))
-    rng = np.random.default_rng(2)
-    pick = (np.arange(2 ** (nv + 1))[:, None] >> np.arange(nv + 1)[None, :]) & 1
-    corners = np.column_stack([np.ones(pick.shape[0]), np.where(pick == 1, high[1:], low[1:])])
-    points = np.vstack([corners, rng.uniform(low, high, size=(500, nv + 2))])
-    for j, (rows, index, sign) in enumerate(kept):
-        basis = duty.torques.demand_basis(j)
-        assert rows.shape[0] < basis.shape[0] / 10  # most rows go
-        np.testing.assert_array_equal(rows, SAFETY * sign[:, None] * basis[index])
-        expected = SAFETY * np.abs(points @ basis.T).max(axis=1)
-        np.testing.assert_allclose((points @ rows.T).max(axis=1), expected, rtol=1e-12, atol=0)
+    # A box where the links' torques set the peak, then one where the rotor's acceleration may: the rows kept
+    # for the first (a memo keeps them) do not cover the second.
+    for rotor in (1e-5, 10.0):
+        low = np.array([1.0, *np.full(nv, 0.05), 1e-6])
+        high = np.array([1.0, *np.full(nv, 1.5), rotor])
+        kept = peak_rows(duty, np.tile(low, (nv, 1)), np.tile(high, (nv, 1)))
+        rng = np.random.default_rng(2)
+        pick = (np.arange(2 ** (nv + 1))[:, None] >> np.arange(nv + 1)[None, :]) & 1
+        corners = np.column_stack([np.ones(pick.shape[0]), np.where(pick == 1, high[1:], low[1:])])
+        points = np.vstack([corners, rng.uniform(low, high, size=(500, nv + 2))])
+        for j, (rows, index, sign) in enumerate(kept):
+            basis = duty.torques.demand_basis(j)
+            assert rows.shape[0] < basis.shape[0] / 10  # most rows go
+            np.testing.assert_array_equal(rows, SAFETY * sign[:, None] * basis[index])
+            expected = SAFETY * np.abs(points @ basis.T).max(axis=1)
+            np.testing.assert_allclose((points @ rows.T).max(axis=1), expected, rtol=1e-12, atol=0)
 
 
 def test_reachability_memo_answers_only_the_same_question(arm, samples):
@@ -293,15 +296,16 @@ def test_reachability_memo_answers_only_the_same_question(arm, samples):
     # same refusal again, and a changed bound must be checked anew, not answered from the memo.
     constraints = cr.Constraints(duty_cycle=_out_and_back(arm, 20.0, 450.0))
     refused = _space(stator_diameter=[(0.02, 0.25), 0.06], gear_ratio=[(1.0, 100.0), (30.0, 40.0)])
-    duty_module._CHECKED.clear()
+    duty_module._BEST_MARGINS.store.clear()
     messages = []
     for _ in range(2):
         with pytest.raises(InvalidParameter, match="joint2") as raised:
             cr.build_problem(arm, samples, refused, _technology(), constraints=constraints)
         messages.append(str(raised.value))
-    assert messages[0] == messages[1] and len(duty_module._CHECKED) == 2  # one grid per joint, found again
+    kept = duty_module._BEST_MARGINS.store
+    assert messages[0] == messages[1] and len(kept) == 2  # one grid per joint, found again
     # Joint 2's gear ratio may now go down to 1: 20 rad/s x 20 = 400 rad/s is within the motor's 492.6.
     allowed = _space(stator_diameter=[(0.02, 0.25), 0.06], gear_ratio=[(1.0, 100.0), (1.0, 40.0)])
     cr.build_problem(arm, samples, allowed, _technology(), constraints=constraints)
-    assert len(duty_module._CHECKED) == 3  # joint 1's grid reused, joint 2's computed for its new bounds
-    assert list(duty_module._CHECKED.values())[-1][2] > 0  # joint 2's best speed margin, now reachable
+    assert len(kept) == 3  # joint 1's grid reused, joint 2's computed for its new bounds
+    assert list(kept.values())[-1][2] > 0  # joint 2's best speed margin, now reachable

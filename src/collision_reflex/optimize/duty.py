@@ -27,8 +27,9 @@ motor speeds of a design, for a torque-speed figure.
 from __future__ import annotations
 
 import hashlib
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple, TypeVar, cast
 
 import casadi as ca
 import numpy as np
@@ -51,6 +52,7 @@ PEAK, RMS, SPEED = "peak torque", "RMS torque", "speed"
 """The duty cycle's constraints, as error messages and labels name them."""
 GEARBOX_RATINGS = ("peak rating", "rated torque (RMS)", "input speed")
 """A gearbox's ratings the duty cycle's peak, RMS and motor speed must be within, as error messages name them."""
+T = TypeVar("T")
 REACHABLE_TOLERANCE = 0.02
 """Best margin, found on a grid (:func:`check_reachable`), below which a requirement is refused before solving:
 the grid's step in gear ratio (1/240 of the log range) can underestimate the best margin by about this much."""
@@ -171,12 +173,23 @@ def peak_rows(
     kept = []
     for j in range(duty.torques.nv):
         basis = duty.safety_factor * duty.torques.demand_basis(j)
-        rows = np.vstack([basis, -basis])
-        keep = binding_rows(rows[:, 0], rows[:, 1:], x_low[j, 1:], x_high[j, 1:])
-        keep[keep] = undominated_rows(rows[keep], x_low[j], x_high[j])
-        index = np.tile(np.arange(basis.shape[0]), 2)
-        sign = np.repeat([1.0, -1.0], basis.shape[0])
-        kept.append((rows[keep], index[keep], sign[keep]))
+        key = _digest(basis, x_low[j], x_high[j])
+        kept.append(_KEPT_ROWS.get(key, lambda b=basis, j=j: _joint_peak_rows(b, x_low[j], x_high[j])))
+    return kept
+
+
+def _joint_peak_rows(
+    basis: np.ndarray, x_low: np.ndarray, x_high: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """One joint's rows of :func:`peak_rows` from its demand basis (safety factor applied), read-only."""
+    rows = np.vstack([basis, -basis])
+    keep = binding_rows(rows[:, 0], rows[:, 1:], x_low[1:], x_high[1:])
+    keep[keep] = undominated_rows(rows[keep], x_low, x_high)
+    index = np.tile(np.arange(basis.shape[0]), 2)
+    sign = np.repeat([1.0, -1.0], basis.shape[0])
+    kept = (rows[keep], index[keep], sign[keep])
+    for array in kept:
+        array.flags.writeable = False  # kept in the memo and shared by every problem built from it
     return kept
 
 
@@ -351,13 +364,24 @@ def check_reachable(
         low = basis[:, 0] + np.minimum(slopes * mass_low, slopes * mass_high).sum(axis=1)
         high = basis[:, 0] + np.maximum(slopes * mass_low, slopes * mass_high).sum(axis=1)
         demand = (low, high, basis[:, -1])
-        key = _margins_key(duty, technology, bounds, j, demand, weights, speed_need[j])
-        best = _CHECKED.get(key)
-        if best is None:
-            best = _best_margins(duty, technology, bounds, j, demand, weights, speed_need[j])
-            _CHECKED[key] = best
-            while len(_CHECKED) > _CHECKED_SIZE:
-                del _CHECKED[next(iter(_CHECKED))]  # the oldest first
+        n_joints = len(joint_names)
+        gearbox = technology.gearbox_figures(n_joints)
+        key = _digest(
+            *demand,
+            weights,
+            duty.safety_factor,
+            float(speed_need[j]),
+            technology.joint_motors(n_joints)[j],
+            technology.scaling_law,
+            *(float(getattr(gearbox, field)[j]) for field in _GEARBOX_FIELDS),
+            *(bounds[name][j] for name in ("gear_ratio", "stator_diameter", "stack_length")),
+        )
+        best = _BEST_MARGINS.get(
+            key,
+            lambda j=j, demand=demand: _best_margins(
+                duty, technology, bounds, j, demand, weights, speed_need[j]
+            ),
+        )
         gearbox = technology.gearbox_figures(len(joint_names)).names[j]
         labels = (PEAK, RMS, SPEED, *(f"gearbox {gearbox} {rating}" for rating in GEARBOX_RATINGS))
         for label, value in zip(labels, best[:-1], strict=True):
@@ -367,39 +391,44 @@ def check_reachable(
             _refuse(name, " and ".join(labels[: 6 if gearbox else 3]) + " together", best[-1])
 
 
-_CHECKED: dict[bytes, np.ndarray] = {}
-"""Best margins found by :func:`_best_margins`, by :func:`_margins_key`: the problems of one study (an objective's,
-its Pareto anchors', every active-set round's) repeat the same joints' grids, 0.1-0.3 s each per build on the
-shipped studies (measured)."""
-_CHECKED_SIZE = 256
+class _Memo:
+    """Results of a pure computation by a digest of everything it reads (:func:`_digest`), the newest kept.
+
+    The problems of one study (its objective's, the Pareto anchors', every active-set round's) repeat the duty
+    cycle's per-joint work: on the UR5 study its reachability grids took 0.1-0.4 s and its peak rows 64 ms a build
+    (measured), for 40-50 builds a run.
+    """
+
+    def __init__(self, size: int) -> None:
+        self.size = size
+        self.store: dict[bytes, Any] = {}
+
+    def get(self, key: bytes, compute: Callable[[], T]) -> T:
+        """The result kept under ``key``, else ``compute()`` kept under it."""
+        if key not in self.store:
+            self.store[key] = compute()
+            while len(self.store) > self.size:
+                del self.store[next(iter(self.store))]  # the oldest first
+        return cast("T", self.store[key])
 
 
-def _margins_key(
-    duty: DutyRequirement,
-    technology: ActuatorTechnology,
-    bounds: dict,
-    joint: int,
-    demand: tuple[np.ndarray, np.ndarray, np.ndarray],
-    weights: np.ndarray,
-    joint_speed: float,
-) -> bytes:
-    """A digest of everything :func:`_best_margins` reads for ``joint`` (its numbers, exactly)."""
-    n_joints = len(bounds["gear_ratio"])
-    gearbox = technology.gearbox_figures(n_joints)
-    scalars = (
-        duty.safety_factor,
-        float(joint_speed),
-        technology.joint_motors(n_joints)[joint],
-        technology.scaling_law,
-        *(float(getattr(gearbox, name)[joint]) for name in _GEARBOX_FIELDS),
-        *(bounds[name][joint] for name in ("gear_ratio", "stator_diameter", "stack_length")),
-    )
-    digest = hashlib.blake2b(repr(scalars).encode(), digest_size=20)
-    for array in (*demand, weights):
-        digest.update(np.ascontiguousarray(array, dtype=float).tobytes())
+def _digest(*parts: object) -> bytes:
+    """A digest of ``parts``: arrays by their values exactly, anything else by its ``repr``."""
+    digest = hashlib.blake2b(digest_size=20)
+    for part in parts:
+        if isinstance(part, np.ndarray):
+            digest.update(repr((part.shape, part.dtype.str)).encode())
+            digest.update(np.ascontiguousarray(part).tobytes())
+        else:
+            digest.update(repr(part).encode())
+        digest.update(b"\x00")
     return digest.digest()
 
 
+_BEST_MARGINS = _Memo(256)
+"""Each joint's best margins over its grid (:func:`_best_margins`)."""
+_KEPT_ROWS = _Memo(256)
+"""Each joint's peak rows (:func:`_joint_peak_rows`)."""
 _GEARBOX_FIELDS = ("efficiency", "counted_inertia", "peak_torque", "rated_torque", "max_input_speed")
 """The gearbox figures :func:`_best_margins` reads."""
 
