@@ -8,6 +8,7 @@ alone.
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import re
 import time
@@ -182,12 +183,30 @@ def with_timings(data: Any, timings: dict[str, float]) -> Any:
 
 
 def _write_csv(path: Path, rows: list[dict[str, Any]]) -> None:
-    import pandas as pd
+    """``rows`` as CSV: every key of any row a column (in order of appearance), a missing or None value empty.
+
+    Written with the standard library, as pandas' ``DataFrame(rows).to_csv(index=False, float_format="%.10g")``
+    writes these rows (the same bytes for the shipped studies' results); importing pandas alone took 0.25-0.35 s
+    of a study run.
+    """
+    import csv
 
     from .._io import atomic_open
 
+    columns = list(dict.fromkeys(key for row in rows for key in row))
     with atomic_open(path, "w", newline="", encoding="utf-8") as handle:
-        pd.DataFrame(rows).to_csv(handle, index=False, float_format="%.10g")
+        writer = csv.writer(handle, lineterminator="\n")
+        writer.writerow(columns)
+        writer.writerows([_csv_text(row.get(column)) for column in columns] for row in rows)
+
+
+def _csv_text(value: Any) -> str:
+    """One CSV cell: floats to 10 significant digits, NaN and None empty, anything else as ``str`` gives it."""
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return ""
+    if isinstance(value, float):
+        return f"{value:.10g}"
+    return str(value)
 
 
 def _unknown_timings(data: Any) -> None:
