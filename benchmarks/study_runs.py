@@ -118,7 +118,8 @@ def snap_only(study: str, base: Path, source: Path | None, repeats: int, smoke: 
         f"{statistics.median(cpus):.2f} s over {repeats} (each wall {', '.join(f'{w:.2f}' for w in walls)}; CPU "
         f"{', '.join(f'{c:.2f}' for c in cpus)}; load {', '.join(loads)}); {len(catalogue['tried'])} "
         f"combinations re-solved ({len(solved)} feasible, {sum(t.get('iterations') or 0 for t in solved)} IPOPT "
-        f"iterations), {catalogue['method']}; chosen: {' + '.join(j['part'] or '-' for j in catalogue['joints'])}",
+        f"iterations), {catalogue['method']}; chosen: {' + '.join(j['part'] or '-' for j in catalogue['joints'])}"
+        f"; its objectives: {', '.join(f'{k} {v:.10g}' for k, v in (catalogue['objectives'] or {}).items())}",
         flush=True,
     )
 

@@ -459,10 +459,14 @@ def test_the_snap_on_active_sets_chooses_what_the_full_nlp_chooses(many_samples)
     }
     full, active = snaps["never"], snaps["always"]
     assert [p.label for p in active.parts] == [p.label for p in full.parts]
-    assert _chosen_value(problem, active) == pytest.approx(_chosen_value(problem, full), rel=SOLVER_TOLERANCE)
+    # Within the tie-break's reach (below): the active sets' re-solves start warm from the optimum's last NLP,
+    # the full NLP's cold (the optimum has no multipliers of it), and land 1.2e-5 apart here (the active set's
+    # lower, its worst case too: 1.1e-5).
+    reach = TIE_BREAK_WEIGHT * 0.05
+    assert _chosen_value(problem, active) == pytest.approx(_chosen_value(problem, full), rel=reach)
     # The worst case is exact on the active set: every sample's impulse at the design found, not the subset's.
     assert active.objectives["worst_case_impulse"] == pytest.approx(
-        full.objectives["worst_case_impulse"], rel=SOLVER_TOLERANCE
+        full.objectives["worst_case_impulse"], rel=reach
     )
     assert solve_method(active.result)[0] == "active set"
     assert solve_method(active.result)[1] < problem.samples.size
@@ -471,7 +475,6 @@ def test_the_snap_on_active_sets_chooses_what_the_full_nlp_chooses(many_samples)
     # the tie-break pulls on the active samples' mean, not every sample's: between designs of nearly equal worst
     # case it moves the worst case by about TIE_BREAK_WEIGHT (1e-3) times the few per cent the mean changes
     # (measured here: up to 1.4e-5 relative, of either sign, the mean up to 0.4 %).
-    reach = TIE_BREAK_WEIGHT * 0.05
     for a, f in zip(active.tried, full.tried, strict=True):
         assert a.parts == f.parts
         assert (a.objective is None) == (f.objective is None)
@@ -595,3 +598,23 @@ def test_the_chosen_parts_are_never_worse_than_their_cold_re_solve(two_link, exa
     arm, problem, optimum = two_link
     cold = solve_parts(problem, optimum, exact.parts, arm, warm=False)
     assert _chosen_value(problem, exact) <= objective_value(problem, cold.numpy_objectives)
+
+
+def test_a_warm_re_solve_on_active_sets_finds_the_cold_one_in_fewer_iterations(many_samples):
+    # On active sets the first round holds the optimum's last active samples and starts from its last NLP's
+    # point and multipliers: every combination of two candidates per joint reaches the cold start's optimum
+    # (or a better one), in fewer iterations in total.
+    arm, problem, optimum = many_samples
+    joints = snapping.joint_candidates(problem, optimum, _catalogue(), candidates=2)
+    warm_iterations = cold_iterations = 0
+    for parts in itertools.product(*(j.parts for j in joints)):
+        warm = solve_parts(problem, optimum, parts, arm, active_set="always")
+        cold = solve_parts(problem, optimum, parts, arm, active_set="always", warm=False)
+        assert solve_method(warm)[0] == solve_method(cold)[0] == "active set"
+        assert warm.rounds[0].samples == optimum.active_samples.size
+        assert objective_value(problem, warm.numpy_objectives) <= objective_value(
+            problem, cold.numpy_objectives
+        ) * (1 + SOLVER_TOLERANCE)
+        warm_iterations += warm.iterations
+        cold_iterations += cold.iterations
+    assert warm_iterations < cold_iterations

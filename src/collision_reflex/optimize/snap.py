@@ -753,14 +753,47 @@ def matched_gear_ratio(part: CataloguePart, design: Design, joint: int) -> float
 def _warm_startable(problem: DesignProblem, optimum: DesignResult, active_set: str) -> bool:
     """Whether a combination of parts is re-solved warm from ``optimum`` (:func:`solve_parts`).
 
-    On all samples only, and from a solution of ``problem`` itself with its multipliers (not of an active set's
-    subset, whose auxiliaries are others): a catalogue problem has the same samples, so the same auxiliaries.
+    From a solution of ``problem`` itself with its multipliers: on all samples, ``optimum``'s own (a catalogue
+    problem has the same samples, so the same auxiliaries); on active sets, those of ``optimum``'s last NLP
+    (``last_round``), whose samples the combination's first round then holds.
     """
+    if not uses_active_set(problem.samples.size, active_set):
+        return optimum.multipliers is not None and optimum.x.size == problem.x0.size
+    last = optimum.last_round if isinstance(optimum, ActiveSetResult) else None
     return (
-        not uses_active_set(problem.samples.size, active_set)
-        and optimum.multipliers is not None
+        last is not None
+        and last.multipliers is not None
+        and optimum.impulses.size == problem.samples.size
         and optimum.x.size == problem.x0.size
     )
+
+
+def _warm_round(
+    problem: DesignProblem, optimum: ActiveSetResult, parts: Sequence[CataloguePart], arm: Arm, x0: np.ndarray
+) -> ActiveSetResult:
+    """``optimum`` as the warm start of ``parts``' active-set solve from ``x0`` (a point of the full problem).
+
+    Its last NLP's point and multipliers are carried (:func:`warm_start`) to the parts' problem on the same
+    samples, started at ``x0``'s design with those samples' auxiliaries at their exact values.
+    """
+    from .active_set import sample_subset
+    from .problem import build_problem
+
+    subset = sample_subset(problem.samples, optimum.active_samples)
+    solved_on = build_problem(
+        arm,
+        subset,
+        problem.space,
+        problem.technology,
+        problem.objective,
+        problem.constraints,
+        problem.bounded_objectives,
+    )
+    built = catalogue_problem(problem, parts, arm, subset)
+    n_design = built.layout.size
+    start = built.exact_point(np.concatenate([x0[:n_design], built.x0[n_design:]]))
+    assert optimum.last_round is not None  # _warm_startable
+    return replace(optimum, x=x0, last_round=warm_start(solved_on, built, optimum.last_round, start))
 
 
 def _parts_start(
@@ -867,6 +900,7 @@ def solve_parts(
         initial=initial,
         x0=x0,
         full=built,
+        warm=_warm_round(problem, optimum, parts, arm, x0) if warm else None,  # type: ignore[arg-type]
     )
 
 
