@@ -10,7 +10,8 @@ the unit registry's cache of ``crx`` (in a temporary user cache folder, ``XDG_CA
 of each command, not timed, writes.
 
 Then ``crx validate``'s phases, each timed in one fresh interpreter doing the command's steps in order (medians
-of R runs): what the imports, the unit registry, reading the study and loading the robot cost.
+of R runs), without garbage collection as in ``crx``: what the imports, the unit registry, reading the study and
+loading the robot cost.
 
 Run: ``PYTHONPATH=src python benchmarks/startup.py [--repeats R]``.
 """
@@ -85,7 +86,8 @@ PHASES = {
 
 def phase_times() -> dict[str, tuple[float, float]]:
     """Wall and CPU time of each phase in one fresh interpreter."""
-    lines = ["import json, time", f"STUDY = {STUDY!r}", "out = {}"]
+    # Without cyclic garbage collection, as crx's start-up (collision_reflex.cli.start_up).
+    lines = ["import gc, json, time", "gc.disable()", f"STUDY = {STUDY!r}", "out = {}"]
     for name, code in PHASES.items():
         lines += ["w, c = time.perf_counter(), time.process_time()", code]
         lines += [f"out[{name!r}] = (time.perf_counter() - w, time.process_time() - c)"]
