@@ -180,3 +180,45 @@ def test_a_subcommands_help_is_the_same_alone(command, capsys):
         build_parser().parse_args([command, "--help"])
     assert capsys.readouterr().out == alone
     assert alone.startswith(f"usage: crx {command}")
+
+
+@pytest.mark.parametrize(
+    "arguments",
+    [
+        ["--help"],
+        ["no-such-command"],
+        ["validate", "studies/two_link_paper.yaml", "studies/two_link_paper.yaml"],
+        ["validate", "studies/no_such_study.yaml"],
+    ],
+    ids=["help", "usage-error", "two-studies", "missing-study"],
+)
+@pytest.mark.parametrize("collecting", [True, False], ids=["gc-on", "gc-off"])
+def test_main_leaves_the_garbage_collector_as_it_found_it(arguments, collecting, capsys):
+    # crx's start-up runs without collection and freezes its objects; a Python caller gets its collector back.
+    import gc
+
+    from collision_reflex.cli import main
+
+    assert gc.get_freeze_count() == 0
+    (gc.enable if collecting else gc.disable)()
+    try:
+        main(arguments)
+        assert gc.isenabled() == collecting
+        assert gc.get_freeze_count() == 0
+    finally:
+        gc.enable()
+    capsys.readouterr()
+
+
+def test_the_crx_process_keeps_its_start_up_frozen():
+    # The frozen start-up is walked by no collection, the last one at exit included; collection stays on.
+    code = (
+        "import gc, sys\nfrom collision_reflex.cli import main\n"
+        "sys.argv = ['crx', 'validate', 'studies/two_link_paper.yaml']\nassert main() == 0\n"
+        "print(gc.isenabled(), gc.get_freeze_count() > 10_000, file=sys.stderr)"
+    )
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True, env=env, cwd=ROOT
+    )
+    assert done.stderr.split() == ["True", "True"]

@@ -11,11 +11,15 @@ time grows with the square of the text's length.
 
 from __future__ import annotations
 
+import contextlib
 import functools
+import hashlib
 import math
+import os
 import re
 import sys
 from importlib import resources
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
@@ -54,8 +58,7 @@ class QuantityError(ValueError):
 
 
 # The registry holds the part of pint's own definitions file (``default_en.txt``) that datasheets and studies
-# use; building pint's whole registry takes ~5x as long (0.14 s of a 0.9 s ``crx validate``; pint's on-disk
-# cache would avoid it, but the package writes nothing outside the folders it is given). The definitions are
+# use; building pint's whole registry takes ~5x as long (0.14 s of a 0.9 s ``crx validate``). The definitions are
 # pint's lines, picked by name here (two groups and the mks system whole), never copied. Kept: SI base and
 # derived units with every prefix, angles (deg, turn, arcmin), rpm and rps, time, temperature, the
 # international inch/foot/yard/mile, the avoirdupois pound and ounce with their forces (lbf, ozf), kgf and gf,
@@ -98,12 +101,22 @@ _KEPT_UNITS = frozenset(_DATASHEET_UNITS.split() + _UNITS_FOR_THEIR_NAMES.split(
 # command's own process imports pint without them (:func:`hide_pint_extras`); library users keep all of pint.
 _PINT_EXTRAS = ("dask", "scipy", "babel")
 _hide_extras = False
+# Parsing the definitions and working out every unit's base units take ~0.04 s at each start of `crx`. The
+# `crx` command keeps pint's parse of them in the user's cache folder (:func:`cache_registry`); a library user's
+# registry writes nothing.
+_use_cache = False
 
 
 def hide_pint_extras() -> None:
     """Import pint, when it is first needed, without its optional integrations (for the ``crx`` command)."""
     global _hide_extras
     _hide_extras = True
+
+
+def cache_registry() -> None:
+    """Build the registry, when it is first needed, through pint's on-disk cache (for the ``crx`` command)."""
+    global _use_cache
+    _use_cache = True
 
 
 def import_pint() -> Any:
@@ -170,9 +183,68 @@ def unit_registry() -> pint.UnitRegistry:
     """The registry every unit string of the package is read with: study files, catalogues, traces."""
     pint = import_pint()
     definitions = registry_definitions()
-    registry = pint.UnitRegistry() if definitions is None else pint.UnitRegistry(definitions)
+    if definitions is None:
+        registry = pint.UnitRegistry()
+    else:
+        cached = cached_registry(definitions, registry_cache_folder()) if _use_cache else None
+        registry = pint.UnitRegistry(definitions) if cached is None else cached
     registry.define("@alias turn = rev")  # datasheets' "counts/rev", "mm/rev"; not a name of pint's own
     return registry
+
+
+def registry_cache_folder() -> Path | None:
+    """The folder of the registry's cache: ``units`` in the user's cache folder (None if there is none)."""
+    import platformdirs  # a dependency of pint
+
+    try:
+        return platformdirs.user_cache_path("collision-reflex", appauthor=False) / "units"
+    except (OSError, RuntimeError, KeyError):  # no home folder
+        return None
+
+
+def cached_registry(definitions: list[str], folder: Path | None) -> pint.UnitRegistry | None:
+    """A registry of ``definitions`` built through pint's cache in ``folder``, or None if it cannot be used.
+
+    The definitions are written to a file named by their hash, which pint reads with ``cache_folder``: pint
+    keeps its parse of the file, keyed by the file's content, its own version and the number type, and skips
+    listing every unit's base units (it works them out when a unit is first used, as it does for a unit
+    defined later). A folder per pint and flexparser (its parser) version, so that no parse is read back into
+    another version's classes. A read-only or missing folder, or one that cannot be created, is not used; an
+    unreadable cache file is deleted and the cache built again.
+
+    Parameters
+    ----------
+    definitions : list of str
+        The lines of the registry (:func:`registry_definitions`).
+    folder : Path or None
+        Where the caches of every version go (:func:`registry_cache_folder`).
+    """
+    pint = import_pint()
+    import flexparser  # a dependency of pint
+
+    if folder is None:
+        return None
+    text = "\n".join(definitions) + "\n"
+    folder = folder / f"pint-{pint.__version__}-flexparser-{flexparser.__version__}"
+    path = folder / f"definitions-{hashlib.sha256(text.encode()).hexdigest()[:16]}.txt"
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        if not os.access(folder, os.W_OK):
+            return None
+        if not path.is_file() or path.read_text(encoding="utf-8") != text:
+            partial = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+            partial.write_text(text, encoding="utf-8")
+            os.replace(partial, path)  # whole or absent for a process reading it at the same time
+    except (OSError, UnicodeDecodeError):
+        return None
+    for _ in range(2):
+        try:
+            return pint.UnitRegistry(path, cache_folder=folder)
+        except Exception:  # a cache file cut short or unreadable: delete pint's files, build them again once
+            with contextlib.suppress(OSError):
+                for stale in (*folder.glob("*.pickle"), *folder.glob("*.json")):
+                    stale.unlink(missing_ok=True)
+    return None
 
 
 @functools.lru_cache(maxsize=4096)  # files repeat their units; a pint conversion costs ~0.2 ms
