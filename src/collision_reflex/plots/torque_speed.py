@@ -7,6 +7,8 @@ against the same limits and doubles the resolution. Torques and speeds are motor
 by the gear ratio, joint speed times the gear ratio). Speed is in rad/s on the bottom axis and in rpm on the
 top axis. Each subplot's title states the joint's margins, limits and RMS torque; one legend for the figure
 (in an empty grid cell, else below the grid) names the kinds of lines and points, which every subplot shares.
+The grid is laid out from the sizes of those texts (:mod:`.grid_layout`), not by measuring a drawing, and the
+figure is saved whole.
 
 The envelope is the rectangle the catalogue can state: the peak torque up to the maximum speed. The
 continuous (thermal) torque bounds the cycle's RMS torque, not single points, so it is drawn as a line and
@@ -26,12 +28,14 @@ import numpy as np
 from .._validate import non_negative, positive
 from ..errors import InvalidParameter
 from . import FigurePath, figure_paths, new_figure, save_figure
+from .grid_layout import lay_out_grid
 
 RAD_PER_S_TO_RPM = 60.0 / (2.0 * math.pi)
 INSIDE_COLOUR = "tab:blue"
 APPROACH_COLOUR = "tab:green"
 WARNING_COLOUR = "tab:red"
 COLUMNS = 3
+CELL = (4.6, 3.9)  # in: width and height of one joint's subplot with its labels and title
 RPM_LABEL_SIZE = 8
 ENVELOPE_LABEL = "peak torque, max speed"
 
@@ -182,7 +186,7 @@ def plot_torque_speed(path: FigurePath, joints: Sequence[JointOperatingPoints]) 
             raise InvalidParameter(f"joints[{index}]", point, "a JointOperatingPoints")
     columns = min(COLUMNS, len(joints))
     rows = math.ceil(len(joints) / columns)
-    fig, axes = new_figure(rows, columns, figsize=(4.6 * columns, 3.9 * rows), squeeze=False)
+    fig, axes = new_figure(rows, columns, figsize=(CELL[0] * columns, CELL[1] * rows), squeeze=False)
     # One legend for the figure: every subplot draws the same kinds of lines and points, and each joint's
     # numbers are in its title. Placed outside the data (an empty grid cell, else below the grid), so it
     # never hides a point and needs no search for a free place.
@@ -192,34 +196,28 @@ def plot_torque_speed(path: FigurePath, joints: Sequence[JointOperatingPoints]) 
     empty = list(axes.flat)[len(joints) :]
     for ax in empty:
         ax.set_visible(False)
-    fig.suptitle(
+    suptitle = fig.suptitle(
         "Motor operating points over the motor envelope (|speed|, |torque|, motor side)", fontsize=11
     )
-    _tight_layout(fig)
-    if legend:
-        _shared_legend(fig, legend, empty[0] if empty else None, columns)
-    return save_figure(fig, path)
+    shared = _shared_legend(fig, legend, empty[0] if empty else None, columns) if legend else None
+    below = shared if shared is not None and not empty else None
+    lay_out_grid(
+        fig, list(axes.flat)[: len(joints)], (rows, columns), CELL, _rpm_axis_height(), suptitle, below
+    )
+    # Everything is inside the figure: saved whole, without measuring its tight bounding box.
+    return save_figure(fig, path, crop=False)
 
 
-def _shared_legend(fig: Any, legend: dict[str, Any], empty_cell: Any | None, columns: int) -> None:
-    """The figure's legend: centred in ``empty_cell`` (an unused subplot), else below the grid of ``columns``."""
+def _shared_legend(fig: Any, legend: dict[str, Any], empty_cell: Any | None, columns: int) -> Any:
+    """The figure's legend: centred in ``empty_cell`` (an unused subplot), else below the grid of ``columns``.
+
+    Below the grid it has two legend columns per subplot column; the layout places it.
+    """
     if empty_cell is not None:
         where = {"loc": "center", "bbox_to_anchor": (0.5, 0.5), "bbox_transform": empty_cell.transAxes}
     else:
-        # Below the figure's bottom edge (the saved file is cropped to include it), two legend columns per subplot column.
-        where = {"loc": "upper center", "bbox_to_anchor": (0.5, 0.0), "ncols": min(2 * columns, len(legend))}
-    fig.legend(list(legend.values()), list(legend.keys()), fontsize=9, **where)
-
-
-def _tight_layout(fig: Any) -> None:
-    """Lay the subplots out as ``fig.tight_layout()`` does, leaving the figure without a layout engine.
-
-    ``fig.tight_layout()`` leaves a placeholder engine behind, and with any engine set ``savefig`` draws the
-    whole figure once more before each file, to no effect here (the layout is done).
-    """
-    from matplotlib.layout_engine import TightLayoutEngine
-
-    TightLayoutEngine().execute(fig)
+        where = {"loc": "lower center", "ncols": min(2 * columns, len(legend))}
+    return fig.legend(list(legend.values()), list(legend.keys()), fontsize=9, **where)
 
 
 def _draw_joint(ax: Any, point: JointOperatingPoints, legend: dict[str, Any]) -> None:
