@@ -304,3 +304,54 @@ def test_one_shared_legend_of_the_kinds_drawn_outside_every_subplot(tmp_path, mo
                 assert not box.overlaps(ax.get_window_extent(renderer))
     finally:
         plt.close(fig)
+
+
+def test_points_on_one_spot_are_drawn_once_and_none_outside_is_lost(tmp_path, monkeypatch):
+    """A cycle run three times draws each spot of it once; a point outside beside one inside keeps its red."""
+    import matplotlib.pyplot as plt
+
+    import collision_reflex.plots.torque_speed as module
+
+    captured, kinds = [], {}
+    monkeypatch.setattr(module, "save_figure", lambda fig, path, **kwargs: captured.append(fig))
+    shared = module._shared_legend
+    monkeypatch.setattr(
+        module, "_shared_legend", lambda fig, legend, *a: (kinds.update(legend), shared(fig, legend, *a))[1]
+    )
+    once = _shoulder()
+    # A point a millionth over the peak torque beside one on it: the same spot, but one of each kind.
+    speed = np.concatenate([np.tile(once.speed, 3), [10.0, 10.0]])
+    torque = np.concatenate([np.tile(once.torque, 3), [PEAK, PEAK * (1 + 1e-6)]])
+    approach = np.tile(once.approach_speed, 5)
+    fields = {
+        name: getattr(once, name) for name in ("peak_torque", "continuous_torque", "max_speed", "rms_torque")
+    }
+    plot_torque_speed(
+        tmp_path / "f.png", [JointOperatingPoints("shoulder", speed, torque, approach, **fields)]
+    )
+    fig = captured[0]
+    try:
+        drawn = {
+            label: np.column_stack(kinds[label].get_data())
+            for label in kinds
+            if label.startswith(("duty", "out", "appr"))
+        }
+        spot = module.SPOT * np.array([fig.axes[0].get_xlim()[1], fig.axes[0].get_ylim()[1]])
+    finally:
+        plt.close(fig)
+    inside = ~outside_envelope(once.speed, once.torque, PEAK, MAX_SPEED)
+    cycle = np.column_stack([np.abs(once.speed), np.abs(once.torque)])[inside]
+    # Every point drawn is a point of the cycle, every point of the cycle is drawn within a spot, and the three
+    # runs of the cycle (folded onto |speed|, |torque|, its halves coincide) are drawn as fewer points than one.
+    duty = drawn["duty cycle"]
+    assert duty[-1].tolist() == [10.0, PEAK]
+    assert all(np.any(np.all(point == cycle, axis=1)) for point in duty[:-1])
+    assert all(np.min(np.max(np.abs(duty - point) / spot, axis=1)) <= 1 for point in cycle)
+    assert len(duty) < len(cycle)
+    assert drawn["outside the envelope"].tolist() == [
+        [100.0, 1.1 * PEAK],
+        [1.1 * MAX_SPEED, 0.5],
+        [10.0, PEAK * (1 + 1e-6)],
+    ]
+    assert drawn["approach"].tolist() == [[40.0, 0.0], [60.0, 0.0]]
+    assert drawn["approach, too fast"].tolist() == [[320.0, 0.0]]

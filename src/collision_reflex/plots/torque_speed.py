@@ -8,7 +8,7 @@ by the gear ratio, joint speed times the gear ratio). Speed is in rad/s on the b
 top axis. Each subplot's title states the joint's margins, limits and RMS torque; one legend for the figure
 (in an empty grid cell, else below the grid) names the kinds of lines and points, which every subplot shares.
 The grid is laid out from the sizes of those texts (:mod:`.grid_layout`), not by measuring a drawing, and the
-figure is saved whole.
+figure is saved whole. Points that fall on one spot (a ten-thousandth of each axis range) are drawn once.
 
 The envelope is the rectangle the catalogue can state: the peak torque up to the maximum speed. The
 continuous (thermal) torque bounds the cycle's RMS torque, not single points, so it is drawn as a line and
@@ -38,6 +38,7 @@ COLUMNS = 3
 CELL = (4.6, 3.9)  # in: width and height of one joint's subplot with its labels and title
 RPM_LABEL_SIZE = 8
 ENVELOPE_LABEL = "peak torque, max speed"
+SPOT = 1e-4  # of an axis range (a twentieth of a pixel at 150 dpi): points on one spot are drawn once
 
 
 @dataclass(frozen=True)
@@ -236,12 +237,13 @@ def _draw_joint(ax: Any, point: JointOperatingPoints, legend: dict[str, Any]) ->
     )
     _draw_envelope(ax, point, legend)
     outside = outside_envelope(speed, torque, point.peak_torque, point.max_speed)
-    if np.any(~outside):
-        (legend["duty cycle"],) = ax.plot(speed[~outside], torque[~outside], ".", ms=4, color=INSIDE_COLOUR)
-    if np.any(outside):
-        (legend["outside the envelope"],) = ax.plot(
-            speed[outside], torque[outside], ".", ms=6, color=WARNING_COLOUR
-        )
+    for selected, size, colour, label in (
+        (~outside, 4, INSIDE_COLOUR, "duty cycle"),
+        (outside, 6, WARNING_COLOUR, "outside the envelope"),
+    ):
+        if np.any(selected):
+            x, y = _one_per_spot(speed[selected], torque[selected], x_top, y_top)
+            (legend[label],) = ax.plot(x, y, ".", ms=size, color=colour)
     # The approach runs at constant speed: its torque is drawn at zero, on the speed axis (not clipped).
     fast = outside_envelope(approach, np.zeros_like(approach), None, point.max_speed)
     for selected, colour, label in (
@@ -249,9 +251,8 @@ def _draw_joint(ax: Any, point: JointOperatingPoints, legend: dict[str, Any]) ->
         (fast, WARNING_COLOUR, "approach, too fast"),
     ):
         if np.any(selected):
-            (legend[label],) = ax.plot(
-                approach[selected], np.zeros(int(np.sum(selected))), "^", ms=7, color=colour, clip_on=False
-            )
+            x, y = _one_per_spot(approach[selected], np.zeros(int(np.sum(selected))), x_top, y_top)
+            (legend[label],) = ax.plot(x, y, "^", ms=7, color=colour, clip_on=False)
     if point.rms_torque is not None:
         too_hot = point.continuous_torque is not None and point.rms_torque > point.continuous_torque
         legend["RMS torque above continuous" if too_hot else "RMS torque"] = ax.axhline(
@@ -274,6 +275,17 @@ def _draw_joint(ax: Any, point: JointOperatingPoints, legend: dict[str, Any]) ->
         pad=_rpm_axis_height(),
     )
     ax.grid(True, alpha=0.3)
+
+
+def _one_per_spot(x: np.ndarray, y: np.ndarray, x_top: float, y_top: float) -> tuple[np.ndarray, np.ndarray]:
+    """The points ``(x, y)`` with those on the same spot (a ``SPOT`` of each axis range) drawn once, in order.
+
+    A cycle dwells and an approach repeats its speed, so many markers fall on one another: drawn again they
+    look the same but cost time, most in the SVG (an element each). A spot is far below a pixel.
+    """
+    cells = np.stack([np.round(x / (SPOT * x_top)), np.round(y / (SPOT * y_top))])
+    first = np.sort(np.unique(cells, axis=1, return_index=True)[1])
+    return x[first], y[first]
 
 
 def _rpm_axis_height() -> float:
