@@ -355,3 +355,28 @@ def test_points_on_one_spot_are_drawn_once_and_none_outside_is_lost(tmp_path, mo
     ]
     assert drawn["approach"].tolist() == [[40.0, 0.0], [60.0, 0.0]]
     assert drawn["approach, too fast"].tolist() == [[320.0, 0.0]]
+
+
+def test_rpm_scale_labels_round_rpm_at_their_speed(tmp_path, monkeypatch):
+    """The top scale's labels are round rpm, evenly stepped over the subplot, each at its speed in rad/s."""
+    import matplotlib.pyplot as plt
+
+    import collision_reflex.plots.torque_speed as module
+
+    captured = []
+    monkeypatch.setattr(module, "save_figure", lambda fig, path, **kwargs: captured.append(fig))
+    plot_torque_speed(tmp_path / "f.png", [_shoulder()])
+    (ax,) = captured[0].axes
+    try:
+        texts = {text.get_text(): text for text in ax.texts}
+        assert "motor speed [rpm]" in texts
+        ticks = [
+            (float(label), text.get_position()[0]) for label, text in texts.items() if label[0].isdigit()
+        ]
+        top = ax.get_xlim()[1] * module.RAD_PER_S_TO_RPM
+    finally:
+        plt.close(captured[0])
+    rpm, at = np.array(ticks).T
+    # Up to 1.15 x 330 rad/s: 0 to 3500 rpm in steps of 500.
+    assert rpm.tolist() == [500.0 * k for k in range(8)] and top < 4000
+    np.testing.assert_allclose(at, rpm / module.RAD_PER_S_TO_RPM, rtol=1e-12)

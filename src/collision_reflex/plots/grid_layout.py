@@ -54,18 +54,12 @@ def lay_out_grid(
     from matplotlib import rcParams
 
     rows, columns = shape
-    renderer = fig.canvas.get_renderer()
 
     def size(artist: Any) -> tuple[float, float]:
-        box = artist.get_window_extent(renderer)
-        return box.width * 72 / fig.dpi, box.height * 72 / fig.dpi
+        return extent(fig, artist)
 
     def text_size(text: str, fontsize: Any) -> tuple[float, float]:
-        from matplotlib.text import Text
-
-        artist = Text(0, 0, text, fontsize=fontsize)
-        artist.set_figure(fig)
-        return size(artist)
+        return extent(fig, text, fontsize)
 
     heading = size(suptitle)
     legend = (
@@ -126,3 +120,14 @@ def _widest_y_tick_label(ax: Any, text_size: Any) -> float:
 
     labels = ax.yaxis.get_major_formatter().format_ticks(ax.yaxis.get_majorticklocs())
     return max((text_size(label, rcParams["ytick.labelsize"])[0] for label in labels), default=0.0)
+
+
+def extent(fig: Any, artist: Any, fontsize: Any = None) -> tuple[float, float]:
+    """Width and height [pt] of ``artist`` (a text, a legend) of ``fig``, or of a string at ``fontsize``."""
+    from matplotlib.text import Text
+
+    if isinstance(artist, str):
+        artist = Text(0, 0, artist, fontsize=fontsize)
+        artist.set_figure(fig)
+    box = artist.get_window_extent(fig.canvas.get_renderer())
+    return box.width * 72 / fig.dpi, box.height * 72 / fig.dpi
