@@ -162,14 +162,14 @@ def test_one_drawing_for_several_files_gives_the_pixels_of_each_drawn_alone(tmp_
         plot_torque_speed((), joints)
 
 
-def test_each_file_is_drawn_once_with_the_layout_tight_layout_gives(tmp_path, monkeypatch):
-    """Saving the figure to its SVG and PNG draws it once per file, laid out as ``fig.tight_layout()`` lays it.
+def test_each_file_is_drawn_once_and_saved_whole(tmp_path, monkeypatch):
+    """Saving the figure to its SVG and PNG draws it once per file: no layout pass, no tight bounding box.
 
     A figure left with a layout engine (``fig.tight_layout()`` leaves a placeholder) is drawn once more before
-    each file by ``savefig``: four drawings instead of two.
+    each file by ``savefig``; a file cropped to the tight bounding box is measured by one more pass.
     """
-    import matplotlib.pyplot as plt
     from matplotlib.figure import Figure
+    from PIL import Image
 
     import collision_reflex.plots.torque_speed as module
 
@@ -177,28 +177,99 @@ def test_each_file_is_drawn_once_with_the_layout_tight_layout_gives(tmp_path, mo
     drawn: list[Figure] = []
     draw = Figure.draw
     monkeypatch.setattr(Figure, "draw", lambda self, renderer: (drawn.append(self), draw(self, renderer))[1])
-    laid_out: list[tuple[float, ...]] = []
+    sizes = []
     save = module.save_figure
 
-    def keep_layout(fig, path):
-        params = fig.subplotpars
-        laid_out.append((params.left, params.right, params.bottom, params.top, params.wspace, params.hspace))
+    def keep_size(fig, path, **kwargs):
         assert fig.get_layout_engine() is None
-        return save(fig, path)
+        sizes.append(tuple(fig.get_size_inches()))
+        return save(fig, path, **kwargs)
 
-    monkeypatch.setattr(module, "save_figure", keep_layout)
+    monkeypatch.setattr(module, "save_figure", keep_size)
     plot_torque_speed((tmp_path / "f.svg", tmp_path / "f.png"), joints)
     assert len(drawn) == 2
+    with Image.open(tmp_path / "f.png") as image:
+        # The whole figure at 150 dpi (to the pixel matplotlib rounds it to).
+        assert all(
+            abs(pixels - 150 * inches) < 1 for pixels, inches in zip(image.size, sizes[0], strict=True)
+        )
 
-    # The same figure laid out by matplotlib's own call, for comparison.
-    monkeypatch.setattr(module, "_tight_layout", lambda fig: fig.tight_layout())
-    captured: list[Figure] = []
-    monkeypatch.setattr(module, "save_figure", lambda fig, path: captured.append(fig))
-    plot_torque_speed(tmp_path / "g.png", joints)
-    params = captured[0].subplotpars
-    expected = (params.left, params.right, params.bottom, params.top, params.wspace, params.hspace)
-    plt.close(captured[0])
-    assert laid_out[0] == expected
+
+def _tiny_and_fast() -> JointOperatingPoints:
+    # Six-character tick labels on both axes: y from 0.0000 N*m, rpm up to 10000.
+    return JointOperatingPoints(
+        joint="wrist_3_joint",
+        speed=[900.0, -50.0],
+        torque=[0.0003, 0.0001],
+        approach_speed=[20.0],
+        peak_torque=0.0004,
+        continuous_torque=0.0002,
+        max_speed=1000.0,
+        rms_torque=0.0001,
+    )
+
+
+@pytest.mark.parametrize("suffix", [".png", ".svg"])
+@pytest.mark.parametrize("count", [1, 2, 6, 7])
+def test_no_text_overlaps_another_or_a_subplot_or_leaves_the_saved_figure(
+    tmp_path, monkeypatch, count, suffix
+):
+    """Every text drawn (titles, labels, tick labels, legend) lies inside the saved figure and overlaps no
+    other text, no subplot and not the legend; the legend overlaps no subplot."""
+    from matplotlib.legend import Legend
+    from matplotlib.text import Text
+
+    import collision_reflex.plots.torque_speed as module
+
+    drawn: dict[type, list] = {Text: [], Legend: []}
+
+    def recording(kind):
+        draw = kind.draw
+
+        def record(self, renderer):
+            draw(self, renderer)
+            if self.get_visible() and (kind is Legend or self.get_text()):
+                box = self.get_window_extent(renderer).transformed(self.figure.dpi_scale_trans.inverted())
+                drawn[kind].append((self, box))
+
+        return record
+
+    for kind in drawn:
+        monkeypatch.setattr(kind, "draw", recording(kind))
+    figures = []
+    save = module.save_figure
+    monkeypatch.setattr(
+        module, "save_figure", lambda fig, path, **kw: (figures.append(fig), save(fig, path, **kw))[1]
+    )
+    kinds = [
+        _shoulder(),
+        _wrist_unknown_limits(),
+        _tiny_and_fast(),
+        JointOperatingPoints("elbow", [1.0], [0.1]),
+    ]
+    plot_torque_speed(tmp_path / f"f{suffix}", (kinds * 2)[:count])
+    (fig,) = figures
+    width, height = fig.get_size_inches()
+    ((legend, legend_box),) = drawn[Legend]
+    in_legend = set(legend.get_texts())
+    inches = fig.dpi_scale_trans.inverted()
+    subplots = [
+        ax.get_position().transformed(fig.transFigure).transformed(inches)
+        for ax in fig.axes
+        if ax.get_visible()
+    ]
+    assert len(subplots) == count
+    texts = [(text, box) for text, box in drawn[Text] if text not in in_legend]
+    assert len(texts) > 15 * count  # tick labels included
+    for text, box in drawn[Text]:
+        assert 0 <= box.x0 and box.x1 <= width and 0 <= box.y0 and box.y1 <= height, text.get_text()
+    for index, (text, box) in enumerate(texts):
+        for other, other_box in texts[index + 1 :]:
+            assert not box.overlaps(other_box), (text.get_text(), other.get_text())
+        for subplot in [*subplots, legend_box]:
+            assert not box.overlaps(subplot), text.get_text()
+    for subplot in subplots:
+        assert not legend_box.overlaps(subplot)
 
 
 @pytest.mark.parametrize("count", [2, 3])
@@ -209,7 +280,7 @@ def test_one_shared_legend_of_the_kinds_drawn_outside_every_subplot(tmp_path, mo
     import collision_reflex.plots.torque_speed as module
 
     captured = []
-    monkeypatch.setattr(module, "save_figure", lambda fig, path: captured.append(fig))
+    monkeypatch.setattr(module, "save_figure", lambda fig, path, **kwargs: captured.append(fig))
     joints = [_shoulder(), _wrist_unknown_limits(), JointOperatingPoints("elbow", [1.0], [0.1])][:count]
     plot_torque_speed(tmp_path / "f.png", joints)
     fig = captured[0]
@@ -233,3 +304,79 @@ def test_one_shared_legend_of_the_kinds_drawn_outside_every_subplot(tmp_path, mo
                 assert not box.overlaps(ax.get_window_extent(renderer))
     finally:
         plt.close(fig)
+
+
+def test_points_on_one_spot_are_drawn_once_and_none_outside_is_lost(tmp_path, monkeypatch):
+    """A cycle run three times draws each spot of it once; a point outside beside one inside keeps its red."""
+    import matplotlib.pyplot as plt
+
+    import collision_reflex.plots.torque_speed as module
+
+    captured, kinds = [], {}
+    monkeypatch.setattr(module, "save_figure", lambda fig, path, **kwargs: captured.append(fig))
+    shared = module._shared_legend
+    monkeypatch.setattr(
+        module, "_shared_legend", lambda fig, legend, *a: (kinds.update(legend), shared(fig, legend, *a))[1]
+    )
+    once = _shoulder()
+    # A point a millionth over the peak torque beside one on it: the same spot, but one of each kind.
+    speed = np.concatenate([np.tile(once.speed, 3), [10.0, 10.0]])
+    torque = np.concatenate([np.tile(once.torque, 3), [PEAK, PEAK * (1 + 1e-6)]])
+    approach = np.tile(once.approach_speed, 5)
+    fields = {
+        name: getattr(once, name) for name in ("peak_torque", "continuous_torque", "max_speed", "rms_torque")
+    }
+    plot_torque_speed(
+        tmp_path / "f.png", [JointOperatingPoints("shoulder", speed, torque, approach, **fields)]
+    )
+    fig = captured[0]
+    try:
+        drawn = {
+            label: np.column_stack(kinds[label].get_data())
+            for label in kinds
+            if label.startswith(("duty", "out", "appr"))
+        }
+        spot = module.SPOT * np.array([fig.axes[0].get_xlim()[1], fig.axes[0].get_ylim()[1]])
+    finally:
+        plt.close(fig)
+    inside = ~outside_envelope(once.speed, once.torque, PEAK, MAX_SPEED)
+    cycle = np.column_stack([np.abs(once.speed), np.abs(once.torque)])[inside]
+    # Every point drawn is a point of the cycle, every point of the cycle is drawn within a spot, and the three
+    # runs of the cycle (folded onto |speed|, |torque|, its halves coincide) are drawn as fewer points than one.
+    duty = drawn["duty cycle"]
+    assert duty[-1].tolist() == [10.0, PEAK]
+    assert all(np.any(np.all(point == cycle, axis=1)) for point in duty[:-1])
+    assert all(np.min(np.max(np.abs(duty - point) / spot, axis=1)) <= 1 for point in cycle)
+    assert len(duty) < len(cycle)
+    assert drawn["outside the envelope"].tolist() == [
+        [100.0, 1.1 * PEAK],
+        [1.1 * MAX_SPEED, 0.5],
+        [10.0, PEAK * (1 + 1e-6)],
+    ]
+    assert drawn["approach"].tolist() == [[40.0, 0.0], [60.0, 0.0]]
+    assert drawn["approach, too fast"].tolist() == [[320.0, 0.0]]
+
+
+def test_rpm_scale_labels_round_rpm_at_their_speed(tmp_path, monkeypatch):
+    """The top scale's labels are round rpm, evenly stepped over the subplot, each at its speed in rad/s."""
+    import matplotlib.pyplot as plt
+
+    import collision_reflex.plots.torque_speed as module
+
+    captured = []
+    monkeypatch.setattr(module, "save_figure", lambda fig, path, **kwargs: captured.append(fig))
+    plot_torque_speed(tmp_path / "f.png", [_shoulder()])
+    (ax,) = captured[0].axes
+    try:
+        texts = {text.get_text(): text for text in ax.texts}
+        assert "motor speed [rpm]" in texts
+        ticks = [
+            (float(label), text.get_position()[0]) for label, text in texts.items() if label[0].isdigit()
+        ]
+        top = ax.get_xlim()[1] * module.RAD_PER_S_TO_RPM
+    finally:
+        plt.close(captured[0])
+    rpm, at = np.array(ticks).T
+    # Up to 1.15 x 330 rad/s: 0 to 3500 rpm in steps of 500.
+    assert rpm.tolist() == [500.0 * k for k in range(8)] and top < 4000
+    np.testing.assert_allclose(at, rpm / module.RAD_PER_S_TO_RPM, rtol=1e-12)

@@ -31,17 +31,23 @@ def figure_paths(path: FigurePath) -> tuple[Path, ...]:
     return tuple(check_figure_path(p) for p in paths)
 
 
-def save_figure(figure: Any, path: FigurePath, dpi: int = 150) -> Path:
+def save_figure(figure: Any, path: FigurePath, dpi: int = 150, crop: bool = True) -> Path:
     """Write a matplotlib figure atomically to each file of ``path`` (format from the suffix), close it.
 
     Cropped to the figure's tight bounding box, found once at ``dpi`` (a second file costs one more drawing,
-    not another layout pass). Returns the first file.
+    not another layout pass); ``crop=False`` saves the whole figure, for a figure laid out to fit inside it
+    (no measuring pass at all). Returns the first file.
     """
     import matplotlib.pyplot as plt
 
     targets = figure_paths(path)
     try:
-        bbox = _tight_bbox(figure, dpi) if len(targets) > 1 else "tight"
+        if not crop:
+            bbox = None
+        elif len(targets) > 1:
+            bbox = _tight_bbox(figure, dpi)
+        else:
+            bbox = "tight"
         for target in targets:
             with atomic_path(target) as tmp:
                 figure.savefig(tmp, dpi=dpi, bbox_inches=bbox)

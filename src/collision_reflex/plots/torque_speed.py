@@ -7,6 +7,8 @@ against the same limits and doubles the resolution. Torques and speeds are motor
 by the gear ratio, joint speed times the gear ratio). Speed is in rad/s on the bottom axis and in rpm on the
 top axis. Each subplot's title states the joint's margins, limits and RMS torque; one legend for the figure
 (in an empty grid cell, else below the grid) names the kinds of lines and points, which every subplot shares.
+The grid is laid out from the sizes of those texts (:mod:`.grid_layout`), not by measuring a drawing, and the
+figure is saved whole. Points that fall on one spot (a ten-thousandth of each axis range) are drawn once.
 
 The envelope is the rectangle the catalogue can state: the peak torque up to the maximum speed. The
 continuous (thermal) torque bounds the cycle's RMS torque, not single points, so it is drawn as a line and
@@ -26,14 +28,18 @@ import numpy as np
 from .._validate import non_negative, positive
 from ..errors import InvalidParameter
 from . import FigurePath, figure_paths, new_figure, save_figure
+from .grid_layout import extent, lay_out_grid
 
 RAD_PER_S_TO_RPM = 60.0 / (2.0 * math.pi)
 INSIDE_COLOUR = "tab:blue"
 APPROACH_COLOUR = "tab:green"
 WARNING_COLOUR = "tab:red"
 COLUMNS = 3
+CELL = (4.6, 3.9)  # in: width and height of one joint's subplot with its labels and title
+RPM_LABEL = "motor speed [rpm]"
 RPM_LABEL_SIZE = 8
 ENVELOPE_LABEL = "peak torque, max speed"
+SPOT = 1e-4  # of an axis range (a twentieth of a pixel at 150 dpi): points on one spot are drawn once
 
 
 @dataclass(frozen=True)
@@ -182,50 +188,47 @@ def plot_torque_speed(path: FigurePath, joints: Sequence[JointOperatingPoints]) 
             raise InvalidParameter(f"joints[{index}]", point, "a JointOperatingPoints")
     columns = min(COLUMNS, len(joints))
     rows = math.ceil(len(joints) / columns)
-    fig, axes = new_figure(rows, columns, figsize=(4.6 * columns, 3.9 * rows), squeeze=False)
+    fig, axes = new_figure(rows, columns, figsize=(CELL[0] * columns, CELL[1] * rows), squeeze=False)
     # One legend for the figure: every subplot draws the same kinds of lines and points, and each joint's
     # numbers are in its title. Placed outside the data (an empty grid cell, else below the grid), so it
     # never hides a point and needs no search for a free place.
     legend: dict[str, Any] = {}
+    rpm_axis = _rpm_axis_offsets(fig)
     for ax, point in zip(axes.flat, joints, strict=False):
-        _draw_joint(ax, point, legend)
+        _draw_joint(ax, point, legend, rpm_axis[2])
     empty = list(axes.flat)[len(joints) :]
     for ax in empty:
         ax.set_visible(False)
-    fig.suptitle(
+    suptitle = fig.suptitle(
         "Motor operating points over the motor envelope (|speed|, |torque|, motor side)", fontsize=11
     )
-    _tight_layout(fig)
-    if legend:
-        _shared_legend(fig, legend, empty[0] if empty else None, columns)
-    return save_figure(fig, path)
+    shared = _shared_legend(fig, legend, empty[0] if empty else None, columns) if legend else None
+    below = shared if shared is not None and not empty else None
+    drawn = list(axes.flat)[: len(joints)]
+    lay_out_grid(fig, drawn, (rows, columns), CELL, rpm_axis[2], suptitle, below)
+    for ax in drawn:
+        _rpm_axis(ax, rpm_axis)
+    # Everything is inside the figure: saved whole, without measuring its tight bounding box.
+    return save_figure(fig, path, crop=False)
 
 
-def _shared_legend(fig: Any, legend: dict[str, Any], empty_cell: Any | None, columns: int) -> None:
-    """The figure's legend: centred in ``empty_cell`` (an unused subplot), else below the grid of ``columns``."""
+def _shared_legend(fig: Any, legend: dict[str, Any], empty_cell: Any | None, columns: int) -> Any:
+    """The figure's legend: centred in ``empty_cell`` (an unused subplot), else below the grid of ``columns``.
+
+    Below the grid it has two legend columns per subplot column; the layout places it.
+    """
     if empty_cell is not None:
         where = {"loc": "center", "bbox_to_anchor": (0.5, 0.5), "bbox_transform": empty_cell.transAxes}
     else:
-        # Below the figure's bottom edge (the saved file is cropped to include it), two legend columns per subplot column.
-        where = {"loc": "upper center", "bbox_to_anchor": (0.5, 0.0), "ncols": min(2 * columns, len(legend))}
-    fig.legend(list(legend.values()), list(legend.keys()), fontsize=9, **where)
+        where = {"loc": "lower center", "ncols": min(2 * columns, len(legend))}
+    return fig.legend(list(legend.values()), list(legend.keys()), fontsize=9, **where)
 
 
-def _tight_layout(fig: Any) -> None:
-    """Lay the subplots out as ``fig.tight_layout()`` does, leaving the figure without a layout engine.
-
-    ``fig.tight_layout()`` leaves a placeholder engine behind, and with any engine set ``savefig`` draws the
-    whole figure once more before each file, to no effect here (the layout is done).
-    """
-    from matplotlib.layout_engine import TightLayoutEngine
-
-    TightLayoutEngine().execute(fig)
-
-
-def _draw_joint(ax: Any, point: JointOperatingPoints, legend: dict[str, Any]) -> None:
+def _draw_joint(ax: Any, point: JointOperatingPoints, legend: dict[str, Any], title_pad: float) -> None:
     """One joint's subplot: envelope lines, cycle points, approach speeds, RMS torque; title with the numbers.
 
-    Each kind of artist drawn is added to ``legend`` (label to artist) for the figure's shared legend.
+    Each kind of artist drawn is added to ``legend`` (label to artist) for the figure's shared legend. The
+    title is ``title_pad`` [pt] above the subplot, over the rpm axis (drawn after the layout).
     """
     speed, torque = np.abs(point.speed), np.abs(point.torque)
     approach = np.abs(point.approach_speed)
@@ -238,12 +241,13 @@ def _draw_joint(ax: Any, point: JointOperatingPoints, legend: dict[str, Any]) ->
     )
     _draw_envelope(ax, point, legend)
     outside = outside_envelope(speed, torque, point.peak_torque, point.max_speed)
-    if np.any(~outside):
-        (legend["duty cycle"],) = ax.plot(speed[~outside], torque[~outside], ".", ms=4, color=INSIDE_COLOUR)
-    if np.any(outside):
-        (legend["outside the envelope"],) = ax.plot(
-            speed[outside], torque[outside], ".", ms=6, color=WARNING_COLOUR
-        )
+    for selected, size, colour, label in (
+        (~outside, 4, INSIDE_COLOUR, "duty cycle"),
+        (outside, 6, WARNING_COLOUR, "outside the envelope"),
+    ):
+        if np.any(selected):
+            x, y = _one_per_spot(speed[selected], torque[selected], x_top, y_top)
+            (legend[label],) = ax.plot(x, y, ".", ms=size, color=colour)
     # The approach runs at constant speed: its torque is drawn at zero, on the speed axis (not clipped).
     fast = outside_envelope(approach, np.zeros_like(approach), None, point.max_speed)
     for selected, colour, label in (
@@ -251,9 +255,8 @@ def _draw_joint(ax: Any, point: JointOperatingPoints, legend: dict[str, Any]) ->
         (fast, WARNING_COLOUR, "approach, too fast"),
     ):
         if np.any(selected):
-            (legend[label],) = ax.plot(
-                approach[selected], np.zeros(int(np.sum(selected))), "^", ms=7, color=colour, clip_on=False
-            )
+            x, y = _one_per_spot(approach[selected], np.zeros(int(np.sum(selected))), x_top, y_top)
+            (legend[label],) = ax.plot(x, y, "^", ms=7, color=colour, clip_on=False)
     if point.rms_torque is not None:
         too_hot = point.continuous_torque is not None and point.rms_torque > point.continuous_torque
         legend["RMS torque above continuous" if too_hot else "RMS torque"] = ax.axhline(
@@ -263,37 +266,96 @@ def _draw_joint(ax: Any, point: JointOperatingPoints, legend: dict[str, Any]) ->
     ax.set_ylim(0.0, y_top)
     ax.set_xlabel("motor speed |ω| [rad/s]")
     ax.set_ylabel("motor torque |τ| = joint torque / N [N·m]", fontsize=8)
-    top = ax.secondary_xaxis("top", functions=(_to_rpm, _from_rpm))
-    top.set_xlabel("motor speed [rpm]", fontsize=RPM_LABEL_SIZE)
     short = any(value is not None and value < 0 for value in margins(point).values())
-    # Placed at a fixed offset above the rpm axis: an automatic title position is measured again at every
-    # drawing from the rpm axis's tick labels, which costs as much as drawing them.
     ax.set_title(
         f"{point.joint}\n{_margin_text(point)}\n{_limits_text(point)}",
         fontsize=8,
         color=WARNING_COLOUR if short else "black",
         y=1.0,
-        pad=_rpm_axis_height(),
+        pad=title_pad,
     )
     ax.grid(True, alpha=0.3)
 
 
-def _rpm_axis_height() -> float:
-    """Height [pt] of the rpm axis above a subplot (ticks, tick labels, label) plus the usual title pad."""
-    import matplotlib
-    from matplotlib.font_manager import FontProperties
+def _one_per_spot(x: np.ndarray, y: np.ndarray, x_top: float, y_top: float) -> tuple[np.ndarray, np.ndarray]:
+    """The points ``(x, y)`` with those on the same spot (a ``SPOT`` of each axis range) drawn once, in order.
 
-    rc = matplotlib.rcParams
-    tick_label = FontProperties(size=rc["xtick.labelsize"]).get_size_in_points()
-    # A line of text is about 1.2 font sizes high (ascent and descent).
-    return (
-        rc["xtick.major.size"]
-        + rc["xtick.major.pad"]
-        + 1.2 * tick_label
-        + rc["axes.labelpad"]
-        + 1.2 * RPM_LABEL_SIZE
-        + rc["axes.titlepad"]
+    A cycle dwells and an approach repeats its speed, so many markers fall on one another: drawn again they
+    look the same but cost time, most in the SVG (an element each). A spot is far below a pixel.
+    """
+    cells = np.stack([np.round(x / (SPOT * x_top)), np.round(y / (SPOT * y_top))])
+    first = np.sort(np.unique(cells, axis=1, return_index=True)[1])
+    return x[first], y[first]
+
+
+def _rpm_axis(ax: Any, offsets: tuple[float, float, float]) -> None:
+    """The rpm scale on top of a laid-out subplot: ticks at round rpm, their labels and the axis's label.
+
+    Drawn as a tick-mark line and texts, which show what a secondary axis shows at a fraction of its cost (an
+    axis is a whole subplot of its own, its tick labels measured at every drawing). As many ticks as
+    matplotlib's own axis would fit: one per three tick-label font sizes of the subplot's width. ``offsets``
+    are from :func:`_rpm_axis_offsets`.
+    """
+    from matplotlib import rcParams
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.markers import TICKUP
+    from matplotlib.ticker import MaxNLocator
+    from matplotlib.transforms import offset_copy
+
+    fig = ax.get_figure()
+    font = FontProperties(size=rcParams["xtick.labelsize"]).get_size_in_points()
+    width = ax.get_position().width * fig.get_size_inches()[0] * 72
+    top = ax.get_xlim()[1] * RAD_PER_S_TO_RPM
+    rpm = MaxNLocator(nbins=max(1, int(width // (3 * font))), steps=[1, 2, 2.5, 5, 10]).tick_values(0.0, top)
+    rpm = rpm[(rpm >= -1e-9 * top) & (rpm <= (1 + 1e-9) * top)]  # those on the axis, as an axis keeps them
+    along = ax.get_xaxis_transform()  # x in rad/s, y in axes fractions: the top edge is y = 1
+    colour = rcParams["xtick.color"]
+    tick, label, _ = offsets
+    ax.plot(
+        rpm / RAD_PER_S_TO_RPM,
+        np.ones_like(rpm),
+        ls="none",
+        marker=TICKUP,
+        ms=rcParams["xtick.major.size"],
+        mew=rcParams["xtick.major.width"],
+        color=colour,
+        transform=along,
+        clip_on=False,
     )
+    above = offset_copy(along, fig=fig, y=tick, units="points")
+    for value in rpm:
+        # %g: every label is its whole number (no offset or multiplier written elsewhere).
+        ax.text(
+            value / RAD_PER_S_TO_RPM,
+            1.0,
+            f"{value:g}",
+            transform=above,
+            ha="center",
+            va="bottom",
+            fontsize=font,
+            color=colour,
+        )
+    ax.text(
+        0.5,
+        1.0,
+        RPM_LABEL,
+        transform=offset_copy(ax.transAxes, fig=fig, y=label, units="points"),
+        ha="center",
+        va="bottom",
+        fontsize=RPM_LABEL_SIZE,
+    )
+
+
+def _rpm_axis_offsets(fig: Any) -> tuple[float, float, float]:
+    """Heights [pt] above a subplot of the bottoms of the rpm tick labels, the rpm axis label and the title.
+
+    Spaced as matplotlib spaces an axis at the top: tick, pad, tick labels, label pad, label, title pad.
+    """
+    from matplotlib import rcParams
+
+    tick = rcParams["xtick.major.size"] + rcParams["xtick.major.pad"]
+    label = tick + extent(fig, "0123456789", rcParams["xtick.labelsize"])[1] + rcParams["axes.labelpad"]
+    return tick, label, label + extent(fig, RPM_LABEL, RPM_LABEL_SIZE)[1] + rcParams["axes.titlepad"]
 
 
 def _draw_envelope(ax: Any, point: JointOperatingPoints, legend: dict[str, Any]) -> None:
@@ -340,11 +402,3 @@ def _margin_text(point: JointOperatingPoints) -> str:
         else:
             parts.append(f"{name} {100 * value:+.0f} %")
     return "margins: " + ", ".join(parts)
-
-
-def _to_rpm(speed: np.ndarray) -> np.ndarray:
-    return speed * RAD_PER_S_TO_RPM
-
-
-def _from_rpm(rpm: np.ndarray) -> np.ndarray:
-    return rpm / RAD_PER_S_TO_RPM
