@@ -38,10 +38,15 @@ DEFAULT_IPOPT_OPTIONS: dict[str, str | float] = {
     "ipopt.mu_strategy": "monotone",
     "ipopt.mu_init": 1e-2,
     "ipopt.linear_solver": "mumps",
-    # MUMPS's own row and column scaling (its option 8): with its default (automatic) choice the KKT matrices
-    # of the UR5 study's fast points needed delayed pivots, 8x MUMPS's memory estimate and ~0.5 s per
-    # iteration (a 100 s solve); scaled so, the same optimum in 10 s.
-    "ipopt.mumps_scaling": 8,
+    # No scaling of the KKT matrix by MUMPS (neither its row and column scaling nor its permuting scaling):
+    # with its default (automatic) choice the KKT matrices of the UR5 study's fast points needed delayed
+    # pivots, 8x MUMPS's memory estimate and ~0.5 s per iteration (a 100 s solve); with its option 8 the same
+    # optimum in 10 s; without scaling the same iterations and optimum again (to 1e-15 on the UR5 study's
+    # 10-point front, full NLP and active sets) in 14-18 % less CPU (UR5 study's one solve 0.99 s against 1.21 s,
+    # its front 11.5 s against 13.3 s; the Panda study's solve 0.57 s against 0.60 s; medians, idle machine).
+    # IPOPT scales the NLP itself (gradient-based), which is what keeps these matrices tame.
+    "ipopt.mumps_scaling": 0,
+    "ipopt.mumps_permuting_scaling": 0,
     # METIS ordering (MUMPS chose QAMD): on the Panda benchmark the same 61 iterations and optimum with 10 %
     # less IPOPT time (CPU median of 7 interleaved runs 1.33 s against 1.49 s, load 8-10), most of which is
     # MUMPS's factorizations (114 for 61 iterations: the inertia correction refactorizes); the UR5 study's
