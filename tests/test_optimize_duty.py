@@ -309,3 +309,24 @@ def test_reachability_memo_answers_only_the_same_question(arm, samples):
     cr.build_problem(arm, samples, allowed, _technology(), constraints=constraints)
     assert len(kept) == 3  # joint 1's grid reused, joint 2's computed for its new bounds
     assert list(kept.values())[-1][2] > 0  # joint 2's best speed margin, now reachable
+
+
+def test_cycle_torques_are_kept_per_arm_and_motion(arm, samples):
+    # The RNEA over the cycle is kept (every problem of a study repeats it) and found again only for the same
+    # arm and the same motion and payload: a payload 1 g heavier is another requirement.
+    from collision_reflex.optimize.duty import duty_requirement
+
+    def cycle(mass):
+        return DutyCycle.through_via_points(
+            [[0.0, 0.0], [1.0, 0.5]], arm.joint_names, 1.0, 5.0, rate=50.0, payload=Payload(mass)
+        )
+
+    first = duty_requirement(arm, samples, cycle(0.5), _technology(), SAFETY)
+    again = duty_requirement(arm, samples, cycle(0.5), _technology(), SAFETY)
+    heavier = duty_requirement(arm, samples, cycle(0.501), _technology(), SAFETY)
+    assert again.torques is first.torques
+    assert heavier.torques is not first.torques
+    assert np.abs(heavier.torques.structure - first.torques.structure).max() > 1e-6
+    # Another arm object (here the same robot loaded again) is never answered from another's torques.
+    other = Arm.from_urdf(TWO_LINK, "tip")
+    assert duty_requirement(other, samples, cycle(0.5), _technology(), SAFETY).torques is not first.torques

@@ -154,7 +154,12 @@ def duty_requirement(
                 f"motor {motor.name!r} has none: add max_speed to its catalogue entry (e.g. '3000 rpm') or "
                 "give Motor(..., max_speed=...)",
             )
-    return DutyRequirement(cycle_torques(arm, cycle), approach_joint_rates(samples), float(safety_factor))
+    # The arm's own object in the key (and kept in the memo with the torques): its id is not reused meanwhile.
+    payload = () if cycle.payload is None else (cycle.payload.mass, cycle.payload.inertia)
+    key = _digest(id(arm), cycle.joint_names, cycle.t, cycle.q, cycle.qd, cycle.qdd, *payload)
+    held, torques = _CYCLE_TORQUES.get(key, lambda: (arm, cycle_torques(arm, cycle)))
+    assert held is arm
+    return DutyRequirement(torques, approach_joint_rates(samples), float(safety_factor))
 
 
 def peak_rows(
@@ -394,9 +399,9 @@ def check_reachable(
 class _Memo:
     """Results of a pure computation by a digest of everything it reads (:func:`_digest`), the newest kept.
 
-    The problems of one study (its objective's, the Pareto anchors', every active-set round's) repeat the duty
-    cycle's per-joint work: on the UR5 study its reachability grids took 0.1-0.4 s and its peak rows 64 ms a build
-    (measured), for 40-50 builds a run.
+    The problems of one study (its objective's, the Pareto anchors', every active-set round's, every catalogue
+    combination's) repeat the duty cycle's work: on the UR5 study its reachability grids took 0.1-0.4 s, its peak
+    rows 64 ms and its RNEA over the cycle 5 ms a build (measured), for 40-50 builds a run.
     """
 
     def __init__(self, size: int) -> None:
@@ -429,6 +434,8 @@ _BEST_MARGINS = _Memo(256)
 """Each joint's best margins over its grid (:func:`_best_margins`)."""
 _KEPT_ROWS = _Memo(256)
 """Each joint's peak rows (:func:`_joint_peak_rows`)."""
+_CYCLE_TORQUES = _Memo(8)
+"""An arm's torques over a cycle (:func:`collision_reflex.arm.dynamics.cycle_torques`: RNEA at every sample)."""
 _GEARBOX_FIELDS = ("efficiency", "counted_inertia", "peak_torque", "rated_torque", "max_input_speed")
 """The gearbox figures :func:`_best_margins` reads."""
 
