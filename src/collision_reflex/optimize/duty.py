@@ -26,6 +26,7 @@ motor speeds of a design, for a torque-speed figure.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -179,7 +180,7 @@ def peak_rows(
     for j in range(duty.torques.nv):
         basis = duty.safety_factor * duty.torques.demand_basis(j)
         key = _digest(basis, x_low[j], x_high[j])
-        kept.append(_KEPT_ROWS.get(key, lambda b=basis, j=j: _joint_peak_rows(b, x_low[j], x_high[j])))
+        kept.append(_KEPT_ROWS.get(key, functools.partial(_joint_peak_rows, basis, x_low[j], x_high[j])))
     return kept
 
 
@@ -370,7 +371,7 @@ def check_reachable(
         high = basis[:, 0] + np.maximum(slopes * mass_low, slopes * mass_high).sum(axis=1)
         demand = (low, high, basis[:, -1])
         n_joints = len(joint_names)
-        gearbox = technology.gearbox_figures(n_joints)
+        figures = technology.gearbox_figures(n_joints)
         key = _digest(
             *demand,
             weights,
@@ -378,16 +379,16 @@ def check_reachable(
             float(speed_need[j]),
             technology.joint_motors(n_joints)[j],
             technology.scaling_law,
-            *(float(getattr(gearbox, field)[j]) for field in _GEARBOX_FIELDS),
-            *(bounds[name][j] for name in ("gear_ratio", "stator_diameter", "stack_length")),
+            *(float(getattr(figures, field)[j]) for field in _GEARBOX_FIELDS),
+            *(bounds[variable][j] for variable in ("gear_ratio", "stator_diameter", "stack_length")),
         )
         best = _BEST_MARGINS.get(
             key,
-            lambda j=j, demand=demand: _best_margins(
-                duty, technology, bounds, j, demand, weights, speed_need[j]
+            functools.partial(
+                _best_margins, duty, technology, bounds, j, demand, weights, float(speed_need[j])
             ),
         )
-        gearbox = technology.gearbox_figures(len(joint_names)).names[j]
+        gearbox = figures.names[j]
         labels = (PEAK, RMS, SPEED, *(f"gearbox {gearbox} {rating}" for rating in GEARBOX_RATINGS))
         for label, value in zip(labels, best[:-1], strict=True):
             if value < -REACHABLE_TOLERANCE:

@@ -900,7 +900,9 @@ def solve_parts(
         initial=initial,
         x0=x0,
         full=built,
-        warm=_warm_round(problem, optimum, parts, arm, x0) if warm else None,  # type: ignore[arg-type]
+        warm=_warm_round(problem, optimum, parts, arm, x0)
+        if warm and isinstance(optimum, ActiveSetResult)
+        else None,
     )
 
 

@@ -44,7 +44,6 @@ DEFAULT_IPOPT_OPTIONS: dict[str, str | float] = {
     # optimum in 10 s; without scaling the same iterations and optimum again (to 1e-15 on the UR5 study's
     # 10-point front, full NLP and active sets) in 14-18 % less CPU (UR5 study's one solve 0.99 s against 1.21 s,
     # its front 11.5 s against 13.3 s; the Panda study's solve 0.57 s against 0.60 s; medians, idle machine).
-    # IPOPT scales the NLP itself (gradient-based), which is what keeps these matrices tame.
     "ipopt.mumps_scaling": 0,
     "ipopt.mumps_permuting_scaling": 0,
     # METIS ordering (MUMPS chose QAMD): on the Panda benchmark the same 61 iterations and optimum with 10 %
