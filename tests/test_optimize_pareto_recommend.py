@@ -10,6 +10,7 @@ import pytest
 from collision_reflex.optimize.pareto import (
     ANCHOR_SLACK,
     MERGE_TOLERANCE,
+    RESOLUTION,
     ParetoSet,
     merge_repeats,
     recommend,
@@ -62,9 +63,12 @@ def test_a_dominating_front_point_is_recommended_with_the_reason():
     points = front(result(0.48551, 0.391), result(0.48560, 0.380))
     found = recommend(optimum, points, "mean_impulse")  # not a front objective: dominance decides
     assert found.pareto_index in (0, 1) and "dominates the single-objective optimum" in found.reason
-    # With the study's objective on the front, the dominating point best in it.
-    assert recommend(optimum, points, "worst_case_impulse").pareto_index == 0
+    # With the study's objective on the front, the dominating point best in it, unless a lighter one is within
+    # RESOLUTION of it: here point 1 is 0.02 % worse in impulse and 3 % lighter.
+    assert recommend(optimum, points, "worst_case_impulse").pareto_index == 1
     assert recommend(optimum, points, "actuator_mass").pareto_index == 1
+    apart = front(result(0.48551, 0.391), result(0.48551 * (1 + 2 * RESOLUTION), 0.380))
+    assert recommend(optimum, apart, "worst_case_impulse").pareto_index == 0
 
 
 def test_equal_within_tolerance_but_heavier_is_dominated():
@@ -125,5 +129,52 @@ def test_a_front_tie_that_is_worse_in_the_studys_own_objective_does_not_win():
     weighted = (("actuator_mass", 0.1), ("worst_case_impulse", 1.0))
     found = recommend(optimum, points, weighted)
     assert found.result is optimum and found.pareto_index is None
-    # Judged on the front's objectives alone the heavy tie would be "the same point".
-    assert recommend(optimum, points, "worst_case_impulse").pareto_index == 0
+    # Judged on the front's objectives alone the heavy tie is "the same point"; being alike in the impulse, the
+    # lighter of the two (the optimum) is recommended all the same.
+    found = recommend(optimum, points, "worst_case_impulse")
+    assert found.result is optimum and "which is Pareto design 0" in found.reason
+
+
+def test_the_lightest_of_the_designs_alike_in_impulse_is_recommended():
+    # The Panda study's case: the 4-start optimum is 0.037 % better in mean impulse than the front's lightest
+    # design and carries 2.8 times its actuator mass; below RESOLUTION that difference ranks no design.
+    optimum = result(2 * 0.4856403, 1.1156)  # result() halves the impulse into the mean impulse
+    points = ParetoSet(
+        ("mean_impulse", "actuator_mass"),
+        (result(2 * 0.4857377, 0.3947327), result(2 * 0.4858196, 0.3947324)),
+        labels=("p0", "p1"),
+    )
+    found = recommend(optimum, points, "mean_impulse")
+    assert found.pareto_index == 1 and found.result is points.points[1]
+    assert "within 0.1 % of it in mean impulse" in found.reason and "0.3947 kg" in found.reason
+    assert found.reason.startswith("the single-objective optimum")  # why it was the best, then why not it
+    # 0.2 % better is a difference the recommendation acts on: the optimum stays.
+    better = result(2 * 0.4858196 * (1 - 2 * RESOLUTION), 1.1156)
+    assert recommend(better, points, "mean_impulse").result is better
+    # Mass and speed objectives are ranked as they are.
+    assert recommend(optimum, points, "actuator_mass").result is not optimum
+
+
+@pytest.mark.parametrize("objective", ["worst_case_impulse", "mean_impulse"])
+def test_no_reported_design_alike_in_impulse_is_lighter_brute_force(objective):
+    """Every optimum against fronts with close points: the recommendation is undominated and no undominated
+    design within RESOLUTION of the best impulse is lighter."""
+    close = 0.4 * (1 + 0.5 * RESOLUTION)
+    points = front(result(0.40, 0.9), result(close, 0.6), result(0.47, 0.3), result(0.55, 0.1))
+    for impulse in (0.3999, 0.40, 0.4001, 0.41, 0.50):
+        for mass in (0.05, 0.5, 0.7, 1.0):
+            optimum = result(impulse, mass)
+            found = recommend(optimum, points, objective).result.numpy_objectives
+            designs = [p.numpy_objectives for p in points.points]
+            if not points.all_dominating(optimum.numpy_objectives, MERGE_TOLERANCE, (*NAMES, objective)):
+                designs.append(optimum.numpy_objectives)
+            least = min(d[objective] for d in designs)
+            for d in designs:
+                no_worse = all(d[n] <= found[n] for n in NAMES)
+                better = any(d[n] < found[n] * (1 - 1e-9) for n in NAMES)
+                assert not (no_worse and better), (impulse, mass, d)
+                if d[objective] <= least * (1 + RESOLUTION):
+                    assert found["actuator_mass"] <= d["actuator_mass"] * (1 + MERGE_TOLERANCE), (
+                        impulse,
+                        mass,
+                    )
