@@ -618,3 +618,36 @@ def test_a_warm_re_solve_on_active_sets_finds_the_cold_one_in_fewer_iterations(m
         warm_iterations += warm.iterations
         cold_iterations += cold.iterations
     assert warm_iterations < cold_iterations
+
+
+@pytest.mark.parametrize(
+    ("gain", "moved"), [(0.3 * MERGE_TOLERANCE, False), (3 * MERGE_TOLERANCE, True)], ids=["repeat", "real"]
+)
+def test_the_descent_moves_only_for_a_gain_beyond_what_re_solving_repeats(monkeypatch, gain, moved):
+    # Two joints of two parts each, the re-solved values by combination: from (0, 0), joint 0's second part
+    # gains 10 %, then joint 1's second part gains ``gain``. A move makes another pass solve a new combination.
+    from types import SimpleNamespace
+
+    value = {(0, 0): 1.0, (1, 0): 0.9, (1, 1): 0.9 * (1 - gain), (0, 1): 1.0}
+    parts = [tuple(SimpleNamespace(label=f"{j}{i}", index=i) for i in range(2)) for j in range(2)]
+
+    def solve_many(combinations, warm=True):
+        return [
+            SimpleNamespace(
+                numpy_objectives={"v": value[tuple(p.index for p in c)]},
+                status="Solve_Succeeded",
+                iterations=1,
+            )
+            for c in combinations
+        ]
+
+    monkeypatch.setattr(snapping, "objective_value", lambda problem, objectives: objectives["v"])
+    search = snapping._Search(None, parts, solve_many, None)
+    assert search.descend() == 2
+    assert search.best() == (1, 1)  # the best tried is kept either way
+    assert ((0, 1) in search.tried) == moved
+    # From an infeasible start (inf) a feasible part is always a move.
+    value[(0, 0)] = float("inf")
+    search = snapping._Search(None, parts, solve_many, None)
+    search.descend()
+    assert search.best() == (1, 1)
