@@ -364,20 +364,20 @@ def check_reachable(
     velocity = bounds["approach_velocity"][0].lower
     speed_need = duty.joint_speed(velocity)
     weights = time_weights(duty.torques.t) / float(duty.torques.t[-1] - duty.torques.t[0])
+    n_joints = len(joint_names)
+    figures, motors = technology.gearbox_figures(n_joints), technology.joint_motors(n_joints)
     for j, name in enumerate(joint_names):
         basis = duty.torques.demand_basis(j)
         slopes = basis[:, 1:-1]
         low = basis[:, 0] + np.minimum(slopes * mass_low, slopes * mass_high).sum(axis=1)
         high = basis[:, 0] + np.maximum(slopes * mass_low, slopes * mass_high).sum(axis=1)
         demand = (low, high, basis[:, -1])
-        n_joints = len(joint_names)
-        figures = technology.gearbox_figures(n_joints)
         key = _digest(
             *demand,
             weights,
             duty.safety_factor,
             float(speed_need[j]),
-            technology.joint_motors(n_joints)[j],
+            motors[j],
             technology.scaling_law,
             *(float(getattr(figures, field)[j]) for field in _GEARBOX_FIELDS),
             *(bounds[variable][j] for variable in ("gear_ratio", "stator_diameter", "stack_length")),

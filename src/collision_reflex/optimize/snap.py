@@ -778,11 +778,12 @@ def _warm_startable(problem: DesignProblem, optimum: DesignResult, active_set: s
 
 def _warm_round(
     problem: DesignProblem, optimum: ActiveSetResult, parts: Sequence[CataloguePart], arm: Arm, x0: np.ndarray
-) -> ActiveSetResult:
+) -> tuple[ActiveSetResult, DesignProblem]:
     """``optimum`` as the warm start of ``parts``' active-set solve from ``x0`` (a point of the full problem).
 
     Its last NLP's point and multipliers are carried (:func:`warm_start`) to the parts' problem on the same
-    samples, started at ``x0``'s design with those samples' auxiliaries at their exact values.
+    samples, started at ``x0``'s design with those samples' auxiliaries at their exact values. Returns the warm
+    start and that problem (the first round's).
     """
     from .active_set import sample_subset
     from .problem import build_problem
@@ -801,7 +802,7 @@ def _warm_round(
     n_design = built.layout.size
     start = built.exact_point(np.concatenate([x0[:n_design], built.x0[n_design:]]))
     assert optimum.last_round is not None  # _warm_startable
-    return replace(optimum, x=x0, last_round=warm_start(solved_on, built, optimum.last_round, start))
+    return replace(optimum, x=x0, last_round=warm_start(solved_on, built, optimum.last_round, start)), built
 
 
 def _parts_start(
@@ -901,17 +902,36 @@ def solve_parts(
         and optimum.impulses.size == built.samples.size
     ):
         initial = optimum.active_samples
+    build: Callable[[ContactSamples], DesignProblem] = functools.partial(
+        catalogue_problem, problem, parts, arm
+    )
+    first: ActiveSetResult | None = None
+    if warm and isinstance(optimum, ActiveSetResult):
+        first, first_round = _warm_round(problem, optimum, parts, arm, x0)
+        build = _reusing(build, first_round)
     return solve_active_set(
-        functools.partial(catalogue_problem, problem, parts, arm),
+        build,
         built.samples,
         ipopt_options=ipopt_options,
         initial=initial,
         x0=x0,
         full=built,
-        warm=_warm_round(problem, optimum, parts, arm, x0)
-        if warm and isinstance(optimum, ActiveSetResult)
-        else None,
+        warm=first,
     )
+
+
+def _reusing(
+    build: Callable[[ContactSamples], DesignProblem], built: DesignProblem
+) -> Callable[[ContactSamples], DesignProblem]:
+    """``build``, giving ``built`` itself for ``built``'s own samples (a problem already made, not made again)."""
+
+    def reuse(samples: ContactSamples) -> DesignProblem:
+        same = np.array_equal(samples.config_index, built.samples.config_index) and np.array_equal(
+            samples.directions, built.samples.directions
+        )
+        return built if same else build(samples)
+
+    return reuse
 
 
 @dataclass(frozen=True)
