@@ -3,10 +3,11 @@
     PYTHONPATH=src python benchmarks/study_executors.py [STUDY] [--points 20] [--repeats 3] [--workers 2]
     PYTHONPATH=src python benchmarks/study_executors.py [STUDY] --runs [--smoke]
 
-By default: the study's front (the paper's two-link study unless another is named) with ``--points`` points,
-solved serially, on a local process pool and on a local Dask cluster of ``--workers`` processes, ``--repeats``
-times each, executors interleaved. Every executor starts cold: its start-up (spawning the workers, importing the
-package, building each problem once per worker) is in its time, and the serial run builds its problems again.
+By default: the study's front (the UR5 study unless another is named) with ``--points`` points, solved
+serially, on a local process pool and on a local Dask cluster of ``--workers`` processes, ``--repeats`` times
+each, executors interleaved. Every executor starts cold: its start-up (starting the workers, forked on Linux with
+this process's imports and the study's setup but no built problem, spawned elsewhere; building each problem
+once per worker) is in its time, and the serial run builds its problems again.
 
 It prints, per executor (medians over the repeats), the wall time and its speed-up over serial, and the largest
 relative difference of the front's objectives from the serial front (0 expected: every point is a pure function

@@ -5,10 +5,13 @@ scale out to Dask with the same numbers; bad input writes nothing."""
 from __future__ import annotations
 
 import json
+import os
 import re
 import shutil
 import subprocess
+import sys
 import textwrap
+import threading
 from html import escape
 from html.parser import HTMLParser
 from pathlib import Path
@@ -280,6 +283,31 @@ def test_process_pool_gives_the_serial_result(runs, tmp_path):
         )
         == 0
     )
+    pd.testing.assert_frame_equal(
+        _numbers(tmp_path / "pool"), _numbers(runs["two_link_paper"]), check_exact=True
+    )
+
+
+_THREADS_AT_FORK: list[int] | None = None
+
+
+def _record_threads_at_fork() -> None:
+    if _THREADS_AT_FORK is not None:
+        _THREADS_AT_FORK.append(threading.active_count())
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="workers are forked on Linux only")
+def test_pool_workers_fork_before_the_run_starts_a_thread(runs, tmp_path):
+    """Forking copies only the forking thread: the progress bars' thread must not exist yet (fork safety)."""
+    global _THREADS_AT_FORK
+    os.register_at_fork(before=_record_threads_at_fork)  # a process-wide hook: records only while a list is set
+    before, _THREADS_AT_FORK = threading.active_count(), []
+    try:
+        run_study(TWO_LINK, tmp_path / "pool", quiet=False, smoke=True, executor="processes", workers=2)
+        forks = _THREADS_AT_FORK
+    finally:
+        _THREADS_AT_FORK = None
+    assert len(forks) == 2 and set(forks) == {before}
     pd.testing.assert_frame_equal(
         _numbers(tmp_path / "pool"), _numbers(runs["two_link_paper"]), check_exact=True
     )

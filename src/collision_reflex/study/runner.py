@@ -214,7 +214,11 @@ def _prepare(loaded: LoadedStudy, text: str) -> None:
 
 
 class _Progress:
-    """Rich progress bars on stderr (none when quiet)."""
+    """Rich progress bars on stderr (none when quiet).
+
+    Drawn from the first bar on: the bars' refresh thread starts then, after the run's executor has started
+    its workers (a local pool forks them: :data:`~collision_reflex.study.executors.START_METHOD`).
+    """
 
     def __init__(self, quiet: bool) -> None:
         self._bar: Any = None
@@ -229,12 +233,16 @@ class _Progress:
                 TimeElapsedColumn(),
                 console=Console(stderr=True),
             )
+
+    def _add(self, description: str, **counts: int) -> Any:
+        if not self._bar.live.is_started:
             self._bar.start()
+        return self._bar.add_task(description, **counts)
 
     def stage(self, description: str, total: int, done: int = 0) -> Callable[[], None]:
         if self._bar is None:
             return lambda: None
-        task = self._bar.add_task(description, total=total, completed=done)
+        task = self._add(description, total=total, completed=done)
         return lambda: self._bar.advance(task)
 
     def counter(self, description: str) -> Callable[[int, int], None]:
@@ -245,7 +253,7 @@ class _Progress:
             if self._bar is None:
                 return
             if "task" not in state:
-                state["task"] = self._bar.add_task(description, total=total)
+                state["task"] = self._add(description, total=total)
             self._bar.update(state["task"], completed=done, total=total)
 
         return update
