@@ -300,7 +300,8 @@ def _record_threads_at_fork() -> None:
 def test_pool_workers_fork_before_the_run_starts_a_thread(runs, tmp_path):
     """Forking copies only the forking thread: the progress bars' thread must not exist yet (fork safety)."""
     global _THREADS_AT_FORK
-    os.register_at_fork(before=_record_threads_at_fork)  # a process-wide hook: records only while a list is set
+    # A process-wide hook (it cannot be removed): it records only while a list is set.
+    os.register_at_fork(before=_record_threads_at_fork)
     before, _THREADS_AT_FORK = threading.active_count(), []
     try:
         run_study(TWO_LINK, tmp_path / "pool", quiet=False, smoke=True, executor="processes", workers=2)
