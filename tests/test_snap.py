@@ -651,3 +651,42 @@ def test_the_descent_moves_only_for_a_gain_beyond_what_re_solving_repeats(monkey
     search = snapping._Search(None, parts, solve_many, None)
     search.descend()
     assert search.best() == (1, 1)
+
+
+@pytest.mark.parametrize(
+    ("objective", "lighter_impulse", "chosen"),
+    [
+        ("mean_impulse", 1.0005, (1, 0)),  # 0.05 % worse, 25 % lighter: the lighter build
+        ("mean_impulse", 1.002, (0, 0)),  # 0.2 % worse: beyond RESOLUTION, the least impulse stays
+        ("worst_case_impulse", 1.0005, (1, 0)),
+        ("actuator_mass", 1.0005, (0, 0)),  # not an impulse objective: the least value alone
+    ],
+    ids=["alike", "beyond", "worst-case", "mass-objective"],
+)
+def test_the_snap_chooses_the_lightest_combination_alike_in_impulse(
+    monkeypatch, objective, lighter_impulse, chosen
+):
+    from types import SimpleNamespace
+
+    from collision_reflex.optimize.pareto import RESOLUTION
+
+    assert 1.0005 - 1 < RESOLUTION < 1.002 - 1
+    # (impulse, actuator mass) by combination; the search value is the study objective's own.
+    table = {(0, 0): (1.0, 2.0), (1, 0): (lighter_impulse, 1.5), (0, 1): (1.01, 1.0), (1, 1): (1.2, 3.0)}
+    if objective == "actuator_mass":
+        table = {c: (impulse, 2.0 if c == (0, 0) else 2.5) for c, (impulse, _) in table.items()}
+    parts = [tuple(SimpleNamespace(label=f"{j}{i}", index=i) for i in range(2)) for j in range(2)]
+
+    def solve_many(combinations, warm=True):
+        out = []
+        for c in combinations:
+            impulse, mass = table[tuple(p.index for p in c)]
+            values = {"mean_impulse": impulse, "worst_case_impulse": impulse, "actuator_mass": mass}
+            out.append(SimpleNamespace(numpy_objectives=values, status="Solve_Succeeded", iterations=1))
+        return out
+
+    monkeypatch.setattr(snapping, "objective_value", lambda problem, values: values[objective])
+    search = snapping._Search(SimpleNamespace(objective={objective: 1.0}), parts, solve_many, None)
+    search.values_of(list(table))
+    assert search.least() == (0, 0)
+    assert search.best() == chosen
