@@ -712,9 +712,8 @@ class _Search:
 
 def _impulse_objective(problem: DesignProblem | None) -> str | None:
     """The name of ``problem``'s objective when it is one impulse objective alone, else None."""
-    weights = {} if problem is None else problem.objective
-    (name,) = weights if len(weights) == 1 else (None,)
-    return name if name in ("worst_case_impulse", "mean_impulse") else None
+    names = [] if problem is None else list(problem.objective)
+    return names[0] if len(names) == 1 and names[0] in ("worst_case_impulse", "mean_impulse") else None
 
 
 def objective_value(problem: DesignProblem, objectives: Mapping[str, float]) -> float:

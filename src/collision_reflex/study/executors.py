@@ -76,13 +76,14 @@ START_METHOD = "fork" if sys.platform.startswith("linux") else "spawn"
 
 A forked worker starts with what this process has loaded (the package, CasADi, Pinocchio, the robot and the
 samples) instead of importing and loading it again: on the UR5 study's 20-point front on active sets, 2
-workers, a worker's start-up took 0.05 s against 0.8 s of CPU spawned, and the front ran 1.77-1.85x faster
-than serially on the pool (1.30-1.36x spawned) and 1.55x on a local Dask cluster (1.28x), the same numbers to
-the last bit (``benchmarks/study_executors.py``). Forking is safe here because the workers start before this
-process starts any thread of its own (the pool launches all of them at its first submission; the run's
-progress bars start after), OpenBLAS stops its threads around a fork, and nothing here runs an OpenMP region
-(Pinocchio's parallel algorithms are not used). macOS and Windows spawn: fork is unsafe with their system
-libraries, or absent."""
+workers, a worker's start-up took 0.0-0.1 s against 0.8 s of CPU spawned, and the front ran 1.95x faster than
+serially on the pool (1.30-1.36x spawned) and 1.82x on a local Dask cluster (1.28x), the same numbers to the
+last bit (``benchmarks/study_executors.py``, medians of 3). Forking is safe here: the pool's workers start
+before this process starts any thread of its own (the pool launches all of them at its first submission, and
+the run's progress bars start after), a Dask nanny forks from its event-loop thread as Dask's
+``multiprocessing-method`` setting provides, OpenBLAS stops its threads around a fork, and nothing here runs
+an OpenMP region (Pinocchio's parallel algorithms are not used). macOS and Windows spawn: fork is unsafe with
+their system libraries, or absent."""
 
 
 def _stop(pool: ProcessPoolExecutor) -> None:
