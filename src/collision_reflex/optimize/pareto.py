@@ -36,7 +36,7 @@ from collections import OrderedDict
 from collections.abc import Callable, Hashable, Iterable, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Executor, Future, wait
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, ParamSpec, Protocol, cast
+from typing import TYPE_CHECKING, Any, ParamSpec, Protocol, TypeVar, cast
 
 import numpy as np
 
@@ -860,22 +860,46 @@ def recommend(optimum: DesignResult, front: ParetoSet | None, objective: Hashabl
     return _lightest_alike(_best_design(optimum, front, objective), optimum, front, objective)
 
 
+IMPULSE_OBJECTIVES = ("worst_case_impulse", "mean_impulse")
+"""The objectives whose designs :func:`lightest_alike` ranks by mass within :data:`RESOLUTION`."""
+
+Alike = TypeVar("Alike")
+
+
+def lightest_alike(
+    candidates: Sequence[Alike],
+    objectives: Callable[[Alike], Mapping[str, float]],
+    objective: str,
+    incumbent: Alike,
+) -> Alike:
+    """The lightest of ``candidates`` within :data:`RESOLUTION` of their least ``objective`` (an impulse).
+
+    ``objectives`` gives a candidate's objective values [their units]. ``incumbent`` is kept unless that
+    lightest candidate has less actuator mass by more than :data:`MERGE_TOLERANCE` (relative).
+    """
+    least = min(objectives(c)[objective] for c in candidates)
+    alike = [c for c in candidates if objectives(c)[objective] <= least + RESOLUTION * abs(least)]
+    lightest = min(alike, key=lambda c: objectives(c)["actuator_mass"])
+    mass = objectives(lightest)["actuator_mass"]
+    return incumbent if mass >= objectives(incumbent)["actuator_mass"] * (1 - MERGE_TOLERANCE) else lightest
+
+
 def _lightest_alike(
     best: Recommendation, optimum: DesignResult, front: ParetoSet | None, objective: Hashable
 ) -> Recommendation:
     """``best``, or the run's lightest undominated design within :data:`RESOLUTION` of the best impulse."""
-    if front is None or not front.points or objective not in ("worst_case_impulse", "mean_impulse"):
+    if front is None or not front.points or objective not in IMPULSE_OBJECTIVES:
         return best
     judged = tuple(dict.fromkeys([*front.objectives, objective]))
     candidates: list[tuple[int | None, DesignResult]] = list(enumerate(front.points))
     if not front.all_dominating(optimum.numpy_objectives, MERGE_TOLERANCE, judged):
         candidates.append((None, optimum))
-    least = min(result.numpy_objectives[objective] for _, result in candidates)
-    alike = [c for c in candidates if c[1].numpy_objectives[objective] <= least + RESOLUTION * abs(least)]
-    index, lightest = min(alike, key=lambda c: c[1].numpy_objectives["actuator_mass"])
-    mine, theirs = best.result.numpy_objectives, lightest.numpy_objectives
-    if theirs["actuator_mass"] >= mine["actuator_mass"] * (1 - MERGE_TOLERANCE):
+    incumbent = (best.pareto_index, best.result)
+    chosen = lightest_alike(candidates, lambda c: c[1].numpy_objectives, str(objective), incumbent)
+    if chosen[1] is best.result:
         return best
+    index, lightest = chosen
+    mine, theirs = best.result.numpy_objectives, lightest.numpy_objectives
     source = "the single-objective optimum" if index is None else f"Pareto design {index}"
     name, unit = str(objective).replace("_", " "), OBJECTIVES[str(objective)][1]
     return Recommendation(

@@ -691,19 +691,14 @@ class _Search:
         the lighter is the better build (on the Panda study two combinations 4.5e-5 apart in mean impulse have
         1.080 kg and 1.098 kg of actuators).
         """
-        from .pareto import MERGE_TOLERANCE, RESOLUTION
+        from .pareto import lightest_alike
 
         least = self.least()
         name = _impulse_objective(self.problem)
         if least is None or name is None:
             return least
         feasible = [c for c in self.tried if math.isfinite(self.values[c])]
-        impulse = {c: self.results[c].numpy_objectives[name] for c in feasible}
-        mass = {c: self.results[c].numpy_objectives["actuator_mass"] for c in feasible}
-        floor = min(impulse.values())
-        alike = [c for c in feasible if impulse[c] <= floor + RESOLUTION * abs(floor)]
-        lightest = min(alike, key=lambda c: mass[c])
-        return lightest if mass[lightest] < mass[least] * (1 - MERGE_TOLERANCE) else least
+        return lightest_alike(feasible, lambda c: self.results[c].numpy_objectives, name, least)
 
     def trials(self) -> tuple[Trial, ...]:
         """Every combination tried, in the order tried."""
@@ -712,8 +707,10 @@ class _Search:
 
 def _impulse_objective(problem: DesignProblem | None) -> str | None:
     """The name of ``problem``'s objective when it is one impulse objective alone, else None."""
+    from .pareto import IMPULSE_OBJECTIVES
+
     names = [] if problem is None else list(problem.objective)
-    return names[0] if len(names) == 1 and names[0] in ("worst_case_impulse", "mean_impulse") else None
+    return names[0] if len(names) == 1 and names[0] in IMPULSE_OBJECTIVES else None
 
 
 def objective_value(problem: DesignProblem, objectives: Mapping[str, float]) -> float:
