@@ -4,11 +4,11 @@
 
 By default ``studies/panda.yaml`` and ``studies/ur5.yaml``. In this process, serially, each study's problems are
 built first (as a run's workers build them), then the stage "optimum" (the multi-start of ``crx run``:
-``pareto.single_optimum`` from ``OPTIMUM_STARTS`` starts) and the stage "pareto" (``pareto.pareto_front``) run as
-``crx run`` runs them. It prints per stage the IPOPT iterations of every run (retries and the multi-start's
-screening runs included), their sum, the CPU time, and the optimum's scaled objective or the front's objective
-values, with the load average before and after: the figures to compare when a change is to leave the answers
-alone and cut the iterations.
+``pareto.single_optimum`` from ``OPTIMUM_STARTS`` starts) and the stage "pareto" (``pareto.pareto_front``, the
+anchor of the study's objective taking the optimum when the optimum stage ran) run as ``crx run`` runs them. It
+prints per stage the IPOPT iterations of every run (retries and the multi-start's screening runs included), their
+sum, the CPU time, and the optimum's scaled objective or the front's objective values, with the load average
+before and after: the figures to compare when a change is to leave the answers alone and cut the iterations.
 """
 
 from __future__ import annotations
@@ -42,6 +42,7 @@ def main() -> None:
         pareto.built_problem(problems, problems.objective, ())
         for name in names:
             pareto.built_problem(problems, name, tuple(other for other in names if other != name))
+        result = None
         if "optimum" in stages:
             runs.clear()
             cpu = time.process_time()
@@ -65,6 +66,9 @@ def main() -> None:
                 IPOPT_OPTIONS,
                 anchor_starts=setup.study.pareto.anchor_starts,
                 active_set=problems.active_set,
+                known=None
+                if result is None
+                else pareto.known_optima(problems.objective, result, setup.study.pareto.anchor_starts),
             )
             cpu = time.process_time() - cpu
             values = "; ".join(", ".join(f"{v:.9g}" for v in row) for row in front.values())

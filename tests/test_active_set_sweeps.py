@@ -97,6 +97,35 @@ def test_an_epsilon_point_warm_started_from_the_anchors_last_nlp_is_the_cold_poi
     assert warm.numpy_objectives["actuator_mass"] <= epsilon["actuator_mass"] * (1 + 1e-8)
 
 
+def test_a_known_optimum_on_active_sets_is_carried_to_its_anchor_with_its_last_nlp(panda):
+    samples, build = panda
+    optimum, _ = pareto.single_optimum(build, NAMES[0], TIGHT, starts=1, active_set="always")
+    assert isinstance(optimum, ActiveSetResult) and optimum.last_round is not None
+    carried = pareto.anchor_start(build, NAMES[0], NAMES[1:], optimum)
+    assert isinstance(carried, ActiveSetResult) and carried.last_round is not None
+    assert np.array_equal(carried.x, optimum.x)
+    assert np.array_equal(carried.active_samples, optimum.active_samples)
+    # The last NLP's multipliers, by row label, on the anchor's problem of the same samples (one more row: the
+    # mass bound, loose at the anchor, at zero).
+    subset = active_set.sample_subset(samples, optimum.active_samples)
+    source = pareto.subset_problem(build, NAMES[0], (), subset)
+    target = pareto.subset_problem(build, NAMES[0], NAMES[1:], subset)
+    assert optimum.last_round.multipliers is not None and carried.last_round.multipliers is not None
+    rows = dict(zip(source.constraint_labels, optimum.last_round.multipliers[1], strict=True))
+    lam_g = carried.last_round.multipliers[1]
+    assert lam_g.size == target.lbg.size == source.lbg.size + 1
+    assert [rows.get(label, 0.0) for label in target.constraint_labels] == list(lam_g)
+    # An epsilon point warm-started from it is the point warm-started from the anchor's own solve.
+    own = pareto.solve_anchor(build, NAMES[0], NAMES, TIGHT, 1, "always").start
+    epsilon = {"actuator_mass": 0.6 * optimum.numpy_objectives["actuator_mass"]}
+    points = [
+        pareto.solve_point(build, NAMES, epsilon, start, TIGHT, "always", start.active_samples).result
+        for start in (carried, own)
+    ]
+    worst = [point.numpy_objectives["worst_case_impulse"] for point in points]
+    assert abs(worst[0] - worst[1]) <= OBJECTIVE_TOLERANCE * worst[1]
+
+
 def test_an_active_set_result_round_trips_and_its_record_says_how_it_was_solved(active_front):
     result = active_front.points[0]
     assert isinstance(result, ActiveSetResult)

@@ -162,3 +162,58 @@ def test_a_front_that_collapses_to_a_point_has_no_epsilon_points():
     grid = pareto.epsilon_grid(same, ("actuator_mass", "approach_velocity"), 3)
     assert [set(g) for g in grid] == [{"approach_velocity"}] * 3
     assert [g["approach_velocity"] for g in grid] == pytest.approx([0.35, 0.4, 0.45], rel=1e-12)
+
+
+def test_an_anchor_takes_a_known_optimum_as_its_first_solve(build, monkeypatch):
+    optimum, _ = pareto.single_optimum(build, NAMES[0], starts=2)
+    own = pareto.pareto_front(build, NAMES, points=5)
+    first_solves = []
+    solve_with = pareto.solve_with
+
+    def counted(build, objective, bounded, active_set, epsilon=None, **kwargs):
+        if not epsilon:
+            first_solves.append(objective)
+        return solve_with(build, objective, bounded, active_set, epsilon, **kwargs)
+
+    monkeypatch.setattr(pareto, "solve_with", counted)
+    front = pareto.pareto_front(build, NAMES, points=5, known={NAMES[0]: optimum})
+    assert first_solves == [NAMES[1]]  # the known objective's anchor did not solve again
+    assert not front.failed and len(front.points) == len(own.points)
+    # The same front as the anchor's own solve found (this problem has one optimum): equal as the sweep merges
+    # designs (MERGE_TOLERANCE, 1e-5; the anchors' masses here differ by 2e-6, as an anchor holds its impulse
+    # within ANCHOR_SLACK of an optimum itself known to ~1e-8).
+    for mine, theirs in zip(front.points, own.points, strict=True):
+        for name in NAMES:
+            assert mine.numpy_objectives[name] == pytest.approx(
+                theirs.numpy_objectives[name], rel=pareto.MERGE_TOLERANCE
+            )
+    # The optimum's multipliers carried to the anchor's problem by row: its objective bound (loose at the
+    # anchor) at zero, every other row the optimum's own.
+    source, target = build(NAMES[0], ()), pareto.built_problem(build, NAMES[0], NAMES[1:])
+    carried = pareto.anchor_start(build, NAMES[0], NAMES[1:], optimum)
+    assert carried is not None and carried.multipliers is not None and optimum.multipliers is not None
+    assert np.array_equal(carried.x, optimum.x)
+    lam_x, lam_g = carried.multipliers
+    assert lam_x.size == target.x0.size and lam_g.size == target.lbg.size == source.lbg.size + 1
+    rows = dict(zip(source.constraint_labels, optimum.multipliers[1], strict=True))
+    for label, value in zip(target.constraint_labels, lam_g, strict=True):
+        assert value == rows.get(label, 0.0)
+    assert sum(label not in rows for label in target.constraint_labels) == 1
+
+
+def test_a_known_optimum_of_other_variables_is_solved_again(build):
+    # Bounding the worst case adds its epigraph variable: the mass optimum is not a point of that problem.
+    optimum = cr.solve(build("actuator_mass", ()))
+    assert pareto.anchor_start(build, "actuator_mass", ("worst_case_impulse",), optimum) is None
+    point = pareto.solve_anchor(build, "actuator_mass", NAMES, None, known=optimum)
+    assert point.result is not None and not point.failures
+    assert point.result.x.size == pareto.built_problem(build, "actuator_mass", NAMES[:1]).x0.size
+
+
+def test_a_study_optimum_is_known_to_its_anchor_only_when_it_is_one_of_them():
+    optimum = object()
+    assert pareto.known_optima("mean_impulse", optimum, 1) == {"mean_impulse": optimum}
+    assert pareto.known_optima("mean_impulse", optimum, pareto.OPTIMUM_STARTS) == {"mean_impulse": optimum}
+    # More starts asked of the anchors than the optimum had, or a weighted objective: the anchors solve.
+    assert pareto.known_optima("mean_impulse", optimum, pareto.OPTIMUM_STARTS + 1) == {}
+    assert pareto.known_optima((("actuator_mass", 0.1), ("worst_case_impulse", 1.0)), optimum, 1) == {}

@@ -468,15 +468,24 @@ ARM_STUDIES = [p.stem for p in STUDIES if p.stem != ACTUATORS.stem]
 
 @pytest.mark.parametrize("name", ARM_STUDIES, ids=ARM_STUDIES)
 def test_study_sweep_is_the_library_sweep(runs, name):
-    """The run's front is what the optimiser's pareto_front gives on the same problem, called directly."""
+    """The run's front is what the optimiser's pareto_front gives on the same problem, called directly.
+
+    As the run does, the anchor of the study's own objective takes the study's optimum (``known_optima``).
+    """
     from collision_reflex.study.arm_setup import IPOPT_OPTIONS, StudyProblems
 
     folder = runs[name]
     results = json.loads((folder / "designs.json").read_text())
     saved, spec = results["pareto"], results["resolved"]["pareto"]
     problems = StudyProblems((folder / "study.resolved.yaml").read_text(encoding="utf-8"))
+    optimum, _ = sweep.single_optimum(problems, problems.objective, IPOPT_OPTIONS)
     front = sweep.pareto_front(
-        problems, spec["objectives"], spec["points"], IPOPT_OPTIONS, anchor_starts=spec["anchor_starts"]
+        problems,
+        spec["objectives"],
+        spec["points"],
+        IPOPT_OPTIONS,
+        anchor_starts=spec["anchor_starts"],
+        known=sweep.known_optima(problems.objective, optimum, spec["anchor_starts"]),
     )
     assert len(front.points) == len(saved["points"]) >= 1
     # Repeats of a point are merged (the smoke Panda front is one design): the sweep still solved several.
@@ -556,9 +565,10 @@ def test_a_study_asks_for_multi_start_anchors(tmp_path, monkeypatch):
     result = run_study(study, tmp_path / "out", quiet=True, smoke=True, executor="serial")
     results = json.loads((result.folder / "designs.json").read_text())
     assert results["resolved"]["pareto"]["anchor_starts"] == 2
-    # Two anchors, each started twice, then one lexicographic step each and two points from one start; the
-    # study's optimum from OPTIMUM_STARTS starts.
-    assert sorted(starts) == sorted([1, 1, 1, 1, 2, 2, sweep.OPTIMUM_STARTS])
+    # The study's optimum from OPTIMUM_STARTS starts (at least the 2 asked), which is the anchor of the study's
+    # objective (worst case impulse), so only the other anchor is started twice; then one lexicographic step
+    # each and two points from one start.
+    assert sorted(starts) == sorted([1, 1, 1, 1, 2, sweep.OPTIMUM_STARTS])
     assert results["pareto"]["points"][0]["label"] == "anchor: worst_case_impulse"
 
 

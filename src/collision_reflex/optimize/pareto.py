@@ -25,6 +25,7 @@ monotone: the 500-iteration cap, its bound held within :data:`ANCHOR_SLACK` bein
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import functools
 import inspect
 import itertools
@@ -42,13 +43,19 @@ import numpy as np
 
 from .. import _validate
 from ..errors import InvalidParameter, SolverFailed
-from .active_set import ACTIVE_SET_CHOICES, ActiveSetResult, solve_active_set, uses_active_set
+from .active_set import (
+    ACTIVE_SET_CHOICES,
+    ActiveSetResult,
+    sample_subset,
+    solve_active_set,
+    uses_active_set,
+)
 from .blas import single_threaded_blas
 from .objectives import OBJECTIVES
 from .problem import DesignProblem
 from .results import PointFailure, SweepPoint, record_row, result_record
 from .serial import SerialExecutor
-from .solve import DesignResult, IpoptOptions, solve
+from .solve import DesignResult, IpoptOptions, solve, warm_start
 
 if TYPE_CHECKING:
     from pathlib import Path
@@ -226,6 +233,7 @@ def pareto_front(
     finished: FinishedHook | None = None,
     save: SaveHook | None = None,
     active_set: str = "auto",
+    known: Mapping[str, DesignResult] | None = None,
 ) -> ParetoSet:
     """Pareto set of two or three objectives by epsilon-constraint sweeps.
 
@@ -251,6 +259,10 @@ def pareto_front(
         at least :data:`collision_reflex.optimize.active_set.ACTIVE_SET_THRESHOLD` of them, ``"always"`` does
         so whatever their number, ``"never"`` solves the full NLP (see :func:`solve_with`); each result says
         which (``method``, and ``active_samples`` in its record).
+    known: optima already found of some of ``objectives`` alone, by name (each of ``build(name, ())``, as
+        :func:`single_optimum` finds it, from at least ``anchor_starts`` starts and with the same
+        ``active_set``): such an anchor takes it as its first solve instead of solving again
+        (:func:`solve_anchor`), so that the front's end is that optimum.
 
     Anchors first: each objective is minimised, then (lexicographically) the others are minimised with it held
     at its optimum, so every anchor is non-dominated. The bounds on the other objectives are then spread
@@ -284,7 +296,10 @@ def pareto_front(
         points,
     )
     anchor_tasks = {
-        f"anchor-{name}": (solve_anchor, (build, name, names, ipopt_options, anchor_starts, active_set))
+        f"anchor-{name}": (
+            solve_anchor,
+            (build, name, names, ipopt_options, anchor_starts, active_set, (known or {}).get(name)),
+        )
         for name in names
     }
     anchors = sweep.run(anchor_tasks)
@@ -365,6 +380,15 @@ def single_optimum(
         failure = point.failures[0]
         raise SolverFailed(failure.message, failure.status, {}, [])
     return point.result, pieces.reused == 1
+
+
+def known_optima(objective: Hashable, optimum: DesignResult, anchor_starts: int) -> dict[str, DesignResult]:
+    """:func:`pareto_front`'s ``known`` from a study's optimum (of ``objective``, :data:`OPTIMUM_STARTS` starts).
+
+    The optimum is that objective's anchor's first solve when the objective is one of them (not a weighted sum)
+    and the anchors ask no more starts.
+    """
+    return {objective: optimum} if isinstance(objective, str) and anchor_starts <= OPTIMUM_STARTS else {}
 
 
 class _Sweep:
@@ -581,18 +605,21 @@ def solve_anchor(
     ipopt_options: IpoptOptions | None,
     starts: int = 1,
     active_set: str = "auto",
+    known: DesignResult | None = None,
 ) -> SweepPoint:
     """A Pareto anchor: ``objective`` minimised, then each other objective with it held at its optimum.
 
-    The first solve runs from ``starts`` start points; the lexicographic steps make the anchor non-dominated.
+    The first solve runs from ``starts`` start points, or is ``known``, an optimum of ``objective`` alone
+    found beforehand (:func:`anchor_start`); the lexicographic steps make the anchor non-dominated.
     A lexicographic step runs without retries, within :data:`LEXICOGRAPHIC_MAX_ITER` iterations; one that
     fails or stops early keeps the anchor found so far and is recorded among the failures. The first
     objective's anchor keeps its first solve as the start of the epsilon points (``SweepPoint.start``). On
     active sets (``active_set``, :func:`solve_with`) each step starts from the active samples of the last.
     """
     label = f"anchor: {objective}"
+    result = None if known is None else anchor_start(build, objective, _others(objectives, objective), known)
     try:
-        result = solve_with(
+        result = result or solve_with(
             build,
             objective,
             _others(objectives, objective),
@@ -621,6 +648,36 @@ def solve_anchor(
         except SolverFailed as error:
             failures.append(PointFailure(other, dict(held), error.status, str(error.args[0])))
     return SweepPoint(label, result, tuple(failures), start)
+
+
+def anchor_start(
+    build: ProblemBuilder, objective: str, bounded: tuple[str, ...], known: DesignResult
+) -> DesignResult | None:
+    """``known``, an optimum of ``build(objective, ())``, as a solution of the anchor's ``build(objective, bounded)``.
+
+    The anchor's problem is the same with rows that bound ``bounded`` (loose at the anchor), so the optimum is
+    its optimum: its multipliers are carried by row label (:func:`collision_reflex.optimize.solve.warm_start`,
+    a bound's at zero), on active sets those of its last NLP, for the epsilon points' warm starts. On the Panda
+    study this saves the anchor's own solve (108 IPOPT iterations) and makes the front's end the multi-started
+    optimum rather than a single start's. None when the two problems' variables differ (bounding the worst
+    case adds its epigraph variable): the anchor is then solved.
+    """
+    source, target = built_problem(build, objective, ()), built_problem(build, objective, bounded)
+    if known.x.size != target.x0.size:
+        return None
+    if isinstance(known, ActiveSetResult):
+        last = known.last_round
+        if last is None or last.multipliers is None:
+            return known
+        subset = sample_subset(target.samples, known.active_samples)
+        carried = warm_start(
+            subset_problem(build, objective, (), subset),
+            subset_problem(build, objective, bounded, subset),
+            last,
+            last.x,
+        )
+        return dataclasses.replace(known, last_round=carried)
+    return known if known.multipliers is None else warm_start(source, target, known, known.x)
 
 
 POINT_START_OPTIONS: dict[str, str | float] = {"ipopt.mu_init": 1e-4}

@@ -56,7 +56,7 @@ import numpy as np
 from ..errors import InvalidParameter, SolverFailed
 from .active_set import ACTIVE_SET_CHOICES, ActiveSetResult, solve_active_set, uses_active_set
 from .objectives import objective_expression
-from .solve import Design, DesignResult, IpoptOptions, solve
+from .solve import Design, DesignResult, IpoptOptions, solve, warm_start
 from .space import Bounds
 
 if TYPE_CHECKING:
@@ -873,30 +873,6 @@ def _parts_start(
             if i is not None:
                 start[i] = math.log(min(max(float(value), b.lower), b.upper))
     return built.exact_point(start)
-
-
-def warm_start(
-    problem: DesignProblem, built: DesignProblem, optimum: DesignResult, x0: np.ndarray
-) -> DesignResult:
-    """``optimum`` of ``problem`` as a warm start of ``built`` (a catalogue problem of it) from point ``x0``.
-
-    The multipliers carried over: of each design variable free in both (by name and joint), of the
-    auxiliaries (the same samples, in the same places after the design variables) and of each row by its
-    label; a row or variable ``problem`` does not have starts at zero. Both problems are scaled from their
-    own starts, so the multipliers are only near ``built``'s: measured on the shipped studies, scaling them
-    to ``built``'s objective and torque scales saved no iterations.
-    """
-    assert optimum.multipliers is not None
-    bounds, rows = optimum.multipliers
-    lam_x = np.zeros(built.x0.size)
-    for name, indices in built.layout.slices.items():
-        for i, k in zip(indices, problem.layout.slices[name], strict=True):
-            if i is not None and k is not None:
-                lam_x[i] = bounds[k]
-    lam_x[built.layout.size :] = bounds[problem.layout.size :]
-    where = {label: k for k, label in enumerate(problem.constraint_labels)}
-    lam_g = np.array([rows[where[label]] if label in where else 0.0 for label in built.constraint_labels])
-    return replace(optimum, x=x0, multipliers=(lam_x, lam_g))
 
 
 def solve_parts(

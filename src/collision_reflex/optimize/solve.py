@@ -5,7 +5,7 @@ from __future__ import annotations
 import time
 import warnings
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -442,6 +442,32 @@ def _start_point(problem: DesignProblem, x0: np.ndarray | DesignResult | None) -
     if array.shape != problem.x0.shape or not np.all(np.isfinite(array)):
         raise InvalidParameter("x0", point, allowed)
     return array
+
+
+def warm_start(
+    problem: DesignProblem, built: DesignProblem, optimum: DesignResult, x0: np.ndarray
+) -> DesignResult:
+    """``optimum`` of ``problem`` as a warm start of ``built`` from point ``x0``.
+
+    ``built`` has ``problem``'s samples and auxiliaries, its design variables a subset of ``problem``'s (a
+    catalogue problem fixes the motors) and rows matched by label (an objective bound ``problem`` lacks, say).
+    The multipliers carried over: of each design variable free in both (by name and joint), of the
+    auxiliaries (in the same places after the design variables) and of each row by its label; a row or
+    variable ``problem`` does not have starts at zero. Both problems are scaled from their own starts, so the
+    multipliers are only near ``built``'s: measured on the shipped studies' catalogue problems, scaling them
+    to ``built``'s objective and torque scales saved no iterations.
+    """
+    assert optimum.multipliers is not None
+    bounds, rows = optimum.multipliers
+    lam_x = np.zeros(built.x0.size)
+    for name, indices in built.layout.slices.items():
+        for i, k in zip(indices, problem.layout.slices[name], strict=True):
+            if i is not None and k is not None:
+                lam_x[i] = bounds[k]
+    lam_x[built.layout.size :] = bounds[problem.layout.size :]
+    where = {label: k for k, label in enumerate(problem.constraint_labels)}
+    lam_g = np.array([rows[where[label]] if label in where else 0.0 for label in built.constraint_labels])
+    return replace(optimum, x=x0, multipliers=(lam_x, lam_g))
 
 
 SCREENING_TOLERANCE = 1e-4

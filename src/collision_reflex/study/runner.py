@@ -283,7 +283,7 @@ def _run_arm(
     resumes (the snap as ``catalogue``, reused while the catalogue file and the settings are the same).
     """
     from ..errors import SolverFailed, StudyRunFailed
-    from ..optimize.pareto import OPTIMUM_STARTS, pareto_front, single_optimum
+    from ..optimize.pareto import OPTIMUM_STARTS, known_optima, pareto_front, single_optimum
     from ..report.verdict import verdict
     from .arm_setup import IPOPT_OPTIONS, StudyProblems
 
@@ -318,6 +318,7 @@ def _run_arm(
                 finished=folder.finished,
                 save=folder.save,
                 active_set=problems.active_set,
+                known=known_optima(problems.objective, optimum, study.pareto.anchor_starts),
             )
         except SolverFailed as error:
             raise StudyRunFailed(str(error.args[0]), "anchor", error.status) from None
