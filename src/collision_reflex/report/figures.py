@@ -99,7 +99,7 @@ def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
         featured[f"Pareto design {last}" + (f" (best {_words(names[1])})" if two else "")] = pareto["points"][
             -1
         ]
-    for index, (title, record) in enumerate(featured.items()):
+    for index, (title, record) in enumerate(_distinct_surfaces(featured).items()):
         draw = functools.partial(
             _surface,
             directions=directions,
@@ -131,6 +131,33 @@ def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
         ),
     )
     return svgs
+
+
+def _distinct_surfaces(featured: dict[str, dict[str, Any]]) -> dict[str, dict[str, Any]]:
+    """The featured designs with one surface each, in order.
+
+    A design whose impulse agrees with an earlier one's within :data:`collision_reflex.optimize.pareto.RESOLUTION`
+    at every sample draws the same picture: its title joins that design's instead (on the Panda study's flat
+    front the chosen design and the first Pareto design differ by 2e-5 at most).
+    """
+    from ..optimize.pareto import RESOLUTION
+
+    kept: list[tuple[list[str], dict[str, Any]]] = []
+    for title, record in featured.items():
+        impulses = np.asarray(record["impulses"], dtype=float)
+        same = next(
+            (
+                titles
+                for titles, other in kept
+                if np.allclose(impulses, other["impulses"], rtol=RESOLUTION, atol=0)
+            ),
+            None,
+        )
+        if same is None:
+            kept.append(([title], record))
+        else:
+            same.append(title)
+    return {" = ".join(titles): record for titles, record in kept}
 
 
 def has_duty_cycle(results: dict[str, Any]) -> bool:
