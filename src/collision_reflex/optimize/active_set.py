@@ -34,7 +34,6 @@ Two things depend on all samples and are handled as follows, never silently:
 from __future__ import annotations
 
 import time
-import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING, NamedTuple
@@ -45,8 +44,9 @@ import numpy as np
 from ..errors import InvalidParameter, SolverFailed
 from .constraints import torque_requirement_rows
 from .evaluate import design_collision_parameters, evaluate_design
+from .objectives import IMPULSE_OBJECTIVES, impulse_objectives
 from .samples import ContactSamples
-from .solve import AGREEMENT_TOLERANCE, DesignResult, IpoptOptions, design_at, solve
+from .solve import DesignResult, IpoptOptions, check_agreement, design_at, solve
 
 if TYPE_CHECKING:
     from .problem import DesignProblem
@@ -561,24 +561,9 @@ def _full_result(
 
     ``x`` is the full problem's point, ``impulses`` [N*s] the NumPy path's of every sample.
     """
-    evaluated = full.evaluate(x)
-    casadi_impulses = np.asarray(evaluated[0]).ravel()
-    objectives = {
-        **last.objectives,
-        "worst_case_impulse": float(casadi_impulses.max()),
-        "mean_impulse": float(casadi_impulses.mean()),
-    }
-    numpy_objectives = {
-        **last.numpy_objectives,
-        "worst_case_impulse": float(impulses.max()),
-        "mean_impulse": float(impulses.mean()),
-    }
-    for name in ("worst_case_impulse", "mean_impulse"):
-        a, b = objectives[name], numpy_objectives[name]
-        if abs(a - b) > AGREEMENT_TOLERANCE * max(abs(a), abs(b)):
-            warnings.warn(
-                f"CasADi and NumPy evaluations of {name} differ: {a!r} vs {b!r}", RuntimeWarning, stacklevel=3
-            )
+    objectives = {**last.objectives, **impulse_objectives(full.evaluate(x)[0])}
+    numpy_objectives = {**last.numpy_objectives, **impulse_objectives(impulses)}
+    check_agreement(objectives, numpy_objectives, IMPULSE_OBJECTIVES)
     return _replace(last, objectives=objectives, numpy_objectives=numpy_objectives, x=x, multipliers=None)
 
 

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..errors import Violation
 from .duty import duty_values
-from .objectives import OBJECTIVES
+from .objectives import OBJECTIVES, objective_values
 from .problem import DesignProblem
 
 FEASIBLE_VIOLATION = 1e-6
@@ -142,12 +142,7 @@ def physical_violations(
     evaluated = problem.evaluate(x)
     impulses, thresholds = (np.asarray(evaluated[i]).ravel() for i in (0, 3))
     required, peak = (np.asarray(evaluated[i]).ravel() for i in (4, 5))
-    objectives = {
-        "worst_case_impulse": float(impulses.max()),
-        "mean_impulse": float(impulses.mean()),
-        "actuator_mass": float(evaluated[1]),
-        "approach_velocity": float(evaluated[2]),
-    }
+    objectives = objective_values(impulses, evaluated[1], evaluated[2])
     duty = None
     if problem.duty is not None:
         from .solve import design_at  # solve imports this module

@@ -23,6 +23,9 @@ A worst case leaves the samples that do not bind it, and the joints that do not 
 small pull toward a lower mean picks a definite design among the equals and pins the per-sample auxiliary
 variables, at a cost of about this relative amount in the main objective."""
 
+IMPULSE_OBJECTIVES = ("worst_case_impulse", "mean_impulse")
+"""The objectives that are statistics of the per-sample collision impulses (:func:`impulse_objectives`)."""
+
 OBJECTIVES: dict[str, tuple[int, str, str]] = {
     # name: (sense: +1 minimise / -1 maximise, unit, description)
     "worst_case_impulse": (1, "N*s", "largest collision impulse over the samples"),
@@ -62,14 +65,29 @@ def objective_terms(impulses: ca.MX, actuator_mass: ca.MX, approach_velocity: ca
     }
 
 
+def impulse_objectives(impulses: np.ndarray) -> dict[str, float]:
+    """The impulse objectives of a design's per-sample impulses [N*s]: the largest and the mean."""
+    values = np.asarray(impulses, dtype=float).ravel()
+    return {"worst_case_impulse": float(values.max()), "mean_impulse": float(values.mean())}
+
+
+def objective_values(
+    impulses: np.ndarray, actuator_mass: float, approach_velocity: float
+) -> dict[str, float]:
+    """Every objective of :data:`OBJECTIVES` for a design.
+
+    From its per-sample impulses [N*s], total actuator mass [kg] and approach velocity [m/s].
+    """
+    return {
+        **impulse_objectives(impulses),
+        "actuator_mass": float(actuator_mass),
+        "approach_velocity": float(approach_velocity),
+    }
+
+
 def objective_scale(start_impulses: np.ndarray, start_mass: np.ndarray, velocity: float) -> dict[str, float]:
     """Each objective's value at the start (impulses [N*s], motor masses [kg], approach velocity [m/s])."""
-    return {
-        "worst_case_impulse": float(start_impulses.max()),
-        "mean_impulse": float(start_impulses.mean()),
-        "actuator_mass": float(start_mass.sum()),
-        "approach_velocity": float(velocity),
-    }
+    return objective_values(start_impulses, float(np.sum(start_mass)), velocity)
 
 
 def add_epigraph(

@@ -51,7 +51,7 @@ from .active_set import (
     uses_active_set,
 )
 from .blas import single_threaded_blas
-from .objectives import OBJECTIVES
+from .objectives import IMPULSE_OBJECTIVES, OBJECTIVES
 from .problem import DesignProblem
 from .results import PointFailure, SweepPoint, record_row, result_record
 from .serial import SerialExecutor
@@ -916,9 +916,6 @@ def recommend(optimum: DesignResult, front: ParetoSet | None, objective: Hashabl
     """
     return _lightest_alike(_best_design(optimum, front, objective), optimum, front, objective)
 
-
-IMPULSE_OBJECTIVES = ("worst_case_impulse", "mean_impulse")
-"""The objectives whose designs :func:`lightest_alike` ranks by mass within :data:`RESOLUTION`."""
 
 Alike = TypeVar("Alike")
 

@@ -55,7 +55,7 @@ import numpy as np
 
 from ..errors import InvalidParameter, SolverFailed
 from .active_set import ACTIVE_SET_CHOICES, ActiveSetResult, solve_active_set, uses_active_set
-from .objectives import objective_expression
+from .objectives import IMPULSE_OBJECTIVES, objective_expression, objective_values
 from .solve import Design, DesignResult, IpoptOptions, solve, warm_start
 from .space import Bounds
 
@@ -707,8 +707,6 @@ class _Search:
 
 def _impulse_objective(problem: DesignProblem | None) -> str | None:
     """The name of ``problem``'s objective when it is one impulse objective alone, else None."""
-    from .pareto import IMPULSE_OBJECTIVES
-
     names = [] if problem is None else list(problem.objective)
     return names[0] if len(names) == 1 and names[0] in IMPULSE_OBJECTIVES else None
 
@@ -1005,12 +1003,7 @@ def evaluate_parts(problem: DesignProblem, design: Design, parts: Sequence[Catal
         shortfalls += _below(
             "gearbox input speed limit", figures.max_input_speed, "the motor speed", speed, names, "rad/s"
         )
-    objectives = {
-        "worst_case_impulse": float(impulses.max()),
-        "mean_impulse": float(impulses.mean()),
-        "actuator_mass": float(masses.sum()),
-        "approach_velocity": float(snapped.approach_velocity),
-    }
+    objectives = objective_values(impulses, masses.sum(), snapped.approach_velocity)
     return PartsEvaluation(parts, snapped, objectives, required, tuple(shortfalls))
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import time
 import warnings
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any, NamedTuple
 
@@ -17,7 +17,7 @@ from .constraints import STATIC_REQUIREMENT
 from .duty import duty_values
 from .evaluate import evaluate_design
 from .feasibility import solve_feasibility
-from .objectives import OBJECTIVES
+from .objectives import OBJECTIVES, objective_values
 from .problem import DesignProblem
 
 IpoptOptions = Mapping[str, str | float]
@@ -572,26 +572,10 @@ def _result(
     """The result at ``x``, found by the last of ``attempts`` (IPOPT's ``stats``), all timed."""
     design = design_at(problem, x)
     evaluated = problem.evaluate(problem.exact_point(x))
-    impulses = np.asarray(evaluated[0]).ravel()
-    objectives = {
-        "worst_case_impulse": float(impulses.max()),
-        "mean_impulse": float(impulses.mean()),
-        "actuator_mass": float(evaluated[1]),
-        "approach_velocity": float(evaluated[2]),
-    }
+    objectives = objective_values(evaluated[0], evaluated[1], evaluated[2])
     numpy_impulses = evaluate_design(problem, design)
-    numpy_objectives = {
-        "worst_case_impulse": float(numpy_impulses.max()),
-        "mean_impulse": float(numpy_impulses.mean()),
-        "actuator_mass": float(design.actuator_mass.sum()),
-        "approach_velocity": float(design.approach_velocity),
-    }
-    for name in OBJECTIVES:
-        a, b = objectives[name], numpy_objectives[name]
-        if abs(a - b) > AGREEMENT_TOLERANCE * max(abs(a), abs(b)):
-            warnings.warn(
-                f"CasADi and NumPy evaluations of {name} differ: {a!r} vs {b!r}", RuntimeWarning, stacklevel=3
-            )
+    numpy_objectives = objective_values(numpy_impulses, design.actuator_mass.sum(), design.approach_velocity)
+    check_agreement(objectives, numpy_objectives, OBJECTIVES)
     required = np.asarray(evaluated[4]).ravel()
     duty: dict[str, Any] = {}
     if problem.duty is not None:
@@ -622,6 +606,22 @@ def _result(
         multipliers=multipliers,
         attempts=attempts,
     )
+
+
+def check_agreement(
+    objectives: Mapping[str, float], numpy_objectives: Mapping[str, float], names: Iterable[str]
+) -> None:
+    """Warn of each objective in ``names`` whose CasADi and NumPy values differ beyond the tolerance.
+
+    :data:`AGREEMENT_TOLERANCE` (relative): both evaluate the same closed forms, so a larger difference is a
+    modelling bug.
+    """
+    for name in names:
+        a, b = objectives[name], numpy_objectives[name]
+        if abs(a - b) > AGREEMENT_TOLERANCE * max(abs(a), abs(b)):
+            warnings.warn(
+                f"CasADi and NumPy evaluations of {name} differ: {a!r} vs {b!r}", RuntimeWarning, stacklevel=4
+            )
 
 
 def _margin(capacity: np.ndarray, need: np.ndarray) -> np.ndarray:

@@ -32,8 +32,6 @@ MARGINS = (("torque_margin", "peak torque"), ("rms_margin", "RMS torque"), ("spe
 """Per-joint margins of a design record (``peak / required - 1``) and the constraint each belongs to; a margin
 absent or ``None`` means the design has no such requirement."""
 
-IMPULSE_OBJECTIVES = ("worst_case_impulse", "mean_impulse")
-
 Position = Literal["lower", "upper", "fixed"] | None
 
 
@@ -217,6 +215,8 @@ def lightest_near_best(pareto: Mapping[str, Any], within: float = NEAR_BEST) -> 
 
     None when the front does not trade an impulse objective against the actuator mass, or is one design.
     """
+    from ..optimize.objectives import IMPULSE_OBJECTIVES
+
     names = pareto["objectives"]
     impulse = next((n for n in IMPULSE_OBJECTIVES if n in names), None)
     points = pareto["points"]
