@@ -217,3 +217,17 @@ def test_a_study_optimum_is_known_to_its_anchor_only_when_it_is_one_of_them():
     # More starts asked of the anchors than the optimum had, or a weighted objective: the anchors solve.
     assert pareto.known_optima("mean_impulse", optimum, pareto.OPTIMUM_STARTS + 1) == {}
     assert pareto.known_optima((("actuator_mass", 0.1), ("worst_case_impulse", 1.0)), optimum, 1) == {}
+
+
+def test_a_numpy_path_that_disagrees_with_casadi_is_warned_of(build, monkeypatch):
+    import importlib
+
+    solving = importlib.import_module("collision_reflex.optimize.solve")  # the module, not the function
+    problem = build("worst_case_impulse", ())
+    agreeing = cr.solve(problem)
+    # The NumPy path 1e-5 off (10 x AGREEMENT_TOLERANCE) in every impulse: both impulse objectives are named.
+    original = solving.evaluate_design
+    monkeypatch.setattr(solving, "evaluate_design", lambda p, d: original(p, d) * (1 + 1e-5))
+    with pytest.warns(RuntimeWarning, match="evaluations of worst_case_impulse differ") as caught:
+        cr.solve(problem, x0=agreeing.x)
+    assert {str(w.message).split()[5] for w in caught} == {"worst_case_impulse", "mean_impulse"}
