@@ -9,6 +9,7 @@ impulse of :mod:`collision_reflex.model.impulse`.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -134,8 +135,12 @@ def finger_mass_directions(
     return np.asarray(formulas.finger_mass_direction(samples.joint_moment_arms, structure))
 
 
+@functools.lru_cache(maxsize=8)
 def sample_function(n_joints: int, sensing: str, reaction: str, reflected_inertia_in: str) -> ca.Function:
-    """SX function of one contact sample.
+    """SX function of one contact sample, built once per process for each set of arguments.
+
+    Every problem of one arm (a study's objective, its anchors, its active-set rounds, each catalogue
+    combination) shares it: it holds no design or technology figure, only the model.
 
     Inputs: the design column (motor masses, reflected inertias, joint stiffnesses (n each), threshold,
     approach velocity), the finger-mass direction ``x`` (n, with ``w^T x = 1``), the reaction compliance ``c``
