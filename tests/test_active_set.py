@@ -23,23 +23,8 @@ case, 1e-9 in the full NLP's objective)."""
 
 
 @pytest.fixture(scope="module")
-def panda():
-    rng = np.random.default_rng(7)
-    arm = Arm.from_example_robot_data("panda")
-    samples = cr.ContactSamples.grid(
-        arm.kinematics(arm.sample_configurations(64, rng)), rng.normal(size=(4, 3))
-    )
-    space = cr.DesignSpace(
-        stator_diameter=(0.02, 0.15),
-        gear_ratio=(1.0, 100.0),
-        software_stiffness=(100.0, 1e4),
-        threshold=(5.0, 40.0),
-        approach_velocity=(0.05, 1.0),
-    )
-    technology = cr.ActuatorTechnology(
-        cr.reference_motor(), mechanical_stiffness=5000.0, reflected_inertia_in="finger"
-    )
-    constraints = cr.Constraints(payload=1.0, safety_factor=1.5, threshold_floor=5.0)
+def panda(panda_case):
+    arm, samples, space, technology, constraints = panda_case(64)
 
     def builder(objective, given=constraints, bounded=()):
         return lambda chosen: cr.build_problem(arm, chosen, space, technology, objective, given, bounded)

@@ -54,12 +54,8 @@ def _catalogue() -> list[cr.Motor]:
     return motors
 
 
-@pytest.fixture(scope="module")
-def two_link():
-    arm = Arm.from_urdf(TWO_LINK, "tip")
-    kinematics = arm.kinematics(arm.sample_configurations(3, np.random.default_rng(0)))
-    angles = np.linspace(0, 2 * np.pi, 6, endpoint=False) + 0.3
-    samples = cr.ContactSamples.grid(kinematics, np.c_[np.cos(angles), np.sin(angles)])
+def _two_link_inputs() -> tuple[cr.DesignSpace, cr.ActuatorTechnology, cr.Constraints]:
+    """The two-link snap problems' design space, technology (scaled reference motor) and given torques."""
     space = cr.DesignSpace(
         stator_diameter=(0.02, 0.12),
         gear_ratio=(1, 50),
@@ -68,7 +64,16 @@ def two_link():
         approach_velocity=(0.05, 1.0),
     )
     technology = cr.ActuatorTechnology(cr.reference_motor(), 1000.0)
-    constraints = cr.Constraints(torque_required=[2.0, 1.0], threshold_floor=0.5)
+    return space, technology, cr.Constraints(torque_required=[2.0, 1.0], threshold_floor=0.5)
+
+
+@pytest.fixture(scope="module")
+def two_link():
+    arm = Arm.from_urdf(TWO_LINK, "tip")
+    kinematics = arm.kinematics(arm.sample_configurations(3, np.random.default_rng(0)))
+    angles = np.linspace(0, 2 * np.pi, 6, endpoint=False) + 0.3
+    samples = cr.ContactSamples.grid(kinematics, np.c_[np.cos(angles), np.sin(angles)])
+    space, technology, constraints = _two_link_inputs()
     problem = cr.build_problem(arm, samples, space, technology, OBJECTIVE, constraints)
     optimum = cr.solve(problem, starts=4)
     return arm, problem, optimum
@@ -432,15 +437,7 @@ def many_samples():
     kinematics = arm.kinematics(arm.sample_configurations(12, np.random.default_rng(1)))
     angles = np.linspace(0, 2 * np.pi, 8, endpoint=False) + 0.3
     samples = cr.ContactSamples.grid(kinematics, np.c_[np.cos(angles), np.sin(angles)])
-    space = cr.DesignSpace(
-        stator_diameter=(0.02, 0.12),
-        gear_ratio=(1, 50),
-        software_stiffness=(5, 500),
-        threshold=(1, 10),
-        approach_velocity=(0.05, 1.0),
-    )
-    technology = cr.ActuatorTechnology(cr.reference_motor(), 1000.0)
-    constraints = cr.Constraints(torque_required=[2.0, 1.0], threshold_floor=0.5)
+    space, technology, constraints = _two_link_inputs()
 
     def build(subset):
         return cr.build_problem(arm, subset, space, technology, OBJECTIVE, constraints)
