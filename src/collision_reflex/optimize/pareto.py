@@ -618,17 +618,18 @@ def solve_anchor(
     """
     label = f"anchor: {objective}"
     result = None if known is None else anchor_start(build, objective, _others(objectives, objective), known)
-    try:
-        result = result or solve_with(
-            build,
-            objective,
-            _others(objectives, objective),
-            active_set,
-            ipopt_options=ipopt_options,
-            starts=starts,
-        )
-    except SolverFailed as error:
-        return SweepPoint(label, None, (PointFailure(objective, {}, error.status, str(error.args[0])),))
+    if result is None:
+        try:
+            result = solve_with(
+                build,
+                objective,
+                _others(objectives, objective),
+                active_set,
+                ipopt_options=ipopt_options,
+                starts=starts,
+            )
+        except SolverFailed as error:
+            return SweepPoint(label, None, (PointFailure(objective, {}, error.status, str(error.args[0])),))
     start = result if objective == objectives[0] else None
     held = {objective: anchor_bound(objective, result.objectives[objective])}
     failures = []
@@ -653,7 +654,7 @@ def solve_anchor(
 def anchor_start(
     build: ProblemBuilder, objective: str, bounded: tuple[str, ...], known: DesignResult
 ) -> DesignResult | None:
-    """``known``, an optimum of ``build(objective, ())``, as a solution of the anchor's ``build(objective, bounded)``.
+    """``known``, an optimum of ``build(objective, ())``, as a solution of ``build(objective, bounded)``.
 
     The anchor's problem is the same with rows that bound ``bounded`` (loose at the anchor), so the optimum is
     its optimum: its multipliers are carried by row label (:func:`collision_reflex.optimize.solve.warm_start`,
