@@ -77,6 +77,22 @@ def test_equal_within_tolerance_but_heavier_is_dominated():
     anchor = result(0.14728616 * (1 + ANCHOR_SLACK), 0.20009)
     found = recommend(optimum, front(anchor, result(0.1478, 0.0108)), "worst_case_impulse")
     assert found.pareto_index == 0 and "within the solver tolerance" in found.reason
+    # Labelled as the sweep labels it, the point is said to be the objective's anchor: the expected way a
+    # front's end beats the optimum (its mass minimised with the impulse held).
+    labelled = ParetoSet(
+        NAMES,
+        (anchor, result(0.1478, 0.0108)),
+        labels=("anchor: worst_case_impulse", "anchor: actuator_mass"),
+    )
+    found = recommend(optimum, labelled, "worst_case_impulse")
+    assert found.reason.startswith(
+        "Pareto design 0 (the anchor of worst case impulse: it minimised, then the other objectives with it held)"
+        " dominates the single-objective optimum"
+    )
+    assert (
+        "anchor of"
+        not in recommend(optimum, front(anchor, result(0.1478, 0.0108)), "worst_case_impulse").reason
+    )
 
 
 def test_an_optimum_that_is_a_front_point_is_that_point():

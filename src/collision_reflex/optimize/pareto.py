@@ -1016,11 +1016,20 @@ def _best_design(optimum: DesignResult, front: ParetoSet | None, objective: Hash
             f"{OBJECTIVES[name][1]}"
             for name in judged
         )
+        # The study objective's anchor minimises it, then the other objectives with it held: said so, as that
+        # is the expected way a front's end beats a single-objective optimum (lighter at the same impulse).
+        anchor = index < len(front.labels) and front.labels[index] == f"anchor: {objective}"
+        words = str(objective).replace("_", " ")
+        held = (
+            f" (the anchor of {words}: it minimised, then the other objectives with it held)"
+            if anchor
+            else ""
+        )
         return Recommendation(
             front.points[index],
             index,
-            f"Pareto design {index} dominates the single-objective optimum (within the solver tolerance, "
-            f"{MERGE_TOLERANCE:g} relative: {gaps})",
+            f"Pareto design {index}{held} dominates the single-objective optimum (within the solver "
+            f"tolerance, {MERGE_TOLERANCE:g} relative: {gaps})",
         )
     return Recommendation(optimum, None, "the single-objective optimum; no Pareto design dominates it")
 
