@@ -143,9 +143,23 @@ def test_oversized_joints_are_warned_unless_their_motor_is_smallest():
     smallest = joint("elbow", diameter=0.03, margin=25.0)
     warnings = oversized_warnings(record(joints=[big, smallest]), BOUNDS)
     assert len(warnings) == 1 and warnings[0].startswith("Warning: shoulder delivers 3.5× its required peak")
-    # The smallest motor's excess is said as such, not warned about.
+    # The smallest motor's excess is said as such, not warned about: at N = 50 it is 26x, and 26 x 10/50 = 5.2x
+    # still at the lowest ratio.
+    assert (
+        "peak torque 26× its requirement at N = 50 (5.2× at its lowest ratio, 10): even the smallest motor is "
+        "more than it needs" in joint_limits(smallest, BOUNDS, "static (gravity only)")
+    )
+    # At its lowest ratio already: the motor alone.
+    lowest = joint("elbow", diameter=0.03, ratio=10.0, margin=25.0)
     assert "peak torque 26× its requirement: even the smallest motor is more than it needs" in joint_limits(
-        smallest, BOUNDS, "static (gravity only)"
+        lowest, BOUNDS, "static (gravity only)"
+    )
+    # 26x at N = 150 is 1.7x at N = 10: the ratio the objective chose gives the excess, not the motor.
+    geared = joint("elbow", diameter=0.03, ratio=150.0, margin=25.0)
+    assert (
+        "peak torque 26× its requirement at N = 150, the ratio the objective chose (1.73× at its lowest ratio, "
+        "10): the gear ratio, not the motor, gives the excess"
+        in joint_limits(geared, BOUNDS, "static (gravity only)")
     )
     assert oversized_warnings(record(joints=[joint(margin=1.9)]), BOUNDS) == []
 

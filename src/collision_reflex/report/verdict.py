@@ -104,10 +104,30 @@ def joint_limits(joint: Mapping[str, Any], bounds: Mapping[str, Any], requiremen
             phrases.append(f"sized by {constraint}")
     margin = joint.get("torque_margin")
     if margin is not None and margin > OVERSIZED_MARGIN and motor_at_smallest_size(joint, bounds):
-        phrases.append(
-            f"peak torque {_g(1 + margin, 3)}× its requirement: even the smallest motor is more than it needs"
-        )
+        phrases.append(_smallest_motor_excess(joint, bounds["gear_ratio"][name], 1 + margin))
     return phrases
+
+
+def _smallest_motor_excess(joint: Mapping[str, Any], ratio_bounds: Sequence[float], multiple: float) -> str:
+    """Why a joint at its smallest motor has ``multiple`` times its required peak torque, in words.
+
+    The motor itself, or the gear ratio the objective chose: the peak torque grows with the ratio, which the
+    collision reflex may want higher (a harder braking torque ``N tau_p``) than the motion needs.
+    """
+    ratio, lowest = float(joint["gear_ratio"]), float(ratio_bounds[0])
+    said = f"peak torque {_g(multiple, 3)}× its requirement"
+    if bound_position(ratio, ratio_bounds) in ("lower", "fixed"):
+        return f"{said}: even the smallest motor is more than it needs"
+    at_lowest = multiple * lowest / ratio
+    if at_lowest > 1 + OVERSIZED_MARGIN:
+        return (
+            f"{said} at N = {_g(ratio)} ({_g(at_lowest, 3)}× at its lowest ratio, {_g(lowest)}): even the "
+            "smallest motor is more than it needs"
+        )
+    return (
+        f"{said} at N = {_g(ratio)}, the ratio the objective chose ({_g(at_lowest, 3)}× at its lowest ratio, "
+        f"{_g(lowest)}): the gear ratio, not the motor, gives the excess"
+    )
 
 
 def design_limits(record: Mapping[str, Any], bounds: Mapping[str, Any]) -> list[str]:
