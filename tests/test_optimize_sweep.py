@@ -231,3 +231,15 @@ def test_a_numpy_path_that_disagrees_with_casadi_is_warned_of(build, monkeypatch
     with pytest.warns(RuntimeWarning, match="evaluations of (worst_case|mean)_impulse differ") as caught:
         cr.solve(problem, x0=agreeing.x)
     assert {str(w.message).split()[5] for w in caught} == {"worst_case_impulse", "mean_impulse"}
+
+
+def test_a_known_optimum_of_another_problem_is_refused(build):
+    # A result whose objectives are not this problem's at its point, as another problem's would be (its
+    # recorded mass doubled here): refused, not taken as the anchor.
+    optimum = cr.solve(build("worst_case_impulse", ()))
+    stranger = dataclasses.replace(
+        optimum, objectives={**optimum.objectives, "actuator_mass": 2 * optimum.objectives["actuator_mass"]}
+    )
+    with pytest.raises(cr.InvalidParameter, match="known optimum of worst_case_impulse"):
+        pareto.anchor_start(build, NAMES[0], NAMES[1:], stranger)
+    assert pareto.anchor_start(build, NAMES[0], NAMES[1:], optimum) is not None

@@ -51,7 +51,7 @@ from .active_set import (
     uses_active_set,
 )
 from .blas import single_threaded_blas
-from .objectives import IMPULSE_OBJECTIVES, OBJECTIVES
+from .objectives import IMPULSE_OBJECTIVES, OBJECTIVES, objective_values
 from .problem import DesignProblem
 from .results import PointFailure, SweepPoint, record_row, result_record
 from .serial import SerialExecutor
@@ -662,10 +662,23 @@ def anchor_start(
     study this saves the anchor's own solve (108 IPOPT iterations) and makes the front's end the multi-started
     optimum rather than a single start's. None when the two problems' variables differ (bounding the worst
     case adds its epigraph variable): the anchor is then solved.
+
+    Raises
+    ------
+    InvalidParameter: ``known`` is not a point of this problem (its objectives there are not its own).
     """
     source, target = built_problem(build, objective, ()), built_problem(build, objective, bounded)
     if known.x.size != target.x0.size:
         return None
+    evaluated = target.evaluate(target.exact_point(known.x))
+    found = objective_values(evaluated[0], evaluated[1], evaluated[2])
+    if not same_point(found, known.objectives, tuple(OBJECTIVES)):  # the same model at the same point: ~1e-15
+        raise InvalidParameter(
+            f"known optimum of {objective}",
+            {name: known.objectives[name] for name in OBJECTIVES},
+            f"a result of this sweep's problem (its objectives at that point are {found})",
+            "pass the optimum single_optimum found with the same builder",
+        )
     if isinstance(known, ActiveSetResult):
         last = known.last_round
         if last is None or last.multipliers is None:
