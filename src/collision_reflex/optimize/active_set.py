@@ -34,7 +34,8 @@ Two things depend on all samples and are handled as follows, never silently:
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Mapping
+from collections import OrderedDict
+from collections.abc import Callable, Hashable, Mapping
 from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING, NamedTuple
 
@@ -192,6 +193,34 @@ def sample_subset(samples: ContactSamples, index: np.ndarray) -> ContactSamples:
     index = np.asarray(index, dtype=int)
     labels = tuple(samples.labels[i] for i in index) if samples.labels else ()
     return ContactSamples(samples.kinematics, samples.directions[index], samples.config_index[index], labels)
+
+
+SUBSET_PROBLEMS = 4
+"""Problems on subsets of the samples kept per process (with their solvers), the last used kept longest: every
+epsilon point's first active set is the first anchor's, and every catalogue combination of a snap warm-starts
+from the continuous problem on the optimum's last active samples, so each is built once per process."""
+_SUBSETS: OrderedDict[tuple[Hashable, ...], tuple[object, DesignProblem]] = OrderedDict()
+
+
+def kept_problem(
+    key: tuple[Hashable, ...],
+    samples: ContactSamples,
+    build: Callable[[], DesignProblem],
+    holds: object = None,
+) -> DesignProblem:
+    """``build()``, a problem on ``samples``, built once per process for ``key`` and those samples.
+
+    The last :data:`SUBSET_PROBLEMS` are kept. ``holds``: an object that ``key`` names by its ``id``, kept with
+    the problem so that its id is not another object's while the entry lives.
+    """
+    full_key = (*key, samples.config_index.tobytes(), samples.directions.tobytes())
+    kept = _SUBSETS.get(full_key)
+    if kept is None or kept[0] is not holds:
+        kept = _SUBSETS[full_key] = (holds, build())
+        while len(_SUBSETS) > SUBSET_PROBLEMS:
+            _SUBSETS.popitem(last=False)
+    _SUBSETS.move_to_end(full_key)
+    return kept[1]
 
 
 def solve_active_set(

@@ -33,7 +33,6 @@ import os
 import threading
 import time
 import warnings
-from collections import OrderedDict
 from collections.abc import Callable, Hashable, Iterable, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Executor, Future, wait
 from dataclasses import dataclass
@@ -46,6 +45,7 @@ from ..errors import InvalidParameter, SolverFailed
 from .active_set import (
     ACTIVE_SET_CHOICES,
     ActiveSetResult,
+    kept_problem,
     sample_subset,
     solve_active_set,
     uses_active_set,
@@ -506,12 +506,6 @@ def warm_started_points(names: Sequence[str]) -> bool:
     return "approach_velocity" not in names[1:]
 
 
-SUBSET_PROBLEMS = 4
-"""Problems on subsets of the samples kept per process (with their solvers): every epsilon point's first
-active set is the first anchor's, so its problem is built once per process."""
-_SUBSETS: OrderedDict[tuple[Hashable, ...], DesignProblem] = OrderedDict()
-
-
 def takes_samples(build: Hashable) -> bool:
     """Whether ``build`` accepts ``build(objective, bounded, samples)`` (it can build on active sets)."""
     try:
@@ -535,16 +529,12 @@ def _check_active_set(build: Hashable, active_set: str) -> None:
 def subset_problem(
     build: Hashable, objective: Hashable, bounded: tuple[str, ...], samples: ContactSamples
 ) -> DesignProblem:
-    """``build(objective, bounded, samples)``, the last :data:`SUBSET_PROBLEMS` kept per process."""
-    key = (build, objective, bounded, samples.config_index.tobytes(), samples.directions.tobytes())
-    problem = _SUBSETS.get(key)
-    if problem is None:
-        problem = build(objective, bounded, samples)  # type: ignore[operator]
-        _SUBSETS[key] = problem
-        while len(_SUBSETS) > SUBSET_PROBLEMS:
-            _SUBSETS.popitem(last=False)
-    _SUBSETS.move_to_end(key)
-    return problem
+    """``build(objective, bounded, samples)``, kept per process (:func:`~.active_set.kept_problem`)."""
+    return kept_problem(
+        (build, objective, bounded),
+        samples,
+        lambda: build(objective, bounded, samples),  # type: ignore[operator]
+    )
 
 
 def solve_with(

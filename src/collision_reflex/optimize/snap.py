@@ -47,7 +47,6 @@ from __future__ import annotations
 import functools
 import itertools
 import math
-from collections import OrderedDict
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
@@ -55,7 +54,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import InvalidParameter, SolverFailed
-from .active_set import ACTIVE_SET_CHOICES, ActiveSetResult, solve_active_set, uses_active_set
+from .active_set import (
+    ACTIVE_SET_CHOICES,
+    ActiveSetResult,
+    kept_problem,
+    solve_active_set,
+    uses_active_set,
+)
 from .objectives import IMPULSE_OBJECTIVES, objective_expression, objective_values
 from .solve import Design, DesignResult, IpoptOptions, solve, warm_start
 from .space import Bounds
@@ -815,37 +820,34 @@ def _warm_startable(problem: DesignProblem, optimum: DesignResult, active_set: s
 
 def _warm_round(
     problem: DesignProblem, optimum: ActiveSetResult, parts: Sequence[CataloguePart], arm: Arm, x0: np.ndarray
-) -> tuple[ActiveSetResult, DesignProblem]:
+) -> ActiveSetResult:
     """``optimum`` as the warm start of ``parts``' active-set solve from ``x0`` (a point of the full problem).
 
     Its last NLP's point and multipliers are carried (:func:`warm_start`) to the parts' problem on the same
-    samples, started at ``x0``'s design with those samples' auxiliaries at their exact values. Returns the warm
-    start and that problem (the first round's).
+    samples (the solve's first round, :func:`_catalogue_on`), started at ``x0``'s design with those samples'
+    auxiliaries at their exact values.
     """
     from .active_set import sample_subset
 
     subset = sample_subset(problem.samples, optimum.active_samples)
     solved_on = _subset_problem(problem, arm, subset)
-    built = catalogue_problem(problem, parts, arm, subset)
+    built = _catalogue_on(problem, parts, arm, subset)
     n_design = built.layout.size
     start = built.exact_point(np.concatenate([x0[:n_design], built.x0[n_design:]]))
     assert optimum.last_round is not None  # _warm_startable
-    return replace(optimum, x=x0, last_round=warm_start(solved_on, built, optimum.last_round, start)), built
-
-
-_SUBSET_PROBLEMS: OrderedDict[tuple[int, bytes, bytes], tuple[DesignProblem, DesignProblem]] = OrderedDict()
-"""The last few continuous problems rebuilt on a subset of their samples, by problem and samples: the same for
-every combination of one snap (measured on the UR5 study: one build instead of 17, 30-40 ms each)."""
+    return replace(optimum, x=x0, last_round=warm_start(solved_on, built, optimum.last_round, start))
 
 
 def _subset_problem(problem: DesignProblem, arm: Arm, subset: ContactSamples) -> DesignProblem:
-    """``problem`` on the samples ``subset`` (its other inputs the same), built once per process and subset."""
+    """``problem`` on the samples ``subset`` (its other inputs the same), built once per process and subset.
+
+    The same for every combination of one snap (measured on the UR5 study: one build instead of 17, 30-40 ms
+    each).
+    """
     from .problem import build_problem
 
-    key = (id(problem), subset.config_index.tobytes(), subset.directions.tobytes())
-    kept = _SUBSET_PROBLEMS.get(key)
-    if kept is None or kept[0] is not problem:  # the problem itself is kept: its id is not reused meanwhile
-        built = build_problem(
+    def build() -> DesignProblem:
+        return build_problem(
             arm,
             subset,
             problem.space,
@@ -854,10 +856,19 @@ def _subset_problem(problem: DesignProblem, arm: Arm, subset: ContactSamples) ->
             problem.constraints,
             problem.bounded_objectives,
         )
-        kept = _SUBSET_PROBLEMS[key] = (problem, built)
-        while len(_SUBSET_PROBLEMS) > 4:
-            _SUBSET_PROBLEMS.popitem(last=False)
-    return kept[1]
+
+    return kept_problem(("continuous", id(problem)), subset, build, holds=problem)
+
+
+def _catalogue_on(
+    problem: DesignProblem, parts: Sequence[CataloguePart], arm: Arm, samples: ContactSamples
+) -> DesignProblem:
+    """:func:`catalogue_problem` on ``samples`` (an active set's round), built once per process.
+
+    The warm start's first round (:func:`_warm_round`) is then the solve's own, not built twice.
+    """
+    key = ("catalogue", id(problem), *((p.label, p.gear_ratio.lower, p.gear_ratio.upper) for p in parts))
+    return kept_problem(key, samples, lambda: catalogue_problem(problem, parts, arm, samples), holds=problem)
 
 
 def _parts_start(
@@ -933,15 +944,11 @@ def solve_parts(
         and optimum.impulses.size == built.samples.size
     ):
         initial = optimum.active_samples
-    build: Callable[[ContactSamples], DesignProblem] = functools.partial(
-        catalogue_problem, problem, parts, arm
-    )
     first: ActiveSetResult | None = None
     if warm and isinstance(optimum, ActiveSetResult):
-        first, first_round = _warm_round(problem, optimum, parts, arm, x0)
-        build = _reusing(build, first_round)
+        first = _warm_round(problem, optimum, parts, arm, x0)
     return solve_active_set(
-        build,
+        functools.partial(_catalogue_on, problem, parts, arm),
         built.samples,
         ipopt_options=ipopt_options,
         initial=initial,
@@ -949,20 +956,6 @@ def solve_parts(
         full=built,
         warm=first,
     )
-
-
-def _reusing(
-    build: Callable[[ContactSamples], DesignProblem], built: DesignProblem
-) -> Callable[[ContactSamples], DesignProblem]:
-    """``build``, giving ``built`` itself for ``built``'s own samples (a problem already made, not made again)."""
-
-    def reuse(samples: ContactSamples) -> DesignProblem:
-        same = np.array_equal(samples.config_index, built.samples.config_index) and np.array_equal(
-            samples.directions, built.samples.directions
-        )
-        return built if same else build(samples)
-
-    return reuse
 
 
 @dataclass(frozen=True)
