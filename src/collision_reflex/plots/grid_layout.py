@@ -12,6 +12,7 @@ figure, so the figure is saved whole, without a tight bounding box.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from typing import Any
 
@@ -54,12 +55,7 @@ def lay_out_grid(
     from matplotlib import rcParams
 
     rows, columns = shape
-
-    def size(artist: Any) -> tuple[float, float]:
-        return extent(fig, artist)
-
-    def text_size(text: str, fontsize: Any) -> tuple[float, float]:
-        return extent(fig, text, fontsize)
+    size = functools.partial(extent, fig)  # of an artist, or of a string at a font size [pt]
 
     heading = size(suptitle)
     legend = (
@@ -71,7 +67,7 @@ def lay_out_grid(
     below = (
         rcParams["xtick.major.size"]
         + rcParams["xtick.major.pad"]
-        + text_size("0123456789", rcParams["xtick.labelsize"])[1]
+        + size("0123456789", rcParams["xtick.labelsize"])[1]
         + rcParams["axes.labelpad"]
         + max(size(ax.xaxis.label)[1] for ax in axes)
     )
@@ -88,11 +84,11 @@ def lay_out_grid(
     left_of = (
         max(size(ax.yaxis.label)[0] for ax in axes)
         + rcParams["axes.labelpad"]
-        + max(_widest_y_tick_label(ax, text_size) for ax in axes)
+        + max(_widest_y_tick_label(ax, size) for ax in axes)
         + rcParams["ytick.major.pad"]
         + rcParams["ytick.major.size"]
     )
-    right_of = text_size("0" * TICK_LABEL_DIGITS, rcParams["xtick.labelsize"])[0] / 2
+    right_of = size("0" * TICK_LABEL_DIGITS, rcParams["xtick.labelsize"])[0] / 2
     nominal = columns * cell[0] * 72 - 2 * EDGE - (columns - 1) * SPACE
     axes_width = nominal / columns - left_of - right_of
     # A title wider than its subplot reaches as far into the margins on either side (centred).
@@ -114,12 +110,12 @@ def lay_out_grid(
         legend_below.set_bbox_to_anchor((0.5, EDGE / height), transform=fig.transFigure)
 
 
-def _widest_y_tick_label(ax: Any, text_size: Any) -> float:
+def _widest_y_tick_label(ax: Any, size: Any) -> float:
     """Width [pt] of the widest major y tick label ``ax`` draws at its present limits and height."""
     from matplotlib import rcParams
 
     labels = ax.yaxis.get_major_formatter().format_ticks(ax.yaxis.get_majorticklocs())
-    return max((text_size(label, rcParams["ytick.labelsize"])[0] for label in labels), default=0.0)
+    return max((size(label, rcParams["ytick.labelsize"])[0] for label in labels), default=0.0)
 
 
 def extent(fig: Any, artist: Any, fontsize: Any = None) -> tuple[float, float]:
