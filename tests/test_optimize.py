@@ -13,6 +13,7 @@ from collision_reflex.arm import Arm
 from collision_reflex.optimize import hypervolume
 from collision_reflex.optimize.evaluate import evaluate_design
 from collision_reflex.optimize.objectives import TIE_BREAK_WEIGHT
+from collision_reflex.optimize.results import undecided_variables
 from collision_reflex.optimize.solve import design_at
 
 TWO_LINK = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
@@ -672,3 +673,43 @@ def test_a_single_contact_sample_is_a_problem_like_any_other():
     assert result.objectives["worst_case_impulse"] == pytest.approx(
         result.numpy_objectives["worst_case_impulse"], rel=1e-6
     )
+
+
+def test_undecided_variables_are_the_ones_no_impulse_or_mass_depends_on(arm):
+    """Contact forces along link 2 through the tip exert no torque about joint 2: its gear ratio and software
+    stiffness change no impulse (and not the mass) anywhere in their bounds, and only they are undecided. Checked
+    against values the probes never try, and against every other free variable moving some impulse."""
+    q = np.array([[0.4, 0.9]])
+    along = np.array([np.cos(1.3), np.sin(1.3)])  # link 2's direction at q1 + q2 = 1.3 rad
+    samples = cr.ContactSamples.grid(arm.kinematics(q), np.stack([along, -along, [0.0, 1.0]]))
+    constraints = cr.Constraints(torque_required=[1.0, 0.5], threshold_floor=0.5)
+    problem = cr.build_problem(arm, samples, FREE_SPACE, _technology(), "worst_case_impulse", constraints)
+    result = cr.solve(problem)
+    # The third direction loads joint 2: nothing is undecided.
+    assert undecided_variables(problem, result.x) == []
+
+    radial = cr.ContactSamples.grid(arm.kinematics(q), np.stack([along, -along]))
+    assert np.abs(radial.joint_moment_arms[:, 1]).max() < 1e-12 * np.abs(radial.joint_moment_arms).max()
+    problem = cr.build_problem(arm, radial, FREE_SPACE, _technology(), "worst_case_impulse", constraints)
+    result = cr.solve(problem)
+    found = undecided_variables(problem, result.x)
+    assert found == [("gear_ratio", 1), ("software_stiffness", 1)]
+
+    base = _numpy_impulses(problem, result.x[: problem.layout.size])
+    rng = np.random.default_rng(7)
+    for name, joint in found:
+        k = problem.layout.slices[name][joint]
+        for value in rng.uniform(problem.lbx[k], problem.ubx[k], 3):
+            z = result.x[: problem.layout.size].copy()
+            z[k] = value
+            np.testing.assert_allclose(_numpy_impulses(problem, z), base, rtol=1e-12)
+    for name, indices in problem.layout.slices.items():
+        for joint, k in enumerate(indices):
+            if k is None or (name, joint) in found or problem.lbx[k] == problem.ubx[k]:
+                continue
+            changes = []
+            for value in (problem.lbx[k], problem.ubx[k]):
+                z = result.x[: problem.layout.size].copy()
+                z[k] = value
+                changes.append(np.max(np.abs(_numpy_impulses(problem, z) / base - 1)))
+            assert max(changes) > 1e-6, (name, joint)

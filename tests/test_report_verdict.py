@@ -13,6 +13,7 @@ from collision_reflex.report.verdict import (
     lightest_near_best,
     objective_spans,
     oversized_warnings,
+    undecided_sentence,
     verdict,
 )
 
@@ -186,3 +187,49 @@ def test_the_verdict_opens_with_the_recommended_design():
     assert "elbow: no torque requirement: static gravity-only requirement is zero for this joint." in lines
     assert "Sensing and approach: threshold at its lower bound (1)." in lines
     assert any(line.startswith("Lightest design within 5 %") for line in lines)
+
+
+def test_variables_no_objective_decides_are_said_so_and_not_called_a_choice():
+    """A joint no sample loads (its gear ratio and software stiffness undecided): the verdict gives their values
+    as the solver's start, not the objective's choice; a decided ratio keeps its sentence."""
+    wrist = joint("elbow", diameter=0.03, ratio=67.0, stiffness=387.3, margin=93.4)
+    recommended = {
+        **record(joints=[joint(margin=0.0), wrist]),
+        "source": "optimum",
+        "reason": "",
+        "undecided": [
+            {"variable": "gear_ratio", "joint": "elbow"},
+            {"variable": "software_stiffness", "joint": "elbow"},
+        ],
+    }
+    results = {
+        "chosen": record(),
+        "recommended": recommended,
+        "pareto": pareto([]),
+        "bounds": BOUNDS,
+        "requirement": "duty cycle (peak, RMS, speed)",
+    }
+    (line,) = [line for line in verdict(results) if line.startswith("elbow:")]
+    # 94.4x at N = 67 is 14.1x at N = 10: the motor, not the ratio, is more than the joint needs.
+    assert line == (
+        "elbow: motor at its smallest size, peak torque 94.4× its requirement at N = 67 (14.1× at its lowest "
+        "ratio, 10): even the smallest motor is more than it needs. Its gear ratio (67) and software stiffness "
+        "(387.3 N·m/rad) change no impulse and not the actuator mass anywhere within their bounds, as no contact "
+        "sample loads this joint: no objective decides them, and they are where the solver started; choose them "
+        "on grounds this study does not model."
+    )
+    # An undecided ratio whose excess at its lowest ratio is small: not "the ratio the objective chose".
+    geared = joint("elbow", diameter=0.03, ratio=150.0, margin=25.0)
+    decided = joint_limits(geared, BOUNDS, "static (gravity only)")
+    assert "the ratio the objective chose" in decided[-1]
+    (undecided,) = [
+        p for p in joint_limits(geared, BOUNDS, "static (gravity only)", ["gear_ratio"]) if "peak torque" in p
+    ]
+    assert undecided == "peak torque 26× its requirement at N = 150 (1.73× at its lowest ratio, 10)"
+    assert undecided_sentence(geared, ["gear_ratio"]) == (
+        "Its gear ratio (150) changes no impulse and not the actuator mass anywhere within its bounds: no "
+        "objective decides it, and it is where the solver started; choose it on grounds this study does not model."
+    )
+    # A record written before the field existed reads as nothing undecided.
+    del recommended["undecided"]
+    assert not any("no objective decides" in line for line in verdict(results))

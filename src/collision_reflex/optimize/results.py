@@ -369,6 +369,61 @@ def design_record(
     return record
 
 
+UNDECIDED_TOLERANCE = 1e-9
+"""Largest relative change of any sample's impulse, and of the actuator mass, with which a design variable
+moved over its bounds decides nothing (:func:`undecided_variables`): far below the solver's tolerance (1e-8 on
+its scaled optimality error, about 1e-7 on the objectives), far above round-off."""
+UNDECIDED_PROBES = 5
+"""Values per variable tried by :func:`undecided_variables`: its bounds first, then evenly spaced in between (in
+its logarithm, as the optimiser sees it)."""
+
+
+def undecided_variables(problem: DesignProblem, x: np.ndarray) -> list[tuple[str, int | None]]:
+    """The design variables of ``x`` that no objective decides, as ``(variable, joint index)`` pairs.
+
+    Moving one anywhere within its bounds, with the rest of the design held, changes no sample's impulse and not
+    the actuator mass. The objectives (every impulse statistic, the actuator mass and the approach velocity) then take the same
+    values whatever the variable is, so the optimiser leaves it where its start put it. A joint that no contact
+    sample loads (its axis through every contact point, as a last wrist joint's often is) has such a software
+    stiffness and gear ratio. Each free variable (bounds not equal) is tried at :data:`UNDECIDED_PROBES` values,
+    the bounds first, and counts as undecided when every change is within :data:`UNDECIDED_TOLERANCE` (NumPy
+    path, :func:`collision_reflex.optimize.evaluate.evaluate_design`). The joint index is None for a global
+    variable (threshold, approach velocity).
+    """
+    from .evaluate import evaluate_design
+    from .solve import design_at
+    from .space import GLOBAL_VARIABLES
+
+    x = np.asarray(x, dtype=float)
+
+    def outcome(point: np.ndarray) -> tuple[np.ndarray, float]:
+        design = design_at(problem, point)
+        with np.errstate(all="ignore"):
+            return evaluate_design(problem, design), float(np.sum(design.actuator_mass))
+
+    impulses, mass = outcome(x)
+
+    def unchanged(index: int, value: float) -> bool:
+        moved = x.copy()
+        moved[index] = value
+        other_impulses, other_mass = outcome(moved)
+        return bool(
+            np.all(np.abs(other_impulses - impulses) <= UNDECIDED_TOLERANCE * np.abs(impulses))
+            and abs(other_mass - mass) <= UNDECIDED_TOLERANCE * abs(mass)
+        )
+
+    found: list[tuple[str, int | None]] = []
+    for name, indices in problem.layout.slices.items():
+        for joint, index in enumerate(indices):
+            if index is None or problem.lbx[index] == problem.ubx[index]:
+                continue
+            inner = np.linspace(problem.lbx[index], problem.ubx[index], UNDECIDED_PROBES)
+            values = [inner[0], inner[-1], *inner[1:-1]]
+            if all(unchanged(index, float(value)) for value in values):
+                found.append((name, None if name in GLOBAL_VARIABLES else joint))
+    return found
+
+
 def nearest_catalogue_motor(catalogue: Mapping[str, Motor], peak_torque: float, rotor_inertia: float) -> str:
     """The catalogue motor closest to a scaled motor (peak torque [N*m], rotor inertia [kg*m^2]).
 

@@ -77,8 +77,14 @@ def motor_at_smallest_size(joint: Mapping[str, Any], bounds: Mapping[str, Any]) 
     return all(p in ("lower", "fixed") for p in positions) and "lower" in positions
 
 
-def joint_limits(joint: Mapping[str, Any], bounds: Mapping[str, Any], requirement: str) -> list[str]:
-    """The bounds and constraints that are active on one joint of a design record, in words."""
+def joint_limits(
+    joint: Mapping[str, Any], bounds: Mapping[str, Any], requirement: str, undecided: Sequence[str] = ()
+) -> list[str]:
+    """The bounds and constraints that are active on one joint of a design record, in words.
+
+    ``undecided``: the joint's design variables that no objective decides (the record's ``undecided``; an
+    undecided gear ratio is not called the objective's choice, :func:`undecided_sentence` says what it is).
+    """
     name = joint["joint"]
     size = {key: bound_position(joint[key], bounds[key][name]) for key in ("stator_diameter", "stack_length")}
     phrases = []
@@ -103,39 +109,77 @@ def joint_limits(joint: Mapping[str, Any], bounds: Mapping[str, Any], requiremen
         if margin is not None and margin < ACTIVE_TOLERANCE:
             phrases.append(f"sized by {constraint}")
     margin = joint.get("torque_margin")
+    chosen_ratio = "gear_ratio" not in undecided
     if margin is not None and margin > OVERSIZED_MARGIN and motor_at_smallest_size(joint, bounds):
-        phrases.append(_smallest_motor_excess(joint, bounds["gear_ratio"][name], 1 + margin))
+        phrases.append(_smallest_motor_excess(joint, bounds["gear_ratio"][name], 1 + margin, chosen_ratio))
     return phrases
 
 
-def _smallest_motor_excess(joint: Mapping[str, Any], ratio_bounds: Sequence[float], multiple: float) -> str:
+def _smallest_motor_excess(
+    joint: Mapping[str, Any], ratio_bounds: Sequence[float], multiple: float, chosen_ratio: bool = True
+) -> str:
     """Why a joint at its smallest motor has ``multiple`` times its required peak torque, in words.
 
     The motor itself, or the gear ratio the objective chose: the peak torque grows with the ratio, which the
     collision reflex may want higher (a harder braking torque ``N tau_p``) than the motion needs.
+    ``chosen_ratio`` False: no objective decides the ratio (:func:`_undecided_phrase` says so), so it is not
+    called the objective's choice.
     """
     ratio, lowest = float(joint["gear_ratio"]), float(ratio_bounds[0])
     said = f"peak torque {_g(multiple, 3)}× its requirement"
     if bound_position(ratio, ratio_bounds) in ("lower", "fixed"):
         return f"{said}: even the smallest motor is more than it needs"
     at_lowest = multiple * lowest / ratio
+    lowest_said = f"{_g(at_lowest, 3)}× at its lowest ratio, {_g(lowest)}"
     if at_lowest > 1 + OVERSIZED_MARGIN:
-        return (
-            f"{said} at N = {_g(ratio)} ({_g(at_lowest, 3)}× at its lowest ratio, {_g(lowest)}): even the "
-            "smallest motor is more than it needs"
-        )
+        return f"{said} at N = {_g(ratio)} ({lowest_said}): even the smallest motor is more than it needs"
+    if not chosen_ratio:
+        return f"{said} at N = {_g(ratio)} ({lowest_said})"
     return (
-        f"{said} at N = {_g(ratio)}, the ratio the objective chose ({_g(at_lowest, 3)}× at its lowest ratio, "
-        f"{_g(lowest)}): the gear ratio, not the motor, gives the excess"
+        f"{said} at N = {_g(ratio)}, the ratio the objective chose ({lowest_said}): the gear ratio, not the "
+        "motor, gives the excess"
+    )
+
+
+UNDECIDED_UNITS = {"software_stiffness": " N·m/rad", "stator_diameter": " m", "stack_length": " m"}
+"""Units printed after an undecided variable's value (none for the gear ratio)."""
+
+
+def undecided_sentence(joint: Mapping[str, Any], undecided: Sequence[str]) -> str:
+    """That no objective decides these design variables of a joint, with their values, as a sentence.
+
+    A software stiffness that changes no impulse belongs to a joint no contact sample loads (the contact forces
+    exert no torque about its axis): said as the reason.
+    """
+    one = len(undecided) == 1
+    values = " and ".join(
+        f"{_words(key)} ({_g(joint[key])}{UNDECIDED_UNITS.get(key, '')})" for key in undecided
+    )
+    reason = ", as no contact sample loads this joint" if "software_stiffness" in undecided else ""
+    them = "it" if one else "them"
+    return (
+        f"Its {values} change{'s' if one else ''} no impulse and not the actuator mass anywhere within "
+        f"{'its' if one else 'their'} bounds{reason}: no objective decides {them}, and "
+        f"{'it is' if one else 'they are'} where the solver started; choose {them} on grounds this study does not "
+        "model."
     )
 
 
 def design_limits(record: Mapping[str, Any], bounds: Mapping[str, Any]) -> list[str]:
-    """The global design variables (threshold, approach velocity) of a record that are at a bound, in words."""
+    """The global design variables (threshold, approach velocity) of a record at a bound or undecided, in words.
+
+    Undecided: named in the record's ``undecided`` (no objective changes with it).
+    """
+    undecided = {entry["variable"] for entry in record.get("undecided", ()) if entry["joint"] is None}
     phrases = []
     for key in ("threshold", "approach_velocity"):
         position = bound_position(record[key], bounds[key])
-        if position in ("lower", "upper"):
+        if key in undecided:
+            phrases.append(
+                f"{_words(key)} ({_g(record[key])}) changes no objective anywhere within its bounds: no "
+                "objective decides it, the value is where the solver started"
+            )
+        elif position in ("lower", "upper"):
             phrases.append(f"{_words(key)} at its {position} bound ({_g(record[key])})")
     return phrases
 
@@ -295,12 +339,15 @@ def verdict(results: Mapping[str, Any]) -> list[str]:
     if results.get("speed_limits"):
         lines.append(str(results["speed_limits"]))
     if bounds is not None:
+        undecided = recommended.get("undecided", ())
         for joint in recommended["joints"]:
-            phrases = joint_limits(joint, bounds, requirement)
+            own = [entry["variable"] for entry in undecided if entry["joint"] == joint["joint"]]
+            phrases = joint_limits(joint, bounds, requirement, own)
             lines.append(
                 f"{joint['joint']}: "
                 + (", ".join(phrases) if phrases else "no bound or constraint active")
                 + "."
+                + (f" {undecided_sentence(joint, own)}" if own else "")
             )
         limits = design_limits(recommended, bounds)
         if limits:
@@ -354,5 +401,6 @@ __all__ = [
     "lightest_near_best",
     "objective_spans",
     "oversized_warnings",
+    "undecided_sentence",
     "verdict",
 ]

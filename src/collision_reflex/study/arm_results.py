@@ -22,7 +22,7 @@ import numpy as np
 
 from ..optimize.duty import torque_speed_points
 from ..optimize.pareto import MERGE_TOLERANCE, built_problem, recommend
-from ..optimize.results import design_record
+from ..optimize.results import design_record, undecided_variables
 from ..optimize.space import GLOBAL_VARIABLES, PER_JOINT_VARIABLES
 from .arm_setup import ArmSetup, SampleLayout, StudyProblems, sample_layout
 from .schema import ArmStudy
@@ -160,8 +160,9 @@ def arm_results(
     The chosen design (the optimum of the study's objective, as solved) records ``dominated_by``: the index of
     a Pareto design that dominates it, or None. The recommended design
     (:func:`collision_reflex.optimize.pareto.recommend`) records ``source`` (``optimum`` or ``Pareto design
-    <i>``), ``pareto_index`` and ``reason``, and with a duty cycle its ``torque_speed``
-    (:func:`torque_speed_record`). With ``catalogue`` (:func:`catalogue_results`), the results gain its
+    <i>``), ``pareto_index``, ``reason``, ``undecided`` (its design variables that no objective decides,
+    :func:`collision_reflex.optimize.results.undecided_variables`: ``{"variable", "joint"}`` each, the joint None
+    for a global one), and with a duty cycle its ``torque_speed`` (:func:`torque_speed_record`). With ``catalogue`` (:func:`catalogue_results`), the results gain its
     ``catalogue`` entry and each Pareto design (the chosen one without a front) its quick snap, ``catalogue``,
     with ``catalogue_part`` per joint.
     """
@@ -194,7 +195,13 @@ def arm_results(
         else {k: v for k, v in chosen_record.items() if k != "dominated_by"}
     )
     recommended.update(
-        source=recommendation.source, pareto_index=recommendation.pareto_index, reason=recommendation.reason
+        source=recommendation.source,
+        pareto_index=recommendation.pareto_index,
+        reason=recommendation.reason,
+        undecided=[
+            {"variable": name, "joint": None if joint is None else setup.arm.joint_names[joint]}
+            for name, joint in undecided_variables(problem, recommendation.result.x)
+        ],
     )
     torque_speed = torque_speed_record(problem, recommendation.result)
     if torque_speed is not None:
