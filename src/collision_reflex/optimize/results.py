@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..errors import InvalidParameter
 from ..model.impulse import optimal_velocity, phase_impulses, series_stiffness
 from .active_set import ActiveSetResult, solve_method, with_active_set
 from .constraints import DUTY_REQUIREMENT, STATIC_REQUIREMENT
@@ -406,7 +407,10 @@ def undecided_variables(problem: DesignProblem, x: np.ndarray) -> list[tuple[str
     def unchanged(index: int, value: float) -> bool:
         moved = x.copy()
         moved[index] = value
-        other_impulses, other_mass = outcome(moved)
+        try:
+            other_impulses, other_mass = outcome(moved)
+        except (InvalidParameter, ValueError, ArithmeticError):  # a design the model refuses: not unchanged
+            return False
         return bool(
             np.all(np.abs(other_impulses - impulses) <= UNDECIDED_TOLERANCE * np.abs(impulses))
             and abs(other_mass - mass) <= UNDECIDED_TOLERANCE * abs(mass)
