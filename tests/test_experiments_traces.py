@@ -138,7 +138,7 @@ def test_cli_reports_bad_traces_and_writes_outputs(tmp_path):
     assert done.returncode == 0, done.stderr
     skipped = [line for line in done.stderr.splitlines() if line.startswith("crx fit: skipped")]
     assert len(skipped) == 9 and "Traceback" not in done.stderr
-    assert "good" in done.stdout and "tab:one_shot" in done.stdout
+    assert "good" in done.stdout and "table of one-shot fits" in done.stdout
     trials = pd.read_csv(out / "trials.csv")
     assert list(trials["trial"]) == ["good"]
     assert len(pd.read_csv(out / "rejected.csv")) == 9

@@ -28,7 +28,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
             "For each trial in the CSV files: find the contact above the noise floor, integrate the impulse "
             "(adaptive Gauss-Kronrod quadrature, trapezoid cross-check, uncertainty), and fit the model's force "
             "profile (m_f, k_s, F_s, a and the impact time, with k_m given). Then per system: mean and std of "
-            "the fitted parameters (tab:one_shot) and the fit I(v) = A v + B/v + C with v*. Bad traces are "
+            "the fitted parameters (as the paper's table of one-shot fits) and the fit I(v) = A v + B/v + C with v*. Bad traces are "
             "reported with the reason; the others are still processed. Files: '# velocity: 100 mm/s', "
             "'# system: NAME' and '# sensor stiffness: 2e7 N/m' comment lines, then 'time [ms],force [N]' "
             "columns (a 'trial' column for many trials per file)."
@@ -112,7 +112,7 @@ def _print_trials(results: ExperimentResults) -> None:
 def _print_summary(results: ExperimentResults) -> None:
     summary = results.one_shot_summary()
     print()
-    print("one-shot fits, mean ± std over trials (tab:one_shot):")
+    print("one-shot fits, mean ± std over trials (as the paper's table of one-shot fits):")
     for system in results.systems:
         rows = summary[summary["system"] == system]
         parts = []

@@ -30,7 +30,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description=(
             "Collision reflex of a finger-spring-robot system hitting a rigid constraint: impulse of the "
             "impact, sensing and reaction phases, their total, the optimal approach velocity v* and the "
-            "minimum impulse I*. Defaults are the paper's direct-drive U8 actuator (soft setting, tab:one_shot) "
+            "minimum impulse I*. Defaults are the paper's direct-drive U8 actuator (soft setting, the paper's one-shot fit) "
             "against a force sensor of stiffness 2e7 N/m."
         ),
     )

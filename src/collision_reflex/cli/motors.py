@@ -25,7 +25,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser = options.add_subcommand(
         subparsers,
         "motors",
-        help="list the motor catalogue; 'motors scale' scales a motor (tab:motor_params)",
+        help="list the motor catalogue; 'motors scale' scales a motor (the paper's motor-parameter table)",
         description=(
             "List the motors of a catalogue (default: the packaged one, with the paper's reference motor, "
             "Celera Motion Omni+ OPN-060-013-A). Quantities in SI units."
@@ -45,8 +45,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="scale a motor to other stator diameters and gear it to a torque requirement",
         description=(
             "Scale a catalogue motor to other stator diameters (and stack length) by a scaling law of the "
-            "paper's tab:scaling_laws, and pick the gear ratio N = max(1, tau_req / tau_p) that meets a torque "
-            "requirement. The defaults reproduce the paper's tab:motor_params (M1, M2, M3): the Omni+ scaled "
+            "paper's table of scaling laws, and pick the gear ratio N = max(1, tau_req / tau_p) that meets a torque "
+            "requirement. The defaults reproduce the paper's table of motor parameters (M1, M2, M3): the Omni+ scaled "
             "to 10, 60 and 100 mm by the Haddadin law with 1.3 N m required."
         ),
     )

@@ -34,7 +34,7 @@ def _common(parser: argparse.ArgumentParser) -> None:
         SWEEP_DEFAULTS["m_f"],
         bound="non-negative",
         note="the link's, besides any reflected inertia; the paper does not state it: the default is its U8 "
-        "fit (tab:one_shot)",
+        "fit (the paper's table of one-shot fits)",
     )
     options.ROBOT_MASS.add(
         parser, SWEEP_DEFAULTS["m_r"], bound="non-negative", note="besides the reflected inertia"

@@ -76,7 +76,7 @@ CONSTANT_SURFACE_SPEED = SpeedScaling(
         "speed, not omega (Pyrhonen, Jokinen, Hrabovcova, Design of Rotating Electrical Machines, Wiley "
         "2014, on peripheral-speed limits). Not chosen: a fixed drive voltage and current, omega_max ∝ "
         "1/tau_p (the back-EMF constant grows with the torque constant), since a scaled motor's winding "
-        "is redesigned for its drive. The scaling laws of tab:scaling_laws say nothing of speed."
+        "is redesigned for its drive. The paper's table of scaling laws says nothing of speed."
     ),
 )
 """The default :class:`SpeedScaling`: constant rotor surface (tip) speed, ``omega_max ∝ 1/r``."""
@@ -114,28 +114,32 @@ SCALING_LAWS: dict[str, ScalingLaw] = {
     law.name: law
     for law in (
         ScalingLaw(
-            "isometric", 2.0, 4.0, 4.0, "Spletzer and Marron 1999 (isometric scaling), tab:scaling_laws"
+            "isometric",
+            2.0,
+            4.0,
+            4.0,
+            "Spletzer and Marron 1999 (isometric scaling), the paper's table of scaling laws",
         ),
         ScalingLaw(
             "empirical",
             2.0,
             4.0,
             2.8,
-            "Dermitzakis et al. 2011 (empirical torque fit; mass and inertia isometric), tab:scaling_laws",
+            "Dermitzakis et al. 2011 (empirical torque fit; mass and inertia isometric), the paper's table of scaling laws",
         ),
         ScalingLaw(
             "quadruped",
             1.0,
             3.0,
             2.0,
-            "Seok et al. 2012, Kenneally et al. 2016 (fixed radial thickness), tab:scaling_laws",
+            "Seok et al. 2012, Kenneally et al. 2016 (fixed radial thickness), the paper's table of scaling laws",
         ),
         ScalingLaw(
             "haddadin",
             2.0,
             4.0,
             2.5,
-            "Haddadin et al. 2012 (electrical and thermal); the paper's choice, tab:scaling_laws",
+            "Haddadin et al. 2012 (electrical and thermal); the paper's choice, in its table of scaling laws",
         ),
     )
 }

@@ -253,7 +253,7 @@ class _MotorScaling:
             "software stiffness k_s at the contact [N/m]": self.k_s,
             "force threshold F_s [N]": self.F_s,
             "lever L [m] (assumed: the paper's 1D experiment length)": self.lever,
-            "finger mass [kg] (assumed: the paper's U8 fit, tab:one_shot)": self.m_f,
+            "finger mass [kg] (assumed: the paper's one-shot fit of the U8)": self.m_f,
             "extra robot mass [kg] (assumed)": self.m_r,
             "reflected inertia in (assumed, see docs)": self.reflected_inertia_in,
             "gearbox inertia": (
@@ -487,7 +487,7 @@ def stiffness_sweep(
         "position-error threshold e_th at the contact [m]": e_th,
         "software stiffness k_s at the contact [N/m]": k_s,
         "lever L [m] (assumed: the paper's 1D experiment length)": lever,
-        "finger mass [kg] (assumed: the paper's U8 fit, tab:one_shot)": m_f,
+        "finger mass [kg] (assumed: the paper's one-shot fit of the U8)": m_f,
         "extra robot mass [kg] (assumed)": m_r,
         "reflected inertia in (assumed, see docs)": reflected_inertia_in,
         "reaction": reaction,
