@@ -8,6 +8,7 @@ import pytest
 from collision_reflex.report.verdict import (
     ACTIVE_TOLERANCE,
     bound_position,
+    catalogue_sentences,
     front_sentences,
     joint_limits,
     lightest_near_best,
@@ -233,3 +234,25 @@ def test_variables_no_objective_decides_are_said_so_and_not_called_a_choice():
     # A record written before the field existed reads as nothing undecided.
     del recommended["undecided"]
     assert not any("no objective decides" in line for line in verdict(results))
+
+
+def test_a_catalogue_gear_ratio_no_objective_decides_is_said_to_be_the_start():
+    joints = [
+        {"joint": "shoulder", "motor": "M-80", "gearbox": None, "gear_ratio": 40.0},
+        {"joint": "elbow", "motor": "M-30", "gearbox": "HD-14", "gear_ratio": 59.85},
+    ]
+    catalogue = {
+        "warnings": [],
+        "method": "exact: enumerated 4 combinations",
+        "joints": joints,
+        "relative_difference": {"worst_case_impulse": 0.0177, "actuator_mass": 1.74},
+        "design": {"undecided": [{"variable": "gear_ratio", "joint": "elbow"}]},
+    }
+    (sentence,) = catalogue_sentences(catalogue)
+    assert (
+        "shoulder M-80 at N = 40, elbow M-30 + HD-14 at N = 59.85 (a ratio no objective decides: the solver's "
+        "start); against the continuous design worst case impulse +1.77 %, actuator mass +174 %." in sentence
+    )
+    # Written before the field existed: no claim either way.
+    del catalogue["design"]["undecided"]
+    assert "no objective decides" not in catalogue_sentences(catalogue)[0]

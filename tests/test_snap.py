@@ -239,6 +239,8 @@ def test_a_study_run_snaps_reports_and_resumes_without_redoing_it(tmp_path, monk
     catalogue = designs["catalogue"]
     assert catalogue["method"].startswith("exact: enumerated")
     assert catalogue["design"] is not None and catalogue["snapped"] == designs["recommended"]["source"]
+    # Every contact sample of the two-link study loads both joints: every design variable is decided.
+    assert catalogue["design"]["undecided"] == [] and designs["recommended"]["undecided"] == []
     for joint in catalogue["joints"]:
         assert joint["part"] in cr.load_catalogue() and joint["source"]
     assert len(catalogue["pareto"]) == len(designs["pareto"]["points"])

@@ -366,6 +366,8 @@ def verdict(results: Mapping[str, Any]) -> list[str]:
 def catalogue_sentences(catalogue: Mapping[str, Any]) -> list[str]:
     """The catalogue design in one sentence, what it costs against the continuous one, and its warnings.
 
+    A gear ratio that no objective decides (the design's ``undecided``) is said to be the solver's start.
+
     ``catalogue``: the ``catalogue`` entry of the results (:class:`collision_reflex.study.arm_results.
     CatalogueRecord`).
     """
@@ -375,10 +377,16 @@ def catalogue_sentences(catalogue: Mapping[str, Any]) -> list[str]:
             f"No design built from catalogue parts meets the requirements ({catalogue['method']}).",
             *warnings,
         ]
+    undecided = {
+        entry["joint"]
+        for entry in catalogue["design"].get("undecided", ())
+        if entry["variable"] == "gear_ratio"
+    }
     parts = ", ".join(
         f"{j['joint']} {j['motor']}"
         + (f" + {j['gearbox']}" if j["gearbox"] else "")
         + f" at N = {_g(j['gear_ratio'])}"
+        + (" (a ratio no objective decides: the solver's start)" if j["joint"] in undecided else "")
         for j in catalogue["joints"]
     )
     costs = ", ".join(

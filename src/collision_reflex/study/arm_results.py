@@ -198,10 +198,7 @@ def arm_results(
         source=recommendation.source,
         pareto_index=recommendation.pareto_index,
         reason=recommendation.reason,
-        undecided=[
-            {"variable": name, "joint": None if joint is None else setup.arm.joint_names[joint]}
-            for name, joint in undecided_variables(problem, recommendation.result.x)
-        ],
+        undecided=_undecided(problems, problem, recommendation.result),
     )
     torque_speed = torque_speed_record(problem, recommendation.result)
     if torque_speed is not None:
@@ -223,6 +220,19 @@ def arm_results(
                 joint["catalogue_part"] = part
         out["catalogue"] = catalogue
     return out
+
+
+def _undecided(problems: StudyProblems, problem: DesignProblem, result: DesignResult) -> list[dict[str, Any]]:
+    """The design variables of ``result`` (a solution of ``problem``) that no objective decides, as plain data.
+
+    ``{"variable", "joint"}`` each, the joint's name, None for a global variable
+    (:func:`collision_reflex.optimize.results.undecided_variables`).
+    """
+    names = problems.setup.arm.joint_names
+    return [
+        {"variable": name, "joint": None if joint is None else names[joint]}
+        for name, joint in undecided_variables(problem, result.x)
+    ]
 
 
 def speed_limits(setup: ArmSetup) -> str | None:
@@ -249,7 +259,8 @@ class CatalogueRecord(TypedDict):
     the answer was found; ``joints``: per joint the chosen part and its provenance, the candidates, and the
     nearest part with what it misses when none is within bounds; ``objectives``, ``continuous_objectives``,
     ``difference`` (catalogue minus continuous), ``relative_difference`` (over the continuous value; None where
-    that is zero) [each objective's unit]; ``design``: the catalogue design's record, None when none was found;
+    that is zero) [each objective's unit]; ``design``: the catalogue design's record (with its ``undecided``
+    design variables, as the recommended design's), None when none was found;
     ``tried``: every combination re-solved; ``pareto``: the quick snap of every Pareto design (the chosen
     design's without a front), see :func:`quick_snap_record`; ``solve_time``: the snap's wall time [s] (in
     ``timings.json``, not ``designs.json``).
@@ -356,7 +367,7 @@ def catalogue_results(
     either way), on active sets of the samples as the study's ``optimizer.active_set`` says (the sweep's
     rule); each Pareto design (the chosen one without a front) by :func:`quick_snap_record`.
     """
-    from ..optimize.snap import snap_to_catalogue
+    from ..optimize.snap import catalogue_problem, snap_to_catalogue
     from .arm_setup import IPOPT_OPTIONS
 
     started = time.perf_counter()
@@ -376,6 +387,11 @@ def catalogue_results(
         active_set=problems.active_set,
     )
     joints = [_joint_record(snap, j, catalogue) for j in range(len(snap.joints))]
+    design = None
+    if snap.result is not None and snap.parts is not None:
+        design = design_record(problem, snap.result, "catalogue design", catalogue.motors)
+        parts_problem = catalogue_problem(problem, snap.parts, problems.setup.arm)
+        design["undecided"] = _undecided(problems, parts_problem, snap.result)
     results = front.points if front is not None and front.points else (chosen,)
     return {
         "key": catalogue.key,
@@ -389,9 +405,7 @@ def catalogue_results(
         "continuous_objectives": snap.continuous_objectives,
         "difference": snap.difference,
         "relative_difference": {k: _finite(v) for k, v in snap.relative_difference.items()},
-        "design": None
-        if snap.result is None
-        else design_record(problem, snap.result, "catalogue design", catalogue.motors),
+        "design": design,
         "tried": [
             {"parts": list(t.parts), "objective": t.objective, "status": t.status, "iterations": t.iterations}
             for t in snap.tried
