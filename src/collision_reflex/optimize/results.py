@@ -383,13 +383,13 @@ def undecided_variables(problem: DesignProblem, x: np.ndarray) -> list[tuple[str
     """The design variables of ``x`` that no objective decides, as ``(variable, joint index)`` pairs.
 
     Moving one anywhere within its bounds, with the rest of the design held, changes no sample's impulse and not
-    the actuator mass. The objectives (every impulse statistic, the actuator mass and the approach velocity) then take the same
-    values whatever the variable is, so the optimiser leaves it where its start put it. A joint that no contact
-    sample loads (its axis through every contact point, as a last wrist joint's often is) has such a software
-    stiffness and gear ratio. Each free variable (bounds not equal) is tried at :data:`UNDECIDED_PROBES` values,
-    the bounds first, and counts as undecided when every change is within :data:`UNDECIDED_TOLERANCE` (NumPy
-    path, :func:`collision_reflex.optimize.evaluate.evaluate_design`). The joint index is None for a global
-    variable (threshold, approach velocity).
+    the actuator mass. The objectives (every impulse statistic, the actuator mass and the approach velocity)
+    then take the same values whatever the variable is, so the optimiser leaves it where its start put it. A
+    joint that no contact sample loads (its axis through every contact point, as a last wrist joint's often is)
+    has such a software stiffness and gear ratio. Each free variable (bounds not equal) is tried at
+    :data:`UNDECIDED_PROBES` values, the bounds first, and counts as undecided when every change is within
+    :data:`UNDECIDED_TOLERANCE` (NumPy path, :func:`collision_reflex.optimize.evaluate.evaluate_design`). The
+    joint index is None for a global variable (threshold, approach velocity).
     """
     from .evaluate import evaluate_design
     from .solve import design_at

@@ -162,9 +162,9 @@ def arm_results(
     (:func:`collision_reflex.optimize.pareto.recommend`) records ``source`` (``optimum`` or ``Pareto design
     <i>``), ``pareto_index``, ``reason``, ``undecided`` (its design variables that no objective decides,
     :func:`collision_reflex.optimize.results.undecided_variables`: ``{"variable", "joint"}`` each, the joint None
-    for a global one), and with a duty cycle its ``torque_speed`` (:func:`torque_speed_record`). With ``catalogue`` (:func:`catalogue_results`), the results gain its
-    ``catalogue`` entry and each Pareto design (the chosen one without a front) its quick snap, ``catalogue``,
-    with ``catalogue_part`` per joint.
+    for a global one), and with a duty cycle its ``torque_speed`` (:func:`torque_speed_record`). With
+    ``catalogue`` (:func:`catalogue_results`), the results gain its ``catalogue`` entry and each Pareto design
+    (the chosen one without a front) its quick snap, ``catalogue``, with ``catalogue_part`` per joint.
     """
     setup = problems.setup
     # Every problem of a study shares its samples and technology: one of them evaluates every record.
