@@ -9,6 +9,7 @@ from collision_reflex.report.verdict import (
     ACTIVE_TOLERANCE,
     bound_position,
     catalogue_sentences,
+    design_limits,
     front_sentences,
     joint_limits,
     lightest_near_best,
@@ -256,3 +257,12 @@ def test_a_catalogue_gear_ratio_no_objective_decides_is_said_to_be_the_start():
     # Written before the field existed: no claim either way.
     del catalogue["design"]["undecided"]
     assert "no objective decides" not in catalogue_sentences(catalogue)[0]
+
+
+def test_an_undecided_global_variable_is_said_so_instead_of_its_bound():
+    undecided = {**record(threshold=1.0), "undecided": [{"variable": "threshold", "joint": None}]}
+    assert design_limits(undecided, BOUNDS) == [
+        "threshold (1) changes no objective anywhere within its bounds: no objective decides it, the value is "
+        "where the solver started"
+    ]
+    assert design_limits(record(threshold=1.0), BOUNDS) == ["threshold at its lower bound (1)"]

@@ -122,7 +122,7 @@ def _smallest_motor_excess(
 
     The motor itself, or the gear ratio the objective chose: the peak torque grows with the ratio, which the
     collision reflex may want higher (a harder braking torque ``N tau_p``) than the motion needs.
-    ``chosen_ratio`` False: no objective decides the ratio (:func:`_undecided_phrase` says so), so it is not
+    ``chosen_ratio`` False: no objective decides the ratio (:func:`undecided_sentence` says so), so it is not
     called the objective's choice.
     """
     ratio, lowest = float(joint["gear_ratio"]), float(ratio_bounds[0])
