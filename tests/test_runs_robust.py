@@ -318,3 +318,103 @@ def test_piping_into_head_gives_no_traceback():
     process.stdout.close()  # as `head -1` does after its line
     _, stderr = process.communicate(timeout=60)
     assert process.returncode == 0 and stderr == "", stderr
+
+
+def _swallowed_ctrl_c() -> None:
+    """A Ctrl-C whose KeyboardInterrupt is caught and dropped, as CasADi's overload tests drop it."""
+    try:
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.01)  # the handler runs here at the latest
+    except KeyboardInterrupt:
+        pass
+
+
+def test_a_ctrl_c_lost_inside_an_interruptible_block_is_raised_when_it_ends():
+    from collision_reflex._interrupt import interruptible
+
+    before = signal.getsignal(signal.SIGINT)
+    with pytest.raises(KeyboardInterrupt):
+        with interruptible():
+            _swallowed_ctrl_c()
+    assert signal.getsignal(signal.SIGINT) is before  # the handler in place is restored
+    # An error the interrupt caused (a conversion left with the exception set, an import cut short) is the
+    # interrupt, with that error as its cause; without an interrupt errors and results pass unchanged.
+    with pytest.raises(KeyboardInterrupt) as caught:
+        with interruptible():
+            _swallowed_ctrl_c()
+            raise SystemError("returned a result with an exception set")
+    assert isinstance(caught.value.__cause__, SystemError)
+    with pytest.raises(ValueError), interruptible():
+        raise ValueError("not an interrupt")
+    with interruptible():
+        pass
+
+
+def test_an_ignored_or_handled_ctrl_c_stays_so_inside_an_interruptible_block():
+    from collision_reflex._interrupt import interruptible
+
+    calls = []
+    for handler in (signal.SIG_IGN, lambda signum, frame: calls.append(signum)):
+        previous = signal.signal(signal.SIGINT, handler)
+        try:
+            with interruptible():
+                os.kill(os.getpid(), signal.SIGINT)
+                time.sleep(0.01)
+        finally:
+            signal.signal(signal.SIGINT, previous)
+    assert calls == [signal.SIGINT]  # the caller's handler ran, and nothing was raised
+
+
+def test_solves_and_problem_builds_raise_a_ctrl_c_their_casadi_code_lost(monkeypatch):
+    from collision_reflex.optimize import problem as problems
+
+    pendulum = cr.Arm.from_example_robot_data("double_pendulum")
+    samples = cr.ContactSamples.grid(pendulum.kinematics(np.array([[0.3, -0.5]])), np.array([[1.0, 0.0]]))
+    space = cr.DesignSpace(
+        stator_diameter=(0.02, 0.12),
+        gear_ratio=(1, 30),
+        software_stiffness=300.0,
+        threshold=(3, 20),
+        approach_velocity=(0.02, 2.0),
+    )
+    technology = cr.ActuatorTechnology(cr.reference_motor(), mechanical_stiffness=[600.0, 400.0])
+    problem = cr.build_problem(pendulum, samples, space, technology, "worst_case_impulse")
+    original = problems.DesignProblem.solver
+
+    def solver(self, *args, **kwargs):
+        _swallowed_ctrl_c()
+        return original(self, *args, **kwargs)
+
+    monkeypatch.setattr(problems.DesignProblem, "solver", solver)
+    with pytest.raises(KeyboardInterrupt):
+        cr.solve(problem)
+    original_structure = problems._sample_structure
+
+    def structure(*args, **kwargs):
+        _swallowed_ctrl_c()
+        return original_structure(*args, **kwargs)
+
+    monkeypatch.setattr(problems, "_sample_structure", structure)
+    with pytest.raises(KeyboardInterrupt):
+        cr.build_problem(pendulum, samples, space, technology, "worst_case_impulse")
+
+
+def test_an_error_a_ctrl_c_caused_ends_crx_as_interrupted(monkeypatch, capsys):
+    from collision_reflex._interrupt import caused_by_interrupt
+    from collision_reflex.cli import run as run_command
+
+    def cut_short(args):
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt:
+            raise ImportError("initialization failed") from None
+
+    # ``from None`` hides the cause from the traceback but keeps the context.
+    try:
+        cut_short(None)
+    except ImportError as error:
+        assert caused_by_interrupt(error)
+    assert not caused_by_interrupt(ValueError("plain"))
+    monkeypatch.setattr(run_command, "run", cut_short)
+    assert main(["run", str(TWO_LINK)]) == 130
+    assert capsys.readouterr().err.strip() == "crx run: interrupted; rerun the same command to resume"

@@ -16,6 +16,7 @@ import sys
 from collections.abc import Iterator, Sequence
 
 from .. import __version__, _units
+from .._interrupt import caused_by_interrupt
 from ..errors import CollisionReflexError
 from . import options
 
@@ -101,7 +102,12 @@ def _command(arguments: list[str]) -> int:
     _units.hide_pint_extras()
     _units.cache_registry()
     try:
-        status = int(args.run(args) or 0)
+        try:
+            status = int(args.run(args) or 0)
+        except Exception as error:
+            if caused_by_interrupt(error):  # Ctrl-C surfacing as another error (an import cut short, say)
+                raise KeyboardInterrupt from error
+            raise
         sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's exit flush
         return status
     except CollisionReflexError as error:

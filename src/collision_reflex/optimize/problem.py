@@ -39,6 +39,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import casadi as ca
 import numpy as np
 
+from .._interrupt import interruptible
 from ..errors import InvalidParameter
 from ..model import effective as formulas
 from .constraints import (
@@ -264,6 +265,7 @@ class DesignProblem:
         return np.array(values)
 
 
+@interruptible()
 def build_problem(
     arm: Arm,
     samples: ContactSamples,

@@ -11,6 +11,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from .. import _validate
+from .._interrupt import interruptible
 from ..errors import InvalidParameter, SolverFailed, Violation
 from .blas import single_threaded_blas
 from .constraints import STATIC_REQUIREMENT
@@ -205,6 +206,7 @@ class DesignResult:
         return int(np.argmax(self.impulses))
 
 
+@interruptible()
 def solve(
     problem: DesignProblem,
     epsilon: Mapping[str, float] | None = None,

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, cast
 
+from .._interrupt import caused_by_interrupt
 from ..report.outputs import StageTimes
 from .arm_results import CatalogueRecord, SnapCatalogue, arm_results, catalogue_results, study_catalogue
 from .executors import open_executor
@@ -184,7 +185,10 @@ def run_study(
         raise OutputFolderUnusable.from_os_error(error, folder.path, exit_status=1) from None
     except BaseException as error:
         progress.stop()
-        folder.update_manifest(status="failed" if isinstance(error, Exception) else "interrupted")
+        interrupted = caused_by_interrupt(error)
+        folder.update_manifest(status="interrupted" if interrupted else "failed")
+        if interrupted and not isinstance(error, KeyboardInterrupt):  # Ctrl-C surfacing as another error
+            raise KeyboardInterrupt from error
         raise
     elapsed = time.perf_counter() - started
     folder.update_manifest(status="finished", elapsed=elapsed, computed=counts[0], reused=counts[1])
