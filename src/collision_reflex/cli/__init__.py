@@ -12,6 +12,7 @@ import contextlib
 import gc
 import importlib
 import os
+import signal
 import sys
 from collections.abc import Iterator, Sequence
 
@@ -80,8 +81,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run ``crx`` with ``argv`` (default: the process's arguments) and return its exit status.
 
     The ``crx`` process keeps what :func:`start_up` froze until it exits (so that its exit does not walk it
-    either); called with ``argv`` (from Python: tests, scripts) it unfreezes it on return, leaving the
-    caller's garbage collector as it found it.
+    either), and ignores Ctrl-C once the command has returned (its status is decided; the exit only flushes);
+    called with ``argv`` (from Python: tests, scripts) it unfreezes it on return, leaving the caller's garbage
+    collector and signal handlers as it found them.
     """
     frozen = gc.get_freeze_count()
     try:
@@ -89,6 +91,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     finally:
         if argv is not None and not frozen:
             gc.unfreeze()
+        if argv is None:
+            # The command is done and its status decided: a Ctrl-C while the interpreter exits would only
+            # turn a finished run's status into "killed by SIGINT".
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _command(arguments: list[str]) -> int:
