@@ -53,6 +53,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._interrupt import interruptible
 from ..errors import InvalidParameter, SolverFailed
 from .active_set import (
     ACTIVE_SET_CHOICES,
@@ -903,6 +904,7 @@ def _parts_start(
     return built.exact_point(start)
 
 
+@interruptible()
 def solve_parts(
     problem: DesignProblem,
     optimum: DesignResult,
@@ -980,6 +982,7 @@ class PartsEvaluation:
         return not self.shortfalls
 
 
+@interruptible()
 def evaluate_parts(problem: DesignProblem, design: Design, parts: Sequence[CataloguePart]) -> PartsEvaluation:
     """``design`` with each joint's motor (and gearbox) the one of ``parts``, evaluated (no re-solve).
 

@@ -98,10 +98,13 @@ class StageTimes:
 
     @contextlib.contextmanager
     def stage(self, name: str) -> Iterator[None]:
-        """Time the body of the ``with`` block as stage ``name``."""
+        """Time the body of the ``with`` block as stage ``name``; a Ctrl-C in it is never lost (:mod:`.._interrupt`)."""
+        from .._interrupt import interruptible
+
         wall, cpu = time.perf_counter(), time.process_time()
         try:
-            yield
+            with interruptible():
+                yield
         finally:
             for kind, spent in (("wall", time.perf_counter() - wall), ("cpu", time.process_time() - cpu)):
                 key = f"{STAGES}/{name}/{kind}"
