@@ -83,7 +83,8 @@ def test_ctrl_c_stops_a_run_saves_its_points_and_the_resumed_run_equals_an_unint
     _same_results(folder, panda_run)
 
 
-def test_an_interrupted_ipopt_run_raises_keyboard_interrupt_and_is_not_retried(monkeypatch):
+def _pendulum_inputs():
+    """A small design problem's inputs: the double pendulum, 2 configurations x 2 directions, space, technology."""
     pendulum = cr.Arm.from_example_robot_data("double_pendulum")
     q = np.array([[0.3, -0.5], [1.0, 0.4]])
     samples = cr.ContactSamples.grid(pendulum.kinematics(q), np.array([[1.0, 0.0], [0.0, 1.0]]))
@@ -95,7 +96,11 @@ def test_an_interrupted_ipopt_run_raises_keyboard_interrupt_and_is_not_retried(m
         approach_velocity=(0.02, 2.0),
     )
     technology = cr.ActuatorTechnology(cr.reference_motor(), mechanical_stiffness=[600.0, 400.0])
-    problem = cr.build_problem(pendulum, samples, space, technology, "worst_case_impulse")
+    return pendulum, samples, space, technology
+
+
+def test_an_interrupted_ipopt_run_raises_keyboard_interrupt_and_is_not_retried(monkeypatch):
+    problem = cr.build_problem(*_pendulum_inputs(), "worst_case_impulse")
     calls = []
 
     class Interrupted:
@@ -368,17 +373,8 @@ def test_an_ignored_or_handled_ctrl_c_stays_so_inside_an_interruptible_block():
 def test_solves_and_problem_builds_raise_a_ctrl_c_their_casadi_code_lost(monkeypatch):
     from collision_reflex.optimize import problem as problems
 
-    pendulum = cr.Arm.from_example_robot_data("double_pendulum")
-    samples = cr.ContactSamples.grid(pendulum.kinematics(np.array([[0.3, -0.5]])), np.array([[1.0, 0.0]]))
-    space = cr.DesignSpace(
-        stator_diameter=(0.02, 0.12),
-        gear_ratio=(1, 30),
-        software_stiffness=300.0,
-        threshold=(3, 20),
-        approach_velocity=(0.02, 2.0),
-    )
-    technology = cr.ActuatorTechnology(cr.reference_motor(), mechanical_stiffness=[600.0, 400.0])
-    problem = cr.build_problem(pendulum, samples, space, technology, "worst_case_impulse")
+    inputs = _pendulum_inputs()
+    problem = cr.build_problem(*inputs, "worst_case_impulse")
     original = problems.DesignProblem.solver
 
     def solver(self, *args, **kwargs):
@@ -396,7 +392,7 @@ def test_solves_and_problem_builds_raise_a_ctrl_c_their_casadi_code_lost(monkeyp
 
     monkeypatch.setattr(problems, "_sample_structure", structure)
     with pytest.raises(KeyboardInterrupt):
-        cr.build_problem(pendulum, samples, space, technology, "worst_case_impulse")
+        cr.build_problem(*inputs, "worst_case_impulse")
 
 
 def test_an_error_a_ctrl_c_caused_ends_crx_as_interrupted(monkeypatch, capsys):
