@@ -67,12 +67,17 @@ def _two_link_inputs() -> tuple[cr.DesignSpace, cr.ActuatorTechnology, cr.Constr
     return space, technology, cr.Constraints(torque_required=[2.0, 1.0], threshold_floor=0.5)
 
 
+def _two_link_samples(arm: Arm, configurations: int, directions: int, seed: int) -> cr.ContactSamples:
+    """Random configurations (seeded) of the two-link arm, each with evenly spaced contact directions."""
+    kinematics = arm.kinematics(arm.sample_configurations(configurations, np.random.default_rng(seed)))
+    angles = np.linspace(0, 2 * np.pi, directions, endpoint=False) + 0.3
+    return cr.ContactSamples.grid(kinematics, np.c_[np.cos(angles), np.sin(angles)])
+
+
 @pytest.fixture(scope="module")
 def two_link():
     arm = Arm.from_urdf(TWO_LINK, "tip")
-    kinematics = arm.kinematics(arm.sample_configurations(3, np.random.default_rng(0)))
-    angles = np.linspace(0, 2 * np.pi, 6, endpoint=False) + 0.3
-    samples = cr.ContactSamples.grid(kinematics, np.c_[np.cos(angles), np.sin(angles)])
+    samples = _two_link_samples(arm, 3, 6, seed=0)
     space, technology, constraints = _two_link_inputs()
     problem = cr.build_problem(arm, samples, space, technology, OBJECTIVE, constraints)
     optimum = cr.solve(problem, starts=4)
@@ -436,9 +441,7 @@ def many_samples():
     from collision_reflex.optimize.active_set import solve_active_set
 
     arm = Arm.from_urdf(TWO_LINK, "tip")
-    kinematics = arm.kinematics(arm.sample_configurations(12, np.random.default_rng(1)))
-    angles = np.linspace(0, 2 * np.pi, 8, endpoint=False) + 0.3
-    samples = cr.ContactSamples.grid(kinematics, np.c_[np.cos(angles), np.sin(angles)])
+    samples = _two_link_samples(arm, 12, 8, seed=1)
     space, technology, constraints = _two_link_inputs()
 
     def build(subset):
