@@ -91,6 +91,11 @@ class Arm:
         unknown = (effort <= 0) | (effort > 1e300) | ~np.isfinite(effort)
         self.urdf_torque_limit: np.ndarray = np.where(unknown, np.nan, effort)
         """The URDF's effort limit per joint [N m], ``nan`` where it gives none."""
+        speed = np.asarray(model.velocityLimit, dtype=float)
+        self.joint_speed_limit: np.ndarray = np.where(
+            (speed <= 0) | (speed > 1e300) | ~np.isfinite(speed), np.inf, speed
+        )
+        """The URDF's velocity limit per joint [rad/s or m/s], ``inf`` where it gives none."""
         params = joint_parameters(actuators, model.nv, model.armature, self.urdf_torque_limit)
         self.joint_parameters = params
         if actuators is None or isinstance(actuators, JointParameters):

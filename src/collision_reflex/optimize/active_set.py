@@ -189,10 +189,21 @@ def uses_active_set(n_samples: int, choice: str) -> bool:
 
 
 def sample_subset(samples: ContactSamples, index: np.ndarray) -> ContactSamples:
-    """The samples at ``index`` (integer indices), with every configuration's kinematics kept."""
+    """The samples at ``index`` (integer indices), with every configuration's kinematics kept.
+
+    A subset of searched samples alone (none drawn) takes its mean over them.
+    """
     index = np.asarray(index, dtype=int)
-    labels = tuple(samples.labels[i] for i in index) if samples.labels else ()
-    return ContactSamples(samples.kinematics, samples.directions[index], samples.config_index[index], labels)
+    assert samples.speed_cap is not None and samples.drawn is not None  # set by ContactSamples
+    drawn = samples.drawn[index]
+    return ContactSamples(
+        samples.kinematics,
+        samples.directions[index],
+        samples.config_index[index],
+        tuple(samples.labels[i] for i in index) if samples.labels else (),
+        samples.speed_cap[index],
+        drawn if np.any(drawn) else None,
+    )
 
 
 SUBSET_PROBLEMS = 4
@@ -529,9 +540,10 @@ def _violated(
     contact threshold is below the noise floor, or its configuration's gravity demand exceeds a joint's driving
     torque.
     """
+    inside = full.samples.inside(design.approach_velocity)  # samples in the design's contact domain
     levels = []
     if "worst_case_impulse" in full.objective:
-        levels.append(impulses[active].max())
+        levels.append(impulses[active][inside[active]].max(initial=0.0))
     bound = (epsilon or {}).get("worst_case_impulse")
     if bound is not None:
         levels.append(bound)
@@ -542,6 +554,7 @@ def _violated(
     if full.technology.sensing == "position" and floor > 0:
         _, thresholds = design_collision_parameters(full, design)
         bad |= thresholds < floor * (1 - tolerance)
+    bad &= inside
     bad[_torque_violated(full, design, impulses, tolerance)] = True
     bad[active] = False
     return np.flatnonzero(bad)
@@ -590,8 +603,9 @@ def _full_result(
 
     ``x`` is the full problem's point, ``impulses`` [N*s] the NumPy path's of every sample.
     """
-    objectives = {**last.objectives, **impulse_objectives(full.evaluate(x)[0])}
-    numpy_objectives = {**last.numpy_objectives, **impulse_objectives(impulses)}
+    velocity = last.design.approach_velocity
+    objectives = {**last.objectives, **impulse_objectives(full.evaluate(x)[0], full.samples, velocity)}
+    numpy_objectives = {**last.numpy_objectives, **impulse_objectives(impulses, full.samples, velocity)}
     check_agreement(objectives, numpy_objectives, IMPULSE_OBJECTIVES)
     return _replace(last, objectives=objectives, numpy_objectives=numpy_objectives, x=x, multipliers=None)
 

@@ -16,7 +16,9 @@ from ..model.impulse import series_stiffness, total_impulse
 if TYPE_CHECKING:
     from ..arm.effective import EffectiveParameters
     from .problem import DesignProblem
+    from .samples import ContactSamples
     from .solve import Design
+    from .technology import ActuatorTechnology
 
 
 def design_collision_parameters(
@@ -27,9 +29,15 @@ def design_collision_parameters(
     The parameters are a :class:`collision_reflex.arm.EffectiveParameters`; the contact-force threshold [N] is
     one per sample, shape (n_samples,).
     """
+    return collision_parameters(problem.samples, problem.technology, design)
+
+
+def collision_parameters(
+    samples: ContactSamples, technology: ActuatorTechnology, design: Design
+) -> tuple[EffectiveParameters, np.ndarray]:
+    """:func:`design_collision_parameters` at any ``samples`` of the arm, with the design's ``technology``."""
     from ..arm import effective_parameters
 
-    samples = problem.samples
     params = effective_parameters(
         samples.kinematics,
         samples.directions,
@@ -40,7 +48,7 @@ def design_collision_parameters(
         torque_limit=design.peak_torque,
         motor_mass=design.actuator_mass,
         finger_joint_inertia=(
-            design.reflected_inertia if problem.technology.reflected_inertia_in == "finger" else None
+            design.reflected_inertia if technology.reflected_inertia_in == "finger" else None
         ),
     )
     threshold = design.threshold if design.sensing == "force" else params.k * design.threshold
@@ -49,7 +57,12 @@ def design_collision_parameters(
 
 def evaluate_design(problem: DesignProblem, design: Design) -> np.ndarray:
     """Collision impulse [N*s] of ``design`` at each of the problem's samples, shape (n_samples,)."""
-    params, threshold = design_collision_parameters(problem, design)
+    return sample_impulses(problem.samples, problem.technology, design)
+
+
+def sample_impulses(samples: ContactSamples, technology: ActuatorTechnology, design: Design) -> np.ndarray:
+    """Collision impulse [N*s] of ``design`` at any ``samples`` of the arm, shape (n_samples,)."""
+    params, threshold = collision_parameters(samples, technology, design)
     return np.asarray(
         total_impulse(
             params.m_f,
@@ -58,6 +71,6 @@ def evaluate_design(problem: DesignProblem, design: Design) -> np.ndarray:
             threshold,
             params.a,
             design.approach_velocity,
-            problem.technology.reaction,
+            technology.reaction,
         )
     )

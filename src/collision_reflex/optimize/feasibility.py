@@ -142,7 +142,7 @@ def physical_violations(
     evaluated = problem.evaluate(x)
     impulses, thresholds = (np.asarray(evaluated[i]).ravel() for i in (0, 3))
     required, peak = (np.asarray(evaluated[i]).ravel() for i in (4, 5))
-    objectives = objective_values(impulses, evaluated[1], evaluated[2])
+    objectives = objective_values(impulses, evaluated[1], evaluated[2], problem.samples)
     duty = None
     if problem.duty is not None:
         from .solve import design_at  # solve imports this module

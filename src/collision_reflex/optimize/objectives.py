@@ -8,6 +8,7 @@ NLP parameter, so one solver serves a whole epsilon-constraint Pareto sweep.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING
 
 import casadi as ca
 import numpy as np
@@ -15,6 +16,11 @@ import numpy as np
 from .. import _validate
 from ..errors import InvalidParameter
 from .constraints import ConstraintList
+
+from .samples import SPEED_CAP_TOLERANCE
+
+if TYPE_CHECKING:
+    from .samples import ContactSamples
 
 TIE_BREAK_WEIGHT = 1e-3
 """Weight of the (start-normalised) mean impulse added to every objective.
@@ -53,41 +59,52 @@ def checked_bounded_objectives(names: Sequence[str]) -> tuple[str, ...]:
     return tuple(names)
 
 
-def objective_terms(impulses: ca.MX, actuator_mass: ca.MX, approach_velocity: ca.MX) -> dict[str, ca.MX]:
+def mean_weights(samples: ContactSamples) -> np.ndarray:
+    """Each sample's weight in a mean impulse, (n_samples,): equal over the drawn samples, 0 for searched ones."""
+    drawn = np.asarray(samples.drawn, dtype=float)
+    return drawn / drawn.sum()
+
+
+def objective_terms(
+    impulses: ca.MX, actuator_mass: ca.MX, approach_velocity: ca.MX, samples: ContactSamples
+) -> dict[str, ca.MX]:
     """The objectives as expressions, but the worst case (an epigraph variable, see :func:`add_epigraph`).
 
-    From the impulses [N*s] (1 x n_samples), the motors' total mass [kg] and the approach velocity [m/s].
+    From the impulses [N*s] (1 x n_samples) at ``samples``, the motors' total mass [kg] and the approach
+    velocity [m/s]; the mean is over the drawn samples (:func:`mean_weights`).
     """
     return {
-        "mean_impulse": ca.sum2(impulses) / impulses.shape[1],
+        "mean_impulse": ca.mtimes(impulses, ca.DM(mean_weights(samples))),
         "actuator_mass": actuator_mass,
         "approach_velocity": approach_velocity,
     }
 
 
-def impulse_objectives(impulses: np.ndarray) -> dict[str, float]:
-    """The impulse objectives of a design's per-sample impulses [N*s]: the largest and the mean."""
-    values = np.asarray(impulses, dtype=float).ravel()
-    return {"worst_case_impulse": float(values.max()), "mean_impulse": float(values.mean())}
+def impulse_objectives(impulses: np.ndarray, samples: ContactSamples, velocity: float) -> dict[str, float]:
+    """The impulse objectives of a design's per-sample impulses [N*s] at ``samples``.
 
-
-def objective_values(
-    impulses: np.ndarray, actuator_mass: float, approach_velocity: float
-) -> dict[str, float]:
-    """Every objective of :data:`OBJECTIVES` for a design.
-
-    From its per-sample impulses [N*s], total actuator mass [kg] and approach velocity [m/s].
+    The worst case is the largest impulse over the samples in the contact domain of a design approaching at
+    ``velocity`` [m/s] (:meth:`ContactSamples.inside`); the mean is over the drawn samples.
     """
+    values = np.asarray(impulses, dtype=float).ravel()
     return {
-        **impulse_objectives(impulses),
-        "actuator_mass": float(actuator_mass),
-        "approach_velocity": float(approach_velocity),
+        "worst_case_impulse": float(values[samples.inside(velocity)].max()),
+        "mean_impulse": float(values @ mean_weights(samples)),
     }
 
 
-def objective_scale(start_impulses: np.ndarray, start_mass: np.ndarray, velocity: float) -> dict[str, float]:
-    """Each objective's value at the start (impulses [N*s], motor masses [kg], approach velocity [m/s])."""
-    return objective_values(start_impulses, float(np.sum(start_mass)), velocity)
+def objective_values(
+    impulses: np.ndarray, actuator_mass: float, approach_velocity: float, samples: ContactSamples
+) -> dict[str, float]:
+    """Every objective of :data:`OBJECTIVES` for a design.
+
+    From its per-sample impulses [N*s] at ``samples``, total actuator mass [kg] and approach velocity [m/s].
+    """
+    return {
+        **impulse_objectives(impulses, samples, float(approach_velocity)),
+        "actuator_mass": float(actuator_mass),
+        "approach_velocity": float(approach_velocity),
+    }
 
 
 def add_epigraph(
@@ -98,21 +115,31 @@ def add_epigraph(
     scale: Mapping[str, float],
     x0: np.ndarray,
     lbx: np.ndarray,
+    samples: ContactSamples,
+    slowest: ca.MX | float,
 ) -> ca.MX:
     """Add ``t >= I_s`` for every sample to ``g`` and give the worst-case bound ``t`` [N*s].
 
-    ``x[index]`` is ``t`` divided by the start's worst case; it starts at 1 and is bounded below by 0.
+    ``x[index]`` is ``t`` divided by the start's worst case; it starts at 1 and is bounded below by 0. A sample
+    whose speed cap is below ``slowest`` [m/s], the least approach velocity the solve allows (its lower bound,
+    or an NLP parameter's bound), is outside the contact domain of every design of the solve: its row is
+    relaxed by :data:`RELAXED_ROW`.
     """
     t = x[index] * scale["worst_case_impulse"]
     x0[index] = 1.0
     lbx[index] = 0.0
-    g.add(
-        ca.transpose(t - impulses) / scale["worst_case_impulse"],
-        0.0,
-        np.inf,
-        [f"worst-case bound >= impulse of sample {s}" for s in range(impulses.shape[1])],
-    )
+    rows = ca.transpose(t - impulses) / scale["worst_case_impulse"]
+    caps = np.asarray(samples.speed_cap, dtype=float)
+    finite = np.isfinite(caps)
+    if np.any(finite):
+        capped = ca.DM(np.where(finite, caps, 0.0))
+        rows = rows + RELAXED_ROW * ca.DM(finite.astype(float)) * (slowest * (1 - SPEED_CAP_TOLERANCE) > capped)
+    g.add(rows, 0.0, np.inf, [f"worst-case bound >= impulse of sample {s}" for s in range(impulses.shape[1])])
     return t
+
+
+RELAXED_ROW = 1e9
+"""Added to the (start-normalised) worst-case row of a sample outside every design's domain of a solve."""
 
 
 def add_objective_bounds(

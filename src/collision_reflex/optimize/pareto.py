@@ -65,6 +65,7 @@ if TYPE_CHECKING:
     from .samples import ContactSamples
 
 _P = ParamSpec("_P")
+_R = TypeVar("_R")
 
 ANCHOR_SLACK = 1e-6
 """Relative slack on the first objective when the second is minimised at an anchor (lexicographic step): small
@@ -484,11 +485,15 @@ def built_problem(build: Hashable, objective: Hashable, bounded: tuple[str, ...]
     return problem
 
 
-def _one_at_a_time(function: Callable[_P, SweepPoint]) -> Callable[_P, SweepPoint]:
-    """Run a piece under the solver lock with single-threaded BLAS (the same numbers in every process)."""
+def one_at_a_time(function: Callable[_P, _R]) -> Callable[_P, _R]:
+    """Run a piece under the solver lock with single-threaded BLAS (the same numbers in every process).
+
+    Within one process the pieces run one at a time (a Dask worker with several threads): BLAS's thread count
+    is a process-wide setting, so a piece running beside another could see it changed under it.
+    """
 
     @functools.wraps(function)
-    def locked(*args: _P.args, **kwargs: _P.kwargs) -> SweepPoint:
+    def locked(*args: _P.args, **kwargs: _P.kwargs) -> _R:
         with _SOLVER_LOCK, single_threaded_blas():
             return function(*args, **kwargs)
 
@@ -587,7 +592,7 @@ def _others(names: Sequence[str], name: str) -> tuple[str, ...]:
     return tuple(other for other in names if other != name)
 
 
-@_one_at_a_time
+@one_at_a_time
 def solve_anchor(
     build: ProblemBuilder,
     objective: str,
@@ -661,7 +666,7 @@ def anchor_start(
     if known.x.size != target.x0.size:
         return None
     evaluated = target.evaluate(target.exact_point(known.x))
-    found = objective_values(evaluated[0], evaluated[1], evaluated[2])
+    found = objective_values(evaluated[0], evaluated[1], evaluated[2], target.samples)
     if not same_point(found, known.objectives, tuple(OBJECTIVES)):  # the same model at the same point: ~1e-15
         raise InvalidParameter(
             f"known optimum of {objective}",
@@ -712,7 +717,7 @@ def velocity_within_bound(
     return problem.exact_point(start)
 
 
-@_one_at_a_time
+@one_at_a_time
 def solve_point(
     build: ProblemBuilder,
     objectives: tuple[str, ...],
@@ -754,7 +759,7 @@ def solve_point(
     return SweepPoint(label, result)
 
 
-@_one_at_a_time
+@one_at_a_time
 def solve_alone(
     build: ProblemBuilder,
     objective: Hashable,

@@ -70,7 +70,7 @@ from .objectives import (
     add_objective_bounds,
     checked_bounded_objectives,
     objective_expression,
-    objective_scale,
+    objective_values,
     objective_terms,
     objective_weights,
 )
@@ -132,6 +132,7 @@ class DesignProblem:
     direction_scale: np.ndarray
     build_time: float
     duty: DutyRequirement | None
+    slowest_bound: float
     _joint_numbers: ca.Function = field(repr=False)
     _sample_function: ca.Function = field(repr=False)
     _sample_data: np.ndarray = field(repr=False)
@@ -164,7 +165,9 @@ class DesignProblem:
         x[self.compliance_index] = np.log(reaction_compliance(self.samples, torques))
         if self.epigraph_index is not None:
             impulses = np.asarray(self.evaluate(x)[0]).ravel()
-            x[self.epigraph_index] = impulses.max() / self.objective_scale["worst_case_impulse"]
+            x[self.epigraph_index] = _epigraph_value(
+                impulses, self.samples, self.slowest_bound, self.objective_scale
+            )
         return x
 
     def sample_parameters(self, x: np.ndarray) -> dict[str, np.ndarray]:
@@ -349,12 +352,20 @@ def build_problem(
     start_impulses = np.asarray(evaluate(x0)[0]).ravel()
     check_finite(start_impulses, "impulse at the start point", samples)
     velocity = layout.values(x0[:n_design])["approach_velocity"][0]
-    scale = objective_scale(start_impulses, start_mass, velocity)
-    expressions = objective_terms(impulses, actuator_mass, design.values["approach_velocity"])
+    scale = objective_values(start_impulses, float(np.sum(start_mass)), velocity, samples)
+    expressions = objective_terms(impulses, actuator_mass, design.values["approach_velocity"], samples)
 
     g = ConstraintList()
+    slowest_bound = float(layout.values(lbx[:n_design])["approach_velocity"][0])
     if epigraph_index is not None:
-        expressions["worst_case_impulse"] = add_epigraph(g, x, epigraph_index, impulses, scale, x0, lbx)
+        slowest: ca.MX | float = slowest_bound
+        if "approach_velocity" in bounded:  # the epsilon bound on the approach velocity, an NLP parameter
+            bound = -p[bounded.index("approach_velocity")] * scale["approach_velocity"]
+            slowest = ca.fmax(slowest_bound, bound)
+        expressions["worst_case_impulse"] = add_epigraph(
+            g, x, epigraph_index, impulses, scale, x0, lbx, samples, slowest
+        )
+        x0[epigraph_index] = _epigraph_value(start_impulses, samples, slowest_bound, scale)
     start_required = (
         required_torque(start_mass)
         if duty is None
@@ -398,11 +409,20 @@ def build_problem(
         direction_scale=per_sample.direction_scale,
         build_time=time.perf_counter() - started,
         duty=duty,
+        slowest_bound=slowest_bound,
         _joint_numbers=joint_numbers,
         _sample_function=per_sample.function,
         _sample_data=per_sample.data,
         _structure=_sample_structure(nlp, layout, design, per_sample, compliance_index, direction_index),
     )
+
+
+def _epigraph_value(
+    impulses: np.ndarray, samples: ContactSamples, slowest: float, scale: Mapping[str, float]
+) -> float:
+    """The scaled epigraph ``t`` that meets every worst-case row any solve keeps: the largest impulse [N*s] of
+    the samples whose speed cap reaches the slowest approach allowed (:func:`.objectives.add_epigraph`)."""
+    return float(np.max(impulses[samples.inside(slowest)])) / scale["worst_case_impulse"]
 
 
 class _SampleTerms(NamedTuple):

@@ -341,9 +341,12 @@ def design_record(
     """:func:`result_record` with what a report shows about the collisions.
 
     That is the impulse phases [N*s] and the optimal approach velocity [m/s] per sample (from ``problem``'s
-    samples), and each joint's nearest catalogue motor.
+    samples), the mean and the :data:`~.statistics.QUANTILE` quantile of the impulse over the drawn samples with
+    their sampling errors (``statistics``, :func:`~.statistics.impulse_statistics`), and each joint's nearest
+    catalogue motor.
     """
     from .evaluate import design_collision_parameters
+    from .statistics import QUANTILE, impulse_statistics
 
     record = result_record(result, label)
     design = result.design
@@ -359,6 +362,14 @@ def design_record(
         "reaction": np.broadcast_to(phases.reaction, params.m_f.shape).tolist(),
     }
     record["optimal_velocity"] = np.asarray(v_star, dtype=float).tolist()
+    drawn = np.asarray(problem.samples.drawn)
+    record["statistics"] = {
+        name: estimate.to_json()
+        for name, estimate in impulse_statistics(
+            np.asarray(result.impulses)[drawn], problem.samples.config_index[drawn]
+        ).items()
+    }
+    record["statistics"]["quantile_impulse"]["quantile"] = QUANTILE
     for i, joint in enumerate(record["joints"]):
         joint["nearest_catalogue_motor"] = (
             nearest_catalogue_motor(

@@ -25,6 +25,11 @@ if TYPE_CHECKING:
     from ..arm.samples import ArmSamples
 
 
+SPEED_CAP_TOLERANCE = 1e-6
+"""Relative amount by which a design's approach velocity may exceed a sample's speed cap with the sample still in
+its domain: an interior-point solve holds a velocity bound to about 1e-8 relative."""
+
+
 @dataclass(frozen=True)
 class ContactSamples:
     """Contact cases the design is evaluated on.
@@ -35,12 +40,20 @@ class ContactSamples:
     kinematics: :class:`collision_reflex.arm.ArmSamples` of the configurations.
     directions: (n_samples, task_dim) unit vectors.
     config_index: (n_samples,) index into the configurations.
+    speed_cap: (n_samples,) the fastest approach velocity [m/s] whose guarded move along the sample's direction
+        stays within the joint speed limits (the contact domain, :mod:`collision_reflex.arm.domain`): the sample
+        counts for designs approaching no faster; default ``inf`` (every design), as for samples drawn at the
+        fastest approach of the design space.
+    drawn: (n_samples,) True for samples drawn at random or given, False for points a worst-case search added;
+        means are taken over the drawn samples, worst cases over all (within their speed caps). Default all.
     """
 
     kinematics: ArmSamples
     directions: np.ndarray
     config_index: np.ndarray
     labels: tuple[str, ...] = field(default=())
+    speed_cap: np.ndarray | None = None
+    drawn: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         directions = np.atleast_2d(np.asarray(self.directions, dtype=float))
@@ -55,6 +68,14 @@ class ContactSamples:
             raise InvalidParameter("config_index", index, f"indices in [0, {self.kinematics.q.shape[0]})")
         object.__setattr__(self, "directions", directions / norms[:, None])
         object.__setattr__(self, "config_index", index)
+        cap = np.full(index.size, np.inf) if self.speed_cap is None else np.asarray(self.speed_cap, float).ravel()
+        if cap.shape != (index.size,) or not np.all(cap > 0):
+            raise InvalidParameter("speed_cap", self.speed_cap, f"{index.size} velocities > 0 [m/s] (inf: none)")
+        drawn = np.ones(index.size, bool) if self.drawn is None else np.asarray(self.drawn, dtype=bool).ravel()
+        if drawn.shape != (index.size,) or not np.any(drawn):
+            raise InvalidParameter("drawn", self.drawn, f"{index.size} flags, at least one sample drawn")
+        object.__setattr__(self, "speed_cap", cap)
+        object.__setattr__(self, "drawn", drawn)
 
     @classmethod
     def grid(cls, kinematics: ArmSamples, directions: np.ndarray) -> ContactSamples:
@@ -68,6 +89,11 @@ class ContactSamples:
     def size(self) -> int:
         """Number of samples."""
         return int(self.config_index.size)
+
+    def inside(self, velocity: float) -> np.ndarray:
+        """Which samples lie in the contact domain of a design approaching at ``velocity`` [m/s], (n,) bool."""
+        assert self.speed_cap is not None  # set in __post_init__
+        return np.asarray(self.speed_cap >= velocity * (1 - SPEED_CAP_TOLERANCE))
 
     @property
     def joint_moment_arms(self) -> np.ndarray:

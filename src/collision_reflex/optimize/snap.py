@@ -1018,7 +1018,7 @@ def evaluate_parts(problem: DesignProblem, design: Design, parts: Sequence[Catal
         shortfalls += _below(
             "gearbox input speed limit", figures.max_input_speed, "the motor speed", speed, names, "rad/s"
         )
-    objectives = objective_values(impulses, masses.sum(), snapped.approach_velocity)
+    objectives = objective_values(impulses, masses.sum(), snapped.approach_velocity, problem.samples)
     return PartsEvaluation(parts, snapped, objectives, required, tuple(shortfalls))
 
 

@@ -574,9 +574,11 @@ def _result(
     """The result at ``x``, found by the last of ``attempts`` (IPOPT's ``stats``), all timed."""
     design = design_at(problem, x)
     evaluated = problem.evaluate(problem.exact_point(x))
-    objectives = objective_values(evaluated[0], evaluated[1], evaluated[2])
+    objectives = objective_values(evaluated[0], evaluated[1], evaluated[2], problem.samples)
     numpy_impulses = evaluate_design(problem, design)
-    numpy_objectives = objective_values(numpy_impulses, design.actuator_mass.sum(), design.approach_velocity)
+    numpy_objectives = objective_values(
+        numpy_impulses, design.actuator_mass.sum(), design.approach_velocity, problem.samples
+    )
     check_agreement(objectives, numpy_objectives, OBJECTIVES)
     required = np.asarray(evaluated[4]).ravel()
     duty: dict[str, Any] = {}

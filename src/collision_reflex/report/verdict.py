@@ -14,6 +14,8 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any, Literal
 
+import numpy as np
+
 ACTIVE_TOLERANCE = 1e-3
 """Relative distance below which a design variable is at its bound, and a margin below which its constraint
 is active (the solver's own tolerances are far smaller: a bound or constraint this close is what set the value)."""
@@ -198,15 +200,113 @@ def design_sentence(record: Mapping[str, Any]) -> str:
     threshold = f"{_g(record['threshold'])} " + (
         "N" if record["sensing"] == "force" else "m (position error)"
     )
+    values = {**record["objectives"]}
+    if record.get("worst_case"):  # the worst case over the contact domain as searched, not over the samples
+        values["worst_case_impulse"] = record["worst_case"]["domain"]
     objectives = ", ".join(
-        f"{_words(name)} {_g(record['objectives'][name])} {unit}"
+        f"{_words(name)} {_g(values[name])} {unit}"
         for name, unit in (("worst_case_impulse", "N·s"), ("mean_impulse", "N·s"), ("actuator_mass", "kg"))
-        if name in record["objectives"]
+        if name in values
     )
     return (
         "; ".join(joints)
         + f"; threshold {threshold}, approach velocity {_g(record['approach_velocity'])} m/s ({objectives})."
     )
+
+
+def domain_sentence(domain: Mapping[str, Any], velocity: float, kept: float | None) -> str:
+    """Where the worst case is taken: the contact domain's floor, its speed check and what it keeps.
+
+    ``kept``: the fraction of the joint-limit box in the domain at ``velocity`` [m/s] (None: unknown).
+    """
+    floor = float(domain["min_singular_value"])
+    where = (
+        f"configurations within the joint limits whose contact Jacobian has a smallest singular value of at "
+        f"least {_g(floor * 1e3, 3)} mm ({_g(floor / domain['reach'], 2)} × the {_g(domain['reach'], 3)} m reach)"
+        if floor > 0
+        else "every configuration within the joint limits (no singular-value floor: near singular poses the "
+        "worst case is unbounded)"
+    )
+    share = f"; it keeps {_percent(100 * kept)} % of the joint-limit box" if kept is not None else ""
+    return (
+        f"Contact domain: {where}, hit along the directions the joints can follow at the approach velocity "
+        f"({_g(velocity)} m/s) within their speed limits{share}."
+    )
+
+
+def worst_case_sentences(
+    record: Mapping[str, Any], domain: Mapping[str, Any] | None, pareto: Mapping[str, Any]
+) -> list[str]:
+    """The recommended design's worst case over the contact domain, where it occurs, and how sure it is.
+
+    Also names the Pareto designs whose worst case the search could not certify.
+    """
+    worst = record.get("worst_case")
+    if not worst or domain is None:
+        return []
+    search = worst.get("searched")
+    lines = [domain_sentence(domain, float(record["approach_velocity"]), (search or {}).get("domain_kept"))]
+    if search is None:
+        lines.append(
+            f"Worst case {_g(worst['sampled'])} N·s over the samples; no search of the domain ran, so it is a "
+            "sampled value, not a bound."
+        )
+        return lines
+    pose = ", ".join(f"{np.degrees(v):.0f}" for v in search["q"])
+    direction = ", ".join(f"{v:+.2f}" for v in search["direction"])
+    effort = f"{search['starts']} local searches, {search['evaluations']:,} impulses evaluated"
+    if worst["certified"]:
+        lines.append(
+            f"Worst case {_g(worst['domain'])} N·s, certified over the domain: {effort}, none more than "
+            f"{_g(100 * worst['tolerance'], 2)} % above the samples' worst case {_g(worst['sampled'])} N·s. The "
+            f"searched worst pose: q = [{pose}] deg, contact direction u = [{direction}]."
+        )
+    else:
+        excess = worst["domain"] / worst["sampled"] - 1
+        lines.append(
+            f"Worst case NOT certified: the search ({effort}) found {_g(worst['domain'])} N·s, "
+            f"{_percent(100 * excess)} % above the samples' worst case {_g(worst['sampled'])} N·s, at q = [{pose}] "
+            f"deg along u = [{direction}]. Take {_g(worst['domain'])} N·s as the worst case found, not as a bound; "
+            "more search rounds (optimizer.worst_case_search.rounds) or samples may certify it."
+        )
+    uncertified = [
+        str(point.get("label", i))
+        for i, point in enumerate(pareto.get("points", ()))
+        if point.get("worst_case") and point["worst_case"].get("searched") and not point["worst_case"]["certified"]
+    ]
+    if uncertified:
+        lines.append(
+            f"Pareto designs whose worst case the search found above their samples' (not certified): "
+            + "; ".join(uncertified)
+            + "."
+        )
+    return lines
+
+
+def statistics_sentences(record: Mapping[str, Any], study: Mapping[str, Any]) -> list[str]:
+    """The recommended design's mean and high quantile with their sampling errors; a warning when the mean is
+    an objective and its error exceeds the study's ``samples.error_tolerance``."""
+    statistics = record.get("statistics")
+    if not statistics:
+        return []
+    mean, quantile = statistics["mean_impulse"], statistics["quantile_impulse"]
+    lines = [
+        f"Sampled statistics (99 % bootstrap intervals over {mean['configurations']} configurations, "
+        f"{mean['samples']:,} samples): mean impulse {_g(mean['value'])} N·s "
+        f"(± {_percent(100 * mean['relative_error'])} %), {_g(100 * quantile['quantile'], 3)}th percentile "
+        f"{_g(quantile['value'])} N·s (± {_percent(100 * quantile['relative_error'])} %)."
+    ]
+    tolerance = float((study.get("samples") or {}).get("error_tolerance", 0.02))
+    pareto = study.get("pareto") or {}
+    objectives = set(study.get("objective") or ()) | set(pareto.get("objectives") or ())
+    if "mean_impulse" in objectives and mean["relative_error"] > tolerance:
+        needed = int(np.ceil(mean["configurations"] * (mean["relative_error"] / tolerance) ** 2))
+        lines.append(
+            f"Warning: the mean impulse, an objective, is uncertain by {_percent(100 * mean['relative_error'])} %, "
+            f"more than the study's {_percent(100 * tolerance)} % (samples.error_tolerance): about {needed:,} "
+            "configurations (samples.configurations.random.count) would meet it."
+        )
+    return lines
 
 
 def objective_spans(points: Sequence[Mapping[str, Any]], objectives: Sequence[str]) -> dict[str, float]:
@@ -335,6 +435,8 @@ def verdict(results: Mapping[str, Any]) -> list[str]:
     lines = [f"Recommended design ({recommended.get('source', 'optimum')}): {design_sentence(recommended)}"]
     if reason:
         lines.append(f"Why this design: {reason}.")
+    lines += worst_case_sentences(recommended, results.get("domain"), results["pareto"])
+    lines += statistics_sentences(recommended, results.get("resolved") or {})
     lines.append(requirement_sentence(requirement))
     if results.get("speed_limits"):
         lines.append(str(results["speed_limits"]))

@@ -12,7 +12,7 @@ import hashlib
 import math
 import threading
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import Executor
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,8 +24,10 @@ from ..optimize.duty import torque_speed_points
 from ..optimize.pareto import MERGE_TOLERANCE, built_problem, recommend
 from ..optimize.results import design_record, undecided_variables
 from ..optimize.space import GLOBAL_VARIABLES, PER_JOINT_VARIABLES
+from ..optimize.worst_case import SEARCH_TOLERANCE, WorstCase
 from .arm_setup import ArmSetup, SampleLayout, StudyProblems, sample_layout
 from .schema import ArmStudy
+from .worst_case import worst_case_record
 
 if TYPE_CHECKING:
     from ..hardware.gearboxes import CatalogueGearbox
@@ -56,13 +58,15 @@ class ParetoRecord(TypedDict):
 class ArmResults(TypedDict):
     """An arm study's own part of ``designs.json``.
 
-    The samples, the chosen and recommended designs, the Pareto front, the bounds of the design variables
+    The samples and the contact domain they were drawn in, the chosen and recommended designs, the Pareto
+    front, the bounds of the design variables
     (``{variable: {joint: [lower, upper]}}`` and ``{threshold|approach_velocity: [lower, upper]}``, SI units)
     the kind of torque requirement (:attr:`collision_reflex.optimize.Constraints.requirement`) and, with a duty
     cycle, where the motors' speed limits come from.
     """
 
     samples: SampleLayout
+    domain: dict[str, Any]
     chosen: dict[str, Any]
     recommended: dict[str, Any]
     pareto: ParetoRecord
@@ -154,6 +158,8 @@ def arm_results(
     chosen: DesignResult,
     front: ParetoSet | None,
     catalogue: CatalogueRecord | None = None,
+    searches: Mapping[str, WorstCase] | None = None,
+    search_tolerance: float = SEARCH_TOLERANCE,
 ) -> ArmResults:
     """``samples``, ``chosen``, ``recommended``, ``pareto``, ``bounds`` and ``requirement`` of an arm study.
 
@@ -164,14 +170,18 @@ def arm_results(
     :func:`collision_reflex.optimize.results.undecided_variables`: ``{"variable", "joint"}`` each, the joint None
     for a global one), and with a duty cycle its ``torque_speed`` (:func:`torque_speed_record`). With
     ``catalogue`` (:func:`catalogue_results`), the results gain its ``catalogue`` entry and each Pareto design
-    (the chosen one without a front) its quick snap, ``catalogue``, with ``catalogue_part`` per joint.
+    (the chosen one without a front) its quick snap, ``catalogue``, with ``catalogue_part`` per joint. Each
+    design's ``worst_case`` says its worst case over the samples and over the contact domain as searched
+    (``searches`` by label, :func:`.worst_case.worst_case_record`); ``domain`` the domain itself.
     """
     setup = problems.setup
     # Every problem of a study shares its samples and technology: one of them evaluates every record.
     problem = built_problem(problems, problems.objective)
 
     def record(result: DesignResult, label: str) -> dict[str, Any]:
-        return design_record(problem, result, label, setup.catalogue)
+        out = design_record(problem, result, label, setup.catalogue)
+        out["worst_case"] = worst_case_record(result, (searches or {}).get(label), search_tolerance)
+        return out
 
     pareto: ParetoRecord = {"objectives": [], "points": [], "failed": [], "dominated": [], "merged": 0}
     chosen_record = record(chosen, "optimum")
@@ -205,6 +215,7 @@ def arm_results(
         recommended["torque_speed"] = torque_speed
     out: ArmResults = {
         "samples": sample_layout(setup),
+        "domain": domain_record(setup),
         "chosen": chosen_record,
         "recommended": recommended,
         "pareto": pareto,
@@ -220,6 +231,21 @@ def arm_results(
                 joint["catalogue_part"] = part
         out["catalogue"] = catalogue
     return out
+
+
+def domain_record(setup: ArmSetup) -> dict[str, Any]:
+    """The study's contact domain as plain data: its settings, how much of the box it keeps, searched samples.
+
+    ``kept`` is the fraction of the joint-limit box's (configuration, direction) pairs inside the domain at
+    ``sampling_velocity`` [m/s] (None when the configurations are listed); ``searched_samples`` the samples the
+    worst-case searches added (the last of ``samples``).
+    """
+    return {
+        **setup.domain.to_json(),
+        "kept": setup.domain_kept,
+        "sampling_velocity": setup.sampling_velocity,
+        "searched_samples": setup.searched,
+    }
 
 
 def _undecided(problems: StudyProblems, problem: DesignProblem, result: DesignResult) -> list[dict[str, Any]]:

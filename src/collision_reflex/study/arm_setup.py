@@ -8,6 +8,7 @@ process).
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from collections.abc import Hashable, Mapping
 from dataclasses import dataclass
@@ -21,12 +22,13 @@ from .duty import payload_of, study_duty_cycle
 from .load import LoadedStudy, parse_study
 from .prepare import check_motors, gearbox_for, joint_actuators, per_joint_bounds
 from .robot import load_arm
-from .samples import configuration_samples, direction_samples
+from .samples import configuration_samples, contact_domain, direction_samples, domain_draw
 from .schema import PER_JOINT_DESIGN_VARIABLES, ArmStudy
 from .source import PathKey
 
 if TYPE_CHECKING:
     from ..arm import Arm, DutyCycle
+    from ..arm.domain import ContactDomain
     from ..hardware.gearboxes import CatalogueGearbox
     from ..hardware.motors import Motor
     from ..optimize import ActuatorTechnology, Bounds, Constraints, ContactSamples, DesignProblem, DesignSpace
@@ -40,9 +42,13 @@ class ArmSetup:
     """Everything an arm study's solves need, built once per process.
 
     arm: the robot; catalogue: the motor catalogue by name; configurations: (n, nq) [rad]; directions:
-    (m, task_dim) unit vectors; samples: the optimiser's contact samples (every configuration with every
-    direction); space, technology, constraints: the optimiser's inputs; duty_cycle: the motion the arm must
-    make (with its payload), or ``None`` when the study gives none (:attr:`static_torque_requirement`).
+    (m, task_dim) unit vectors; samples: the optimiser's contact samples (each configuration with the
+    directions feasible there, then the points a worst-case search added); space, technology, constraints: the
+    optimiser's inputs; duty_cycle: the motion the arm must make (with its payload), or ``None`` when the study
+    gives none (:attr:`static_torque_requirement`); domain: where contacts are considered; domain_kept: the
+    fraction of the joint-limit box's (configuration, direction) pairs in it at ``sampling_velocity`` [m/s],
+    the fastest approach of the design space (None when the configurations are listed, not drawn); searched:
+    how many samples a worst-case search added (the last ones).
     """
 
     study: ArmStudy
@@ -54,7 +60,11 @@ class ArmSetup:
     space: DesignSpace
     technology: ActuatorTechnology
     constraints: Constraints
+    domain: ContactDomain
+    sampling_velocity: float
     duty_cycle: DutyCycle | None = None
+    domain_kept: float | None = None
+    searched: int = 0
 
     @property
     def static_torque_requirement(self) -> bool:
@@ -138,9 +148,19 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
             torque_required=study.constraints.torque_required,
             threshold_floor=study.constraints.threshold_floor,
         )
-    configurations = configuration_samples(loaded, arm)
     directions = direction_samples(loaded, arm)
-    samples = ContactSamples.grid(arm.kinematics(configurations), directions)
+    domain = contact_domain(loaded, arm)
+    velocity = space.approach_velocity
+    sampling_velocity = float(velocity.upper if isinstance(velocity, Bounds) else velocity)
+    kept = None
+    if study.samples.configurations.random is not None:
+        draw = domain_draw(loaded, arm, domain, directions, sampling_velocity)
+        configurations, kept = draw.q, draw.samples_kept
+        config_index, direction_index = np.nonzero(draw.feasible)
+        samples = ContactSamples(arm.kinematics(configurations), directions[direction_index], config_index)
+    else:
+        configurations = configuration_samples(loaded, arm)
+        samples = ContactSamples.grid(arm.kinematics(configurations), directions)
     return ArmSetup(
         study,
         arm,
@@ -151,8 +171,38 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
         space,
         technology,
         constraints,
+        domain,
+        sampling_velocity,
         duty_cycle=duty_cycle,
+        domain_kept=kept,
     )
+
+
+ExtraSamples = tuple[tuple[tuple[float, ...], tuple[float, ...]], ...]
+"""Samples a worst-case search added, as plain data: ``((q, u), ...)``, q [rad] (nq,), u unit (task_dim,)."""
+
+
+def with_extra_samples(setup: ArmSetup, extra: ExtraSamples) -> ArmSetup:
+    """``setup`` with the samples ``extra`` appended (each its own configuration), in order."""
+    from ..optimize import ContactSamples
+
+    if not extra:
+        return setup
+    q_extra = np.array([q for q, _ in extra], dtype=float)
+    u_extra = np.array([u for _, u in extra], dtype=float)
+    configurations = np.vstack([setup.configurations, q_extra])
+    base = setup.samples
+    kinematics = setup.arm.kinematics(configurations)
+    n_base = setup.configurations.shape[0]
+    caps = setup.domain.speed_caps(kinematics.jacobian[n_base:], u_extra)
+    samples = ContactSamples(
+        kinematics,
+        np.vstack([base.directions, u_extra]),
+        np.concatenate([base.config_index, n_base + np.arange(len(extra))]),
+        speed_cap=np.concatenate([np.asarray(base.speed_cap), caps]),
+        drawn=np.concatenate([np.asarray(base.drawn), np.zeros(len(extra), dtype=bool)]),
+    )
+    return dataclasses.replace(setup, configurations=configurations, samples=samples, searched=len(extra))
 
 
 def _check_supported(loaded: LoadedStudy, study: ArmStudy) -> None:
@@ -227,8 +277,10 @@ def _joint_gearboxes(
 
 
 @functools.lru_cache(maxsize=4)
-def setup_from_text(resolved_text: str) -> ArmSetup:
-    """The setup of a resolved study, built once per process."""
+def setup_from_text(resolved_text: str, extra: ExtraSamples = ()) -> ArmSetup:
+    """The setup of a resolved study with the searched samples ``extra``, built once per process."""
+    if extra:
+        return with_extra_samples(setup_from_text(resolved_text), extra)
     with single_threaded_blas():  # the same arithmetic in every process (see single_threaded_blas)
         return arm_setup(parse_study(resolved_text, "resolved study"))
 
@@ -249,10 +301,12 @@ class StudyProblems:
 
     Called as :func:`collision_reflex.optimize.pareto.pareto_front` builds them:
     ``StudyProblems(text)(objective, bounded)``, or on some of the samples (an active set)
-    ``StudyProblems(text)(objective, bounded, samples)``. Plain text inside, so it crosses process boundaries.
+    ``StudyProblems(text)(objective, bounded, samples)``. Plain text and numbers inside, so it crosses process
+    boundaries. ``extra``: samples a worst-case search added to the study's (the exchange method).
     """
 
     resolved_text: str
+    extra: ExtraSamples = ()
 
     def __call__(
         self, objective: Hashable, bounded: tuple[str, ...] = (), samples: ContactSamples | None = None
@@ -263,7 +317,7 @@ class StudyProblems:
         """
         from ..optimize import build_problem
 
-        setup = setup_from_text(self.resolved_text)
+        setup = self.setup
         weighted: Any = objective if isinstance(objective, str) else dict(objective)  # type: ignore[call-overload]
         return build_problem(
             setup.arm,
@@ -278,7 +332,7 @@ class StudyProblems:
     @property
     def setup(self) -> ArmSetup:
         """The study's setup, rebuilt from the resolved text (once per process)."""
-        return setup_from_text(self.resolved_text)
+        return setup_from_text(self.resolved_text, self.extra)
 
     @property
     def objective(self) -> Hashable:

@@ -122,7 +122,7 @@ def _through_via_points(
                 )
             )
     limits = {
-        name: _per_joint(loaded, name, getattr(spec, name), joints, problems)
+        name: per_joint_values(loaded, (*_SECTION, name), getattr(spec, name), joints, problems)
         for name in ("max_speed", "max_acceleration")
     }
     if problems:
@@ -159,10 +159,10 @@ def _position_limits(arm: Arm) -> tuple[np.ndarray, np.ndarray]:
     return lower, upper
 
 
-def _per_joint(
-    loaded: LoadedStudy, name: str, value: Any, joints: list[str], problems: list[StudyProblem]
+def per_joint_values(
+    loaded: LoadedStudy, path: tuple[str, ...], value: Any, joints: list[str], problems: list[StudyProblem]
 ) -> np.ndarray:
-    """A limit given for every joint (a number) or by joint name (a mapping naming every joint)."""
+    """A limit at ``path`` given for every joint (a number) or by joint name (a mapping naming every joint)."""
     if not isinstance(value, Mapping):
         return np.full(len(joints), float(value))
     unknown = [key for key in value if key not in joints]
@@ -170,13 +170,13 @@ def _per_joint(
     for key in unknown:
         problems.append(
             loaded.problem(
-                (*_SECTION, name, key), f"joint {key!r}, not a joint of the arm", ", ".join(joints)
+                (*path, key), f"joint {key!r}, not a joint of the arm", ", ".join(joints)
             )
         )
     if missing:
         problems.append(
             loaded.problem(
-                (*_SECTION, name),
+                path,
                 "no limit for " + ", ".join(missing),
                 "a limit for every joint (or one number for all)",
             )

@@ -190,6 +190,8 @@ def describe_study(loaded: LoadedStudy, load_robot: bool = True) -> str:
         n_joints = len(arm.joint_names)
         n_config, n_dir = sample_counts(loaded, arm)  # random samples are counted, not drawn
         text += f" ({n_joints} joints: {', '.join(arm.joint_names)}), {n_config} configurations x {n_dir} directions"
+        if study.samples.configurations.random is not None:
+            text += " (those feasible there), drawn in the contact domain"
         cycle_summary = describe_duty_cycle(study_duty_cycle(loaded, arm), study, prismatic_joints(arm))
     else:
         cycle_summary = _duty_cycle_spec_summary(study)

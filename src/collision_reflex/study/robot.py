@@ -39,7 +39,7 @@ def load_arm(loaded: LoadedStudy) -> Arm:
     spec = study.robot
     from ..arm import Arm
 
-    offset = list(spec.contact_offset)
+    offset = None if spec.contact_offset is None else list(spec.contact_offset)
     locked = list(spec.locked_joints)
     try:
         if spec.example_robot_data is not None:

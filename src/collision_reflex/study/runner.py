@@ -17,16 +17,20 @@ from collections.abc import Callable
 from concurrent.futures import Executor
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, cast
+from typing import TYPE_CHECKING, Any, cast
 
 from .._interrupt import caused_by_interrupt
 from ..report.outputs import StageTimes
 from .arm_results import CatalogueRecord, SnapCatalogue, arm_results, catalogue_results, study_catalogue
+from .arm_setup import ExtraSamples
 from .executors import open_executor
 from .load import LoadedStudy, load_study, parse_study
 from .resolve import fingerprint, resolved_study, resolved_yaml
 from .schema import ActuatorStudy, ArmStudy
 from .store import OutputFolderUnusable, RunFolder
+
+if TYPE_CHECKING:
+    from ..optimize import DesignResult, ParetoSet
 
 SMOKE_ENVIRONMENT = "CRX_SMOKE"
 """Set to 1 to run every study with small sample counts (tests, quick checks): see :func:`smoke_study`."""
@@ -57,8 +61,8 @@ class RunResult:
 def smoke_study(data: dict[str, Any]) -> dict[str, Any]:
     """A resolved study shrunk for a quick run.
 
-    A few configurations, directions, Pareto points and velocities. The shrunk study is what the run records
-    as its resolved study.
+    A few configurations, directions, Pareto points and velocities, and a lighter worst-case search. The shrunk
+    study is what the run records as its resolved study.
     """
     data = {**data}
     if data.get("kind") == "actuator":
@@ -85,7 +89,14 @@ def smoke_study(data: dict[str, Any]) -> dict[str, Any]:
     for key in ("named", "list"):
         if directions.get(key):
             directions[key] = directions[key][:4]
-    data["samples"] = {"configurations": configurations, "directions": directions}
+    data["samples"] = {**samples, "configurations": configurations, "directions": directions}
+    optimizer = {**data.get("optimizer", {})}
+    search = {**optimizer.get("worst_case_search", {})}
+    if search:  # a lighter search: a few starts, two rounds
+        search.update(
+            starts=min(search["starts"], 3), random_starts=min(search["random_starts"], 2), rounds=min(search["rounds"], 2)
+        )
+        data["optimizer"] = {**optimizer, "worst_case_search": search}
     data.pop("simulate", None)  # the time-domain simulation is no quick check
     if data.get("pareto"):
         data["pareto"] = {**data["pareto"], "points": min(data["pareto"]["points"], 4)}
@@ -280,18 +291,86 @@ def _run_arm(
 ) -> tuple[dict[str, Any], tuple[int, int]]:
     """The study's optimum (multi-started), its Pareto front by the optimiser's one sweep, and the verdict.
 
-    Each stage is timed into ``stages``.
+    Each stage is timed into ``stages``. After each round of solves, every design's worst case is searched
+    over the contact domain (:mod:`.worst_case`); with a worst-case objective the violators join the samples and
+    the next round solves on them, until none is found or ``optimizer.worst_case_search.rounds`` is reached.
 
     Then, with a ``catalogue``, the recommended design and every Pareto design snapped to it
     (:func:`.arm_results.catalogue_results`). Each piece is saved as it finishes and found again when the run
     resumes (the snap as ``catalogue``, reused while the catalogue file and the settings are the same).
     """
+    from ..report.verdict import verdict
+    from .arm_setup import StudyProblems
+    from .worst_case import exchanges_samples, search_designs, violators
+
+    search = study.optimizer.worst_case_search
+    extra: ExtraSamples = ()
+    computed = reused = 0
+    for round_ in range(search.rounds if search.enabled else 1):
+        problems = StudyProblems(text, extra)
+        prefix = f"round-{round_}-{_digest(extra)}-" if extra else ""
+        optimum, front, counts = _solve_round(problems, study, folder, pool, progress, window, stages, prefix)
+        computed, reused = computed + counts[0], reused + counts[1]
+        if not search.enabled:
+            searches = {}
+            break
+        designs = {"optimum": optimum, **(dict(zip(front.labels, front.points, strict=True)) if front else {})}
+        searches = stages.timed("worst-case search", search_designs)(problems, designs, search, pool)
+        added = violators(designs, searches, search.tolerance)
+        if not added or not exchanges_samples(study) or round_ == search.rounds - 1:
+            break
+        extra = extra + added
+    snapped = None
+    if catalogue is not None:
+        saved = folder.finished(prefix + "catalogue")
+        if saved is not None and saved.get("key") == catalogue.key:
+            snapped, reused = cast("CatalogueRecord", saved), reused + 1
+        else:
+            snapped = stages.timed("catalogue snap", catalogue_results)(
+                problems, optimum, front, catalogue, progress.counter("catalogue snap"), pool
+            )
+            folder.save(prefix + "catalogue", dict(snapped))
+            computed += 1
+    results = {
+        "kind": "arm",
+        "study": study.name,
+        "description": study.description,
+        "resolved": resolved_study(parse_study(text, "resolved study")),
+        **stages.timed("results", arm_results)(problems, optimum, front, snapped, searches, search.tolerance),
+    }
+    if study.simulate is not None:
+        from ..optimize.pareto import recommend
+        from .simulate_design import simulate_designs
+
+        recommended = recommend(optimum, front, problems.objective).result
+        results["simulation"] = stages.timed("simulation", simulate_designs)(
+            problems, recommended, front, study.simulate, folder
+        )
+    results["verdict"] = stages.timed("results", verdict)(results)
+    return results, (computed, reused)
+
+
+def _solve_round(
+    problems: StudyProblems,
+    study: ArmStudy,
+    folder: RunFolder,
+    pool: Executor,
+    progress: _Progress,
+    window: int,
+    stages: StageTimes,
+    prefix: str,
+) -> tuple[DesignResult, ParetoSet | None, tuple[int, int]]:
+    """The optimum (multi-started) and the Pareto front of ``problems``; their pieces saved under ``prefix``."""
     from ..errors import SolverFailed, StudyRunFailed
     from ..optimize.pareto import OPTIMUM_STARTS, known_optima, pareto_front, single_optimum
-    from ..report.verdict import verdict
-    from .arm_setup import IPOPT_OPTIONS, StudyProblems
+    from .arm_setup import IPOPT_OPTIONS
 
-    problems = StudyProblems(text)
+    def finished(name: str) -> dict[str, Any] | None:
+        return folder.finished(prefix + name)
+
+    def save(name: str, record: dict[str, Any]) -> None:
+        folder.save(prefix + name, record)
+
     try:
         optimum, found = stages.timed("optimum", single_optimum)(
             problems,
@@ -299,8 +378,8 @@ def _run_arm(
             IPOPT_OPTIONS,
             progress.counter("optimum of the study's objective"),
             executor=pool,
-            finished=folder.finished,
-            save=folder.save,
+            finished=finished,
+            save=save,
             starts=OPTIMUM_STARTS,
             active_set=problems.active_set,
         )
@@ -319,42 +398,22 @@ def _run_arm(
                 anchor_starts=study.pareto.anchor_starts,
                 executor=pool,
                 in_flight=window,
-                finished=folder.finished,
-                save=folder.save,
+                finished=finished,
+                save=save,
                 active_set=problems.active_set,
                 known=known_optima(problems.objective, optimum, study.pareto.anchor_starts),
             )
         except SolverFailed as error:
             raise StudyRunFailed(str(error.args[0]), "anchor", error.status) from None
         computed, reused = computed + front.computed, reused + front.reused
-    snapped = None
-    if catalogue is not None:
-        saved = folder.finished("catalogue")
-        if saved is not None and saved.get("key") == catalogue.key:
-            snapped, reused = cast("CatalogueRecord", saved), reused + 1
-        else:
-            snapped = stages.timed("catalogue snap", catalogue_results)(
-                problems, optimum, front, catalogue, progress.counter("catalogue snap"), pool
-            )
-            folder.save("catalogue", dict(snapped))
-            computed += 1
-    results = {
-        "kind": "arm",
-        "study": study.name,
-        "description": study.description,
-        "resolved": resolved_study(parse_study(text, "resolved study")),
-        **stages.timed("results", arm_results)(problems, optimum, front, snapped),
-    }
-    if study.simulate is not None:
-        from ..optimize.pareto import recommend
-        from .simulate_design import simulate_designs
+    return optimum, front, (computed, reused)
 
-        recommended = recommend(optimum, front, problems.objective).result
-        results["simulation"] = stages.timed("simulation", simulate_designs)(
-            problems, recommended, front, study.simulate, folder
-        )
-    results["verdict"] = stages.timed("results", verdict)(results)
-    return results, (computed, reused)
+
+def _digest(extra: ExtraSamples) -> str:
+    """A short digest of searched samples: the pieces solved on them are saved under it."""
+    import hashlib
+
+    return hashlib.sha256(repr(extra).encode()).hexdigest()[:10]
 
 
 def _run_actuators(

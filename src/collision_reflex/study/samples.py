@@ -1,8 +1,10 @@
-"""Configurations and contact directions of a study's samples.
+"""Configurations and contact directions of a study's samples, and the contact domain they are drawn in.
 
 Directions are unit vectors in the arm's task coordinates (2 components for a planar arm, 3 otherwise). The
 circle and sphere samplings are deterministic (evenly spread), and random configurations come from the study's
-seed, so a study's numbers depend only on its file.
+seed, so a study's numbers depend only on its file. Random configurations are drawn in the study's contact
+domain (:class:`collision_reflex.arm.domain.ContactDomain`), each with the directions feasible there; listed
+and trajectory configurations are taken as given, with every direction.
 """
 
 from __future__ import annotations
@@ -13,13 +15,16 @@ import numpy as np
 
 from .._table import TableProblem, header_index, read_table
 from ..arm.directions import circle_directions, sphere_directions, unit_directions
-from ..errors import InvalidParameter
+from ..arm.domain import ContactDomain, DomainTooSmall
+from ..errors import InvalidParameter, StudyFileError, StudyProblem
+from .duty import per_joint_values
 from .load import LoadedStudy
 from .schema import ArmStudy, ConfigurationSamples, DirectionSamples
 from .source import excerpt
 
 if TYPE_CHECKING:
     from ..arm import Arm
+    from ..arm.domain import DomainDraw
 
 
 def direction_samples(loaded: LoadedStudy, arm: Arm) -> np.ndarray:
@@ -49,19 +54,50 @@ def direction_samples(loaded: LoadedStudy, arm: Arm) -> np.ndarray:
     return np.array(out)
 
 
-def configuration_samples(loaded: LoadedStudy, arm: Arm) -> np.ndarray:
-    """The configurations of an arm study [rad], shape (n, nq).
+def contact_domain(loaded: LoadedStudy, arm: Arm) -> ContactDomain:
+    """The study's contact domain (``samples.domain``), its speed limits checked against the arm's joints."""
+    study = loaded.study
+    assert isinstance(study, ArmStudy)
+    spec = study.samples.domain
+    limits = None
+    if spec.joint_speed_limit is not None:
+        problems: list[StudyProblem] = []
+        limits = per_joint_values(
+            loaded, ("samples", "domain", "joint_speed_limit"), spec.joint_speed_limit, list(arm.joint_names), problems
+        )
+        if problems:
+            raise StudyFileError(loaded.source.file, problems)
+    return ContactDomain.of_arm(arm, spec.min_singular_value, limits)
 
-    Random configurations come from ``arm.sample_configurations`` with ``numpy.random.default_rng(seed)``; a
-    trajectory is a CSV file with one column per joint, named by the joint's name (other columns, e.g. time,
-    are ignored), of which every ``every``-th row is used.
+
+def domain_draw(
+    loaded: LoadedStudy, arm: Arm, domain: ContactDomain, directions: np.ndarray, velocity: float
+) -> DomainDraw:
+    """The study's random configurations drawn in ``domain``, with the ``directions`` feasible at ``velocity``.
+
+    ``velocity`` [m/s] is the fastest approach the design space allows, so that every sample is in the domain
+    of every design. A domain that keeps almost nothing is refused at ``samples.domain``.
+    """
+    study = loaded.study
+    assert isinstance(study, ArmStudy) and study.samples.configurations.random is not None
+    spec = study.samples.configurations.random
+    try:
+        return domain.draw(arm, spec.count, directions, velocity, np.random.default_rng(spec.seed))
+    except DomainTooSmall as error:
+        raise loaded.fail(("samples", "domain"), str(error.value), f"{error.allowed}; {error.hint}") from None
+
+
+def configuration_samples(loaded: LoadedStudy, arm: Arm) -> np.ndarray:
+    """The listed or trajectory configurations of an arm study [rad], shape (n, nq).
+
+    A trajectory is a CSV file with one column per joint, named by the joint's name (other columns, e.g.
+    time, are ignored), of which every ``every``-th row is used. Random configurations are drawn in the
+    contact domain by :func:`domain_draw`.
     """
     study = loaded.study
     assert isinstance(study, ArmStudy)
     spec: ConfigurationSamples = study.samples.configurations
-    if spec.random is not None:
-        rng = np.random.default_rng(spec.random.seed)
-        return np.asarray(arm.sample_configurations(spec.random.count, rng), dtype=float)
+    assert spec.random is None, "random configurations are drawn in the domain (domain_draw)"
     if spec.list is not None:
         return np.asarray(arm.configuration(np.asarray(spec.list, dtype=float)), dtype=float)
     assert spec.trajectory is not None  # exactly one source is guaranteed by the schema

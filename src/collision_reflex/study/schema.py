@@ -97,8 +97,10 @@ class RobotSpec(_Model):
     contact_frame: str | None = Field(
         None, description="frame of the contact point (default: the robot's tip)"
     )
-    contact_offset: tuple[Offset, Offset, Offset] = Field(
-        (0.0, 0.0, 0.0), description="contact point in the contact frame [m]"
+    contact_offset: tuple[Offset, Offset, Offset] | None = Field(
+        None,
+        description="contact point in the contact frame [m]; null: the robot's default with its default frame "
+        "(the double pendulum's tip, 0.2 m along its second link), else the frame's origin",
     )
     locked_joints: list[str] = Field(default_factory=list, description="joints held fixed (not actuated)")
 
@@ -324,11 +326,41 @@ class DirectionSamples(_Model):
         return self
 
 
+SingularValueFloor = quantity_type("m", "a length", "0.08 m", 0.0, 100.0)
+
+
+class DomainSpec(_Model):
+    """Where contacts are considered: the domain a worst case is taken over.
+
+    Configurations within the joint limits whose contact Jacobian has ``sigma_min(J_v)`` at least
+    ``min_singular_value``, and directions along which the guarded move at the approach velocity stays within
+    the joint speed limits (``J_v^+ u v0``). Random configurations are drawn in it.
+    """
+
+    min_singular_value: SingularValueFloor | None = Field(
+        None,
+        description="floor on the smallest singular value of the contact Jacobian [m]; null: a tenth of the "
+        "arm's reach (the largest base-to-contact distance); 0: no floor (near singular poses the finger mass, "
+        "and so the worst case, is unbounded)",
+    )
+    joint_speed_limit: JointSpeed | None = Field(
+        None,
+        description="joint speed limits of the guarded move [rad/s], one for all or by joint name; null: the "
+        "URDF's velocity limits (a joint without one is not limited)",
+    )
+
+
 class SamplesSpec(_Model):
-    """The contact samples: arm configurations crossed with contact directions."""
+    """The contact samples: arm configurations crossed with contact directions, within the contact domain."""
 
     configurations: ConfigurationSamples
     directions: DirectionSamples
+    domain: DomainSpec = Field(default_factory=DomainSpec)  # type: ignore[arg-type]
+    error_tolerance: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = Field(
+        0.02,
+        description="largest relative sampling error (99 % bootstrap interval) of a mean impulse objective "
+        "before the report warns and names the configurations that would meet it",
+    )
 
 
 # --- duty cycle --------------------------------------------------------------------------------------------------
@@ -704,8 +736,34 @@ class SimulateSpec(_Model):
         return value
 
 
+class SearchSpec(_Model):
+    """The adversarial search of the contact domain that certifies each design's worst case.
+
+    After the solves, the impulse of each design is maximised over the domain from its worst samples and from
+    random points; the maxima above the design's worst case by more than ``tolerance`` join the samples, and
+    the solves are repeated (the exchange method), at most ``rounds`` times.
+    """
+
+    enabled: bool = Field(True, description="search the domain after the solves; false: samples only")
+    starts: Annotated[int, Field(ge=1, le=64, strict=True)] = Field(
+        6, description="local searches from the worst samples of each design"
+    )
+    random_starts: Annotated[int, Field(ge=0, le=64, strict=True)] = Field(
+        4, description="local searches from random points of the domain, per design"
+    )
+    tolerance: Annotated[float, Field(gt=0, le=0.5, allow_inf_nan=False)] = Field(
+        0.005, description="relative excess over the reported worst case that makes a searched point a violator"
+    )
+    rounds: Annotated[int, Field(ge=1, le=10, strict=True)] = Field(
+        4, description="most solve-and-search rounds; a worst case still exceeded after them is reported so"
+    )
+    seed: int = Field(0, ge=0, lt=2**64, strict=True, description="seed of the random starts")
+
+
 class OptimizerSpec(_Model):
     """How the optimiser solves the study's problems (the numbers agree within the solver's tolerance)."""
+
+    worst_case_search: SearchSpec = Field(default_factory=SearchSpec)  # type: ignore[arg-type]
 
     active_set: Literal["auto", "always", "never"] = Field(
         "auto",

@@ -1,0 +1,119 @@
+"""Does a run's reported worst case hold on fresh samples it was not optimised on?
+
+    PYTHONPATH=src python benchmarks/worst_case_fresh.py RUN_FOLDER [--samples 20000] [--seed 1] [--design recommended]
+
+Reads the run's ``designs.json`` (the design, the contact domain it reports and the study), draws ``--samples``
+configurations uniformly within the joint limits and directions uniformly on the sphere (the circle for a planar
+arm) with its own generator, keeps the pairs inside the reported domain (smallest singular value of the contact
+Jacobian at least the floor; the guarded move ``J^+ u v0`` within the joint speed limits at the design's approach
+velocity) and evaluates the design's impulse there (NumPy path). It prints the fraction of the box the domain
+keeps, the largest fresh impulse against the reported worst case (``worst_case.domain``) and their ratio, and the
+same without the domain (every fresh pair), to show what the domain excludes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+
+
+def design_of(record: dict, sensing: str):
+    """A :class:`collision_reflex.optimize.solve.Design` from a design record of ``designs.json``."""
+    from collision_reflex.optimize.solve import Design
+
+    joints = record["joints"]
+
+    def column(name: str) -> np.ndarray:
+        return np.array([j[name] for j in joints], dtype=float)
+
+    return Design(
+        joint_names=tuple(j["joint"] for j in joints),
+        stator_diameter=column("stator_diameter"),
+        stack_length=column("stack_length"),
+        gear_ratio=column("gear_ratio"),
+        software_stiffness=column("software_stiffness"),
+        mechanical_stiffness=column("mechanical_stiffness"),
+        rotor_inertia=column("rotor_inertia"),
+        reflected_inertia=column("reflected_inertia"),
+        motor_peak_torque=column("motor_peak_torque"),
+        peak_torque=column("peak_torque"),
+        motor_mass=column("motor_mass"),
+        threshold=float(record["threshold"]),
+        approach_velocity=float(record["approach_velocity"]),
+        sensing=sensing,
+        gearbox=tuple(j["gearbox"] for j in joints),
+        gearbox_mass=column("gearbox_mass"),
+        gearbox_inertia=column("gearbox_inertia"),
+        gearbox_efficiency=column("gearbox_efficiency"),
+    )
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("run", type=Path)
+    parser.add_argument("--samples", type=int, default=20_000)
+    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--design", default="recommended", help="recommended, chosen, or a Pareto index")
+    args = parser.parse_args()
+
+    from collision_reflex.arm.domain import smallest_singular_values, unit_speed_joint_rates
+    from collision_reflex.optimize.evaluate import sample_impulses
+    from collision_reflex.optimize.samples import ContactSamples
+    from collision_reflex.study.arm_setup import StudyProblems
+    from collision_reflex.study.load import parse_study
+    from collision_reflex.study.resolve import resolved_yaml
+
+    results = json.loads((args.run / "designs.json").read_text())
+    text = resolved_yaml(parse_study(_yaml(results["resolved"]), "resolved study"))
+    setup = StudyProblems(text).setup
+    arm, technology = setup.arm, setup.technology
+    record = (
+        results["pareto"]["points"][int(args.design)] if args.design.isdigit() else results[args.design]
+    )
+    design = design_of(record, setup.technology.sensing)
+    domain = results["domain"]
+    rng = np.random.default_rng(args.seed)
+    started = time.perf_counter()
+    lower, upper = np.array(domain["joint_lower"]), np.array(domain["joint_upper"])
+    q = arm.configuration(rng.uniform(lower, upper, size=(args.samples, lower.size)))
+    u = rng.normal(size=(args.samples, arm.task_dim))
+    u /= np.linalg.norm(u, axis=1)[:, None]
+    kinematics = arm.kinematics(q)
+    jacobian = kinematics.jacobian
+    limits = np.array([np.inf if v is None else v for v in domain["joint_speed_limit"]])
+    floor_ok = smallest_singular_values(jacobian) >= domain["min_singular_value"]
+    rates = np.abs(unit_speed_joint_rates(jacobian, u)) * design.approach_velocity
+    inside = floor_ok & np.all(rates <= limits, axis=1)
+    with np.errstate(all="ignore"):
+        impulses = sample_impulses(ContactSamples(kinematics, u, np.arange(args.samples)), technology, design)
+    reported = record["worst_case"]["domain"]
+    fresh = float(impulses[inside].max())
+    print(f"run: {args.run}  design: {args.design} ({record['label']})  load {os.getloadavg()[0]:.2f}")
+    print(
+        f"domain: sigma_min >= {domain['min_singular_value']:.4g} m (reach {domain['reach']:.4g} m), "
+        f"v0 = {design.approach_velocity:.4g} m/s; keeps {inside.mean():.1%} of {args.samples} fresh pairs "
+        f"(configurations {floor_ok.mean():.1%})"
+    )
+    print(
+        f"reported worst case {reported:.6g} N*s (sampled {record['worst_case']['sampled']:.6g}); "
+        f"fresh in the domain {fresh:.6g} N*s: ratio {fresh / reported:.4f}"
+    )
+    print(
+        f"fresh without the domain {float(np.nanmax(impulses)):.6g} N*s: ratio "
+        f"{float(np.nanmax(impulses)) / reported:.3f}  ({time.perf_counter() - started:.1f} s)"
+    )
+
+
+def _yaml(data: dict) -> str:
+    import yaml
+
+    return yaml.safe_dump(data, sort_keys=False)
+
+
+if __name__ == "__main__":
+    main()

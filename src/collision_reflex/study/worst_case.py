@@ -1,0 +1,128 @@
+"""An arm study's worst cases certified over its contact domain: the searches and the exchange of samples.
+
+After a round of solves (the optimum and the Pareto front), each design's impulse is maximised over the contact
+domain (:func:`collision_reflex.optimize.worst_case.search_worst_case`), from its worst samples and from random
+points of the domain. When the study's objectives include the worst case, the maxima above a design's worst case
+by more than the search's tolerance join the samples (:data:`~.arm_setup.ExtraSamples`), and the runner solves
+again on them: the exchange method for semi-infinite programs.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from concurrent.futures import Executor
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..optimize.pareto import one_at_a_time
+from ..optimize.worst_case import WorstCase, search_worst_case
+from .arm_setup import ExtraSamples, StudyProblems
+from .schema import ArmStudy, SearchSpec
+
+if TYPE_CHECKING:
+    from ..optimize import DesignResult
+    from ..optimize.solve import Design
+
+
+def exchanges_samples(study: ArmStudy) -> bool:
+    """Whether the study's problems minimise or bound the worst case, so that violators join the samples.
+
+    A mean impulse is a statistic of the drawn samples: adding searched points would bias it, so a study
+    without a worst-case objective only reports its searched worst cases.
+    """
+    named = set(study.objective) | set(study.pareto.objectives if study.pareto is not None else ())
+    return "worst_case_impulse" in named
+
+
+@one_at_a_time
+def _search_one(
+    problems: StudyProblems,
+    design: Design,
+    start_q: np.ndarray,
+    start_directions: np.ndarray,
+    random_starts: int,
+    seed: tuple[int, int],
+) -> WorstCase:
+    """One design's search (a piece of work for an executor: picklable arguments, run in any process)."""
+    setup = problems.setup
+    return search_worst_case(
+        setup.arm,
+        setup.domain,
+        setup.technology,
+        design,
+        start_q,
+        start_directions,
+        random_starts=random_starts,
+        rng=np.random.default_rng(list(seed)),
+    )
+
+
+def worst_samples(problems: StudyProblems, impulses: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """The ``count`` samples of largest impulse with distinct configurations: (q (k, nq), directions (k, d))."""
+    samples = problems.setup.samples
+    order = np.argsort(np.asarray(impulses, dtype=float))[::-1]
+    picked: list[int] = []
+    seen: set[int] = set()
+    for s in order:
+        config = int(samples.config_index[s])
+        if config not in seen:
+            seen.add(config)
+            picked.append(int(s))
+        if len(picked) == count:
+            break
+    index = np.array(picked, dtype=int)
+    return samples.kinematics.q[samples.config_index[index]], samples.directions[index]
+
+
+def search_designs(
+    problems: StudyProblems,
+    results: Mapping[str, DesignResult],
+    spec: SearchSpec,
+    executor: Executor,
+) -> dict[str, WorstCase]:
+    """Each design's searched worst case over the study's domain, by label, through ``executor``."""
+    futures = {}
+    for index, (label, result) in enumerate(results.items()):
+        start_q, start_directions = worst_samples(problems, result.impulses, spec.starts)
+        futures[label] = executor.submit(
+            _search_one,
+            problems,
+            result.design,
+            start_q,
+            start_directions,
+            spec.random_starts,
+            (spec.seed, index),
+        )
+    return {label: future.result() for label, future in futures.items()}
+
+
+def violators(
+    results: Mapping[str, DesignResult], searches: Mapping[str, WorstCase], tolerance: float
+) -> ExtraSamples:
+    """The searched points above their design's sampled worst case by more than ``tolerance``, as samples."""
+    found: list[tuple[tuple[float, ...], tuple[float, ...]]] = []
+    for label, search in searches.items():
+        level = results[label].numpy_objectives["worst_case_impulse"]
+        for i in search.violators(level, tolerance):
+            found.append((tuple(map(float, search.maxima_q[i])), tuple(map(float, search.maxima_directions[i]))))
+    return tuple(dict.fromkeys(found))  # one sample per point, in order
+
+
+def worst_case_record(result: DesignResult, search: WorstCase | None, tolerance: float) -> dict[str, Any]:
+    """What a design's record says of its worst case: over the samples, as searched, and whether it holds.
+
+    ``sampled`` [N*s] the largest impulse over the samples in the design's domain; ``searched`` the search's result (None when none
+    ran); ``domain`` [N*s] the larger of the two, the worst case over the domain as far as it was searched;
+    ``certified``: no searched point exceeds the sampled worst case by more than ``tolerance``.
+    """
+    sampled = float(result.numpy_objectives["worst_case_impulse"])
+    if search is None:
+        return {"sampled": sampled, "searched": None, "domain": sampled, "certified": False}
+    return {
+        "sampled": sampled,
+        "searched": search.to_json(),
+        "domain": max(sampled, search.impulse),
+        "certified": bool(search.impulse <= sampled * (1 + tolerance)),
+        "tolerance": tolerance,
+    }
