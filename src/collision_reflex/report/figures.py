@@ -108,6 +108,24 @@ def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
             title=f"impulse by contact direction [N*s]: {title}",
         )
         svgs[f"surface-{index}"] = _draw(directory, f"impulse_directions_{index}", formats, draw)
+    pose = (results.get("recommended") or {}).get("worst_case", {}).get("pose")
+    if pose is not None:
+        from ..plots.worst_pose import plot_worst_pose
+
+        worst = results["recommended"]["worst_case"]
+        svgs["worst_pose"] = _draw(
+            directory,
+            "worst_pose",
+            formats,
+            lambda path: plot_worst_pose(
+                path,
+                np.asarray(pose["joint_positions"]),
+                np.asarray(pose["contact_position"]),
+                np.asarray(pose["direction"]),
+                f"worst case over the contact domain: {worst['domain']:.4g} N·s"
+                + ("" if worst["certified"] else " (not certified)"),
+            ),
+        )
     joints = recommended_torque_speed(results)
     if joints is not None:
         from ..plots.torque_speed import plot_torque_speed

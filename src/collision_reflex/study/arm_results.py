@@ -180,7 +180,10 @@ def arm_results(
 
     def record(result: DesignResult, label: str) -> dict[str, Any]:
         out = design_record(problem, result, label, setup.catalogue)
-        out["worst_case"] = worst_case_record(result, (searches or {}).get(label), search_tolerance)
+        search = (searches or {}).get(label)
+        out["worst_case"] = worst_case_record(result, search, search_tolerance)
+        if search is not None:
+            out["worst_case"]["pose"] = worst_pose(setup, search.q, search.direction)
         return out
 
     pareto: ParetoRecord = {"objectives": [], "points": [], "failed": [], "dominated": [], "merged": 0}
@@ -231,6 +234,20 @@ def arm_results(
                 joint["catalogue_part"] = part
         out["catalogue"] = catalogue
     return out
+
+
+def worst_pose(setup: ArmSetup, q: np.ndarray, direction: np.ndarray) -> dict[str, Any]:
+    """Where a worst case occurs, for the report's drawing: the joints' and the contact point's world positions
+    [m] at configuration ``q`` and the contact direction in world axes."""
+    kinematics = setup.arm.kinematics(np.asarray(q, dtype=float)[None])
+    assert kinematics.joint_positions is not None and kinematics.contact_position is not None  # full kinematics
+    plane = setup.arm.plane
+    world = np.asarray(direction, dtype=float) if plane is None else plane @ np.asarray(direction, dtype=float)
+    return {
+        "joint_positions": kinematics.joint_positions[0].tolist(),
+        "contact_position": kinematics.contact_position[0].tolist(),
+        "direction": world.tolist(),
+    }
 
 
 def domain_record(setup: ArmSetup) -> dict[str, Any]:
