@@ -85,7 +85,7 @@ def test_saved_points_are_the_recomputed_ones_and_the_envelope_is_the_records(ru
     fields = {field.name for field in dataclasses.fields(JointOperatingPoints)}
     assert set(JointTorqueSpeed.__annotations__) == fields
     assert all(set(entry) == fields for entry in saved)
-    problems = StudyProblems((folder / "study.resolved.yaml").read_text(encoding="utf-8"))
+    problems = StudyProblems.of_run(folder)
     problem = built_problem(problems, problems.objective)
     points = torque_speed_points(problem, _recorded_design(recommended))
     factor = results["resolved"]["constraints"]["safety_factor"]

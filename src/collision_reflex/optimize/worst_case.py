@@ -25,6 +25,7 @@ import numpy as np
 
 from ..arm.directions import sphere_directions
 from ..errors import InvalidParameter
+from .blas import single_threaded_blas
 from .evaluate import sample_impulses
 from .samples import ContactSamples, loaded_joints
 
@@ -80,7 +81,7 @@ class WorstCase:
             "direction": self.direction.tolist(),
             "starts": self.starts,
             "evaluations": self.evaluations,
-            "elapsed": self.elapsed,
+            "search_time": self.elapsed,
             "domain_kept": self.domain_kept,
         }
 
@@ -313,6 +314,26 @@ def search_worst_case(
     ------
     InvalidParameter: no start, or starts of the wrong shape.
     """
+    import scipy.optimize  # noqa: F401  # loaded (with its BLAS) before the BLAS is limited to one thread
+
+    # Every BLAS on one thread, SciPy's too: a threaded BLAS sums in another order, and SLSQP's path (so the
+    # maximum found) would depend on whether SciPy's BLAS was loaded before a caller limited the threads.
+    with single_threaded_blas():
+        return _search(arm, domain, technology, design, start_q, start_directions, random_starts, rng, max_iter)
+
+
+def _search(
+    arm: Arm,
+    domain: ContactDomain,
+    technology: ActuatorTechnology,
+    design: Design,
+    start_q: np.ndarray,
+    start_directions: np.ndarray,
+    random_starts: int,
+    rng: np.random.Generator | None,
+    max_iter: int,
+) -> WorstCase:
+    """:func:`search_worst_case` with every BLAS on one thread."""
     started = time.perf_counter()
     generator = rng if rng is not None else np.random.default_rng(0)
     start_q = np.atleast_2d(np.asarray(start_q, dtype=float))

@@ -75,7 +75,7 @@ def _actuator_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
     return rows
 
 
-TIMING_KEYS = frozenset({"solve_time", "build_time"})
+TIMING_KEYS = frozenset({"solve_time", "build_time", "search_time"})
 """Wall times in the results [s]: kept in ``timings.json``, so that the other result files are the same bytes
 for the same study on every executor and machine load."""
 

@@ -218,7 +218,7 @@ def arm_results(
         recommended["torque_speed"] = torque_speed
     out: ArmResults = {
         "samples": sample_layout(setup),
-        "domain": domain_record(setup),
+        "domain": domain_record(problems),
         "chosen": chosen_record,
         "recommended": recommended,
         "pareto": pareto,
@@ -250,18 +250,21 @@ def worst_pose(setup: ArmSetup, q: np.ndarray, direction: np.ndarray) -> dict[st
     }
 
 
-def domain_record(setup: ArmSetup) -> dict[str, Any]:
+def domain_record(problems: StudyProblems) -> dict[str, Any]:
     """The study's contact domain as plain data: its settings, how much of the box it keeps, searched samples.
 
     ``kept`` is the fraction of the joint-limit box's (configuration, direction) pairs inside the domain at
-    ``sampling_velocity`` [m/s] (None when the configurations are listed); ``searched_samples`` the samples the
-    worst-case searches added (the last of ``samples``).
+    ``sampling_velocity`` [m/s] (None when the configurations are listed); ``searched_samples`` the number of
+    samples the worst-case searches added (the last of ``samples``) and ``searched`` those samples as the
+    problems took them, ``[q, u]`` each (:meth:`~.arm_setup.StudyProblems.of_run` reads them back).
     """
+    setup = problems.setup
     return {
         **setup.domain.to_json(),
         "kept": setup.domain_kept,
         "sampling_velocity": setup.sampling_velocity,
         "searched_samples": setup.searched,
+        "searched": [[list(q), list(u)] for q, u in problems.extra],
     }
 
 
@@ -297,9 +300,9 @@ def speed_limits(setup: ArmSetup) -> str | None:
 class CatalogueRecord(TypedDict):
     """The catalogue snap of a study as plain data (``designs.json``: ``catalogue``).
 
-    ``key``: a digest of the catalogue file and the snap settings (a resumed run reuses a saved snap only with
-    the same key); ``snapped``: which design was snapped (``optimum`` or ``Pareto design <i>``); ``method``: how
-    the answer was found; ``joints``: per joint the chosen part and its provenance, the candidates, and the
+    ``key``: a digest of the catalogue file and the snap settings, and of the searched samples when there are
+    any (a resumed run reuses a saved snap only with the same key); ``snapped``: which design was snapped
+    (``optimum`` or ``Pareto design <i>``); ``method``: how the answer was found; ``joints``: per joint the chosen part and its provenance, the candidates, and the
     nearest part with what it misses when none is within bounds; ``objectives``, ``continuous_objectives``,
     ``difference`` (catalogue minus continuous), ``relative_difference`` (over the continuous value; None where
     that is zero) [each objective's unit]; ``design``: the catalogue design's record (with its ``undecided``

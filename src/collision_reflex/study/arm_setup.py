@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import os
 from collections.abc import Hashable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypedDict
@@ -307,6 +308,20 @@ class StudyProblems:
 
     resolved_text: str
     extra: ExtraSamples = ()
+
+    @classmethod
+    def of_run(cls, folder: str | os.PathLike[str]) -> StudyProblems:
+        """The problems a finished run solved last: its resolved study and the samples its searches added.
+
+        Read from the run folder's ``study.resolved.yaml`` and ``designs.json`` (``domain.searched``).
+        """
+        import json
+        from pathlib import Path
+
+        path = Path(folder)
+        results = json.loads((path / "designs.json").read_text(encoding="utf-8"))
+        extra = tuple((tuple(q), tuple(u)) for q, u in results["domain"]["searched"])
+        return cls((path / "study.resolved.yaml").read_text(encoding="utf-8"), extra)
 
     def __call__(
         self, objective: Hashable, bounded: tuple[str, ...] = (), samples: ContactSamples | None = None

@@ -322,14 +322,16 @@ def _run_arm(
         extra = extra + added
     snapped = None
     if catalogue is not None:
-        saved = folder.finished(prefix + "catalogue")
-        if saved is not None and saved.get("key") == catalogue.key:
+        saved = folder.finished("catalogue")
+        key = catalogue.key + (f"-{_digest(extra)}" if extra else "")  # the same parts on the same samples
+        if saved is not None and saved.get("key") == key:
             snapped, reused = cast("CatalogueRecord", saved), reused + 1
         else:
             snapped = stages.timed("catalogue snap", catalogue_results)(
                 problems, optimum, front, catalogue, progress.counter("catalogue snap"), pool
             )
-            folder.save(prefix + "catalogue", dict(snapped))
+            snapped["key"] = key
+            folder.save("catalogue", dict(snapped))
             computed += 1
     results = {
         "kind": "arm",

@@ -37,15 +37,19 @@ def exchanges_samples(study: ArmStudy) -> bool:
 
 @one_at_a_time
 def _search_one(
-    problems: StudyProblems,
+    resolved_text: str,
     design: Design,
     start_q: np.ndarray,
     start_directions: np.ndarray,
     random_starts: int,
     seed: tuple[int, int],
 ) -> WorstCase:
-    """One design's search (a piece of work for an executor: picklable arguments, run in any process)."""
-    setup = problems.setup
+    """One design's search (a piece of work for an executor: picklable arguments, run in any process).
+
+    The search needs the arm, its domain and the technology, which the searched samples do not change: the
+    study's own setup serves every round (built once per process).
+    """
+    setup = StudyProblems(resolved_text).setup
     return search_worst_case(
         setup.arm,
         setup.domain,
@@ -87,7 +91,7 @@ def search_designs(
         start_q, start_directions = worst_samples(problems, result.impulses, spec.starts)
         futures[label] = executor.submit(
             _search_one,
-            problems,
+            problems.resolved_text,
             result.design,
             start_q,
             start_directions,
