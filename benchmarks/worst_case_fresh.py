@@ -72,9 +72,7 @@ def main() -> None:
     text = resolved_yaml(parse_study(_yaml(results["resolved"]), "resolved study"))
     setup = StudyProblems(text).setup
     arm, technology = setup.arm, setup.technology
-    record = (
-        results["pareto"]["points"][int(args.design)] if args.design.isdigit() else results[args.design]
-    )
+    record = results["pareto"]["points"][int(args.design)] if args.design.isdigit() else results[args.design]
     design = design_of(record, setup.technology.sensing)
     domain = results["domain"]
     rng = np.random.default_rng(args.seed)

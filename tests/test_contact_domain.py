@@ -124,7 +124,9 @@ def test_a_study_whose_domain_keeps_nothing_gets_a_located_error_and_writes_noth
 def test_a_study_names_its_joint_speed_limits_by_joint(tmp_path):
     path = tmp_path / "study.yaml"
     path.write_text(
-        STUDY.replace("{min_singular_value: 0.4 m}", "{joint_speed_limit: {joint1: 90 deg/s, joint2: 2 rad/s}}")
+        STUDY.replace(
+            "{min_singular_value: 0.4 m}", "{joint_speed_limit: {joint1: 90 deg/s, joint2: 2 rad/s}}"
+        )
     )
     loaded = load_study(path)
     from collision_reflex.study.robot import load_arm

@@ -87,7 +87,9 @@ def test_the_search_finds_a_narrow_peak_the_samples_miss(case):
         heading + np.radians(np.linspace(-2, 2, 201)),
     )
     assert found.impulse >= 0.995 * max(everywhere, nearby)
-    assert found.impulse <= 1.0001 * max(everywhere, nearby)  # a point of the domain: no value above the grids'
+    assert found.impulse <= 1.0001 * max(
+        everywhere, nearby
+    )  # a point of the domain: no value above the grids'
     assert found.maxima_impulse[0] == found.impulse and np.all(np.diff(found.maxima_impulse) <= 0)
 
 
@@ -96,7 +98,9 @@ def test_the_search_is_deterministic(case):
     q = arm.configuration(np.array([[0.2, 2.0], [1.0, -1.0]]))
     u = np.array([[1.0, 0.0], [0.0, 1.0]])
     runs = [
-        search_worst_case(arm, domain, technology, design, q, u, random_starts=2, rng=np.random.default_rng(4))
+        search_worst_case(
+            arm, domain, technology, design, q, u, random_starts=2, rng=np.random.default_rng(4)
+        )
         for _ in range(2)
     ]
     assert runs[0].impulse == runs[1].impulse

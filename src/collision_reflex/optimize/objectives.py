@@ -16,7 +16,6 @@ import numpy as np
 from .. import _validate
 from ..errors import InvalidParameter
 from .constraints import ConstraintList
-
 from .samples import SPEED_CAP_TOLERANCE
 
 if TYPE_CHECKING:
@@ -133,7 +132,9 @@ def add_epigraph(
     finite = np.isfinite(caps)
     if np.any(finite):
         capped = ca.DM(np.where(finite, caps, 0.0))
-        rows = rows + RELAXED_ROW * ca.DM(finite.astype(float)) * (slowest * (1 - SPEED_CAP_TOLERANCE) > capped)
+        rows = rows + RELAXED_ROW * ca.DM(finite.astype(float)) * (
+            slowest * (1 - SPEED_CAP_TOLERANCE) > capped
+        )
     g.add(rows, 0.0, np.inf, [f"worst-case bound >= impulse of sample {s}" for s in range(impulses.shape[1])])
     return t
 

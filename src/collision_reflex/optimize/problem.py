@@ -70,8 +70,8 @@ from .objectives import (
     add_objective_bounds,
     checked_bounded_objectives,
     objective_expression,
-    objective_values,
     objective_terms,
+    objective_values,
     objective_weights,
 )
 from .samples import (
@@ -420,8 +420,11 @@ def build_problem(
 def _epigraph_value(
     impulses: np.ndarray, samples: ContactSamples, slowest: float, scale: Mapping[str, float]
 ) -> float:
-    """The scaled epigraph ``t`` that meets every worst-case row any solve keeps: the largest impulse [N*s] of
-    the samples whose speed cap reaches the slowest approach allowed (:func:`.objectives.add_epigraph`)."""
+    """The scaled epigraph ``t`` that meets every worst-case row any solve keeps.
+
+    That is the largest impulse [N*s] of the samples whose speed cap reaches the slowest approach allowed
+    (:func:`.objectives.add_epigraph`).
+    """
     return float(np.max(impulses[samples.inside(slowest)])) / scale["worst_case_impulse"]
 
 

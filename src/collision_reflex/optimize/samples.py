@@ -68,10 +68,18 @@ class ContactSamples:
             raise InvalidParameter("config_index", index, f"indices in [0, {self.kinematics.q.shape[0]})")
         object.__setattr__(self, "directions", directions / norms[:, None])
         object.__setattr__(self, "config_index", index)
-        cap = np.full(index.size, np.inf) if self.speed_cap is None else np.asarray(self.speed_cap, float).ravel()
+        cap = (
+            np.full(index.size, np.inf)
+            if self.speed_cap is None
+            else np.asarray(self.speed_cap, float).ravel()
+        )
         if cap.shape != (index.size,) or not np.all(cap > 0):
-            raise InvalidParameter("speed_cap", self.speed_cap, f"{index.size} velocities > 0 [m/s] (inf: none)")
-        drawn = np.ones(index.size, bool) if self.drawn is None else np.asarray(self.drawn, dtype=bool).ravel()
+            raise InvalidParameter(
+                "speed_cap", self.speed_cap, f"{index.size} velocities > 0 [m/s] (inf: none)"
+            )
+        drawn = (
+            np.ones(index.size, bool) if self.drawn is None else np.asarray(self.drawn, dtype=bool).ravel()
+        )
         if drawn.shape != (index.size,) or not np.any(drawn):
             raise InvalidParameter("drawn", self.drawn, f"{index.size} flags, at least one sample drawn")
         object.__setattr__(self, "speed_cap", cap)

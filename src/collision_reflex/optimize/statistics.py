@@ -47,7 +47,9 @@ class Estimate:
     @property
     def relative_error(self) -> float:
         """The interval's larger half-width relative to the estimate [-]."""
-        return float(max(self.value - self.low, self.high - self.value) / abs(self.value)) if self.value else 0.0
+        return (
+            float(max(self.value - self.low, self.high - self.value) / abs(self.value)) if self.value else 0.0
+        )
 
     def to_json(self) -> dict[str, float | int]:
         """The estimate as JSON types."""
@@ -62,7 +64,10 @@ class Estimate:
 
 
 def impulse_statistics(
-    impulses: np.ndarray, groups: np.ndarray, quantile: float = QUANTILE, rng: np.random.Generator | None = None
+    impulses: np.ndarray,
+    groups: np.ndarray,
+    quantile: float = QUANTILE,
+    rng: np.random.Generator | None = None,
 ) -> dict[str, Estimate]:
     """The mean and the ``quantile`` of ``impulses`` [N*s] with their :data:`LEVEL` intervals.
 
@@ -76,7 +81,9 @@ def impulse_statistics(
     values = np.asarray(impulses, dtype=float).ravel()
     labels = np.asarray(groups).ravel()
     if values.size == 0 or labels.shape != values.shape:
-        raise InvalidParameter("impulses", values.shape, f"a non-empty array, one group label each {labels.shape}")
+        raise InvalidParameter(
+            "impulses", values.shape, f"a non-empty array, one group label each {labels.shape}"
+        )
     if not np.all(np.isfinite(values)):
         raise InvalidParameter("impulses", values, "finite impulses [N*s]")
     if not 0 < quantile < 1:
@@ -101,7 +108,9 @@ def impulse_statistics(
 
     def estimate(value: float, replicates: np.ndarray) -> Estimate:
         low, high = np.percentile(replicates, [50 * (1 - LEVEL), 50 * (1 + LEVEL)])
-        return Estimate(float(value), float(min(low, value)), float(max(high, value)), n_clusters, values.size)
+        return Estimate(
+            float(value), float(min(low, value)), float(max(high, value)), n_clusters, values.size
+        )
 
     return {
         "mean_impulse": estimate(float(values.mean()), np.concatenate(means)),

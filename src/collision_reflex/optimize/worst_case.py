@@ -106,7 +106,9 @@ class _Objective:
         self.nv = domain.nv
         self.speed_rows = np.flatnonzero(np.isfinite(domain.joint_speed_limit))
         self.evaluations = 0
-        self.best: list[tuple[float, np.ndarray, np.ndarray]] = [(-np.inf, np.empty(0), np.empty(0))] * len(bases)
+        self.best: list[tuple[float, np.ndarray, np.ndarray]] = [(-np.inf, np.empty(0), np.empty(0))] * len(
+            bases
+        )
 
     def directions(self, angles: np.ndarray, owner: np.ndarray) -> np.ndarray:
         """Unit directions (m, task_dim) from angles (m, task_dim - 1) about each point's start direction."""
@@ -119,8 +121,10 @@ class _Objective:
         return np.asarray(np.einsum("sd,sde->se", local, bases))
 
     def __call__(self, z: np.ndarray, owner: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Impulses (m,) [N*s] and margins (m, rows) (>= 0 inside the domain) at points ``z`` (m, nz) of starts
-        ``owner`` (m,)."""
+        """Impulses (m,) [N*s] and margins (m, rows) (>= 0 inside the domain) at points of several starts.
+
+        ``z`` (m, nz) are the points, ``owner`` (m,) the start each belongs to.
+        """
         q = self.arm.configuration(z[:, : self.nv])
         u = self.directions(z[:, self.nv :], owner)
         kinematics = self.arm.kinematics(q)
@@ -139,10 +143,12 @@ class _Objective:
                 self.best[k] = (float(impulses[s]), q[s].copy(), u[s].copy())
         return impulses, margin
 
-
     def _impulses(self, kinematics: ArmSamples, u: np.ndarray) -> np.ndarray:
-        """Impulses [N*s] along ``u`` at each configuration; ``inf`` where the model is undefined there (the arm
-        cannot move along ``u``: a point the search's stencil or line search tried beyond the domain)."""
+        """Impulses [N*s] along ``u`` at each configuration; ``inf`` where the model is undefined there.
+
+        That is where the arm cannot move along ``u``: a point the search's stencil or line search tried
+        beyond the domain.
+        """
         out = np.full(u.shape[0], np.inf)
         index = np.arange(u.shape[0])
         movable = np.any(loaded_joints(ContactSamples(kinematics, u, index)), axis=1)
@@ -156,7 +162,9 @@ class _Objective:
                 for s in part:
                     try:
                         out[s] = sample_impulses(
-                            ContactSamples(kinematics, u[s : s + 1], index[s : s + 1]), self.technology, self.design
+                            ContactSamples(kinematics, u[s : s + 1], index[s : s + 1]),
+                            self.technology,
+                            self.design,
                         )[0]
                     except InvalidParameter:
                         out[s] = np.inf
@@ -319,7 +327,9 @@ def search_worst_case(
     # Every BLAS on one thread, SciPy's too: a threaded BLAS sums in another order, and SLSQP's path (so the
     # maximum found) would depend on whether SciPy's BLAS was loaded before a caller limited the threads.
     with single_threaded_blas():
-        return _search(arm, domain, technology, design, start_q, start_directions, random_starts, rng, max_iter)
+        return _search(
+            arm, domain, technology, design, start_q, start_directions, random_starts, rng, max_iter
+        )
 
 
 def _search(
@@ -341,8 +351,10 @@ def _search(
     task_dim = int(arm.task_dim)
     kept = None
     if random_starts:
-        pool = sphere_directions(32) if task_dim == 3 else np.column_stack(
-            [np.cos(a := np.linspace(0, 2 * np.pi, 16, endpoint=False)), np.sin(a)]
+        pool = (
+            sphere_directions(32)
+            if task_dim == 3
+            else np.column_stack([np.cos(a := np.linspace(0, 2 * np.pi, 16, endpoint=False)), np.sin(a)])
         )
         draw = domain.draw(arm, random_starts, pool, design.approach_velocity, generator)
         picks = [pool[generator.choice(np.flatnonzero(row))] for row in draw.feasible]
@@ -351,7 +363,9 @@ def _search(
         start_directions = np.vstack([start_directions, picks]) if start_directions.size else np.array(picks)
     if start_q.shape[0] == 0 or start_directions.shape != (start_q.shape[0], task_dim):
         raise InvalidParameter(
-            "starts", (start_q.shape, start_directions.shape), f"k configurations and k directions of {task_dim}"
+            "starts",
+            (start_q.shape, start_directions.shape),
+            f"k configurations and k directions of {task_dim}",
         )
     theta_starts = np.clip(arm.joint_coordinates(start_q), domain.lower, domain.upper)
     joint_bounds = list(zip(domain.lower, domain.upper, strict=True))
@@ -366,7 +380,15 @@ def _search(
     threads = [
         threading.Thread(
             target=_local_search,
-            args=(lockstep, k, theta_starts[k], joint_bounds + angle_bounds, scales[k], max_iter, constrained),
+            args=(
+                lockstep,
+                k,
+                theta_starts[k],
+                joint_bounds + angle_bounds,
+                scales[k],
+                max_iter,
+                constrained,
+            ),
             daemon=True,
         )
         for k in owners

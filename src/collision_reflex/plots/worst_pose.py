@@ -25,7 +25,9 @@ def plot_worst_pose(
     extent = float(np.max(np.linalg.norm(chain - chain[0], axis=1))) or 1.0
     arrow = 0.25 * extent * np.asarray(direction, dtype=float)
     fig, axes = new_figure(1, 3, figsize=(9.0, 3.3))
-    for ax, (a, b), name in zip(axes, ((0, 1), (0, 2), (1, 2)), ("top (x, y)", "front (x, z)", "side (y, z)"), strict=True):
+    for ax, (a, b), name in zip(
+        axes, ((0, 1), (0, 2), (1, 2)), ("top (x, y)", "front (x, z)", "side (y, z)"), strict=True
+    ):
         ax.plot(chain[:, a], chain[:, b], "-", color="0.35", lw=3, solid_capstyle="round")
         ax.plot(chain[1:-1, a], chain[1:-1, b], "o", color="0.15", ms=4)
         ax.plot(chain[:1, a], chain[:1, b], "s", color="0.15", ms=6)

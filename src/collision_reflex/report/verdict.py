@@ -272,11 +272,13 @@ def worst_case_sentences(
     uncertified = [
         str(point.get("label", i))
         for i, point in enumerate(pareto.get("points", ()))
-        if point.get("worst_case") and point["worst_case"].get("searched") and not point["worst_case"]["certified"]
+        if point.get("worst_case")
+        and point["worst_case"].get("searched")
+        and not point["worst_case"]["certified"]
     ]
     if uncertified:
         lines.append(
-            f"Pareto designs whose worst case the search found above their samples' (not certified): "
+            "Pareto designs whose worst case the search found above their samples' (not certified): "
             + "; ".join(uncertified)
             + "."
         )
@@ -284,8 +286,10 @@ def worst_case_sentences(
 
 
 def statistics_sentences(record: Mapping[str, Any], study: Mapping[str, Any]) -> list[str]:
-    """The recommended design's mean and high quantile with their sampling errors; a warning when the mean is
-    an objective and its error exceeds the study's ``samples.error_tolerance``."""
+    """The recommended design's mean and high quantile with their sampling errors.
+
+    A warning when the mean is an objective and its error exceeds the study's ``samples.error_tolerance``.
+    """
     statistics = record.get("statistics")
     if not statistics:
         return []

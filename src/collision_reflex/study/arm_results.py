@@ -237,12 +237,19 @@ def arm_results(
 
 
 def worst_pose(setup: ArmSetup, q: np.ndarray, direction: np.ndarray) -> dict[str, Any]:
-    """Where a worst case occurs, for the report's drawing: the joints' and the contact point's world positions
-    [m] at configuration ``q`` and the contact direction in world axes."""
+    """Where a worst case occurs, for the report's drawing.
+
+    The joints' and the contact point's world positions [m] at configuration ``q``, and the contact direction
+    in world axes.
+    """
     kinematics = setup.arm.kinematics(np.asarray(q, dtype=float)[None])
-    assert kinematics.joint_positions is not None and kinematics.contact_position is not None  # full kinematics
+    assert (
+        kinematics.joint_positions is not None and kinematics.contact_position is not None
+    )  # full kinematics
     plane = setup.arm.plane
-    world = np.asarray(direction, dtype=float) if plane is None else plane @ np.asarray(direction, dtype=float)
+    world = (
+        np.asarray(direction, dtype=float) if plane is None else plane @ np.asarray(direction, dtype=float)
+    )
     return {
         "joint_positions": kinematics.joint_positions[0].tolist(),
         "contact_position": kinematics.contact_position[0].tolist(),

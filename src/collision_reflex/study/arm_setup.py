@@ -151,8 +151,7 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
         )
     directions = direction_samples(loaded, arm)
     domain = contact_domain(loaded, arm)
-    velocity = space.approach_velocity
-    sampling_velocity = float(velocity.upper if isinstance(velocity, Bounds) else velocity)
+    sampling_velocity = float(space.global_bounds("approach_velocity").upper)  # the fastest approach allowed
     kept = None
     if study.samples.configurations.random is not None:
         draw = domain_draw(loaded, arm, domain, directions, sampling_velocity)

@@ -169,9 +169,7 @@ def per_joint_values(
     missing = [joint for joint in joints if joint not in value]
     for key in unknown:
         problems.append(
-            loaded.problem(
-                (*path, key), f"joint {key!r}, not a joint of the arm", ", ".join(joints)
-            )
+            loaded.problem((*path, key), f"joint {key!r}, not a joint of the arm", ", ".join(joints))
         )
     if missing:
         problems.append(

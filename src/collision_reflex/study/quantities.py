@@ -158,3 +158,5 @@ JointPosition = quantity_type("rad", "an angle", "45 deg", -1e3, 1e3)
 SafetyFactor = quantity_type("", "a dimensionless number", "1.5", 1.0, 100.0)
 # Sensing noise floors: up to the largest threshold.
 NoiseFloor = quantity_type("N", "a force", "0.5 N", 0.0, 1e4)
+# Floors on a contact Jacobian's smallest singular value: 0 (none) up to a reach no arm has.
+SingularValueFloor = quantity_type("m", "a length", "0.08 m", 0.0, 100.0)

@@ -31,6 +31,7 @@ from .store import OutputFolderUnusable, RunFolder
 
 if TYPE_CHECKING:
     from ..optimize import DesignResult, ParetoSet
+    from .arm_setup import StudyProblems
 
 SMOKE_ENVIRONMENT = "CRX_SMOKE"
 """Set to 1 to run every study with small sample counts (tests, quick checks): see :func:`smoke_study`."""
@@ -94,7 +95,9 @@ def smoke_study(data: dict[str, Any]) -> dict[str, Any]:
     search = {**optimizer.get("worst_case_search", {})}
     if search:  # a lighter search: a few starts, two rounds
         search.update(
-            starts=min(search["starts"], 3), random_starts=min(search["random_starts"], 2), rounds=min(search["rounds"], 2)
+            starts=min(search["starts"], 3),
+            random_starts=min(search["random_starts"], 2),
+            rounds=min(search["rounds"], 2),
         )
         data["optimizer"] = {**optimizer, "worst_case_search": search}
     data.pop("simulate", None)  # the time-domain simulation is no quick check
@@ -314,7 +317,10 @@ def _run_arm(
         if not search.enabled:
             searches = {}
             break
-        designs = {"optimum": optimum, **(dict(zip(front.labels, front.points, strict=True)) if front else {})}
+        designs = {
+            "optimum": optimum,
+            **(dict(zip(front.labels, front.points, strict=True)) if front else {}),
+        }
         searches = stages.timed("worst-case search", search_designs)(problems, designs, search, pool)
         added = violators(designs, searches, search.tolerance)
         if not added or not exchanges_samples(study) or round_ == search.rounds - 1:

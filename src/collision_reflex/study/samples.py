@@ -63,7 +63,11 @@ def contact_domain(loaded: LoadedStudy, arm: Arm) -> ContactDomain:
     if spec.joint_speed_limit is not None:
         problems: list[StudyProblem] = []
         limits = per_joint_values(
-            loaded, ("samples", "domain", "joint_speed_limit"), spec.joint_speed_limit, list(arm.joint_names), problems
+            loaded,
+            ("samples", "domain", "joint_speed_limit"),
+            spec.joint_speed_limit,
+            list(arm.joint_names),
+            problems,
         )
         if problems:
             raise StudyFileError(loaded.source.file, problems)

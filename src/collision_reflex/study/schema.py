@@ -47,6 +47,7 @@ from .quantities import (
     Payload,
     PositionError,
     SafetyFactor,
+    SingularValueFloor,
     ThresholdForce,
     quantity_type,
     to_si,
@@ -326,9 +327,6 @@ class DirectionSamples(_Model):
         return self
 
 
-SingularValueFloor = quantity_type("m", "a length", "0.08 m", 0.0, 100.0)
-
-
 class DomainSpec(_Model):
     """Where contacts are considered: the domain a worst case is taken over.
 
@@ -343,7 +341,7 @@ class DomainSpec(_Model):
         "arm's reach (the largest base-to-contact distance); 0: no floor (near singular poses the finger mass, "
         "and so the worst case, is unbounded)",
     )
-    joint_speed_limit: JointSpeed | None = Field(
+    joint_speed_limit: JointSpeed | None = Field(  # type: ignore[valid-type]
         None,
         description="joint speed limits of the guarded move [rad/s], one for all or by joint name; null: the "
         "URDF's velocity limits (a joint without one is not limited)",
@@ -752,7 +750,8 @@ class SearchSpec(_Model):
         4, description="local searches from random points of the domain, per design"
     )
     tolerance: Annotated[float, Field(gt=0, le=0.5, allow_inf_nan=False)] = Field(
-        0.005, description="relative excess over the reported worst case that makes a searched point a violator"
+        0.005,
+        description="relative excess over the reported worst case that makes a searched point a violator",
     )
     rounds: Annotated[int, Field(ge=1, le=10, strict=True)] = Field(
         4, description="most solve-and-search rounds; a worst case still exceeded after them is reported so"

@@ -109,7 +109,9 @@ def violators(
     for label, search in searches.items():
         level = results[label].numpy_objectives["worst_case_impulse"]
         for i in search.violators(level, tolerance):
-            found.append((tuple(map(float, search.maxima_q[i])), tuple(map(float, search.maxima_directions[i]))))
+            found.append(
+                (tuple(map(float, search.maxima_q[i])), tuple(map(float, search.maxima_directions[i])))
+            )
     return tuple(dict.fromkeys(found))  # one sample per point, in order
 
 
