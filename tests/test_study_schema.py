@@ -87,7 +87,7 @@ def test_defaults_are_explicit_in_the_resolved_study():
         "torque_required": None,
     }
     assert resolved["execution"] == {"executor": "serial", "workers": 2, "scheduler": None}
-    assert resolved["robot"]["contact_offset"] == [0.0, 0.0, 0.0]
+    assert resolved["robot"]["contact_offset"] is None  # the robot's default contact point
 
 
 @pytest.mark.parametrize(

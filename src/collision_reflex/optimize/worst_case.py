@@ -289,7 +289,7 @@ def _local_search(
             bounds=bounds,
             constraints=constraints,
             method="SLSQP",
-            options={"maxiter": max_iter, "ftol": 1e-7},
+            options={"maxiter": max_iter, "ftol": 1e-6},
         )
     except _Stopped:
         pass
@@ -306,7 +306,7 @@ def search_worst_case(
     start_directions: np.ndarray,
     random_starts: int = 6,
     rng: np.random.Generator | None = None,
-    max_iter: int = 60,
+    max_iter: int = 30,
 ) -> WorstCase:
     """The largest collision impulse of ``design`` over ``domain``, by local searches from several starts.
 
