@@ -15,6 +15,7 @@ from collision_reflex.report.verdict import (
     lightest_near_best,
     objective_spans,
     oversized_warnings,
+    statistics_sentences,
     undecided_sentence,
     verdict,
 )
@@ -266,3 +267,57 @@ def test_an_undecided_global_variable_is_said_so_instead_of_its_bound():
         "where the solver started"
     ]
     assert design_limits(record(threshold=1.0), BOUNDS) == ["threshold at its lower bound (1)"]
+
+
+def _estimate(value, error, configurations, samples, **extra):
+    return {
+        "value": value,
+        "low": value * (1 - error),
+        "high": value * (1 + error),
+        "relative_error": error,
+        "configurations": configurations,
+        "samples": samples,
+        **extra,
+    }
+
+
+def _fresh(largest, exceeds, mean_error=0.01, quantile_error=0.015):
+    return {
+        "configurations": 4096,
+        "samples": 24_000,
+        "largest": largest,
+        "mean": 0.3,
+        "exceeds": exceeds,
+        "statistics": {
+            "mean_impulse": _estimate(0.3, mean_error, 4096, 24_000),
+            "quantile_impulse": _estimate(1.2, quantile_error, 4096, 24_000, quantile=0.99),
+        },
+    }
+
+
+def test_the_fresh_check_and_its_errors_are_stated_and_warned_about():
+    recommended = {
+        **record(),
+        "worst_case": {"domain": 2.0},
+        "fresh": _fresh(1.9, False),
+        "statistics": {
+            "mean_impulse": _estimate(0.28, 0.12, 48, 288),
+            "quantile_impulse": _estimate(1.1, 0.3, 48, 288, quantile=0.99),
+        },
+    }
+    study = {"objective": "worst_case_impulse", "samples": {"error_tolerance": 0.02}}
+    lines = statistics_sentences(recommended, study, {"points": [recommended]})
+    assert lines[0].startswith("Checked on 4,096 fresh configurations of the domain (24,000 samples")
+    assert "largest impulse 1.9 N·s, within its worst case 2 N·s" in lines[0]
+    assert "mean 0.3 N·s (± 1 %)" in lines[0] and "99th percentile 1.2 N·s (± 1.5 %)" in lines[0]
+    assert lines[1].startswith("On the samples it was optimised on (48 configurations")
+    assert len(lines) == 2  # errors within the tolerance; the mean is no objective: no warning
+    # A fresh sample above the worst case, errors over the tolerance, the mean an objective: each is said.
+    recommended["fresh"] = _fresh(2.2, True, quantile_error=0.04)
+    recommended["label"] = "anchor: worst_case_impulse"
+    lines = statistics_sentences(recommended, {**study, "objective": "mean_impulse"}, {"points": [recommended]})
+    assert "WARNING: 2.2 N·s, 10 % above its worst case 2 N·s, which is therefore not a bound" in lines[0]
+    # 4 % against 2 %: four times the configurations.
+    assert "about 16,384 fresh configurations (samples.fresh) would meet it" in lines[1]
+    assert lines[2] == "Pareto designs whose worst case a fresh sample exceeds: anchor: worst_case_impulse."
+    assert "about 1,728 configurations (samples.configurations.random.count)" in lines[4]

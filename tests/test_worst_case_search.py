@@ -170,6 +170,28 @@ def test_a_study_s_certified_worst_case_holds_on_fresh_samples(tmp_path):
         ContactSamples(kinematics, u[inside], np.flatnonzero(inside)), setup.technology, chosen
     )
     assert fresh.max() <= 1.02 * worst["domain"]
+    # The run's own fresh check (another stream, its 8 directions) agrees with this one: its largest impulse is
+    # within the certified worst case, and the mean over the same pairs drawn here (the 8 directions at every
+    # fresh configuration, inside the domain) lies in its stated 99 % interval, widened by this estimate's error.
+    check = record["fresh"]
+    assert check["configurations"] > 0.95 * 4096 and not check["exceeds"]
+    assert check["largest"] <= (1 + worst["tolerance"]) * worst["domain"]
+    directions = setup.directions
+    pairs = ContactDomain(
+        np.array(domain["joint_lower"]), np.array(domain["joint_upper"]), domain["min_singular_value"], limits, 1.0
+    ).contains(
+        np.repeat(kinematics.jacobian, len(directions), axis=0),
+        np.tile(directions, (n, 1)),
+        record["approach_velocity"],
+    )
+    config = np.repeat(np.arange(n), len(directions))[pairs]
+    reference = sample_impulses(
+        ContactSamples(kinematics, np.tile(directions, (n, 1))[pairs], config), setup.technology, chosen
+    )
+    spread = 3 * reference.std() / np.sqrt(np.unique(config).size)  # 3 standard errors (clustered: generous)
+    mean = check["statistics"]["mean_impulse"]
+    assert mean["low"] - spread <= reference.mean() <= mean["high"] + spread
+    assert mean["relative_error"] <= 0.02  # the default 4096 fresh configurations meet the default tolerance
 
 
 def _design_of(record, problem):

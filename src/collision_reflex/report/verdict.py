@@ -285,24 +285,64 @@ def worst_case_sentences(
     return lines
 
 
-def statistics_sentences(record: Mapping[str, Any], study: Mapping[str, Any]) -> list[str]:
-    """The recommended design's mean and high quantile with their sampling errors.
+def statistics_sentences(
+    record: Mapping[str, Any], study: Mapping[str, Any], pareto: Mapping[str, Any] | None = None
+) -> list[str]:
+    """The recommended design on fresh samples and on its own: worst case, mean and quantile with their errors.
 
-    A warning when the mean is an objective and its error exceeds the study's ``samples.error_tolerance``.
+    Warnings when a fresh sample exceeds a design's worst case, when a fresh statistic's error exceeds the
+    study's ``samples.error_tolerance`` (naming the fresh configurations that would meet it), and when the mean
+    is an objective whose error on the optimised samples exceeds it.
     """
+    tolerance = float((study.get("samples") or {}).get("error_tolerance", 0.02))
+    lines = []
+    fresh = record.get("fresh")
+    if fresh and fresh.get("largest") is not None:
+        worst = float(record["worst_case"]["domain"])
+        stats = fresh["statistics"]
+        mean, quantile = stats["mean_impulse"], stats["quantile_impulse"]
+        check = (
+            f"WARNING: {_g(fresh['largest'])} N·s, {_percent(100 * (fresh['largest'] / worst - 1))} % above its "
+            f"worst case {_g(worst)} N·s, which is therefore not a bound"
+            if fresh["exceeds"]
+            else f"{_g(fresh['largest'])} N·s, within its worst case {_g(worst)} N·s"
+        )
+        lines.append(
+            f"Checked on {fresh['configurations']:,} fresh configurations of the domain ({fresh['samples']:,} "
+            f"samples it was not optimised on): largest impulse {check}; mean {_g(mean['value'])} N·s "
+            f"(± {_percent(100 * mean['relative_error'])} %), {_g(100 * quantile['quantile'], 3)}th percentile "
+            f"{_g(quantile['value'])} N·s (± {_percent(100 * quantile['relative_error'])} %), 99 % bootstrap "
+            "intervals."
+        )
+        error = max(mean["relative_error"], quantile["relative_error"])
+        if error > tolerance:
+            needed = int(np.ceil(fresh["configurations"] * (error / tolerance) ** 2))
+            lines.append(
+                f"Warning: the fresh statistics are uncertain by up to {_percent(100 * error)} %, more than the "
+                f"study's {_percent(100 * tolerance)} % (samples.error_tolerance): about {needed:,} fresh "
+                "configurations (samples.fresh) would meet it."
+            )
+    exceeded = [
+        str(point.get("label", i))
+        for i, point in enumerate((pareto or {}).get("points", ()))
+        if (point.get("fresh") or {}).get("exceeds")
+    ]
+    if exceeded:
+        lines.append("Pareto designs whose worst case a fresh sample exceeds: " + "; ".join(exceeded) + ".")
     statistics = record.get("statistics")
     if not statistics:
-        return []
+        return lines
     mean, quantile = statistics["mean_impulse"], statistics["quantile_impulse"]
-    lines = [
-        f"Sampled statistics (99 % bootstrap intervals over {mean['configurations']} configurations, "
-        f"{mean['samples']:,} samples): mean impulse {_g(mean['value'])} N·s "
-        f"(± {_percent(100 * mean['relative_error'])} %), {_g(100 * quantile['quantile'], 3)}th percentile "
-        f"{_g(quantile['value'])} N·s (± {_percent(100 * quantile['relative_error'])} %)."
-    ]
-    tolerance = float((study.get("samples") or {}).get("error_tolerance", 0.02))
-    pareto = study.get("pareto") or {}
-    objectives = set(study.get("objective") or ()) | set(pareto.get("objectives") or ())
+    lines.append(
+        f"On the samples it was optimised on ({mean['configurations']} configurations, {mean['samples']:,} "
+        f"samples): mean impulse {_g(mean['value'])} N·s (± {_percent(100 * mean['relative_error'])} %), "
+        f"{_g(100 * quantile['quantile'], 3)}th percentile {_g(quantile['value'])} N·s "
+        f"(± {_percent(100 * quantile['relative_error'])} %)."
+    )
+    pareto_spec = study.get("pareto") or {}
+    objective = study.get("objective") or ()
+    objectives = {objective} if isinstance(objective, str) else set(objective)  # a name or a weighted sum
+    objectives |= set(pareto_spec.get("objectives") or ())
     if "mean_impulse" in objectives and mean["relative_error"] > tolerance:
         needed = int(np.ceil(mean["configurations"] * (mean["relative_error"] / tolerance) ** 2))
         lines.append(
@@ -440,7 +480,7 @@ def verdict(results: Mapping[str, Any]) -> list[str]:
     if reason:
         lines.append(f"Why this design: {reason}.")
     lines += worst_case_sentences(recommended, results.get("domain"), results["pareto"])
-    lines += statistics_sentences(recommended, results.get("resolved") or {})
+    lines += statistics_sentences(recommended, results.get("resolved") or {}, results.get("pareto"))
     lines.append(requirement_sentence(requirement))
     if results.get("speed_limits"):
         lines.append(str(results["speed_limits"]))

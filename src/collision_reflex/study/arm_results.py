@@ -26,6 +26,7 @@ from ..optimize.results import design_record, undecided_variables
 from ..optimize.space import GLOBAL_VARIABLES, PER_JOINT_VARIABLES
 from ..optimize.worst_case import SEARCH_TOLERANCE, WorstCase
 from .arm_setup import ArmSetup, SampleLayout, StudyProblems, sample_layout
+from .fresh import fresh_record, fresh_samples
 from .schema import ArmStudy
 from .worst_case import worst_case_record
 
@@ -172,11 +173,19 @@ def arm_results(
     ``catalogue`` (:func:`catalogue_results`), the results gain its ``catalogue`` entry and each Pareto design
     (the chosen one without a front) its quick snap, ``catalogue``, with ``catalogue_part`` per joint. Each
     design's ``worst_case`` says its worst case over the samples and over the contact domain as searched
-    (``searches`` by label, :func:`.worst_case.worst_case_record`); ``domain`` the domain itself.
+    (``searches`` by label, :func:`.worst_case.worst_case_record`), its ``fresh`` what samples it was not
+    optimised on say of it (:func:`.fresh.fresh_record`, the recommended design's with the bootstrap
+    statistics; None without fresh samples); ``domain`` the domain itself.
     """
     setup = problems.setup
     # Every problem of a study shares its samples and technology: one of them evaluates every record.
     problem = built_problem(problems, problems.objective)
+    fresh = fresh_samples(setup)
+
+    def fresh_check(result: DesignResult, worst_case: float, statistics: bool = False) -> dict[str, Any] | None:
+        if fresh is None:
+            return None
+        return fresh_record(fresh, setup, result.design, worst_case, search_tolerance, statistics)
 
     def record(result: DesignResult, label: str) -> dict[str, Any]:
         out = design_record(problem, result, label, setup.catalogue)
@@ -184,6 +193,7 @@ def arm_results(
         out["worst_case"] = worst_case_record(result, search, search_tolerance)
         if search is not None:
             out["worst_case"]["pose"] = worst_pose(setup, search.q, search.direction)
+        out["fresh"] = fresh_check(result, out["worst_case"]["domain"])
         return out
 
     pareto: ParetoRecord = {"objectives": [], "points": [], "failed": [], "dominated": [], "merged": 0}
@@ -212,6 +222,7 @@ def arm_results(
         pareto_index=recommendation.pareto_index,
         reason=recommendation.reason,
         undecided=_undecided(problems, problem, recommendation.result),
+        fresh=fresh_check(recommendation.result, recommended["worst_case"]["domain"], statistics=True),
     )
     torque_speed = torque_speed_record(problem, recommendation.result)
     if torque_speed is not None:

@@ -62,8 +62,8 @@ class RunResult:
 def smoke_study(data: dict[str, Any]) -> dict[str, Any]:
     """A resolved study shrunk for a quick run.
 
-    A few configurations, directions, Pareto points and velocities, and a lighter worst-case search. The shrunk
-    study is what the run records as its resolved study.
+    A few configurations, directions, fresh configurations, Pareto points and velocities, and a lighter
+    worst-case search. The shrunk study is what the run records as its resolved study.
     """
     data = {**data}
     if data.get("kind") == "actuator":
@@ -90,7 +90,12 @@ def smoke_study(data: dict[str, Any]) -> dict[str, Any]:
     for key in ("named", "list"):
         if directions.get(key):
             directions[key] = directions[key][:4]
-    data["samples"] = {**samples, "configurations": configurations, "directions": directions}
+    data["samples"] = {
+        **samples,
+        "configurations": configurations,
+        "directions": directions,
+        "fresh": min(samples.get("fresh", 0), 64),
+    }
     optimizer = {**data.get("optimizer", {})}
     search = {**optimizer.get("worst_case_search", {})}
     if search:  # a lighter search: a few starts, two rounds

@@ -359,6 +359,13 @@ class SamplesSpec(_Model):
         description="largest relative sampling error (99 % bootstrap interval) of a mean impulse objective "
         "before the report warns and names the configurations that would meet it",
     )
+    fresh: Annotated[int, Field(ge=0, le=65_536, strict=True)] = Field(
+        4096,
+        description="configurations drawn afresh in the contact domain (an independent stream of the random "
+        "configurations' seed, with the study's directions) on which every reported design is checked after "
+        "the solves: its largest impulse against its worst case, its mean and high quantile with their "
+        "sampling errors; 0: no check (random configurations only)",
+    )
 
 
 # --- duty cycle --------------------------------------------------------------------------------------------------
