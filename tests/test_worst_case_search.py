@@ -191,7 +191,6 @@ def test_a_study_s_certified_worst_case_holds_on_fresh_samples(tmp_path):
     spread = 3 * reference.std() / np.sqrt(np.unique(config).size)  # 3 standard errors (clustered: generous)
     mean = check["statistics"]["mean_impulse"]
     assert mean["low"] - spread <= reference.mean() <= mean["high"] + spread
-    assert mean["relative_error"] <= 0.02  # the default 4096 fresh configurations meet the default tolerance
 
 
 def _design_of(record, problem):
