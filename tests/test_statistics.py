@@ -71,3 +71,24 @@ def test_bad_samples_are_refused():
         impulse_statistics(np.array([1.0, 2.0]), np.array([0, 1]), quantile=1.0)
     with pytest.raises(InvalidParameter, match="non-empty"):
         impulse_statistics(np.array([]), np.array([]))
+
+
+@pytest.mark.parametrize("top", [64, 2000])  # the ranked top alone, and with replicates falling back to all
+def test_each_replicate_s_quantile_is_the_quantile_of_its_resampled_impulses(top):
+    """A replicate's weighted quantile against NumPy's inverted-CDF quantile of the samples it repeats."""
+    from collision_reflex.optimize.statistics import _weighted_quantiles
+
+    rng = np.random.default_rng(3)
+    clusters, per = 400, 5
+    cluster = np.repeat(np.arange(clusters), per)
+    values = np.round(rng.lognormal(size=cluster.size), 2)  # rounded: ties, as equal impulses give
+    counts = np.zeros((30, clusters))
+    np.add.at(counts, (np.arange(30)[:, None], rng.integers(0, clusters, (30, clusters))), 1.0)
+    descending = np.argsort(values)[::-1]
+    for q in (0.5, 0.99):
+        found = _weighted_quantiles(
+            values, counts, cluster, descending, descending[:top], counts @ np.bincount(cluster), q
+        )
+        for row, value in zip(counts, found, strict=True):
+            repeated = np.repeat(values, row[cluster].astype(int))
+            assert value == np.quantile(repeated, q, method="inverted_cdf")

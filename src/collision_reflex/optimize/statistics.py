@@ -25,6 +25,12 @@ LEVEL = 0.99
 """Confidence level of the stated intervals (the module's description says why not 95 %)."""
 
 _CHUNK = 50
+"""Bootstrap replicates drawn at a time (a replicate's cluster counts are one row)."""
+
+_TAIL_FACTOR = 4
+"""Samples ranked per replicate for a quantile q: this many times the (1 - q) tail's share of the samples
+(a replicate's tail of 1.0 its expected size fits unless its weight is 4x the expected, far beyond the 99 %
+interval; a replicate whose tail does not fit is ranked over every sample)."""
 
 QUANTILE = 0.99
 """The quantile of the impulse every design reports beside its mean."""
@@ -91,20 +97,22 @@ def impulse_statistics(
     generator = rng if rng is not None else np.random.default_rng(0)
     _, cluster = np.unique(labels, return_inverse=True)
     n_clusters = int(cluster.max()) + 1
-    order = np.argsort(values)
+    sizes = np.bincount(cluster).astype(float)
+    sums = np.bincount(cluster, weights=values)
+    # A replicate's quantile lies in the upper tail: only the largest samples are ranked per replicate (those
+    # whose weight does not reach the quantile's tail fall back to every sample).
+    descending = np.argsort(values)[::-1]
+    top = descending[: min(values.size, max(64, int(np.ceil(_TAIL_FACTOR * (1 - quantile) * values.size))))]
     means, quantiles = [], []
-    for start in range(0, BOOTSTRAP_REPLICATES, _CHUNK):  # in chunks: a replicate's weights are one row of n
+    for start in range(0, BOOTSTRAP_REPLICATES, _CHUNK):
         count = min(_CHUNK, BOOTSTRAP_REPLICATES - start)
         picks = generator.integers(0, n_clusters, size=(count, n_clusters))
-        # Each replicate's multiplicity of every cluster, then of every sample (counted as its cluster).
+        # Each replicate's multiplicity of every cluster; a sample counts as many times as its cluster.
         counts = np.zeros((count, n_clusters))
         np.add.at(counts, (np.arange(count)[:, None], picks), 1.0)
-        weights = counts[:, cluster]  # (count, n)
-        means.append(weights @ values / weights.sum(axis=1))
-        cumulative = np.cumsum(weights[:, order], axis=1)
-        # The weighted quantile of each replicate: the first sorted value whose cumulative weight reaches q.
-        position = (cumulative < quantile * cumulative[:, -1:]).sum(axis=1)
-        quantiles.append(values[order][np.minimum(position, values.size - 1)])
+        total = counts @ sizes
+        means.append(counts @ sums / total)
+        quantiles.append(_weighted_quantiles(values, counts, cluster, descending, top, total, quantile))
 
     def estimate(value: float, replicates: np.ndarray) -> Estimate:
         low, high = np.percentile(replicates, [50 * (1 - LEVEL), 50 * (1 + LEVEL)])
@@ -118,3 +126,35 @@ def impulse_statistics(
             float(np.quantile(values, quantile, method="inverted_cdf")), np.concatenate(quantiles)
         ),
     }
+
+
+def _weighted_quantiles(
+    values: np.ndarray,
+    counts: np.ndarray,
+    cluster: np.ndarray,
+    descending: np.ndarray,
+    top: np.ndarray,
+    total: np.ndarray,
+    quantile: float,
+) -> np.ndarray:
+    """Each replicate's weighted ``quantile`` of ``values``, its weights its clusters' ``counts`` (count, n).
+
+    The inverted-CDF quantile: the smallest value whose cumulative weight from below reaches ``quantile`` of
+    ``total``, i.e. the largest value with no more than ``(1 - quantile) total`` of the weight strictly above
+    it. Ranked over the ``top`` samples (the largest, in ``descending`` order), over all for a replicate whose
+    tail reaches beyond them.
+    """
+    tail = (1 - quantile) * total
+
+    def ranked(order: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        weights = counts[rows][:, cluster[order]]
+        above = np.cumsum(weights, axis=1) - weights  # weight strictly above each ranked sample
+        position = (above <= tail[rows, None]).sum(axis=1) - 1
+        return values[order][position], above[:, -1] + weights[:, -1]
+
+    rows = np.arange(counts.shape[0])
+    out, ranked_weight = ranked(top, rows)
+    beyond = ranked_weight <= tail  # the whole top fits in the tail: the quantile lies below it
+    if np.any(beyond) and top.size < values.size:
+        out[beyond] = ranked(descending, rows[beyond])[0]
+    return out
