@@ -137,6 +137,15 @@ class ContactDomain:
         with np.errstate(divide="ignore"):
             return np.asarray(1 / rates.max(axis=1))
 
+    def direction_speed_caps(self, jacobian: np.ndarray, directions: np.ndarray) -> np.ndarray:
+        """:meth:`speed_caps` of every direction (m, task_dim) at every configuration (n, task_dim, nv), (n, m).
+
+        One pseudo-inverse per configuration, however many directions.
+        """
+        rates = np.abs(np.einsum("cjd,md->cmj", np.linalg.pinv(jacobian), directions)) / self.joint_speed_limit
+        with np.errstate(divide="ignore"):
+            return np.asarray(1 / rates.max(axis=2))
+
     def contains(self, jacobian: np.ndarray, directions: np.ndarray, velocity: float) -> np.ndarray:
         """Whether each sample (a configuration's Jacobian with a direction) lies in the domain, (n,) bool."""
         inside_configuration = self.configuration_margin(jacobian) >= 0
@@ -159,7 +168,7 @@ class ContactDomain:
         directions = np.atleast_2d(np.asarray(directions, dtype=float))
         m = directions.shape[0]
         kept_q: list[np.ndarray] = []
-        kept_pairs: list[np.ndarray] = []
+        kept_caps: list[np.ndarray] = []
         drawn = drawn_pairs = inside_configurations = inside_pairs = 0
         most = int(np.ceil(count / MIN_KEPT_FRACTION)) + _DRAW_BATCH
         while len(kept_q) < count:
@@ -170,21 +179,25 @@ class ContactDomain:
             drawn += q.shape[0]
             good = self.configuration_margin(jacobian) >= 0
             inside_configurations += int(good.sum())
-            pairs = np.zeros((q.shape[0], m), dtype=bool)
+            caps = np.zeros((q.shape[0], m))
             if np.any(good):
-                stacked = np.repeat(jacobian[good], m, axis=0)
-                feasible = self.contains(stacked, np.tile(directions, (int(good.sum()), 1)), velocity)
-                pairs[good] = feasible.reshape(-1, m)
+                caps[good] = self.direction_speed_caps(jacobian[good], directions)
+            pairs = caps >= velocity
             drawn_pairs += q.shape[0] * m
             inside_pairs += int(pairs.sum())
             for s in np.flatnonzero(pairs.any(axis=1)):
                 if len(kept_q) < count:
                     kept_q.append(q[s])
-                    kept_pairs.append(pairs[s])
+                    kept_caps.append(caps[s])
         if inside_pairs < MIN_KEPT_FRACTION * drawn_pairs:
             raise DomainTooSmall(self, drawn, inside_configurations, drawn_pairs, inside_pairs, velocity)
+        speed_cap = np.array(kept_caps)
         return DomainDraw(
-            np.array(kept_q), np.array(kept_pairs), inside_configurations / drawn, inside_pairs / drawn_pairs
+            np.array(kept_q),
+            speed_cap >= velocity,
+            speed_cap,
+            inside_configurations / drawn,
+            inside_pairs / drawn_pairs,
         )
 
     def to_json(self) -> dict[str, object]:
@@ -203,12 +216,14 @@ class DomainDraw:
     """Configurations drawn in a domain and which directions are feasible at each.
 
     q: (count, nq) configurations [rad]; feasible: (count, m) bool, direction ``j`` feasible at configuration
-    ``i``; configurations_kept: fraction of the drawn configurations that meet the singular-value floor;
-    samples_kept: fraction of the drawn (configuration, direction) pairs inside the domain.
+    ``i``; speed_cap: (count, m) the fastest approach [m/s] along each direction within the joint speed limits
+    (:meth:`ContactDomain.speed_caps`); configurations_kept: fraction of the drawn configurations that meet the
+    singular-value floor; samples_kept: fraction of the drawn (configuration, direction) pairs inside the domain.
     """
 
     q: np.ndarray
     feasible: np.ndarray
+    speed_cap: np.ndarray
     configurations_kept: float
     samples_kept: float
 

@@ -108,8 +108,8 @@ def impulse_statistics(
         count = min(_CHUNK, BOOTSTRAP_REPLICATES - start)
         picks = generator.integers(0, n_clusters, size=(count, n_clusters))
         # Each replicate's multiplicity of every cluster; a sample counts as many times as its cluster.
-        counts = np.zeros((count, n_clusters))
-        np.add.at(counts, (np.arange(count)[:, None], picks), 1.0)
+        flat = (np.arange(count)[:, None] * n_clusters + picks).ravel()
+        counts = np.bincount(flat, minlength=count * n_clusters).reshape(count, n_clusters).astype(float)
         total = counts @ sizes
         means.append(counts @ sums / total)
         quantiles.append(_weighted_quantiles(values, counts, cluster, descending, top, total, quantile))

@@ -26,7 +26,7 @@ from ..optimize.results import design_record, undecided_variables
 from ..optimize.space import GLOBAL_VARIABLES, PER_JOINT_VARIABLES
 from ..optimize.worst_case import SEARCH_TOLERANCE, WorstCase
 from .arm_setup import ArmSetup, SampleLayout, StudyProblems, sample_layout
-from .fresh import fresh_record, fresh_samples
+from .fresh import fresh_draw, fresh_impulses, fresh_record
 from .schema import ArmStudy
 from .worst_case import worst_case_record
 
@@ -180,12 +180,24 @@ def arm_results(
     setup = problems.setup
     # Every problem of a study shares its samples and technology: one of them evaluates every record.
     problem = built_problem(problems, problems.objective)
-    fresh = fresh_samples(setup)
+    draw = fresh_draw(setup)
+    every = [chosen, *(front.points if front else ()), *(front.dominated if front else ())]
+    fresh = (
+        {}
+        if draw is None
+        else {
+            id(result): found
+            for result, found in zip(
+                every, fresh_impulses(setup, draw, [r.design for r in every]), strict=True
+            )
+        }
+    )
 
     def fresh_check(result: DesignResult, worst_case: float, statistics: bool = False) -> dict[str, Any] | None:
-        if fresh is None:
+        if draw is None:
             return None
-        return fresh_record(fresh, setup, result.design, worst_case, search_tolerance, statistics)
+        found = fresh.get(id(result)) or fresh_impulses(setup, draw, [result.design])[0]
+        return fresh_record(found, worst_case, search_tolerance, statistics)
 
     def record(result: DesignResult, label: str) -> dict[str, Any]:
         out = design_record(problem, result, label, setup.catalogue)

@@ -11,6 +11,8 @@ design does, with an error that the number of fresh configurations sets, not the
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -20,6 +22,7 @@ from ..optimize.samples import ContactSamples
 from ..optimize.statistics import QUANTILE, impulse_statistics
 
 if TYPE_CHECKING:
+    from ..arm.domain import DomainDraw
     from ..optimize import Design
     from .arm_setup import ArmSetup
 
@@ -27,13 +30,30 @@ FRESH_STREAM = 0x0F7E5
 """Spawn key of the fresh samples' generator under the study's seed: a stream independent of the optimised
 samples' (``numpy.random.SeedSequence``)."""
 
+CHUNK_CONFIGURATIONS = 4096
+"""Fresh configurations whose kinematics are held at a time (the Panda's are about 4 kB each)."""
 
-def fresh_samples(setup: ArmSetup) -> ContactSamples | None:
-    """The study's fresh samples, or None (no random configurations, or ``samples.fresh: 0``).
 
-    Configurations are drawn in the domain at the slowest approach the design space allows (the largest
-    domain: every design's samples are among them); each sample carries its speed cap, so that a design keeps
-    those inside its own domain.
+@dataclass(frozen=True)
+class FreshImpulses:
+    """A design's impulses at the fresh samples inside its domain.
+
+    impulses: [N*s] (k,); configuration: (k,) each one's fresh configuration; q: (k_max, nq) [rad] and
+    direction: the configuration and direction of the largest.
+    """
+
+    impulses: np.ndarray
+    configuration: np.ndarray
+    q: np.ndarray | None
+    direction: np.ndarray | None
+
+
+def fresh_draw(setup: ArmSetup) -> DomainDraw | None:
+    """The study's fresh configurations and their directions' speed caps, or None (no random configurations, or
+    ``samples.fresh: 0``).
+
+    Drawn in the domain at the slowest approach the design space allows (the largest domain: every design's
+    samples are among them); a design keeps the directions whose speed cap its approach velocity meets.
     """
     spec = setup.study.samples
     random = spec.configurations.random
@@ -41,36 +61,51 @@ def fresh_samples(setup: ArmSetup) -> ContactSamples | None:
         return None
     rng = np.random.default_rng(np.random.SeedSequence(random.seed, spawn_key=(FRESH_STREAM,)))
     slowest = float(setup.space.global_bounds("approach_velocity").lower)
-    draw = setup.domain.draw(setup.arm, spec.fresh, setup.directions, slowest, rng)
+    return setup.domain.draw(setup.arm, spec.fresh, setup.directions, slowest, rng)
+
+
+def fresh_impulses(setup: ArmSetup, draw: DomainDraw, designs: Sequence[Design]) -> list[FreshImpulses]:
+    """Each design's impulses at the fresh samples of ``draw`` inside its domain.
+
+    The kinematics are computed once for all designs, :data:`CHUNK_CONFIGURATIONS` configurations at a time.
+    """
     config_index, direction_index = np.nonzero(draw.feasible)
-    kinematics = setup.arm.kinematics(draw.q)
-    directions = setup.directions[direction_index]
-    caps = setup.domain.speed_caps(kinematics.jacobian[config_index], directions)
-    return ContactSamples(kinematics, directions, config_index, speed_cap=caps)
-
-
-def fresh_impulses(
-    samples: ContactSamples, setup: ArmSetup, design: Design
-) -> tuple[np.ndarray, np.ndarray]:
-    """``design``'s impulses [N*s] at the fresh samples inside its domain, and their configurations' indices."""
-    inside = samples.inside(design.approach_velocity)
-    if not np.any(inside):
-        return np.empty(0), np.empty(0, dtype=int)
-    kept = ContactSamples(
-        samples.kinematics, samples.directions[inside], samples.config_index[inside]
-    )
-    return sample_impulses(kept, setup.technology, design), kept.config_index
+    found: list[list[tuple[np.ndarray, np.ndarray]]] = [[] for _ in designs]
+    for first in range(0, draw.q.shape[0], CHUNK_CONFIGURATIONS):
+        rows = np.flatnonzero((config_index >= first) & (config_index < first + CHUNK_CONFIGURATIONS))
+        if rows.size == 0:
+            continue
+        chunk = ContactSamples(
+            setup.arm.kinematics(draw.q[first : first + CHUNK_CONFIGURATIONS]),
+            setup.directions[direction_index[rows]],
+            config_index[rows] - first,
+            speed_cap=draw.speed_cap[config_index[rows], direction_index[rows]],
+        )
+        for out, design in zip(found, designs, strict=True):
+            inside = chunk.inside(design.approach_velocity)
+            if np.any(inside):
+                kept = ContactSamples(chunk.kinematics, chunk.directions[inside], chunk.config_index[inside])
+                out.append((sample_impulses(kept, setup.technology, design), rows[inside]))
+    results = []
+    for out in found:
+        impulses = np.concatenate([i for i, _ in out]) if out else np.empty(0)
+        where = np.concatenate([r for _, r in out]) if out else np.empty(0, dtype=int)
+        worst = where[int(np.argmax(impulses))] if impulses.size else None
+        results.append(
+            FreshImpulses(
+                impulses,
+                config_index[where],
+                None if worst is None else draw.q[config_index[worst]],
+                None if worst is None else setup.directions[direction_index[worst]],
+            )
+        )
+    return results
 
 
 def fresh_record(
-    samples: ContactSamples,
-    setup: ArmSetup,
-    design: Design,
-    worst_case: float,
-    tolerance: float,
-    statistics: bool = False,
+    fresh: FreshImpulses, worst_case: float, tolerance: float, statistics: bool = False
 ) -> dict[str, Any]:
-    """What the fresh samples say of ``design``, as plain data.
+    """What the fresh samples say of a design, as plain data.
 
     ``configurations``, ``samples``: how many lie in the design's domain; ``largest`` [N*s] the largest impulse
     there with ``q`` [rad] and ``direction`` where it occurs; ``mean`` [N*s]; ``exceeds``: ``largest`` is
@@ -79,23 +114,25 @@ def fresh_record(
     bootstrap intervals (``statistics``: ``mean_impulse`` and ``quantile_impulse``, as
     :meth:`~collision_reflex.optimize.statistics.Estimate.to_json`).
     """
-    impulses, configurations = fresh_impulses(samples, setup, design)
-    out: dict[str, Any] = {"configurations": int(np.unique(configurations).size), "samples": int(impulses.size)}
-    if impulses.size == 0:
+    impulses = fresh.impulses
+    out: dict[str, Any] = {
+        "configurations": int(np.unique(fresh.configuration).size),
+        "samples": int(impulses.size),
+    }
+    if impulses.size == 0 or fresh.q is None or fresh.direction is None:
         return {**out, "largest": None, "q": None, "direction": None, "mean": None, "exceeds": False}
-    worst = int(np.argmax(impulses))
-    where = np.flatnonzero(samples.inside(design.approach_velocity))[worst]
-    largest = float(impulses[worst])
+    largest = float(impulses.max())
     out.update(
         largest=largest,
-        q=samples.kinematics.q[samples.config_index[where]].tolist(),
-        direction=samples.directions[where].tolist(),
+        q=fresh.q.tolist(),
+        direction=fresh.direction.tolist(),
         mean=float(impulses.mean()),
         exceeds=bool(largest > worst_case * (1 + tolerance)),
     )
     if statistics:
         out["statistics"] = {
-            name: estimate.to_json() for name, estimate in impulse_statistics(impulses, configurations).items()
+            name: estimate.to_json()
+            for name, estimate in impulse_statistics(impulses, fresh.configuration).items()
         }
         out["statistics"]["quantile_impulse"]["quantile"] = QUANTILE
     return out
