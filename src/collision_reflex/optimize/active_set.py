@@ -213,6 +213,11 @@ from the continuous problem on the optimum's last active samples, so each is bui
 _SUBSETS: OrderedDict[tuple[Hashable, ...], tuple[object, DesignProblem]] = OrderedDict()
 
 
+def release_subsets() -> None:
+    """Drop the kept subset problems (:func:`kept_problem`)."""
+    _SUBSETS.clear()
+
+
 def kept_problem(
     key: tuple[Hashable, ...],
     samples: ContactSamples,

@@ -485,6 +485,18 @@ def built_problem(build: Hashable, objective: Hashable, bounded: tuple[str, ...]
     return problem
 
 
+def release_problems() -> None:
+    """Drop this process's built problems (:func:`built_problem`, the active sets' subset problems).
+
+    For a caller that moves on to other samples (a worst-case search's exchange round): the problems on the
+    samples before would otherwise stay beside the new ones, each as large as its samples.
+    """
+    from .active_set import release_subsets
+
+    built_problem.cache_clear()
+    release_subsets()
+
+
 def one_at_a_time(function: Callable[_P, _R]) -> Callable[_P, _R]:
     """Run a piece under the solver lock with single-threaded BLAS (the same numbers in every process).
 

@@ -307,6 +307,7 @@ def _run_arm(
     (:func:`.arm_results.catalogue_results`). Each piece is saved as it finishes and found again when the run
     resumes (the snap as ``catalogue``, reused while the catalogue file and the settings are the same).
     """
+    from ..optimize.pareto import release_problems
     from ..report.verdict import verdict
     from .arm_setup import StudyProblems
     from .worst_case import exchanges_samples, search_designs, violators
@@ -315,6 +316,8 @@ def _run_arm(
     extra: ExtraSamples = ()
     computed = reused = 0
     for round_ in range(search.rounds if search.enabled else 1):
+        if round_:  # the last round's problems, on fewer samples, are not solved again
+            release_problems()
         problems = StudyProblems(text, extra)
         prefix = f"round-{round_}-{_digest(extra)}-" if extra else ""
         optimum, front, counts = _solve_round(problems, study, folder, pool, progress, window, stages, prefix)
