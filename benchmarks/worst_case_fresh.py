@@ -22,37 +22,6 @@ from pathlib import Path
 import numpy as np
 
 
-def design_of(record: dict, sensing: str):
-    """A :class:`collision_reflex.optimize.solve.Design` from a design record of ``designs.json``."""
-    from collision_reflex.optimize.solve import Design
-
-    joints = record["joints"]
-
-    def column(name: str) -> np.ndarray:
-        return np.array([j[name] for j in joints], dtype=float)
-
-    return Design(
-        joint_names=tuple(j["joint"] for j in joints),
-        stator_diameter=column("stator_diameter"),
-        stack_length=column("stack_length"),
-        gear_ratio=column("gear_ratio"),
-        software_stiffness=column("software_stiffness"),
-        mechanical_stiffness=column("mechanical_stiffness"),
-        rotor_inertia=column("rotor_inertia"),
-        reflected_inertia=column("reflected_inertia"),
-        motor_peak_torque=column("motor_peak_torque"),
-        peak_torque=column("peak_torque"),
-        motor_mass=column("motor_mass"),
-        threshold=float(record["threshold"]),
-        approach_velocity=float(record["approach_velocity"]),
-        sensing=sensing,
-        gearbox=tuple(j["gearbox"] for j in joints),
-        gearbox_mass=column("gearbox_mass"),
-        gearbox_inertia=column("gearbox_inertia"),
-        gearbox_efficiency=column("gearbox_efficiency"),
-    )
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("run", type=Path)
@@ -63,6 +32,7 @@ def main() -> None:
 
     from collision_reflex.arm.domain import smallest_singular_values, unit_speed_joint_rates
     from collision_reflex.optimize.evaluate import sample_impulses
+    from collision_reflex.optimize.results import record_design
     from collision_reflex.optimize.samples import ContactSamples
     from collision_reflex.study.arm_setup import StudyProblems
     from collision_reflex.study.load import parse_study
@@ -73,7 +43,7 @@ def main() -> None:
     setup = StudyProblems(text).setup
     arm, technology = setup.arm, setup.technology
     record = results["pareto"]["points"][int(args.design)] if args.design.isdigit() else results[args.design]
-    design = design_of(record, setup.technology.sensing)
+    design = record_design(record, setup.technology.sensing)
     domain = results["domain"]
     rng = np.random.default_rng(args.seed)
     started = time.perf_counter()

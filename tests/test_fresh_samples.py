@@ -13,7 +13,7 @@ from collision_reflex.optimize.pareto import built_problem
 from collision_reflex.optimize.samples import ContactSamples
 from collision_reflex.optimize.solve import design_at
 from collision_reflex.study.arm_setup import StudyProblems
-from collision_reflex.study.fresh import CHUNK_CONFIGURATIONS, fresh_draw, fresh_impulses, fresh_record
+from collision_reflex.study.fresh import fresh_draw, fresh_impulses, fresh_record
 from collision_reflex.study.load import load_study
 from collision_reflex.study.resolve import resolved_yaml
 
@@ -104,7 +104,9 @@ def test_a_design_s_fresh_check_is_its_impulses_inside_its_own_domain(two_link):
         setup.technology,
         design,
     )
-    assert 0.05 < 1 - inside.mean() < 0.95  # the design's approach velocity excludes part of the fresh samples
+    assert (
+        0.05 < 1 - inside.mean() < 0.95
+    )  # the design's approach velocity excludes part of the fresh samples
     slow = dataclasses.replace(design, approach_velocity=setup.space.global_bounds("approach_velocity").lower)
     with pytest.MonkeyPatch.context() as patch:  # two chunks, the second partial
         patch.setattr("collision_reflex.study.fresh.CHUNK_CONFIGURATIONS", int(0.7 * draw.q.shape[0]))

@@ -225,12 +225,16 @@ def test_a_numpy_path_that_disagrees_with_casadi_is_warned_of(build, monkeypatch
     solving = importlib.import_module("collision_reflex.optimize.solve")  # the module, not the function
     problem = build("worst_case_impulse", ())
     agreeing = cr.solve(problem)
-    # The NumPy path 1e-5 off (10 x AGREEMENT_TOLERANCE) in every impulse: both impulse objectives are named.
+    # The NumPy path 1e-5 off (10 x AGREEMENT_TOLERANCE) in every impulse: every impulse objective is named.
     original = solving.evaluate_design
     monkeypatch.setattr(solving, "evaluate_design", lambda p, d: original(p, d) * (1 + 1e-5))
-    with pytest.warns(RuntimeWarning, match="evaluations of (worst_case|mean)_impulse differ") as caught:
+    with pytest.warns(RuntimeWarning, match="evaluations of (worst_case|mean|cvar)_impulse differ") as caught:
         cr.solve(problem, x0=agreeing.x)
-    assert {str(w.message).split()[5] for w in caught} == {"worst_case_impulse", "mean_impulse"}
+    assert {str(w.message).split()[5] for w in caught} == {
+        "worst_case_impulse",
+        "mean_impulse",
+        "cvar_impulse",
+    }
 
 
 def test_a_known_optimum_of_another_problem_is_refused(build):

@@ -290,6 +290,7 @@ def _fresh(largest, exceeds, mean_error=0.01, quantile_error=0.015):
         "exceeds": exceeds,
         "statistics": {
             "mean_impulse": _estimate(0.3, mean_error, 4096, 24_000),
+            "cvar_impulse": _estimate(1.0, mean_error, 4096, 24_000),
             "quantile_impulse": _estimate(1.2, quantile_error, 4096, 24_000, quantile=0.99),
         },
     }
@@ -302,6 +303,7 @@ def test_the_fresh_check_and_its_errors_are_stated_and_warned_about():
         "fresh": _fresh(1.9, False),
         "statistics": {
             "mean_impulse": _estimate(0.28, 0.12, 48, 288),
+            "cvar_impulse": _estimate(0.9, 0.2, 48, 288),
             "quantile_impulse": _estimate(1.1, 0.3, 48, 288, quantile=0.99),
         },
     }
@@ -309,15 +311,49 @@ def test_the_fresh_check_and_its_errors_are_stated_and_warned_about():
     lines = statistics_sentences(recommended, study, {"points": [recommended]})
     assert lines[0].startswith("Checked on 4,096 fresh configurations of the domain (24,000 samples")
     assert "largest impulse 1.9 N·s, within its worst case 2 N·s" in lines[0]
-    assert "mean 0.3 N·s (± 1 %)" in lines[0] and "99th percentile 1.2 N·s (± 1.5 %)" in lines[0]
+    assert "mean impulse 0.3 N·s (± 1 %), mean of the worst 5 % (CVaR) 1 N·s (± 1 %)" in lines[0]
+    assert "99th percentile 1.2 N·s (± 1.5 %)" in lines[0]
     assert lines[1].startswith("On the samples it was optimised on (48 configurations")
     assert len(lines) == 2  # errors within the tolerance; the mean is no objective: no warning
     # A fresh sample above the worst case, errors over the tolerance, the mean an objective: each is said.
     recommended["fresh"] = _fresh(2.2, True, quantile_error=0.04)
     recommended["label"] = "anchor: worst_case_impulse"
-    lines = statistics_sentences(recommended, {**study, "objective": "mean_impulse"}, {"points": [recommended]})
+    study = {
+        **study,
+        "objective": "mean_impulse",
+        "pareto": {"objectives": ["cvar_impulse", "actuator_mass"]},
+    }
+    lines = statistics_sentences(recommended, study, {"points": [recommended]})
     assert "WARNING: 2.2 N·s, 10 % above its worst case 2 N·s, which is therefore not a bound" in lines[0]
     # 4 % against 2 %: four times the configurations.
     assert "about 16,384 fresh configurations (samples.fresh) would meet it" in lines[1]
     assert lines[2] == "Pareto designs whose worst case a fresh sample exceeds: anchor: worst_case_impulse."
+    assert lines[4].startswith("Warning: the mean impulse, an objective, is uncertain by 12 %")
     assert "about 1,728 configurations (samples.configurations.random.count)" in lines[4]
+    # The CVaR, a Pareto objective, at 20 %: a hundred times the 48 configurations.
+    assert lines[5].startswith("Warning: the CVaR impulse, an objective, is uncertain by 20 %")
+    assert "about 4,800 configurations" in lines[5]
+
+
+def test_an_uncertified_worst_case_names_the_remedy_that_applies():
+    from collision_reflex.report.verdict import worst_case_sentences
+
+    searched = {"q": [0.1, 0.2], "direction": [1.0, 0.0], "starts": 4, "evaluations": 900, "domain_kept": 0.8}
+    recommended = {
+        **record(),
+        "worst_case": {
+            "sampled": 1.0,
+            "domain": 1.5,
+            "certified": False,
+            "searched": searched,
+            "tolerance": 0.005,
+        },
+    }
+    domain = {"min_singular_value": 0.1, "reach": 1.0}
+    exchanged = worst_case_sentences(recommended, domain, {"points": []})[1]
+    assert "50 % above the samples' worst case 1 N·s" in exchanged
+    assert "more search rounds (optimizer.worst_case_search.rounds)" in exchanged
+    # A study whose objectives leave the worst case alone never exchanges samples: more rounds would not help.
+    reported = worst_case_sentences(recommended, domain, {"points": []}, exchanged=False)[1]
+    assert "more search rounds" not in reported
+    assert "the worst case is no objective of this study" in reported

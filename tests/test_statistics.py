@@ -10,6 +10,7 @@ import pytest
 
 from collision_reflex.errors import InvalidParameter
 from collision_reflex.optimize.evaluate import sample_impulses
+from collision_reflex.optimize.objectives import CVAR_LEVEL
 from collision_reflex.optimize.pareto import built_problem
 from collision_reflex.optimize.samples import ContactSamples
 from collision_reflex.optimize.solve import design_at
@@ -44,16 +45,22 @@ def test_stated_intervals_cover_the_true_mean_and_quantile(impulses_of):
     reference, _ = impulses_of(12_500, 12345)
     assert reference.size >= 95_000  # about 10^5 samples: the reference's own error is a tenth of a run's
     true_mean, true_quantile = reference.mean(), np.quantile(reference, QUANTILE)
-    runs, covered = 100, {"mean_impulse": 0, "quantile_impulse": 0}
+    true_cvar = np.sort(reference)[-round((1 - CVAR_LEVEL) * reference.size) :].mean()
+    runs, covered = 100, {"mean_impulse": 0, "quantile_impulse": 0, "cvar_impulse": 0}
     errors = []
     for seed in range(runs):
         values, groups = impulses_of(150, seed)
         stats = impulse_statistics(values, groups, rng=np.random.default_rng(seed))
-        for name, truth in (("mean_impulse", true_mean), ("quantile_impulse", true_quantile)):
+        truths = (
+            ("mean_impulse", true_mean),
+            ("quantile_impulse", true_quantile),
+            ("cvar_impulse", true_cvar),
+        )
+        for name, truth in truths:
             covered[name] += stats[name].low <= truth <= stats[name].high
         errors.append(stats["mean_impulse"].relative_error)
     # 99 % intervals; a percentile bootstrap of a skewed statistic covers less than its level: at least 90 %.
-    assert covered["mean_impulse"] >= 0.9 * runs and covered["quantile_impulse"] >= 0.9 * runs, covered
+    assert all(count >= 0.9 * runs for count in covered.values()), covered
     # Not vacuous: intervals half as wide would miss far more often (the error is a real few per cent).
     assert 0.01 < np.median(errors) < 0.3
 
@@ -74,9 +81,10 @@ def test_bad_samples_are_refused():
 
 
 @pytest.mark.parametrize("top", [64, 2000])  # the ranked top alone, and with replicates falling back to all
-def test_each_replicate_s_quantile_is_the_quantile_of_its_resampled_impulses(top):
-    """A replicate's weighted quantile against NumPy's inverted-CDF quantile of the samples it repeats."""
-    from collision_reflex.optimize.statistics import _weighted_quantiles
+def test_each_replicate_s_quantile_and_cvar_are_those_of_its_resampled_impulses(top):
+    """A replicate's weighted quantile against NumPy's inverted-CDF quantile of the samples it repeats, and its
+    CVaR against the mean of the repeated samples' top (1 - level) share, the boundary sample's part pro rata."""
+    from collision_reflex.optimize.statistics import _tail_statistics
 
     rng = np.random.default_rng(3)
     clusters, per = 400, 5
@@ -85,10 +93,32 @@ def test_each_replicate_s_quantile_is_the_quantile_of_its_resampled_impulses(top
     counts = np.zeros((30, clusters))
     np.add.at(counts, (np.arange(30)[:, None], rng.integers(0, clusters, (30, clusters))), 1.0)
     descending = np.argsort(values)[::-1]
-    for q in (0.5, 0.99):
-        found = _weighted_quantiles(
+    for q in (0.5, 0.95, 0.99):
+        found, cvar = _tail_statistics(
             values, counts, cluster, descending, descending[:top], counts @ np.bincount(cluster), q
         )
-        for row, value in zip(counts, found, strict=True):
-            repeated = np.repeat(values, row[cluster].astype(int))
+        for row, value, tail_mean in zip(counts, found, cvar, strict=True):
+            repeated = np.sort(np.repeat(values, row[cluster].astype(int)))[::-1]
             assert value == np.quantile(repeated, q, method="inverted_cdf")
+            share = (1 - q) * repeated.size  # the tail's weight in samples, a fraction of one at its end
+            whole = int(np.floor(share))
+            expected = (repeated[:whole].sum() + (share - whole) * repeated[whole]) / share
+            assert tail_mean == pytest.approx(expected, rel=1e-12)
+
+
+def test_cvar_is_the_tail_mean_and_the_rockafellar_uryasev_minimum():
+    from collision_reflex.optimize.objectives import conditional_value_at_risk
+
+    rng = np.random.default_rng(8)
+    values = rng.lognormal(size=200)
+    # Equal weights, a tail of exactly 10 samples: their mean.
+    assert conditional_value_at_risk(values, np.ones(200), 0.95) == pytest.approx(
+        np.sort(values)[-10:].mean()
+    )
+    # Unequal weights: the minimum over t of t + E[(v - t)+] / (1 - level), scanned over every candidate t.
+    weights = rng.uniform(0.2, 2.0, 200)
+    p = weights / weights.sum()
+    scanned = min(t + p @ np.maximum(values - t, 0) / 0.1 for t in values)
+    assert conditional_value_at_risk(values, weights, 0.9) == pytest.approx(scanned, rel=1e-12)
+    # Zero-weight samples (points a search added) take no part.
+    assert conditional_value_at_risk(np.r_[values, 1e6], np.r_[weights, 0.0], 0.9) == pytest.approx(scanned)

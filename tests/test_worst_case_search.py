@@ -11,6 +11,7 @@ import pytest
 from collision_reflex.arm.domain import ContactDomain, smallest_singular_values
 from collision_reflex.optimize.evaluate import sample_impulses
 from collision_reflex.optimize.pareto import built_problem
+from collision_reflex.optimize.results import record_design
 from collision_reflex.optimize.samples import ContactSamples
 from collision_reflex.optimize.solve import design_at
 from collision_reflex.optimize.worst_case import search_worst_case
@@ -165,7 +166,7 @@ def test_a_study_s_certified_worst_case_holds_on_fresh_samples(tmp_path):
         1.0,
     ).contains(kinematics.jacobian, u, record["approach_velocity"])
     assert inside.mean() > 0.5
-    chosen = _design_of(record, problem)
+    chosen = record_design(record, problem.technology.sensing)
     fresh = sample_impulses(
         ContactSamples(kinematics, u[inside], np.flatnonzero(inside)), setup.technology, chosen
     )
@@ -178,7 +179,11 @@ def test_a_study_s_certified_worst_case_holds_on_fresh_samples(tmp_path):
     assert check["largest"] <= (1 + worst["tolerance"]) * worst["domain"]
     directions = setup.directions
     pairs = ContactDomain(
-        np.array(domain["joint_lower"]), np.array(domain["joint_upper"]), domain["min_singular_value"], limits, 1.0
+        np.array(domain["joint_lower"]),
+        np.array(domain["joint_upper"]),
+        domain["min_singular_value"],
+        limits,
+        1.0,
     ).contains(
         np.repeat(kinematics.jacobian, len(directions), axis=0),
         np.tile(directions, (n, 1)),
@@ -191,34 +196,3 @@ def test_a_study_s_certified_worst_case_holds_on_fresh_samples(tmp_path):
     spread = 3 * reference.std() / np.sqrt(np.unique(config).size)  # 3 standard errors (clustered: generous)
     mean = check["statistics"]["mean_impulse"]
     assert mean["low"] - spread <= reference.mean() <= mean["high"] + spread
-
-
-def _design_of(record, problem):
-    """The design of a ``designs.json`` record (its per-joint figures), for evaluating it anew."""
-    from collision_reflex.optimize.solve import Design
-
-    joints = record["joints"]
-
-    def column(name):
-        return np.array([j[name] for j in joints], dtype=float)
-
-    return Design(
-        joint_names=tuple(j["joint"] for j in joints),
-        stator_diameter=column("stator_diameter"),
-        stack_length=column("stack_length"),
-        gear_ratio=column("gear_ratio"),
-        software_stiffness=column("software_stiffness"),
-        mechanical_stiffness=column("mechanical_stiffness"),
-        rotor_inertia=column("rotor_inertia"),
-        reflected_inertia=column("reflected_inertia"),
-        motor_peak_torque=column("motor_peak_torque"),
-        peak_torque=column("peak_torque"),
-        motor_mass=column("motor_mass"),
-        threshold=float(record["threshold"]),
-        approach_velocity=float(record["approach_velocity"]),
-        sensing=problem.technology.sensing,
-        gearbox=tuple(j["gearbox"] for j in joints),
-        gearbox_mass=column("gearbox_mass"),
-        gearbox_inertia=column("gearbox_inertia"),
-        gearbox_efficiency=column("gearbox_efficiency"),
-    )

@@ -142,7 +142,9 @@ class ContactDomain:
 
         One pseudo-inverse per configuration, however many directions.
         """
-        rates = np.abs(np.einsum("cjd,md->cmj", np.linalg.pinv(jacobian), directions)) / self.joint_speed_limit
+        rates = (
+            np.abs(np.einsum("cjd,md->cmj", np.linalg.pinv(jacobian), directions)) / self.joint_speed_limit
+        )
         with np.errstate(divide="ignore"):
             return np.asarray(1 / rates.max(axis=2))
 

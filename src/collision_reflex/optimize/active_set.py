@@ -457,8 +457,9 @@ def _check_settings(start_samples: int, tolerance: float, max_rounds: int, start
 
 def _needs_every_sample(problem: DesignProblem) -> str | None:
     """Why the problem must be solved on all samples at once (a mean impulse), or None."""
-    if "mean_impulse" in problem.objective or "mean_impulse" in problem.bounded_objectives:
-        return "all samples: the mean impulse (objective or bound) needs every sample"
+    for name in ("mean_impulse", "cvar_impulse"):
+        if name in problem.objective or name in problem.bounded_objectives:
+            return f"all samples: the {name.replace('_', ' ')} (objective or bound) needs every sample"
     return None
 
 

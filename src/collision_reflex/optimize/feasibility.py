@@ -33,6 +33,7 @@ remainder is a constraint that cannot be met, not round-off."""
 OBJECTIVE_UNITS = {
     "worst_case_impulse": "N*s",
     "mean_impulse": "N*s",
+    "cvar_impulse": "N*s",
     "actuator_mass": "kg",
     "approach_velocity": "m/s",
 }

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..errors import CollisionReflexError, InvalidParameter
 from .evaluate import evaluate_design
-from .objectives import OBJECTIVES
+from .objectives import OBJECTIVES, objective_values
 from .problem import DesignProblem
 from .solve import design_at
 
@@ -81,12 +81,9 @@ def nsga2_front(
     def evaluate(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         design = design_at(problem, z)
         impulses = evaluate_design(problem, design)
-        values = {
-            "worst_case_impulse": impulses.max(),
-            "mean_impulse": impulses.mean(),
-            "actuator_mass": design.actuator_mass.sum(),
-            "approach_velocity": design.approach_velocity,
-        }
+        values = objective_values(
+            impulses, design.actuator_mass.sum(), design.approach_velocity, problem.samples
+        )
         required = np.asarray(problem.required_torque_function(design.actuator_mass)).ravel()
         # pymoo's convention: constraint values <= 0 are satisfied.
         return np.array([values[n] for n in names]) * senses, required - design.driving_peak_torque

@@ -64,15 +64,19 @@ from .duty import (
 )
 from .layout import DesignLayout, DesignQuantities, design_layout, design_quantities
 from .objectives import (
+    CVAR_LEVEL,
     OBJECTIVES,
     TIE_BREAK_WEIGHT,
     add_epigraph,
     add_objective_bounds,
+    add_tail,
     checked_bounded_objectives,
+    mean_weights,
     objective_expression,
     objective_terms,
     objective_values,
     objective_weights,
+    value_at_risk,
 )
 from .samples import (
     ContactSamples,
@@ -127,6 +131,7 @@ class DesignProblem:
     joint_names: tuple[str, ...]
     required_torque_function: ca.Function
     epigraph_index: int | None
+    tail_index: slice | None
     compliance_index: slice
     direction_index: slice
     direction_scale: np.ndarray
@@ -163,11 +168,14 @@ class DesignProblem:
             finger_mass_directions(self.samples, masses, finger) / self.direction_scale[:, None]
         ).ravel()
         x[self.compliance_index] = np.log(reaction_compliance(self.samples, torques))
-        if self.epigraph_index is not None:
+        if self.epigraph_index is not None or self.tail_index is not None:
             impulses = np.asarray(self.evaluate(x)[0]).ravel()
+        if self.epigraph_index is not None:
             x[self.epigraph_index] = _epigraph_value(
                 impulses, self.samples, self.slowest_bound, self.objective_scale
             )
+        if self.tail_index is not None:
+            x[self.tail_index] = _tail_values(impulses, self.samples, self.objective_scale)
         return x
 
     def sample_parameters(self, x: np.ndarray) -> dict[str, np.ndarray]:
@@ -312,8 +320,9 @@ def build_problem(
         else duty_requirement(arm, samples, constraints.duty_cycle, technology, constraints.safety_factor)
     )
     n_samples, n_design = samples.size, layout.size
-    epigraph_index, compliance_index, direction_index = _variable_slices(
-        n_design, n_samples, n_joints, "worst_case_impulse" in set(weights) | set(bounded)
+    named = set(weights) | set(bounded)
+    epigraph_index, tail_index, compliance_index, direction_index = _variable_slices(
+        n_design, n_samples, n_joints, "worst_case_impulse" in named, "cvar_impulse" in named
     )
     x = ca.MX.sym("x", direction_index.stop)
     p = ca.MX.sym("p", len(bounded))
@@ -366,6 +375,10 @@ def build_problem(
             g, x, epigraph_index, impulses, scale, x0, lbx, samples, slowest
         )
         x0[epigraph_index] = _epigraph_value(start_impulses, samples, slowest_bound, scale)
+    if tail_index is not None:
+        expressions["cvar_impulse"] = add_tail(
+            g, x, tail_index, impulses, scale, x0, lbx, samples, start_impulses
+        )
     start_required = (
         required_torque(start_mass)
         if duty is None
@@ -404,6 +417,7 @@ def build_problem(
         joint_names=joint_names,
         required_torque_function=required_torque,
         epigraph_index=epigraph_index,
+        tail_index=tail_index,
         compliance_index=compliance_index,
         direction_index=direction_index,
         direction_scale=per_sample.direction_scale,
@@ -426,6 +440,16 @@ def _epigraph_value(
     (:func:`.objectives.add_epigraph`).
     """
     return float(np.max(impulses[samples.inside(slowest)])) / scale["worst_case_impulse"]
+
+
+def _tail_values(impulses: np.ndarray, samples: ContactSamples, scale: Mapping[str, float]) -> np.ndarray:
+    """The CVaR's scaled value at risk and slacks at their optimal values for ``impulses`` [N*s].
+
+    As :func:`.objectives.add_tail` lays them out.
+    """
+    var = value_at_risk(impulses, mean_weights(samples), CVAR_LEVEL)
+    unit = scale["cvar_impulse"]
+    return np.concatenate([[var / unit], np.maximum(impulses - var, 0.0) / unit])
 
 
 class _SampleTerms(NamedTuple):
@@ -540,18 +564,22 @@ def _joint_names(arm: Arm, samples: ContactSamples) -> tuple[str, ...]:
 
 
 def _variable_slices(
-    n_design: int, n_samples: int, n_joints: int, with_epigraph: bool
-) -> tuple[int | None, slice, slice]:
-    """Where the auxiliaries sit in ``x``: the epigraph ``t``, ``g = log(1/F_a)`` and the directions ``x_s``.
+    n_design: int, n_samples: int, n_joints: int, with_epigraph: bool, with_tail: bool
+) -> tuple[int | None, slice | None, slice, slice]:
+    """Where the auxiliaries sit in ``x``: epigraph, CVaR's value at risk and slacks, ``g``, directions.
 
-    The layout is: design (log values) | epigraph ``t`` (if needed) | ``g`` (n_samples) | finger-mass
-    directions (n_joints * n_samples).
+    ``g = log(1/F_a)`` per sample, ``x_s`` the finger-mass directions.
+
+    The layout is: design (log values) | epigraph ``t`` (if needed) | value at risk and one slack per sample
+    (if needed) | ``g`` (n_samples) | finger-mass directions (n_joints * n_samples).
     """
     epigraph_index = n_design if with_epigraph else None
-    compliance_start = n_design + (epigraph_index is not None)
+    tail_start = n_design + (epigraph_index is not None)
+    tail_index = slice(tail_start, tail_start + 1 + n_samples) if with_tail else None
+    compliance_start = tail_start if tail_index is None else tail_index.stop
     compliance_index = slice(compliance_start, compliance_start + n_samples)
     direction_index = slice(compliance_index.stop, compliance_index.stop + n_joints * n_samples)
-    return epigraph_index, compliance_index, direction_index
+    return epigraph_index, tail_index, compliance_index, direction_index
 
 
 def _bounds_and_start(

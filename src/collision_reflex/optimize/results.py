@@ -264,6 +264,32 @@ def _result_from_json(data: Mapping[str, Any], saved: Mapping[str, Any]) -> Desi
     )
 
 
+def record_design(record: Mapping[str, Any], sensing: str) -> Design:
+    """The :class:`~.solve.Design` a design record holds, to evaluate it anew.
+
+    ``record``: as :func:`result_record` writes it (``designs.json``); ``sensing``: the study's scheme
+    (``force`` or ``position``).
+    """
+    joints = record["joints"]
+
+    def column(name: str) -> np.ndarray:
+        return np.array([joint[name] for joint in joints], dtype=float)
+
+    names = (
+        "stator_diameter stack_length gear_ratio software_stiffness mechanical_stiffness rotor_inertia "
+        "reflected_inertia motor_peak_torque peak_torque motor_mass gearbox_mass gearbox_inertia "
+        "gearbox_efficiency"
+    ).split()
+    return Design(
+        joint_names=tuple(joint["joint"] for joint in joints),
+        threshold=float(record["threshold"]),
+        approach_velocity=float(record["approach_velocity"]),
+        sensing=sensing,
+        gearbox=tuple(joint["gearbox"] for joint in joints),
+        **{name: column(name) for name in names},
+    )
+
+
 def result_record(result: DesignResult, label: str) -> dict[str, Any]:
     """A design and its solve as plain data: objectives, per-joint quantities and margins, solver status."""
     design = result.design

@@ -1,13 +1,12 @@
-"""How sure a sampled statistic of the collision impulse is: the mean and a high quantile with their errors.
+"""How sure a sampled statistic of the collision impulse is: mean, high quantile and CVaR with their errors.
 
 A mean or a quantile over random samples of the contact domain is an estimate; its sampling error shrinks as
 one over the square root of the number of configurations. The samples of one configuration (its directions) are
 correlated, so the error comes from a cluster bootstrap: configurations are drawn with replacement, each with all
 its drawn samples, and the statistic recomputed; the 0.5 and 99.5 percentiles of the replicates bound a 99 %
 interval. A percentile interval of a skewed statistic covers less than its level with a few hundred
-configurations (measured on correlated lognormal samples, 300 configurations of 14 samples: 95 % intervals held
-the true mean in 90 % and the true 99th percentile in 86-88 % of 200 seeded draws; 99 % intervals in 96 % and
-93 %), so the stated interval is the 99 % one. The relative error is its larger half-width over the estimate.
+configurations, so the stated interval is the 99 % one (benchmarks/results/worst_case.md gives the coverage
+measured at 95 %). The relative error is its larger half-width over the estimate.
 """
 
 from __future__ import annotations
@@ -17,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InvalidParameter
+from .objectives import CVAR_LEVEL, conditional_value_at_risk
 
 BOOTSTRAP_REPLICATES = 1000
 """Bootstrap replicates of a statistic: enough for the 0.5 and 99.5 percentiles (five replicates beyond each)."""
@@ -75,7 +75,9 @@ def impulse_statistics(
     quantile: float = QUANTILE,
     rng: np.random.Generator | None = None,
 ) -> dict[str, Estimate]:
-    """The mean and the ``quantile`` of ``impulses`` [N*s] with their :data:`LEVEL` intervals.
+    """The mean, the ``quantile`` and the CVaR of ``impulses`` [N*s] with their :data:`LEVEL` intervals.
+
+    Keyed ``mean_impulse``, ``quantile_impulse`` and ``cvar_impulse`` (at :data:`~.objectives.CVAR_LEVEL`).
 
     ``groups`` (n,) names each impulse's configuration (the bootstrap's clusters); ``rng`` draws the replicates
     (default ``numpy.random.default_rng(0)``: the same figures for the same samples).
@@ -102,8 +104,9 @@ def impulse_statistics(
     # A replicate's quantile lies in the upper tail: only the largest samples are ranked per replicate (those
     # whose weight does not reach the quantile's tail fall back to every sample).
     descending = np.argsort(values)[::-1]
-    top = descending[: min(values.size, max(64, int(np.ceil(_TAIL_FACTOR * (1 - quantile) * values.size))))]
-    means, quantiles = [], []
+    widest = 1 - min(quantile, CVAR_LEVEL)
+    top = descending[: min(values.size, max(64, int(np.ceil(_TAIL_FACTOR * widest * values.size))))]
+    means, quantiles, tails = [], [], []
     for start in range(0, BOOTSTRAP_REPLICATES, _CHUNK):
         count = min(_CHUNK, BOOTSTRAP_REPLICATES - start)
         picks = generator.integers(0, n_clusters, size=(count, n_clusters))
@@ -112,7 +115,8 @@ def impulse_statistics(
         counts = np.bincount(flat, minlength=count * n_clusters).reshape(count, n_clusters).astype(float)
         total = counts @ sizes
         means.append(counts @ sums / total)
-        quantiles.append(_weighted_quantiles(values, counts, cluster, descending, top, total, quantile))
+        quantiles.append(_tail_statistics(values, counts, cluster, descending, top, total, quantile)[0])
+        tails.append(_tail_statistics(values, counts, cluster, descending, top, total, CVAR_LEVEL)[1])
 
     def estimate(value: float, replicates: np.ndarray) -> Estimate:
         low, high = np.percentile(replicates, [50 * (1 - LEVEL), 50 * (1 + LEVEL)])
@@ -125,36 +129,44 @@ def impulse_statistics(
         "quantile_impulse": estimate(
             float(np.quantile(values, quantile, method="inverted_cdf")), np.concatenate(quantiles)
         ),
+        "cvar_impulse": estimate(
+            conditional_value_at_risk(values, np.ones(values.size)), np.concatenate(tails)
+        ),
     }
 
 
-def _weighted_quantiles(
+def _tail_statistics(
     values: np.ndarray,
     counts: np.ndarray,
     cluster: np.ndarray,
     descending: np.ndarray,
     top: np.ndarray,
     total: np.ndarray,
-    quantile: float,
-) -> np.ndarray:
-    """Each replicate's weighted ``quantile`` of ``values``, its weights its clusters' ``counts`` (count, n).
+    level: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Each replicate's weighted ``level`` quantile and CVaR of ``values``, its weights its clusters' ``counts``.
 
-    The inverted-CDF quantile: the smallest value whose cumulative weight from below reaches ``quantile`` of
-    ``total``, i.e. the largest value with no more than ``(1 - quantile) total`` of the weight strictly above
-    it. Ranked over the ``top`` samples (the largest, in ``descending`` order), over all for a replicate whose
-    tail reaches beyond them.
+    The quantile is the inverted CDF's: the smallest value whose cumulative weight from below reaches ``level``
+    of ``total``, i.e. the largest value with no more than the tail's weight ``(1 - level) total`` strictly
+    above it. The CVaR is the weighted mean of that tail (the values above, and the quantile for the rest of the
+    tail's weight). Ranked over the ``top`` samples (the largest, in ``descending`` order), over all for a
+    replicate whose tail reaches beyond them.
     """
-    tail = (1 - quantile) * total
+    tail = (1 - level) * total
 
-    def ranked(order: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def ranked(order: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         weights = counts[rows][:, cluster[order]]
         above = np.cumsum(weights, axis=1) - weights  # weight strictly above each ranked sample
+        weighted = np.cumsum(weights * values[order], axis=1) - weights * values[order]
         position = (above <= tail[rows, None]).sum(axis=1) - 1
-        return values[order][position], above[:, -1] + weights[:, -1]
+        at = np.arange(rows.size)
+        quantile = values[order][position]
+        cvar = (weighted[at, position] + (tail[rows] - above[at, position]) * quantile) / tail[rows]
+        return quantile, cvar, above[:, -1] + weights[:, -1]
 
     rows = np.arange(counts.shape[0])
-    out, ranked_weight = ranked(top, rows)
+    quantile, cvar, ranked_weight = ranked(top, rows)
     beyond = ranked_weight <= tail  # the whole top fits in the tail: the quantile lies below it
     if np.any(beyond) and top.size < values.size:
-        out[beyond] = ranked(descending, rows[beyond])[0]
-    return out
+        quantile[beyond], cvar[beyond], _ = ranked(descending, rows[beyond])
+    return quantile, cvar

@@ -235,11 +235,16 @@ def domain_sentence(domain: Mapping[str, Any], velocity: float, kept: float | No
 
 
 def worst_case_sentences(
-    record: Mapping[str, Any], domain: Mapping[str, Any] | None, pareto: Mapping[str, Any]
+    record: Mapping[str, Any],
+    domain: Mapping[str, Any] | None,
+    pareto: Mapping[str, Any],
+    exchanged: bool = True,
 ) -> list[str]:
     """The recommended design's worst case over the contact domain, where it occurs, and how sure it is.
 
-    Also names the Pareto designs whose worst case the search could not certify.
+    Also names the Pareto designs whose worst case the search could not certify. ``exchanged``: the study
+    minimises or bounds the worst case, so that searched points joined its samples (else they are only
+    reported).
     """
     worst = record.get("worst_case")
     if not worst or domain is None:
@@ -263,11 +268,17 @@ def worst_case_sentences(
         )
     else:
         excess = worst["domain"] / worst["sampled"] - 1
+        remedy = (
+            "more search rounds (optimizer.worst_case_search.rounds) or samples may certify it"
+            if exchanged
+            else "the worst case is no objective of this study, so the points found do not join its samples "
+            "(make worst_case_impulse an objective or a Pareto objective to bound it)"
+        )
         lines.append(
             f"Worst case NOT certified: the search ({effort}) found {_g(worst['domain'])} N·s, "
             f"{_percent(100 * excess)} % above the samples' worst case {_g(worst['sampled'])} N·s, at q = [{pose}] "
             f"deg along u = [{direction}]. Take {_g(worst['domain'])} N·s as the worst case found, not as a bound; "
-            "more search rounds (optimizer.worst_case_search.rounds) or samples may certify it."
+            f"{remedy}."
         )
     uncertified = [
         str(point.get("label", i))
@@ -300,7 +311,6 @@ def statistics_sentences(
     if fresh and fresh.get("largest") is not None:
         worst = float(record["worst_case"]["domain"])
         stats = fresh["statistics"]
-        mean, quantile = stats["mean_impulse"], stats["quantile_impulse"]
         check = (
             f"WARNING: {_g(fresh['largest'])} N·s, {_percent(100 * (fresh['largest'] / worst - 1))} % above its "
             f"worst case {_g(worst)} N·s, which is therefore not a bound"
@@ -309,12 +319,10 @@ def statistics_sentences(
         )
         lines.append(
             f"Checked on {fresh['configurations']:,} fresh configurations of the domain ({fresh['samples']:,} "
-            f"samples it was not optimised on): largest impulse {check}; mean {_g(mean['value'])} N·s "
-            f"(± {_percent(100 * mean['relative_error'])} %), {_g(100 * quantile['quantile'], 3)}th percentile "
-            f"{_g(quantile['value'])} N·s (± {_percent(100 * quantile['relative_error'])} %), 99 % bootstrap "
-            "intervals."
+            f"samples it was not optimised on): largest impulse {check}; {_statistics_phrase(stats)}, 99 % "
+            "bootstrap intervals."
         )
-        error = max(mean["relative_error"], quantile["relative_error"])
+        error = max(estimate["relative_error"] for estimate in stats.values())
         if error > tolerance:
             needed = int(np.ceil(fresh["configurations"] * (error / tolerance) ** 2))
             lines.append(
@@ -332,25 +340,52 @@ def statistics_sentences(
     statistics = record.get("statistics")
     if not statistics:
         return lines
-    mean, quantile = statistics["mean_impulse"], statistics["quantile_impulse"]
+    mean = statistics["mean_impulse"]
     lines.append(
         f"On the samples it was optimised on ({mean['configurations']} configurations, {mean['samples']:,} "
-        f"samples): mean impulse {_g(mean['value'])} N·s (± {_percent(100 * mean['relative_error'])} %), "
-        f"{_g(100 * quantile['quantile'], 3)}th percentile {_g(quantile['value'])} N·s "
-        f"(± {_percent(100 * quantile['relative_error'])} %)."
+        f"samples): {_statistics_phrase(statistics)}."
     )
-    pareto_spec = study.get("pareto") or {}
-    objective = study.get("objective") or ()
-    objectives = {objective} if isinstance(objective, str) else set(objective)  # a name or a weighted sum
-    objectives |= set(pareto_spec.get("objectives") or ())
-    if "mean_impulse" in objectives and mean["relative_error"] > tolerance:
-        needed = int(np.ceil(mean["configurations"] * (mean["relative_error"] / tolerance) ** 2))
+    objectives = study_objectives(study)
+    for name in ("mean_impulse", "cvar_impulse"):
+        estimate = statistics.get(name)
+        if name not in objectives or estimate is None or estimate["relative_error"] <= tolerance:
+            continue
+        needed = int(np.ceil(estimate["configurations"] * (estimate["relative_error"] / tolerance) ** 2))
         lines.append(
-            f"Warning: the mean impulse, an objective, is uncertain by {_percent(100 * mean['relative_error'])} %, "
-            f"more than the study's {_percent(100 * tolerance)} % (samples.error_tolerance): about {needed:,} "
-            "configurations (samples.configurations.random.count) would meet it."
+            f"Warning: the {_STATISTIC_NAMES[name]}, an objective, is uncertain by "
+            f"{_percent(100 * estimate['relative_error'])} % on the samples it was optimised on, more than the "
+            f"study's {_percent(100 * tolerance)} % (samples.error_tolerance): about {needed:,} configurations "
+            "(samples.configurations.random.count) would meet it."
         )
     return lines
+
+
+def study_objectives(study: Mapping[str, Any]) -> set[str]:
+    """The objectives a resolved study names: its objective (a name or a weighted sum) and its Pareto ones."""
+    objective = study.get("objective") or ()
+    named = {objective} if isinstance(objective, str) else set(objective)
+    return named | set((study.get("pareto") or {}).get("objectives") or ())
+
+
+_STATISTIC_NAMES = {"mean_impulse": "mean impulse", "cvar_impulse": "CVaR impulse"}
+
+
+def _statistics_phrase(statistics: Mapping[str, Any]) -> str:
+    """``mean ..., mean of the worst 5 % (CVaR) ..., 99th percentile ...``, each with its relative error."""
+
+    def one(estimate: Mapping[str, Any]) -> str:
+        return f"{_g(estimate['value'])} N·s (± {_percent(100 * estimate['relative_error'])} %)"
+
+    parts = [f"mean impulse {one(statistics['mean_impulse'])}"]
+    if "cvar_impulse" in statistics:
+        from ..optimize.objectives import CVAR_LEVEL
+
+        parts.append(
+            f"mean of the worst {_g(100 * (1 - CVAR_LEVEL), 2)} % (CVaR) {one(statistics['cvar_impulse'])}"
+        )
+    quantile = statistics["quantile_impulse"]
+    parts.append(f"{_g(100 * quantile['quantile'], 3)}th percentile {one(quantile)}")
+    return ", ".join(parts)
 
 
 def objective_spans(points: Sequence[Mapping[str, Any]], objectives: Sequence[str]) -> dict[str, float]:
@@ -479,7 +514,9 @@ def verdict(results: Mapping[str, Any]) -> list[str]:
     lines = [f"Recommended design ({recommended.get('source', 'optimum')}): {design_sentence(recommended)}"]
     if reason:
         lines.append(f"Why this design: {reason}.")
-    lines += worst_case_sentences(recommended, results.get("domain"), results["pareto"])
+    resolved = results.get("resolved") or {}
+    exchanged = "worst_case_impulse" in study_objectives(resolved) or not resolved
+    lines += worst_case_sentences(recommended, results.get("domain"), results["pareto"], exchanged)
     lines += statistics_sentences(recommended, results.get("resolved") or {}, results.get("pareto"))
     lines.append(requirement_sentence(requirement))
     if results.get("speed_limits"):

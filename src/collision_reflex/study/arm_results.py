@@ -193,7 +193,9 @@ def arm_results(
         }
     )
 
-    def fresh_check(result: DesignResult, worst_case: float, statistics: bool = False) -> dict[str, Any] | None:
+    def fresh_check(
+        result: DesignResult, worst_case: float, statistics: bool = False
+    ) -> dict[str, Any] | None:
         if draw is None:
             return None
         found = fresh.get(id(result)) or fresh_impulses(setup, draw, [result.design])[0]

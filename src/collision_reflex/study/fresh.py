@@ -49,8 +49,9 @@ class FreshImpulses:
 
 
 def fresh_draw(setup: ArmSetup) -> DomainDraw | None:
-    """The study's fresh configurations and their directions' speed caps, or None (no random configurations, or
-    ``samples.fresh: 0``).
+    """The study's fresh configurations and their directions' speed caps, or None.
+
+    None without random configurations or with ``samples.fresh: 0``.
 
     Drawn in the domain at the slowest approach the design space allows (the largest domain: every design's
     samples are among them); a design keeps the directions whose speed cap its approach velocity meets.

@@ -53,8 +53,10 @@ from .quantities import (
     to_si,
 )
 
-OBJECTIVE_NAMES = ("worst_case_impulse", "mean_impulse", "actuator_mass", "approach_velocity")
-ObjectiveName = Literal["worst_case_impulse", "mean_impulse", "actuator_mass", "approach_velocity"]
+OBJECTIVE_NAMES = ("worst_case_impulse", "mean_impulse", "cvar_impulse", "actuator_mass", "approach_velocity")
+ObjectiveName = Literal[
+    "worst_case_impulse", "mean_impulse", "cvar_impulse", "actuator_mass", "approach_velocity"
+]
 SCALING_LAW_NAMES = ("haddadin", "isometric", "empirical", "quadruped")
 GEARBOX_KINDS = ("planetary", "parallel_shaft", "harmonic", "cycloidal", "ball_screw")
 NAMED_DIRECTIONS = ("+x", "-x", "+y", "-y", "+z", "-z")
