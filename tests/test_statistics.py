@@ -93,10 +93,13 @@ def test_each_replicate_s_quantile_and_cvar_are_those_of_its_resampled_impulses(
     counts = np.zeros((30, clusters))
     np.add.at(counts, (np.arange(30)[:, None], rng.integers(0, clusters, (30, clusters))), 1.0)
     descending = np.argsort(values)[::-1]
-    for q in (0.5, 0.95, 0.99):
-        found, cvar = _tail_statistics(
-            values, counts, cluster, descending, descending[:top], counts @ np.bincount(cluster), q
-        )
+    levels = (0.5, 0.95, 0.99)
+    total = counts @ np.bincount(cluster)
+    for q, (found, cvar) in zip(
+        levels,
+        _tail_statistics(values, counts, cluster, descending, descending[:top], total, levels),
+        strict=True,
+    ):
         for row, value, tail_mean in zip(counts, found, cvar, strict=True):
             repeated = np.sort(np.repeat(values, row[cluster].astype(int)))[::-1]
             assert value == np.quantile(repeated, q, method="inverted_cdf")

@@ -478,7 +478,13 @@ def test_study_sweep_is_the_library_sweep(runs, name):
     results = json.loads((folder / "designs.json").read_text())
     saved, spec = results["pareto"], results["resolved"]["pareto"]
     problems = StudyProblems.of_run(folder)
-    optimum, _ = sweep.single_optimum(problems, problems.objective, IPOPT_OPTIONS)
+    rounds = sorted(
+        (folder / "points").glob("round-*-optimum*.json"), key=lambda p: int(p.name.split("-")[1])
+    )
+    if rounds:  # an exchange round's optimum starts from the last round's: the run's own is the known one
+        optimum = sweep.SweepPoint.from_json(json.loads(rounds[-1].read_text())).result
+    else:
+        optimum, _ = sweep.single_optimum(problems, problems.objective, IPOPT_OPTIONS)
     front = sweep.pareto_front(
         problems,
         spec["objectives"],

@@ -14,7 +14,8 @@ built per sampled configuration: a configuration whose gravity demand exceeds a 
 design found is a violation too, and its worst sample is added (the first active set holds, per joint, the
 configuration of the largest demand at the start). With a duty cycle, the sample of each joint's largest
 approach rate, which sets the motor-speed row, is in every active set. A last check evaluates every constraint
-row of the full NLP at the design found.
+row of the full NLP at the design found, up to :data:`FULL_ROW_CHECK_SAMPLES` samples; beyond them the full
+NLP is never built (its start, bounds and scales are NumPy), and the NumPy checks on every sample decide.
 
 Sweeps, optima and studies solve on active sets through :func:`collision_reflex.optimize.pareto.solve_with`
 (``active_set="auto"`` from :data:`ACTIVE_SET_THRESHOLD` samples, ``"always"``, ``"never"``; a study's
@@ -22,7 +23,7 @@ Sweeps, optima and studies solve on active sets through :func:`collision_reflex.
 
 Two things depend on all samples and are handled as follows, never silently:
 
-- A mean-impulse objective or bound needs every sample: the problem is then solved on all samples
+- A mean-impulse or CVaR objective or bound needs every sample: the problem is then solved on all samples
   (``ActiveSetResult.method`` says so).
 - The tie-break pull toward a lower mean impulse (:data:`collision_reflex.optimize.objectives.TIE_BREAK_WEIGHT`,
   1e-3 of the objective) acts on the active samples' mean: it picks among designs of equal worst case, and may
@@ -439,7 +440,8 @@ def _settle(
             )
         active = np.union1d(active, added)
     x = full.exact_point(np.concatenate([x_design, full.x0[n_design:]]))
-    _check_full_rows(full, x, problem, result.x, epsilon)
+    if checks_full_rows(full):
+        _check_full_rows(full, x, problem, result.x, epsilon)
     return _Settled(result, x, impulses, active, tuple(rounds), full.objective_value(x))
 
 
@@ -566,6 +568,18 @@ def _violated(
     return np.flatnonzero(bad)
 
 
+FULL_ROW_CHECK_SAMPLES = 2048
+"""Most samples for which the full NLP's graph is built to check every row at an active set's design (and
+its objectives evaluated by CasADi beside NumPy). Beyond it building that graph costs more than the active set
+saves: the design is checked on every sample by the NumPy rules that add samples (:func:`_violated`), and
+the subset NLPs' own CasADi and NumPy values are compared at each solve."""
+
+
+def checks_full_rows(full: DesignProblem) -> bool:
+    """Whether the active set checks the full NLP's rows and objectives by CasADi (:data:`FULL_ROW_CHECK_SAMPLES`)."""
+    return full.samples.size <= FULL_ROW_CHECK_SAMPLES
+
+
 def _check_full_rows(
     full: DesignProblem,
     x: np.ndarray,
@@ -610,9 +624,11 @@ def _full_result(
     ``x`` is the full problem's point, ``impulses`` [N*s] the NumPy path's of every sample.
     """
     velocity = last.design.approach_velocity
-    objectives = {**last.objectives, **impulse_objectives(full.evaluate(x)[0], full.samples, velocity)}
     numpy_objectives = {**last.numpy_objectives, **impulse_objectives(impulses, full.samples, velocity)}
-    check_agreement(objectives, numpy_objectives, IMPULSE_OBJECTIVES)
+    objectives = numpy_objectives  # beyond FULL_ROW_CHECK_SAMPLES the full NLP is not built
+    if checks_full_rows(full):
+        objectives = {**last.objectives, **impulse_objectives(full.evaluate(x)[0], full.samples, velocity)}
+        check_agreement(objectives, numpy_objectives, IMPULSE_OBJECTIVES)
     return _replace(last, objectives=objectives, numpy_objectives=numpy_objectives, x=x, multipliers=None)
 
 

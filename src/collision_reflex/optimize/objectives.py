@@ -103,25 +103,17 @@ def add_tail(
     index: slice,
     impulses: ca.MX,
     scale: Mapping[str, float],
-    x0: np.ndarray,
-    lbx: np.ndarray,
     samples: ContactSamples,
-    start_impulses: np.ndarray,
 ) -> ca.MX:
     """Add the tail rows ``z_s >= I_s - t`` and give the CVaR expression [N*s] (Rockafellar-Uryasev).
 
-    ``x[index]`` holds ``t`` (the value at risk) then one ``z_s >= 0`` per sample, all divided by the start's
-    CVaR; the CVaR is ``t + sum_s w_s z_s / (1 - CVAR_LEVEL)`` with ``w`` the mean's weights (drawn samples
-    only). At the optimum ``t`` is the value at risk and ``z_s = (I_s - t)+``; they start at those values for the
-    start's impulses ``start_impulses`` [N*s].
+    ``x[index]`` holds ``t`` (the value at risk) then one ``z_s >= 0`` per sample (their lower bound), all
+    divided by the start's CVaR; the CVaR is ``t + sum_s w_s z_s / (1 - CVAR_LEVEL)`` with ``w`` the mean's
+    weights (drawn samples only). At the optimum ``t`` is the value at risk and ``z_s = (I_s - t)+``.
     """
     unit = scale["cvar_impulse"]
     weights = mean_weights(samples)
     t, z = x[index.start], x[index.start + 1 : index.stop]
-    var = value_at_risk(start_impulses, weights, CVAR_LEVEL)
-    x0[index.start] = var / unit
-    x0[index.start + 1 : index.stop] = np.maximum(start_impulses - var, 0.0) / unit
-    lbx[index.start + 1 : index.stop] = 0.0
     rows = z - ca.transpose(impulses) / unit + t
     g.add(
         rows,
@@ -184,21 +176,17 @@ def add_epigraph(
     index: int,
     impulses: ca.MX,
     scale: Mapping[str, float],
-    x0: np.ndarray,
-    lbx: np.ndarray,
     samples: ContactSamples,
     slowest: ca.MX | float,
 ) -> ca.MX:
     """Add ``t >= I_s`` for every sample to ``g`` and give the worst-case bound ``t`` [N*s].
 
-    ``x[index]`` is ``t`` divided by the start's worst case; it starts at 1 and is bounded below by 0. A sample
+    ``x[index]`` is ``t`` divided by the start's worst case (bounded below by 0). A sample
     whose speed cap is below ``slowest`` [m/s], the least approach velocity the solve allows (its lower bound,
     or an NLP parameter's bound), is outside the contact domain of every design of the solve: its row is
     relaxed by :data:`RELAXED_ROW`.
     """
     t = x[index] * scale["worst_case_impulse"]
-    x0[index] = 1.0
-    lbx[index] = 0.0
     rows = ca.transpose(t - impulses) / scale["worst_case_impulse"]
     caps = np.asarray(samples.speed_cap, dtype=float)
     finite = np.isfinite(caps)

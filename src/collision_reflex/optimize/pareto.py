@@ -357,13 +357,16 @@ def single_optimum(
     save: SaveHook | None = None,
     starts: int = OPTIMUM_STARTS,
     active_set: str = "auto",
+    x0: np.ndarray | None = None,
+    initial: np.ndarray | None = None,
 ) -> tuple[DesignResult, bool]:
     """The optimum of one objective (a name, or what ``build`` takes for a weighted one).
 
     It is run, saved and found again like a piece of :func:`pareto_front` (its name: ``optimum``, or
     ``optimum-<starts>-starts``). ``starts``: start points of the solve (multi-start, seeded: see
     :func:`collision_reflex.optimize.solve.solve`; on an active set each start settles its own);
-    ``active_set``: as :func:`pareto_front`. Returns the result and whether it was found finished.
+    ``active_set``: as :func:`pareto_front`; ``x0`` and ``initial``: the first start's point and first active
+    samples, as :func:`solve_with` takes them. Returns the result and whether it was found finished.
 
     Raises
     ------
@@ -375,7 +378,7 @@ def single_optimum(
     name = "optimum" if starts == 1 else f"optimum-{starts}-starts"
     pieces = _Sweep(executor or SerialExecutor(), 1, finished, save, progress, 1)
     (point,) = pieces.run(
-        {name: (solve_alone, (build, objective, ipopt_options, starts, active_set))}
+        {name: (solve_alone, (build, objective, ipopt_options, starts, active_set, x0, initial))}
     ).values()
     if point.result is None:
         failure = point.failures[0]
@@ -778,14 +781,25 @@ def solve_alone(
     ipopt_options: IpoptOptions | None,
     starts: int = 1,
     active_set: str = "auto",
+    x0: np.ndarray | None = None,
+    initial: np.ndarray | None = None,
 ) -> SweepPoint:
     """A single-objective optimum as a piece run like the sweep's.
 
     ``objective``: a name, or what ``build`` takes for a weighted one; ``starts``: start points (multi-start);
-    ``active_set``: see :func:`solve_with`.
+    ``active_set``, ``x0`` and ``initial``: see :func:`solve_with`.
     """
     try:
-        result = solve_with(build, objective, (), active_set, ipopt_options=ipopt_options, starts=starts)
+        result = solve_with(
+            build,
+            objective,
+            (),
+            active_set,
+            x0=x0,
+            ipopt_options=ipopt_options,
+            starts=starts,
+            initial=initial,
+        )
     except SolverFailed as error:
         return SweepPoint(
             "optimum", None, (PointFailure(str(objective), {}, error.status, str(error.args[0])),)

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, NamedTuple
 
@@ -110,19 +110,19 @@ class DesignProblem:
     cycle's requirement (:class:`collision_reflex.optimize.duty.DutyRequirement`), None without one; with one,
     ``required_torque_function`` takes the actuator masses (motor and gearbox) [kg] and the reflected inertias
     ``N^2 (J_m + J_g)`` [kg m^2], without one the actuator masses alone.
+
+    The CasADi graph (``nlp``, ``lbg``/``ubg``, ``constraint_labels``, ``evaluate`` and the solvers) is built
+    on first use: a problem that is only evaluated in NumPy (an active set's problem on every sample, a study's
+    results) never builds it. Its start, bounds and scales are there from the start, and every bad input is
+    refused when the problem is built.
     """
 
-    nlp: dict[str, ca.MX]
     x0: np.ndarray
     lbx: np.ndarray
     ubx: np.ndarray
-    lbg: np.ndarray
-    ubg: np.ndarray
-    constraint_labels: list[str]
     objective: dict[str, float]
     bounded_objectives: tuple[str, ...]
     objective_scale: dict[str, float]
-    evaluate: ca.Function
     layout: DesignLayout
     samples: ContactSamples
     space: DesignSpace
@@ -139,17 +139,61 @@ class DesignProblem:
     duty: DutyRequirement | None
     slowest_bound: float
     _joint_numbers: ca.Function = field(repr=False)
-    _sample_function: ca.Function = field(repr=False)
     _sample_data: np.ndarray = field(repr=False)
-    _structure: SampleStructure = field(repr=False)
+    _build_graph: Callable[[], NlpGraph] = field(repr=False)
+    _graph: NlpGraph | None = field(default=None, repr=False)
     _solvers: dict[str, ca.Function] = field(default_factory=dict, repr=False)
     _structured: tuple[dict[str, ca.MX], dict[str, ca.Function]] | None = field(default=None, repr=False)
-    _objective: ca.Function | None = field(default=None, repr=False)
 
     @property
     def n_joints(self) -> int:
         """Number of joints."""
         return len(self.joint_names)
+
+    @property
+    def graph(self) -> NlpGraph:
+        """The CasADi side of the problem, built on first use."""
+        if self._graph is None:
+            self._graph = self._build_graph()
+        return self._graph
+
+    @property
+    def graph_built(self) -> bool:
+        """Whether the CasADi graph has been built (:attr:`graph`)."""
+        return self._graph is not None
+
+    @property
+    def nlp(self) -> dict[str, ca.MX]:
+        """CasADi's ``{"x", "f", "g", "p"}``."""
+        return self.graph.nlp
+
+    @property
+    def lbg(self) -> np.ndarray:
+        """Lower bounds of the constraint rows ``g``."""
+        return self.graph.lbg
+
+    @property
+    def ubg(self) -> np.ndarray:
+        """Upper bounds of the constraint rows ``g``."""
+        return self.graph.ubg
+
+    @property
+    def constraint_labels(self) -> list[str]:
+        """``constraint_labels[i]`` names constraint ``g[i]``."""
+        return self.graph.constraint_labels
+
+    @property
+    def evaluate(self) -> ca.Function:
+        """The CasADi function of ``x`` giving the quantities the class describes, by name."""
+        return self.graph.evaluate
+
+    @property
+    def _sample_function(self) -> ca.Function:
+        return self.graph.sample_function
+
+    @property
+    def _structure(self) -> SampleStructure:
+        return self.graph.structure
 
     @property
     def requirement(self) -> str:
@@ -169,7 +213,7 @@ class DesignProblem:
         ).ravel()
         x[self.compliance_index] = np.log(reaction_compliance(self.samples, torques))
         if self.epigraph_index is not None or self.tail_index is not None:
-            impulses = np.asarray(self.evaluate(x)[0]).ravel()
+            impulses = self.numpy_impulses(x)
         if self.epigraph_index is not None:
             x[self.epigraph_index] = _epigraph_value(
                 impulses, self.samples, self.slowest_bound, self.objective_scale
@@ -177,6 +221,14 @@ class DesignProblem:
         if self.tail_index is not None:
             x[self.tail_index] = _tail_values(impulses, self.samples, self.objective_scale)
         return x
+
+    def numpy_impulses(self, x: np.ndarray) -> np.ndarray:
+        """The impulse [N*s] of every sample at the design in ``x`` (its design part), by the NumPy path."""
+        from .evaluate import sample_impulses
+        from .solve import layout_design
+
+        design = layout_design(self.layout, self.technology, self.joint_names, x[: self.layout.size])
+        return sample_impulses(self.samples, self.technology, design)
 
     def sample_parameters(self, x: np.ndarray) -> dict[str, np.ndarray]:
         """The effective 1D parameters of every sample as the NLP evaluates them at the design in ``x``.
@@ -252,10 +304,31 @@ class DesignProblem:
         return solver
 
     def objective_value(self, x: np.ndarray) -> float:
-        """The NLP's (scaled) objective at ``x``, auxiliaries at their exact values: for comparing results."""
-        if self._objective is None:
-            self._objective = ca.Function("objective", [self.nlp["x"]], [self.nlp["f"]])
-        return float(self._objective(self.exact_point(x)))
+        """The NLP's (scaled) objective at ``x``, auxiliaries at their exact values: for comparing results.
+
+        By the NumPy path: the weighted, start-normalised objectives and the tie-break pull on the mean, the
+        worst case as the epigraph takes it (over the samples within reach of the slowest approach allowed).
+        """
+        from .solve import layout_design
+
+        z = np.asarray(x, dtype=float)[: self.layout.size]
+        design = layout_design(self.layout, self.technology, self.joint_names, z)
+        impulses = self.numpy_impulses(z)
+        values = objective_values(
+            impulses, float(np.sum(design.actuator_mass)), design.approach_velocity, self.samples
+        )
+        if self.epigraph_index is not None:
+            scale = self.objective_scale["worst_case_impulse"]
+            values["worst_case_impulse"] = scale * _epigraph_value(
+                impulses, self.samples, self.slowest_bound, self.objective_scale
+            )
+        return float(
+            sum(
+                weight * OBJECTIVES[name][0] * values[name] / self.objective_scale[name]
+                for name, weight in self.objective.items()
+            )
+            + TIE_BREAK_WEIGHT * values["mean_impulse"] / self.objective_scale["mean_impulse"]
+        )
 
     def parameters(self, epsilon: Mapping[str, float] | None = None) -> np.ndarray:
         """NLP parameter vector bounding the objectives in ``epsilon`` (unbounded: +inf in scaled units)."""
@@ -340,75 +413,96 @@ def build_problem(
     lbx[compliance_index], ubx[compliance_index] = _compliance_bounds(samples, joint_numbers, lbx, ubx)
 
     start_mass, start_torque, start_finger = (np.asarray(v).ravel() for v in joint_numbers(x0))
-    per_sample = _sample_terms(
-        x[direction_index], x[compliance_index], design, samples, technology, start_mass, start_finger
-    )
-    impulses, actuator_mass = per_sample.impulses, ca.sum1(design.actuator_mass)
     mass_range = [np.asarray(joint_numbers(bound)[0]).ravel() for bound in (lbx, ubx)]
     if duty is None:
         torque_demands = binding_torque_demands(samples, constraints, joint_names, *mass_range)
         check_gearbox_ratings(torque_demands, technology, joint_names, *mass_range)
         required_torque = required_torque_function(torque_demands, n_joints)
-        required_expression = required_torque(design.actuator_mass)
     else:
         torque_demands = []
         required_torque = _duty_required_torque(duty_rows, n_joints)
-        required_expression = required_torque(design.actuator_mass, design.reflected_inertia)
-    evaluate = _evaluate_function(x, design, per_sample, actuator_mass, required_expression)
-    # Start point: auxiliaries at their exact values for the start design.
-    x0[direction_index] = (per_sample.start_directions / per_sample.direction_scale[:, None]).ravel()
+    data = sample_data(samples, technology.joint_mechanical_stiffness(n_joints))
+    # Start point: auxiliaries at their exact values for the start design, impulses by the NumPy path.
+    start_directions = finger_mass_directions(samples, start_mass, start_finger)
+    direction_scale = np.maximum(np.abs(start_directions).max(axis=1), 1e-300)
+    x0[direction_index] = (start_directions / direction_scale[:, None]).ravel()
     x0[compliance_index] = np.log(reaction_compliance(samples, start_torque))
-    start_impulses = np.asarray(evaluate(x0)[0]).ravel()
+    start_impulses = _start_impulses(layout, technology, joint_names, samples, x0)
     check_finite(start_impulses, "impulse at the start point", samples)
     velocity = layout.values(x0[:n_design])["approach_velocity"][0]
     scale = objective_values(start_impulses, float(np.sum(start_mass)), velocity, samples)
-    expressions = objective_terms(impulses, actuator_mass, design.values["approach_velocity"], samples)
-
-    g = ConstraintList()
     slowest_bound = float(layout.values(lbx[:n_design])["approach_velocity"][0])
     if epigraph_index is not None:
-        slowest: ca.MX | float = slowest_bound
-        if "approach_velocity" in bounded:  # the epsilon bound on the approach velocity, an NLP parameter
-            bound = -p[bounded.index("approach_velocity")] * scale["approach_velocity"]
-            slowest = ca.fmax(slowest_bound, bound)
-        expressions["worst_case_impulse"] = add_epigraph(
-            g, x, epigraph_index, impulses, scale, x0, lbx, samples, slowest
-        )
+        lbx[epigraph_index] = 0.0
         x0[epigraph_index] = _epigraph_value(start_impulses, samples, slowest_bound, scale)
     if tail_index is not None:
-        expressions["cvar_impulse"] = add_tail(
-            g, x, tail_index, impulses, scale, x0, lbx, samples, start_impulses
-        )
+        lbx[tail_index.start + 1 : tail_index.stop] = 0.0
+        x0[tail_index] = _tail_values(start_impulses, samples, scale)
     start_required = (
         required_torque(start_mass)
         if duty is None
         else required_torque(start_mass, _start_reflected_inertia(layout, x0, technology))
     )
     torque_scale = np.maximum(np.asarray(start_required).ravel(), 1e-3)
-    terms = _model_terms(x[compliance_index], design, per_sample)
-    add_model_constraints(
-        g, terms, torque_scale, torque_demands, samples, technology, constraints, joint_names
-    )
-    if duty is not None:
-        add_duty_constraints(g, duty, design, duty_rows, torque_scale, joint_names)
-        add_gearbox_duty_constraints(g, duty, design, duty_rows, technology, joint_names)
-    else:
-        add_gearbox_peak_constraints(g, terms, torque_demands, technology, joint_names)
-    add_objective_bounds(g, bounded, expressions, scale, p)
 
-    nlp = {"x": x, "f": objective_expression(weights, expressions, scale), "g": ca.vertcat(*g.parts), "p": p}
+    @interruptible()  # a Ctrl-C that CasADi's C++ swallowed while building ends in KeyboardInterrupt
+    def graph() -> NlpGraph:
+        """The NLP's CasADi side: the per-sample terms, the rows, the objective and their split."""
+        per_sample = _sample_terms(
+            x[direction_index], x[compliance_index], design, samples, technology, data, direction_scale
+        )
+        impulses, actuator_mass = per_sample.impulses, ca.sum1(design.actuator_mass)
+        required_expression = (
+            required_torque(design.actuator_mass)
+            if duty is None
+            else required_torque(design.actuator_mass, design.reflected_inertia)
+        )
+        evaluate = _evaluate_function(x, design, per_sample, actuator_mass, required_expression)
+        expressions = objective_terms(impulses, actuator_mass, design.values["approach_velocity"], samples)
+        g = ConstraintList()
+        if epigraph_index is not None:
+            slowest: ca.MX | float = slowest_bound
+            if "approach_velocity" in bounded:  # the epsilon bound on the approach velocity, an NLP parameter
+                bound = -p[bounded.index("approach_velocity")] * scale["approach_velocity"]
+                slowest = ca.fmax(slowest_bound, bound)
+            expressions["worst_case_impulse"] = add_epigraph(
+                g, x, epigraph_index, impulses, scale, samples, slowest
+            )
+        if tail_index is not None:
+            expressions["cvar_impulse"] = add_tail(g, x, tail_index, impulses, scale, samples)
+        terms = _model_terms(x[compliance_index], design, per_sample)
+        add_model_constraints(
+            g, terms, torque_scale, torque_demands, samples, technology, constraints, joint_names
+        )
+        if duty is not None:
+            add_duty_constraints(g, duty, design, duty_rows, torque_scale, joint_names)
+            add_gearbox_duty_constraints(g, duty, design, duty_rows, technology, joint_names)
+        else:
+            add_gearbox_peak_constraints(g, terms, torque_demands, technology, joint_names)
+        add_objective_bounds(g, bounded, expressions, scale, p)
+        nlp = {
+            "x": x,
+            "f": objective_expression(weights, expressions, scale),
+            "g": ca.vertcat(*g.parts),
+            "p": p,
+        }
+        return NlpGraph(
+            nlp,
+            np.concatenate(g.lower),
+            np.concatenate(g.upper),
+            g.labels,
+            evaluate,
+            per_sample.function,
+            _sample_structure(nlp, layout, design, per_sample, compliance_index, direction_index),
+        )
+
     return DesignProblem(
-        nlp=nlp,
         x0=x0,
         lbx=lbx,
         ubx=ubx,
-        lbg=np.concatenate(g.lower),
-        ubg=np.concatenate(g.upper),
-        constraint_labels=g.labels,
         objective=weights,
         bounded_objectives=bounded,
         objective_scale=scale,
-        evaluate=evaluate,
         layout=layout,
         samples=samples,
         space=space,
@@ -420,15 +514,46 @@ def build_problem(
         tail_index=tail_index,
         compliance_index=compliance_index,
         direction_index=direction_index,
-        direction_scale=per_sample.direction_scale,
+        direction_scale=direction_scale,
         build_time=time.perf_counter() - started,
         duty=duty,
         slowest_bound=slowest_bound,
         _joint_numbers=joint_numbers,
-        _sample_function=per_sample.function,
-        _sample_data=per_sample.data,
-        _structure=_sample_structure(nlp, layout, design, per_sample, compliance_index, direction_index),
+        _sample_data=data,
+        _build_graph=graph,
     )
+
+
+class NlpGraph(NamedTuple):
+    """The CasADi side of a :class:`DesignProblem`, built on first use.
+
+    ``nlp`` is CasADi's ``{"x", "f", "g", "p"}``, ``lbg``/``ubg`` the rows' bounds and ``constraint_labels``
+    their names; ``evaluate`` gives the quantities :class:`DesignProblem` describes; ``sample_function`` is the
+    per-sample model and ``structure`` the NLP's split for its derivatives (:mod:`.derivatives`).
+    """
+
+    nlp: dict[str, ca.MX]
+    lbg: np.ndarray
+    ubg: np.ndarray
+    constraint_labels: list[str]
+    evaluate: ca.Function
+    sample_function: ca.Function
+    structure: SampleStructure
+
+
+def _start_impulses(
+    layout: DesignLayout,
+    technology: ActuatorTechnology,
+    joint_names: tuple[str, ...],
+    samples: ContactSamples,
+    x0: np.ndarray,
+) -> np.ndarray:
+    """The impulse [N*s] of every sample at the start design, by the NumPy path (the objectives' scales)."""
+    from .evaluate import sample_impulses
+    from .solve import layout_design
+
+    design = layout_design(layout, technology, joint_names, x0[: layout.size])
+    return sample_impulses(samples, technology, design)
 
 
 def _epigraph_value(
@@ -457,7 +582,6 @@ class _SampleTerms(NamedTuple):
 
     function: ca.Function
     data: np.ndarray
-    start_directions: np.ndarray
     direction_scale: np.ndarray
     impulses: ca.MX
     thresholds: ca.MX
@@ -471,28 +595,26 @@ def _sample_terms(
     design: DesignQuantities,
     samples: ContactSamples,
     technology: ActuatorTechnology,
-    start_mass: np.ndarray,
-    start_finger: np.ndarray,
+    data: np.ndarray,
+    direction_scale: np.ndarray,
 ) -> _SampleTerms:
     """The per-sample function mapped over all samples, on the NLP's auxiliaries of every sample.
 
     ``scaled_directions`` are the finger-mass directions ``x_s`` (n_joints * n_samples) divided by their size
-    at the start (actuator masses ``start_mass`` [kg], finger inertias ``start_finger`` [kg m^2]): across samples
-    they span orders of magnitude. ``log_compliance`` is ``log(1/F_a)`` per sample.
+    at the start, ``direction_scale`` (across samples they span orders of magnitude). ``log_compliance`` is
+    ``log(1/F_a)`` per sample; ``data`` the samples' data columns (:func:`.samples.sample_data`).
     """
-    n_joints, n_samples = start_mass.size, samples.size
-    data = sample_data(samples, technology.joint_mechanical_stiffness(n_joints))
+    n_samples = samples.size
+    n_joints = int(scaled_directions.numel()) // n_samples
     function = sample_function(
         n_joints, technology.sensing, technology.reaction, technology.reflected_inertia_in
     )
-    start_directions = finger_mass_directions(samples, start_mass, start_finger)
-    direction_scale = np.maximum(np.abs(start_directions).max(axis=1), 1e-300)
     directions = ca.reshape(scaled_directions, n_joints, n_samples) * dense_dm(
         np.tile(direction_scale, (n_joints, 1))
     )
     compliance = ca.exp(ca.transpose(log_compliance))
     outputs = function.map(n_samples)(design.design_column, directions, compliance, dense_dm(data))
-    return _SampleTerms(function, data, start_directions, direction_scale, *outputs)
+    return _SampleTerms(function, data, direction_scale, *outputs)
 
 
 def _sample_structure(

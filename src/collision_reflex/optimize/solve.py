@@ -6,7 +6,7 @@ import time
 import warnings
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
@@ -20,6 +20,10 @@ from .evaluate import evaluate_design
 from .feasibility import solve_feasibility
 from .objectives import OBJECTIVES, objective_values
 from .problem import DesignProblem
+
+if TYPE_CHECKING:
+    from .layout import DesignLayout
+    from .technology import ActuatorTechnology
 
 IpoptOptions = Mapping[str, str | float]
 """Options of CasADi's ``nlpsol`` with IPOPT (``"ipopt.<option>"`` and CasADi's own): strings, numbers, flags."""
@@ -636,18 +640,24 @@ def _margin(capacity: np.ndarray, need: np.ndarray) -> np.ndarray:
 
 def design_at(problem: DesignProblem, x: np.ndarray) -> Design:
     """The design (and its derived actuator quantities) at NLP point ``x``."""
-    values = problem.layout.values(np.asarray(x, dtype=float))
-    technology = problem.technology
+    return layout_design(problem.layout, problem.technology, problem.joint_names, x)
+
+
+def layout_design(
+    layout: DesignLayout, technology: ActuatorTechnology, joint_names: tuple[str, ...], x: np.ndarray
+) -> Design:
+    """The design at ``x`` (its design part, log values as ``layout`` lays them out) of ``technology``."""
+    values = layout.values(np.asarray(x, dtype=float))
     gear = values["gear_ratio"]
     joint = technology.joint_quantities(values["stator_diameter"], values["stack_length"], gear)
     motor = joint.motor
     return Design(
-        joint_names=problem.joint_names,
+        joint_names=joint_names,
         stator_diameter=values["stator_diameter"],
         stack_length=values["stack_length"],
         gear_ratio=gear,
         software_stiffness=values["software_stiffness"],
-        mechanical_stiffness=technology.joint_mechanical_stiffness(problem.n_joints),
+        mechanical_stiffness=technology.joint_mechanical_stiffness(len(joint_names)),
         rotor_inertia=np.asarray(motor.rotor_inertia, dtype=float),
         reflected_inertia=np.asarray(joint.reflected_inertia, dtype=float),
         motor_peak_torque=np.asarray(motor.peak_torque, dtype=float),

@@ -24,13 +24,13 @@ BOOTSTRAP_REPLICATES = 1000
 LEVEL = 0.99
 """Confidence level of the stated intervals (the module's description says why not 95 %)."""
 
-_CHUNK = 50
+_CHUNK = 20
 """Bootstrap replicates drawn at a time (a replicate's cluster counts are one row)."""
 
-_TAIL_FACTOR = 4
-"""Samples ranked per replicate for a quantile q: this many times the (1 - q) tail's share of the samples
-(a replicate's tail of 1.0 its expected size fits unless its weight is 4x the expected, far beyond the 99 %
-interval; a replicate whose tail does not fit is ranked over every sample)."""
+_TAIL_FACTOR = 2
+"""Samples ranked per replicate: this many times the widest tail's share of the samples (the quantile's and the
+CVaR's). A replicate's tail fits in them unless the ranked samples weigh less than half their expected weight
+in it, far beyond the 99 % interval; a replicate whose tail does not fit is ranked over every sample."""
 
 QUANTILE = 0.99
 """The quantile of the impulse every design reports beside its mean."""
@@ -115,8 +115,9 @@ def impulse_statistics(
         counts = np.bincount(flat, minlength=count * n_clusters).reshape(count, n_clusters).astype(float)
         total = counts @ sizes
         means.append(counts @ sums / total)
-        quantiles.append(_tail_statistics(values, counts, cluster, descending, top, total, quantile)[0])
-        tails.append(_tail_statistics(values, counts, cluster, descending, top, total, CVAR_LEVEL)[1])
+        found = _tail_statistics(values, counts, cluster, descending, top, total, (quantile, CVAR_LEVEL))
+        quantiles.append(found[0][0])
+        tails.append(found[1][1])
 
     def estimate(value: float, replicates: np.ndarray) -> Estimate:
         low, high = np.percentile(replicates, [50 * (1 - LEVEL), 50 * (1 + LEVEL)])
@@ -142,31 +143,39 @@ def _tail_statistics(
     descending: np.ndarray,
     top: np.ndarray,
     total: np.ndarray,
-    level: float,
-) -> tuple[np.ndarray, np.ndarray]:
-    """Each replicate's weighted ``level`` quantile and CVaR of ``values``, its weights its clusters' ``counts``.
+    levels: tuple[float, ...],
+) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Each replicate's weighted quantile and CVaR of ``values`` at each of ``levels``.
 
-    The quantile is the inverted CDF's: the smallest value whose cumulative weight from below reaches ``level``
+    A replicate's weights are its clusters' ``counts`` (replicates, clusters); ``total`` (replicates,) their sums.
+
+    The quantile is the inverted CDF's: the smallest value whose cumulative weight from below reaches the level
     of ``total``, i.e. the largest value with no more than the tail's weight ``(1 - level) total`` strictly
     above it. The CVaR is the weighted mean of that tail (the values above, and the quantile for the rest of the
     tail's weight). Ranked over the ``top`` samples (the largest, in ``descending`` order), over all for a
     replicate whose tail reaches beyond them.
     """
-    tail = (1 - level) * total
+    tails = [(1 - level) * total for level in levels]
 
-    def ranked(order: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def ranked(order: np.ndarray, rows: np.ndarray) -> tuple[list[tuple[np.ndarray, np.ndarray]], np.ndarray]:
         weights = counts[rows][:, cluster[order]]
+        ordered = values[order]
         above = np.cumsum(weights, axis=1) - weights  # weight strictly above each ranked sample
-        weighted = np.cumsum(weights * values[order], axis=1) - weights * values[order]
-        position = (above <= tail[rows, None]).sum(axis=1) - 1
+        weighted = np.cumsum(weights * ordered, axis=1) - weights * ordered
         at = np.arange(rows.size)
-        quantile = values[order][position]
-        cvar = (weighted[at, position] + (tail[rows] - above[at, position]) * quantile) / tail[rows]
-        return quantile, cvar, above[:, -1] + weights[:, -1]
+        out = []
+        for tail in tails:
+            position = (above <= tail[rows, None]).sum(axis=1) - 1
+            quantile = ordered[position]
+            cvar = (weighted[at, position] + (tail[rows] - above[at, position]) * quantile) / tail[rows]
+            out.append((quantile, cvar))
+        return out, above[:, -1] + weights[:, -1]
 
     rows = np.arange(counts.shape[0])
-    quantile, cvar, ranked_weight = ranked(top, rows)
-    beyond = ranked_weight <= tail  # the whole top fits in the tail: the quantile lies below it
+    found, ranked_weight = ranked(top, rows)
+    beyond = ranked_weight <= max(tails, key=lambda tail: float(tail.sum()))  # a tail beyond the ranked top
     if np.any(beyond) and top.size < values.size:
-        quantile[beyond], cvar[beyond], _ = ranked(descending, rows[beyond])
-    return quantile, cvar
+        again, _ = ranked(descending, rows[beyond])
+        for (quantile, cvar), (quantile_all, cvar_all) in zip(found, again, strict=True):
+            quantile[beyond], cvar[beyond] = quantile_all, cvar_all
+    return found

@@ -156,6 +156,8 @@ def split_timings(data: Any, at: str = "") -> tuple[Any, dict[str, float]]:
                 timings.update(inner)
         return kept, timings
     if isinstance(data, list):
+        if all(isinstance(value, (int, float)) for value in data):
+            return data, timings  # a per-sample array: no times inside
         items = []
         for index, value in enumerate(data):
             item, inner = split_timings(value, f"{at}{index}/")

@@ -19,6 +19,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
 
+import numpy as np
+
 from .._interrupt import caused_by_interrupt
 from ..report.outputs import StageTimes
 from .arm_results import CatalogueRecord, SnapCatalogue, arm_results, catalogue_results, study_catalogue
@@ -315,12 +317,15 @@ def _run_arm(
     search = study.optimizer.worst_case_search
     extra: ExtraSamples = ()
     computed = reused = 0
+    optimum: DesignResult | None = None  # the last round's, which the next one starts from
     for round_ in range(search.rounds if search.enabled else 1):
         if round_:  # the last round's problems, on fewer samples, are not solved again
             release_problems()
         problems = StudyProblems(text, extra)
         prefix = f"round-{round_}-{_digest(extra)}-" if extra else ""
-        optimum, front, counts = _solve_round(problems, study, folder, pool, progress, window, stages, prefix)
+        optimum, front, counts = _solve_round(
+            problems, study, folder, pool, progress, window, stages, prefix, optimum
+        )
         computed, reused = computed + counts[0], reused + counts[1]
         if not search.enabled:
             searches = {}
@@ -334,6 +339,7 @@ def _run_arm(
         if not added or not exchanges_samples(study) or round_ == search.rounds - 1:
             break
         extra = extra + added
+    assert optimum is not None  # at least one round ran
     snapped = None
     if catalogue is not None:
         saved = folder.finished("catalogue")
@@ -375,11 +381,28 @@ def _solve_round(
     window: int,
     stages: StageTimes,
     prefix: str,
+    before: DesignResult | None = None,
 ) -> tuple[DesignResult, ParetoSet | None, tuple[int, int]]:
-    """The optimum (multi-started) and the Pareto front of ``problems``; their pieces saved under ``prefix``."""
+    """The optimum and the Pareto front of ``problems``; their pieces saved under ``prefix``.
+
+    The optimum is multi-started, or, in an exchange round, started from ``before`` (the last round's, on the
+    samples but the ones a search added since) with its active samples and the added ones: the exchange method
+    re-solves from its last design.
+    """
     from ..errors import SolverFailed, StudyRunFailed
-    from ..optimize.pareto import OPTIMUM_STARTS, known_optima, pareto_front, single_optimum
+    from ..optimize.active_set import ActiveSetResult
+    from ..optimize.pareto import OPTIMUM_STARTS, built_problem, known_optima, pareto_front, single_optimum
     from .arm_setup import IPOPT_OPTIONS
+
+    starts, x0, initial = OPTIMUM_STARTS, None, None
+    if before is not None:
+        full = built_problem(problems, problems.objective)
+        n_design = full.layout.size
+        starts, x0 = 1, full.exact_point(np.concatenate([before.x[:n_design], full.x0[n_design:]]))
+        if isinstance(before, ActiveSetResult) and before.method == "active set":
+            # The samples are the last round's and then the searched ones added since.
+            added = np.arange(np.asarray(before.impulses).size, full.samples.size)
+            initial = np.union1d(before.active_samples, added)
 
     def finished(name: str) -> dict[str, Any] | None:
         return folder.finished(prefix + name)
@@ -396,8 +419,10 @@ def _solve_round(
             executor=pool,
             finished=finished,
             save=save,
-            starts=OPTIMUM_STARTS,
+            starts=starts,
             active_set=problems.active_set,
+            x0=x0,
+            initial=initial,
         )
     except SolverFailed as error:
         raise StudyRunFailed(f"the optimum solve failed: {error.args[0]}", "optimum", error.status) from None
