@@ -158,11 +158,6 @@ class DesignProblem:
         return self._graph
 
     @property
-    def graph_built(self) -> bool:
-        """Whether the CasADi graph has been built (:attr:`graph`)."""
-        return self._graph is not None
-
-    @property
     def nlp(self) -> dict[str, ca.MX]:
         """CasADi's ``{"x", "f", "g", "p"}``."""
         return self.graph.nlp
@@ -224,11 +219,7 @@ class DesignProblem:
 
     def numpy_impulses(self, x: np.ndarray) -> np.ndarray:
         """The impulse [N*s] of every sample at the design in ``x`` (its design part), by the NumPy path."""
-        from .evaluate import sample_impulses
-        from .solve import layout_design
-
-        design = layout_design(self.layout, self.technology, self.joint_names, x[: self.layout.size])
-        return sample_impulses(self.samples, self.technology, design)
+        return _numpy_impulses(self.layout, self.technology, self.joint_names, self.samples, x)
 
     def sample_parameters(self, x: np.ndarray) -> dict[str, np.ndarray]:
         """The effective 1D parameters of every sample as the NLP evaluates them at the design in ``x``.
@@ -427,7 +418,7 @@ def build_problem(
     direction_scale = np.maximum(np.abs(start_directions).max(axis=1), 1e-300)
     x0[direction_index] = (start_directions / direction_scale[:, None]).ravel()
     x0[compliance_index] = np.log(reaction_compliance(samples, start_torque))
-    start_impulses = _start_impulses(layout, technology, joint_names, samples, x0)
+    start_impulses = _numpy_impulses(layout, technology, joint_names, samples, x0)
     check_finite(start_impulses, "impulse at the start point", samples)
     velocity = layout.values(x0[:n_design])["approach_velocity"][0]
     scale = objective_values(start_impulses, float(np.sum(start_mass)), velocity, samples)
@@ -541,18 +532,18 @@ class NlpGraph(NamedTuple):
     structure: SampleStructure
 
 
-def _start_impulses(
+def _numpy_impulses(
     layout: DesignLayout,
     technology: ActuatorTechnology,
     joint_names: tuple[str, ...],
     samples: ContactSamples,
-    x0: np.ndarray,
+    x: np.ndarray,
 ) -> np.ndarray:
-    """The impulse [N*s] of every sample at the start design, by the NumPy path (the objectives' scales)."""
+    """The impulse [N*s] of every sample at the design in ``x`` (its design part), by the NumPy path."""
     from .evaluate import sample_impulses
-    from .solve import layout_design
+    from .solve import layout_design  # solve imports this module
 
-    design = layout_design(layout, technology, joint_names, x0[: layout.size])
+    design = layout_design(layout, technology, joint_names, np.asarray(x, dtype=float)[: layout.size])
     return sample_impulses(samples, technology, design)
 
 
