@@ -221,9 +221,8 @@ def test_motor_without_speed_limit_is_refused_before_building(arm, samples, cycl
     assert "OPN-060-013-A" in str(raised.value)
 
 
-def test_duty_cycle_excludes_the_static_requirement(cycle):
-    with pytest.raises(InvalidParameter, match="payload"):
-        cr.Constraints(payload=1.0, duty_cycle=cycle)
+def test_duty_cycle_adds_to_the_static_hold_not_to_given_torques(cycle):
+    assert cr.Constraints(payload=1.0, duty_cycle=cycle).payload == 1.0  # held still besides the cycle
     with pytest.raises(InvalidParameter, match="torque_required"):
         cr.Constraints(torque_required=[1.0, 1.0], duty_cycle=cycle)
 

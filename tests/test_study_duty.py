@@ -129,14 +129,23 @@ def test_constraints_payload_is_the_cycles_point_mass(tmp_path):
     np.testing.assert_array_equal(cycle.payload.inertia, np.zeros((3, 3)))
 
 
-def test_a_duty_cycle_replaces_the_static_requirement(tmp_path):
-    """The optimiser gets the cycle (its RNEA torques carry the payload) instead of the static payload."""
+def test_a_duty_cycle_adds_to_the_static_hold_of_its_payload(tmp_path):
+    """The optimiser gets the cycle (its RNEA torques carry the payload) and the same payload held still."""
     loaded = load_study(_study(tmp_path, VIA))
     setup = arm_setup(loaded)
     assert setup.constraints.duty_cycle is setup.duty_cycle
     assert setup.duty_cycle is not None and setup.duty_cycle.payload.mass == 1.5
-    assert setup.constraints.payload == 0.0 and setup.constraints.torque_required is None
+    assert setup.constraints.payload == 1.5 and setup.constraints.torque_required is None
     assert not setup.static_torque_requirement and setup.constraints.requirement.startswith("duty cycle")
+
+
+def test_the_rated_payload_is_the_one_held_still(tmp_path):
+    """``rating.payload`` (the datasheet's) sizes the static hold; the cycle keeps carrying its own."""
+    setup = arm_setup(load_study(_study(tmp_path, VIA + "rating: {payload: 4 kg}\n")))
+    assert setup.constraints.payload == 4.0 and setup.duty_cycle.payload.mass == 1.5
+    bad = _study(tmp_path, VIA + "rating: {payload: -1 kg}\n")
+    with pytest.raises(StudyFileError, match=r"rating\.payload"):
+        arm_setup(load_study(bad))
 
 
 def test_given_torques_and_a_duty_cycle_are_refused_at_their_line(tmp_path):

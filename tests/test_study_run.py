@@ -494,8 +494,10 @@ def test_study_sweep_is_the_library_sweep(runs, name):
         known=sweep.known_optima(problems.objective, optimum, spec["anchor_starts"]),
     )
     assert len(front.points) == len(saved["points"]) >= 1
-    # Repeats of a point are merged (the smoke Panda front is one design): the sweep still solved several.
-    assert front.merged == saved["merged"] and len(front.points) + front.merged >= 2
+    # Repeats of a point are merged and dominated points set aside (the smoke Panda front is one design): the
+    # sweep still solved several.
+    assert front.merged == saved["merged"] and len(front.dominated) == len(saved["dominated"])
+    assert len(front.points) + front.merged + len(front.dominated) >= 2
     assert [f.as_dict() for f in front.failed] == saved["failed"]
     for ours, theirs in zip(front.records(), saved["points"], strict=True):
         assert ours["label"] == theirs["label"]
@@ -685,12 +687,17 @@ def test_torque_speed_figure_exactly_for_duty_cycle_studies(runs, name):
     if results["requirement"] == DUTY_REQUIREMENT:
         saved = recommended["torque_speed"]
         assert [e["joint"] for e in saved] == [j["joint"] for j in recommended["joints"]]
-        # The record's margins are the saved points' (motor side: peak torque over the largest cycle torque).
+        # The record's margins are the saved points' (motor side: peak torque over the largest cycle torque)
+        # where the cycle sets the requirement; where the static hold does, the cycle asks less.
         factor = results["resolved"]["constraints"]["safety_factor"]
         for entry, joint in zip(saved, recommended["joints"], strict=True):
             output = joint["gear_ratio"] * joint.get("gearbox_efficiency", 1.0)  # per motor torque
             largest = factor * max(abs(t) for t in entry["torque"]) * output
-            assert largest == pytest.approx(joint["required_torque"], rel=1e-6), joint["joint"]
+            if joint["required_by"] == "duty cycle":
+                assert largest == pytest.approx(joint["required_torque"], rel=1e-6), joint["joint"]
+            else:
+                assert joint["required_by"] == "static hold"
+                assert largest <= joint["required_torque"] * (1 + 1e-6), joint["joint"]
         assert (folder / "figures" / "torque_speed.png").is_file()
         assert 'id="torque-speed"' in html
     else:

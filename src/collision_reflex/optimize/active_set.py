@@ -495,13 +495,14 @@ def _first_active_set(
 def _requirement_samples(full: DesignProblem, start: Design, impulses: np.ndarray) -> np.ndarray:
     """Samples that carry the requirement rows of the start design: the first active set's torque and speed.
 
-    Static requirement: per joint the configuration of the largest gravity demand at the start design (its
-    worst sample at the start); more are added when they bind (:func:`_torque_violated`). Duty cycle: per joint
-    the sample of the largest approach joint rate, which sets the motor-speed row for every design.
+    The static hold: per joint the configuration of the largest gravity demand at the start design (its worst
+    sample at the start); more are added when they bind (:func:`_torque_violated`). With a duty cycle also, per
+    joint, the sample of the largest approach joint rate, which sets the motor-speed row for every design.
     """
+    static = _torque_violated(full, start, impulses, np.inf)
     if full.duty is not None:
-        return np.abs(full.duty.approach_rates).argmax(axis=0)
-    return _torque_violated(full, start, impulses, np.inf)
+        return np.union1d(np.abs(full.duty.approach_rates).argmax(axis=0), static)
+    return static
 
 
 def _torque_violated(
@@ -509,14 +510,14 @@ def _torque_violated(
 ) -> np.ndarray:
     """Per configuration whose gravity demand exceeds a joint's driving torque, its worst sample.
 
-    With the static requirement the torque rows are per sampled configuration (plus and minus the gravity
-    torque, :func:`collision_reflex.optimize.constraints.torque_requirement_rows`): a configuration missing from
-    the active samples has no row. A demand above ``(1 + tolerance)`` times the driving peak torque [N m] of
-    ``design`` flags its configuration; ``tolerance=inf`` flags, per joint, the configuration of the largest
-    demand instead. Given torques and duty cycles do not depend on the configurations: nothing is flagged.
+    The static hold's torque rows (with or without a duty cycle) are per sampled configuration (plus and minus
+    the gravity torque, :func:`collision_reflex.optimize.constraints.torque_requirement_rows`): a configuration
+    missing from the active samples has no row. A demand above ``(1 + tolerance)`` times the driving peak torque
+    [N m] of ``design`` flags its configuration; ``tolerance=inf`` flags, per joint, the configuration of the
+    largest demand instead. Given torques do not depend on the configurations: nothing is flagged.
     """
     samples = full.samples
-    if full.duty is not None or full.constraints.torque_required is not None:
+    if full.constraints.torque_required is not None:
         return np.empty(0, dtype=int)
     rows, _ = torque_requirement_rows(samples, full.constraints, full.joint_names)
     demands = np.array(

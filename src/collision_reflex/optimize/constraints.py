@@ -27,7 +27,7 @@ STATIC_REQUIREMENT = "static (gravity only)"
 GIVEN_REQUIREMENT = "given peak torques"
 """The requirement when the caller gives the peak torques."""
 DUTY_REQUIREMENT = "duty cycle (peak, RMS, speed)"
-"""The requirement of a duty cycle: peak and RMS torque and the motor speed."""
+"""The requirement of a duty cycle: peak and RMS torque and the motor speed, and the static hold besides."""
 
 TorqueDemands = tuple[np.ndarray, np.ndarray, list[str]]
 """One joint's affine torque demands ``b + S m`` [N m]: bases ``b`` (R,), slopes ``S`` (R, n) per actuator mass
@@ -38,16 +38,18 @@ TorqueDemands = tuple[np.ndarray, np.ndarray, list[str]]
 class Constraints:
     """Constraints of a design problem.
 
-    payload: mass carried at the contact point [kg], adds its gravity torques to the requirement.
+    payload: mass carried at the contact point [kg], adds its gravity torques to the requirement (with a duty
+        cycle: to the static hold, which every sampled configuration must meet besides the cycle).
     safety_factor: peak output torque must be at least this times the required torque [-], >= 1.
     torque_required: per-joint required torque [N m]; ``None`` derives it from Pinocchio gravity torques of the
         structure, the motors and the payload over the sampled configurations.
     threshold_floor: sensing noise floor [N]: the contact-force threshold may not go below it.
     duty_cycle: the motion the arm must make, with its payload (:class:`collision_reflex.arm.DutyCycle`).
-        Given, it replaces the static requirement: per joint the peak torque over the cycle (rotor term and
-        safety factor included), the RMS torque within the continuous torque, and the motor speed over the
-        cycle and the approach within the motor's maximum speed (:mod:`collision_reflex.optimize.duty`).
-        Its payload is the cycle's own, so ``payload`` and ``torque_required`` must then be left unset.
+        Given, it adds to the static hold (the arm and ``payload`` held still at every sampled configuration):
+        per joint the peak torque over the cycle (rotor term and safety factor included), the RMS torque within
+        the continuous torque, and the motor speed over the cycle and the approach within the motor's maximum
+        speed (:mod:`collision_reflex.optimize.duty`); the peak requirement is the larger of the two. The
+        cycle's own payload moves with it; ``torque_required`` must then be left unset.
     """
 
     payload: float = 0.0
@@ -74,13 +76,12 @@ class Constraints:
 
             if not isinstance(self.duty_cycle, DutyCycle):
                 raise InvalidParameter("duty_cycle", self.duty_cycle, "a DutyCycle or None")
-            if self.payload != 0 or self.torque_required is not None:
+            if self.torque_required is not None:
                 raise InvalidParameter(
                     "duty_cycle",
-                    "given with payload or torque_required",
+                    "given with torque_required",
                     "one requirement",
-                    "a duty cycle carries its own payload (DutyCycle.payload); leave payload and "
-                    "torque_required unset",
+                    "the duty cycle's torques and the static hold size the joints; leave torque_required unset",
                 )
 
     @property

@@ -109,7 +109,8 @@ class DesignProblem:
     :meth:`exact_point` first so that the auxiliary variables hold their exact values. ``duty`` is the duty
     cycle's requirement (:class:`collision_reflex.optimize.duty.DutyRequirement`), None without one; with one,
     ``required_torque_function`` takes the actuator masses (motor and gearbox) [kg] and the reflected inertias
-    ``N^2 (J_m + J_g)`` [kg m^2], without one the actuator masses alone.
+    ``N^2 (J_m + J_g)`` [kg m^2], without one the actuator masses alone; ``static_torque_function`` takes the
+    actuator masses and gives the static hold's part of it (or the given torques).
 
     The CasADi graph (``nlp``, ``lbg``/``ubg``, ``constraint_labels``, ``evaluate`` and the solvers) is built
     on first use: a problem that is only evaluated in NumPy (an active set's problem on every sample, a study's
@@ -130,6 +131,7 @@ class DesignProblem:
     constraints: Constraints
     joint_names: tuple[str, ...]
     required_torque_function: ca.Function
+    static_torque_function: ca.Function
     epigraph_index: int | None
     tail_index: slice | None
     compliance_index: slice
@@ -405,13 +407,15 @@ def build_problem(
 
     start_mass, start_torque, start_finger = (np.asarray(v).ravel() for v in joint_numbers(x0))
     mass_range = [np.asarray(joint_numbers(bound)[0]).ravel() for bound in (lbx, ubx)]
-    if duty is None:
-        torque_demands = binding_torque_demands(samples, constraints, joint_names, *mass_range)
-        check_gearbox_ratings(torque_demands, technology, joint_names, *mass_range)
-        required_torque = required_torque_function(torque_demands, n_joints)
-    else:
-        torque_demands = []
-        required_torque = _duty_required_torque(duty_rows, n_joints)
+    # The static hold (or the given torques); with a duty cycle the peak requirement is the larger of both.
+    torque_demands = binding_torque_demands(samples, constraints, joint_names, *mass_range)
+    check_gearbox_ratings(torque_demands, technology, joint_names, *mass_range)
+    static_torque = required_torque_function(torque_demands, n_joints)
+    required_torque = (
+        static_torque
+        if duty is None
+        else _envelope_required_torque(static_torque, _duty_required_torque(duty_rows, n_joints), n_joints)
+    )
     data = sample_data(samples, technology.joint_mechanical_stiffness(n_joints))
     # Start point: auxiliaries at their exact values for the start design, impulses by the NumPy path.
     start_directions = finger_mass_directions(samples, start_mass, start_finger)
@@ -465,11 +469,10 @@ def build_problem(
         add_model_constraints(
             g, terms, torque_scale, torque_demands, samples, technology, constraints, joint_names
         )
+        add_gearbox_peak_constraints(g, terms, torque_demands, technology, joint_names)
         if duty is not None:
             add_duty_constraints(g, duty, design, duty_rows, torque_scale, joint_names)
             add_gearbox_duty_constraints(g, duty, design, duty_rows, technology, joint_names)
-        else:
-            add_gearbox_peak_constraints(g, terms, torque_demands, technology, joint_names)
         add_objective_bounds(g, bounded, expressions, scale, p)
         nlp = {
             "x": x,
@@ -501,6 +504,7 @@ def build_problem(
         constraints=constraints,
         joint_names=joint_names,
         required_torque_function=required_torque,
+        static_torque_function=static_torque,
         epigraph_index=epigraph_index,
         tail_index=tail_index,
         compliance_index=compliance_index,
@@ -819,6 +823,17 @@ def _duty_required_torque(
         for j, (joint_rows, _, _) in enumerate(rows)
     ]
     return ca.Function("required_torque", [masses, reflected], [ca.vertcat(*required)])
+
+
+def _envelope_required_torque(static: ca.Function, duty: ca.Function, n_joints: int) -> ca.Function:
+    """CasADi function: actuator masses [kg], ``N^2 (J_m + J_g)`` [kg m^2] -> peak requirement per joint [N m].
+
+    The larger of the static hold's and the duty cycle's.
+    """
+    masses = ca.MX.sym("actuator_mass", n_joints)
+    reflected = ca.MX.sym("reflected_inertia", n_joints)
+    envelope = ca.fmax(static(masses), duty(masses, reflected))
+    return ca.Function("required_torque", [masses, reflected], [envelope])
 
 
 def _start_reflected_inertia(

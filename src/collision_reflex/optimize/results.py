@@ -368,8 +368,9 @@ def design_record(
 
     That is the impulse phases [N*s] and the optimal approach velocity [m/s] per sample (from ``problem``'s
     samples), the mean and the :data:`~.statistics.QUANTILE` quantile of the impulse over the drawn samples with
-    their sampling errors (``statistics``, :func:`~.statistics.impulse_statistics`), and each joint's nearest
-    catalogue motor.
+    their sampling errors (``statistics``, :func:`~.statistics.impulse_statistics`), and per joint what sets
+    its required peak torque (``required_by``: ``static hold``, ``duty cycle``, ``given torque`` or None) and
+    its nearest catalogue motor.
     """
     from .evaluate import design_collision_parameters
     from .statistics import QUANTILE, impulse_statistics
@@ -396,7 +397,9 @@ def design_record(
         ).items()
     }
     record["statistics"]["quantile_impulse"]["quantile"] = QUANTILE
+    static = np.asarray(problem.static_torque_function(design.actuator_mass), dtype=float).ravel()
     for i, joint in enumerate(record["joints"]):
+        joint["required_by"] = _required_by(problem, float(static[i]), float(result.required_torque[i]))
         joint["nearest_catalogue_motor"] = (
             nearest_catalogue_motor(
                 catalogue, float(design.motor_peak_torque[i]), float(design.rotor_inertia[i])
@@ -405,6 +408,18 @@ def design_record(
             else None
         )
     return record
+
+
+def _required_by(problem: DesignProblem, static: float, required: float) -> str | None:
+    """What sets a joint's required peak torque: ``static hold``, ``duty cycle``, ``given torque`` or None.
+
+    None: no requirement. ``static`` [N m] is the static hold's (or the given) part of ``required`` [N m].
+    """
+    if required <= 0:
+        return None
+    if problem.constraints.torque_required is not None:
+        return "given torque"
+    return "static hold" if problem.duty is None or static >= required * (1 - 1e-9) else "duty cycle"
 
 
 UNDECIDED_TOLERANCE = 1e-9

@@ -109,7 +109,10 @@ def joint_limits(
     for key, constraint in MARGINS:
         margin = joint.get(key)
         if margin is not None and margin < ACTIVE_TOLERANCE:
-            phrases.append(f"sized by {constraint}")
+            by = joint.get("required_by") if key == "torque_margin" else None
+            phrases.append(
+                f"sized by {constraint}" + (f" ({by})" if by in ("static hold", "duty cycle") else "")
+            )
     margin = joint.get("torque_margin")
     chosen_ratio = "gear_ratio" not in undecided
     if margin is not None and margin > OVERSIZED_MARGIN and motor_at_smallest_size(joint, bounds):

@@ -130,25 +130,21 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
                 loaded.problem(
                     ("constraints", "torque_required"),
                     "given torques with a duty cycle",
-                    "one requirement: remove torque_required (the duty cycle's torques replace it) or the "
-                    "duty_cycle section",
+                    "one requirement: remove torque_required (the duty cycle's torques and the static hold "
+                    "replace it) or the duty_cycle section",
                 )
             ],
         )
-    if duty_cycle is not None:  # the cycle's torques (RNEA, payload included) replace the static requirement
-        constraints = Constraints(
-            safety_factor=study.constraints.safety_factor,
-            threshold_floor=study.constraints.threshold_floor,
-            duty_cycle=duty_cycle,
-        )
-    else:
-        payload = payload_of(study)
-        constraints = Constraints(
-            payload=payload.mass if payload is not None else 0.0,  # the one payload (see .duty)
-            safety_factor=study.constraints.safety_factor,
-            torque_required=study.constraints.torque_required,
-            threshold_floor=study.constraints.threshold_floor,
-        )
+    # The static hold's payload: the rated one, else the one the study carries (over its cycle, if any).
+    payload = payload_of(study)
+    held = study.rating.payload if study.rating.payload is not None else payload.mass if payload else 0.0
+    constraints = Constraints(
+        payload=held,
+        safety_factor=study.constraints.safety_factor,
+        torque_required=study.constraints.torque_required,
+        threshold_floor=study.constraints.threshold_floor,
+        duty_cycle=duty_cycle,
+    )
     directions = direction_samples(loaded, arm)
     domain = contact_domain(loaded, arm)
     sampling_velocity = float(space.global_bounds("approach_velocity").upper)  # the fastest approach allowed

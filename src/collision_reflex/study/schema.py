@@ -801,6 +801,17 @@ class ExecutionSpec(_Model):
 Weight = Annotated[float, Field(gt=0, le=1e6, allow_inf_nan=False)]
 
 
+class RatingSpec(_Model):
+    """What the robot is rated for, as its datasheet gives it."""
+
+    payload: Payload | None = Field(
+        None,
+        ge=0,
+        description="rated payload [kg], held still at every sampled configuration (the static hold); null: the "
+        "payload the study carries (duty_cycle.payload or constraints.payload)",
+    )
+
+
 class ArmStudy(_Model):
     """A design study of the actuators of a robot arm."""
 
@@ -822,6 +833,7 @@ class ArmStudy(_Model):
         None,
         description="the motion the arm must make; null: the torque requirement is static (gravity only)",
     )
+    rating: RatingSpec = Field(default_factory=RatingSpec)  # type: ignore[arg-type]
     design: DesignSpec = Field(default_factory=DesignSpec)
     objective: Annotated[
         dict[ObjectiveName, Weight],

@@ -1,0 +1,59 @@
+"""The static hold: with a duty cycle the joints must also hold the arm and its payload still, everywhere."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from collision_reflex.arm.dynamics import peak
+from collision_reflex.optimize.pareto import built_problem, single_optimum
+from collision_reflex.optimize.results import design_record
+from collision_reflex.study.arm_setup import StudyProblems
+from collision_reflex.study.load import load_study
+from collision_reflex.study.resolve import resolved_yaml
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def panda():
+    problems = StudyProblems(resolved_yaml(load_study(ROOT / "studies" / "panda.yaml")))
+    optimum, _ = single_optimum(problems, problems.objective, starts=1)
+    return problems, built_problem(problems, problems.objective), optimum
+
+
+def _gravity_demand(kinematics, payload, masses):
+    """|gravity torque| [N m] of the links, the payload at the contact point and the actuators, per configuration."""
+    motors = np.einsum("cij,i->cj", kinematics.motor_gravity, masses)
+    return np.abs(kinematics.gravity + payload * kinematics.contact_gravity + motors)
+
+
+def test_the_peak_requirement_is_the_larger_of_the_static_hold_and_the_cycle(panda):
+    problems, problem, optimum = panda
+    setup, design = problems.setup, optimum.design
+    factor = setup.constraints.safety_factor
+    # Written out here: the static hold over the sampled configurations (Pinocchio's gravity terms); the
+    # cycle's peak from its torques over time, rotor term included.
+    static = factor * _gravity_demand(
+        setup.samples.kinematics, setup.constraints.payload, design.actuator_mass
+    )
+    duty = factor * peak(problem.duty.demand(design.actuator_mass, design.reflected_inertia).T)
+    np.testing.assert_allclose(optimum.required_torque, np.maximum(static.max(axis=0), duty), rtol=1e-9)
+    record = design_record(problem, optimum, "optimum")
+    by = [joint["required_by"] for joint in record["joints"]]
+    assert "static hold" in by and "duty cycle" in by  # each sizes some joint of this study
+    for joint, hold, moving in zip(record["joints"], static.max(axis=0), duty, strict=True):
+        assert joint["required_by"] == ("static hold" if hold >= moving else "duty cycle")
+    assert np.all(design.driving_peak_torque >= optimum.required_torque * (1 - 1e-7))
+
+
+def test_the_design_holds_its_payload_still_at_fresh_configurations(panda):
+    problems, _, optimum = panda
+    setup, design = problems.setup, optimum.design
+    rng = np.random.default_rng(2026)
+    draw = setup.domain.draw(setup.arm, 10_000, setup.directions, design.approach_velocity, rng)
+    demand = _gravity_demand(setup.arm.kinematics(draw.q), setup.constraints.payload, design.actuator_mass)
+    # Without the safety factor: the sampled configurations carry it, fresh ones must at least be held.
+    assert np.all(design.driving_peak_torque >= demand.max(axis=0))
