@@ -186,6 +186,9 @@ def test_the_verdict_opens_with_the_recommended_design():
     assert "at N = 50" in lines[0] and "threshold 1 N, approach velocity 0.2 m/s" in lines[0]
     assert lines[1] == "Why this design: Pareto design 1 dominates the single-objective optimum."
     assert lines[2].startswith("Torque requirement: static (gravity only).")
+    from collision_reflex.report.verdict import requirement_sentence
+
+    assert "the static hold" in requirement_sentence("duty cycle (peak, RMS, speed)")
     assert "shoulder: motor at its smallest size, sized by peak torque." in lines
     assert "elbow: no torque requirement: static gravity-only requirement is zero for this joint." in lines
     assert "Sensing and approach: threshold at its lower bound (1)." in lines

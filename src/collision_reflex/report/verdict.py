@@ -487,6 +487,11 @@ def requirement_sentence(requirement: str) -> str:
             "sampled configurations only: the motion's dynamics, RMS (thermal) torque and motor speed are not "
             "checked; give the study a duty cycle to size for them."
         )
+    if requirement.startswith("duty"):
+        return (
+            f"Torque requirement: {requirement}, and the static hold: the arm and its rated payload held still "
+            "at every sampled configuration; each joint's peak requirement is the larger of the two."
+        )
     return f"Torque requirement: {requirement}."
 
 
