@@ -193,11 +193,10 @@ class ContactDomain:
                     kept_caps.append(caps[s])
         if inside_pairs < MIN_KEPT_FRACTION * drawn_pairs:
             raise DomainTooSmall(self, drawn, inside_configurations, drawn_pairs, inside_pairs, velocity)
-        speed_cap = np.array(kept_caps)
         return DomainDraw(
             np.array(kept_q),
-            speed_cap >= velocity,
-            speed_cap,
+            np.array(kept_caps),
+            velocity,
             inside_configurations / drawn,
             inside_pairs / drawn_pairs,
         )
@@ -217,17 +216,22 @@ class ContactDomain:
 class DomainDraw:
     """Configurations drawn in a domain and which directions are feasible at each.
 
-    q: (count, nq) configurations [rad]; feasible: (count, m) bool, direction ``j`` feasible at configuration
-    ``i``; speed_cap: (count, m) the fastest approach [m/s] along each direction within the joint speed limits
-    (:meth:`ContactDomain.speed_caps`); configurations_kept: fraction of the drawn configurations that meet the
-    singular-value floor; samples_kept: fraction of the drawn (configuration, direction) pairs inside the domain.
+    q: (count, nq) configurations [rad]; speed_cap: (count, m) the fastest approach [m/s] along each direction
+    within the joint speed limits (:meth:`ContactDomain.speed_caps`); velocity: the approach [m/s] they were
+    drawn for; configurations_kept: fraction of the drawn configurations that meet the singular-value floor;
+    samples_kept: fraction of the drawn (configuration, direction) pairs inside the domain.
     """
 
     q: np.ndarray
-    feasible: np.ndarray
     speed_cap: np.ndarray
+    velocity: float
     configurations_kept: float
     samples_kept: float
+
+    @property
+    def feasible(self) -> np.ndarray:
+        """(count, m) bool: direction ``j`` feasible at configuration ``i`` at the drawn velocity."""
+        return np.asarray(self.speed_cap >= self.velocity)
 
 
 class DomainTooSmall(InvalidParameter):

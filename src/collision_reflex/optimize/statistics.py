@@ -173,7 +173,7 @@ def _tail_statistics(
 
     rows = np.arange(counts.shape[0])
     found, ranked_weight = ranked(top, rows)
-    beyond = ranked_weight <= max(tails, key=lambda tail: float(tail.sum()))  # a tail beyond the ranked top
+    beyond = ranked_weight <= tails[int(np.argmin(levels))]  # the widest tail reaches beyond the ranked top
     if np.any(beyond) and top.size < values.size:
         again, _ = ranked(descending, rows[beyond])
         for (quantile, cvar), (quantile_all, cvar_all) in zip(found, again, strict=True):
