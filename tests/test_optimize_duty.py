@@ -270,7 +270,7 @@ def test_peak_rows_give_the_unreduced_peak_everywhere_in_the_box(arm, samples, c
     # box and at its corners (a linear function's extremes over a box are at corners).
     from collision_reflex.optimize.duty import duty_requirement, peak_rows
 
-    duty = duty_requirement(arm, samples, cycle, _technology(), SAFETY)
+    duty = duty_requirement(arm, samples, cycle, None, _technology(), SAFETY)
     nv = duty.torques.nv
     # A box where the links' torques set the peak, then one where the rotor's acceleration may: the rows kept
     # for the first (a memo keeps them) do not cover the second.
@@ -320,12 +320,14 @@ def test_cycle_torques_are_kept_per_arm_and_motion(arm, samples):
             [[0.0, 0.0], [1.0, 0.5]], arm.joint_names, 1.0, 5.0, rate=50.0, payload=Payload(mass)
         )
 
-    first = duty_requirement(arm, samples, cycle(0.5), _technology(), SAFETY)
-    again = duty_requirement(arm, samples, cycle(0.5), _technology(), SAFETY)
-    heavier = duty_requirement(arm, samples, cycle(0.501), _technology(), SAFETY)
+    first = duty_requirement(arm, samples, cycle(0.5), None, _technology(), SAFETY)
+    again = duty_requirement(arm, samples, cycle(0.5), None, _technology(), SAFETY)
+    heavier = duty_requirement(arm, samples, cycle(0.501), None, _technology(), SAFETY)
     assert again.torques is first.torques
     assert heavier.torques is not first.torques
     assert np.abs(heavier.torques.structure - first.torques.structure).max() > 1e-6
     # Another arm object (here the same robot loaded again) is never answered from another's torques.
     other = Arm.from_urdf(TWO_LINK, "tip")
-    assert duty_requirement(other, samples, cycle(0.5), _technology(), SAFETY).torques is not first.torques
+    assert (
+        duty_requirement(other, samples, cycle(0.5), None, _technology(), SAFETY).torques is not first.torques
+    )

@@ -33,19 +33,28 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class CycleTorques:
-    """Joint torques of an arm over a duty cycle, split so that the motor masses enter exactly.
+    """Joint torques of an arm over a set of motion states, split so that the motor masses enter exactly.
+
+    The states are a duty cycle's samples (timed: they carry quadrature weights for the RMS) and the rated
+    motion's peak states (untimed: weight zero, see :mod:`collision_reflex.arm.rating`), or both
+    (:func:`joined`).
 
     Attributes
     ----------
     joint_names: the arm's joints, the order of every last axis below.
-    t: (n,) sample times [s].
+    weights: (n,) each state's weight in the cycle's mean square: the trapezoidal weights over the cycle's
+        duration (:func:`time_weights`), summing to 1; zero for an untimed state [-].
+    labels: (n,) what each state is, for constraint labels ("t = 1.2 s", "braking at configuration 3 ...").
+    sources: (n,) the requirement each state belongs to: ``"duty cycle"``, ``"rated motion"`` or ``"braking"``.
     qd, qdd: (n, nv) joint velocities [rad/s, m/s] and accelerations [rad/s^2, m/s^2].
     structure: (n, nv) ``tau0``: torques of the links and the payload (no motors, no rotors) [N m or N].
     per_motor_mass: (nv motors, n, nv) ``tau_unit``: torques of a 1 kg point mass at each motor [N m/kg].
     """
 
     joint_names: tuple[str, ...]
-    t: np.ndarray
+    weights: np.ndarray
+    labels: tuple[str, ...]
+    sources: tuple[str, ...]
     qd: np.ndarray
     qdd: np.ndarray
     structure: np.ndarray
@@ -55,6 +64,11 @@ class CycleTorques:
     def nv(self) -> int:
         """Number of joints."""
         return int(self.structure.shape[1])
+
+    @property
+    def timed(self) -> bool:
+        """True when some states are a timed cycle's (an RMS torque exists)."""
+        return bool(np.any(self.weights > 0))
 
     def torque(self, motor_mass: Any = None) -> np.ndarray:
         """``tau0 + sum_i m_i tau_unit[i]`` [N m], (n, nv), for motor masses [kg] (scalar or (nv,))."""
@@ -86,36 +100,75 @@ class CycleTorques:
     def rms_form(self, joint: int) -> np.ndarray:
         """``Q_j`` (nv + 2, nv + 2) with ``rms(demand_j)^2 = x^T Q_j x`` exactly (``x`` as in :meth:`demand_basis`).
 
-        ``Q_j = B_j^T diag(w) B_j / T``, with ``w`` the trapezoidal weights of :func:`time_weights` and ``T`` the
-        cycle's duration, so that ``sqrt(quadratic_form(Q_j, x))`` equals :func:`rms` of the demand.
+        ``Q_j = B_j^T diag(w) B_j`` with the states' :attr:`weights`, so that ``sqrt(quadratic_form(Q_j, x))``
+        equals :func:`rms` of the cycle's demand (untimed states weigh nothing).
         """
         basis = self.demand_basis(joint)
-        weights = time_weights(self.t) / float(self.t[-1] - self.t[0])
-        return basis.T @ (weights[:, None] * basis)
+        return basis.T @ (self.weights[:, None] * basis)
+
+
+def joined(first: CycleTorques, second: CycleTorques) -> CycleTorques:
+    """The states of ``first`` and then ``second`` (the same arm), as one set."""
+    if first.joint_names != second.joint_names:
+        raise InvalidParameter("joint_names", second.joint_names, f"the same joints: {first.joint_names}")
+    return CycleTorques(
+        joint_names=first.joint_names,
+        weights=np.concatenate([first.weights, second.weights]),
+        labels=first.labels + second.labels,
+        sources=first.sources + second.sources,
+        qd=np.vstack([first.qd, second.qd]),
+        qdd=np.vstack([first.qdd, second.qdd]),
+        structure=np.vstack([first.structure, second.structure]),
+        per_motor_mass=np.concatenate([first.per_motor_mass, second.per_motor_mass], axis=1),
+    )
 
 
 def cycle_torques(arm: Arm, cycle: DutyCycle) -> CycleTorques:
-    """Joint torques of an :class:`~collision_reflex.arm.Arm` over a duty cycle.
-
-    One Pinocchio pass per sample: RNEA of the links and the payload, and the joint Jacobians with their time
-    derivative, from which the torques of a unit mass at every motor are assembled for all samples at once:
-    ``tau_unit[i] = J_i^T (a_i - g)``, ``J_i`` the translational Jacobian of motor ``i``'s point and
-    ``a_i = J_i qdd + dJ_i/dt qd`` its acceleration. The rotors are not included (see :func:`joint_side_torque`).
+    """Joint torques of an :class:`~collision_reflex.arm.Arm` over a duty cycle (its samples timed).
 
     Parameters
     ----------
     arm: the arm; its joints must all be in the cycle (by name), and its model's gravity is used.
     cycle: the motion; its payload (if any) is held with its centre of mass at the arm's contact point.
     """
+    columns = cycle.columns(arm.joint_names)
+    return state_torques(
+        arm,
+        arm.configuration(cycle.q[:, columns]),
+        cycle.qd[:, columns],
+        cycle.qdd[:, columns],
+        cycle.payload,
+        time_weights(cycle.t) / cycle.duration,
+        tuple(f"t = {t:.4g} s" for t in cycle.t),
+        ("duty cycle",) * cycle.t.size,
+    )
+
+
+def state_torques(
+    arm: Arm,
+    q: np.ndarray,
+    qd: np.ndarray,
+    qdd: np.ndarray,
+    payload: Payload | None,
+    weights: np.ndarray,
+    labels: tuple[str, ...],
+    sources: tuple[str, ...],
+) -> CycleTorques:
+    """Joint torques of an arm in the motion states ``(q (n, nq), qd (n, nv), qdd (n, nv))``.
+
+    One Pinocchio pass per state: RNEA of the links and the payload, and the joint Jacobians with their time
+    derivative, from which the torques of a unit mass at every motor are assembled for all states at once:
+    ``tau_unit[i] = J_i^T (a_i - g)``, ``J_i`` the translational Jacobian of motor ``i``'s point and
+    ``a_i = J_i qdd + dJ_i/dt qd`` its acceleration. The rotors are not included (see :func:`joint_side_torque`).
+    ``payload`` (or None) is held with its centre of mass at the arm's contact point; ``weights``, ``labels``
+    and ``sources`` are the states' (:class:`CycleTorques`).
+    """
     import pinocchio as pin
 
-    columns = cycle.columns(arm.joint_names)
-    angles, qd, qdd = cycle.q[:, columns], cycle.qd[:, columns], cycle.qdd[:, columns]
-    q = arm.configuration(angles)
     model = arm.model.copy()
     model.armature = np.zeros(model.nv)  # the rotors enter through joint_side_torque
-    if cycle.payload is not None:
-        _add_payload(model, arm.contact_frame, arm.contact_offset, cycle.payload)
+    if payload is not None:
+        _add_payload(model, arm.contact_frame, arm.contact_offset, payload)
     data = model.createData()
     n, nv = q.shape[0], model.nv
     structure = np.empty((n, nv))
@@ -148,7 +201,9 @@ def cycle_torques(arm: Arm, cycle: DutyCycle) -> CycleTorques:
     unit = masks.T * (linear @ force + angular @ np.cross(points, force, axis=1))  # (n, nv, i)
     return CycleTorques(
         joint_names=tuple(arm.joint_names),
-        t=cycle.t,
+        weights=np.asarray(weights, dtype=float),
+        labels=tuple(labels),
+        sources=tuple(sources),
         qd=qd,
         qdd=qdd,
         structure=structure,

@@ -9,7 +9,9 @@ between makers for one default to be honest, and the paper ignores gearbox inert
 :class:`~collision_reflex.hardware.actuators.Actuator` unless asked).
 
 Real gearboxes one can buy are :class:`CatalogueGearbox` entries of ``designs/gearboxes.yaml``
-(:func:`load_gearbox_catalogue`), each figure with its source.
+(:func:`load_gearbox_catalogue`), each figure with its source. A :class:`ScaledGearbox` is a joint's
+transmission in a design optimisation: a catalogue unit of its kind scaled, by the same laws, to carry the
+motor's peak output torque, so that its mass and inertia grow with the torque the design asks of it.
 
 Inertia convention: ``inertia`` is the gearbox's own inertia seen at its input (motor) shaft [kg m^2], so its
 reflected inertia at the output is ``N**2 inertia`` (the table's ``l r^4 N^2``); a ball screw's ``inertia`` is
@@ -23,6 +25,7 @@ import numbers
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -35,6 +38,7 @@ __all__ = [
     "CatalogueGearbox",
     "Gearbox",
     "GearboxScaling",
+    "ScaledGearbox",
     "load_gearbox_catalogue",
 ]
 
@@ -249,6 +253,107 @@ class CatalogueGearbox:
         """Gearbox inertia seen at the output [kg m^2]: ``N**2 inertia``."""
         _validate.positive("gear_ratio", gear_ratio)
         return float(gear_ratio**2 * self.inertia)
+
+
+class ScaledFigures(NamedTuple):
+    """A :class:`ScaledGearbox`'s figures at one size (NumPy arrays or CasADi expressions alike).
+
+    mass [kg]; inertia: at the input [kg m^2]; rated_torque, peak_torque: output [N m]; max_input_speed
+    [rad/s] (None when the reference gives none).
+    """
+
+    mass: Any
+    inertia: Any
+    rated_torque: Any
+    peak_torque: Any
+    max_input_speed: Any
+
+
+@dataclass(frozen=True)
+class ScaledGearbox:
+    """A gearbox of ``reference``'s kind sized to carry its motor's peak output torque ``N tau_p``.
+
+    The size follows the kind's law of :data:`GEARBOX_SCALING` at the reference's length and stages: the
+    output torque scales as ``d**e_T`` in the outer diameter ``d``, so a unit whose repeated peak torque is
+    ``T`` has ``d/d0 = (T/T0)**(1/e_T)``, mass ``m0 (d/d0)**e_m`` and input inertia ``J0 (d/d0)**e_J`` (a
+    strain-wave unit: mass ``∝ T**(2/3)``, inertia ``∝ T**(4/3)``); rated torque and efficiency are the
+    reference's, the rated torque in proportion. Sizing it to the motor's peak output torque (not to the
+    requirement) is the rule that a gearbox survives whatever its motor can apply (the collision reaction brakes
+    with the full ``N tau_p``). ESTIMATE: the maximum input speed, where the reference gives one, scales as
+    ``1/d`` (a constant pitch-line speed of the gear mesh), which the table of laws does not give.
+
+    reference: the catalogue unit scaled from (its kind, figures and source).
+    ratios: the ratios the kind is sold with [-], ascending: a design relaxes them to the range between the
+        first and the last; its catalogue design picks an offered one.
+    """
+
+    reference: CatalogueGearbox
+    ratios: tuple[float, ...]
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.reference, CatalogueGearbox):
+            raise InvalidParameter("ScaledGearbox.reference", self.reference, "a CatalogueGearbox")
+        if self.reference.kind not in GEARBOX_SCALING:
+            raise InvalidParameter(
+                "ScaledGearbox.reference.kind", self.reference.kind, f"one of {GEARBOX_KINDS}"
+            )
+        ratios = tuple(sorted(float(r) for r in self.ratios))
+        if not ratios or not all(math.isfinite(r) and r >= 1 for r in ratios):
+            raise InvalidParameter("ScaledGearbox.ratios", self.ratios, "ratios >= 1, at least one")
+        object.__setattr__(self, "ratios", ratios)
+
+    @property
+    def kind(self) -> str:
+        """The kind of gearbox (the reference's)."""
+        return self.reference.kind
+
+    @property
+    def name(self) -> str:
+        """What reports call it."""
+        return f"{self.kind} scaled from {self.reference.name}"
+
+    @property
+    def ratio_range(self) -> tuple[float, float]:
+        """The smallest and largest ratio offered [-]."""
+        return self.ratios[0], self.ratios[-1]
+
+    @property
+    def efficiency(self) -> float | None:
+        """The reference's efficiency (None when it gives none)."""
+        return self.reference.efficiency
+
+    def figures(self, peak_torque: Any) -> ScaledFigures:
+        """The unit whose repeated peak output torque is ``peak_torque`` [N m] (NumPy or CasADi)."""
+        mass_law, inertia_law, torque_law = GEARBOX_SCALING[self.kind]
+        scale = peak_torque / self.reference.peak_torque
+        diameter = scale ** (1.0 / torque_law.diameter)
+        speed = self.reference.max_input_speed
+        return ScaledFigures(
+            mass=self.reference.mass * diameter**mass_law.diameter,
+            inertia=self.reference.inertia * diameter**inertia_law.diameter,
+            rated_torque=self.reference.rated_torque * scale,
+            peak_torque=peak_torque,
+            max_input_speed=None if speed is None else speed / diameter,
+        )
+
+    def unit(self, peak_torque: float) -> CatalogueGearbox:
+        """The unit at ``peak_torque`` [N m] as a catalogue entry (for the catalogue search and the report)."""
+        figures = self.figures(float(peak_torque))
+        reference = self.reference
+        return CatalogueGearbox(
+            name=f"{self.name} to {float(peak_torque):.4g} N*m",
+            kind=self.kind,
+            ratios=self.ratio_range,
+            continuous_ratio=True,
+            rated_torque=float(figures.rated_torque),
+            peak_torque=float(peak_torque),
+            mass=float(figures.mass),
+            inertia=float(figures.inertia),
+            source=f"scaled by the {self.kind} law of Saerens et al. 2019 from: {reference.source}",
+            efficiency=reference.efficiency,
+            stages=reference.stages,
+            max_input_speed=None if figures.max_input_speed is None else float(figures.max_input_speed),
+        )
 
 
 def load_gearbox_catalogue(path: str | os.PathLike[str] | None = None) -> dict[str, CatalogueGearbox]:

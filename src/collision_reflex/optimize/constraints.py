@@ -21,6 +21,7 @@ from .technology import ActuatorTechnology
 
 if TYPE_CHECKING:
     from ..arm.duty_cycle import DutyCycle
+    from ..arm.rating import Rating
 
 STATIC_REQUIREMENT = "static (gravity only)"
 """The requirement without a duty cycle: gravity torques over the sampled configurations only."""
@@ -28,6 +29,9 @@ GIVEN_REQUIREMENT = "given peak torques"
 """The requirement when the caller gives the peak torques."""
 DUTY_REQUIREMENT = "duty cycle (peak, RMS, speed)"
 """The requirement of a duty cycle: peak and RMS torque and the motor speed, and the static hold besides."""
+RATED_REQUIREMENT = "rated motion (peak, speed)"
+"""The requirement of a rating without a duty cycle: the rated motion's and the braking's peak torques and the
+rated speeds, and the static hold besides."""
 
 TorqueDemands = tuple[np.ndarray, np.ndarray, list[str]]
 """One joint's affine torque demands ``b + S m`` [N m]: bases ``b`` (R,), slopes ``S`` (R, n) per actuator mass
@@ -50,6 +54,10 @@ class Constraints:
         the continuous torque, and the motor speed over the cycle and the approach within the motor's maximum
         speed (:mod:`collision_reflex.optimize.duty`); the peak requirement is the larger of the two. The
         cycle's own payload moves with it; ``torque_required`` must then be left unset.
+    rating: the robot's rated joint speeds, accelerations and stopping times with its payload
+        (:class:`collision_reflex.arm.rating.Rating`): the rated motion's and the braking's states at every
+        sampled configuration add to the peak requirement and the rated speeds to the speed requirement, as a
+        duty cycle's samples do (:mod:`collision_reflex.optimize.duty`); ``torque_required`` must be left unset.
     """
 
     payload: float = 0.0
@@ -57,6 +65,7 @@ class Constraints:
     torque_required: Sequence[float] | None = None
     threshold_floor: float = 0.0
     duty_cycle: DutyCycle | None = None
+    rating: Rating | None = None
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.payload) and self.payload >= 0):
@@ -84,11 +93,31 @@ class Constraints:
                     "the duty cycle's torques and the static hold size the joints; leave torque_required unset",
                 )
 
+        if self.rating is not None:
+            from ..arm.rating import Rating
+
+            if not isinstance(self.rating, Rating):
+                raise InvalidParameter("rating", self.rating, "a Rating or None")
+            if self.torque_required is not None and self.rating.moves:
+                raise InvalidParameter(
+                    "rating",
+                    "given with torque_required",
+                    "one requirement",
+                    "the rated motion and the static hold size the joints; leave torque_required unset",
+                )
+
+    @property
+    def moves(self) -> bool:
+        """True when a duty cycle or a rated motion adds to the static hold."""
+        return self.duty_cycle is not None or (self.rating is not None and self.rating.moves)
+
     @property
     def requirement(self) -> str:
-        """What sizes the torques: :data:`STATIC_REQUIREMENT`, :data:`GIVEN_REQUIREMENT` or :data:`DUTY_REQUIREMENT`."""
+        """What sizes the torques: :data:`STATIC_REQUIREMENT`, :data:`GIVEN_REQUIREMENT`, :data:`DUTY_REQUIREMENT` or :data:`RATED_REQUIREMENT`."""
         if self.duty_cycle is not None:
             return DUTY_REQUIREMENT
+        if self.moves:
+            return RATED_REQUIREMENT
         return STATIC_REQUIREMENT if self.torque_required is None else GIVEN_REQUIREMENT
 
 

@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple, TypeVar, cast
 import casadi as ca
 import numpy as np
 
-from ..arm.dynamics import CycleTorques, cycle_torques, max_speed, rms, time_weights
+from ..arm.dynamics import CycleTorques, cycle_torques, joined, max_speed
 from ..errors import InvalidParameter
 from ..hardware.motors import scaled_motor_quantities
 from .constraints import ConstraintList, binding_rows, undominated_rows
@@ -43,6 +43,7 @@ from .samples import ContactSamples
 
 if TYPE_CHECKING:
     from ..arm.duty_cycle import DutyCycle
+    from ..arm.rating import Rating
     from ..arm.robot import Arm
     from .layout import DesignLayout, DesignQuantities
     from .problem import DesignProblem
@@ -136,30 +137,52 @@ def approach_joint_rates(samples: ContactSamples) -> np.ndarray:
 def duty_requirement(
     arm: Arm,
     samples: ContactSamples,
-    cycle: DutyCycle,
+    cycle: DutyCycle | None,
+    rating: Rating | None,
     technology: ActuatorTechnology,
     safety_factor: float,
-) -> DutyRequirement:
-    """The duty cycle's requirement on ``arm`` (RNEA over the cycle, approach rates over ``samples``).
+) -> DutyRequirement | None:
+    """The motion's requirement on ``arm``: the duty cycle's and the rating's states, or None without either.
+
+    RNEA over the cycle's samples and over the rated motion's and the braking's states at every configuration
+    of ``samples`` (:func:`collision_reflex.arm.rating.rated_torques`); approach rates over ``samples``.
 
     Raises
     ------
     InvalidParameter: the reference motor has no maximum speed (the speed requirement needs it).
     """
+    from ..arm.rating import rated_torques
+
+    moving = rating is not None and rating.moves
+    if cycle is None and not moving:
+        return None
     for motor in technology.motors:
         if motor.max_speed is None:
             raise InvalidParameter(
                 "reference_motor.max_speed",
                 None,
-                "a maximum speed [rad/s] when a duty cycle is given",
+                "a maximum speed [rad/s] when a duty cycle or rated motion is given",
                 f"motor {motor.name!r} has none: add max_speed to its catalogue entry (e.g. '3000 rpm') or "
                 "give Motor(..., max_speed=...)",
             )
-    # The arm's own object in the key (and kept in the memo with the torques): its id is not reused meanwhile.
-    payload = () if cycle.payload is None else (cycle.payload.mass, cycle.payload.inertia)
-    key = _digest(id(arm), cycle.joint_names, cycle.t, cycle.q, cycle.qd, cycle.qdd, *payload)
-    held, torques = _CYCLE_TORQUES.get(key, lambda: (arm, cycle_torques(arm, cycle)))
-    assert held is arm
+    parts = []
+    # The arm's own object in the keys (and kept in the memo with the torques): its id is not reused meanwhile.
+    if cycle is not None:
+        payload = () if cycle.payload is None else (cycle.payload.mass, cycle.payload.inertia)
+        key = _digest(id(arm), cycle.joint_names, cycle.t, cycle.q, cycle.qd, cycle.qdd, *payload)
+        held, torques = _CYCLE_TORQUES.get(key, lambda: (arm, cycle_torques(arm, cycle)))
+        assert held is arm
+        parts.append(torques)
+    if moving:
+        assert rating is not None
+        kinematics = samples.kinematics
+        payload = () if rating.payload is None else (rating.payload.mass, rating.payload.inertia)
+        fields = (rating.joint_speeds, rating.joint_accelerations, rating.stopping_time)
+        key = _digest(id(arm), kinematics.q, *(f if f is not None else "-" for f in fields), *payload)
+        held, rated = _CYCLE_TORQUES.get(key, lambda: (arm, rated_torques(arm, kinematics, rating)))
+        assert held is arm and rated is not None
+        parts.append(rated)
+    torques = parts[0] if len(parts) == 1 else joined(*parts)
     return DutyRequirement(torques, approach_joint_rates(samples), float(safety_factor))
 
 
@@ -212,7 +235,7 @@ def add_duty_constraints(
     ``demands``: :func:`peak_rows`; ``torque_scale``: per joint the peak requirement at the start [N m], which
     the peak rows are divided by.
     """
-    t = duty.torques.t
+    states = duty.torques.labels
     gear, velocity = design.values["gear_ratio"], design.values["approach_velocity"][0]
     assert design.max_speed is not None  # duty_requirement checked the reference motor
     log_limit = ca.log(design.max_speed)
@@ -224,10 +247,12 @@ def add_duty_constraints(
             0.0,
             np.inf,
             [
-                f"peak torque of {name} >= {'+' if s > 0 else '-'}{duty.safety_factor:g} x demand at t = {t[i]:.4g} s"
+                f"peak torque of {name} >= {'+' if s > 0 else '-'}{duty.safety_factor:g} x demand at {states[i]}"
                 for i, s in zip(index, sign, strict=True)
             ],
         )
+        if not duty.torques.timed:
+            continue
         form = ca.DM(duty.torques.rms_form(j))
         g.add(
             ca.bilin(form, x_j, x_j) / design.continuous_torque[j] ** 2,
@@ -236,7 +261,7 @@ def add_duty_constraints(
             [f"RMS torque of {name} over the cycle <= driving continuous torque"],
         )
     for rate, label, speed in (
-        (duty.cycle_speed, "the cycle", 1.0),
+        (duty.cycle_speed, "the motion", 1.0),
         (duty.approach_rate, "the approach", velocity),
     ):
         moving = np.flatnonzero(rate > 0).tolist()
@@ -272,26 +297,27 @@ def add_gearbox_duty_constraints(
         label = f"gearbox {figures.names[j]} of {name}"
         x_j = ca.vertcat(1.0, design.actuator_mass, design.reflected_inertia[j])
         rows, index, sign = demands[j]
-        t = duty.torques.t
+        states = duty.torques.labels
         g.add(
             1.0 - ca.mtimes(ca.DM(rows), x_j) / figures.peak_torque[j],
             0.0,
             np.inf,
             [
                 f"{label}: repeated peak rating {figures.peak_torque[j]:.4g} N*m >= "
-                f"{'+' if s > 0 else '-'}{duty.safety_factor:g} x demand at t = {t[i]:.4g} s"
+                f"{'+' if s > 0 else '-'}{duty.safety_factor:g} x demand at {states[i]}"
                 for i, s in zip(index, sign, strict=True)
             ],
         )
-        g.add(
-            ca.bilin(ca.DM(duty.torques.rms_form(j)), x_j, x_j) / figures.rated_torque[j] ** 2,
-            -np.inf,
-            1.0,
-            [f"{label}: RMS output over the cycle <= rated {figures.rated_torque[j]:.4g} N*m"],
-        )
+        if duty.torques.timed:
+            g.add(
+                ca.bilin(ca.DM(duty.torques.rms_form(j)), x_j, x_j) / figures.rated_torque[j] ** 2,
+                -np.inf,
+                1.0,
+                [f"{label}: RMS output over the cycle <= rated {figures.rated_torque[j]:.4g} N*m"],
+            )
         limit = figures.max_input_speed[j]
         for rate, over, speed in (
-            (duty.cycle_speed[j], "the cycle", 1.0),
+            (duty.cycle_speed[j], "the motion", 1.0),
             (duty.approach_rate[j], "the approach", velocity),
         ):
             if np.isfinite(limit) and rate > 0:
@@ -309,7 +335,7 @@ def duty_values(duty: DutyRequirement, design: Design, technology: ActuatorTechn
     demand = duty.demand(design.actuator_mass, design.reflected_inertia).T  # (nv, n)
     return DutyValues(
         required_torque=duty.safety_factor * np.abs(demand).max(axis=1),
-        required_rms_torque=np.asarray(rms(demand, duty.torques.t), dtype=float),
+        required_rms_torque=np.sqrt((demand**2) @ duty.torques.weights),
         continuous_torque=np.asarray(joint.driving_continuous_torque, dtype=float),
         max_motor_speed=design.gear_ratio * duty.joint_speed(design.approach_velocity),
         speed_limit=np.asarray(joint.motor.max_speed, dtype=float) * np.ones(design.gear_ratio.size),
@@ -363,7 +389,7 @@ def check_reachable(
     bounds = layout.bounds
     velocity = bounds["approach_velocity"][0].lower
     speed_need = duty.joint_speed(velocity)
-    weights = time_weights(duty.torques.t) / float(duty.torques.t[-1] - duty.torques.t[0])
+    weights = duty.torques.weights
     n_joints = len(joint_names)
     figures, motors = technology.gearbox_figures(n_joints), technology.joint_motors(n_joints)
     for j, name in enumerate(joint_names):
@@ -390,11 +416,12 @@ def check_reachable(
         )
         gearbox = figures.names[j]
         labels = (PEAK, RMS, SPEED, *(f"gearbox {gearbox} {rating}" for rating in GEARBOX_RATINGS))
+        what = " and ".join(dict.fromkeys(duty.torques.sources))
         for label, value in zip(labels, best[:-1], strict=True):
             if value < -REACHABLE_TOLERANCE:
-                _refuse(name, label, value)
+                _refuse(what, name, label, value)
         if best[-1] < -REACHABLE_TOLERANCE:
-            _refuse(name, " and ".join(labels[: 6 if gearbox else 3]) + " together", best[-1])
+            _refuse(what, name, " and ".join(labels[: 6 if gearbox else 3]) + " together", best[-1])
 
 
 class _Memo:
@@ -497,12 +524,13 @@ def _margin(capacity: np.ndarray, need: np.ndarray) -> np.ndarray:
         return np.where(need > 0, capacity / np.where(need > 0, need, 1.0) - 1.0, np.inf)
 
 
-def _refuse(joint: str, constraint: str, margin: float) -> None:
+def _refuse(what: str, joint: str, constraint: str, margin: float) -> None:
+    """Refuse ``joint``'s ``constraint`` of the motion ``what`` (e.g. "duty cycle and braking")."""
     gearbox = constraint.startswith("gearbox")
     raise InvalidParameter(
-        f"duty cycle requirement of {joint}",
+        f"{what} requirement of {joint}",
         f"{constraint}: best margin reachable {margin:+.1%}",
         f"a design within the bounds that meets its {constraint} requirement",
         ("choose a gearbox of higher ratings, " if gearbox else "widen the motor-size or gear-ratio bounds, ")
-        + "or ask for a gentler cycle (slower, lighter payload)",
+        + "or ask for a gentler motion (slower, lighter payload, a longer stopping time)",
     )

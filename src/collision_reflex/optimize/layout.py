@@ -16,7 +16,7 @@ import casadi as ca
 import numpy as np
 
 from ..errors import InvalidParameter
-from ..hardware.gearboxes import CatalogueGearbox
+from ..hardware.gearboxes import CatalogueGearbox, ScaledGearbox
 from ..model import effective as formulas
 from ..model.impulse import series_stiffness
 from .constraints import Constraints
@@ -109,7 +109,9 @@ def design_layout(
     return layout
 
 
-def _within_ratio_range(bounds: Bounds, gearbox: CatalogueGearbox | None, joint: str) -> Bounds:
+def _within_ratio_range(
+    bounds: Bounds, gearbox: CatalogueGearbox | ScaledGearbox | None, joint: str
+) -> Bounds:
     """The gear-ratio bounds of ``joint`` intersected with its gearbox's ratio range.
 
     Raises

@@ -380,10 +380,8 @@ def build_problem(
     joint_names = _joint_names(arm, samples)
     n_joints = len(joint_names)
     layout = design_layout(space, technology, constraints, n_joints, joint_names)
-    duty = (
-        None
-        if constraints.duty_cycle is None
-        else duty_requirement(arm, samples, constraints.duty_cycle, technology, constraints.safety_factor)
+    duty = duty_requirement(
+        arm, samples, constraints.duty_cycle, constraints.rating, technology, constraints.safety_factor
     )
     n_samples, n_design = samples.size, layout.size
     named = set(weights) | set(bounded)

@@ -19,7 +19,7 @@ import numpy as np
 from ..errors import InvalidParameter
 from ..model.impulse import optimal_velocity, phase_impulses, series_stiffness
 from .active_set import ActiveSetResult, solve_method, with_active_set
-from .constraints import DUTY_REQUIREMENT, STATIC_REQUIREMENT
+from .constraints import DUTY_REQUIREMENT, RATED_REQUIREMENT, STATIC_REQUIREMENT
 from .objectives import OBJECTIVES
 from .solve import Attempt, Design, DesignResult
 
@@ -369,7 +369,7 @@ def design_record(
     That is the impulse phases [N*s] and the optimal approach velocity [m/s] per sample (from ``problem``'s
     samples), the mean and the :data:`~.statistics.QUANTILE` quantile of the impulse over the drawn samples with
     their sampling errors (``statistics``, :func:`~.statistics.impulse_statistics`), and per joint what sets
-    its required peak torque (``required_by``: ``static hold``, ``duty cycle``, ``given torque`` or None) and
+    its required peak torque (``required_by``, :func:`required_by`) and
     its nearest catalogue motor.
     """
     from .evaluate import design_collision_parameters
@@ -397,9 +397,9 @@ def design_record(
         ).items()
     }
     record["statistics"]["quantile_impulse"]["quantile"] = QUANTILE
-    static = np.asarray(problem.static_torque_function(design.actuator_mass), dtype=float).ravel()
+    sizing = required_by(problem, design, np.asarray(result.required_torque, dtype=float))
     for i, joint in enumerate(record["joints"]):
-        joint["required_by"] = _required_by(problem, float(static[i]), float(result.required_torque[i]))
+        joint["required_by"] = sizing[i]
         joint["nearest_catalogue_motor"] = (
             nearest_catalogue_motor(
                 catalogue, float(design.motor_peak_torque[i]), float(design.rotor_inertia[i])
@@ -410,16 +410,23 @@ def design_record(
     return record
 
 
-def _required_by(problem: DesignProblem, static: float, required: float) -> str | None:
-    """What sets a joint's required peak torque: ``static hold``, ``duty cycle``, ``given torque`` or None.
+def required_by(problem: DesignProblem, design: Design, required: np.ndarray) -> list[str | None]:
+    """Per joint what sets its required peak torque ``required`` [N m], None where nothing is required.
 
-    None: no requirement. ``static`` [N m] is the static hold's (or the given) part of ``required`` [N m].
+    One of ``static hold`` (or ``given torque``), ``duty cycle``, ``rated motion``, ``braking``: the requirement
+    whose own peak (safety factor included) is the largest at ``design``.
     """
-    if required <= 0:
-        return None
-    if problem.constraints.torque_required is not None:
-        return "given torque"
-    return "static hold" if problem.duty is None or static >= required * (1 - 1e-9) else "duty cycle"
+    static = np.asarray(problem.static_torque_function(design.actuator_mass), dtype=float).ravel()
+    given = problem.constraints.torque_required is not None
+    peaks = {"given torque" if given else "static hold": static}
+    duty = problem.duty
+    if duty is not None:
+        demand = np.abs(duty.demand(design.actuator_mass, design.reflected_inertia))
+        sources = np.array(duty.torques.sources)
+        for source in dict.fromkeys(duty.torques.sources):
+            peaks[source] = duty.safety_factor * demand[sources == source].max(axis=0)
+    names, values = list(peaks), np.array(list(peaks.values()))
+    return [names[int(np.argmax(values[:, j]))] if required[j] > 0 else None for j in range(required.size)]
 
 
 UNDECIDED_TOLERANCE = 1e-9
@@ -507,7 +514,7 @@ def record_row(record: Mapping[str, Any], index: int) -> dict[str, Any]:
     columns = (
         JOINT_COLUMNS
         + (GEARBOX_COLUMNS if geared else ())
-        + (DUTY_COLUMNS if record.get("requirement") == DUTY_REQUIREMENT else ())
+        + (DUTY_COLUMNS if record.get("requirement") in (DUTY_REQUIREMENT, RATED_REQUIREMENT) else ())
     )
     for key, unit in columns:
         for joint in record["joints"]:

@@ -55,6 +55,7 @@ import numpy as np
 
 from .._interrupt import interruptible
 from ..errors import InvalidParameter, SolverFailed
+from ..hardware.gearboxes import ScaledGearbox
 from .active_set import (
     ACTIVE_SET_CHOICES,
     ActiveSetResult,
@@ -252,8 +253,11 @@ def joint_candidates(
     for j, joint in enumerate(problem.joint_names):
         torque, inertia = float(design.motor_peak_torque[j]), float(design.rotor_inertia[j])
         required = float(optimum.required_torque[j])
+        gearbox = joint_gearboxes[j]
+        if isinstance(gearbox, ScaledGearbox):  # its unit at the continuous optimum's size
+            gearbox = gearbox.unit(float(design.peak_torque[j]))
         options, gearbox_misses = gearbox_options(
-            joint_gearboxes[j], space_ratios[j], required, gearboxes, gearbox_candidates
+            gearbox, space_ratios[j], required, gearboxes, gearbox_candidates
         )
         largest = max((_ratio_range(space_ratios[j], g)[1] for g, _ in options), default=0.0)
         ranked = sorted(catalogue, key=lambda m: motor_distance(m, torque, inertia))
@@ -276,7 +280,7 @@ def joint_candidates(
                 joint,
                 parts,
                 nearest,
-                () if parts else (*gearbox_misses, *misses[nearest]),
+                () if parts else gearbox_misses if not options else misses[nearest],
                 _coverage_warning(joint, catalogue, float(design.stator_diameter[j]), torque),
             )
         )

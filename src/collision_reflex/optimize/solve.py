@@ -651,6 +651,7 @@ def layout_design(
     gear = values["gear_ratio"]
     joint = technology.joint_quantities(values["stator_diameter"], values["stack_length"], gear)
     motor = joint.motor
+    gearbox = technology.gearbox_figures(len(joint_names), np.asarray(joint.peak_torque, dtype=float))
     return Design(
         joint_names=joint_names,
         stator_diameter=values["stator_diameter"],
@@ -666,8 +667,8 @@ def layout_design(
         threshold=float(values["threshold"][0]),
         approach_velocity=float(values["approach_velocity"][0]),
         sensing=technology.sensing,
-        gearbox=joint.gearbox.names,
-        gearbox_mass=joint.gearbox.mass,
-        gearbox_inertia=joint.gearbox.inertia,
-        gearbox_efficiency=joint.gearbox.efficiency,
+        gearbox=gearbox.names,
+        gearbox_mass=gearbox.mass,
+        gearbox_inertia=gearbox.inertia,
+        gearbox_efficiency=gearbox.efficiency,
     )

@@ -22,7 +22,7 @@ import numpy as np
 from .. import _validate
 from ..errors import InvalidParameter
 from ..hardware.actuators import REFLECTED_INERTIA_PLACEMENTS
-from ..hardware.gearboxes import CatalogueGearbox
+from ..hardware.gearboxes import CatalogueGearbox, ScaledGearbox
 from ..hardware.motors import Motor, MotorQuantities, scaled_motor_quantities
 from ..model.effective import reflected_inertia
 from ..model.impulse import REACTION_MODES
@@ -47,7 +47,9 @@ class ActuatorTechnology:
         transmission with the compliance at the contact, as the paper measured for its geared A8 actuator
         (fitted finger mass 20 kg against 0.12 kg direct-drive).
     gearboxes: one gearbox per joint (None at a joint: direct drive, or no gearbox model there), or None for
-        none at all. See :func:`joint_quantities` for what a gearbox changes.
+        none at all: a catalogue unit (fixed figures) or a :class:`~collision_reflex.hardware.gearboxes.
+        ScaledGearbox` (sized to carry the motor's peak output torque ``N tau_p``). See :func:`joint_quantities`
+        for what a gearbox changes.
     gearbox_inertia: count the gearboxes' input-side inertia in the reflected inertia ``N^2 (J_m + J_g)``;
         False is the paper's choice (gearbox inertia ignored: ``N^2 J_m``).
     """
@@ -58,7 +60,7 @@ class ActuatorTechnology:
     sensing: str = "force"
     reaction: str = "at_rest"
     reflected_inertia_in: str = "robot"
-    gearboxes: tuple[CatalogueGearbox | None, ...] | None = None
+    gearboxes: tuple[CatalogueGearbox | ScaledGearbox | None, ...] | None = None
     gearbox_inertia: bool = True
 
     def __post_init__(self) -> None:
@@ -75,9 +77,11 @@ class ActuatorTechnology:
         _validate.choice("reflected_inertia_in", self.reflected_inertia_in, REFLECTED_INERTIA_PLACEMENTS)
         if self.gearboxes is not None:
             gearboxes = tuple(self.gearboxes)
-            if not all(g is None or isinstance(g, CatalogueGearbox) for g in gearboxes):
+            if not all(g is None or isinstance(g, (CatalogueGearbox, ScaledGearbox)) for g in gearboxes):
                 raise InvalidParameter(
-                    "gearboxes", self.gearboxes, "one CatalogueGearbox or None per joint, or None"
+                    "gearboxes",
+                    self.gearboxes,
+                    "one CatalogueGearbox, ScaledGearbox or None per joint, or None",
                 )
             for gearbox in gearboxes:
                 if gearbox is not None and gearbox.efficiency is not None:
@@ -144,7 +148,7 @@ class ActuatorTechnology:
             speeds,
         )
 
-    def joint_gearboxes(self, n_joints: int) -> tuple[CatalogueGearbox | None, ...]:
+    def joint_gearboxes(self, n_joints: int) -> tuple[CatalogueGearbox | ScaledGearbox | None, ...]:
         """The gearbox of each of ``n_joints`` joints (None: no gearbox at that joint)."""
         if self.gearboxes is None:
             return (None,) * n_joints
@@ -154,13 +158,33 @@ class ActuatorTechnology:
             )
         return self.gearboxes
 
-    def gearbox_figures(self, n_joints: int) -> GearboxFigures:
-        """The figures of each joint's gearbox as arrays (n_joints,); see :class:`GearboxFigures`."""
+    def gearbox_figures(self, n_joints: int, peak_torque: np.ndarray | None = None) -> GearboxFigures:
+        """The figures of each joint's gearbox as arrays (n_joints,); see :class:`GearboxFigures`.
+
+        A scaled gearbox's figures are those of its size at the joint's peak output torque ``N tau_p``
+        ``peak_torque`` [N m]; without it, its constant part: its efficiency, none of its mass and inertia
+        (:meth:`joint_quantities` adds them) and no ratings (its repeated peak rating is ``N tau_p`` itself, which
+        the driving torque ``eta N tau_p`` a requirement must be within never exceeds).
+        """
         gearboxes = self.joint_gearboxes(n_joints)
+        scaled = {
+            j: g.figures(float(peak_torque[j])) if peak_torque is not None else None
+            for j, g in enumerate(gearboxes)
+            if isinstance(g, ScaledGearbox)
+        }
 
         def figure(name: str, absent: float) -> np.ndarray:
-            values = [getattr(g, name, None) if g is not None else None for g in gearboxes]
-            return np.array([absent if v is None else float(v) for v in values], dtype=float)
+            values = []
+            for j, g in enumerate(gearboxes):
+                if j in scaled:
+                    at = scaled[j]
+                    value = getattr(at, name, None) if at is not None else None
+                    if name == "efficiency":
+                        value = g.efficiency  # type: ignore[union-attr]
+                else:
+                    value = getattr(g, name, None) if g is not None else None
+                values.append(absent if value is None else float(value))
+            return np.array(values, dtype=float)
 
         inertia = figure("inertia", 0.0)
         return GearboxFigures(
@@ -206,15 +230,37 @@ class ActuatorTechnology:
         mass, counted, efficiency = (
             _column(v, gear_ratio) for v in (gearbox.mass, gearbox.counted_inertia, gearbox.efficiency)
         )
+        scaled_mass, scaled_inertia = self._scaled_terms(peak)
         return JointQuantities(
             motor=motor,
             gearbox=gearbox,
-            actuator_mass=motor.mass + mass,
-            reflected_inertia=reflected_inertia(gear_ratio, motor.rotor_inertia + counted),
+            actuator_mass=motor.mass + mass + scaled_mass,
+            reflected_inertia=reflected_inertia(gear_ratio, motor.rotor_inertia + counted + scaled_inertia),
             peak_torque=peak,
             driving_peak_torque=efficiency * peak,
             driving_continuous_torque=efficiency * continuous,
         )
+
+    def _scaled_terms(self, peak_torque: Any) -> tuple[Any, Any]:
+        """The scaled gearboxes' masses [kg] and counted input inertias [kg m^2] at the joints' ``N tau_p``.
+
+        Zero at the other joints; NumPy arrays or CasADi columns as ``peak_torque`` [N m] is.
+        """
+        import casadi as ca
+
+        symbolic = isinstance(peak_torque, (ca.MX, ca.SX, ca.DM))
+        n = _rows(peak_torque)
+        gearboxes = self.joint_gearboxes(n)
+        masses: list[Any] = [0.0] * n
+        inertias: list[Any] = [0.0] * n
+        for j, gearbox in enumerate(gearboxes):
+            if isinstance(gearbox, ScaledGearbox):
+                figures = gearbox.figures(peak_torque[j])
+                masses[j] = figures.mass
+                inertias[j] = figures.inertia if self.gearbox_inertia else 0.0
+        if symbolic:
+            return ca.vertcat(*masses), ca.vertcat(*inertias)
+        return np.array(masses, dtype=float), np.array(inertias, dtype=float)
 
     def default_stack_lengths(self, n_joints: int) -> list[float]:
         """Each joint's reference motor's stack length [m]: the stack length when the design leaves it out."""
@@ -243,8 +289,8 @@ class GearboxFigures(NamedTuple):
 class JointQuantities(NamedTuple):
     """Each joint's actuator quantities, joint side (see :meth:`ActuatorTechnology.joint_quantities`).
 
-    motor: the motor's own quantities; gearbox: the gearbox figures; actuator_mass: motor plus gearbox mass
-    [kg]; reflected_inertia: ``N^2 (J_m + J_g)`` [kg m^2]; peak_torque: ``N tau_p`` [N m];
+    motor: the motor's own quantities; gearbox: the gearbox figures (a scaled gearbox's constant part,
+    :meth:`ActuatorTechnology.gearbox_figures`); actuator_mass: motor plus gearbox mass [kg]; reflected_inertia: ``N^2 (J_m + J_g)`` [kg m^2]; peak_torque: ``N tau_p`` [N m];
     driving_peak_torque: ``eta N tau_p`` [N m]; driving_continuous_torque: ``eta N tau_c`` [N m].
     """
 

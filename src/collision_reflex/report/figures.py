@@ -179,11 +179,14 @@ def _distinct_surfaces(featured: dict[str, dict[str, Any]]) -> dict[str, dict[st
 
 
 def has_duty_cycle(results: dict[str, Any]) -> bool:
-    """Whether the recommended design was sized by a duty cycle (its record's ``requirement``)."""
-    from ..optimize.constraints import DUTY_REQUIREMENT
+    """Whether the recommended design was sized by a motion: a duty cycle or a rated motion (its ``requirement``)."""
+    from ..optimize.constraints import DUTY_REQUIREMENT, RATED_REQUIREMENT
 
     recommended = results.get("recommended")
-    return isinstance(recommended, dict) and recommended.get("requirement") == DUTY_REQUIREMENT
+    return isinstance(recommended, dict) and recommended.get("requirement") in (
+        DUTY_REQUIREMENT,
+        RATED_REQUIREMENT,
+    )
 
 
 def recommended_torque_speed(results: dict[str, Any]) -> list[JointOperatingPoints] | None:

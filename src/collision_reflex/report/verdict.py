@@ -529,6 +529,7 @@ def verdict(results: Mapping[str, Any]) -> list[str]:
     lines.append(requirement_sentence(requirement))
     if results.get("speed_limits"):
         lines.append(str(results["speed_limits"]))
+    lines += [str(line) for line in results.get("transmissions", ())]
     if bounds is not None:
         undecided = recommended.get("undecided", ())
         for joint in recommended["joints"]:

@@ -62,8 +62,9 @@ class ArmResults(TypedDict):
     The samples and the contact domain they were drawn in, the chosen and recommended designs, the Pareto
     front, the bounds of the design variables
     (``{variable: {joint: [lower, upper]}}`` and ``{threshold|approach_velocity: [lower, upper]}``, SI units)
-    the kind of torque requirement (:attr:`collision_reflex.optimize.Constraints.requirement`) and, with a duty
-    cycle, where the motors' speed limits come from.
+    the kind of torque requirement (:attr:`collision_reflex.optimize.Constraints.requirement`), with a duty
+    cycle or a rated motion where the motors' speed limits come from, and what the transmissions are
+    (:func:`transmissions`).
     """
 
     samples: SampleLayout
@@ -74,6 +75,7 @@ class ArmResults(TypedDict):
     bounds: dict[str, Any]
     requirement: str
     speed_limits: str | None
+    transmissions: list[str]
     catalogue: NotRequired[CatalogueRecord]
 
 
@@ -140,16 +142,20 @@ def torque_speed_record(problem: DesignProblem, result: DesignResult) -> list[Jo
 
 
 def design_bounds(setup: ArmSetup) -> dict[str, Any]:
-    """The bounds every design of the study was solved within, as plain data [SI units]."""
+    """The bounds every design of the study was solved within, as plain data [SI units].
+
+    The design space's, as the optimiser lays it out: a joint's gear ratio within its gearbox's ratios, the force
+    threshold above the noise floor.
+    """
+    from ..optimize.layout import design_layout
+
     joints = list(setup.arm.joint_names)
-    space = setup.space
-    defaults = {"stack_length": setup.technology.default_stack_lengths(len(joints))}
+    layout = design_layout(setup.space, setup.technology, setup.constraints, len(joints), tuple(joints))
     out: dict[str, Any] = {}
     for name in PER_JOINT_VARIABLES:
-        bounds = space.per_joint(name, len(joints), defaults.get(name))
-        out[name] = {j: [b.lower, b.upper] for j, b in zip(joints, bounds, strict=True)}
+        out[name] = {j: [b.lower, b.upper] for j, b in zip(joints, layout.bounds[name], strict=True)}
     for name in GLOBAL_VARIABLES:
-        one = space.global_bounds(name)
+        one = layout.bounds[name][0]
         out[name] = [one.lower, one.upper]
     return out
 
@@ -250,6 +256,7 @@ def arm_results(
         "bounds": design_bounds(setup),
         "requirement": setup.constraints.requirement,
         "speed_limits": speed_limits(setup),
+        "transmissions": transmissions(setup),
     }
     if catalogue is not None:
         rows = pareto["points"] or [chosen_record]
@@ -314,10 +321,10 @@ def _undecided(problems: StudyProblems, problem: DesignProblem, result: DesignRe
 
 
 def speed_limits(setup: ArmSetup) -> str | None:
-    """Where the motors' speed limits come from, for the report (None without a duty cycle, which uses none)."""
+    """Where the motors' speed limits come from, for the report (None without a duty cycle or a rated motion)."""
     from ..hardware.motors import scaling_law
 
-    if setup.constraints.duty_cycle is None:
+    if not setup.constraints.moves:
         return None
     motor = setup.technology.motors[0]
     law = scaling_law(setup.technology.scaling_law).speed
@@ -327,6 +334,44 @@ def speed_limits(setup: ArmSetup) -> str | None:
         f"limit follows omega_max ∝ (l/l0)^{law.length_exponent:g} (r/r0)^{law.diameter_exponent:g}. "
         f"{law.source}"
     )
+
+
+def transmissions(setup: ArmSetup) -> list[str]:
+    """What the joints' transmissions are, for the report: scaled gearboxes, and geared joints without a model."""
+    from ..hardware.gearboxes import GEARBOX_SCALING, ScaledGearbox
+
+    joints = list(setup.arm.joint_names)
+    gearboxes = setup.technology.joint_gearboxes(len(joints))
+    ratios = setup.space.per_joint("gear_ratio", len(joints))
+    lines = []
+    scaled: dict[ScaledGearbox, list[str]] = {}
+    for joint, gearbox in zip(joints, gearboxes, strict=True):
+        if isinstance(gearbox, ScaledGearbox):
+            scaled.setdefault(gearbox, []).append(joint)
+    for gearbox, named in scaled.items():
+        mass, inertia, torque = (law.diameter for law in GEARBOX_SCALING[gearbox.kind])
+        low, high = gearbox.ratio_range
+        lines.append(
+            f"Transmissions of {', '.join(named)}: a {gearbox.kind} gearbox scaled from {gearbox.reference.name} "
+            f"to carry its motor's peak torque N tau_p (mass ∝ torque^{mass / torque:.3g}, input inertia ∝ "
+            f"torque^{inertia / torque:.3g}: Saerens et al. 2019 at the reference's length), its mass in the "
+            f"actuator mass and its input inertia in N^2 (J_m + J_g). Its ratios "
+            f"({', '.join(f'{r:g}' for r in gearbox.ratios)}) are relaxed to the range {low:g} to {high:g} in the "
+            "continuous designs; the catalogue design takes a unit of the catalogue at a ratio it is sold with."
+        )
+    bare = [
+        joint
+        for joint, gearbox, bounds in zip(joints, gearboxes, ratios, strict=True)
+        if gearbox is None and bounds.upper > 1
+    ]
+    if bare:
+        lines.append(
+            f"Warning: {', '.join(bare)} may be geared (N up to {max(b.upper for b in ratios):g}) but have no "
+            "transmission model: their gearboxes weigh nothing and have no inertia, so a larger ratio costs "
+            "nothing but the reflected rotor inertia. Give actuators.gearbox (a catalogue unit, its figures, or "
+            "{scaled_from: ...}), or fix the gear ratio at 1 for direct drive."
+        )
+    return lines
 
 
 class CatalogueRecord(TypedDict):

@@ -19,18 +19,19 @@ import numpy as np
 
 from ..errors import StudyFileError, StudyProblem
 from ..optimize.blas import single_threaded_blas
-from .duty import payload_of, study_duty_cycle
+from .duty import payload_of, study_duty_cycle, study_rating
 from .load import LoadedStudy, parse_study
 from .prepare import check_motors, gearbox_for, joint_actuators, per_joint_bounds
 from .robot import load_arm
 from .samples import configuration_samples, contact_domain, direction_samples, domain_draw
-from .schema import PER_JOINT_DESIGN_VARIABLES, ArmStudy
+from .schema import PER_JOINT_DESIGN_VARIABLES, ArmStudy, ScaledGearboxSpec
 from .source import PathKey
 
 if TYPE_CHECKING:
     from ..arm import Arm, DutyCycle
     from ..arm.domain import ContactDomain
-    from ..hardware.gearboxes import CatalogueGearbox
+    from ..arm.rating import Rating
+    from ..hardware.gearboxes import CatalogueGearbox, ScaledGearbox
     from ..hardware.motors import Motor
     from ..optimize import ActuatorTechnology, Bounds, Constraints, ContactSamples, DesignProblem, DesignSpace
 
@@ -144,6 +145,7 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
         torque_required=study.constraints.torque_required,
         threshold_floor=study.constraints.threshold_floor,
         duty_cycle=duty_cycle,
+        rating=_study_rating(loaded, arm),
     )
     directions = direction_samples(loaded, arm)
     domain = contact_domain(loaded, arm)
@@ -172,6 +174,26 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
         duty_cycle=duty_cycle,
         domain_kept=kept,
     )
+
+
+def _study_rating(loaded: LoadedStudy, arm: Arm) -> Rating | None:
+    """The study's rating; refused at ``constraints.torque_required`` when it moves and torques are given."""
+    rating = study_rating(loaded, arm)
+    study = loaded.study
+    assert isinstance(study, ArmStudy)
+    if rating is not None and rating.moves and study.constraints.torque_required is not None:
+        raise StudyFileError(
+            loaded.source.file,
+            [
+                loaded.problem(
+                    ("constraints", "torque_required"),
+                    "given torques with a rated motion",
+                    "one requirement: remove torque_required (the rated motion and the static hold replace it) "
+                    "or the rating's speeds and accelerations",
+                )
+            ],
+        )
+    return rating
 
 
 ExtraSamples = tuple[tuple[tuple[float, ...], tuple[float, ...]], ...]
@@ -222,17 +244,17 @@ def _check_supported(loaded: LoadedStudy, study: ArmStudy) -> None:
 
 def _joint_gearboxes(
     loaded: LoadedStudy, study: ArmStudy, joints: list[str], ratio_bounds: list[Bounds]
-) -> tuple[CatalogueGearbox | None, ...] | None:
+) -> tuple[CatalogueGearbox | ScaledGearbox | None, ...] | None:
     """Each joint's gearbox (None: none), or None when no joint has one; every problem located.
 
     A name is a catalogue entry of ``designs/gearboxes.yaml`` (the schema checks it); figures (:class:`GearboxSpec`) become an entry
-    whose ratios are the joint's gear-ratio bounds. A gearbox whose ratios miss the joint's gear-ratio bounds
+    whose ratios are the joint's gear-ratio bounds; ``scaled_from`` a :class:`ScaledGearbox` of that entry. A gearbox whose ratios miss the joint's gear-ratio bounds
     is refused here, at the gearbox's line.
     """
-    from ..hardware.gearboxes import load_gearbox_catalogue
+    from ..hardware.gearboxes import ScaledGearbox, load_gearbox_catalogue
 
     catalogue: dict[str, CatalogueGearbox] | None = None
-    gearboxes: list[CatalogueGearbox | None] = []
+    gearboxes: list[CatalogueGearbox | ScaledGearbox | None] = []
     problems: list[StudyProblem] = []
     for joint, bounds in zip(joints, ratio_bounds, strict=True):
         override = study.actuators.joints.get(joint)
@@ -240,10 +262,14 @@ def _joint_gearboxes(
         spec = study.actuators.gearbox
         if override is not None and override.gearbox is not None:
             path, spec = ("actuators", "joints", joint, "gearbox"), override.gearbox
-        gearbox: CatalogueGearbox | None = None
+        gearbox: CatalogueGearbox | ScaledGearbox | None = None
         if isinstance(spec, str):  # a catalogue name, checked by the schema
             catalogue = catalogue if catalogue is not None else load_gearbox_catalogue()
             gearbox = catalogue[spec]
+        elif isinstance(spec, ScaledGearboxSpec):
+            catalogue = catalogue if catalogue is not None else load_gearbox_catalogue()
+            reference = catalogue[spec.scaled_from]
+            gearbox = ScaledGearbox(reference, tuple(spec.ratios or reference.ratios))
         elif spec is not None:
             scaled = gearbox_for(spec)
             assert scaled is not None  # a spec gives a gearbox

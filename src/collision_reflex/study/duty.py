@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..arm.duty_cycle import DutyCycle, Payload
+from ..arm.rating import Rating
 from ..errors import InvalidParameter, StudyFileError, StudyProblem, TrajectoryError
 from .load import LoadedStudy
 from .schema import ArmStudy, DutyCycleSpec
@@ -61,6 +62,32 @@ def study_duty_cycle(loaded: LoadedStudy, arm: Arm) -> DutyCycle | None:
     if spec.file is not None:
         return _from_file(loaded, arm, spec.file, payload)
     return _through_via_points(loaded, arm, spec, payload)
+
+
+def study_rating(loaded: LoadedStudy, arm: Arm) -> Rating | None:
+    """The rating of an arm study for ``arm`` (per-joint figures in its joint order), or None without one.
+
+    Raises
+    ------
+    StudyFileError: at the ``rating`` entry that names no joint of the arm or misses one.
+    """
+    study = loaded.study
+    assert isinstance(study, ArmStudy)
+    spec = study.rating
+    joints, problems = list(arm.joint_names), list[StudyProblem]()
+    figures = {
+        name: None if value is None else per_joint_values(loaded, ("rating", name), value, joints, problems)
+        for name in ("joint_speeds", "joint_accelerations", "stopping_time")
+        for value in (getattr(spec, name),)
+    }
+    if problems:
+        raise StudyFileError(loaded.source.file, problems)
+    if all(value is None for value in figures.values()):
+        return None
+    payload = (
+        payload_of(study) if spec.payload is None else (Payload(spec.payload) if spec.payload > 0 else None)
+    )
+    return Rating(payload=payload, **figures)
 
 
 def static_requirement(study: ArmStudy) -> str:

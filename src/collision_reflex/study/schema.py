@@ -199,12 +199,31 @@ def _catalogue_gearbox(value: Any) -> Any:
     return value
 
 
+class ScaledGearboxSpec(_Model):
+    """A gearbox of a catalogue unit's kind, sized by its kind's scaling law to carry the motor's peak torque.
+
+    Its mass enters the actuator mass, its input inertia ``N^2 J_g`` the reflected inertia, its efficiency the
+    driving torque (:class:`collision_reflex.hardware.gearboxes.ScaledGearbox`). The design relaxes ``ratios``
+    to the range between the first and the last; its catalogue design picks a catalogue unit of the kind at a
+    ratio it is sold with.
+    """
+
+    scaled_from: str = Field(description="the catalogue gearbox (designs/gearboxes.yaml) scaled from")
+    ratios: list[GearRatio] | None = Field(
+        None, min_length=1, description="ratios the kind is sold with [-]; null: the reference's own"
+    )
+
+    _known_gearbox = field_validator("scaled_from")(_catalogue_gearbox)
+
+
 class JointActuatorSpec(_Model):
     """Per-joint overrides of the actuator defaults (every field optional)."""
 
     motor: MotorSpec | None = None
-    gearbox: str | GearboxSpec | None = Field(
-        None, description="catalogue name (designs/gearboxes.yaml) or a gearbox's figures; null: the default"
+    gearbox: str | GearboxSpec | ScaledGearboxSpec | None = Field(
+        None,
+        description="catalogue name (designs/gearboxes.yaml), a gearbox's figures or {scaled_from: name}; null: "
+        "the default",
     )
     gear_ratio: GearRatio | None = Field(None, ge=1)
     mechanical_stiffness: JointStiffness | None = Field(None, gt=0)
@@ -217,10 +236,10 @@ class ActuatorsSpec(_Model):
     """The actuator of every joint; ``joints`` overrides fields for named joints."""
 
     motor: MotorSpec = Field(default_factory=MotorSpec)  # type: ignore[arg-type]
-    gearbox: str | GearboxSpec | None = Field(
+    gearbox: str | GearboxSpec | ScaledGearboxSpec | None = Field(
         None,
-        description="every joint's gearbox: a catalogue name (designs/gearboxes.yaml) or a gearbox's figures; "
-        "null: none (the gear ratio alone)",
+        description="every joint's gearbox: a catalogue name (designs/gearboxes.yaml), a gearbox's figures, or "
+        "{scaled_from: name, ratios: [...]} (sized to its motor); null: none (the gear ratio alone)",
     )
     gearbox_inertia: bool = Field(
         True,
@@ -801,15 +820,39 @@ class ExecutionSpec(_Model):
 Weight = Annotated[float, Field(gt=0, le=1e6, allow_inf_nan=False)]
 
 
+StoppingTime = _quantities("s", "a stopping time", "0.25 s", dict, "> 0", 60.0)
+
+
 class RatingSpec(_Model):
-    """What the robot is rated for, as its datasheet gives it."""
+    """What the robot is rated for, as its datasheet gives it (each figure optional).
+
+    At every sampled configuration the joints must hold the payload still (the static hold), move at their rated
+    speeds while accelerating at their rated accelerations (the rated motion) and stop from their rated speeds
+    within their stopping times (braking), all with the rated payload; the motors and gearboxes must turn at the
+    rated speeds. Speeds, accelerations and stopping times: one value for every joint or a mapping by joint name.
+    """
 
     payload: Payload | None = Field(
         None,
         ge=0,
-        description="rated payload [kg], held still at every sampled configuration (the static hold); null: the "
-        "payload the study carries (duty_cycle.payload or constraints.payload)",
+        description="rated payload [kg], held still at every sampled configuration (the static hold) and carried "
+        "in the rated motion; null: the payload the study carries (duty_cycle.payload or constraints.payload)",
     )
+    joint_speeds: JointSpeed | None = Field(  # type: ignore[valid-type]
+        None, description="rated joint speeds [rad/s]: one for all joints or by joint name"
+    )
+    joint_accelerations: JointAcceleration | None = Field(  # type: ignore[valid-type]
+        None, description="rated joint accelerations [rad/s^2]: one for all joints or by joint name"
+    )
+    stopping_time: StoppingTime | None = Field(  # type: ignore[valid-type]
+        None, description="time to stop from the rated speed [s] (needs joint_speeds): one or by joint name"
+    )
+
+    @model_validator(mode="after")
+    def _stops_from_a_speed(self) -> RatingSpec:
+        if self.stopping_time is not None and self.joint_speeds is None:
+            raise ValueError("stopping_time needs the joint_speeds it stops from")
+        return self
 
 
 class ArmStudy(_Model):
