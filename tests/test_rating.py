@@ -166,3 +166,27 @@ def test_the_shipped_studies_ask_for_the_real_robots_torques(study):
     ratio = optimum.required_torque / np.array(REAL_TORQUES[study])
     assert np.all((ratio[:-1] > 1 / 3) & (ratio[:-1] < 3)), ratio
     assert ratio[-1] < 0.1
+
+
+def test_a_rating_no_gearbox_of_the_catalogue_meets_is_refused_before_solving(tmp_path):
+    # A planetary gearbox scaled from the NPS015 may grow only to the largest planetary unit of the catalogue,
+    # the Beckhoff SP140 (468 N m repeated peak): 400 kg at the planar arm's tip (0.55 m) accelerated at
+    # 300 deg/s^2 asks at least 400 x 0.55^2 x 5.2 x 1.5 = 950 N m of the shoulder.
+    study = yaml.safe_load((ROOT / "studies" / "two_link_planetary.yaml").read_text())
+    study["robot"]["urdf"] = str(TWO_LINK)
+    study["actuators"]["gearbox"] = {"scaled_from": "NPS015-MF-1"}
+    study["rating"] = {"payload": "400 kg", "joint_accelerations": "300 deg/s^2"}
+    study.pop("pareto")
+    path = tmp_path / "heavy.yaml"
+    path.write_text(yaml.safe_dump(study))
+    problems = StudyProblems(resolved_yaml(load_study(path)))
+    with pytest.raises(InvalidParameter) as error:
+        built_problem(problems, problems.objective)
+    message = str(error.value)
+    assert "joint1" in message and "SP140-MF-1" in message and "468 N*m" in message
+    # A run refuses it before solving, at the gearbox's line, with the largest unit named.
+    from collision_reflex.study.runner import run_study
+
+    with pytest.raises(StudyFileError, match=r"actuators\.gearbox: found joint1: best margin reachable") as run:
+        run_study(path, tmp_path / "out", quiet=True, executor="serial", figures=False)
+    assert "SP140-MF-1's 468 N*m" in str(run.value) and not (tmp_path / "out" / "designs.json").exists()

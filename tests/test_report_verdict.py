@@ -10,6 +10,7 @@ from collision_reflex.report.verdict import (
     bound_position,
     catalogue_sentences,
     design_limits,
+    flat_impulse_reason,
     front_sentences,
     joint_limits,
     lightest_near_best,
@@ -120,6 +121,19 @@ def test_the_flat_front_sentence_fires_on_a_flat_front_only():
     lines = front_sentences(trade_off)
     assert lines[0] == "The front (3 designs) spans 50 % in worst case impulse, 900 % in actuator mass."
     assert not any("Flat" in line or "Degenerate" in line for line in lines)
+
+
+def test_a_flat_impulse_front_says_which_phase_carries_the_impulse():
+    # Phases by hand: the worst sample (1.0 + 0.05 + 0.05 N s) is 90.9 % impact; all samples 1.6 of 1.8 N s.
+    phases = {"initial": [1.0, 0.4, 0.2], "sensing": [0.05, 0.05, 0.03], "reaction": [0.05, 0.01, 0.01]}
+    recommended = {**record(0.5005, 1.0), "phases": phases}
+    flat = pareto([record(0.5000, 2.0), recommended, record(0.5011, 0.11)])
+    (line,) = flat_impulse_reason(flat, recommended, {"reflected_inertia_in": "robot"})
+    assert line.startswith("Why the front is flat in worst case impulse:")
+    assert "carries 90.9 % of the worst sample's impulse (1 of 1.1 N·s)" in line
+    assert "88.9 % of all samples' together" in line and "rotors sit behind the joint springs" in line
+    trade_off = pareto([record(0.40, 2.0), recommended, record(0.60, 0.2)])
+    assert flat_impulse_reason(trade_off, recommended, {}) == []
 
 
 def test_degenerate_fronts_are_said_in_plain_words():

@@ -17,11 +17,20 @@ from collision_reflex.study.resolve import resolved_yaml
 ROOT = Path(__file__).resolve().parents[1]
 
 
-@pytest.fixture(scope="module")
-def panda():
-    problems = StudyProblems(resolved_yaml(load_study(ROOT / "studies" / "panda.yaml")))
+def _solved(name: str):
+    problems = StudyProblems(resolved_yaml(load_study(ROOT / "studies" / f"{name}.yaml")))
     optimum, _ = single_optimum(problems, problems.objective, starts=1)
     return problems, built_problem(problems, problems.objective), optimum
+
+
+@pytest.fixture(scope="module")
+def panda():
+    return _solved("panda")
+
+
+@pytest.fixture(scope="module", params=["panda", "ur5"])
+def shipped(request):
+    return _solved(request.param)
 
 
 def _gravity_demand(kinematics, payload, masses):
@@ -58,8 +67,8 @@ def test_the_peak_requirement_is_the_larger_of_the_static_hold_and_the_cycle(pan
     assert np.all(design.driving_peak_torque >= optimum.required_torque * (1 - 1e-7))
 
 
-def test_the_design_holds_its_payload_still_at_fresh_configurations(panda):
-    problems, _, optimum = panda
+def test_the_design_holds_its_payload_still_at_fresh_configurations(shipped):
+    problems, _, optimum = shipped
     setup, design = problems.setup, optimum.design
     rng = np.random.default_rng(2026)
     draw = setup.domain.draw(setup.arm, 10_000, setup.directions, design.approach_velocity, rng)

@@ -30,6 +30,7 @@ class InvalidParameter(CollisionReflexError, ValueError):
         self.name = name
         self.value = value
         self.allowed = allowed
+        self.hint = hint
         message = f"{name} = {_describe(value)} is invalid: expected {allowed}"
         if hint:
             message += f"; {hint}"

@@ -285,10 +285,13 @@ class ScaledGearbox:
     reference: the catalogue unit scaled from (its kind, figures and source).
     ratios: the ratios the kind is sold with [-], ascending: a design relaxes them to the range between the
         first and the last; its catalogue design picks an offered one.
+    largest: the largest unit of the kind one can buy (by repeated peak torque), or None: a design whose
+        requirement is beyond its rating has no gearbox to buy, so its rating bounds the requirement.
     """
 
     reference: CatalogueGearbox
     ratios: tuple[float, ...]
+    largest: CatalogueGearbox | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.reference, CatalogueGearbox):
@@ -301,6 +304,12 @@ class ScaledGearbox:
         if not ratios or not all(math.isfinite(r) and r >= 1 for r in ratios):
             raise InvalidParameter("ScaledGearbox.ratios", self.ratios, "ratios >= 1, at least one")
         object.__setattr__(self, "ratios", ratios)
+        if self.largest is not None and self.largest.kind != self.kind:
+            raise InvalidParameter(
+                "ScaledGearbox.largest",
+                self.largest.name,
+                f"a {self.kind} gearbox, the kind of the reference",
+            )
 
     @property
     def kind(self) -> str:
@@ -310,7 +319,9 @@ class ScaledGearbox:
     @property
     def name(self) -> str:
         """What reports call it."""
-        return f"{self.kind} scaled from {self.reference.name}"
+        largest = self.largest
+        beyond = "" if largest is None else f" (at most {largest.name}'s {largest.peak_torque:.4g} N*m)"
+        return f"{self.kind} scaled from {self.reference.name}{beyond}"
 
     @property
     def ratio_range(self) -> tuple[float, float]:
@@ -341,7 +352,7 @@ class ScaledGearbox:
         figures = self.figures(float(peak_torque))
         reference = self.reference
         return CatalogueGearbox(
-            name=f"{self.name} to {float(peak_torque):.4g} N*m",
+            name=f"{self.kind} scaled from {reference.name} to {float(peak_torque):.4g} N*m",
             kind=self.kind,
             ratios=self.ratio_range,
             continuous_ratio=True,

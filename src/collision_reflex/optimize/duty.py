@@ -417,7 +417,10 @@ def check_reachable(
         gearbox = figures.names[j]
         labels = (PEAK, RMS, SPEED, *(f"gearbox {gearbox} {rating}" for rating in GEARBOX_RATINGS))
         what = " and ".join(dict.fromkeys(duty.torques.sources))
-        for label, value in zip(labels, best[:-1], strict=True):
+        # The gearbox's ratings first: no bound of the study moves them (another gearbox must be chosen).
+        for label, value in sorted(
+            zip(labels, best[:-1], strict=True), key=lambda p: not p[0].startswith("gearbox")
+        ):
             if value < -REACHABLE_TOLERANCE:
                 _refuse(what, name, label, value)
         if best[-1] < -REACHABLE_TOLERANCE:

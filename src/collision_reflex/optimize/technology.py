@@ -163,8 +163,9 @@ class ActuatorTechnology:
 
         A scaled gearbox's figures are those of its size at the joint's peak output torque ``N tau_p``
         ``peak_torque`` [N m]; without it, its constant part: its efficiency, none of its mass and inertia
-        (:meth:`joint_quantities` adds them) and no ratings (its repeated peak rating is ``N tau_p`` itself, which
-        the driving torque ``eta N tau_p`` a requirement must be within never exceeds).
+        (:meth:`joint_quantities` adds them), and as its repeated peak rating the largest unit of its kind one can
+        buy (infinite when not known): its own rating is ``N tau_p``, which the driving torque ``eta N tau_p`` a
+        requirement must be within never exceeds, so the requirement is bounded by what can be bought.
         """
         gearboxes = self.joint_gearboxes(n_joints)
         scaled = {
@@ -177,10 +178,13 @@ class ActuatorTechnology:
             values = []
             for j, g in enumerate(gearboxes):
                 if j in scaled:
+                    assert isinstance(g, ScaledGearbox)
                     at = scaled[j]
                     value = getattr(at, name, None) if at is not None else None
                     if name == "efficiency":
-                        value = g.efficiency  # type: ignore[union-attr]
+                        value = g.efficiency
+                    elif name == "peak_torque" and at is None and g.largest is not None:
+                        value = g.largest.peak_torque
                 else:
                     value = getattr(g, name, None) if g is not None else None
                 values.append(absent if value is None else float(value))

@@ -456,6 +456,47 @@ def front_sentences(pareto: Mapping[str, Any]) -> list[str]:
     return lines
 
 
+def flat_impulse_reason(
+    pareto: Mapping[str, Any], record: Mapping[str, Any], resolved: Mapping[str, Any]
+) -> list[str]:
+    """Why an impulse objective is flat over the front, with the recommended design's impulse phases.
+
+    The impact phase ``m_f v0`` is the links' (and, with ``reflected_inertia_in: finger``, the rotors'); the
+    sensing and reaction phases are what the actuators set. Empty unless an impulse objective is flat.
+    """
+    from ..optimize.objectives import IMPULSE_OBJECTIVES
+
+    points, names = pareto.get("points") or [], pareto.get("objectives") or []
+    phases = record.get("phases")
+    if len(points) < 2 or not phases:
+        return []
+    spans = objective_spans(points, names)
+    flat = [n for n in names if n in IMPULSE_OBJECTIVES and spans[n] < FLAT_SPAN]
+    if not flat:
+        return []
+    initial, sensing, reaction = (
+        np.asarray(phases[k], dtype=float) for k in ("initial", "sensing", "reaction")
+    )
+    total = initial + sensing + reaction
+    worst = int(np.argmax(total))
+    share_worst = 100 * initial[worst] / total[worst]
+    share_all = 100 * initial.sum() / total.sum()
+    placement = resolved.get("reflected_inertia_in", "robot")
+    where = (
+        "the links' inertia with the actuator masses they carry; the rotors sit behind the joint springs "
+        "(reflected_inertia_in: robot)"
+        if placement == "robot"
+        else "the links' inertia with the actuator masses and the rotors (reflected_inertia_in: finger)"
+    )
+    return [
+        f"Why the front is flat in {_words(flat[0])}: at the recommended design the impact phase m_f v0, set by "
+        f"{where}, carries {_g(share_worst, 3)} % of the worst sample's impulse ({_g(initial[worst], 4)} of "
+        f"{_g(total[worst], 4)} N·s) and {_g(share_all, 3)} % of all samples' together. The sensing and reaction "
+        "phases, which the motors, gears and controller set, carry the rest, and the actuator masses on the links "
+        "move the impact little: actuator mass buys almost nothing here."
+    ]
+
+
 def lightest_near_best(pareto: Mapping[str, Any], within: float = NEAR_BEST) -> tuple[int, str] | None:
     """The lightest front design within ``within`` (relative) of the best impulse, and its sentence.
 
@@ -545,6 +586,7 @@ def verdict(results: Mapping[str, Any]) -> list[str]:
         if limits:
             lines.append("Sensing and approach: " + ", ".join(limits) + ".")
     lines += front_sentences(results["pareto"])
+    lines += flat_impulse_reason(results["pareto"], recommended, results.get("resolved") or {})
     near = lightest_near_best(results["pareto"])
     if near is not None:
         lines.append(near[1])

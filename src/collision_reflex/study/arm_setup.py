@@ -269,7 +269,10 @@ def _joint_gearboxes(
         elif isinstance(spec, ScaledGearboxSpec):
             catalogue = catalogue if catalogue is not None else load_gearbox_catalogue()
             reference = catalogue[spec.scaled_from]
-            gearbox = ScaledGearbox(reference, tuple(spec.ratios or reference.ratios))
+            units = _gearbox_units(loaded, study)
+            kind = [unit for unit in units.values() if unit.kind == reference.kind]
+            largest = max(kind, key=lambda unit: unit.peak_torque) if kind else None
+            gearbox = ScaledGearbox(reference, tuple(spec.ratios or reference.ratios), largest)
         elif spec is not None:
             scaled = gearbox_for(spec)
             assert scaled is not None  # a spec gives a gearbox
@@ -296,6 +299,14 @@ def _joint_gearboxes(
     if problems:
         raise StudyFileError(loaded.source.file, problems)
     return tuple(gearboxes) if any(g is not None for g in gearboxes) else None
+
+
+def _gearbox_units(loaded: LoadedStudy, study: ArmStudy) -> dict[str, CatalogueGearbox]:
+    """The gearboxes one can buy: the study's gearbox catalogue (``catalogue.gearboxes``), else the packaged one."""
+    from ..hardware.gearboxes import load_gearbox_catalogue
+
+    named = study.catalogue.gearboxes
+    return load_gearbox_catalogue(None if named is None else loaded.path(named))
 
 
 @functools.lru_cache(maxsize=4)
@@ -426,6 +437,15 @@ def checked_setup(loaded: LoadedStudy, resolved_text: str) -> ArmSetup:
         problems = StudyProblems(resolved_text)
         built_problem(problems, problems.objective)
     except InvalidParameter as error:
+        if " requirement of " in error.name:  # a motion's requirement: said in full, at what asks for it
+            what, _, joint = error.name.rpartition(" requirement of ")
+            constraint, _, margin = str(error.value).rpartition(": ")
+            hint = f"; {error.hint}" if error.hint else ""
+            raise loaded.fail(
+                _motion_field(loaded.study, constraint),
+                f"{joint}: {margin}",
+                f"{error.allowed} ({what}){hint}",
+            ) from None
         raise loaded.fail(_field_of(error.name), f"{error}", "inputs the design problem accepts") from None
     return setup
 
@@ -464,6 +484,15 @@ def _torque_out_of_reach(loaded: LoadedStudy, setup: ArmSetup) -> list[StudyProb
                 )
             )
     return problems
+
+
+def _motion_field(study: Any, constraint: str) -> tuple[str, ...]:
+    """Where a motion requirement's refusal belongs: the gearbox, else the rating or the duty cycle."""
+    if constraint.startswith("gearbox"):
+        return ("actuators", "gearbox")
+    rating = study.rating
+    moves = rating.joint_speeds is not None or rating.joint_accelerations is not None
+    return ("rating",) if moves else ("duty_cycle",)
 
 
 def _field_of(name: str) -> tuple[str, ...]:
