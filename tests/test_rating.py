@@ -187,6 +187,8 @@ def test_a_rating_no_gearbox_of_the_catalogue_meets_is_refused_before_solving(tm
     # A run refuses it before solving, at the gearbox's line, with the largest unit named.
     from collision_reflex.study.runner import run_study
 
-    with pytest.raises(StudyFileError, match=r"actuators\.gearbox: found joint1: best margin reachable") as run:
+    with pytest.raises(
+        StudyFileError, match=r"actuators\.gearbox: found joint1: best margin reachable"
+    ) as run:
         run_study(path, tmp_path / "out", quiet=True, executor="serial", figures=False)
     assert "SP140-MF-1's 468 N*m" in str(run.value) and not (tmp_path / "out" / "designs.json").exists()
