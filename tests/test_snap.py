@@ -644,15 +644,30 @@ def test_the_descent_moves_only_for_a_gain_beyond_what_re_solving_repeats(monkey
         ]
 
     monkeypatch.setattr(snapping, "objective_value", lambda problem, objectives: objectives["v"])
-    search = snapping._Search(None, parts, solve_many, None)
+    monkeypatch.setattr(snapping._Search, "start", lambda self: (0, 0))
+    search = snapping._Search(None, None, parts, solve_many, None)
     assert search.descend() == 2
     assert search.best() == (1, 1)  # the best tried is kept either way
     assert ((0, 1) in search.tried) == moved
     # From an infeasible start (inf) a feasible part is always a move.
     value[(0, 0)] = float("inf")
-    search = snapping._Search(None, parts, solve_many, None)
+    search = snapping._Search(None, None, parts, solve_many, None)
     search.descend()
     assert search.best() == (1, 1)
+
+
+def test_the_descent_starts_where_every_joint_meets_its_own_requirement(monkeypatch):
+    # Both joints' nearest parts (index 0) miss their requirement once the other's part is chosen; no step of
+    # one joint from (0, 0) is feasible, so the descent must start at (1, 1), found without solving.
+    from types import SimpleNamespace
+
+    def evaluate(problem, design, parts):
+        return SimpleNamespace(shortfalls=tuple(f"j{k}: short" for k, p in enumerate(parts) if p.index == 0))
+
+    monkeypatch.setattr(snapping, "evaluate_parts", evaluate)
+    parts = [tuple(SimpleNamespace(label=f"{j}{i}", index=i) for i in range(3)) for j in range(2)]
+    problem = SimpleNamespace(joint_names=("j0", "j1"))
+    assert snapping._Search(problem, None, parts, None, None).start() == (1, 1)
 
 
 @pytest.mark.parametrize(
@@ -688,7 +703,23 @@ def test_the_snap_chooses_the_lightest_combination_alike_in_impulse(
         return out
 
     monkeypatch.setattr(snapping, "objective_value", lambda problem, values: values[objective])
-    search = snapping._Search(SimpleNamespace(objective={objective: 1.0}), parts, solve_many, None)
+    search = snapping._Search(SimpleNamespace(objective={objective: 1.0}), None, parts, solve_many, None)
     search.values_of(list(table))
     assert search.least() == (0, 0)
     assert search.best() == chosen
+
+
+def test_a_motor_too_slow_at_every_ratio_strong_enough_is_no_candidate(cycle_sized):
+    # Joint speed x the smallest ratio that carries the required torque is the motor speed the joint needs; a
+    # motor 20 % slower than that is no candidate for it, one as fast is, and the miss says why in numbers.
+    _arm, problem, optimum, catalogue = cycle_sized
+    speed = problem.duty.joint_speed(float(optimum.design.approach_velocity))
+    motor = catalogue[-1]
+    needs = float(speed[0]) * float(optimum.required_torque[0]) / motor.peak_torque
+    slow = dataclasses.replace(motor, name="slow", max_speed=0.8 * needs)
+    fast = dataclasses.replace(motor, name="fast", max_speed=1.01 * needs)
+    first = snapping.joint_candidates(problem, optimum, [slow], candidates=1)[0]
+    assert not first.parts
+    assert any("no gear ratio both strong and fast enough" in why for why in first.misses)
+    kept = snapping.joint_candidates(problem, optimum, [slow, fast], candidates=2)[0]
+    assert {p.motor.name for p in kept.parts} == {"fast"}

@@ -249,6 +249,7 @@ def joint_candidates(
     bounds = problem.layout.bounds
     space_ratios = problem.space.per_joint("gear_ratio", problem.n_joints)
     joint_gearboxes = problem.technology.joint_gearboxes(problem.n_joints)
+    joint_speeds = None if problem.duty is None else problem.duty.joint_speed(float(design.approach_velocity))
     out = []
     for j, joint in enumerate(problem.joint_names):
         torque, inertia = float(design.motor_peak_torque[j]), float(design.rotor_inertia[j])
@@ -265,15 +266,35 @@ def joint_candidates(
         misses = {
             m.name: _misses(m, j, bounds, required, rms, largest, problem.duty is not None) for m in ranked
         }
-        fitting = [m for m in ranked if not misses[m.name]][:candidates]
-        parts = tuple(
-            part
-            for m in fitting
-            for gearbox, listed in options
-            for part in _parts_of(
-                m, space_ratios[j], gearbox, listed, float(design.peak_torque[j]), torque, inertia
-            )
-        )
+        speed = None if joint_speeds is None else float(joint_speeds[j])
+        kept: list[CataloguePart] = []
+        fitting = 0
+        for m in ranked:
+            if fitting == candidates:
+                break
+            if misses[m.name]:
+                continue
+            screened = [
+                _screened_parts(
+                    m,
+                    space_ratios[j],
+                    gearbox,
+                    listed,
+                    float(design.peak_torque[j]),
+                    torque,
+                    inertia,
+                    required,
+                    speed,
+                )
+                for gearbox, listed in options
+            ]
+            found = [part for fits, _ in screened for part in fits]
+            if found:
+                kept += found
+                fitting += 1
+            else:
+                misses[m.name] = tuple(dict.fromkeys(why for _, whys in screened for why in whys))
+        parts = tuple(kept)
         nearest = ranked[0].name
         out.append(
             JointCandidates(
@@ -406,7 +427,7 @@ def _misses(
     return tuple(found)
 
 
-def _parts_of(
+def _screened_parts(
     motor: Motor,
     ratio: Bounds,
     gearbox: CatalogueGearbox | None,
@@ -414,26 +435,62 @@ def _parts_of(
     output_torque: float,
     torque: float,
     inertia: float,
-) -> list[CataloguePart]:
-    """``motor``'s parts with ``gearbox``: the ratio bounds, or the offered ratios bracketing the matched one.
+    required: float,
+    joint_speed: float | None,
+) -> tuple[list[CataloguePart], tuple[str, ...]]:
+    """``motor``'s parts with ``gearbox`` that can meet the joint's own needs, and why none can if so.
 
-    The matched ratio gives ``motor`` the continuous optimum's peak output torque ``output_torque`` [N*m]
-    (:func:`matched_gear_ratio`). ``ratio``: the joint's gear-ratio bounds of the design space (the problem
-    intersects them with the gearbox's range); ``torque`` [N*m], ``inertia`` [kg*m^2]: the continuous motor's.
+    A part is the ratio bounds, or an offered ratio: of the offered ratios at which the motor's peak torque
+    covers the ``required`` torque [N*m] and its maximum speed (and the gearbox's input speed) the joint's
+    ``joint_speed`` [rad/s, None: no speed requirement], the two bracketing the matched ratio, which gives the
+    motor the continuous optimum's peak output torque ``output_torque`` [N*m] (:func:`matched_gear_ratio`).
+    A joint's need depends on the other joints' parts only through the masses they add, so a part that fails
+    here fails in every combination, and the search starts from parts that can each do their own joint's work.
+    ``ratio``: the joint's gear-ratio bounds of the design space; ``torque`` [N*m], ``inertia`` [kg*m^2]: the
+    continuous motor's.
     """
     matched = output_torque / motor.peak_torque
     distance = motor_distance(motor, torque, inertia)
+    low, high = _ratio_range(ratio, gearbox)
+    fastest = math.inf
+    if joint_speed is not None and joint_speed > 0:
+        limits = [s for s in (motor.max_speed, gearbox and gearbox.max_input_speed) if s is not None]
+        fastest = min(limits, default=math.inf) / joint_speed  # the largest ratio fast enough
+    slowest = required / motor.peak_torque  # the smallest ratio strong enough
     if gearbox is None or gearbox.continuous_ratio:
-        return [CataloguePart(motor, ratio, distance, gearbox, from_catalogue)]
-    low, high = ratio.lower * (1 - BOUND_TOLERANCE), ratio.upper * (1 + BOUND_TOLERANCE)
-    offered = [r for r in gearbox.ratios if low <= r <= high]
-    below = [r for r in offered if r <= matched]
-    above = [r for r in offered if r >= matched]
-    bracket = sorted({*below[-1:], *above[:1]})
-    return [
-        CataloguePart(motor, Bounds.fixed(float(r), ratio.name), distance, gearbox, from_catalogue)
-        for r in bracket
-    ]
+        if max(low, slowest) <= min(high, fastest) * (1 + BOUND_TOLERANCE):
+            return [CataloguePart(motor, ratio, distance, gearbox, from_catalogue)], ()
+        offered = [high]
+    else:
+        tolerance = (ratio.lower * (1 - BOUND_TOLERANCE), ratio.upper * (1 + BOUND_TOLERANCE))
+        offered = [r for r in gearbox.ratios if tolerance[0] <= r <= tolerance[1]]
+        fits = [
+            r
+            for r in offered
+            if r >= slowest * (1 - BOUND_TOLERANCE) and r <= fastest * (1 + BOUND_TOLERANCE)
+        ]
+        if fits:
+            below = [r for r in fits if r <= matched]
+            above = [r for r in fits if r >= matched]
+            bracket = sorted({*below[-1:], *above[:1]})
+            return [
+                CataloguePart(motor, Bounds.fixed(float(r), ratio.name), distance, gearbox, from_catalogue)
+                for r in bracket
+            ], ()
+    with_gearbox = "" if gearbox is None else f" with {gearbox.name}"
+    if slowest > fastest:
+        why = (
+            f"{motor.name}{with_gearbox}: no gear ratio both strong and fast enough: its peak torque needs "
+            f"N >= {slowest:.4g} for the required {required:.4g} N*m, its speed limit allows N <= "
+            f"{fastest:.4g} at the joint's {joint_speed:.4g} rad/s"
+        )
+    else:
+        why = (
+            f"{motor.name}{with_gearbox}: needs a gear ratio from {slowest:.4g} to {min(fastest, 1e9):.4g} "
+            f"(peak torque for the required {required:.4g} N*m, speed limit), offered "
+            + (", ".join(f"{r:g}" for r in offered) if offered else "none within the bounds")
+        )
+    return [], (why,)
 
 
 def _coverage_warning(joint: str, catalogue: list[Motor], diameter: float, torque: float) -> str | None:
@@ -519,7 +576,7 @@ def snap_to_catalogue(
         return _design(joints, None, None, optimum, (), "none: " + " / ".join(reasons), [*warnings, *reasons])
     if solve_many is None:
         solve_many = _InProcess(problem, optimum, arm, ipopt_options, active_set)
-    search = _Search(problem, [j.parts for j in joints], solve_many, progress)
+    search = _Search(problem, optimum.design, [j.parts for j in joints], solve_many, progress)
     total = math.prod(len(j.parts) for j in joints)
     if total <= max_combinations:
         search.total = total
@@ -606,7 +663,9 @@ def solved_or_status(
     try:
         return solve_parts(problem, optimum, parts, arm, ipopt_options, active_set, warm)
     except SolverFailed as error:
-        return error.status
+        # What the parts miss at the ratios that cover their own masses says why, where anything does.
+        shortfalls = evaluate_parts(problem, optimum.design, parts).shortfalls
+        return error.status + (f" ({'; '.join(shortfalls)})" if shortfalls else "")
     except InvalidParameter as error:  # refused before solving: no design of these parts can meet it
         return f"refused: {error}"
 
@@ -617,11 +676,13 @@ class _Search:
     def __init__(
         self,
         problem: DesignProblem,
+        design: Design,
         parts: list[tuple[CataloguePart, ...]],
         solve_many: PartsSolver,
         progress: Callable[[int, int], None] | None,
     ) -> None:
-        self.problem, self.parts, self.solve_many, self.progress = problem, parts, solve_many, progress
+        self.problem, self.design, self.parts = problem, design, parts
+        self.solve_many, self.progress = solve_many, progress
         self.values: dict[tuple[int, ...], float] = {}
         self.results: dict[tuple[int, ...], DesignResult] = {}
         self.tried: dict[tuple[int, ...], Trial] = {}
@@ -672,7 +733,7 @@ class _Search:
         """
         from .pareto import MERGE_TOLERANCE
 
-        current = (0,) * len(self.parts)
+        current = self.start()
         (value,) = self.values_of([current])
         passes, improved = 0, True
         while improved:
@@ -687,6 +748,35 @@ class _Search:
                 ):
                     current, value, improved = options[best], values[best], True
         return passes
+
+    def start(self) -> tuple[int, ...]:
+        """The nearest parts, each joint that misses its own requirement moved to its nearest part that meets it.
+
+        The requirement is of the chosen parts' masses (:func:`evaluate_parts`, no solve), which the continuous
+        optimum's lighter ones understate: from a start where two joints miss theirs, no step of the descent,
+        which changes one joint, reaches a feasible design.
+        """
+        current = [0] * len(self.parts)
+
+        def misses(combination: list[int], j: int) -> bool:
+            parts = [self.parts[k][i] for k, i in enumerate(combination)]
+            prefix = f"{self.problem.joint_names[j]}:"
+            shortfalls = evaluate_parts(self.problem, self.design, parts).shortfalls
+            return any(s.startswith(prefix) for s in shortfalls)
+
+        for _ in range(REQUIREMENT_PASSES):
+            moved = False
+            for j, joint_parts in enumerate(self.parts):
+                if not misses(current, j):
+                    continue
+                for c in range(len(joint_parts)):
+                    trial = [*current[:j], c, *current[j + 1 :]]
+                    if c != current[j] and not misses(trial, j):
+                        current, moved = trial, True
+                        break
+            if not moved:
+                break
+        return tuple(current)
 
     def least(self) -> tuple[int, ...] | None:
         """The feasible combination of least value (the first tried among equals), or None."""

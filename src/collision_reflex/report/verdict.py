@@ -110,9 +110,7 @@ def joint_limits(
         margin = joint.get(key)
         if margin is not None and margin < ACTIVE_TOLERANCE:
             by = joint.get("required_by") if key == "torque_margin" else None
-            phrases.append(
-                f"sized by {constraint}" + (f" ({by})" if by in ("static hold", "duty cycle") else "")
-            )
+            phrases.append(f"sized by {constraint}" + (f" ({by})" if by else ""))
     margin = joint.get("torque_margin")
     chosen_ratio = "gear_ratio" not in undecided
     if margin is not None and margin > OVERSIZED_MARGIN and motor_at_smallest_size(joint, bounds):
@@ -520,8 +518,17 @@ def lightest_near_best(pareto: Mapping[str, Any], within: float = NEAR_BEST) -> 
     )
 
 
-def requirement_sentence(requirement: str) -> str:
-    """What the torque requirement is, and what it leaves out."""
+def requirement_sentence(requirement: str, rating: Mapping[str, Any] | None = None) -> str:
+    """What the torque requirement is, and what it leaves out; ``rating``: the resolved study's, if any."""
+    if rating and requirement.startswith(("duty", "rated")):
+        cycle = "the duty cycle (peak, RMS, speed), " if requirement.startswith("duty") else ""
+        return (
+            f"Torque requirement: {cycle}the rated motion (each joint alone, either way, at its rated speed "
+            "while accelerating at its rated acceleration, and braking from its rated speed within its stopping "
+            "time) and the static hold, all with the rated payload at every sampled configuration; each joint's "
+            "peak requirement is the largest of these (the table says which), its speed the largest rated or "
+            "cycle speed."
+        )
     if requirement.startswith("static"):
         return (
             f"Torque requirement: {requirement}. The peak torque covers gravity (and the payload) over the "
@@ -567,7 +574,7 @@ def verdict(results: Mapping[str, Any]) -> list[str]:
     exchanged = "worst_case_impulse" in study_objectives(resolved) or not resolved
     lines += worst_case_sentences(recommended, results.get("domain"), results["pareto"], exchanged)
     lines += statistics_sentences(recommended, results.get("resolved") or {}, results.get("pareto"))
-    lines.append(requirement_sentence(requirement))
+    lines.append(requirement_sentence(requirement, resolved.get("rating")))
     if results.get("speed_limits"):
         lines.append(str(results["speed_limits"]))
     lines += [str(line) for line in results.get("transmissions", ())]
