@@ -454,7 +454,8 @@ def _screened_parts(
     low, high = _ratio_range(ratio, gearbox)
     fastest = math.inf
     if joint_speed is not None and joint_speed > 0:
-        limits = [s for s in (motor.max_speed, gearbox and gearbox.max_input_speed) if s is not None]
+        gearbox_speed = None if gearbox is None else gearbox.max_input_speed
+        limits = [s for s in (motor.max_speed, gearbox_speed) if s is not None]
         fastest = min(limits, default=math.inf) / joint_speed  # the largest ratio fast enough
     slowest = required / motor.peak_torque  # the smallest ratio strong enough
     if gearbox is None or gearbox.continuous_ratio:
