@@ -134,6 +134,10 @@ def test_a_flat_impulse_front_says_which_phase_carries_the_impulse():
     assert "88.9 % of all samples' together" in line and "rotors sit behind the joint springs" in line
     trade_off = pareto([record(0.40, 2.0), recommended, record(0.60, 0.2)])
     assert flat_impulse_reason(trade_off, recommended, {}) == []
+    # A front of one design gets the same numbers and says the lightest is the gentlest.
+    (line,) = flat_impulse_reason(pareto([recommended]), recommended, {"reflected_inertia_in": "robot"})
+    assert line.startswith("Why the front is one design:") and "90.9 %" in line
+    assert line.endswith("the lightest actuators that meet the requirements are also the gentlest.")
 
 
 def test_degenerate_fronts_are_said_in_plain_words():

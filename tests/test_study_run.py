@@ -696,8 +696,8 @@ def test_torque_speed_figure_exactly_for_duty_cycle_studies(runs, name):
             largest = factor * max(abs(t) for t in entry["torque"]) * output
             if joint["required_by"] in ("duty cycle", "rated motion", "braking"):
                 assert largest == pytest.approx(joint["required_torque"], rel=1e-6), joint["joint"]
-            else:
-                assert joint["required_by"] == "static hold"
+            else:  # the static hold, or another joint of its module, asks more than its own motion
+                assert joint["required_by"] == "static hold" or " of " in joint["required_by"]
                 assert largest <= joint["required_torque"] * (1 + 1e-6), joint["joint"]
         assert (folder / "figures" / "torque_speed.png").is_file()
         assert 'id="torque-speed"' in html

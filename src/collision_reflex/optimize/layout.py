@@ -20,7 +20,7 @@ from ..hardware.gearboxes import CatalogueGearbox, ScaledGearbox
 from ..model import effective as formulas
 from ..model.impulse import series_stiffness
 from .constraints import Constraints
-from .space import GLOBAL_VARIABLES, PER_JOINT_VARIABLES, Bounds, DesignSpace
+from .space import GLOBAL_VARIABLES, MODULE_VARIABLES, PER_JOINT_VARIABLES, Bounds, DesignSpace
 from .technology import ActuatorTechnology
 
 
@@ -32,13 +32,22 @@ class DesignLayout:
     slices: dict[str, list[int | None]] = field(default_factory=dict)
     size: int = 0
 
-    def add(self, name: str, bounds: list[Bounds]) -> None:
-        """Append variable ``name`` with one bounds per entry; fixed entries take no place in ``x``."""
+    def add(self, name: str, bounds: list[Bounds], owner: list[int] | None = None) -> None:
+        """Append variable ``name`` with one bounds per entry; fixed entries take no place in ``x``.
+
+        ``owner``: per entry the entry whose variable it shares (its own index: none shared); sharing entries
+        take the intersection of their bounds (:meth:`DesignSpace.module_of`).
+        """
+        owner = list(range(len(bounds))) if owner is None else owner
+        shared = {k: [b for b, o in zip(bounds, owner, strict=True) if o == k] for k in set(owner)}
+        bounds = [_intersection(shared[o]) for o in owner]
         self.bounds[name] = bounds
         indices: list[int | None] = []
-        for b in bounds:
+        for k, b in enumerate(bounds):
             if b.is_fixed:
                 indices.append(None)
+            elif owner[k] != k:
+                indices.append(indices[owner[k]])
             else:
                 indices.append(self.size)
                 self.size += 1
@@ -91,22 +100,47 @@ def design_layout(
     """
     layout = DesignLayout()
     defaults = {"stack_length": technology.default_stack_lengths(n_joints)}
+    names = joint_names or tuple(f"joint{j + 1}" for j in range(n_joints))
+    owner = space.module_of(n_joints)
     for name in PER_JOINT_VARIABLES:
         joint_bounds = space.per_joint(name, n_joints, defaults.get(name))
         if name == "gear_ratio":
-            names = joint_names or tuple(f"joint{j + 1}" for j in range(n_joints))
             gearboxes = technology.joint_gearboxes(n_joints)
             joint_bounds = [
                 _within_ratio_range(b, g, joint)
                 for b, g, joint in zip(joint_bounds, gearboxes, names, strict=True)
             ]
-        layout.add(name, joint_bounds)
+        if name in MODULE_VARIABLES:
+            _check_module_bounds(name, joint_bounds, owner, names)
+            layout.add(name, joint_bounds, owner)
+        else:
+            layout.add(name, joint_bounds)
     for name in GLOBAL_VARIABLES:
         bounds = space.global_bounds(name)
         if name == "threshold" and technology.sensing == "force":
             bounds = _with_noise_floor(bounds, constraints.threshold_floor)
         layout.add(name, [bounds])
     return layout
+
+
+def _intersection(bounds: list[Bounds]) -> Bounds:
+    """The bounds all of ``bounds`` allow (checked non-empty by :func:`_check_module_bounds`)."""
+    return Bounds(max(b.lower for b in bounds), min(b.upper for b in bounds), bounds[0].name)
+
+
+def _check_module_bounds(name: str, bounds: list[Bounds], owner: list[int], joints: tuple[str, ...]) -> None:
+    """Raise unless the joints of each module have bounds of ``name`` in common."""
+    for k in sorted(set(owner)):
+        members = [j for j, o in enumerate(owner) if o == k]
+        if len(members) > 1:
+            low, high = max(bounds[j].lower for j in members), min(bounds[j].upper for j in members)
+            if low > high:
+                raise InvalidParameter(
+                    f"{name} bounds of the module {', '.join(joints[j] for j in members)}",
+                    [(bounds[j].lower, bounds[j].upper) for j in members],
+                    "bounds that overlap: the module's joints share one actuator",
+                    "widen the joints' bounds or take the joint out of the module",
+                )
 
 
 def _within_ratio_range(

@@ -409,10 +409,11 @@ def build_problem(
     torque_demands = binding_torque_demands(samples, constraints, joint_names, *mass_range)
     check_gearbox_ratings(torque_demands, technology, joint_names, *mass_range)
     static_torque = required_torque_function(torque_demands, n_joints)
-    required_torque = (
+    required_torque = _module_required_torque(
         static_torque
         if duty is None
-        else _envelope_required_torque(static_torque, _duty_required_torque(duty_rows, n_joints), n_joints)
+        else _envelope_required_torque(static_torque, _duty_required_torque(duty_rows, n_joints), n_joints),
+        space.module_of(n_joints),
     )
     data = sample_data(samples, technology.joint_mechanical_stiffness(n_joints))
     # Start point: auxiliaries at their exact values for the start design, impulses by the NumPy path.
@@ -743,12 +744,7 @@ def _feasible_gear_start(
     torques = efficiency * peak
     rows, _ = torque_requirement_rows(samples, constraints, joint_names)
     required = np.max([base + per_motor @ masses for base, per_motor in rows], axis=0)
-    for joint, index in enumerate(layout.slices["gear_ratio"]):
-        if index is not None and required[joint] > torques[joint]:
-            x0[index] = min(
-                x0[index] + math.log(1.1 * required[joint] / torques[joint]),
-                math.log(layout.bounds["gear_ratio"][joint].upper),
-            )
+    _raise_gear_ratios(x0, layout, required, torques)
 
 
 def _evaluate_function(
@@ -800,14 +796,27 @@ def _duty_setup(
     x_high = np.column_stack([np.ones(n), np.tile(mass_high, (n, 1)), reflected_high])
     rows = peak_rows(duty, x_low, x_high)
     masses, reflected, torques = (np.asarray(v).ravel() for v in numbers(x0))
-    for j, index in enumerate(layout.slices["gear_ratio"]):
-        required = float(np.max(rows[j][0] @ np.concatenate([[1.0], masses, [reflected[j]]])))
-        if index is not None and required > torques[j]:
-            x0[index] = min(
-                x0[index] + math.log(1.1 * required / torques[j]),
-                math.log(layout.bounds["gear_ratio"][j].upper),
-            )
+    required = np.array(
+        [np.max(rows[j][0] @ np.concatenate([[1.0], masses, [reflected[j]]])) for j in range(n)]
+    )
+    _raise_gear_ratios(x0, layout, required, torques)
     return rows
+
+
+def _raise_gear_ratios(
+    x0: np.ndarray, layout: DesignLayout, required: np.ndarray, torques: np.ndarray
+) -> None:
+    """Raise the start's gear ratios (log values in ``x0``) to 1.1 x what the ``required`` torques [N m] need.
+
+    ``torques``: the start's driving peak torques [N m]; a ratio shared by a module is raised for the most
+    demanding of its joints. Within the ratios' upper bounds.
+    """
+    start = x0.copy()
+    for joint, index in enumerate(layout.slices["gear_ratio"]):
+        if index is not None and required[joint] > torques[joint]:
+            raised = start[index] + math.log(1.1 * required[joint] / torques[joint])
+            upper = math.log(layout.bounds["gear_ratio"][joint].upper)
+            x0[index] = max(x0[index], min(raised, upper))
 
 
 def _duty_required_torque(
@@ -832,6 +841,21 @@ def _envelope_required_torque(static: ca.Function, duty: ca.Function, n_joints: 
     reflected = ca.MX.sym("reflected_inertia", n_joints)
     envelope = ca.fmax(static(masses), duty(masses, reflected))
     return ca.Function("required_torque", [masses, reflected], [envelope])
+
+
+def _module_required_torque(required: ca.Function, owner: list[int]) -> ca.Function:
+    """``required`` with each module's joints given the largest requirement of the module.
+
+    ``owner``: per joint its module's first joint (:meth:`DesignSpace.module_of`); one actuator must do the
+    work of any of its joints.
+    """
+    if owner == list(range(len(owner))):
+        return required
+    inputs = [ca.MX.sym(required.name_in(i), required.size1_in(i)) for i in range(required.n_in())]
+    own = required(*inputs)
+    modules = {k: [j for j, o in enumerate(owner) if o == k] for k in set(owner)}
+    envelope = ca.vertcat(*(ca.mmax(own[modules[owner[j]]]) for j in range(len(owner))))
+    return ca.Function("required_torque", inputs, [envelope])
 
 
 def _start_reflected_inertia(

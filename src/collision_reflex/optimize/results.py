@@ -398,8 +398,11 @@ def design_record(
     }
     record["statistics"]["quantile_impulse"]["quantile"] = QUANTILE
     sizing = required_by(problem, design, np.asarray(result.required_torque, dtype=float))
+    owner = problem.space.module_of(len(record["joints"]))
     for i, joint in enumerate(record["joints"]):
         joint["required_by"] = sizing[i]
+        if owner.count(owner[i]) > 1:
+            joint["module"] = [problem.joint_names[k] for k, o in enumerate(owner) if o == owner[i]]
         joint["nearest_catalogue_motor"] = (
             nearest_catalogue_motor(
                 catalogue, float(design.motor_peak_torque[i]), float(design.rotor_inertia[i])
@@ -414,7 +417,8 @@ def required_by(problem: DesignProblem, design: Design, required: np.ndarray) ->
     """Per joint what sets its required peak torque ``required`` [N m], None where nothing is required.
 
     One of ``static hold`` (or ``given torque``), ``duty cycle``, ``rated motion``, ``braking``: the requirement
-    whose own peak (safety factor included) is the largest at ``design``.
+    whose own peak (safety factor included) is the largest at ``design``; for a joint of a module whose
+    requirement comes from another of its joints, ``"braking of <joint>"``.
     """
     static = np.asarray(problem.static_torque_function(design.actuator_mass), dtype=float).ravel()
     given = problem.constraints.torque_required is not None
@@ -426,7 +430,17 @@ def required_by(problem: DesignProblem, design: Design, required: np.ndarray) ->
         for source in dict.fromkeys(duty.torques.sources):
             peaks[source] = duty.safety_factor * demand[sources == source].max(axis=0)
     names, values = list(peaks), np.array(list(peaks.values()))
-    return [names[int(np.argmax(values[:, j]))] if required[j] > 0 else None for j in range(required.size)]
+    own = values.max(axis=0)
+    owner = problem.space.module_of(required.size)
+    out: list[str | None] = []
+    for j in range(required.size):
+        # A module meets the largest requirement of its joints: name the joint it comes from.
+        k = max((m for m in range(required.size) if owner[m] == owner[j]), key=lambda m: own[m])
+        source = names[int(np.argmax(values[:, k]))]
+        out.append(
+            None if required[j] <= 0 else source if k == j else f"{source} of {problem.joint_names[k]}"
+        )
+    return out
 
 
 UNDECIDED_TOLERANCE = 1e-9

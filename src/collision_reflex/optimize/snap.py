@@ -47,7 +47,7 @@ from __future__ import annotations
 import functools
 import itertools
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
@@ -65,7 +65,7 @@ from .active_set import (
 )
 from .objectives import IMPULSE_OBJECTIVES, objective_expression, objective_values
 from .solve import Design, DesignResult, IpoptOptions, solve, warm_start
-from .space import Bounds
+from .space import Bounds, module_envelope
 
 if TYPE_CHECKING:
     from ..arm.robot import Arm
@@ -227,6 +227,7 @@ def joint_candidates(
     candidates: int = DEFAULT_CANDIDATES,
     gearboxes: Mapping[str, CatalogueGearbox] | None = None,
     gearbox_candidates: int = DEFAULT_GEARBOX_CANDIDATES,
+    screen: bool = True,
 ) -> tuple[JointCandidates, ...]:
     """Each joint's candidate parts near the continuous ``optimum`` of ``problem`` (module docstring).
 
@@ -240,6 +241,9 @@ def joint_candidates(
         figures) gets its ``gearbox_candidates`` nearest entries of the same kind (:func:`gearbox_options`).
         None: every joint keeps its gearbox.
     gearbox_candidates: catalogue gearboxes kept per such joint (>= 1).
+    screen: keep only parts with a sold ratio at which the motor is both strong and fast enough for the joint
+        (:func:`_screened_parts`); False: the nearest within bounds whatever they miss, for a quick snap that
+        reports what they miss.
     """
     catalogue = _motor_list(motors)
     for name, value in (("candidates", candidates), ("gearbox_candidates", gearbox_candidates)):
@@ -249,9 +253,17 @@ def joint_candidates(
     bounds = problem.layout.bounds
     space_ratios = problem.space.per_joint("gear_ratio", problem.n_joints)
     joint_gearboxes = problem.technology.joint_gearboxes(problem.n_joints)
-    joint_speeds = None if problem.duty is None else problem.duty.joint_speed(float(design.approach_velocity))
-    out = []
+    owner = problem.space.module_of(problem.n_joints)
+    joint_speeds = (  # a module's motor must turn as fast as its fastest joint
+        None
+        if problem.duty is None
+        else module_envelope(problem.duty.joint_speed(float(design.approach_velocity)), owner)
+    )
+    out: list[JointCandidates] = []
     for j, joint in enumerate(problem.joint_names):
+        if owner[j] != j:  # a module's joints share its first joint's part
+            out.append(replace(out[owner[j]], joint=joint))
+            continue
         torque, inertia = float(design.motor_peak_torque[j]), float(design.rotor_inertia[j])
         required = float(optimum.required_torque[j])
         gearbox = joint_gearboxes[j]
@@ -266,7 +278,7 @@ def joint_candidates(
         misses = {
             m.name: _misses(m, j, bounds, required, rms, largest, problem.duty is not None) for m in ranked
         }
-        speed = None if joint_speeds is None else float(joint_speeds[j])
+        speed = None if joint_speeds is None or not screen else float(joint_speeds[j])
         kept: list[CataloguePart] = []
         fitting = 0
         for m in ranked:
@@ -283,7 +295,7 @@ def joint_candidates(
                     float(design.peak_torque[j]),
                     torque,
                     inertia,
-                    required,
+                    required if screen else 0.0,
                     speed,
                 )
                 for gearbox, listed in options
@@ -577,11 +589,12 @@ def snap_to_catalogue(
         return _design(joints, None, None, optimum, (), "none: " + " / ".join(reasons), [*warnings, *reasons])
     if solve_many is None:
         solve_many = _InProcess(problem, optimum, arm, ipopt_options, active_set)
-    search = _Search(problem, optimum.design, [j.parts for j in joints], solve_many, progress)
-    total = math.prod(len(j.parts) for j in joints)
+    owner = problem.space.module_of(problem.n_joints)
+    search = _Search(problem, optimum.design, [j.parts for j in joints], solve_many, progress, owner)
+    total = math.prod(len(j.parts) for k, j in enumerate(joints) if owner[k] == k)
     if total <= max_combinations:
         search.total = total
-        search.values_of(list(itertools.product(*(range(len(j.parts)) for j in joints))))
+        search.values_of(search.tied(itertools.product(*(range(len(j.parts)) for j in joints))))
         method = f"exact: enumerated {total} combinations"
     else:
         passes = search.descend()
@@ -681,13 +694,20 @@ class _Search:
         parts: list[tuple[CataloguePart, ...]],
         solve_many: PartsSolver,
         progress: Callable[[int, int], None] | None,
+        owner: Sequence[int] | None = None,
     ) -> None:
         self.problem, self.design, self.parts = problem, design, parts
         self.solve_many, self.progress = solve_many, progress
+        # Per joint the joint whose part it takes (a module's first joint): combinations keep modules whole.
+        self.owner = list(range(len(parts))) if owner is None else list(owner)
         self.values: dict[tuple[int, ...], float] = {}
         self.results: dict[tuple[int, ...], DesignResult] = {}
         self.tried: dict[tuple[int, ...], Trial] = {}
         self.total = 0
+
+    def tied(self, combinations: Iterable[Sequence[int]]) -> list[tuple[int, ...]]:
+        """The distinct ``combinations`` with every module's joints at its first joint's part."""
+        return list(dict.fromkeys(tuple(c[o] for o in self.owner) for c in combinations))
 
     def values_of(self, combinations: list[tuple[int, ...]]) -> list[float]:
         """The problem's objective of each combination re-optimised (inf: no feasible design); new ones solved."""
@@ -740,7 +760,9 @@ class _Search:
         while improved:
             improved, passes = False, passes + 1
             for j, joint_parts in enumerate(self.parts):
-                options = [(*current[:j], c, *current[j + 1 :]) for c in range(len(joint_parts))]
+                if self.owner[j] != j:  # moved with its module's first joint
+                    continue
+                options = self.tied((*current[:j], c, *current[j + 1 :]) for c in range(len(joint_parts)))
                 values = self.values_of(options)
                 best = min(range(len(options)), key=lambda i: values[i])
                 # From an infeasible design (inf) any feasible one is a move.
@@ -761,17 +783,19 @@ class _Search:
 
         def misses(combination: list[int], j: int) -> bool:
             parts = [self.parts[k][i] for k, i in enumerate(combination)]
-            prefix = f"{self.problem.joint_names[j]}:"
+            prefixes = tuple(
+                f"{name}:" for name, o in zip(self.problem.joint_names, self.owner, strict=True) if o == j
+            )
             shortfalls = evaluate_parts(self.problem, self.design, parts).shortfalls
-            return any(s.startswith(prefix) for s in shortfalls)
+            return any(s.startswith(prefixes) for s in shortfalls)
 
         for _ in range(REQUIREMENT_PASSES):
             moved = False
             for j, joint_parts in enumerate(self.parts):
-                if not misses(current, j):
+                if self.owner[j] != j or not misses(current, j):
                     continue
                 for c in range(len(joint_parts)):
-                    trial = [*current[:j], c, *current[j + 1 :]]
+                    trial = list(self.tied([[*current[:j], c, *current[j + 1 :]]])[0])
                     if c != current[j] and not misses(trial, j):
                         current, moved = trial, True
                         break

@@ -12,6 +12,8 @@ import numpy as np
 from ..errors import InvalidParameter
 
 PER_JOINT_VARIABLES = ("stator_diameter", "stack_length", "gear_ratio", "software_stiffness")
+MODULE_VARIABLES = ("stator_diameter", "stack_length", "gear_ratio")
+"""The per-joint variables that make an actuator: joints of one module share them (:class:`DesignSpace`)."""
 GLOBAL_VARIABLES = ("threshold", "approach_velocity")
 OPTIMIZED_SENSING_SCHEMES: tuple[str, ...] = ("force", "position")
 """The schemes of :data:`collision_reflex.model.sensing.SENSING_SCHEMES` the optimiser handles: a
@@ -111,6 +113,11 @@ class DesignSpace:
     contact-force threshold [N] for force sensing, the contact position-error threshold [m] for position
     sensing) and ``approach_velocity`` [m/s]. Any variable is fixed by giving a number. Bounds must lie within
     :data:`SUPPORTED_RANGES` (checked here, naming the variable).
+
+    ``modules``: groups of joint indices built from one actuator module, as arms are (one motor, gearbox and
+    gear ratio for several joints, bought and spared as one part): the joints of a group share one variable of
+    each of :data:`MODULE_VARIABLES`, within the intersection of their bounds, and the module must meet the
+    largest requirement of its joints; each joint keeps its own software stiffness.
     """
 
     stator_diameter: BoundsLike | Sequence[BoundsLike]
@@ -119,8 +126,22 @@ class DesignSpace:
     threshold: BoundsLike
     approach_velocity: BoundsLike
     stack_length: BoundsLike | Sequence[BoundsLike] | None = None
+    modules: tuple[tuple[int, ...], ...] = ()
 
     def __post_init__(self) -> None:
+        seen: set[int] = set()
+        for group in self.modules:
+            members = list(group)
+            if len(members) < 2 or not all(_is_number(j) and int(j) == j and j >= 0 for j in members):
+                raise InvalidParameter("modules", self.modules, "groups of two or more joint indices >= 0")
+            if seen & set(members) or len(set(members)) != len(members):
+                raise InvalidParameter(
+                    "modules",
+                    self.modules,
+                    "groups in which every joint appears once",
+                    "a joint has one actuator",
+                )
+            seen |= set(members)
         for name in (*PER_JOINT_VARIABLES, *GLOBAL_VARIABLES):
             value = getattr(self, name)
             if value is None and name == "stack_length":
@@ -151,9 +172,31 @@ class DesignSpace:
             bounds = [as_bounds(value, f"{name}[{i}]") for i in range(n_joints)]
         return bounds
 
+    def module_of(self, n_joints: int) -> list[int]:
+        """Per joint the index of the joint whose actuator variables it uses: its module's first, else its own.
+
+        Raises
+        ------
+        InvalidParameter: a module names a joint index beyond ``n_joints``.
+        """
+        owner = list(range(n_joints))
+        for group in self.modules:
+            if max(group) >= n_joints:
+                raise InvalidParameter("modules", self.modules, f"joint indices below {n_joints}")
+            for j in group:
+                owner[j] = min(group)
+        return owner
+
     def global_bounds(self, name: str) -> Bounds:
         """The bounds of global variable ``name`` (``threshold`` or ``approach_velocity``)."""
         return as_bounds(getattr(self, name), name)
+
+
+def module_envelope(values: np.ndarray, owner: Sequence[int]) -> np.ndarray:
+    """Per joint the largest of ``values`` over its module (``owner``: :meth:`DesignSpace.module_of`)."""
+    values = np.asarray(values, dtype=float)
+    owners = np.asarray(owner)
+    return np.array([values[owners == owners[j]].max() for j in range(values.size)])
 
 
 def _within_supported(bounds: Bounds, variable: str) -> None:

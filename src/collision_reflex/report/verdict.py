@@ -466,10 +466,11 @@ def flat_impulse_reason(
 
     points, names = pareto.get("points") or [], pareto.get("objectives") or []
     phases = record.get("phases")
-    if len(points) < 2 or not phases:
+    if not points or not phases:
         return []
+    one = len(points) == 1  # the front collapsed: no design trades the objectives
     spans = objective_spans(points, names)
-    flat = [n for n in names if n in IMPULSE_OBJECTIVES and spans[n] < FLAT_SPAN]
+    flat = [n for n in names if n in IMPULSE_OBJECTIVES and (one or spans[n] < FLAT_SPAN)]
     if not flat:
         return []
     initial, sensing, reaction = (
@@ -486,12 +487,19 @@ def flat_impulse_reason(
         if placement == "robot"
         else "the links' inertia with the actuator masses and the rotors (reflected_inertia_in: finger)"
     )
+    why = "is one design" if one else f"is flat in {_words(flat[0])}"
     return [
-        f"Why the front is flat in {_words(flat[0])}: at the recommended design the impact phase m_f v0, set by "
+        f"Why the front {why}: at the recommended design the impact phase m_f v0, set by "
         f"{where}, carries {_g(share_worst, 3)} % of the worst sample's impulse ({_g(initial[worst], 4)} of "
         f"{_g(total[worst], 4)} N·s) and {_g(share_all, 3)} % of all samples' together. The sensing and reaction "
         "phases, which the motors, gears and controller set, carry the rest, and the actuator masses on the links "
-        "move the impact little: actuator mass buys almost nothing here."
+        "move the impact little: actuator mass buys almost nothing here"
+        + (
+            ", and what it adds to the links' mass only raises it: the lightest actuators that meet the "
+            "requirements are also the gentlest."
+            if one
+            else "."
+        )
     ]
 
 
@@ -592,6 +600,17 @@ def verdict(results: Mapping[str, Any]) -> list[str]:
         limits = design_limits(recommended, bounds)
         if limits:
             lines.append("Sensing and approach: " + ", ".join(limits) + ".")
+        if limits or any(
+            " bound" in phrase or " size" in phrase
+            for joint in recommended["joints"]
+            for phrase in joint_limits(joint, bounds, requirement)
+        ):
+            lines.append(
+                "A variable at a bound of the study's design section, with no requirement named beside it, is "
+                "held there by that bound alone: the objectives would take it beyond. The bound, not the "
+                "physics, decides it; widen it to see where the design would settle."
+            )
+    lines += module_sentences(recommended)
     lines += front_sentences(results["pareto"])
     lines += flat_impulse_reason(results["pareto"], recommended, results.get("resolved") or {})
     near = lightest_near_best(results["pareto"])
@@ -602,6 +621,23 @@ def verdict(results: Mapping[str, Any]) -> list[str]:
     if results.get("catalogue"):
         lines += catalogue_sentences(results["catalogue"])
     return lines
+
+
+def module_sentences(record: Mapping[str, Any]) -> list[str]:
+    """One sentence per actuator module of a design record: its joints and what sizes it."""
+    out = []
+    for joint in record["joints"]:
+        members = joint.get("module")
+        if not members or joint["joint"] != members[0]:
+            continue
+        by = joint.get("required_by") or "nothing"
+        origin = next((m for m in members if by.endswith(f" of {m}")), joint["joint"])
+        out.append(
+            f"Module {', '.join(members)}: one actuator (motor, gearbox, gear ratio) for all of them, sized for "
+            f"the most demanding, {origin} ({by.removesuffix(f' of {origin}')}); each table row gives that "
+            "requirement."
+        )
+    return out
 
 
 def catalogue_sentences(catalogue: Mapping[str, Any]) -> list[str]:

@@ -631,7 +631,9 @@ def quick_snap_record(
     """
     from ..optimize.snap import evaluate_parts, joint_candidates, quick_parts
 
-    joints = joint_candidates(problem, result, catalogue.motors, 1, catalogue.gearboxes or None, 1)
+    joints = joint_candidates(
+        problem, result, catalogue.motors, 1, catalogue.gearboxes or None, 1, screen=False
+    )
     missing = [
         {"joint": j.joint, "nearest": j.nearest, "misses": list(j.misses)} for j in joints if not j.parts
     ]

@@ -74,6 +74,52 @@ class ArmSetup:
         return self.duty_cycle is None
 
 
+def _modules(
+    loaded: LoadedStudy, study: ArmStudy, joints: list[str], actuators: list[Any]
+) -> tuple[tuple[int, ...], ...]:
+    """The study's actuator modules as joint indices; every problem located at ``actuators.modules``.
+
+    A module is one part: its joints must name joints of the arm, each once, and share the motor and gearbox
+    the study gives them (one reference motor, one gearbox).
+    """
+    problems = []
+    seen: set[str] = set()
+    out = []
+    for k, group in enumerate(study.actuators.modules):
+        path = ("actuators", "modules", k)
+        unknown = [name for name in group if name not in joints]
+        twice = [name for name in group if name in seen or group.count(name) > 1]
+        seen |= set(group)
+        if unknown:
+            problems.append(
+                loaded.problem(path, f"joint {unknown[0]!r}, not a joint of the arm", ", ".join(joints))
+            )
+        elif len(group) < 2 or twice:
+            problems.append(
+                loaded.problem(
+                    path,
+                    f"{group}" + (f": {twice[0]} in two modules or twice" if twice else ""),
+                    "two or more joints, each in one module only",
+                )
+            )
+        else:
+            members = [joints.index(name) for name in group]
+            parts = {(str(actuators[j].motor), str(actuators[j].gearbox)) for j in members}
+            if len(parts) > 1:
+                problems.append(
+                    loaded.problem(
+                        path,
+                        f"joints {', '.join(group)} with different motors or gearboxes",
+                        "one motor and one gearbox for every joint of a module (actuators.joints overrides "
+                        "them per joint)",
+                    )
+                )
+            out.append(tuple(members))
+    if problems:
+        raise StudyFileError(loaded.source.file, problems)
+    return tuple(out)
+
+
 def arm_setup(loaded: LoadedStudy) -> ArmSetup:
     """Load the robot and motors and translate the study into the optimiser's inputs; every problem located."""
     from ..optimize import ActuatorTechnology, Bounds, Constraints, ContactSamples, DesignSpace
@@ -111,6 +157,7 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
         approach_velocity=Bounds(*velocity_spec.bounds, "approach_velocity")
         if velocity_spec
         else study.approach_velocity,
+        modules=_modules(loaded, study, joints, actuators),
     )
     gearboxes = _joint_gearboxes(loaded, study, joints, space.per_joint("gear_ratio", len(joints)))
     technology = ActuatorTechnology(

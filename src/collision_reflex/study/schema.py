@@ -249,6 +249,11 @@ class ActuatorsSpec(_Model):
     mechanical_stiffness: JointStiffness = Field(gt=0, description="joint mechanical stiffness [N m/rad]")
     software_stiffness: JointStiffness = Field(gt=0, description="joint controller stiffness [N m/rad]")
     joints: dict[str, JointActuatorSpec] = Field(default_factory=dict)
+    modules: list[list[str]] = Field(
+        default_factory=list,
+        description="groups of joints built from one actuator module (one motor, gearbox and gear ratio, sized "
+        "for the most demanding of them), e.g. [[wrist_1_joint, wrist_2_joint, wrist_3_joint]]",
+    )
 
     _known_gearbox = field_validator("gearbox")(_catalogue_gearbox)
 
