@@ -76,7 +76,7 @@ def _numpy_parameters(problem, x):
         mechanical_stiffness=design.mechanical_stiffness,
         torque_limit=design.peak_torque,
         motor_mass=design.motor_mass,
-        finger_joint_inertia=finger_inertia(design.reflected_inertia, placement),
+        finger_joint_inertia=finger_inertia(design.reflected_inertia, float(placement == "finger")),
     )
     threshold = threshold_force(problem.technology.sensing, design.threshold, params.k)
     return {"m_f": params.m_f, "m_r": params.m_r, "k": params.k, "k_m": params.k_m, "a": params.a}, threshold

@@ -91,8 +91,9 @@ def test_reflected_inertia_reproduces_the_paper_m1_motor():
 
 def test_finger_inertia_placement():
     inertia = np.array([0.1, 0.2])
-    np.testing.assert_array_equal(effective.finger_inertia(inertia, "finger"), inertia)
-    np.testing.assert_array_equal(effective.finger_inertia(inertia, "robot"), 0.0)
+    np.testing.assert_array_equal(effective.finger_inertia(inertia, 1.0), inertia)
+    np.testing.assert_array_equal(effective.finger_inertia(inertia, 0.0), 0.0)
+    np.testing.assert_array_equal(effective.finger_inertia(inertia, np.array([True, False])), [0.1, 0.0])
 
 
 def test_casadi_backend_gives_the_numpy_values(system):

@@ -327,7 +327,7 @@ class Actuator:
         _validate.non_negative("m_r", m_r)
         _validate.choice("reflected_inertia_in", reflected_inertia_in, REFLECTED_INERTIA_PLACEMENTS)
         reflected_mass = self.reflected_inertia / lever**2
-        finger = m_f + effective.finger_inertia(reflected_mass, reflected_inertia_in)
+        finger = m_f + effective.finger_inertia(reflected_mass, float(reflected_inertia_in == "finger"))
         if finger <= 0:
             raise InvalidParameter(
                 "m_f",

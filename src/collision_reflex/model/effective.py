@@ -48,13 +48,14 @@ def reflected_inertia(gear_ratio: Any, rotor_inertia: Any) -> Any:
     return gear_ratio**2 * rotor_inertia
 
 
-def finger_inertia(joint_reflected_inertia: Any, reflected_inertia_in: str) -> Any:
+def finger_inertia(joint_reflected_inertia: Any, in_finger: Any) -> Any:
     """The part of the reflected inertia [kg m^2] that acts rigidly on the link side during the impact.
 
-    All of it for ``reflected_inertia_in == "finger"`` (a stiff transmission with the compliance at the
-    contact), none (zeros) for ``"robot"`` (the paper's arm model, reflected inertia behind the joint springs).
+    ``in_finger``: per joint (or for all) 1 where the rotor takes part in the impact (a stiff transmission with
+    the compliance at the contact: ``reflected_inertia_in: finger``), 0 where it sits behind the joint spring
+    (the paper's arm model: ``robot``).
     """
-    return joint_reflected_inertia if reflected_inertia_in == "finger" else 0 * joint_reflected_inertia
+    return joint_reflected_inertia * in_finger
 
 
 def finger_mass_matrix(

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..model import effective as formulas
 from ..model.impulse import series_stiffness, total_impulse
 
 if TYPE_CHECKING:
@@ -38,6 +39,7 @@ def collision_parameters(
     """:func:`design_collision_parameters` at any ``samples`` of the arm, with the design's ``technology``."""
     from ..arm import effective_parameters
 
+    in_finger = technology.finger_joints(design.reflected_inertia.size)
     params = effective_parameters(
         samples.kinematics,
         samples.directions,
@@ -48,7 +50,7 @@ def collision_parameters(
         torque_limit=design.peak_torque,
         motor_mass=design.actuator_mass,
         finger_joint_inertia=(
-            design.reflected_inertia if technology.reflected_inertia_in == "finger" else None
+            formulas.finger_inertia(design.reflected_inertia, np.array(in_finger)) if any(in_finger) else None
         ),
     )
     threshold = design.threshold if design.sensing == "force" else params.k * design.threshold

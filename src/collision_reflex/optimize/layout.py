@@ -226,7 +226,8 @@ def design_quantities(
         values["threshold"],
         values["approach_velocity"],
     )
-    finger_inertia = formulas.finger_inertia(joint.reflected_inertia, technology.reflected_inertia_in)
+    in_finger = technology.finger_joints(values["gear_ratio"].shape[0])
+    finger_inertia = formulas.finger_inertia(joint.reflected_inertia, ca.DM(in_finger))
     return DesignQuantities(
         values,
         design_column,

@@ -601,7 +601,7 @@ def _sample_terms(
     n_samples = samples.size
     n_joints = int(scaled_directions.numel()) // n_samples
     function = sample_function(
-        n_joints, technology.sensing, technology.reaction, technology.reflected_inertia_in
+        n_joints, technology.sensing, technology.reaction, technology.finger_joints(n_joints)
     )
     directions = ca.reshape(scaled_directions, n_joints, n_samples) * dense_dm(
         np.tile(direction_scale, (n_joints, 1))

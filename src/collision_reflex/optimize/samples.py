@@ -170,7 +170,9 @@ def finger_mass_directions(
 
 
 @functools.lru_cache(maxsize=8)
-def sample_function(n_joints: int, sensing: str, reaction: str, reflected_inertia_in: str) -> ca.Function:
+def sample_function(
+    n_joints: int, sensing: str, reaction: str, finger_joints: tuple[bool, ...]
+) -> ca.Function:
     """SX function of one contact sample, built once per process for each set of arguments.
 
     Every problem of one arm (a study's objective, its anchors, its active-set rounds, each catalogue
@@ -196,7 +198,7 @@ def sample_function(n_joints: int, sensing: str, reaction: str, reflected_inerti
         ca.reshape(data[n:offset], n, n),
         influence,
         mass,
-        inertia if reflected_inertia_in == "finger" else None,
+        formulas.finger_inertia(inertia, ca.DM(finger_joints)) if any(finger_joints) else None,
     )
     # x^T M_f x: the finger mass at the optimal x (the NLP's constraint w^T x = 1 and its minimisation).
     finger_mass = formulas.finger_mass(direction, finger_matrix)

@@ -59,7 +59,7 @@ class ActuatorTechnology:
     scaling_law: str = "haddadin"
     sensing: str = "force"
     reaction: str = "at_rest"
-    reflected_inertia_in: str = "robot"
+    reflected_inertia_in: str | tuple[str, ...] = "robot"
     gearboxes: tuple[CatalogueGearbox | ScaledGearbox | None, ...] | None = None
     gearbox_inertia: bool = True
 
@@ -74,7 +74,13 @@ class ActuatorTechnology:
             object.__setattr__(self, "reference_motor", motors)
         object.__setattr__(self, "sensing", sensing_scheme(self.sensing, OPTIMIZED_SENSING_SCHEMES))
         _validate.choice("reaction", self.reaction, REACTION_MODES)
-        _validate.choice("reflected_inertia_in", self.reflected_inertia_in, REFLECTED_INERTIA_PLACEMENTS)
+        if isinstance(self.reflected_inertia_in, str):
+            _validate.choice("reflected_inertia_in", self.reflected_inertia_in, REFLECTED_INERTIA_PLACEMENTS)
+        else:
+            placements = tuple(self.reflected_inertia_in)
+            for j, placement in enumerate(placements):
+                _validate.choice(f"reflected_inertia_in[{j}]", placement, REFLECTED_INERTIA_PLACEMENTS)
+            object.__setattr__(self, "reflected_inertia_in", placements)
         if self.gearboxes is not None:
             gearboxes = tuple(self.gearboxes)
             if not all(g is None or isinstance(g, (CatalogueGearbox, ScaledGearbox)) for g in gearboxes):
@@ -92,6 +98,22 @@ class ActuatorTechnology:
             object.__setattr__(self, "gearboxes", gearboxes)
         if not isinstance(self.gearbox_inertia, bool):
             raise InvalidParameter("gearbox_inertia", self.gearbox_inertia, "True or False")
+
+    def finger_joints(self, n_joints: int) -> tuple[bool, ...]:
+        """Per joint whether its reflected inertia takes part in the impact (``reflected_inertia_in: finger``).
+
+        Raises
+        ------
+        InvalidParameter: per-joint placements not one per joint.
+        """
+        placements = self.reflected_inertia_in
+        if isinstance(placements, str):
+            return (placements == "finger",) * n_joints
+        if len(placements) != n_joints:
+            raise InvalidParameter(
+                "reflected_inertia_in", placements, f"one placement or {n_joints}, one per joint"
+            )
+        return tuple(p == "finger" for p in placements)
 
     def joint_mechanical_stiffness(self, n_joints: int) -> np.ndarray:
         """The mechanical stiffness of each of ``n_joints`` joints [N m/rad], shape (n_joints,)."""
@@ -305,6 +327,32 @@ class JointQuantities(NamedTuple):
     peak_torque: Any
     driving_peak_torque: Any
     driving_continuous_torque: Any
+
+
+PLACEMENT_STIFFNESS_RATIO = 10.0
+"""How much stiffer than the contact (seen at the joint) a transmission must be for its rotor to take part in the
+impact. The time-domain validity map (README, "Where the arm closed form holds") sweeps the contact stiffness
+at 0.1, 10 and 1000 times the joints' stiffness along the contact direction: compliant joints against a
+contact ten or more times stiffer take no part of the rotor into the short impact (``robot``); a transmission
+ten times stiffer than the contact carries the rotor along (``finger``, where the closed form is an estimate).
+Between, the map validates neither."""
+
+
+def placements_from_stiffness(
+    moment_arms: np.ndarray, mechanical_stiffness: np.ndarray, contact_stiffness: float
+) -> tuple[tuple[str, ...], np.ndarray]:
+    """Each joint's reflected-inertia placement from its transmission's stiffness, and the stiffness ratios.
+
+    The contact stiffness ``k_c`` [N/m] seen at joint ``j`` is ``k_c l_j^2``, with ``l_j^2`` the median over the
+    samples of the squared moment arm ``(J^T u)_j^2`` [m^2/rad^2] (``moment_arms``: (n_samples, n_joints));
+    against the joint's mechanical stiffness ``k_m,j`` [N m/rad] it gives the ratio ``k_c l_j^2 / k_m,j``.
+    ``finger`` where the ratio is at most ``1 / PLACEMENT_STIFFNESS_RATIO`` (the transmission is the stiff
+    side), ``robot`` elsewhere. Returns the placements and the ratios (n_joints,).
+    """
+    lever_squared = np.median(np.asarray(moment_arms, dtype=float) ** 2, axis=0)
+    ratios = contact_stiffness * lever_squared / np.asarray(mechanical_stiffness, dtype=float)
+    placements = tuple("finger" if r <= 1 / PLACEMENT_STIFFNESS_RATIO else "robot" for r in ratios)
+    return placements, ratios
 
 
 def _rows(values: Any) -> int:

@@ -481,12 +481,20 @@ def flat_impulse_reason(
     share_worst = 100 * initial[worst] / total[worst]
     share_all = 100 * initial.sum() / total.sum()
     placement = resolved.get("reflected_inertia_in", "robot")
-    where = (
-        "the links' inertia with the actuator masses they carry; the rotors sit behind the joint springs "
-        "(reflected_inertia_in: robot)"
-        if placement == "robot"
-        else "the links' inertia with the actuator masses and the rotors (reflected_inertia_in: finger)"
-    )
+    own = {
+        p.get("reflected_inertia_in") for p in (resolved.get("actuators") or {}).get("joints", {}).values()
+    }
+    if placement == "robot" and not own - {None, "robot"}:
+        where = (
+            "the links' inertia with the actuator masses they carry; the rotors sit behind the joint springs "
+            "(reflected_inertia_in: robot)"
+        )
+    elif placement == "finger" and not own - {None, "finger"}:
+        where = "the links' inertia with the actuator masses and the rotors (reflected_inertia_in: finger)"
+    else:
+        where = (
+            "the links' inertia with the actuator masses, and the rotors of the joints placed in the impact"
+        )
     why = "is one design" if one else f"is flat in {_words(flat[0])}"
     return [
         f"Why the front {why}: at the recommended design the impact phase m_f v0, set by "

@@ -336,6 +336,50 @@ def speed_limits(setup: ArmSetup) -> str | None:
     )
 
 
+def placement_sentences(setup: ArmSetup) -> list[str]:
+    """Where each joint's reflected inertia acts in the impact, when the joints differ or a rule chose it."""
+    from ..optimize.technology import PLACEMENT_STIFFNESS_RATIO
+
+    joints = list(setup.arm.joint_names)
+    in_finger = setup.technology.finger_joints(len(joints))
+    ratios = setup.placement_ratios
+    if ratios is None and len(set(in_finger)) < 2:
+        return []
+    named = [f"{joint}" + ("" if ratios is None else f" ({ratios[j]:.3g})") for j, joint in enumerate(joints)]
+    finger = [n for n, f in zip(named, in_finger, strict=True) if f]
+    robot = [n for n, f in zip(named, in_finger, strict=True) if not f]
+    lines = [
+        "Reflected inertia: "
+        + (
+            f"per joint from its transmission's stiffness against the contact's "
+            f"({setup.study.reflected_inertia_in.contact_stiffness:.4g} N/m, seen at the joint through its "  # type: ignore[union-attr]
+            "median squared moment arm; in brackets the contact's stiffness over the transmission's): "
+            if ratios is not None
+            else "per joint as the study gives it: "
+        )
+        + (
+            f"in the impact (a stiff transmission) at {', '.join(finger)}"
+            if finger
+            else "in the impact nowhere"
+        )
+        + (f"; behind the joint spring (a compliant joint) at {', '.join(robot)}" if robot else "")
+        + "."
+    ]
+    if ratios is not None:
+        between = [
+            joints[j]
+            for j, r in enumerate(ratios)
+            if 1 / PLACEMENT_STIFFNESS_RATIO < r < PLACEMENT_STIFFNESS_RATIO
+        ]
+        if between:
+            lines.append(
+                f"Warning: at {', '.join(between)} the contact and the transmission are of like stiffness "
+                f"(within {PLACEMENT_STIFFNESS_RATIO:g}x): the simulator validates neither placement there "
+                '(README, "Where the arm closed form holds"); simulate the design before trusting its impulse.'
+            )
+    return lines
+
+
 def transmissions(setup: ArmSetup) -> list[str]:
     """What the joints' transmissions are, for the report: scaled gearboxes, and geared joints without a model."""
     from ..hardware.gearboxes import GEARBOX_SCALING, ScaledGearbox
@@ -359,6 +403,7 @@ def transmissions(setup: ArmSetup) -> list[str]:
             f"({', '.join(f'{r:g}' for r in gearbox.ratios)}) are relaxed to the range {low:g} to {high:g} in the "
             "continuous designs; the catalogue design takes a unit of the catalogue at a ratio it is sold with."
         )
+    lines += placement_sentences(setup)
     bare = [
         joint
         for joint, gearbox, bounds in zip(joints, gearboxes, ratios, strict=True)

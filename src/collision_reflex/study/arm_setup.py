@@ -24,7 +24,7 @@ from .load import LoadedStudy, parse_study
 from .prepare import check_motors, gearbox_for, joint_actuators, per_joint_bounds
 from .robot import load_arm
 from .samples import configuration_samples, contact_domain, direction_samples, domain_draw
-from .schema import PER_JOINT_DESIGN_VARIABLES, ArmStudy, ScaledGearboxSpec
+from .schema import PER_JOINT_DESIGN_VARIABLES, ArmStudy, PlacementRuleSpec, ScaledGearboxSpec
 from .source import PathKey
 
 if TYPE_CHECKING:
@@ -50,7 +50,9 @@ class ArmSetup:
     gives none (:attr:`static_torque_requirement`); domain: where contacts are considered; domain_kept: the
     fraction of the joint-limit box's (configuration, direction) pairs in it at ``sampling_velocity`` [m/s],
     the fastest approach of the design space (None when the configurations are listed, not drawn); searched:
-    how many samples a worst-case search added (the last ones).
+    how many samples a worst-case search added (the last ones); placement_ratios: per joint the contact's
+    stiffness seen at the joint over its transmission's (:func:`collision_reflex.optimize.technology.
+    placements_from_stiffness`), when the study places the reflected inertias by that rule, else None.
     """
 
     study: ArmStudy
@@ -67,11 +69,28 @@ class ArmSetup:
     duty_cycle: DutyCycle | None = None
     domain_kept: float | None = None
     searched: int = 0
+    placement_ratios: np.ndarray | None = None
 
     @property
     def static_torque_requirement(self) -> bool:
         """True when the torque requirement is the static (gravity-only) one: the study gives no duty cycle."""
         return self.duty_cycle is None
+
+
+def _own_placements(study: ArmStudy) -> dict[str, str]:
+    """The joints that state their own reflected-inertia placement (``actuators.joints.NAME``), with it."""
+    return {
+        j: spec.reflected_inertia_in
+        for j, spec in study.actuators.joints.items()
+        if spec.reflected_inertia_in
+    }
+
+
+def _placements(study: ArmStudy, joints: list[str]) -> tuple[str, ...]:
+    """Each joint's reflected-inertia placement as the study gives it (a rule's joints: ``robot`` until ruled)."""
+    default = study.reflected_inertia_in if isinstance(study.reflected_inertia_in, str) else "robot"
+    own = _own_placements(study)
+    return tuple(own.get(j, default) for j in joints)
 
 
 def _modules(
@@ -123,6 +142,7 @@ def _modules(
 def arm_setup(loaded: LoadedStudy) -> ArmSetup:
     """Load the robot and motors and translate the study into the optimiser's inputs; every problem located."""
     from ..optimize import ActuatorTechnology, Bounds, Constraints, ContactSamples, DesignSpace
+    from ..optimize.technology import placements_from_stiffness
 
     study = loaded.study
     assert isinstance(study, ArmStudy)
@@ -166,7 +186,7 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
         scaling_law=reference_spec.scaling_law,
         sensing=scheme,
         reaction=study.reaction,
-        reflected_inertia_in=study.reflected_inertia_in,
+        reflected_inertia_in=_placements(study, joints),
         gearboxes=gearboxes,
         gearbox_inertia=study.actuators.gearbox_inertia,
     )
@@ -206,6 +226,16 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
     else:
         configurations = configuration_samples(loaded, arm)
         samples = ContactSamples.grid(arm.kinematics(configurations), directions)
+    placement_ratios = None
+    if isinstance(study.reflected_inertia_in, PlacementRuleSpec):  # per joint, from the stiffnesses
+        ruled, placement_ratios = placements_from_stiffness(
+            samples.joint_moment_arms,
+            technology.joint_mechanical_stiffness(len(joints)),
+            study.reflected_inertia_in.contact_stiffness,
+        )
+        own = _own_placements(study)  # a joint's own choice stands
+        chosen = tuple(own.get(j, r) for j, r in zip(joints, ruled, strict=True))
+        technology = dataclasses.replace(technology, reflected_inertia_in=chosen)
     return ArmSetup(
         study,
         arm,
@@ -220,6 +250,7 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
         sampling_velocity,
         duty_cycle=duty_cycle,
         domain_kept=kept,
+        placement_ratios=placement_ratios,
     )
 
 

@@ -228,6 +228,9 @@ class JointActuatorSpec(_Model):
     gear_ratio: GearRatio | None = Field(None, ge=1)
     mechanical_stiffness: JointStiffness | None = Field(None, gt=0)
     software_stiffness: JointStiffness | None = Field(None, gt=0)
+    reflected_inertia_in: Literal["robot", "finger"] | None = Field(
+        None, description="this joint's rotor placement in the impact; null: the study's reflected_inertia_in"
+    )
 
     _known_gearbox = field_validator("gearbox")(_catalogue_gearbox)
 
@@ -256,6 +259,16 @@ class ActuatorsSpec(_Model):
     )
 
     _known_gearbox = field_validator("gearbox")(_catalogue_gearbox)
+
+
+class PlacementRuleSpec(_Model):
+    """Each joint's rotor placement from its transmission's stiffness against the contact's, seen at the joint.
+
+    ``finger`` where the joint's mechanical stiffness is at least 10 times the contact stiffness times the
+    joint's squared moment arm along the contact direction (median over the samples), ``robot`` elsewhere.
+    """
+
+    contact_stiffness: ContactStiffness = Field(gt=0, description="stiffness of the object hit [N/m]")
 
 
 # --- sensing -----------------------------------------------------------------------------------------------------
@@ -871,10 +884,11 @@ class ArmStudy(_Model):
     sensing: SensingSpec
     approach_velocity: ApproachVelocity = Field(gt=0, description="approach velocity [m/s]")
     reaction: Literal["at_rest", "moving"] = "at_rest"
-    reflected_inertia_in: Literal["robot", "finger"] = Field(
+    reflected_inertia_in: Literal["robot", "finger"] | PlacementRuleSpec = Field(
         "robot",
-        description="where N^2 J_m acts: 'robot' (behind the joint springs, the paper's arm model) or 'finger' "
-        "(also rigidly in the finger mass: a stiff transmission with the compliance at the contact)",
+        description="where N^2 J_m acts: 'robot' (behind the joint springs, the paper's arm model), 'finger' "
+        "(also rigidly in the finger mass: a stiff transmission with the compliance at the contact), or "
+        "{contact_stiffness: ...}: per joint from its transmission's stiffness against that contact's",
     )
     samples: SamplesSpec
     duty_cycle: DutyCycleSpec | None = Field(
