@@ -723,3 +723,27 @@ def test_a_motor_too_slow_at_every_ratio_strong_enough_is_no_candidate(cycle_siz
     assert any("no gear ratio both strong and fast enough" in why for why in first.misses)
     kept = snapping.joint_candidates(problem, optimum, [slow, fast], candidates=2)[0]
     assert {p.motor.name for p in kept.parts} == {"fast"}
+
+
+def test_a_joint_may_take_gearboxes_of_other_kinds_in_the_catalogue_design():
+    # The study's own harmonic figures; the catalogue holds harmonic and planetary units. By default only the
+    # harmonic ones are options; with both kinds, the nearest of each kind (count per kind) that covers 30 N m.
+    own = _harmonic("study figures", (30.0, 160.0), 40.0, 0.5, continuous=True)
+    planetary = dataclasses.replace(_harmonic("P-50", (20.0, 50.0), 60.0, 1.2), kind="planetary")
+    weak = dataclasses.replace(_harmonic("P-weak", (20.0, 50.0), 20.0, 0.4), kind="planetary")
+    catalogue = {
+        g.name: g
+        for g in (
+            _harmonic("HD-a", (50.0, 100.0), 45.0, 0.6),
+            _harmonic("HD-b", (100.0,), 90.0, 1.0),
+            planetary,
+            weak,
+        )
+    }
+    ratio = cr.Bounds(1.0, 200.0)
+    default, _ = snapping.gearbox_options(own, ratio, 30.0, catalogue, count=1)
+    assert [g.name for g, _ in default] == ["HD-a"]
+    both, _ = snapping.gearbox_options(own, ratio, 30.0, catalogue, count=1, kinds=["harmonic", "planetary"])
+    assert [g.name for g, _ in both] == ["HD-a", "P-50"]  # P-weak's 20 N m does not cover 30 N m
+    none, misses = snapping.gearbox_options(own, ratio, 30.0, catalogue, kinds=["cycloidal"])
+    assert none == [] and misses == ("no cycloidal gearbox in the gearbox catalogue",)

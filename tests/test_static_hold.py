@@ -45,8 +45,12 @@ def test_the_peak_requirement_is_the_larger_of_the_static_hold_and_the_cycle(pan
     factor = setup.constraints.safety_factor
     # Written out here: the static hold over the sampled configurations (Pinocchio's gravity terms); the
     # cycle's peak from its torques over time, rotor term included.
-    static = factor * _gravity_demand(
-        setup.samples.kinematics, setup.constraints.payload, design.actuator_mass
+    # The sampled configurations and each joint's searched worst pose.
+    static = factor * np.vstack(
+        [
+            _gravity_demand(kinematics, setup.constraints.payload, design.actuator_mass)
+            for kinematics in (setup.samples.kinematics, setup.constraints.hold_poses)
+        ]
     )
     demand = problem.duty.demand(design.actuator_mass, design.reflected_inertia)
     sources = np.array(problem.duty.torques.sources)
@@ -83,3 +87,37 @@ def test_the_design_holds_its_payload_still_at_fresh_configurations(shipped):
     demand = _gravity_demand(setup.arm.kinematics(draw.q), setup.constraints.payload, design.actuator_mass)
     # Without the safety factor: the sampled configurations carry it, fresh ones must at least be held.
     assert np.all(design.driving_peak_torque >= demand.max(axis=0))
+
+
+@pytest.mark.parametrize("robot", ["ur5", "panda"])
+def test_each_joints_worst_hold_pose_is_found(robot):
+    # Brute force: 20,000 uniform configurations within the joint limits (another generator); the searched pose
+    # of each joint needs at least their largest holding torque of it (within 0.1 %).
+    from collision_reflex.arm import Arm
+    from collision_reflex.arm.static_hold import hold_torques, worst_hold_poses
+
+    arm = Arm.from_example_robot_data(robot)
+    masses = np.linspace(2.0, 0.5, arm.nv)
+    poses = worst_hold_poses(arm, 3.0, masses, np.random.default_rng(0))
+    found = np.abs(hold_torques(arm.kinematics(poses), 3.0, masses)).diagonal()
+    drawn = arm.sample_configurations(20_000, np.random.default_rng(7))
+    brute = np.abs(hold_torques(arm.kinematics(drawn), 3.0, masses)).max(axis=0)
+    assert np.all(found >= brute * (1 - 1e-3) - 1e-9), (found, brute)  # 1e-9 N m: joints gravity never loads
+    # Written out for one pose: the torque is Pinocchio's gravity torque with the masses where they are.
+    np.testing.assert_allclose(
+        found, _gravity_demand(arm.kinematics(poses), 3.0, masses).diagonal(), rtol=1e-12
+    )
+
+
+def test_the_static_hold_rows_hold_the_searched_poses(panda):
+    problems, problem, optimum = panda
+    setup, design = problems.setup, optimum.design
+    hold = setup.constraints.hold_poses
+    assert hold is not None and hold.gravity.shape[0] == len(problem.joint_names)
+    at_poses = setup.constraints.safety_factor * _gravity_demand(
+        hold, setup.constraints.payload, design.actuator_mass
+    )
+    static = np.asarray(problem.static_torque_function(design.actuator_mass)).ravel()
+    assert np.all(static >= at_poses.max(axis=0) * (1 - 1e-12))
+    # Where a searched pose binds for the masses of the start, the problem has its row, and says so.
+    assert any("worst hold pose" in label for label in problem.constraint_labels)

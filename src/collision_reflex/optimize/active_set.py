@@ -520,10 +520,11 @@ def _torque_violated(
     if full.constraints.torque_required is not None:
         return np.empty(0, dtype=int)
     rows, _ = torque_requirement_rows(samples, full.constraints, full.joint_names)
-    demands = np.array(
-        [base + per_motor @ design.actuator_mass for base, per_motor in rows]
-    )  # (rows, joints)
     configurations = np.repeat(np.unique(samples.config_index), 2)  # a + and a - row per configuration
+    # The rows of the searched hold poses follow; every active set's problem has them.
+    demands = np.array(
+        [base + per_motor @ design.actuator_mass for base, per_motor in rows[: configurations.size]]
+    )  # (rows, joints)
     if np.isinf(tolerance):
         flagged = configurations[demands.argmax(axis=0)]
     else:

@@ -22,6 +22,7 @@ from .technology import ActuatorTechnology
 if TYPE_CHECKING:
     from ..arm.duty_cycle import DutyCycle
     from ..arm.rating import Rating
+    from ..arm.samples import ArmSamples
 
 STATIC_REQUIREMENT = "static (gravity only)"
 """The requirement without a duty cycle: gravity torques over the sampled configurations only."""
@@ -54,6 +55,9 @@ class Constraints:
         the continuous torque, and the motor speed over the cycle and the approach within the motor's maximum
         speed (:mod:`collision_reflex.optimize.duty`); the peak requirement is the larger of the two. The
         cycle's own payload moves with it; ``torque_required`` must then be left unset.
+    hold_poses: the kinematics (:meth:`collision_reflex.arm.Arm.kinematics`) of further configurations the static
+        hold must meet, one per joint in order (:func:`collision_reflex.arm.static_hold.worst_hold_poses`: each
+        joint's worst pose within the joint limits), or None.
     rating: the robot's rated joint speeds, accelerations and stopping times with its payload
         (:class:`collision_reflex.arm.rating.Rating`): the rated motion's and the braking's states at every
         sampled configuration add to the peak requirement and the rated speeds to the speed requirement, as a
@@ -66,6 +70,7 @@ class Constraints:
     threshold_floor: float = 0.0
     duty_cycle: DutyCycle | None = None
     rating: Rating | None = None
+    hold_poses: ArmSamples | None = None
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.payload) and self.payload >= 0):
@@ -299,12 +304,30 @@ def torque_requirement_rows(
         kinematic_term(samples, name) for name in ("gravity", "contact_gravity", "motor_gravity")
     )
     rows, labels = [], []
-    for c in np.unique(samples.config_index):
-        base = gravity[c] + constraints.payload * contact_gravity[c]
-        per_motor = motor_gravity[c].T  # (joint j, motor i)
+    poses = [
+        (gravity[c], contact_gravity[c], motor_gravity[c], f"configuration {c}")
+        for c in np.unique(samples.config_index)
+    ]
+    hold = constraints.hold_poses
+    if hold is not None:
+        assert (
+            hold.gravity is not None and hold.contact_gravity is not None and hold.motor_gravity is not None
+        )
+        poses += [
+            (
+                hold.gravity[k],
+                hold.contact_gravity[k],
+                hold.motor_gravity[k],
+                f"the worst hold pose of {name}",
+            )
+            for k, name in enumerate(joint_names[: hold.gravity.shape[0]])
+        ]
+    for structure, payload, motors, where in poses:
+        base = structure + constraints.payload * payload
+        per_motor = motors.T  # (joint j, motor i)
         for sign, word in ((1.0, "+"), (-1.0, "-")):
             rows.append((sign * factor * base, sign * factor * per_motor))
-            labels.append(f"{word}gravity torque at configuration {c}")
+            labels.append(f"{word}gravity torque at {where}")
     return rows, labels
 
 

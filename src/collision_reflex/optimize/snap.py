@@ -228,6 +228,7 @@ def joint_candidates(
     gearboxes: Mapping[str, CatalogueGearbox] | None = None,
     gearbox_candidates: int = DEFAULT_GEARBOX_CANDIDATES,
     screen: bool = True,
+    gearbox_kinds: Sequence[str] | None = None,
 ) -> tuple[JointCandidates, ...]:
     """Each joint's candidate parts near the continuous ``optimum`` of ``problem`` (module docstring).
 
@@ -244,6 +245,8 @@ def joint_candidates(
     screen: keep only parts with a sold ratio at which the motor is both strong and fast enough for the joint
         (:func:`_screened_parts`); False: the nearest within bounds whatever they miss, for a quick snap that
         reports what they miss.
+    gearbox_kinds: the kinds of catalogue gearbox a joint of the study's own (or scaled) gearbox may take (its
+        ``gearbox_candidates`` nearest of each); None: its own kind.
     """
     catalogue = _motor_list(motors)
     for name, value in (("candidates", candidates), ("gearbox_candidates", gearbox_candidates)):
@@ -270,7 +273,7 @@ def joint_candidates(
         if isinstance(gearbox, ScaledGearbox):  # its unit at the continuous optimum's size
             gearbox = gearbox.unit(float(design.peak_torque[j]))
         options, gearbox_misses = gearbox_options(
-            gearbox, space_ratios[j], required, gearboxes, gearbox_candidates
+            gearbox, space_ratios[j], required, gearboxes, gearbox_candidates, gearbox_kinds
         )
         largest = max((_ratio_range(space_ratios[j], g)[1] for g, _ in options), default=0.0)
         ranked = sorted(catalogue, key=lambda m: motor_distance(m, torque, inertia))
@@ -326,13 +329,14 @@ def gearbox_options(
     required: float,
     catalogue: Mapping[str, CatalogueGearbox] | None,
     count: int = DEFAULT_GEARBOX_CANDIDATES,
+    kinds: Sequence[str] | None = None,
 ) -> tuple[list[tuple[CatalogueGearbox | None, bool]], tuple[str, ...]]:
     """A joint's gearbox options ``(gearbox, from the catalogue)``, and what the nearest misses if none fits.
 
     No gearbox: ``[(None, True)]``. A catalogue entry (its name in ``catalogue``, or no catalogue given): kept.
-    The study's own figures with a catalogue given: the ``count`` entries of the same kind nearest to it in
-    (log repeated peak torque, log mass) whose ratios overlap the joint's gear-ratio bounds ``ratio`` and whose
-    repeated peak rating covers the joint's ``required`` torque [N*m].
+    The study's own figures with a catalogue given: of each of ``kinds`` (None: the gearbox's own kind), the
+    ``count`` entries nearest to it in (log repeated peak torque, log mass) whose ratios overlap the joint's
+    gear-ratio bounds ``ratio`` and whose repeated peak rating covers the joint's ``required`` torque [N*m].
     """
     if gearbox is None:
         return [(None, True)], ()
@@ -344,16 +348,20 @@ def gearbox_options(
             math.log(other.peak_torque / gearbox.peak_torque), math.log(other.mass / gearbox.mass)
         )
 
-    ranked = sorted((g for g in catalogue.values() if g.kind == gearbox.kind), key=distance)
+    wanted = [gearbox.kind] if kinds is None else list(kinds)
+    ranked = sorted((g for g in catalogue.values() if g.kind in wanted), key=distance)
     fitting: list[tuple[CatalogueGearbox | None, bool]] = []
-    for other in ranked:
-        low, high = _ratio_range(ratio, other)
-        if low <= high * (1 + BOUND_TOLERANCE) and other.peak_torque >= required * (1 - BOUND_TOLERANCE):
-            fitting.append((other, True))
+    for kind in wanted:
+        of_kind = []
+        for other in (g for g in ranked if g.kind == kind):
+            low, high = _ratio_range(ratio, other)
+            if low <= high * (1 + BOUND_TOLERANCE) and other.peak_torque >= required * (1 - BOUND_TOLERANCE):
+                of_kind.append((other, True))
+        fitting += of_kind[:count]
     if fitting:
-        return fitting[:count], ()
+        return fitting, ()
     if not ranked:
-        return [], (f"no {gearbox.kind} gearbox in the gearbox catalogue",)
+        return [], (f"no {' or '.join(wanted)} gearbox in the gearbox catalogue",)
     nearest = ranked[0]
     low, high = nearest.ratio_range
     found = [f"nearest gearbox {nearest.name}:"]
@@ -537,6 +545,7 @@ def snap_to_catalogue(
     gearboxes: Mapping[str, CatalogueGearbox] | None = None,
     candidates: int = DEFAULT_CANDIDATES,
     gearbox_candidates: int = DEFAULT_GEARBOX_CANDIDATES,
+    gearbox_kinds: Sequence[str] | None = None,
     max_combinations: int = DEFAULT_MAX_COMBINATIONS,
     ipopt_options: IpoptOptions | None = None,
     progress: Callable[[int, int], None] | None = None,
@@ -556,7 +565,10 @@ def snap_to_catalogue(
         load_gearbox_catalogue`), for joints whose gearbox is the study's own figures; None keeps every joint's
         gearbox (see :func:`joint_candidates`).
     candidates: motors considered per joint (>= 1), the nearest first.
-    gearbox_candidates: catalogue gearboxes considered per joint with the study's own gearbox figures (>= 1).
+    gearbox_candidates: catalogue gearboxes considered per joint with the study's own gearbox figures (>= 1),
+        of each kind in ``gearbox_kinds``.
+    gearbox_kinds: the gearbox kinds such a joint may take in the catalogue design (a transmission is a design
+        choice: strain-wave, planetary, ...); None: the kind of its own gearbox.
     max_combinations: the most combinations enumerated exactly (>= 1); beyond, the heuristic runs.
     ipopt_options: options of every re-solve (see :func:`collision_reflex.optimize.solve`).
     progress: called as ``progress(done, total)`` after each batch of combinations solved.
@@ -577,7 +589,9 @@ def snap_to_catalogue(
         raise InvalidParameter("max_combinations", max_combinations, "an integer >= 1")
     if active_set not in ACTIVE_SET_CHOICES:
         raise InvalidParameter("active_set", active_set, "one of " + ", ".join(map(repr, ACTIVE_SET_CHOICES)))
-    joints = joint_candidates(problem, optimum, motors, candidates, gearboxes, gearbox_candidates)
+    joints = joint_candidates(
+        problem, optimum, motors, candidates, gearboxes, gearbox_candidates, gearbox_kinds=gearbox_kinds
+    )
     warnings = [j.warning for j in joints if j.warning]
     empty = [j for j in joints if not j.parts]
     if empty:

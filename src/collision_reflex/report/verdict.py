@@ -541,20 +541,21 @@ def requirement_sentence(requirement: str, rating: Mapping[str, Any] | None = No
         return (
             f"Torque requirement: {cycle}the rated motion (each joint alone, either way, at its rated speed "
             "while accelerating at its rated acceleration, and braking from its rated speed within its stopping "
-            "time) and the static hold, all with the rated payload at every sampled configuration; each joint's "
-            "peak requirement is the largest of these (the table says which), its speed the largest rated or "
+            "time), all with the rated payload at every sampled configuration, and the static hold there and at "
+            "each joint's worst pose within the joint limits; each joint's peak requirement is the largest of these (the table says which), its speed the largest rated or "
             "cycle speed."
         )
     if requirement.startswith("static"):
         return (
             f"Torque requirement: {requirement}. The peak torque covers gravity (and the payload) over the "
-            "sampled configurations only: the motion's dynamics, RMS (thermal) torque and motor speed are not "
+            "sampled configurations and each joint's worst pose within the joint limits only: the motion's dynamics, RMS (thermal) torque and motor speed are not "
             "checked; give the study a duty cycle to size for them."
         )
     if requirement.startswith("duty"):
         return (
             f"Torque requirement: {requirement}, and the static hold: the arm and its rated payload held still "
-            "at every sampled configuration; each joint's peak requirement is the larger of the two."
+            "at every sampled configuration and at each joint's worst pose within the joint limits; each joint's "
+            "peak requirement is the larger of the two."
         )
     return f"Torque requirement: {requirement}."
 

@@ -457,7 +457,7 @@ class SnapCatalogue:
 
     motors, gearboxes: the catalogue's motors and gearboxes by name (no gearboxes when no joint has one);
     provenance: per part, each field's source or estimate (as :func:`collision_reflex.hardware.catalogue.
-    read_entries` gives it); files: the catalogue files read; candidates, max_combinations:
+    read_entries` gives it); files: the catalogue files read; candidates, max_combinations, gearbox_kinds:
     :func:`collision_reflex.optimize.snap.snap_to_catalogue`'s settings.
     """
 
@@ -467,6 +467,7 @@ class SnapCatalogue:
     files: tuple[Path, ...]
     candidates: int
     max_combinations: int
+    gearbox_kinds: tuple[str, ...] | None = None
 
     @property
     def key(self) -> str:
@@ -474,7 +475,7 @@ class SnapCatalogue:
         digest = hashlib.sha256()
         for file in self.files:
             digest.update(file.read_bytes())
-        digest.update(f"{self.candidates}/{self.max_combinations}".encode())
+        digest.update(f"{self.candidates}/{self.max_combinations}/{self.gearbox_kinds}".encode())
         return digest.hexdigest()[:16]
 
 
@@ -517,7 +518,8 @@ def study_catalogue(loaded: LoadedStudy) -> SnapCatalogue | None:
             {name: dict(e.provenance) for name, e in read_entries(gearbox_file, "gearboxes").items()}
         )
         files += (gearbox_file,)
-    return SnapCatalogue(motors, gearboxes, provenance, files, spec.candidates, spec.max_combinations)
+    kinds = None if spec.gearbox_kinds is None else tuple(spec.gearbox_kinds)
+    return SnapCatalogue(motors, gearboxes, provenance, files, spec.candidates, spec.max_combinations, kinds)
 
 
 def catalogue_results(
@@ -548,6 +550,7 @@ def catalogue_results(
         arm=problems.setup.arm,
         gearboxes=catalogue.gearboxes or None,
         candidates=catalogue.candidates,
+        gearbox_kinds=catalogue.gearbox_kinds,
         max_combinations=catalogue.max_combinations,
         ipopt_options=IPOPT_OPTIONS,
         progress=progress,

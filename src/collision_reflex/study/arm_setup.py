@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
 
+from ..arm.static_hold import worst_hold_poses
 from ..errors import StudyFileError, StudyProblem
 from ..optimize.blas import single_threaded_blas
 from .duty import payload_of, study_duty_cycle, study_rating
@@ -75,6 +76,19 @@ class ArmSetup:
     def static_torque_requirement(self) -> bool:
         """True when the torque requirement is the static (gravity-only) one: the study gives no duty cycle."""
         return self.duty_cycle is None
+
+
+def _nominal_actuator_mass(space: DesignSpace, technology: ActuatorTechnology, n: int) -> np.ndarray:
+    """The actuator masses [kg] at the middle of the design space (log midpoints), where hold poses are sought."""
+    stacks = technology.default_stack_lengths(n)
+    middle = {
+        name: np.array([b.midpoint for b in space.per_joint(name, n, default)])
+        for name, default in (("stator_diameter", None), ("stack_length", stacks), ("gear_ratio", None))
+    }
+    joint = technology.joint_quantities(
+        middle["stator_diameter"], middle["stack_length"], middle["gear_ratio"]
+    )
+    return np.asarray(joint.actuator_mass, dtype=float)
 
 
 def _own_placements(study: ArmStudy) -> dict[str, str]:
@@ -206,6 +220,10 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
     # The static hold's payload: the rated one, else the one the study carries (over its cycle, if any).
     payload = payload_of(study)
     held = study.rating.payload if study.rating.payload is not None else payload.mass if payload else 0.0
+    hold = None
+    if study.constraints.torque_required is None:  # each joint's worst static pose joins the samples'
+        masses = _nominal_actuator_mass(space, technology, len(joints))
+        hold = arm.kinematics(worst_hold_poses(arm, held, masses, np.random.default_rng(0)))
     constraints = Constraints(
         payload=held,
         safety_factor=study.constraints.safety_factor,
@@ -213,6 +231,7 @@ def arm_setup(loaded: LoadedStudy) -> ArmSetup:
         threshold_floor=study.constraints.threshold_floor,
         duty_cycle=duty_cycle,
         rating=_study_rating(loaded, arm),
+        hold_poses=hold,
     )
     directions = direction_samples(loaded, arm)
     domain = contact_domain(loaded, arm)

@@ -59,6 +59,7 @@ ObjectiveName = Literal[
 ]
 SCALING_LAW_NAMES = ("haddadin", "isometric", "empirical", "quadruped")
 GEARBOX_KINDS = ("planetary", "parallel_shaft", "harmonic", "cycloidal", "ball_screw")
+GearboxKind = Literal["planetary", "parallel_shaft", "harmonic", "cycloidal", "ball_screw"]
 NAMED_DIRECTIONS = ("+x", "-x", "+y", "-y", "+z", "-z")
 DEFAULT_REFERENCE_MOTOR = "OPN-060-013-A"
 
@@ -160,7 +161,7 @@ class GearboxSpec(_Model):
     its ratios are the design's gear-ratio bounds.
     """
 
-    kind: Literal["planetary", "parallel_shaft", "harmonic", "cycloidal", "ball_screw"]
+    kind: GearboxKind
     stages: PositiveInt = 1
     diameter: PartSize = Field(gt=0, description="outer diameter [m]")
     length: PartSize = Field(gt=0, description="length [m]")
@@ -738,6 +739,11 @@ class CatalogueSpec(_Model):
     )
     max_combinations: Annotated[int, Field(ge=1, le=10000, strict=True)] = Field(
         64, description="the most combinations re-solved exactly; beyond, a coordinate-descent heuristic"
+    )
+    gearbox_kinds: list[GearboxKind] | None = Field(
+        None,
+        description="the gearbox kinds a joint may take in the catalogue design, e.g. [harmonic, planetary]; "
+        "null: the kind of its study gearbox",
     )
 
 
