@@ -481,7 +481,7 @@ def _screened_parts(
     if gearbox is None or gearbox.continuous_ratio:
         if max(low, slowest) <= min(high, fastest) * (1 + BOUND_TOLERANCE):
             return [CataloguePart(motor, ratio, distance, gearbox, from_catalogue)], ()
-        offered = [high]
+        offered = []
     else:
         tolerance = (ratio.lower * (1 - BOUND_TOLERANCE), ratio.upper * (1 + BOUND_TOLERANCE))
         offered = [r for r in gearbox.ratios if tolerance[0] <= r <= tolerance[1]]
@@ -509,7 +509,13 @@ def _screened_parts(
         why = (
             f"{motor.name}{with_gearbox}: needs a gear ratio from {slowest:.4g} to {min(fastest, 1e9):.4g} "
             f"(peak torque for the required {required:.4g} N*m, speed limit), offered "
-            + (", ".join(f"{r:g}" for r in offered) if offered else "none within the bounds")
+            + (
+                ", ".join(f"{r:g}" for r in offered)
+                if offered
+                else "none"
+                if gearbox is not None and not gearbox.continuous_ratio
+                else f"{low:g} to {high:g}"
+            )
         )
     return [], (why,)
 
