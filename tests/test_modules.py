@@ -130,3 +130,20 @@ def test_a_module_of_joints_with_different_gearboxes_is_refused(tmp_path):
     )
     with pytest.raises(StudyFileError, match="different motors or gearboxes"):
         arm_setup(load_study(path))
+
+
+def test_a_modules_shared_variables_count_once_in_the_study_summary():
+    from collision_reflex.study.prepare import free_variables
+
+    study = load_study(ROOT / "studies" / "ur5.yaml").study
+    joints = [
+        "shoulder_pan_joint",
+        "shoulder_lift_joint",
+        "elbow_joint",
+        "wrist_1_joint",
+        "wrist_2_joint",
+        "wrist_3_joint",
+    ]
+    counts = free_variables(study, 6, joints)
+    # Two modules: one motor size and one gear ratio each; every joint its own software stiffness.
+    assert (counts["stator_diameter"], counts["gear_ratio"], counts["software_stiffness"]) == (2, 2, 6)

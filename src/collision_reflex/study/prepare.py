@@ -131,15 +131,25 @@ def joint_actuators(study: ArmStudy, joint_names: list[str]) -> list[JointActuat
 
 
 def free_variables(study: ArmStudy, n_joints: int, joint_names: list[str] | None = None) -> dict[str, int]:
-    """Number of free scalar design variables, by name (per joint unless ``joint_names`` are given)."""
+    """Number of free scalar design variables, by name (per joint unless ``joint_names`` are given).
+
+    With ``joint_names``, the joints of an actuator module count once for the variables they share.
+    """
+    from ..optimize.space import MODULE_VARIABLES
+
     counts: dict[str, int] = {}
     design = study.design
+    sharing = {
+        name for group in study.actuators.modules for name in group[1:] if joint_names and name in joint_names
+    }
     for name in (*PER_JOINT_DESIGN_VARIABLES, "threshold", "position_error", "approach_velocity"):
         spec = getattr(design, name)
         if spec is None:
             continue
         if name in PER_JOINT_DESIGN_VARIABLES:
-            free = sum(_is_free(b) for b in _per_joint_bounds(spec, n_joints, joint_names))
+            bounds = _per_joint_bounds(spec, n_joints, joint_names)
+            shared = [j in sharing and name in MODULE_VARIABLES for j in joint_names or [""] * len(bounds)]
+            free = sum(_is_free(b) for b, s in zip(bounds, shared, strict=True) if not s)
         else:
             free = int(_is_free(spec))
         if free:
