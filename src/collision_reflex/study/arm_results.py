@@ -365,6 +365,13 @@ def placement_sentences(setup: ArmSetup) -> list[str]:
         + (f"; behind the joint spring (a compliant joint) at {', '.join(robot)}" if robot else "")
         + "."
     ]
+    if ratios is not None and finger:
+        lines.append(
+            "Against an object softer than its transmission a joint's rotor moves with the links, but there the "
+            "contact's own compliance spreads the impact, which the closed form (a rigid object) does not: the "
+            'simulator finds it overestimates the impulse (README, "Where the arm closed form holds"); treat the '
+            "impulse as an upper estimate."
+        )
     if ratios is not None:
         between = [
             joints[j]
