@@ -595,6 +595,7 @@ def verdict(results: Mapping[str, Any]) -> list[str]:
     if results.get("speed_limits"):
         lines.append(str(results["speed_limits"]))
     lines += [str(line) for line in results.get("transmissions", ())]
+    lines += transmission_choice_sentences(results.get("transmission_choice"))
     if bounds is not None:
         undecided = recommended.get("undecided", ())
         for joint in recommended["joints"]:
@@ -630,6 +631,27 @@ def verdict(results: Mapping[str, Any]) -> list[str]:
     if results.get("catalogue"):
         lines += catalogue_sentences(results["catalogue"])
     return lines
+
+
+def transmission_choice_sentences(tried: Sequence[Mapping[str, Any]] | None) -> list[str]:
+    """The gearbox options tried per module and the one chosen, with each assignment's objective."""
+    if not tried:
+        return []
+    chosen = next(t for t in tried if t["chosen"])
+
+    def described(entry: Mapping[str, Any]) -> str:
+        parts = "; ".join(f"{joints}: {option}" for joints, option in entry["assignment"].items())
+        if entry["objective"] is None:
+            return f"{parts} (no design: {entry['status']})"
+        return (
+            f"{parts} (objective {_g(entry['objective'], 4)}, actuators {_g(entry['actuator_mass'], 4)} kg)"
+        )
+
+    others = [described(t) for t in tried if not t["chosen"]]
+    return [
+        f"Transmissions chosen among the study's gearbox options, by the objective at each assignment's "
+        f"optimum: {described(chosen)}; also tried: " + " / ".join(others) + "."
+    ]
 
 
 def module_sentences(record: Mapping[str, Any]) -> list[str]:

@@ -357,6 +357,8 @@ def _joint_gearboxes(
         override = study.actuators.joints.get(joint)
         path: PathKey = ("actuators", "gearbox")
         spec = study.actuators.gearbox
+        if isinstance(spec, list):  # options a run chooses among (transmission_choice); checked as the first
+            path, spec = ("actuators", "gearbox", 0), spec[0]
         if override is not None and override.gearbox is not None:
             path, spec = ("actuators", "joints", joint, "gearbox"), override.gearbox
         gearbox: CatalogueGearbox | ScaledGearbox | None = None

@@ -14,7 +14,14 @@ from typing import TYPE_CHECKING, Any
 from ..errors import StudyFileError, StudyProblem
 from .duty import describe_duty_cycle, prismatic_joints, static_requirement, study_duty_cycle
 from .load import LoadedStudy
-from .schema import PER_JOINT_DESIGN_VARIABLES, ActuatorStudy, ArmStudy, GearboxSpec, MotorSpec
+from .schema import (
+    MODULE_DESIGN_VARIABLES,
+    PER_JOINT_DESIGN_VARIABLES,
+    ActuatorStudy,
+    ArmStudy,
+    GearboxSpec,
+    MotorSpec,
+)
 from .source import PathKey, excerpt
 
 if TYPE_CHECKING:
@@ -135,8 +142,6 @@ def free_variables(study: ArmStudy, n_joints: int, joint_names: list[str] | None
 
     With ``joint_names``, the joints of an actuator module count once for the variables they share.
     """
-    from ..optimize.space import MODULE_VARIABLES
-
     counts: dict[str, int] = {}
     design = study.design
     sharing = {
@@ -148,7 +153,9 @@ def free_variables(study: ArmStudy, n_joints: int, joint_names: list[str] | None
             continue
         if name in PER_JOINT_DESIGN_VARIABLES:
             bounds = _per_joint_bounds(spec, n_joints, joint_names)
-            shared = [j in sharing and name in MODULE_VARIABLES for j in joint_names or [""] * len(bounds)]
+            shared = [
+                j in sharing and name in MODULE_DESIGN_VARIABLES for j in joint_names or [""] * len(bounds)
+            ]
             free = sum(_is_free(b) for b, s in zip(bounds, shared, strict=True) if not s)
         else:
             free = int(_is_free(spec))

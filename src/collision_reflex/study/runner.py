@@ -160,6 +160,14 @@ def run_study(
             resolved = smoke_study(resolved)
             loaded = parse_study(_dump(resolved), str(path), loaded.directory)
         text = resolved_yaml(loaded)
+    transmissions = None
+    if isinstance(loaded.study, ArmStudy) and isinstance(loaded.study.actuators.gearbox, list):
+        from .transmission_choice import choose_transmissions
+
+        with stages.stage("transmissions"):  # the best gearbox option per module, by the study's objective
+            resolved, transmissions = choose_transmissions(as_written, resolved)  # located as written
+            loaded = parse_study(_dump(resolved), str(path), loaded.directory)
+            text = resolved_yaml(loaded)
     # Robot, motors, samples and the problem build: every problem is raised here, located in the file as
     # written, before any output.
     with stages.stage("prepare"):
@@ -190,7 +198,7 @@ def run_study(
         with open_executor(kind, n_workers, scheduler) as pool:
             if isinstance(loaded.study, ArmStudy):
                 results, counts = _run_arm(
-                    loaded.study, text, folder, pool, progress, window, stages, catalogue
+                    loaded.study, text, folder, pool, progress, window, stages, catalogue, transmissions
                 )
             else:
                 with stages.stage("actuators"):
@@ -298,6 +306,7 @@ def _run_arm(
     window: int,
     stages: StageTimes,
     catalogue: SnapCatalogue | None = None,
+    transmissions: list[dict[str, Any]] | None = None,
 ) -> tuple[dict[str, Any], tuple[int, int]]:
     """The study's optimum (multi-started), its Pareto front by the optimiser's one sweep, and the verdict.
 
@@ -308,6 +317,8 @@ def _run_arm(
     Then, with a ``catalogue``, the recommended design and every Pareto design snapped to it
     (:func:`.arm_results.catalogue_results`). Each piece is saved as it finishes and found again when the run
     resumes (the snap as ``catalogue``, reused while the catalogue file and the settings are the same).
+    ``transmissions``: the gearbox assignments tried before (:func:`.transmission_choice.choose_transmissions`),
+    kept in the results.
     """
     from ..optimize.pareto import release_problems
     from ..report.verdict import verdict
@@ -360,6 +371,8 @@ def _run_arm(
         "resolved": resolved_study(parse_study(text, "resolved study")),
         **stages.timed("results", arm_results)(problems, optimum, front, snapped, searches, search.tolerance),
     }
+    if transmissions is not None:
+        results["transmission_choice"] = transmissions
     if study.simulate is not None:
         from ..optimize.pareto import recommend
         from .simulate_design import simulate_designs

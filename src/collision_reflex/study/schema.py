@@ -240,10 +240,17 @@ class ActuatorsSpec(_Model):
     """The actuator of every joint; ``joints`` overrides fields for named joints."""
 
     motor: MotorSpec = Field(default_factory=MotorSpec)  # type: ignore[arg-type]
-    gearbox: str | GearboxSpec | ScaledGearboxSpec | None = Field(
+    gearbox: (
+        str
+        | GearboxSpec
+        | ScaledGearboxSpec
+        | Annotated[list[str | GearboxSpec | ScaledGearboxSpec], Field(min_length=2, max_length=4)]
+        | None
+    ) = Field(
         None,
         description="every joint's gearbox: a catalogue name (designs/gearboxes.yaml), a gearbox's figures, or "
-        "{scaled_from: name, ratios: [...]} (sized to its motor); null: none (the gear ratio alone)",
+        "{scaled_from: name, ratios: [...]} (sized to its motor); a list of 2 to 4 of these: the run chooses "
+        "one per module (or joint) by the study's objective; null: none (the gear ratio alone)",
     )
     gearbox_inertia: bool = Field(
         True,
@@ -259,7 +266,12 @@ class ActuatorsSpec(_Model):
         "for the most demanding of them), e.g. [[wrist_1_joint, wrist_2_joint, wrist_3_joint]]",
     )
 
-    _known_gearbox = field_validator("gearbox")(_catalogue_gearbox)
+    @field_validator("gearbox")
+    @classmethod
+    def _known_gearboxes(cls, value: Any) -> Any:
+        for option in value if isinstance(value, list) else [value]:
+            _catalogue_gearbox(option)
+        return value
 
 
 class PlacementRuleSpec(_Model):
@@ -658,6 +670,9 @@ PositionErrorVariable = _variable_model(
 VelocityVariable = _variable_model("VelocityVariable", ApproachVelocity, None, "approach velocity [m/s]")
 
 PER_JOINT_DESIGN_VARIABLES = ("stator_diameter", "stack_length", "gear_ratio", "software_stiffness")
+MODULE_DESIGN_VARIABLES = ("stator_diameter", "stack_length", "gear_ratio")
+"""The optimiser's ``MODULE_VARIABLES`` (what a module's joints share), named here for the study layer, which
+loads no optimiser (tests/test_modules.py checks they agree)."""
 
 
 class DesignSpec(_Model):

@@ -1,0 +1,111 @@
+"""The transmission as a design choice: one of a study's gearbox options per actuator module (or joint).
+
+A study may list two to four gearboxes as ``actuators.gearbox`` (strain-wave, planetary, ... each a catalogue
+unit, figures or a unit scaled to its motor). A kind is discrete, so the run tries every assignment of an option
+to each module (each joint outside a module, without a gearbox of its own), solves the study's optimum for each
+and goes on with the best by the study's objective: its front, catalogue design and report. Every assignment
+tried, with its objective or why it has none, is kept for the report.
+"""
+
+from __future__ import annotations
+
+import copy
+import itertools
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from .load import LoadedStudy
+
+MAX_ASSIGNMENTS = 16
+"""Most assignments of gearbox options tried (each one solve of the study's optimum)."""
+
+
+def gearbox_groups(resolved: dict[str, Any], joints: list[str]) -> list[list[str]]:
+    """The joints that take one option together: each module, and each other joint without its own gearbox."""
+    actuators = resolved["actuators"]
+    own = {j for j, spec in actuators.get("joints", {}).items() if (spec or {}).get("gearbox") is not None}
+    modules = [list(group) for group in actuators.get("modules") or []]
+    grouped = {j for group in modules for j in group}
+    return [g for g in modules if not own & set(g)] + [[j] for j in joints if j not in grouped | own]
+
+
+def option_name(option: Any) -> str:
+    """A gearbox option in a few words: its catalogue name, the unit it is scaled from, or its kind."""
+    if isinstance(option, str):
+        return option
+    if "scaled_from" in option:
+        return f"{option['scaled_from']} scaled"
+    return str(option.get("name") or f"{option['kind']} figures")
+
+
+def choose_transmissions(
+    loaded: LoadedStudy, resolved: dict[str, Any]
+) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """The resolved study with the best assignment of its gearbox options, and every assignment tried.
+
+    Each entry: ``assignment`` (per group of joints the option's name), ``objective`` (the study's objective at
+    the optimum, None without one), ``actuator_mass`` [kg] (None without one), ``status`` and ``chosen``.
+
+    Raises
+    ------
+    StudyFileError: more than :data:`MAX_ASSIGNMENTS` assignments, or none with a design (located at
+        ``actuators.gearbox``).
+    KeyboardInterrupt: Ctrl-C, from any solve.
+    """
+    import yaml
+
+    from ..errors import InvalidParameter, SolverFailed, StudyFileError
+    from ..optimize.pareto import built_problem, single_optimum
+    from ..optimize.snap import objective_value
+    from .arm_setup import StudyProblems
+    from .robot import load_arm
+
+    options = resolved["actuators"]["gearbox"]
+    groups = gearbox_groups(resolved, list(load_arm(loaded).joint_names))
+    assignments = list(itertools.product(range(len(options)), repeat=len(groups)))
+    if len(assignments) > MAX_ASSIGNMENTS:
+        raise loaded.fail(
+            ("actuators", "gearbox"),
+            f"{len(options)} gearbox options for {len(groups)} modules or joints: {len(assignments)} assignments",
+            f"at most {MAX_ASSIGNMENTS}: group joints into actuators.modules, or list fewer options",
+        )
+    tried, variants = [], []
+    for assignment in assignments:
+        variant = copy.deepcopy(resolved)
+        variant["actuators"]["gearbox"] = None
+        joints = variant["actuators"].setdefault("joints", {})
+        for group, k in zip(groups, assignment, strict=True):
+            for joint in group:
+                joints[joint] = {**(joints.get(joint) or {}), "gearbox": options[k]}
+        entry: dict[str, Any] = {
+            "assignment": {
+                ", ".join(g): option_name(options[k]) for g, k in zip(groups, assignment, strict=True)
+            },
+            "objective": None,
+            "actuator_mass": None,
+            "chosen": False,
+        }
+        try:
+            problems = StudyProblems(yaml.safe_dump(variant, sort_keys=False))
+            optimum, _ = single_optimum(problems, problems.objective, starts=1)
+            entry["objective"] = objective_value(
+                built_problem(problems, problems.objective), optimum.numpy_objectives
+            )
+            entry["actuator_mass"] = float(optimum.numpy_objectives["actuator_mass"])
+            entry["status"] = optimum.status
+        except SolverFailed as error:
+            entry["status"] = error.status
+        except (InvalidParameter, StudyFileError) as error:  # refused before solving
+            entry["status"] = f"refused: {error}"
+        tried.append(entry)
+        variants.append(variant)
+    feasible = [i for i, entry in enumerate(tried) if entry["objective"] is not None]
+    if not feasible:
+        raise loaded.fail(
+            ("actuators", "gearbox"),
+            "no gearbox option gives a design: " + "; ".join(str(entry["status"]) for entry in tried[:2]),
+            "gearbox options that can carry the study's requirements",
+        )
+    best = min(feasible, key=lambda i: tried[i]["objective"])
+    tried[best]["chosen"] = True
+    return variants[best], tried

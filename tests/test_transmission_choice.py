@@ -1,0 +1,85 @@
+"""The transmission as a design choice: a study's gearbox options, one per module or joint, chosen by the run."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+import yaml
+
+from collision_reflex.errors import StudyFileError
+from collision_reflex.optimize.pareto import built_problem, single_optimum
+from collision_reflex.optimize.snap import objective_value
+from collision_reflex.study.arm_setup import StudyProblems
+from collision_reflex.study.load import load_study
+from collision_reflex.study.resolve import resolved_yaml
+from collision_reflex.study.runner import run_study
+from test_snap import ROOT, TWO_LINK
+
+OPTIONS = ["NPS015-MF-1", "SP060-MF-1"]  # two planetary units of the catalogue: light and strong
+
+
+def _study(tmp_path, gearbox, name="study.yaml", **changes):
+    study = yaml.safe_load((ROOT / "studies" / "two_link_planetary.yaml").read_text())
+    study["robot"]["urdf"] = str(TWO_LINK)
+    study["actuators"]["gearbox"] = gearbox
+    study.pop("pareto")
+    study.update(changes)
+    path = tmp_path / name
+    path.write_text(yaml.safe_dump(study))
+    return path
+
+
+def _objective(path):
+    problems = StudyProblems(resolved_yaml(load_study(path)))
+    optimum, _ = single_optimum(problems, problems.objective, starts=1)
+    return objective_value(built_problem(problems, problems.objective), optimum.numpy_objectives)
+
+
+def test_the_run_goes_on_with_the_best_gearbox_per_joint(tmp_path):
+    result = run_study(
+        _study(tmp_path, OPTIONS), tmp_path / "out", quiet=True, executor="serial", figures=False
+    )
+    results = json.loads((result.folder / "designs.json").read_text())
+    tried = results["transmission_choice"]
+    assert len(tried) == 4  # two options at each of two joints
+    chosen = next(t for t in tried if t["chosen"])
+    assert chosen["objective"] == min(t["objective"] for t in tried if t["objective"] is not None)
+    # Independently: the study with the chosen gearbox at each joint, solved on its own, gives that objective.
+    joints = {j: {"gearbox": option} for j, option in chosen["assignment"].items()}  # one joint per group
+    alone = _study(tmp_path, None, "alone.yaml")
+    fixed = yaml.safe_load(alone.read_text())
+    fixed["actuators"]["joints"] = joints
+    alone.write_text(yaml.safe_dump(fixed))
+    assert _objective(alone) == pytest.approx(chosen["objective"], rel=1e-6)
+    # The run's resolved study is the chosen one, and the report says what was tried.
+    resolved = yaml.safe_load((result.folder / "study.resolved.yaml").read_text())
+    assert resolved["actuators"]["gearbox"] is None
+    assert {j: s["gearbox"] for j, s in resolved["actuators"]["joints"].items()} == {
+        j: s["gearbox"] for j, s in joints.items()
+    }
+    assert any(line.startswith("Transmissions chosen among") for line in results["verdict"])
+    # Run again: the same choice, so the run resumes from its finished work.
+    again = run_study(
+        _study(tmp_path, OPTIONS), tmp_path / "out", quiet=True, executor="serial", figures=False
+    )
+    assert again.resumed and again.computed == 0
+
+
+def test_too_many_assignments_are_refused_at_the_gearbox_line(tmp_path, monkeypatch):
+    from collision_reflex.study import transmission_choice
+
+    monkeypatch.setattr(transmission_choice, "MAX_ASSIGNMENTS", 3)
+    with pytest.raises(
+        StudyFileError, match=r"actuators\.gearbox: found 2 gearbox options for 2 modules or joints"
+    ):
+        run_study(_study(tmp_path, OPTIONS), tmp_path / "out", quiet=True, executor="serial", figures=False)
+    assert not (tmp_path / "out").exists()
+
+
+def test_options_of_which_none_can_carry_the_study_are_refused(tmp_path):
+    # 400 kg at the tip accelerated hard: no planetary unit of the catalogue carries it.
+    path = _study(tmp_path, OPTIONS, rating={"payload": "400 kg", "joint_accelerations": "300 deg/s^2"})
+    with pytest.raises(StudyFileError, match="no gearbox option gives a design"):
+        run_study(path, tmp_path / "out", quiet=True, executor="serial", figures=False)
+    assert not (tmp_path / "out").exists()
