@@ -80,6 +80,23 @@ def test_too_many_assignments_are_refused_at_the_gearbox_line(tmp_path, monkeypa
 def test_options_of_which_none_can_carry_the_study_are_refused(tmp_path):
     # 400 kg at the tip accelerated hard: no planetary unit of the catalogue carries it.
     path = _study(tmp_path, OPTIONS, rating={"payload": "400 kg", "joint_accelerations": "300 deg/s^2"})
-    with pytest.raises(StudyFileError, match="no gearbox option gives a design"):
+    with pytest.raises(StudyFileError, match=r"actuators\.gearbox.*best margin reachable"):
         run_study(path, tmp_path / "out", quiet=True, executor="serial", figures=False)
     assert not (tmp_path / "out").exists()
+
+
+def test_an_option_that_cannot_carry_the_study_is_passed_over(tmp_path):
+    # 20 kg accelerated at 300 deg/s^2 at the 0.55 m tip asks the shoulder some 20 x 0.55^2 x 5.2 x 1.5 = 47 N m:
+    # beyond the NPS015's 32 N m repeated peak, within the SP100's 282 N m.
+    path = _study(
+        tmp_path,
+        ["NPS015-MF-1", "SP100-MF-1"],
+        rating={"payload": "20 kg", "joint_accelerations": "300 deg/s^2"},
+    )
+    result = run_study(path, tmp_path / "out", quiet=True, executor="serial", figures=False)
+    tried = json.loads((result.folder / "designs.json").read_text())["transmission_choice"]
+    refused = [t for t in tried if t["objective"] is None]
+    assert refused and all(t["assignment"]["joint1"] == "NPS015-MF-1" for t in refused)
+    assert all(t["status"].startswith("refused:") for t in refused)
+    chosen = next(t for t in tried if t["chosen"])
+    assert chosen["assignment"]["joint1"] == "SP100-MF-1"

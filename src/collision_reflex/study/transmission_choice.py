@@ -48,8 +48,8 @@ def choose_transmissions(
 
     Raises
     ------
-    StudyFileError: more than :data:`MAX_ASSIGNMENTS` assignments, or none with a design (located at
-        ``actuators.gearbox``).
+    StudyFileError: more than :data:`MAX_ASSIGNMENTS` assignments, or none with a design (the first
+        assignment's own refusal when every one is refused, located in the file; else at ``actuators.gearbox``).
     KeyboardInterrupt: Ctrl-C, from any solve.
     """
     import yaml
@@ -57,7 +57,7 @@ def choose_transmissions(
     from ..errors import InvalidParameter, SolverFailed, StudyFileError
     from ..optimize.pareto import built_problem, single_optimum
     from ..optimize.snap import objective_value
-    from .arm_setup import StudyProblems
+    from .arm_setup import StudyProblems, checked_setup
     from .robot import load_arm
 
     options = resolved["actuators"]["gearbox"]
@@ -70,6 +70,7 @@ def choose_transmissions(
             f"at most {MAX_ASSIGNMENTS}: group joints into actuators.modules, or list fewer options",
         )
     tried, variants = [], []
+    refusals: list[Exception] = []
     for assignment in assignments:
         variant = copy.deepcopy(resolved)
         variant["actuators"]["gearbox"] = None
@@ -85,8 +86,10 @@ def choose_transmissions(
             "actuator_mass": None,
             "chosen": False,
         }
+        text = yaml.safe_dump(variant, sort_keys=False)
         try:
-            problems = StudyProblems(yaml.safe_dump(variant, sort_keys=False))
+            checked_setup(loaded, text)  # every problem of this assignment, located in the file as written
+            problems = StudyProblems(text)
             optimum, _ = single_optimum(problems, problems.objective, starts=1)
             entry["objective"] = objective_value(
                 built_problem(problems, problems.objective), optimum.numpy_objectives
@@ -97,9 +100,12 @@ def choose_transmissions(
             entry["status"] = error.status
         except (InvalidParameter, StudyFileError) as error:  # refused before solving
             entry["status"] = f"refused: {error}"
+            refusals.append(error)
         tried.append(entry)
         variants.append(variant)
     feasible = [i for i, entry in enumerate(tried) if entry["objective"] is not None]
+    if not feasible and len(refusals) == len(tried) and isinstance(refusals[0], StudyFileError):
+        raise refusals[0]  # as a study of one gearbox would be refused, at its lines
     if not feasible:
         raise loaded.fail(
             ("actuators", "gearbox"),
