@@ -9,25 +9,19 @@ import pytest
 import yaml
 
 import collision_reflex as cr
-from collision_reflex.arm import Arm
 from collision_reflex.errors import InvalidParameter, StudyFileError
 from collision_reflex.optimize.layout import design_layout
 from collision_reflex.optimize.snap import snap_to_catalogue
 from collision_reflex.study.load import load_study
-from test_snap import OBJECTIVE, ROOT, TWO_LINK, _catalogue, _two_link_inputs, _two_link_samples
+from test_snap import OBJECTIVE, ROOT, TWO_LINK, _catalogue, _two_link_inputs, two_link_problem
 
 MODULE = ((0, 1),)
 
 
 @pytest.fixture(scope="module")
 def moduled():
-    arm = Arm.from_urdf(TWO_LINK, "tip")
-    samples = _two_link_samples(arm, 3, 6, seed=0)
-    space, technology, constraints = _two_link_inputs()
-    free = cr.build_problem(arm, samples, space, technology, OBJECTIVE, constraints)
-    tied = cr.build_problem(
-        arm, samples, dataclasses.replace(space, modules=MODULE), technology, OBJECTIVE, constraints
-    )
+    arm, free = two_link_problem()
+    _, tied = two_link_problem(modules=MODULE)
     return arm, free, cr.solve(free, starts=3), tied, cr.solve(tied, starts=3)
 
 

@@ -74,14 +74,19 @@ def _two_link_samples(arm: Arm, configurations: int, directions: int, seed: int)
     return cr.ContactSamples.grid(kinematics, np.c_[np.cos(angles), np.sin(angles)])
 
 
-@pytest.fixture(scope="module")
-def two_link():
+def two_link_problem(**space_changes) -> tuple[Arm, cr.DesignProblem]:
+    """The two-link snap problem (3 configurations x 6 directions), its design space changed as given."""
     arm = Arm.from_urdf(TWO_LINK, "tip")
     samples = _two_link_samples(arm, 3, 6, seed=0)
     space, technology, constraints = _two_link_inputs()
-    problem = cr.build_problem(arm, samples, space, technology, OBJECTIVE, constraints)
-    optimum = cr.solve(problem, starts=4)
-    return arm, problem, optimum
+    space = dataclasses.replace(space, **space_changes)
+    return arm, cr.build_problem(arm, samples, space, technology, OBJECTIVE, constraints)
+
+
+@pytest.fixture(scope="module")
+def two_link():
+    arm, problem = two_link_problem()
+    return arm, problem, cr.solve(problem, starts=4)
 
 
 @pytest.fixture(scope="module")

@@ -598,9 +598,11 @@ def verdict(results: Mapping[str, Any]) -> list[str]:
     lines += transmission_choice_sentences(results.get("transmission_choice"))
     if bounds is not None:
         undecided = recommended.get("undecided", ())
+        at_bound = False
         for joint in recommended["joints"]:
             own = [entry["variable"] for entry in undecided if entry["joint"] == joint["joint"]]
             phrases = joint_limits(joint, bounds, requirement, own)
+            at_bound = at_bound or any(" bound" in phrase or " size" in phrase for phrase in phrases)
             lines.append(
                 f"{joint['joint']}: "
                 + (", ".join(phrases) if phrases else "no bound or constraint active")
@@ -610,11 +612,7 @@ def verdict(results: Mapping[str, Any]) -> list[str]:
         limits = design_limits(recommended, bounds)
         if limits:
             lines.append("Sensing and approach: " + ", ".join(limits) + ".")
-        if limits or any(
-            " bound" in phrase or " size" in phrase
-            for joint in recommended["joints"]
-            for phrase in joint_limits(joint, bounds, requirement)
-        ):
+        if limits or at_bound:
             lines.append(
                 "A variable at a bound of the study's design section, with no requirement named beside it, is "
                 "held there by that bound alone: the objectives would take it beyond. The bound, not the "
