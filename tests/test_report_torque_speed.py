@@ -14,7 +14,7 @@ import pytest
 from collision_reflex.cli import main
 from collision_reflex.optimize.duty import torque_speed_points
 from collision_reflex.optimize.pareto import built_problem
-from collision_reflex.optimize.results import _DESIGN_ARRAYS
+from collision_reflex.optimize.results import _DESIGN_ARRAYS, _GEARBOX_ARRAYS
 from collision_reflex.optimize.solve import Design
 from collision_reflex.plots.torque_speed import JointOperatingPoints
 from collision_reflex.study.arm_results import SAVED_DIGITS, JointTorqueSpeed
@@ -60,7 +60,7 @@ def runs(tmp_path_factory):
 
 
 def _recorded_design(record: dict) -> Design:
-    """The design of a saved record (its unrounded per-joint numbers)."""
+    """The design of a saved record (its unrounded per-joint numbers, the gearboxes' among them)."""
     joints = record["joints"]
 
     def per_joint(key: str) -> np.ndarray:
@@ -68,7 +68,8 @@ def _recorded_design(record: dict) -> Design:
 
     return Design(
         joint_names=tuple(j["joint"] for j in joints),
-        **{key: per_joint(key) for key in _DESIGN_ARRAYS},
+        **{key: per_joint(key) for key in _DESIGN_ARRAYS + _GEARBOX_ARRAYS},
+        gearbox=tuple(j["gearbox"] for j in joints),
         threshold=record["threshold"],
         approach_velocity=record["approach_velocity"],
         sensing=record["sensing"],

@@ -13,6 +13,7 @@ import pytest
 
 import collision_reflex as cr
 from collision_reflex.arm import Arm
+from collision_reflex.hardware.gearboxes import load_gearbox_catalogue
 from collision_reflex.optimize import snap as snapping
 from collision_reflex.optimize.active_set import solve_method
 from collision_reflex.optimize.objectives import TIE_BREAK_WEIGHT
@@ -251,8 +252,12 @@ def test_a_study_run_snaps_reports_and_resumes_without_redoing_it(tmp_path, monk
     assert catalogue["design"] is not None and catalogue["snapped"] == designs["recommended"]["source"]
     # Every contact sample of the two-link study loads both joints: every design variable is decided.
     assert catalogue["design"]["undecided"] == [] and designs["recommended"]["undecided"] == []
+    gearboxes = load_gearbox_catalogue()
     for joint in catalogue["joints"]:
-        assert joint["part"] in cr.load_catalogue() and joint["source"]
+        assert joint["motor"] in cr.load_catalogue() and joint["source"]
+        # The study's gearboxes are scaled units: the catalogue design takes a unit of the catalogue, at a
+        # ratio it is sold with.
+        assert joint["gearbox"] in gearboxes and joint["gear_ratio"] in gearboxes[joint["gearbox"]].ratios
     assert len(catalogue["pareto"]) == len(designs["pareto"]["points"])
     report = (folder / "report.html").read_text()
     assert 'id="catalogue"' in report and 'id="catalogue-objectives"' in report
@@ -266,7 +271,9 @@ def test_a_study_run_snaps_reports_and_resumes_without_redoing_it(tmp_path, monk
     assert (folder / "points" / "catalogue.json").exists()
     (sentence,) = [line for line in designs["verdict"] if line.startswith("Built from catalogue parts")]
     for joint in catalogue["joints"]:
-        assert f"{joint['joint']} {joint['part']} at N = " in sentence
+        assert f"{joint['joint']} {joint['part']}" in sentence and joint["part"].endswith(
+            f"at N = {joint['gear_ratio']:g}"
+        )
     change = 100 * catalogue["relative_difference"]["worst_case_impulse"]
     assert f"worst case impulse +{change:.3g} %" in sentence and sentence in report
 

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+import yaml
 
 from collision_reflex.cli import main
 from collision_reflex.errors import StudyFileError
@@ -564,9 +565,11 @@ def test_a_dominated_chosen_design_is_flagged_in_the_report(runs, tmp_path):
 
 def test_a_study_asks_for_multi_start_anchors(tmp_path, monkeypatch):
     study = tmp_path / "two_link.yaml"
-    text = TWO_LINK.read_text().replace("points: 12}", "points: 4, anchor_starts: 2}")
-    text += "optimizer: {worst_case_search: {enabled: false}}\n"  # one round of solves: counted below
-    study.write_text(text.replace("../designs/", f"{ROOT / 'designs'}/"))
+    data = yaml.safe_load(TWO_LINK.read_text().replace("../designs/", f"{ROOT / 'designs'}/"))
+    data["pareto"].update(points=4, anchor_starts=2)
+    data["optimizer"] = {"worst_case_search": {"enabled": False}}  # one round of solves: counted below
+    data["actuators"]["gearbox"] = data["actuators"]["gearbox"][-1]  # one gearbox: no choice solves them
+    study.write_text(yaml.safe_dump(data))
     starts = []
     original = sweep.solve
 

@@ -100,3 +100,42 @@ def test_an_option_that_cannot_carry_the_study_is_passed_over(tmp_path):
     assert all(t["status"].startswith("refused:") for t in refused)
     chosen = next(t for t in tried if t["chosen"])
     assert chosen["assignment"]["joint1"] == "SP100-MF-1"
+
+
+def test_direct_drive_is_an_option_at_a_gear_ratio_of_one(tmp_path):
+    # A light cycle (0.2 kg) that a direct-drive motor within the design's 120 mm can carry.
+    light = {
+        "duty_cycle": {
+            **yaml.safe_load((ROOT / "studies" / "two_link_planetary.yaml").read_text())["duty_cycle"]
+        }
+    }
+    light["duty_cycle"]["payload"] = {"mass": "0.2 kg"}
+    path = _study(tmp_path, ["direct_drive", "NPS015-MF-1"], **light)
+    result = run_study(path, tmp_path / "out", quiet=True, executor="serial", figures=False)
+    results = json.loads((result.folder / "designs.json").read_text())
+    tried = {tuple(t["assignment"].values()): t for t in results["transmission_choice"]}
+    assert set(tried) == {
+        (a, b) for a in ("direct drive", "NPS015-MF-1") for b in ("direct drive", "NPS015-MF-1")
+    }
+    both = tried[("direct drive", "direct drive")]
+    assert both["objective"] is not None
+    # Independently: the study written by hand with no gearbox and N fixed at 1 gives that objective.
+    alone = _study(tmp_path, None, "alone.yaml", **light)
+    fixed = yaml.safe_load(alone.read_text())
+    fixed["actuators"]["gear_ratio"] = 1
+    fixed["design"]["gear_ratio"] = 1
+    alone.write_text(yaml.safe_dump(fixed))
+    assert _objective(alone) == pytest.approx(both["objective"], rel=1e-6)
+    # Where the run chose direct drive, the design has N = 1 and no gearbox mass.
+    chosen = next(t for t in results["transmission_choice"] if t["chosen"])
+    records = {record["joint"]: record for record in results["recommended"]["joints"]}
+    for joint, option in chosen["assignment"].items():
+        direct = option == "direct drive"
+        assert (records[joint]["gear_ratio"] == 1 and not records[joint]["gearbox_mass"]) == direct
+
+
+def test_direct_drive_twice_or_alone_is_refused_with_what_to_write(tmp_path):
+    with pytest.raises(StudyFileError, match="listed twice"):
+        load_study(_study(tmp_path, ["direct_drive", "direct_drive"]))
+    with pytest.raises(StudyFileError, match=r"gearbox: null.*gear_ratio: 1"):
+        load_study(_study(tmp_path, "direct_drive"))

@@ -25,7 +25,7 @@ from .load import LoadedStudy, parse_study
 from .prepare import check_motors, gearbox_for, joint_actuators, per_joint_bounds
 from .robot import load_arm
 from .samples import configuration_samples, contact_domain, direction_samples, domain_draw
-from .schema import PER_JOINT_DESIGN_VARIABLES, ArmStudy, PlacementRuleSpec, ScaledGearboxSpec
+from .schema import DIRECT_DRIVE, PER_JOINT_DESIGN_VARIABLES, ArmStudy, PlacementRuleSpec, ScaledGearboxSpec
 from .source import PathKey
 
 if TYPE_CHECKING:
@@ -358,7 +358,8 @@ def _joint_gearboxes(
         path: PathKey = ("actuators", "gearbox")
         spec = study.actuators.gearbox
         if isinstance(spec, list):  # options a run chooses among (transmission_choice); checked as the first
-            path, spec = ("actuators", "gearbox", 0), spec[0]
+            first = next(i for i, option in enumerate(spec) if option != DIRECT_DRIVE)  # no two direct drives
+            path, spec = ("actuators", "gearbox", first), spec[first]
         if override is not None and override.gearbox is not None:
             path, spec = ("actuators", "joints", joint, "gearbox"), override.gearbox
         gearbox: CatalogueGearbox | ScaledGearbox | None = None

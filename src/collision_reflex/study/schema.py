@@ -181,10 +181,19 @@ class GearboxSpec(_Model):
     )
 
 
+DIRECT_DRIVE = "direct_drive"
+"""The gearbox option of no gearbox: the motor drives the joint at N = 1."""
+
+
 def _catalogue_gearbox(value: Any) -> Any:
     """A gearbox name must be one of the packaged catalogue's (figures are checked by :class:`GearboxSpec`)."""
     if not isinstance(value, str):
         return value
+    if value == DIRECT_DRIVE:
+        raise ValueError(
+            "a gearbox: direct_drive is one of several options (gearbox: [direct_drive, ...]); for direct drive "
+            "alone write gearbox: null and gear_ratio: 1"
+        )
     from ..hardware.gearboxes import load_gearbox_catalogue
 
     names = sorted(load_gearbox_catalogue())
@@ -249,8 +258,9 @@ class ActuatorsSpec(_Model):
     ) = Field(
         None,
         description="every joint's gearbox: a catalogue name (designs/gearboxes.yaml), a gearbox's figures, or "
-        "{scaled_from: name, ratios: [...]} (sized to its motor); a list of 2 to 4 of these: the run chooses "
-        "one per module (or joint) by the study's objective; null: none (the gear ratio alone)",
+        "{scaled_from: name, ratios: [...]} (sized to its motor); a list of 2 to 4 of these, or direct_drive "
+        "(no gearbox, N = 1): the run chooses one per module (or joint) by the study's objective; null: none "
+        "(the gear ratio alone)",
     )
     gearbox_inertia: bool = Field(
         True,
@@ -269,8 +279,13 @@ class ActuatorsSpec(_Model):
     @field_validator("gearbox")
     @classmethod
     def _known_gearboxes(cls, value: Any) -> Any:
-        for option in value if isinstance(value, list) else [value]:
-            _catalogue_gearbox(option)
+        if not isinstance(value, list):
+            return _catalogue_gearbox(value)
+        if len(set(map(repr, value))) < len(value):
+            raise ValueError("gearbox options that differ: one of them is listed twice")
+        for option in value:
+            if option != DIRECT_DRIVE:
+                _catalogue_gearbox(option)
         return value
 
 

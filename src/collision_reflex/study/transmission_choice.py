@@ -1,7 +1,7 @@
 """The transmission as a design choice: one of a study's gearbox options per actuator module (or joint).
 
 A study may list two to four gearboxes as ``actuators.gearbox`` (strain-wave, planetary, ... each a catalogue
-unit, figures or a unit scaled to its motor). A kind is discrete, so the run tries every assignment of an option
+unit, figures or a unit scaled to its motor; or ``direct_drive``, no gearbox at N = 1). A kind is discrete, so the run tries every assignment of an option
 to each module (each joint outside a module, without a gearbox of its own), solves the study's optimum for each
 and goes on with the best by the study's objective: its front, catalogue design and report. Every assignment
 tried, with its objective or why it has none, is kept for the report.
@@ -12,6 +12,8 @@ from __future__ import annotations
 import copy
 import itertools
 from typing import TYPE_CHECKING, Any
+
+from .schema import DIRECT_DRIVE
 
 if TYPE_CHECKING:
     from .load import LoadedStudy
@@ -29,8 +31,23 @@ def gearbox_groups(resolved: dict[str, Any], joints: list[str]) -> list[list[str
     return [g for g in modules if not own & set(g)] + [[j] for j in joints if j not in grouped | own]
 
 
+def _assign(variant: dict[str, Any], joint: str, option: Any) -> None:
+    """Give ``joint`` the gearbox ``option`` in the resolved study ``variant``; direct drive fixes its N at 1."""
+    joints = variant["actuators"].setdefault("joints", {})
+    spec = joints.get(joint) or {}
+    if option != DIRECT_DRIVE:
+        joints[joint] = {**spec, "gearbox": option}
+        return
+    joints[joint] = {**spec, "gearbox": None, "gear_ratio": 1.0}
+    ratio = (variant.get("design") or {}).get("gear_ratio")
+    if ratio is not None:
+        ratio.setdefault("joints", {})[joint] = {"value": 1.0}
+
+
 def option_name(option: Any) -> str:
     """A gearbox option in a few words: its catalogue name, the unit it is scaled from, or its kind."""
+    if option == DIRECT_DRIVE:
+        return "direct drive"
     if isinstance(option, str):
         return option
     if "scaled_from" in option:
@@ -74,10 +91,9 @@ def choose_transmissions(
     for assignment in assignments:
         variant = copy.deepcopy(resolved)
         variant["actuators"]["gearbox"] = None
-        joints = variant["actuators"].setdefault("joints", {})
         for group, k in zip(groups, assignment, strict=True):
             for joint in group:
-                joints[joint] = {**(joints.get(joint) or {}), "gearbox": options[k]}
+                _assign(variant, joint, options[k])
         entry: dict[str, Any] = {
             "assignment": {
                 ", ".join(g): option_name(options[k]) for g, k in zip(groups, assignment, strict=True)
