@@ -18,7 +18,16 @@ from collision_reflex.cli.options import LENGTH, QuantityParser
 REPO = Path(__file__).resolve().parents[1]
 TWO_LINK = str(REPO / "designs" / "planar_two_link.urdf")
 TRACE = REPO / "studies" / "traces" / "u8_soft" / "u8_soft_v50mm.csv"
-SURFACE_FAST = ["--urdf", TWO_LINK, "--directions", "12", "--q2-values", "45,0", "--velocities", "0.1,1"]
+SURFACE_FAST = [
+    "--urdf",
+    TWO_LINK,
+    "--directions",
+    "12",
+    "--q2-values",
+    "45deg,0deg",
+    "--velocities",
+    "0.1,1",
+]
 
 SUBCOMMANDS = [
     ["impulse"],
@@ -337,7 +346,7 @@ UNITS = {
             "--task-stiffness",
             "100",
             "--q2-values",
-            "45,0",
+            "45deg,0deg",
             "--offset",
             "0.01",
             "0",
@@ -354,7 +363,7 @@ UNITS = {
             "--task-stiffness",
             "0.1 N/mm",
             "--q2-values",
-            "45deg,0deg",
+            "0.7853981633974483rad,0rad",
             "--offset",
             "1cm",
             "0m",

@@ -23,7 +23,7 @@ FAST = [
     "--directions",
     "24",
     "--q2-values",
-    "45,0",
+    "45deg,0deg",
     "--stator-diameters",
     "0.01,0.06",
     "--velocities",
@@ -64,10 +64,12 @@ def test_spatial_figure(tmp_path, capsys):
         (["--urdf", "missing.urdf"], "no such file"),
         (["--urdf", str(TWO_LINK), "--frame", "gripper"], "tip_joint, tip"),
         (["--robot", "double_pendulum"], "--torque"),
-        (["--urdf", str(TWO_LINK), "--q", "10"], "2 joint angles"),
+        (["--urdf", str(TWO_LINK), "--q", "10deg"], "2 joint positions"),
+        (["--urdf", str(TWO_LINK), "--q", "10", "20"], "a bare number could be either"),
+        (["--urdf", str(TWO_LINK), "--q2-values", "45,0"], "has no unit"),
         (["--urdf", str(TWO_LINK), "--plot", "figure.txt"], ".png"),
     ],
-    ids=["missing-urdf", "unknown-frame", "no-torque", "wrong-q", "bad-figure-name"],
+    ids=["missing-urdf", "unknown-frame", "no-torque", "wrong-q", "bare-q", "bare-q2", "bad-figure-name"],
 )
 def test_bad_input_is_one_line_and_status_2(tmp_path, monkeypatch, capsys, arguments, message):
     monkeypatch.chdir(tmp_path)

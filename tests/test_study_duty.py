@@ -54,7 +54,7 @@ FILE_LINE = BASE.count("\n") + 2  # the study line of `file:`
 def _csv(rows: int = 60, *, time_unit: str = "s") -> str:
     """A smooth cycle (joint1 in deg, joint2 in rad) with a comment line and an extra column."""
     t = np.linspace(0.0, 2.0, rows)
-    lines = ["# recorded cycle", f"time [{time_unit}], joint1 [deg], joint2, gripper [mm]"]
+    lines = ["# recorded cycle", f"time [{time_unit}], joint1 [deg], joint2 [rad], gripper [mm]"]
     lines += [
         f"{ti:.12g}, {30 * math.sin(math.pi * ti):.12g}, {0.5 * math.cos(math.pi * ti):.12g}, 5" for ti in t
     ]
@@ -197,7 +197,7 @@ def test_json_schema_describes_the_duty_cycle():
 
 
 def test_resolved_study_makes_the_defaults_explicit_and_reloads(tmp_path):
-    section = "duty_cycle:\n  via: [[0, 0], [1, 1]]\n  max_speed: 1\n  max_acceleration: 2\n"
+    section = "duty_cycle:\n  via: [[0 rad, 0 rad], [1 rad, 1 rad]]\n  max_speed: 1\n  max_acceleration: 2\n"
     path = _study(tmp_path, section)
     text = resolved_yaml(load_study(path))
     cycle = yaml.safe_load(text)["duty_cycle"]
@@ -232,19 +232,22 @@ def _bad_csv(kind: str) -> tuple[str, int | None, str]:
         lines[20] = lines[20].split(",")[0] + ", nan, 0.1, 5"
         return "\n".join(lines), 21, "non-numeric joint1"
     if kind == "wrong-unit":
-        lines[1] = "time [s], joint1 [kg], joint2, gripper [mm]"
+        lines[1] = "time [s], joint1 [kg], joint2 [rad], gripper [mm]"
         return "\n".join(lines), header, "kg"
+    if kind == "bare-angle":  # radians or degrees? The unit must be written.
+        lines[1] = "time [s], joint1 [deg], joint2, gripper [mm]"
+        return "\n".join(lines), header, "without a unit"
     if kind == "too-few":
         return "\n".join(lines[:6]), None, "too few samples"
     if kind == "too-coarse":
         t = np.linspace(0.0, 2.0, 8)
         rows = [f"{ti:.9g}, {30 * math.sin(3 * math.pi * ti):.9g}, 0" for ti in t]
-        return "time [s], joint1 [deg], joint2\n" + "\n".join(rows), None, "too coarse"
+        return "time [s], joint1 [deg], joint2 [rad]\n" + "\n".join(rows), None, "too coarse"
     raise AssertionError(kind)
 
 
 @pytest.mark.parametrize(
-    "kind", ["missing-column", "non-increasing", "nan", "wrong-unit", "too-few", "too-coarse"]
+    "kind", ["missing-column", "non-increasing", "nan", "wrong-unit", "bare-angle", "too-few", "too-coarse"]
 )
 def test_trajectory_file_problems_name_the_study_line_and_the_csv_line(tmp_path, kind):
     text, csv_line, word = _bad_csv(kind)
@@ -278,17 +281,27 @@ BAD_STUDIES = [
     ("duty_cycle:\n  file: cycle.csv\n  spline: 5\n", "", 2, ["unknown key 'spline'"]),
     ("duty_cycle:\n  file: nowhere.csv\n", "", 1, ["no such file"]),
     ("duty_cycle:\n  file: cycle.csv\n  rate: 100 Hz\n", "", 0, ["only with via points"]),
-    ("duty_cycle:\n  via: [[0, 0], [1, 1]]\n  max_speed: 1\n", "", 0, ["max_acceleration"]),
-    ("duty_cycle:\n  via: [[0, 0], [1, 1]]\n  max_speed: 1 m\n  max_acceleration: 1\n", "", 2, ["[length]"]),
-    ("duty_cycle:\n  via: [[0, 0], [1, 1]]\n  max_speed: -1\n  max_acceleration: 1\n", "", 2, ["> 0"]),
+    ("duty_cycle:\n  via: [[0 rad, 0 rad], [1 rad, 1 rad]]\n  max_speed: 1\n", "", 0, ["max_acceleration"]),
     (
-        "duty_cycle:\n  via: [[0, 0], [1, 1]]\n  max_speed: 1\n  max_acceleration: 1\n  dwell: [1 s, -2]\n",
+        "duty_cycle:\n  via: [[0 rad, 0 rad], [1 rad, 1 rad]]\n  max_speed: 1 m\n  max_acceleration: 1\n",
+        "",
+        2,
+        ["[length]"],
+    ),
+    (
+        "duty_cycle:\n  via: [[0 rad, 0 rad], [1 rad, 1 rad]]\n  max_speed: -1\n  max_acceleration: 1\n",
+        "",
+        2,
+        ["> 0"],
+    ),
+    (
+        "duty_cycle:\n  via: [[0 rad, 0 rad], [1 rad, 1 rad]]\n  max_speed: 1\n  max_acceleration: 1\n  dwell: [1 s, -2]\n",
         "",
         4,
         [">= 0 (found -2)"],
     ),
     (
-        "duty_cycle:\n  via: [[0, 0], [1, 1]]\n  max_speed: 1\n  max_acceleration: 1\n  dwell: [1 s]\n",
+        "duty_cycle:\n  via: [[0 rad, 0 rad], [1 rad, 1 rad]]\n  max_speed: 1\n  max_acceleration: 1\n  dwell: [1 s]\n",
         "",
         0,
         ["one per via point"],
@@ -342,13 +355,13 @@ def test_bad_duty_cycle_sections_are_located(tmp_path, section, extra, offset, w
 ROBOT_BAD = [
     # (section, path of the problem, line within the section, words)
     (
-        "  via: [[0, 0, 0], [1, 1]]\n  max_speed: 1\n  max_acceleration: 1\n",
+        "  via: [[0 rad, 0 rad, 0 rad], [1 rad, 1 rad]]\n  max_speed: 1\n  max_acceleration: 1\n",
         "duty_cycle.via[0]",
         1,
         ["3 joint"],
     ),
     (
-        "  via: [[0, 0], [1, 1]]\n  max_speed: {joint1: 1, elbow: 1}\n  max_acceleration: 1\n",
+        "  via: [[0 rad, 0 rad], [1 rad, 1 rad]]\n  max_speed: {joint1: 1, elbow: 1}\n  max_acceleration: 1\n",
         "duty_cycle.max_speed",
         2,
         ["joint2", "elbow"],
@@ -369,7 +382,9 @@ def test_via_points_and_limits_are_checked_against_the_arm(tmp_path, section, fi
 
 
 def test_via_points_within_the_urdf_limits(tmp_path):
-    section = "duty_cycle:\n  via: [[0, 0], [1, 200 deg]]\n  max_speed: 1\n  max_acceleration: 1\n"
+    section = (
+        "duty_cycle:\n  via: [[0 rad, 0 rad], [1 rad, 200 deg]]\n  max_speed: 1\n  max_acceleration: 1\n"
+    )
     base = _two_link_base()
     with pytest.raises(StudyFileError) as error:  # the two-link URDF limits its joints to +-pi
         _cycle(_study(tmp_path, section, base=base))

@@ -314,9 +314,10 @@ def test_a_key_with_a_line_break_is_printed_on_one_line(tmp_path, capsys):
         ('joint1,joint2\n0,0\n"1,2\n', 3, "not a CSV table"),
         ("# comment\n\njoint1,joint2\n0,0\n1,2,3\n", 5, "not a CSV table"),
         ("joint1,joint2\n0,0\n1,2,3,4\n", 3, "not a CSV table"),
-        ("# comment\njoint1,joint2\n0,0\n0.1,x\n", 4, "not a finite number"),
+        ("# comment\njoint1 [rad],joint2 [rad]\n0,0\n0.1,x\n", 4, "not a finite number"),
+        ("joint1,joint2 [deg]\n0,0\n", 1, "without a unit"),
     ],
-    ids=["open-quote", "too-many-fields-after-comments", "too-many-fields", "not-a-number"],
+    ids=["open-quote", "too-many-fields-after-comments", "too-many-fields", "not-a-number", "bare-angle"],
 )
 def test_a_bad_trajectory_csv_is_one_line_with_its_csv_line(tmp_path, csv, csv_line, words):
     (tmp_path / "traj.csv").write_text(csv)
@@ -412,7 +413,7 @@ def test_a_catalogue_quantity_is_read_by_the_study_grammar(tmp_path):
 def test_a_unit_tower_in_a_trajectory_header_is_refused_at_once(tmp_path):
     """Units in CSV headers go through the same bounded grammar (pint alone ran for minutes on this)."""
     rows = "\n".join(f"{0.01 * i:.2f}, 0, 0" for i in range(200))
-    (tmp_path / "cycle.csv").write_text("time [s**9**9**9], joint1, joint2\n" + rows + "\n")
+    (tmp_path / "cycle.csv").write_text("time [s**9**9**9], joint1 [rad], joint2 [rad]\n" + rows + "\n")
     text = BASE + "duty_cycle: {file: cycle.csv}\n"
     start = time.perf_counter()
     with pytest.raises(StudyFileError) as caught:

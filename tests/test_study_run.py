@@ -341,7 +341,7 @@ STUDY = textwrap.dedent(
     sensing: {scheme: force, threshold: 3 N}
     approach_velocity: 0.5 m/s
     samples:
-      configurations: {list: [[0, 0.8]]}
+      configurations: {list: [[0 rad, 0.8 rad]]}
       directions: {circle: 4}
     design:
       gear_ratio: {min: 1, max: 50}
@@ -398,7 +398,8 @@ def test_validate_checks_the_robot_with_lines(tmp_path, capsys):
     study = tmp_path / "study.yaml"
     study.write_text(
         STUDY.replace("contact_frame: link2", "contact_frame: lnk2").replace(
-            "configurations: {list: [[0, 0.8]]}", "configurations: {list: [[0, 0.8, 0.1]]}"
+            "configurations: {list: [[0 rad, 0.8 rad]]}",
+            "configurations: {list: [[0 rad, 0.8 rad, 0.1 rad]]}",
         )
     )
     assert main(["validate", str(study)]) == 2
@@ -439,11 +440,14 @@ def test_trajectory_configurations_come_from_the_csv_by_joint_name(tmp_path):
     from collision_reflex.study.samples import configuration_samples
 
     # Columns in another order than the joints, plus a time column that is ignored.
-    (tmp_path / "traj.csv").write_text("t,joint2,joint1\n0,0.1,1.0\n0.1,0.2,1.1\n0.2,0.3,1.2\n0.3,0.4,1.3\n")
+    (tmp_path / "traj.csv").write_text(
+        "t,joint2 [rad],joint1 [rad]\n0,0.1,1.0\n0.1,0.2,1.1\n0.2,0.3,1.2\n0.3,0.4,1.3\n"
+    )
     study = tmp_path / "study.yaml"
     study.write_text(
         STUDY.replace(
-            "configurations: {list: [[0, 0.8]]}", "configurations: {trajectory: {file: traj.csv, every: 2}}"
+            "configurations: {list: [[0 rad, 0.8 rad]]}",
+            "configurations: {trajectory: {file: traj.csv, every: 2}}",
         )
     )
     loaded = load_study(study)
@@ -451,8 +455,8 @@ def test_trajectory_configurations_come_from_the_csv_by_joint_name(tmp_path):
     q = configuration_samples(loaded, arm)
     # Rows 0 and 2, joints in the arm's order (the double pendulum's joints are bounded: q holds the angles).
     np.testing.assert_allclose(arm.joint_coordinates(q), [[1.0, 0.1], [1.2, 0.3]], atol=1e-12)  # exact copies
-    (tmp_path / "traj.csv").write_text("t,joint1\n0,0.1\n")
-    with pytest.raises(StudyFileError, match="without columns joint2") as caught:
+    (tmp_path / "traj.csv").write_text("t,joint1 [rad]\n0,0.1\n")
+    with pytest.raises(StudyFileError, match=r"no column for joint\(s\) joint2") as caught:
         configuration_samples(loaded, arm)
     assert caught.value.problems[0].line == 12
 

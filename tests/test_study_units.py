@@ -6,6 +6,7 @@ from __future__ import annotations
 import itertools
 import math
 from concurrent.futures import Future
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -370,3 +371,56 @@ def test_a_number_converts_to_the_bit_as_pint_converts_it(registries, text, unit
     for value in np.random.default_rng(7).normal(0.0, 1.0, 20) * 10.0 ** np.arange(-9, 11):
         expected = float(default.Quantity(float(value), name.replace("^", "**")).to(unit or "").magnitude)
         assert parse_quantity(f"{float(value)!r} {name}", unit) == expected, (value, name)
+
+
+# --- joint positions: never a bare number -------------------------------------------------------------------
+
+PAPER_STUDY = Path(__file__).resolve().parents[1] / "studies" / "two_link_paper.yaml"
+
+
+def _paper_text(old: str, new: str) -> str:
+    text = PAPER_STUDY.read_text()
+    assert old in text
+    return text.replace(old, new).replace("../designs/", f"{PAPER_STUDY.parents[1] / 'designs'}/")
+
+
+@pytest.mark.parametrize("bare", ["45", "0.785"])
+def test_a_bare_joint_position_is_refused_at_its_line_with_the_fix(bare):
+    from collision_reflex.errors import StudyFileError
+    from collision_reflex.study import parse_study
+
+    text = _paper_text("- [0 deg, 45 deg]", f"- [0 deg, {bare}]")
+    line = text.splitlines().index(f"      - [0 deg, {bare}]") + 1
+    with pytest.raises(StudyFileError) as caught:
+        parse_study(text, "paper.yaml", PAPER_STUDY.parent)
+    (problem,) = caught.value.problems
+    assert (problem.line, problem.path) == (line, "samples.configurations.list[1][1]")
+    assert "'30 deg'" in problem.expected and "'0.5 rad'" in problem.expected  # the fix, in the message
+    assert str(problem).startswith(f"paper.yaml:{line}:")
+
+
+def test_a_length_for_a_revolute_joint_is_refused_against_the_robot():
+    from collision_reflex.errors import StudyFileError
+    from collision_reflex.study import parse_study
+    from collision_reflex.study.prepare import describe_study
+
+    loaded = parse_study(
+        _paper_text("- [0 deg, 45 deg]", "- [0 deg, 0.1 m]"), "paper.yaml", PAPER_STUDY.parent
+    )
+    with pytest.raises(StudyFileError, match=r"found '0.1 m' for joint joint2; expected an angle"):
+        describe_study(loaded)
+
+
+def test_the_resolved_study_writes_joint_positions_with_their_units():
+    import yaml
+
+    from collision_reflex.study import parse_study, resolved_yaml
+
+    loaded = parse_study(
+        _paper_text("- [0 deg, 45 deg]", "- [0.5 rad, 45 deg]"), "paper.yaml", PAPER_STUDY.parent
+    )
+    text = resolved_yaml(loaded)
+    rows = yaml.safe_load(text)["samples"]["configurations"]["list"]
+    assert rows[1] == [f"{0.5!r} rad", f"{math.radians(45)!r} rad"]
+    again = parse_study(text, "resolved.yaml", PAPER_STUDY.parent)  # a resolved study is a valid study
+    assert again.study.samples.configurations.list == loaded.study.samples.configurations.list

@@ -2,11 +2,10 @@
 
 CasADi's Python operators pick among overloads by calling Python helpers (``DM_from_array``, ``IM_from_array``,
 ...) to test each argument; a Ctrl-C whose ``KeyboardInterrupt`` is raised inside such a test is taken for "this
-overload does not match" and cleared, so the interrupt is lost and the work goes on. Measured on the Panda
-smoke study: 9 of 60 interrupts sent at evenly spaced times over its solves were lost this way (the run then
-finished normally, with exit status 0), and one surfaced as a ``SystemError`` (an exception left set while
-NumPy converted a CasADi matrix). Problem construction, solves, each catalogue combination's work and every
-stage of a study run run inside :func:`interruptible`, which records every Ctrl-C and raises
+overload does not match" and cleared, so the interrupt is lost and the work goes on (a study run then
+finishes normally, with exit status 0), or it surfaces as another error, such as a ``SystemError`` (an exception
+left set while NumPy converted a CasADi matrix). Problem construction, solves, each catalogue combination's work
+and every stage of a study run run inside :func:`interruptible`, which records every Ctrl-C and raises
 ``KeyboardInterrupt`` when its block ends if the interrupt was lost, or instead of an error the interrupt
 caused (``benchmarks/ctrl_c_runs.py`` sends the interrupts and counts the outcomes).
 """

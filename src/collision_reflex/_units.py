@@ -58,8 +58,8 @@ class QuantityError(ValueError):
 
 
 # The registry holds the part of pint's own definitions file (``default_en.txt``) that datasheets and studies
-# use; building pint's whole registry takes ~5x as long (0.14 s of a 0.9 s ``crx validate``). The definitions are
-# pint's lines, picked by name here (two groups and the mks system whole), never copied. Kept: SI base and
+# use: pint's whole registry is much slower to build, and ``crx`` builds one at every start. The definitions
+# are pint's lines, picked by name here (two groups and the mks system whole), never copied. Kept: SI base and
 # derived units with every prefix, angles (deg, turn, arcmin), rpm and rps, time, temperature, the
 # international inch/foot/yard/mile, the avoirdupois pound and ounce with their forces (lbf, ozf), kgf and gf,
 # and the power, pressure and electrical units of motor datasheets. Also kept: every unit whose name the
@@ -97,11 +97,11 @@ _UNITS_FOR_THEIR_NAMES = """
 _KEPT_UNITS = frozenset(_DATASHEET_UNITS.split() + _UNITS_FOR_THEIR_NAMES.split())
 
 # pint.compat imports Dask, SciPy and Babel when they are installed, for integrations the package never uses
-# (Quantity-wrapped Dask arrays, `to_preferred`, locale formatting): 0.09 s of `crx validate`. The `crx`
+# (Quantity-wrapped Dask arrays, `to_preferred`, locale formatting), slowing every start of `crx`. The `crx`
 # command's own process imports pint without them (:func:`hide_pint_extras`); library users keep all of pint.
 _PINT_EXTRAS = ("dask", "scipy", "babel")
 _hide_extras = False
-# Parsing the definitions and working out every unit's base units take ~0.04 s at each start of `crx`. The
+# Parsing the definitions and working out every unit's base units would be redone at each start of `crx`. The
 # `crx` command keeps pint's parse of them in the user's cache folder (:func:`cache_registry`); a library user's
 # registry writes nothing.
 _use_cache = False
@@ -247,7 +247,7 @@ def cached_registry(definitions: list[str], folder: Path | None) -> pint.UnitReg
     return None
 
 
-@functools.lru_cache(maxsize=4096)  # files repeat their units; a pint conversion costs ~0.2 ms
+@functools.lru_cache(maxsize=4096)  # files repeat their units, and a pint conversion is slow beside a look-up
 def parse_quantity(text: str, unit: str, *, angle_explicit: bool = False) -> float:
     """The quantity ``text`` (e.g. ``"60 mm"``, or a bare number taken in ``unit``) as a float in ``unit``.
 

@@ -3,7 +3,7 @@
 Near a singular pose the contact Jacobian ``J_v`` loses rank along a direction, and the finger mass along it,
 ``1 / (u^T J M^-1 J^T u)``, grows like ``1 / sigma_min(J_v)^2``: over every configuration and every direction
 the worst collision impulse is unbounded, and a sampled maximum is only a quantile of a heavy-tailed
-distribution. A worst case is therefore taken over a stated domain (the README's "Contact domain"):
+distribution. A worst case is therefore taken over a stated domain (the studies guide, "The contact domain"):
 
 - configurations within the joint limits whose contact Jacobian has ``sigma_min(J_v) >= min_singular_value``
   (default a tenth of the arm's reach, the largest base-to-contact distance): arms are not operated at their
@@ -25,7 +25,7 @@ if TYPE_CHECKING:
     from .robot import Arm
 
 REACH_FRACTION = 0.1
-"""Default singular-value floor as a fraction of the arm's reach [-] (the README's "Contact domain")."""
+"""Default singular-value floor as a fraction of the arm's reach [-] (the studies guide, "The contact domain")."""
 
 REACH_SAMPLES = 4096
 """Configurations drawn (seeded) to estimate an arm's reach: the largest base-to-contact distance found."""

@@ -15,7 +15,8 @@ samples is not determined by them (for a sine that happens below about 10 sample
 
 CSV layout: optional leading ``#`` comment lines, then a header with a time column (``time`` or ``t``) and one
 column per joint, named by the joint, each with its unit in brackets (``time [s]``, ``shoulder [deg]``,
-``slide [mm]``; a column without one is in s, rad or m), then one row per sample. Other columns are ignored.
+``slide [mm]``; a joint column must name its unit, the time column without one is in s), then one row per
+sample. Other columns are ignored.
 """
 
 from __future__ import annotations
@@ -225,32 +226,8 @@ class DutyCycle:
             raise TrajectoryError(
                 source, f"no time column among {list(columns.values())}; name one 'time [s]'", header_line
             )
-        missing = [name for name in joint_names if name not in columns]
-        if missing:
-            raise TrajectoryError(
-                source,
-                f"no column for joint(s) {', '.join(missing)}; the header names {list(columns.values())}, "
-                "and needs one column per joint: " + ", ".join(joint_names),
-                header_line,
-            )
-        import pandas as pd
-
-        def numbers(column: str, default_unit: str, what: str) -> np.ndarray:
-            match = HEADER.match(column)
-            unit = (match.group("unit") if match else None) or default_unit
-            try:
-                scale = unit_factor(unit, default_unit, what, source)
-            except TraceError as error:
-                raise TrajectoryError(source, error.reason, header_line) from None
-            return pd.to_numeric(table[column], errors="coerce").to_numpy(dtype=float) * scale
-
-        t = numbers(time_column, "s", "time")
-        q = np.column_stack(
-            [
-                numbers(columns[name], "m" if name in prismatic else "rad", f"joint {name!r}")
-                for name in joint_names
-            ]
-        )
+        t = _column(table, time_column, "s", "time", source, header_line)
+        q = joint_positions(table, joint_names, prismatic, source, header_line)
         lines = np.arange(t.size) + header_line + 1
         return cls.from_positions(t, q, joint_names, payload, source=source, lines=lines)
 
@@ -307,6 +284,66 @@ class DutyCycle:
             points, limits["max_velocity"], limits["max_acceleration"], rate, rest
         )
         return cls(names, t, q, qd, qdd, payload)
+
+
+def joint_positions(
+    table: Any, joint_names: Sequence[str], prismatic: Sequence[str], source: str, header_line: int
+) -> np.ndarray:
+    """The joints' columns of a table (text cells) in SI, shape (rows, joints): rad, or m for ``prismatic``.
+
+    Each joint's header names its unit (``shoulder [deg]``, ``slide [mm]``): a bare angle could be degrees or
+    radians. A cell that is not a number is NaN (the callers locate it).
+
+    Raises
+    ------
+    TrajectoryError: a joint without a column, a column without a unit or with one of another kind.
+    """
+    columns = {HEADER.match(str(c)).group("name"): str(c) for c in table.columns}  # type: ignore[union-attr]
+    missing = [name for name in joint_names if name not in columns]
+    if missing:
+        raise TrajectoryError(
+            source,
+            f"no column for joint(s) {', '.join(missing)}; the header names {list(columns.values())}, "
+            "and needs one column per joint: " + ", ".join(joint_names),
+            header_line,
+        )
+    bare = [columns[name] for name in joint_names if not (HEADER.match(columns[name]).group("unit") or "")]  # type: ignore[union-attr]
+    if bare:
+        name = HEADER.match(bare[0]).group("name")  # type: ignore[union-attr]
+        raise TrajectoryError(
+            source,
+            f"joint column(s) {', '.join(map(repr, bare))} without a unit: write '{name} [deg]' or "
+            f"'{name} [rad]' (a bare angle could be either; a prismatic joint's '[mm]')",
+            header_line,
+        )
+    return np.column_stack(
+        [
+            _column(
+                table,
+                columns[name],
+                "m" if name in prismatic else "rad",
+                f"joint {name!r}",
+                source,
+                header_line,
+            )
+            for name in joint_names
+        ]
+    )
+
+
+def _column(
+    table: Any, column: str, default_unit: str, what: str, source: str, header_line: int
+) -> np.ndarray:
+    """A column's values in SI, by the unit its header names (``default_unit`` when it names none)."""
+    import pandas as pd
+
+    match = HEADER.match(column)
+    unit = (match.group("unit") if match else None) or default_unit
+    try:
+        scale = unit_factor(unit, default_unit, what, source)
+    except TraceError as error:
+        raise TrajectoryError(source, error.reason, header_line) from None
+    return pd.to_numeric(table[column], errors="coerce").to_numpy(dtype=float) * scale
 
 
 def _read_table(path: str | os.PathLike[str]) -> tuple[int, Any]:

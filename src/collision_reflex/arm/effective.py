@@ -1,7 +1,7 @@
 """Effective 1D collision parameters of an arm along many directions at once, and their collision impulses.
 
-The paper's section "Collision Reflex in Higher Dimensions", ``eq:eff_mf`` to ``eq:eff_a``; the README's
-"Model decisions".
+The paper's section "Collision Reflex in Higher Dimensions", ``eq:eff_mf`` to ``eq:eff_a``; the documentation's
+model page ("The model") for the decisions taken where the paper is ambiguous.
 
 :func:`effective_parameters` maps :class:`ArmSamples` and unit directions ``u`` to ``m_f``, ``m_r``, ``k``,
 ``k_m``, ``F_a`` and ``a``; :func:`collision_impulses` applies the 1D model of

@@ -64,9 +64,9 @@ def _cachedexample_robot(name: str) -> tuple[Any, str, np.ndarray]:
 def _kinematic_model(name: str) -> tuple[Any, str, np.ndarray] | None:
     """The robot's model, URDF path and reference posture read as its loader does, without its meshes.
 
-    ``example_robot_data.load`` also builds the visual and collision geometry (0.6-0.7 s for the Panda or
-    UR5); the kinematic and inertial model alone takes milliseconds. The loader's own class attributes say
-    where its files are. None (and the caller loads the whole robot) for anything this does not cover.
+    ``example_robot_data.load`` also builds the visual and collision geometry, which is slow; the kinematic and
+    inertial model alone is fast. The loader's own class attributes say where its files are. None (and the
+    caller loads the whole robot) for anything this does not cover.
     """
     import pinocchio as pin
     from example_robot_data import robots_loader

@@ -29,6 +29,8 @@ SUBCOMMANDS = (
     "surface",
     "fit",
     "simulate",
+    "robots",
+    "init",
     "validate",
     "schema",
     "run",
@@ -64,8 +66,8 @@ def start_up() -> Iterator[None]:
 
     For the imports and first steps of a command: their objects (modules, classes, schemas, the unit registry)
     live to its end, and the collector would walk them again and again as they are created, and at each full
-    collection (~0.05 s of a 0.5 s ``crx validate``). They are frozen (:func:`gc.freeze`) at the end of the
-    block, with the garbage among them (~1 MB after ``crx validate``'s start-up).
+    collection. They are frozen (:func:`gc.freeze`) at the end of the block, with the little garbage among
+    them.
     """
     collecting = gc.isenabled()
     gc.disable()

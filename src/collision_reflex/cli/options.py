@@ -6,8 +6,9 @@ one flag each; deprecated spellings go through one mechanism.
 Rules, the same for every subcommand:
 
 - A bare number is in the option's unit, shown in brackets in ``--help``: SI everywhere (m, kg, N, N/m,
-  N*m/rad, m/s, s, Hz), angles in degrees. Any value may carry a unit instead (``60mm``, ``"2e7 N/m"``,
-  ``10ms``), read by the study files' pint parser; a unit of another dimension is an error naming the option.
+  N*m/rad, m/s, s, Hz). An angle needs its unit (``30deg``, ``0.5rad``), as in study files: a bare angle could
+  be degrees or radians. Any value may carry a unit instead (``60mm``, ``"2e7 N/m"``, ``10ms``), read by the
+  study files' pint parser; a unit of another dimension is an error naming the option.
 - A contact-level quantity (1D, along the contact direction) and a joint-level one are different quantities
   with different flags: ``--mech-stiffness`` [N/m] at the contact, ``--joint-mech-stiffness`` [N*m/rad] at a
   joint.
@@ -28,8 +29,8 @@ from typing import Any, Literal, NoReturn
 import numpy as np
 
 UNITS_EPILOG = (
-    "A bare number is in the unit shown in brackets (SI; angles in degrees). Any physical value may carry a "
-    "unit instead: 60mm, '2e7 N/m', 10ms, '1.3 N*m' (quote values with spaces)."
+    "A bare number is in the unit shown in brackets (SI); an angle needs its unit (30deg, 0.5rad). Any physical "
+    "value may carry a unit instead: 60mm, '2e7 N/m', 10ms, '1.3 N*m' (quote values with spaces)."
 )
 
 
@@ -59,6 +60,8 @@ class Quantity:
     """What an option measures: the unit of a bare number, and how to name it in messages.
 
     ``unit`` is a pint unit expression; ``shown`` is how ``--help`` writes it (``-`` for a pure number).
+    ``bare``: a bare number is read in ``unit``; False (angles) refuses it: degrees and radians both read
+    naturally.
     """
 
     unit: str
@@ -66,6 +69,7 @@ class Quantity:
     example: str
     metavar: str
     shown: str = ""
+    bare: bool = True
 
     @property
     def label(self) -> str:
@@ -84,7 +88,7 @@ ACCELERATION = Quantity("m/s^2", "an acceleration", "20 m/s^2", "M/S2")
 DAMPING = Quantity("N*s/m", "a damping", "5 N*s/m", "N*S/M")
 TIME = Quantity("s", "a time", "10ms", "S")
 FREQUENCY = Quantity("Hz", "a frequency", "1 kHz", "HZ")
-ANGLE = Quantity("deg", "an angle", "45deg", "DEG")
+ANGLE = Quantity("deg", "an angle", "45deg", "DEG", shown="deg/rad", bare=False)
 NUMBER = Quantity("", "a pure number", "0.5", "X", shown="-")
 
 Bound = Literal["positive", "non-negative", "any"]
@@ -121,6 +125,11 @@ class QuantityParser:
         if not parts:
             raise argparse.ArgumentTypeError(f"{text!r} is not a comma-separated list")
         _same_unit_rule(text, parts)
+        if not self.quantity.bare and any(_is_number(part) for part in parts):
+            raise argparse.ArgumentTypeError(
+                f"{text!r} has no unit: {self.quantity.what} needs one on every value, e.g. "
+                + ",".join(f"{part}deg" for part in parts[:2])
+            )
         if self.form == "list":
             try:
                 return np.array([self.one(part) for part in parts])
@@ -140,6 +149,10 @@ class QuantityParser:
         except ValueError:
             value = self._with_unit(stripped)
         else:
+            if not self.quantity.bare:
+                raise argparse.ArgumentTypeError(
+                    f"{text!r} has no unit: {self.quantity.what} needs one, e.g. {stripped}deg or {stripped}rad"
+                )
             if self.bare_unit is not None:
                 value = self._with_unit(f"{stripped} {self.bare_unit}")
         if not math.isfinite(value) or not self._in_bounds(value):
@@ -179,6 +192,21 @@ class QuantityParser:
         if count > 1 and stop <= start:
             raise argparse.ArgumentTypeError(f"{text!r}: STOP must be greater than START")
         return np.geomspace(start, stop, count)
+
+
+def joint_position(text: str) -> float:
+    """A joint position given on the command line, in SI: an angle in rad or (prismatic) a length in m.
+
+    It needs its unit (``30deg``, ``0.5rad``, ``0.1m``), as in study files.
+    """
+    from pydantic_core import PydanticCustomError
+
+    from ..study.quantities import joint_position_si
+
+    try:
+        return joint_position_si(text.strip())[0]
+    except PydanticCustomError as error:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected {error.message()}") from None
 
 
 def _same_unit_rule(text: str, parts: Sequence[str]) -> None:
@@ -318,6 +346,9 @@ _RANGE_HINT = "START:STOP:N (N log-spaced values) or v1,v2,..."
 # Contact-level quantities (1D, along the contact direction): the paper's symbols as destinations.
 FINGER_MASS = Option("--finger-mass", "m_f", MASS, "finger (sprung) mass m_f at the contact")
 ROBOT_MASS = Option("--robot-mass", "m_r", MASS, "robot (unsprung) mass m_r at the contact")
+RATED_PAYLOAD = Option(
+    "--payload", "payload", MASS, "the robot's rated payload (its datasheet's)", bound="non-negative"
+)
 MECH_STIFFNESS = Option(
     "--mech-stiffness", "k_m", LINEAR_STIFFNESS, "mechanical stiffness k_m at the contact"
 )
@@ -446,7 +477,7 @@ SECOND_JOINT_ANGLES = Option(
     "second joint angles of the grid's first row",
     bound="non-negative",
     form="list",
-    hint="a1,a2,...",
+    hint="a1,a2,..., each with its unit (45deg, 0.8rad)",
 )
 
 

@@ -20,7 +20,7 @@ from . import options
 if TYPE_CHECKING:  # the simulator is imported when the command runs, not when `crx` starts
     from ..simulate import CollisionSetup, Detection, Sweep
 
-# Defaults: a light direct-drive finger (the README's example) whose robot mass the spring does push back.
+# Defaults: a light direct-drive finger (the getting-started example) whose robot mass the spring does push back.
 _DEFAULTS = {"m_f": 0.2, "m_r": 0.5, "k_m": 1000.0, "k_s": 100.0, "F_s": 3.0, "F_a": 10.0}
 
 

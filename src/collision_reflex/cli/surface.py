@@ -29,7 +29,7 @@ _DEFAULTS = {
     "task_stiffness": 100.0,
     "mechanical_stiffness": 250.0,
     "software_stiffness": math.inf,
-    "q2_values": "90,45,20,5,0",
+    "q2_values": "90deg,45deg,20deg,5deg,0deg",
     "stator_diameters": "10mm,30mm,60mm,100mm",
     "velocities": "0.1,0.25,0.5,1,2",
 }
@@ -94,12 +94,12 @@ def _add_arm_options(parser: argparse.ArgumentParser) -> None:
     )
     add(
         "--q",
-        type=float,
+        type=options.joint_position,
         nargs="+",
         default=None,
-        metavar="DEG",
-        help="joint angles [deg] (prismatic joints [m]); default q1 = 0, q2 = 45 for a planar arm, the robot's "
-        "reference pose otherwise",
+        metavar="Q",
+        help="joint positions [deg/rad/m], each with its unit (30deg, 0.5rad; a prismatic joint's 0.1m); default q1 = 0, "
+        "q2 = 45deg for a planar arm, the robot's reference pose otherwise",
     )
 
 
@@ -270,19 +270,19 @@ def _plot_spatial(
     return plot_spatial_surface(args.plot, baseline, sections, title)
 
 
-def _configuration(arm: Arm, degrees: list[float] | None) -> np.ndarray:
-    """The configuration of ``degrees`` [deg] (prismatic joints [m]), else the default pose (see ``--q``)."""
+def _configuration(arm: Arm, positions: list[float] | None) -> np.ndarray:
+    """The configuration of ``positions`` [rad, prismatic joints m], else the default pose (see ``--q``)."""
     from ..errors import InvalidParameter
 
-    if degrees is None:
+    if positions is None:
         if arm.task_dim == 2 and not np.any(arm.reference_configuration):
             angles = np.zeros(arm.nv)
             angles[1] = math.radians(45.0)
             return arm.configuration(angles)
         return arm.reference_configuration.copy()
-    if len(degrees) != arm.nv:
-        raise InvalidParameter("--q", degrees, f"{arm.nv} joint angles [deg], one per joint of {arm.name}")
-    return arm.configuration(np.radians(degrees))
+    if len(positions) != arm.nv:
+        raise InvalidParameter("--q", positions, f"{arm.nv} joint positions, one per joint of {arm.name}")
+    return arm.configuration(np.asarray(positions, dtype=float))
 
 
 def _print_summary(arm: Arm, surface: ReflexSurface) -> None:

@@ -51,12 +51,12 @@ REFLECTED_INERTIA_PLACEMENTS: tuple[str, ...] = ("finger", "robot")
 def gear_ratio_for(torque_required: ArrayLike, peak_torque: ArrayLike) -> float | np.ndarray:
     """The smallest gear ratio that meets a torque requirement: ``N = max(1, tau_req / tau_p)``.
 
+    Floats and NumPy arrays (broadcast); the paper's sweep rule (``tab:motor_params``).
+
     Parameters
     ----------
     torque_required: output torque the joint must deliver [N m], > 0.
     peak_torque: the motor's peak torque ``tau_p`` [N m], > 0.
-
-    Floats and NumPy arrays (broadcast); the paper's sweep rule (``tab:motor_params``).
     """
     _validate.positive("torque_required", torque_required)
     _validate.positive("peak_torque", peak_torque)

@@ -27,9 +27,8 @@ Two things depend on all samples and are handled as follows, never silently:
   (``ActiveSetResult.method`` says so).
 - The tie-break pull toward a lower mean impulse (:data:`collision_reflex.optimize.objectives.TIE_BREAK_WEIGHT`,
   1e-3 of the objective) acts on the active samples' mean: it picks among designs of equal worst case, and may
-  place the undetermined variables elsewhere than the full solve does (measured on the tests' Panda problem:
-  the mean impulse 1e-6 relative above the full solve's, the worst case within 1e-10 and the full NLP's
-  objective within 1e-9).
+  place the undetermined variables elsewhere than the full solve does (the worst case is the same, the mean
+  impulse over all samples may be a little higher).
 """
 
 from __future__ import annotations
@@ -69,15 +68,10 @@ __all__ = [
 ACTIVE_SET_THRESHOLD = 128
 """Number of samples from which ``active_set="auto"`` solves a problem on active sets.
 
-Measured on 2 cores at a load average of 0.6-1.4 (wall times), one solve each in a fresh process
-(``benchmarks/optimize_samples_scaling.py --threshold``). The Panda benchmark problem at 64 / 128 / 256 / 512 /
-1,024 samples: full NLP 0.56 / 1.08 / 1.91 / 6.68 / 73 s against 0.62 / 0.55 / 0.77 / 0.69 / 0.68 s on active sets;
-``studies/ur5.yaml`` (duty cycle, weighted objective) at 70 / 126 / 252 / 336 / 504 samples: 0.69 / 0.70 / 1.20 /
-1.64 / 2.49 s against 0.76 / 0.62 / 0.73 / 0.88 / 0.61 s. Below about 100 samples the two are alike (the active
-set then holds most samples); from 126 samples the active set was faster in every case. The whole UR5 study at
-its 336 samples (``crx run``, serial, ``benchmarks/study_runs.py``): 18.9 s on active sets against 35.4 s as one
-NLP, the same front within 3e-5 relative (the active set's equal or lower). An earlier measurement (512) predates
-the duty cycle's row reduction and the screened multi-start, which had made each start's active set expensive."""
+Chosen from one solve of each method, each in a fresh process, on the Panda benchmark problem and on
+``studies/ur5.yaml`` (duty cycle, weighted objective) at sample counts around it
+(``benchmarks/optimize_samples_scaling.py --threshold`` measures them): with few samples the two are alike (the
+active set then holds most samples), with more the full NLP's cost grows much faster than the active set's."""
 
 ACTIVE_SET_CHOICES = ("auto", "always", "never")
 """How a problem's samples are solved: ``auto`` on an active set from :data:`ACTIVE_SET_THRESHOLD` samples,

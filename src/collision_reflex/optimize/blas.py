@@ -28,8 +28,8 @@ def single_threaded_blas() -> contextlib.AbstractContextManager[object]:
 def _load_casadi_openblas() -> None:
     """Load IPOPT with its OpenBLAS now: threadpoolctl limits only the libraries already loaded.
 
-    CasADi loads them with the first solver; without this, a first solve spins two BLAS threads (measured:
-    the kernel took as much time as the solve itself).
+    CasADi loads them with the first solver; without this, a first solve spins two BLAS threads, whose
+    contention costs kernel time on the small matrices here.
     """
     import casadi
     import threadpoolctl

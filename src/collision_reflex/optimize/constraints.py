@@ -343,8 +343,8 @@ def binding_torque_demands(
     A demand whose largest value over the box of actuator masses ``[mass_low, mass_high]`` [kg] is below another
     demand's smallest value there never sets the requirement, so it is left out: an exact reduction (on arms,
     from two rows per sampled configuration to a handful). The stronger pairwise test of
-    :func:`undominated_rows` is not applied here: on the Panda benchmark it kept 9 of 74 rows and raised one
-    solve's IPOPT iterations from 61 to 114 (the same optimum), its 20-point front's from 521 to 579.
+    :func:`undominated_rows` is not applied here: on the Panda benchmark it kept fewer rows but raised the IPOPT
+    iterations of a solve and of a front (to the same optimum).
     """
     rows, labels = torque_requirement_rows(samples, constraints, joint_names)
     demands = []

@@ -2,8 +2,8 @@
 
 The NLP is ``f, g = outer(x, Y(x), p)``, where column ``s`` of ``Y`` (impulse, force threshold, ``w^T x``) is the
 per-sample function of the sample's own variables ``v_s`` (the design's log values, ``log(1/F_a)`` and the
-finger-mass direction: about 30 entries). Differentiating the whole expanded NLP symbolically costs seconds
-(the Hessian alone has about a million nodes for 256 samples); here each sample's Jacobian and Hessian are
+finger-mass direction: about 30 entries). Differentiating the whole expanded NLP symbolically is slow (the
+Hessian's graph grows with every sample); here each sample's Jacobian and Hessian are
 differentiated once in SX over ``v_s``, mapped over the samples, and combined with the outer part's derivatives
 by the chain rule::
 
@@ -11,8 +11,8 @@ by the chain rule::
     hess L = T^T hess(outer L) T + sum_s P_s^T (sum_k ybar_sk hess y_sk) P_s,   T = [I; J],
 
 with ``J = dY/dx`` (block-sparse), ``ybar = sigma f_Y + g_Y^T lambda`` and ``P_s`` the selection of ``v_s``.
-IPOPT gets the NLP's values the same way (:func:`structured_nlp`): on the Panda benchmark, expanding the whole NLP
-to SX and building a solver on it took 0.2-0.3 s CPU, three times the per-sample differentiation.
+IPOPT gets the NLP's values the same way (:func:`structured_nlp`): expanding the whole NLP to SX and building a
+solver on it is slower than the per-sample differentiation.
 """
 
 from __future__ import annotations
@@ -52,8 +52,7 @@ def _scatter(rows: np.ndarray, cols: np.ndarray, shape: tuple[int, int]) -> tupl
     keys = cols.astype(np.int64) * shape[0] + rows
     unique, position = np.unique(keys, return_inverse=True)
     # Built column-compressed: the sorted keys are already in CasADi's (column-major) order and the summing
-    # matrix has one entry per column, so nothing is sorted again (the UR5 study's two scatters: 9.6 ms CPU
-    # against 12.3 ms from triplets, measured, medians of 31 at load 2.6).
+    # matrix has one entry per column, so nothing is sorted again (faster than building them from triplets).
     pattern = ca.Sparsity(
         shape[0],
         shape[1],
@@ -69,8 +68,7 @@ def _scatter(rows: np.ndarray, cols: np.ndarray, shape: tuple[int, int]) -> tupl
 def dense_dm(values: np.ndarray) -> ca.DM:
     """``ca.DM(values)`` for a 2-D array, every entry a structural nonzero, built from a flat list.
 
-    The same matrix, faster than CasADi's conversion of a NumPy array: 3.7 ms CPU against 6.9 ms for the UR5
-    study's 259 x 336 sample data (measured, medians of 31 at load 2.6).
+    The same matrix, faster than CasADi's conversion of a NumPy array.
     """
     values = np.asarray(values, dtype=float)
     if values.ndim == 1:
@@ -125,7 +123,7 @@ def derivative_functions(structure: SampleStructure) -> dict[str, ca.Function]:
     y = sample(v, data, scale)
     jacobian = ca.jacobian(y, v)
     hessian = ca.triu(ca.hessian(ca.dot(weights, y), v)[0])
-    # Common subexpressions merged: 4 % fewer operations in the Hessian, the same values.
+    # Common subexpressions merged: fewer operations in the Hessian, the same values.
     first = ca.Function("sample_jacobian", [v, data, scale], [y, _nonzeros(jacobian)], {"cse": True})
     second = ca.Function("sample_hessian", [v, data, scale, weights], [_nonzeros(hessian)], {"cse": True})
 
@@ -160,7 +158,7 @@ def derivative_functions(structure: SampleStructure) -> dict[str, ca.Function]:
     jac_g = jac[:, :n_x] + ca.mtimes(jac[:, n_x:], jac_y)
 
     # The Hessian needs Y only through the outer part, and then the outputs alone: an outer part linear in Y
-    # (the usual case) needs no per-sample evaluation besides the Hessians (a fifth of their cost saved).
+    # (the usual case) needs no per-sample evaluation besides the Hessians (an evaluation of the samples saved).
     y_second: ca.MX | ca.DM = ca.DM.zeros(n_y, n_samples)
     if any(ca.depends_on(e, ca.vec(yo)) for e in (ybar_expression, hess_expression)):
         y_second = sample.map(n_samples)(variables, *constants)

@@ -13,13 +13,14 @@ faster even in series. On active sets of the samples (``active_set``, :func:`sol
 epsilon point starts from the first anchor's active set and its last NLP (point and multipliers), and each
 lexicographic step from its anchor's active set.
 
-Barrier strategy per kind of solve (measured on the Panda benchmark, 256 samples): a cold anchor with IPOPT's
-monotone barrier from ``mu = 1e-2`` (77 iterations; adaptive: 122, each dearer); an epsilon point warm-started
-from the anchor with the adaptive barrier (25-27 iterations; from the point alone, monotone: 63-134; on the
-UR5 study the point alone, its approach velocity raised to the point's bound, with the monotone barrier from
-``mu = 1e-4`` is the better start: :func:`warm_started_points`, :data:`POINT_START_OPTIONS`); a
-lexicographic step with the adaptive barrier and at most :data:`LEXICOGRAPHIC_MAX_ITER` iterations (about 35;
-monotone: the 500-iteration cap, its bound held within :data:`ANCHOR_SLACK` being nearly degenerate).
+Barrier strategy per kind of solve, each the one that needed the fewest IPOPT iterations on the Panda
+benchmark: a cold anchor with IPOPT's monotone barrier from ``mu = 1e-2`` (the adaptive barrier needs more
+iterations, each dearer); an epsilon point warm-started from the anchor with the adaptive barrier (from the
+point alone, monotone, it needs far more; on the UR5 study the point alone, its approach velocity raised to the
+point's bound, with the monotone barrier from ``mu = 1e-4`` is the better start: :func:`warm_started_points`,
+:data:`POINT_START_OPTIONS`); a lexicographic step with the adaptive barrier and at most
+:data:`LEXICOGRAPHIC_MAX_ITER` iterations (monotone, it runs into the 500-iteration cap, its bound held within
+:data:`ANCHOR_SLACK` being nearly degenerate).
 """
 
 from __future__ import annotations
@@ -97,8 +98,8 @@ LEXICOGRAPHIC_OPTIONS: dict[str, str | float] = {
 OPTIMUM_STARTS = 4
 """Start points of the single-objective solve by default: the given start and three seeded random ones (see
 :func:`collision_reflex.optimize.solve.solve`), against local optima of the non-convex worst case. Each start is
-screened at a loose tolerance and only those on distinct central paths are finished: on the studies' optimum
-272 iterations against 421 (Panda) and 288 against 432 (UR5), the same optimum to 2e-7 relative."""
+screened at a loose tolerance and only those on distinct central paths are finished: fewer iterations than
+finishing every start, for the same optimum."""
 
 
 class ProblemBuilder(Protocol):
@@ -238,6 +239,10 @@ def pareto_front(
 ) -> ParetoSet:
     """Pareto set of two or three objectives by epsilon-constraint sweeps.
 
+    Anchors first: each objective is minimised, then (lexicographically) the others are minimised with it held
+    at its optimum, so every anchor is non-dominated. The bounds on the other objectives are then spread
+    evenly between the anchors; every point starts from the first objective's anchor (module docstring).
+
     Parameters
     ----------
     build: ``build(objective, bounded_objectives) -> DesignProblem``, e.g.
@@ -264,10 +269,6 @@ def pareto_front(
         :func:`single_optimum` finds it, from at least ``anchor_starts`` starts and with the same
         ``active_set``): such an anchor takes it as its first solve instead of solving again
         (:func:`solve_anchor`), so that the front's end is that optimum.
-
-    Anchors first: each objective is minimised, then (lexicographically) the others are minimised with it held
-    at its optimum, so every anchor is non-dominated. The bounds on the other objectives are then spread
-    evenly between the anchors; every point starts from the first objective's anchor (module docstring).
 
     Raises
     ------
@@ -323,9 +324,9 @@ def pareto_front(
         f"point-{i:03d}": (solve_point, (build, names, epsilon, start, ipopt_options, active_set, initial))
         for i, epsilon in enumerate(grid)
     }
-    # Submitted from the far end of the grid, whose points are the farthest from their start and the dearest
-    # (UR5 study, 18 points: 2.6-6.7 s CPU, one 23 s, near the end): a worker then does not solve the dearest
-    # point alone while the others idle. Each point is a pure function of its bounds: the order changes no number.
+    # Submitted from the far end of the grid, whose points are the farthest from their start and the dearest:
+    # a worker then does not solve the dearest point alone while the others idle. Each point is a pure function
+    # of its bounds: the order changes no number.
     solved = sweep.run(dict(reversed(point_tasks.items())))
     pieces = [*anchors.values(), *(solved[name] for name in point_tasks)]
     label = {id(p.result): p.label for p in pieces if p.result is not None}
@@ -518,10 +519,10 @@ def one_at_a_time(function: Callable[_P, _R]) -> Callable[_P, _R]:
 def warm_started_points(names: Sequence[str]) -> bool:
     """Whether a sweep of ``names`` starts its epsilon points from the anchor's multipliers (module docstring).
 
-    Not when the approach velocity is bounded: measured on the UR5 study (impulse against approach velocity),
-    the points warm-started from the anchor took 111-400+ iterations with the adaptive barrier (153-400+
-    monotone), from the anchor's point alone with the monotone barrier 94-127 (and, since the start meets the
-    point's velocity bound from ``mu = 1e-4``, :data:`POINT_START_OPTIONS`, 64-91 in the study's sweep).
+    Not when the approach velocity is bounded: on the UR5 study (impulse against approach velocity) the points
+    warm-started from the anchor needed far more iterations, with either barrier, than from the anchor's point
+    alone with the monotone barrier (and fewer still once the start meets the point's velocity bound, from
+    ``mu = 1e-4``: :data:`POINT_START_OPTIONS`).
     """
     return "approach_velocity" not in names[1:]
 
@@ -668,9 +669,9 @@ def anchor_start(
 
     The anchor's problem is the same with rows that bound ``bounded`` (loose at the anchor), so the optimum is
     its optimum: its multipliers are carried by row label (:func:`collision_reflex.optimize.solve.warm_start`,
-    a bound's at zero), on active sets those of its last NLP, for the epsilon points' warm starts. On the Panda
-    study this saves the anchor's own solve (108 IPOPT iterations) and makes the front's end the multi-started
-    optimum rather than a single start's. None when the two problems' variables differ (bounding the worst
+    a bound's at zero), on active sets those of its last NLP, for the epsilon points' warm starts. This saves
+    the anchor's own solve and makes the front's end the multi-started optimum rather than a single start's.
+    None when the two problems' variables differ (bounding the worst
     case adds its epigraph variable): the anchor is then solved.
 
     Raises
@@ -706,10 +707,10 @@ def anchor_start(
 
 POINT_START_OPTIONS: dict[str, str | float] = {"ipopt.mu_init": 1e-4}
 """IPOPT options, under the sweep's, of an epsilon point started from the anchor's point alone (monotone barrier
-from a smaller ``mu`` than a cold solve's 1e-2: the anchor's point is near the front). Measured on the UR5 study's
-8 points, each started at the anchor's design with the approach velocity raised to its bound
-(:func:`velocity_within_bound`): 658 iterations (76-95 a point) against 751 from ``mu = 1e-2``, 719 from 1e-3;
-from 1e-6, 820 with two points retried; the same objectives to 1e-7 relative."""
+from a smaller ``mu`` than a cold solve's 1e-2: the anchor's point is near the front). On the UR5 study's
+points, each started at the anchor's design with the approach velocity raised to its bound
+(:func:`velocity_within_bound`), it needed fewer iterations than ``mu = 1e-2`` or 1e-3, and than 1e-6, with
+which some points needed a retry; the objectives were the same."""
 
 
 def velocity_within_bound(
@@ -719,9 +720,9 @@ def velocity_within_bound(
 
     The anchor of the worst-case impulse sits at the slowest approach; an epsilon point demands a faster one,
     which the start then meets, its auxiliaries (epigraph, reaction) set at their exact values for it. On the
-    UR5 study's 8 points, with :data:`POINT_START_OPTIONS`: 658 iterations against 931 from the anchor's point as
-    it is (CPU 19 s against 30 s), every objective within 1e-7 relative of the old one; from ``mu = 1e-2`` (751
-    iterations) one point stopped 9e-6 worse. A start without a velocity bound, or with a fixed velocity, is kept.
+    UR5 study's points, with :data:`POINT_START_OPTIONS`, that takes fewer iterations than the anchor's point
+    as it is, to the same objectives (from ``mu = 1e-2`` a point may stop at a worse design). A start without a
+    velocity bound, or with a fixed velocity, is kept.
     """
     start = np.array(start, dtype=float)
     bound = epsilon.get("approach_velocity")
@@ -935,11 +936,10 @@ class Recommendation:
 RESOLUTION = 1e-3
 """Relative difference in an impulse objective below which the recommendation does not rank designs by it.
 
-Measured on the Panda study (mean impulse, 96 samples): the same multi-start's four paths stop 0.05 % apart in
-the objective at IPOPT's ``tol`` 1e-7 and again 0.04 % apart at 1e-8, each moving by up to 0.05 % between the
-two, as the objective is that flat; its designs 0.02 % apart in mean impulse differ by 0.7 kg of actuators. The
-closed form itself agrees with the time-domain simulation within a few per cent at best (the validity map), so
-a difference of 0.1 % is no reason to build a heavier arm."""
+An objective as flat as the Panda study's mean impulse leaves the same multi-start's paths apart by more
+than IPOPT's ``tol`` in the objective, whatever that ``tol``, and designs alike in impulse may differ much in
+actuator mass. The closed form itself agrees with the time-domain simulation far less closely than 0.1 % (the
+validity map, ``benchmarks/validity_map.py``), so such a difference is no reason to build a heavier arm."""
 
 
 def recommend(optimum: DesignResult, front: ParetoSet | None, objective: Hashable) -> Recommendation:

@@ -1,6 +1,6 @@
 """Build the actuator-design NLP for a URDF arm (CasADi, exact derivatives).
 
-Structure (see the README's "Design optimisation" section):
+Structure (see the guide's "Optimisation and Pareto fronts"):
 
 - Design variables, all positive, are optimised as their logarithms (:mod:`.layout`): per joint the stator
   diameter (and optionally stack length) of a motor scaled from a reference motor, the gear ratio and the
@@ -630,8 +630,8 @@ def _sample_structure(
     # The NLP's own design column, taken as a function of x (only its design part enters): not built again.
     design_column = ca.Function("design_column", [nlp["x"]], [design.design_column]).expand()
     local = ca.SX.sym("v", n_design + 1 + n_joints)
-    # Data the same for every sample (most motor-mass influence entries are zero) become constants: a third
-    # fewer operations in the per-sample Hessian.
+    # Data the same for every sample (most motor-mass influence entries are zero) become constants: fewer
+    # operations in the per-sample Hessian.
     varying = np.flatnonzero(np.any(per_sample.data != per_sample.data[:, :1], axis=1))
     data = ca.SX.sym("data", varying.size)
     column_data = ca.SX(ca.DM(per_sample.data[:, 0]))

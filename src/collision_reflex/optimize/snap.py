@@ -27,14 +27,13 @@ Each combination is solved on all samples or on an active set of them by the swe
 :func:`collision_reflex.optimize.active_set.uses_active_set`), the first round on the continuous optimum's active
 samples. Each re-solve on all samples starts from the continuous optimum's values with the gear ratios raised
 to cover the parts' own torque requirements (:func:`covering_gear_ratios`), IPOPT warm-started from the
-continuous optimum's multipliers (:func:`warm_start`): measured on the shipped studies, 780 IPOPT iterations
-for the Panda's 30 combinations and 463 for the UR5's 17, against 1,924 and 1,035 cold from the matched gear
-ratios. A combination may have more than one local optimum (measured on the UR5 study: the warm start reached
-another one than the cold start in 10 of 17 combinations, 1e-5 to 1.5e-4 apart, either way); which one is
-found depends on its start, so the start is the same for every combination (never another combination's
-solution: the result does not depend on the order of the search), and the best combination is re-solved
-cold as well, from the matched gear ratios, keeping the better (:meth:`_Search.confirm`). On an active set
-every re-solve is cold from the matched gear ratios (the continuous optimum's multipliers are its subset's).
+continuous optimum's multipliers (:func:`warm_start`), in fewer IPOPT iterations than a cold start from the
+matched gear ratios. A combination may have more than one local optimum (the warm and the cold start may reach
+different ones, either of them the better); which one is found depends on its start, so the start is the same
+for every combination (never another combination's solution: the result does not depend on the order of the
+search), and the best combination is re-solved cold as well, from the matched gear ratios, keeping the better
+(:meth:`_Search.confirm`). On an active set every re-solve is cold from the matched gear ratios (the continuous
+optimum's multipliers are its subset's).
 
 The objective is the problem's own, without the objective bounds of an epsilon-constraint point: a Pareto design
 snapped is the study objective's best design of those parts. A catalogue design is the continuous problem with
@@ -117,7 +116,7 @@ COVERAGE_MARGIN = 0.1
 largest stator diameter and peak torque counts as covered (its nearest part is then at most that far)."""
 REQUIREMENT_PASSES = 4
 """Passes of :func:`evaluate_parts` raising the gear ratios to the requirement of the parts' own masses (it
-changes little with the ratio: two passes settle it to 1e-6 on the shipped studies)."""
+changes little with the ratio: a few passes settle it)."""
 BOUND_TOLERANCE = 1e-6
 """Relative slack on the motor bounds and the torque screen: a part at a bound is within it, and IPOPT's
 optimum may pass a bound by its relaxation (1e-8 relative)."""
@@ -750,8 +749,8 @@ class _Search:
         """Solve ``combination`` again from the continuous optimum's values alone (cold) and keep the better.
 
         The warm start may lead a combination to another of its local optima than the cold start from the same
-        values does (measured on the UR5 study: 10 of 17 combinations, 1e-5 to 1.5e-4 relative, either way);
-        the chosen parts' design is then never worse than the cold start's.
+        values does, either of them the better; the chosen parts' design is then never worse than the cold
+        start's.
         """
         parts = tuple(self.parts[j][i] for j, i in enumerate(combination))
         (solved,) = self.solve_many([parts], warm=False)
@@ -768,8 +767,8 @@ class _Search:
 
         A step solves every candidate of one joint with the others held (one batch) and moves to the best, if
         it is better than the current design by more than :data:`collision_reflex.optimize.pareto.MERGE_TOLERANCE`
-        (relative): a smaller difference is within what re-solving repeats, and chasing it cost the Panda
-        study a third pass of 14 re-solves for 2.7e-6 (measured). The best combination tried is kept either way
+        (relative): a smaller difference is within what re-solving repeats, and chasing it costs whole passes of
+        re-solves for nothing a design would show. The best combination tried is kept either way
         (:meth:`best`).
         """
         from .pareto import MERGE_TOLERANCE
@@ -834,8 +833,7 @@ class _Search:
         For an impulse objective alone, the lightest combination within
         :data:`collision_reflex.optimize.pareto.RESOLUTION` of the least impulse, as a run recommends a continuous
         design (:func:`collision_reflex.optimize.pareto.recommend`): a smaller difference ranks no design, and
-        the lighter is the better build (on the Panda study two combinations 4.5e-5 apart in mean impulse have
-        1.080 kg and 1.098 kg of actuators).
+        the lighter is the better build.
         """
         from .pareto import lightest_alike
 
@@ -981,8 +979,7 @@ def _warm_round(
 def _subset_problem(problem: DesignProblem, arm: Arm, subset: ContactSamples) -> DesignProblem:
     """``problem`` on the samples ``subset`` (its other inputs the same), built once per process and subset.
 
-    The same for every combination of one snap (measured on the UR5 study: one build instead of 17, 30-40 ms
-    each).
+    The same for every combination of one snap: one build serves all of them.
     """
     from .problem import build_problem
 

@@ -30,7 +30,7 @@ IpoptOptions = Mapping[str, str | float]
 
 DEFAULT_IPOPT_OPTIONS: dict[str, str | float] = {
     # For an NLP that CasADi differentiates itself (the feasibility solve): expanding its MX graph (mapped
-    # per-sample functions) to SX makes every derivative evaluation an order of magnitude cheaper. The
+    # per-sample functions) to SX makes every derivative evaluation much cheaper. The
     # design solvers get SX functions assembled per sample (DesignProblem.solver), nothing to expand.
     "expand": True,
     "ipopt.print_level": 0,
@@ -38,24 +38,21 @@ DEFAULT_IPOPT_OPTIONS: dict[str, str | float] = {
     "print_time": False,
     "ipopt.tol": 1e-8,
     "ipopt.max_iter": 500,
-    # Monotone barrier from mu = 1e-2: on arm problems about half the iterations of the adaptive strategy,
-    # to the same optimum (benchmarks/optimize_panda.py).
+    # Monotone barrier from mu = 1e-2: on arm problems (benchmarks/optimize_panda.py's) fewer iterations than
+    # the adaptive strategy, to the same optimum.
     "ipopt.mu_strategy": "monotone",
     "ipopt.mu_init": 1e-2,
     "ipopt.linear_solver": "mumps",
     # No scaling of the KKT matrix by MUMPS (neither its row and column scaling nor its permuting scaling):
     # with its default (automatic) choice the KKT matrices of the UR5 study's fast points needed delayed
-    # pivots, 8x MUMPS's memory estimate and ~0.5 s per iteration (a 100 s solve); with its option 8 the same
-    # optimum in 10 s; without scaling the same iterations and optimum again (to 1e-15 on the UR5 study's
-    # 10-point front, full NLP and active sets) in 14-18 % less CPU (UR5 study's one solve 0.99 s against 1.21 s,
-    # its front 11.5 s against 13.3 s; the Panda study's solve 0.57 s against 0.60 s; medians, idle machine).
+    # pivots, far more memory than MUMPS estimates and slow iterations; its option 8 avoids that, and without
+    # scaling the iterations and optimum are those of option 8 again, in less CPU.
     "ipopt.mumps_scaling": 0,
     "ipopt.mumps_permuting_scaling": 0,
-    # METIS ordering (MUMPS chose QAMD): on the Panda benchmark the same 61 iterations and optimum with 10 %
-    # less IPOPT time (CPU median of 7 interleaved runs 1.33 s against 1.49 s, load 8-10), most of which is
-    # MUMPS's factorizations (114 for 61 iterations: the inertia correction refactorizes); the UR5 study's
-    # sweep 1,067 iterations against 1,072 (CPU 78 s against 82 s). Skipping the residual check of each
-    # step (fast_step_computation) saved another 8 % on the Panda but cost the UR5 sweep 1,132 iterations.
+    # METIS ordering (MUMPS chose QAMD): on the Panda benchmark the same iterations and optimum in less IPOPT
+    # time, most of which is MUMPS's factorizations (the inertia correction refactorizes), and on the UR5
+    # study's sweep alike. Skipping the residual check of each step (fast_step_computation) saved more time on
+    # the Panda but cost the UR5 sweep iterations.
     "ipopt.mumps_pivot_order": 5,
 }
 WARM_START_OPTIONS: dict[str, str | float] = {
@@ -64,8 +61,8 @@ WARM_START_OPTIONS: dict[str, str | float] = {
     "ipopt.warm_start_bound_push": 1e-6,
     "ipopt.warm_start_mult_bound_push": 1e-6,
     "ipopt.mu_init": 1e-4,
-    # From a solution's multipliers the adaptive barrier needs half the iterations of the monotone one: on
-    # the Panda benchmark's epsilon points from the anchor, 25-27 against 44-58 (cold: 63-134).
+    # From a solution's multipliers the adaptive barrier needs fewer iterations than the monotone one (the
+    # Panda benchmark's epsilon points from the anchor).
     "ipopt.mu_strategy": "adaptive",
 }
 AGREEMENT_TOLERANCE = 1e-6
@@ -478,21 +475,16 @@ def warm_start(
 
 SCREENING_TOLERANCE = 1e-4
 """IPOPT's ``tol`` for the first run of every start of a multi-start (:func:`_multi_start`): the run stops on the
-central path, before the barrier's last decreases. Measured on the 4 starts of each study's optimum
-(``studies/panda.yaml``, ``studies/ur5.yaml``): 42-67 (Panda) and 34-88 (UR5) iterations against 110-168 and
-63-130 for each start solved alone to ``tol = 1e-8``; a finish from a screened point takes 53-91 (Panda) and
-31-42 (UR5) more. A looser ``tol`` changes little, as IPOPT also waits for its absolute complementarity and
-constraint-violation tolerances (1e-4 by default): in all, screening and finishes, 1e-3 and 1e-2 took 463 and
-443 iterations against 489 (Panda) and 300 against 298 (UR5, whose optimum then moved by 7e-7). IPOPT's
-acceptable level at 1e-2, or a cap of 20-40 iterations, saved 5-19 % of the Panda's iterations but split the
-UR5's merged paths (3-4 finishes instead of 2: 324-362 iterations)."""
+central path, before the barrier's last decreases: on the 4 starts of each shipped study's optimum
+(``studies/panda.yaml``, ``studies/ur5.yaml``) a screening run takes far fewer iterations than a start solved
+alone to ``tol = 1e-8``, and only the starts on distinct paths are finished from their screened points. A looser ``tol`` (1e-3, 1e-2) changes little, as IPOPT also waits for its absolute complementarity
+and constraint-violation tolerances (1e-4 by default). IPOPT's acceptable level at 1e-2, or a cap of 20-40
+iterations, saved some of the Panda's iterations but split the UR5's merged paths (more finishes)."""
 SAME_PATH_DISTANCE = 1e-3
 """Largest difference of any log design variable (0.1 % of the variable) at which two screened starts count as
-one central path, so one optimum. Measured on both studies' 4 starts: the UR5's screened starts are two pairs, each
-within 7.6e-5, the pairs 2.1e-2 apart and leading to different optima (1.4 apart in a log design variable);
-the Panda's are 4.4e-2 to 2.6 apart (none merged), two of them 4.4e-2 apart leading to optima 2.5 apart. So
-screened designs a few 1e-2 apart can be on different paths: 1e-3 merges the same pairs as 2e-2 did on both
-studies, with a margin of 20x to the closest split seen."""
+one central path, so one optimum. Chosen on both shipped studies' 4 starts: the screened starts that lead to
+one optimum lie well within it, and the closest pair seen that leads to different optima lies well beyond
+it."""
 
 
 def _multi_start(

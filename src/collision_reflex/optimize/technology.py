@@ -331,7 +331,7 @@ class JointQuantities(NamedTuple):
 
 PLACEMENT_STIFFNESS_RATIO = 10.0
 """How much stiffer than the contact (seen at the joint) a transmission must be for its rotor to take part in the
-impact. The time-domain validity map (README, "Where the arm closed form holds") sweeps the contact stiffness
+impact. The time-domain validity map (documentation: Time-domain simulation, "Where the arm closed form holds") sweeps the contact stiffness
 at 0.1, 10 and 1000 times the joints' stiffness along the contact direction: compliant joints against a
 contact ten or more times stiffer take no part of the rotor into the short impact (``robot``); a transmission
 ten times stiffer than the contact carries the rotor along (``finger``, where the closed form is an estimate).

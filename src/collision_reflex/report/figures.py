@@ -155,8 +155,8 @@ def _distinct_surfaces(featured: dict[str, dict[str, Any]]) -> dict[str, dict[st
     """The featured designs with one surface each, in order.
 
     A design whose impulse agrees with an earlier one's within :data:`collision_reflex.optimize.pareto.RESOLUTION`
-    at every sample draws the same picture: its title joins that design's instead (on the Panda study's flat
-    front the chosen design and the first Pareto design differ by 2e-5 at most).
+    at every sample draws the same picture: its title joins that design's instead (on a flat front the chosen
+    design and the first Pareto design may be such a pair).
     """
     from ..optimize.pareto import RESOLUTION
 

@@ -32,17 +32,17 @@ change of ``J`` during the contact.
 Why ``a/2`` matched the first test better than ``a`` (0.1 v*, spring-torque detection; elbow-up-x,
 elbow-up-oblique, folded-x of ``tests/test_simulate_arm.py``): two errors of opposite sign, not a factor in
 ``a``. (1) The closed form's reaction moves the robot mass at the constant ``a``; the spring compressed by
-``F_s`` pushes it away as well, ``m_r x'' = -F_a - k_m x``, and with ``F_s / F_a = 0.6-1`` the simulated
-reaction impulse is 37 %, 26 % and 18 % *below* the closed form's;
-:func:`collision_reflex.model.impulse.sprung_reaction` (derived there, an option beside the paper's reaction:
-``ArmCollision.closed_form_sprung``) matches it within 1.3 %, 1.4 % and 0.5 %. A smaller ``a`` moves the reaction the wrong way. (2) The
-spring-torque detector fires late: the impulse until detection is 5.1 %, 3.2 % and 0.9 % above ``m_f v0 +
-F_s^2 / (2 k v0)`` (the contact force at detection is 2.6 N, not 3 N, on elbow-up-x: the joint torques carry
-the links' inertia as they oscillate along the wall). ``a/2`` adds ``(sqrt(2) - 1) I3``, 2-3 % of the impulse,
-which cancels (2) less (1). With the contact-force sensor the sensing phase matches on folded-x (-0.2 %), and
-the total with the sprung reaction is within 0.1 %; on the elbow-up configurations the contact force itself
-ramps up slower than ``k v0 t`` (impulse until detection +4 % and +21 %): the operational-space inertia couples
-the wall normal to the tangent, and the 1D reduction has no term for it.
+``F_s`` pushes it away as well, ``m_r x'' = -F_a - k_m x``, and with ``F_s`` comparable to ``F_a`` the simulated
+reaction impulse is well *below* the closed form's; :func:`collision_reflex.model.impulse.sprung_reaction`
+(derived there, an option beside the paper's reaction: ``ArmCollision.closed_form_sprung``) matches it closely.
+A smaller ``a`` moves the reaction the wrong way. (2) The spring-torque detector fires late: the impulse until
+detection is above ``m_f v0 + F_s^2 / (2 k v0)`` (the contact force at detection is below ``F_s`` on
+elbow-up-x: the joint torques carry the links' inertia as they oscillate along the wall). ``a/2`` adds
+``(sqrt(2) - 1) I3``, which cancels (2) less (1). With the contact-force sensor the sensing phase matches on
+folded-x, and so does the total with the sprung reaction; on the elbow-up configurations the contact force
+itself ramps up slower than ``k v0 t`` (a larger impulse until detection): the operational-space inertia
+couples the wall normal to the tangent, and the 1D reduction has no term for it. ``benchmarks/arm_reaction.py``
+prints each phase against each model.
 """
 
 from __future__ import annotations

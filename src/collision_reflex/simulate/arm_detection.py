@@ -6,9 +6,9 @@ Each scheme gives a force-equivalent along the wall normal ``n`` that is compare
 - ``"force"``: a force sensor at the contact (the closed form's meaning of ``F_s``). Like the 1D simulator's,
   it measures its own deflection: the contact's elastic force ``k_c d`` (depth ``d``). The damper's part
   ``c_c d'`` is left out: in the Kelvin-Voigt contact it jumps at each touch, and the finger's small rebound
-  off a stiff contact after the impact would trip a sensor at once at the re-touch (measured: 47 % of the
-  sensing impulse missing at ``v*`` against 10^6 N/m), an artefact of the contact model, not a force a
-  sensor spring could follow. Against a soft, damped object the viscous part is a real share of the force
+  off a stiff contact after the impact would trip a sensor at once at the re-touch (much of the sensing impulse
+  then missing), an artefact of the contact model, not a force a sensor spring could follow. Against a soft,
+  damped object the viscous part is a real share of the force
   (:func:`collision_reflex.simulate.validity.damper_share`): there the object is not the closed form's
   elastic one.
 - ``"observer"``: the external-force estimate of a generalized-momentum observer from the joint torques, as

@@ -27,7 +27,7 @@ WATCH_PERIODS = 5
 
 SEGMENT_STEPS = 3
 """Steps' worth of work that each segment costs (a control sample or a mode change): a new solver, its first
-step and its trace points (measured: 0.35-0.6 ms a sample against 0.15 ms a step)."""
+step and its trace points cost more than a step does."""
 
 _MIN_STEPS_PER_PHASE = 10  # a phase without a time scale of its own still takes a few steps
 

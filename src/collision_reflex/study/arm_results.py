@@ -369,7 +369,7 @@ def placement_sentences(setup: ArmSetup) -> list[str]:
         lines.append(
             "Against an object softer than its transmission a joint's rotor moves with the links, but there the "
             "contact's own compliance spreads the impact, which the closed form (a rigid object) does not: the "
-            'simulator finds it overestimates the impulse (README, "Where the arm closed form holds"); treat the '
+            'simulator finds it overestimates the impulse (documentation: Time-domain simulation, "Where the arm closed form holds"); treat the '
             "impulse as an upper estimate."
         )
     if ratios is not None:
@@ -382,7 +382,7 @@ def placement_sentences(setup: ArmSetup) -> list[str]:
             lines.append(
                 f"Warning: at {', '.join(between)} the contact and the transmission are of like stiffness "
                 f"(within {PLACEMENT_STIFFNESS_RATIO:g}x): the simulator validates neither placement there "
-                '(README, "Where the arm closed form holds"); simulate the design before trusting its impulse.'
+                '(documentation: Time-domain simulation, "Where the arm closed form holds"); simulate the design before trusting its impulse.'
             )
     return lines
 
@@ -677,8 +677,8 @@ def quick_snap_record(
 
     Each joint's nearest part within bounds (:func:`collision_reflex.optimize.snap.quick_parts`) at the
     gear ratio that keeps the joint's peak torque, raised where the parts' own masses need more
-    (:func:`collision_reflex.optimize.snap.evaluate_parts`), the other variables the design's. Measured on the
-    full Panda study: 8 ms per design, where re-solving it (build and IPOPT) takes about 0.8 s. ``parts``: the
+    (:func:`collision_reflex.optimize.snap.evaluate_parts`), the other variables the design's: far cheaper than
+    re-solving it (build and IPOPT). ``parts``: the
     part per joint (None: no catalogue part within bounds, with ``missing``: the nearest part and what it
     misses); ``feasible`` and ``shortfalls``: whether it meets every torque and speed requirement as it is;
     ``objectives``, ``difference``, ``relative_difference``: as in :class:`CatalogueRecord` (empty without

@@ -75,10 +75,9 @@ START_METHOD = "fork" if sys.platform.startswith("linux") else "spawn"
 """How a local pool's or cluster's workers start: forked from this process on Linux, spawned elsewhere.
 
 A forked worker starts with what this process has loaded (the package, CasADi, Pinocchio, the robot and the
-samples) instead of importing and loading it again: on the UR5 study's 20-point front on active sets, 2
-workers, a worker's start-up took 0.0-0.1 s against 0.8 s of CPU spawned, and the front ran 1.95x faster than
-serially on the pool (1.30-1.36x spawned) and 1.82x on a local Dask cluster (1.28x), the same numbers to the
-last bit (``benchmarks/study_executors.py``, medians of 3). Forking is safe here: the pool's workers start
+samples) instead of importing and loading it again, so its start-up costs next to nothing and a parallel
+front gains more over a serial one than with spawned workers, with the same numbers to the last bit
+(``benchmarks/study_executors.py`` measures the executors). Forking is safe here: the pool's workers start
 before this process starts any thread of its own (the pool launches all of them at its first submission, and
 the run's progress bars start after), a Dask nanny forks from its event-loop thread as Dask's
 ``multiprocessing-method`` setting provides, OpenBLAS stops its threads around a fork, and nothing here runs
@@ -166,11 +165,10 @@ _LOCAL_DASK_CONFIG = {
 
 A worker's environment without Dask's ``MALLOC_TRIM_THRESHOLD_=65536`` (set to hand freed memory back to the
 system sooner): it also turns off glibc's adaptive mmap threshold, so that CasADi's and IPOPT's large work
-arrays are mapped and unmapped afresh (measured on the two-link study's 20-point front, in one process: 13 times
-the page faults, 2.3k to 30.6k, and 20-25 % more CPU). No statistical profiler (it samples every thread's stack
-every 10 ms). Each worker gets its next piece when it finishes one (saturation 1: the others wait at the
-scheduler), so no piece waits behind a long one and no stealing is needed. Slower ticks and monitors: an idle
-cluster of two workers took 7 % of a core (the scheduler in this process 4 %), with these 1 %."""
+arrays are mapped and unmapped afresh, with many more page faults and more CPU. No statistical profiler (it
+samples every thread's stack every 10 ms). Each worker gets its next piece when it finishes one (saturation 1:
+the others wait at the scheduler), so no piece waits behind a long one and no stealing is needed. Slower ticks
+and monitors: an idle cluster then takes little CPU."""
 
 
 @contextlib.contextmanager

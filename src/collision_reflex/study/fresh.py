@@ -31,7 +31,7 @@ FRESH_STREAM = 0x0F7E5
 samples' (``numpy.random.SeedSequence``)."""
 
 CHUNK_CONFIGURATIONS = 4096
-"""Fresh configurations whose kinematics are held at a time (the Panda's are about 4 kB each)."""
+"""Fresh configurations whose kinematics are held at a time (memory stays bounded however many are drawn)."""
 
 
 @dataclass(frozen=True)

@@ -13,9 +13,10 @@ from typing import Any
 import yaml
 
 from .load import LoadedStudy
+from .quantities import joint_position_si
 from .schema import ArmStudy
 
-UNITS_NOTE = "All quantities in SI units: m, kg, s, N, N*m, N*m/rad, rad, m/s."
+UNITS_NOTE = "All quantities in SI units: m, kg, s, N, N*m, N*m/rad, rad, m/s (joint positions with theirs)."
 
 
 def resolved_study(loaded: LoadedStudy) -> dict[str, Any]:
@@ -32,7 +33,23 @@ def resolved_study(loaded: LoadedStudy) -> dict[str, Any]:
         cycle = data["duty_cycle"]
         if cycle is not None and cycle["file"] is not None:
             cycle["file"] = str(loaded.path(cycle["file"]))
+        for path in (("samples", "configurations", "list"), ("duty_cycle", "via")):
+            _with_units(data, loaded.source.data, path)
     return data
+
+
+def _with_units(data: dict[str, Any], source: Any, path: tuple[str, ...]) -> None:
+    """Write the joint positions at ``path`` with their units (a study file refuses bare ones): SI, as given."""
+    rows: Any = data
+    written: Any = source
+    for key in path:
+        rows = rows.get(key) if isinstance(rows, dict) else None
+        written = written.get(key) if isinstance(written, dict) else None
+    if not rows:
+        return
+    for row, written_row in zip(rows, written, strict=True):
+        for j, (value, text) in enumerate(zip(row, written_row, strict=True)):
+            row[j] = f"{value!r} {joint_position_si(text)[1]}"
 
 
 def resolved_yaml(loaded: LoadedStudy) -> str:

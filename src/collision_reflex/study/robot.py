@@ -7,7 +7,7 @@ the study file that names them.
 from __future__ import annotations
 
 import difflib
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from ..errors import FrameNotFound, InvalidParameter, StudyFileError, StudyProblem, UrdfError
 from .load import LoadedStudy
@@ -142,9 +142,10 @@ def check_against_arm(loaded: LoadedStudy, arm: Arm) -> list[StudyProblem]:
                 loaded.problem(
                     ("samples", "configurations", "list", index),
                     f"{len(q)} joint angles",
-                    f"{nv}, one per joint ({', '.join(joints)}) in rad",
+                    f"{nv}, one per joint ({', '.join(joints)}), each with its unit",
                 )
             )
+    problems += _position_units(loaded, arm)
     task_dim = int(arm.task_dim)
     directions = study.samples.directions
     for index, vector in enumerate(directions.list or []):
@@ -173,4 +174,29 @@ def check_against_arm(loaded: LoadedStudy, arm: Arm) -> list[StudyProblem]:
                 f"one per actuated joint ({len(joints)}: {', '.join(joints)}) in N*m",
             )
         )
+    return problems
+
+
+def _position_units(loaded: LoadedStudy, arm: Arm) -> list[StudyProblem]:
+    """An angle for each revolute joint, a length for each prismatic one, in the study's joint positions."""
+    from .duty import prismatic_joints
+    from .quantities import joint_position_si
+
+    prismatic = prismatic_joints(arm)
+    units = ["m" if name in prismatic else "rad" for name in arm.joint_names]
+    problems = []
+    for path in (("samples", "configurations", "list"), ("duty_cycle", "via")):
+        rows: Any = loaded.source.data
+        for key in path:
+            rows = rows.get(key) if isinstance(rows, dict) else None
+        for index, row in enumerate(rows if isinstance(rows, list) else []):
+            if not isinstance(row, list) or len(row) != len(units):
+                continue  # its length is refused where it is checked
+            for joint, (text, unit) in enumerate(zip(row, units, strict=True)):
+                if joint_position_si(text)[1] != unit:
+                    name = arm.joint_names[joint]
+                    kind = "a length (prismatic joint)" if unit == "m" else "an angle (revolute joint)"
+                    problems.append(
+                        loaded.problem((*path, index, joint), f"{excerpt(str(text))} for joint {name}", kind)
+                    )
     return problems

@@ -144,8 +144,10 @@ def run_study(
     executor, workers: override the study's execution settings (``serial``, ``processes``, ``dask``).
     smoke: shrink sample counts for a quick run (default: the environment variable ``CRX_SMOKE``).
 
-    Every input is checked before the output folder is touched: a bad study raises
-    :class:`~collision_reflex.errors.StudyFileError` (with its lines) and writes nothing.
+    Raises
+    ------
+    StudyFileError: a bad study, with its lines; every input is checked before the output folder is touched,
+        so nothing is written then.
     """
     from .. import __version__
 

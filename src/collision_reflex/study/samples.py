@@ -16,8 +16,9 @@ import numpy as np
 from .._table import TableProblem, header_index, read_table
 from ..arm.directions import circle_directions, sphere_directions, unit_directions
 from ..arm.domain import ContactDomain, DomainTooSmall
-from ..errors import InvalidParameter, StudyFileError, StudyProblem
-from .duty import per_joint_values
+from ..arm.duty_cycle import joint_positions
+from ..errors import InvalidParameter, StudyFileError, StudyProblem, TrajectoryError
+from .duty import per_joint_values, prismatic_joints
 from .load import LoadedStudy
 from .schema import ArmStudy, ConfigurationSamples, DirectionSamples
 from .source import excerpt
@@ -133,10 +134,8 @@ _MAX_TRAJECTORY_SIZE = 64 << 20
 
 def _trajectory(loaded: LoadedStudy, arm: Arm, file: str, every: int) -> np.ndarray:
     """Every ``every``-th row of a trajectory CSV; each problem located at the study line and the CSV line."""
-    import pandas as pd
-
     where = ("samples", "configurations", "trajectory", "file")
-    expected = "a CSV file with a header row naming every joint, one row per configuration [rad]"
+    expected = "a CSV file with a header row naming every joint with its unit (joint1 [deg]), one row per configuration"
     try:
         with loaded.path(file).open("rb") as stream:
             data = stream.read(_MAX_TRAJECTORY_SIZE + 1)
@@ -155,15 +154,10 @@ def _trajectory(loaded: LoadedStudy, arm: Arm, file: str, every: int) -> np.ndar
         table = read_table(lines, header)
     except TableProblem as problem:
         raise loaded.fail(where, f"{file}:{problem.line}: {problem.reason}", expected) from None
-    joints = list(arm.joint_names)
-    missing = [name for name in joints if name not in table.columns]
-    if missing:
-        raise loaded.fail(
-            where,
-            f"{excerpt(file)} without columns {', '.join(missing)}",
-            "a header row naming every joint: " + ", ".join(joints),
-        )
-    values = table[joints].apply(pd.to_numeric, errors="coerce").to_numpy(dtype=float)
+    try:
+        values = joint_positions(table, arm.joint_names, prismatic_joints(arm), file, header + 1)
+    except TrajectoryError as error:
+        raise loaded.fail(where, f"{file}:{error.line}: {error.reason}", expected) from None
     finite = np.isfinite(values).all(axis=1)
     if not finite.all():
         line = header + 2 + int(np.argmin(finite))  # file lines are 1-based; the header is one line

@@ -74,7 +74,7 @@ Name = Annotated[str, Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9._-]*$", max_length=
 
 
 class _Model(BaseModel):
-    # defer_build: a model's validator is built on its first use, not at import (0.05 s of `crx validate`).
+    # defer_build: a model's validator is built on its first use, not at import (a cost every start would pay).
     model_config = ConfigDict(extra="forbid", frozen=True, validate_default=True, defer_build=True)
 
 
@@ -303,7 +303,7 @@ class PlacementRuleSpec(_Model):
 
 
 class SensingSpec(_Model):
-    """How contact is detected (MODEL.md §2).
+    """How contact is detected (the model's sensing schemes).
 
     A contact-force threshold, a position-error threshold (``F_s = k e``) or a motor-current threshold
     (joint-side threshold torque ``N tau_s``).

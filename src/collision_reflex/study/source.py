@@ -261,7 +261,7 @@ def _constructed_key(key_node: yaml.Node, raw: Any) -> Any:
 
 
 _LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
-"""The safe loader, on libyaml's parser where PyYAML was built with it (six times faster; the same marks)."""
+"""The safe loader, on libyaml's parser where PyYAML was built with it (faster; the same marks)."""
 
 _KEY_CONSTRUCTOR = yaml.SafeLoader("")
 """Constructs single key nodes (a loader over no text: only its constructor is used)."""
