@@ -33,18 +33,25 @@ def resolved_study(loaded: LoadedStudy) -> dict[str, Any]:
         cycle = data["duty_cycle"]
         if cycle is not None and cycle["file"] is not None:
             cycle["file"] = str(loaded.path(cycle["file"]))
-        for path in (("samples", "configurations", "list"), ("duty_cycle", "via")):
+        for path in JOINT_POSITION_PATHS:
             _with_units(data, loaded.source.data, path)
+    return data
+
+
+JOINT_POSITION_PATHS = (("samples", "configurations", "list"), ("duty_cycle", "via"))
+"""Where a study lists joint positions (rows of one position per joint)."""
+
+
+def at_path(data: Any, path: tuple[str, ...]) -> Any:
+    """The node of plain YAML data at ``path`` (mapping keys), or None where the path leaves the data."""
+    for key in path:
+        data = data.get(key) if isinstance(data, dict) else None
     return data
 
 
 def _with_units(data: dict[str, Any], source: Any, path: tuple[str, ...]) -> None:
     """Write the joint positions at ``path`` with their units (a study file refuses bare ones): SI, as given."""
-    rows: Any = data
-    written: Any = source
-    for key in path:
-        rows = rows.get(key) if isinstance(rows, dict) else None
-        written = written.get(key) if isinstance(written, dict) else None
+    rows, written = at_path(data, path), at_path(source, path)
     if not rows:
         return
     for row, written_row in zip(rows, written, strict=True):

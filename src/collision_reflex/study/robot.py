@@ -7,7 +7,7 @@ the study file that names them.
 from __future__ import annotations
 
 import difflib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from ..errors import FrameNotFound, InvalidParameter, StudyFileError, StudyProblem, UrdfError
 from .load import LoadedStudy
@@ -181,14 +181,13 @@ def _position_units(loaded: LoadedStudy, arm: Arm) -> list[StudyProblem]:
     """An angle for each revolute joint, a length for each prismatic one, in the study's joint positions."""
     from .duty import prismatic_joints
     from .quantities import joint_position_si
+    from .resolve import JOINT_POSITION_PATHS, at_path
 
     prismatic = prismatic_joints(arm)
     units = ["m" if name in prismatic else "rad" for name in arm.joint_names]
     problems = []
-    for path in (("samples", "configurations", "list"), ("duty_cycle", "via")):
-        rows: Any = loaded.source.data
-        for key in path:
-            rows = rows.get(key) if isinstance(rows, dict) else None
+    for path in JOINT_POSITION_PATHS:
+        rows = at_path(loaded.source.data, path)
         for index, row in enumerate(rows if isinstance(rows, list) else []):
             if not isinstance(row, list) or len(row) != len(units):
                 continue  # its length is refused where it is checked

@@ -19,8 +19,6 @@ import numpy as np
 
 from ..errors import InvalidParameter
 
-GRAVITY = 9.81
-"""Standard gravity [m/s^2], for the payload estimate."""
 SAFETY_FACTOR = 1.5
 """The torque safety factor the written study asks for (as the shipped UR5 and Panda studies)."""
 PAYLOAD_SHARE = 0.5
@@ -37,6 +35,8 @@ SANE_SPEED = (1e-3, 100.0)
 MAX_RATED_SPEED = math.radians(180.0)
 """Largest rated joint speed written [rad/s]: a collaborative arm's (the UR5's 180 deg/s, Universal Robots' UR5
 technical specifications); URDF velocity limits of a spine or a finger may be a motor's no-load speed."""
+POSES = 256
+"""Poses drawn within the joint limits for the payload, hold-torque and reach estimates."""
 APPROACH_VELOCITY = 0.25
 """Approach velocity of the written study [m/s], as the shipped UR5 study; lower for a slow or small arm."""
 _TIP_WORDS = re.compile(r"tcp|tool|eef|end_effector|ee_|hand|gripper|wrist", re.IGNORECASE)
@@ -273,6 +273,7 @@ class _Figures:
     payload_note: str
     home: np.ndarray  # (n,) [rad]
     approach_velocity: float  # [m/s]
+    poses: Any  # ArmSamples at poses drawn within the limits: gravity, payload gravity, contact positions
 
 
 def _figures(arm: Any) -> _Figures:
@@ -289,72 +290,43 @@ def _figures(arm: Any) -> _Figures:
     efforts = np.where((efforts > SANE_EFFORT[0]) & (efforts < SANE_EFFORT[1]), efforts, np.nan)
     inside = 0.01 * (high - low)  # off the limits by more than the written digits move a value
     home = np.clip(np.ravel(arm.joint_coordinates(arm.reference_configuration)), low + inside, high - inside)
-    poses = [
-        arm.configuration(angles) for angles in np.random.default_rng(0).uniform(low, high, (256, low.size))
-    ]
-    payload, note = _payload(arm, poses, efforts)
+    angles = np.random.default_rng(0).uniform(low, high, (POSES, low.size))
+    poses = arm.kinematics(arm.configuration(angles))  # the gravity terms the static hold uses, batched
+    payload, note = _payload(poses, efforts)
     # A tenth of the slowest joint's speed at the arm's reach: an approach its joints can follow everywhere.
-    approach = min(APPROACH_VELOCITY, float(f"{0.1 * float(np.min(speeds)) * _reach(arm, poses):.2g}"))
-    return _Figures(np.array([low, high]), speeds, speeds_from_urdf, efforts, payload, note, home, approach)
+    reach = float(np.max(np.linalg.norm(poses.contact_position, axis=1)))
+    approach = min(APPROACH_VELOCITY, float(f"{0.1 * float(np.min(speeds)) * reach:.2g}"))
+    return _Figures(
+        np.array([low, high]), speeds, speeds_from_urdf, efforts, payload, note, home, approach, poses
+    )
 
 
-def _hold_torques(arm: Any, figures: _Figures) -> np.ndarray:
-    """Each joint's largest gravity torque [N m] holding the links and the rated payload.
+def _hold_torques(figures: _Figures) -> np.ndarray:
+    """Each joint's largest gravity torque [N m] holding the links and the rated payload over the poses.
 
-    Over poses drawn within the joint limits; the designed actuators' own masses are left out.
+    The designed actuators' own masses are left out (:func:`collision_reflex.arm.static_hold.hold_torques`
+    with none).
     """
-    import pinocchio as pin
+    from ..arm.static_hold import hold_torques
 
-    model, data = arm.model, arm.model.createData()
-    frame = model.getFrameId(arm.contact_frame)
-    low, high = figures.limits
-    hold = np.zeros(low.size)
-    for angles in np.random.default_rng(1).uniform(low, high, (256, low.size)):
-        q = arm.configuration(angles)
-        gravity = pin.computeGeneralizedGravity(model, data, q)
-        jacobian = pin.computeFrameJacobian(model, data, q, frame, pin.LOCAL_WORLD_ALIGNED)[:3]
-        load = jacobian.T @ np.array([0.0, 0.0, GRAVITY * figures.payload])
-        hold = np.maximum(hold, np.abs(gravity + load))
-    return hold
+    nv = figures.limits.shape[1]
+    return np.max(np.abs(hold_torques(figures.poses, figures.payload, np.zeros(nv))), axis=0)
 
 
-def _reach(arm: Any, poses: list[np.ndarray]) -> float:
-    """The largest distance of the contact frame from the base over ``poses`` [m]."""
-    import pinocchio as pin
-
-    model, data = arm.model, arm.model.createData()
-    frame = model.getFrameId(arm.contact_frame)
-    reach = 0.0
-    for q in poses:
-        pin.framesForwardKinematics(model, data, q)
-        reach = max(reach, float(np.linalg.norm(data.oMf[frame].translation)))
-    return reach
-
-
-def _payload(arm: Any, poses: list[np.ndarray], efforts: np.ndarray) -> tuple[float, str]:
-    """A payload to rate the arm for, from the URDF's effort limits, and how it was found."""
-    import pinocchio as pin
-
+def _payload(poses: Any, efforts: np.ndarray) -> tuple[float, str]:
+    """A payload to rate the arm for, from the URDF's effort limits at ``poses`` (ArmSamples), and how."""
     if np.isnan(efforts).all():
         return 0.5, "SET: the rated payload from the datasheet (the URDF gives no usable effort limit)"
-    model = arm.model
-    data = model.createData()
-    frame = model.getFrameId(arm.contact_frame)
-    capacity = math.inf
-    for q in poses:
-        gravity = np.abs(pin.computeGeneralizedGravity(model, data, q))
-        jacobian = pin.computeFrameJacobian(model, data, q, frame, pin.LOCAL_WORLD_ALIGNED)[:3]
-        per_kg = np.abs(jacobian.T @ np.array([0.0, 0.0, GRAVITY]))  # joint torque per kg at the contact
-        spare = efforts / SAFETY_FACTOR - gravity
-        with np.errstate(divide="ignore", invalid="ignore"):
-            held = np.where(per_kg > 1e-9, spare / per_kg, np.inf)
-        capacity = min(capacity, float(np.nanmin(held)))
-    payload = PAYLOAD_SHARE * capacity
+    spare = efforts / SAFETY_FACTOR - np.abs(poses.gravity)  # (poses, joints) left for the payload [N m]
+    per_kg = np.abs(poses.contact_gravity)  # joint torque per kg at the contact point [N m/kg]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        held = np.where(per_kg > 1e-9, spare / per_kg, np.inf)
+    payload = PAYLOAD_SHARE * float(np.nanmin(held))
     if not math.isfinite(payload) or payload < 0.05:
         return 0.5, "SET: the rated payload from the datasheet (the URDF's effort limits barely hold the arm)"
     payload = float(f"{payload:.2g}")
     return payload, (
-        f"ESTIMATE: {PAYLOAD_SHARE:g} x the mass the URDF's effort limits hold at the contact frame over 256\n"
+        f"ESTIMATE: {PAYLOAD_SHARE:g} x the mass the URDF's effort limits hold at the contact point over {POSES}\n"
         f"  # poses within the joint limits, with the {SAFETY_FACTOR:g} safety factor; SET the datasheet figure"
     )
 
@@ -481,7 +453,7 @@ def _study_text(
         )
     joints = tuple(arm.joint_names)
     groups = _groups(joints)
-    heavy, strongest = _heavy_joints(groups, joints, _hold_torques(arm, figures))
+    heavy, strongest = _heavy_joints(groups, joints, _hold_torques(figures))
     low_d, high_d = _stator_bounds(figures.efforts, HEAVY_RATIO if heavy else MAX_RATIO)
     planar = int(arm.task_dim) == 2
     directions = "{circle: 16}" if planar else "{sphere: 14}"
