@@ -15,6 +15,20 @@ FigurePath: TypeAlias = str | os.PathLike[str] | tuple[str | os.PathLike[str], .
 """A figure file, or several files of one figure (its PNG and SVG, say): the figure is drawn and laid out once."""
 
 
+def margin_text(margin: float) -> str:
+    """A margin ``available / required - 1`` as a designer reads it.
+
+    ``0 %`` where the limit is met exactly, ``+25 %`` or ``−9 %`` below twice the requirement, a plain multiple
+    (``3.7×``, ``838×``) above.
+    """
+    if margin == 0:
+        return "0 %"
+    ratio = 1 + margin
+    if ratio >= 2:
+        return f"{ratio:,.0f}×" if ratio >= 100 else f"{ratio:.3g}×"
+    return f"{100 * margin:+.3g} %".replace("-", "−")
+
+
 def check_figure_path(path: str | os.PathLike[str]) -> Path:
     """Return ``path`` as a Path if its suffix is a supported figure format, else raise."""
     target = Path(path)

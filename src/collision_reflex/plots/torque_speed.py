@@ -27,7 +27,7 @@ import numpy as np
 
 from .._validate import non_negative, positive
 from ..errors import InvalidParameter
-from . import FigurePath, figure_paths, new_figure, save_figure
+from . import FigurePath, figure_paths, margin_text, new_figure, save_figure
 from .grid_layout import extent, lay_out_grid
 
 RAD_PER_S_TO_RPM = 60.0 / (2.0 * math.pi)
@@ -392,7 +392,10 @@ def _limits_text(point: JointOperatingPoints) -> str:
 
 
 def _margin_text(point: JointOperatingPoints) -> str:
-    """``peak +35 %, RMS none, speed -4 %``: each margin in %, "none" where a limit or requirement is absent."""
+    """``peak +35 %, RMS 14.3×, speed −4 %``: each margin as :func:`margin_text` says it.
+
+    "none" where a limit or requirement is absent.
+    """
     parts = []
     for name, value in margins(point).items():
         if value is None:
@@ -400,5 +403,5 @@ def _margin_text(point: JointOperatingPoints) -> str:
         elif math.isinf(value):
             parts.append(f"{name} unloaded")
         else:
-            parts.append(f"{name} {100 * value:+.0f} %")
+            parts.append(f"{name} {margin_text(value)}")
     return "margins: " + ", ".join(parts)

@@ -90,24 +90,21 @@ def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
                 else None,
             ),
         )
-    featured = {"chosen design": chosen}
-    if pareto["points"]:
-        last = len(pareto["points"]) - 1
-        # Sorted by the first objective: the ends of a two-objective front are its best in each.
-        two = len(names) == 2
-        featured[f"Pareto design 0 (best {_words(names[0])})"] = pareto["points"][0]
-        featured[f"Pareto design {last}" + (f" (best {_words(names[1])})" if two else "")] = pareto["points"][
-            -1
-        ]
-    for index, (title, record) in enumerate(_distinct_surfaces(featured).items()):
-        draw = functools.partial(
+    # One surface, the recommended design's: the front's other designs differ from it in the table, not in where
+    # around the arm the impulse is large.
+    recommended = results.get("recommended") or chosen
+    svgs["surface-0"] = _draw(
+        directory,
+        "impulse_directions",
+        formats,
+        functools.partial(
             _surface,
             directions=directions,
             config_index=config_index,
-            impulses=np.asarray(record["impulses"]),
-            title=f"impulse by contact direction [N*s]: {title}",
-        )
-        svgs[f"surface-{index}"] = _draw(directory, f"impulse_directions_{index}", formats, draw)
+            impulses=np.asarray(recommended["impulses"]),
+            title="impulse by contact direction [N*s]: " + str(recommended.get("source", "chosen design")),
+        ),
+    )
     pose = (results.get("recommended") or {}).get("worst_case", {}).get("pose")
     if pose is not None:
         from ..plots.worst_pose import plot_worst_pose
@@ -133,7 +130,9 @@ def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
         svgs["torque_speed"] = _draw(
             directory, "torque_speed", formats, lambda path: plot_torque_speed(path, joints)
         )
-    records = [("chosen", chosen)] + [(str(i), p) for i, p in enumerate(pareto["points"])]
+    # The phases of each front design (of the recommended one without a front): where a front is flat, this
+    # shows why.
+    records = [(str(i), p) for i, p in enumerate(pareto["points"])] or [("recommended", recommended)]
     worst = [int(np.argmax(r["impulses"])) for _, r in records]
     svgs["phases"] = _draw(
         directory,
@@ -149,33 +148,6 @@ def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
         ),
     )
     return svgs
-
-
-def _distinct_surfaces(featured: dict[str, dict[str, Any]]) -> dict[str, dict[str, Any]]:
-    """The featured designs with one surface each, in order.
-
-    A design whose impulse agrees with an earlier one's within :data:`collision_reflex.optimize.pareto.RESOLUTION`
-    at every sample draws the same picture: its title joins that design's instead (on a flat front the chosen
-    design and the first Pareto design may be such a pair).
-    """
-    from ..optimize.pareto import RESOLUTION
-
-    kept: list[tuple[list[str], dict[str, Any]]] = []
-    for title, record in featured.items():
-        impulses = np.asarray(record["impulses"], dtype=float)
-        same = next(
-            (
-                titles
-                for titles, other in kept
-                if np.allclose(impulses, other["impulses"], rtol=RESOLUTION, atol=0)
-            ),
-            None,
-        )
-        if same is None:
-            kept.append(([title], record))
-        else:
-            same.append(title)
-    return {" = ".join(titles): record for titles, record in kept}
 
 
 def has_duty_cycle(results: dict[str, Any]) -> bool:

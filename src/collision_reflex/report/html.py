@@ -32,6 +32,16 @@ UNITS = {
     "contact_stiffness": "N/m",
     "position_error": "m",
     "list": "rad",
+    "mass": "kg",
+    "joint_speeds": "rad/s",
+    "joint_accelerations": "rad/s^2",
+    "stopping_time": "s",
+    "max_speed": "rad/s",
+    "max_acceleration": "rad/s^2",
+    "dwell": "s",
+    "rate": "Hz",
+    "min_singular_value": "m",
+    "joint_speed_limit": "rad/s",
 }
 
 
@@ -43,6 +53,8 @@ def number(value: object, digits: int = 4) -> str:
         return str(value)
     if math.isinf(value):
         return "∞" if value > 0 else "−∞"
+    if isinstance(value, int) or (value.is_integer() and 1e4 <= abs(value) < 1e15):
+        return f"{int(value):,}"  # a count or a whole figure: all its digits, no exponent
     return f"{value:.{digits}g}"
 
 
@@ -86,39 +98,200 @@ def _shown_path(value: str) -> str:
     return path.name if path.is_absolute() or re.match(r"^[A-Za-z]:[\\/]", value) else value
 
 
-def _assumptions(resolved: dict[str, Any]) -> list[tuple[str, str]]:
-    """The resolved study flattened to (field, value with unit) rows."""
-    rows: list[tuple[str, str]] = []
+def mm(value: object) -> str:
+    """A length in metres shown in millimetres (motor sizes), 3 significant digits."""
+    return number(value * 1e3, 3) if isinstance(value, (int, float)) and not isinstance(value, bool) else "–"
 
-    def walk(prefix: str, value: Any, unit: str) -> None:
-        if isinstance(value, dict):
-            if not value:
-                rows.append((prefix, "–"))
-            for key, item in value.items():
-                walk(f"{prefix}.{key}" if prefix else str(key), item, UNITS.get(str(key), unit))
-        elif isinstance(value, list) and value and all(isinstance(v, (int, float)) for v in value):
-            rows.append(
-                (prefix, "[" + ", ".join(number(v) for v in value) + "]" + (f" {unit}" if unit else ""))
+
+def unit(text: str) -> str:
+    """A unit as a designer reads it: ``N*m`` as ``N·m``, ``kg*m^2`` as ``kg·m²``."""
+    return text.replace("**2", "²").replace("^2", "²").replace("*", "·")
+
+
+def margin_cell(value: object) -> Any:
+    """A table cell for a margin (:func:`~collision_reflex.plots.margin_text`), red when negative.
+
+    "–" where the joint has no such requirement.
+    """
+    import markupsafe
+
+    from ..plots import margin_text
+
+    if not isinstance(value, (int, float)) or isinstance(value, bool):
+        return markupsafe.Markup("<td>–</td>")
+    value = float(settled(value))  # type: ignore[arg-type]
+    bad = ' class="bad"' if value < 0 else ""
+    return markupsafe.Markup(f"<td{bad}>{markupsafe.escape(margin_text(value))}</td>")
+
+
+def change(value: object) -> str:
+    """A relative difference as a signed percentage (``+9.88 %``), "–" when unknown."""
+    if not isinstance(value, (int, float)) or isinstance(value, bool):
+        return "–"
+    return f"{100 * value:+.3g} %".replace("-", "−")
+
+
+def gearbox_name(text: object) -> str:
+    """A gearbox as the tables name it: its kind and unit, without the scaling note in brackets."""
+    return "–" if not text else str(text).split(" (")[0]
+
+
+ASSUMPTION_GROUPS = {
+    "robot": "robot",
+    "actuators": "actuators",
+    "sensing": "sensing",
+    "samples": "contact samples",
+    "rating": "rating",
+    "duty_cycle": "duty cycle",
+    "design": "design bounds",
+    "constraints": "constraints",
+    "objective": "objective",
+    "pareto": "Pareto front",
+    "simulate": "simulation",
+}
+"""The resolved study's sections as the assumptions table names them (the others, the optimiser's, the
+catalogue snap's and the executor's settings, are in ``study.resolved.yaml``)."""
+
+_MILLIMETRES = {"stator_diameter", "stack_length", "contact_offset"}
+
+
+def assumption_rows(results: dict[str, Any]) -> list[tuple[str, str, str, str]]:
+    """The study as run, as (part, assumption, value with unit, source) rows a designer reads.
+
+    Empty fields are left out, a per-joint mapping that holds the same value for every joint is one row,
+    motor sizes are in mm, and the model's own assumptions (the impulse model, the motor scaling and speed
+    laws, the transmissions) carry their sources.
+    """
+    resolved = results["resolved"]
+    rows: list[tuple[str, str, str, str]] = []
+    for key, group in ASSUMPTION_GROUPS.items():
+        value = resolved.get(key)
+        if key == "objective" and isinstance(value, dict):
+            value = " + ".join(f"{number(w)} × {str(n).replace('_', ' ')}" for n, w in value.items())
+        for field, text in _flattened(value, "", UNITS.get(key, "")):
+            rows.append((group, field or key.replace("_", " "), text, _source(key, field, resolved)))
+    model = (
+        [
+            (
+                "impulse",
+                f"closed form, reaction from rest ({resolved.get('reaction', 'at_rest')}), rotors "
+                + (
+                    "in the impact"
+                    if resolved.get("reflected_inertia_in") == "finger"
+                    else "behind the joint springs"
+                )
+                + " unless a joint says otherwise",
+                "Bhatia, Mason and Johnson, Reacting to Contact: Transparency and Collision Reflex in Actuation",
             )
-        elif isinstance(value, list) and len(value) > 6 and all(isinstance(v, list) for v in value):
-            rows.append((prefix, f"{len(value)} entries"))
-        elif isinstance(value, list):
-            for index, item in enumerate(value):
-                walk(f"{prefix}[{index}]", item, unit)
-            if not value:
-                rows.append((prefix, "[]"))
-        elif isinstance(value, (int, float)) and not isinstance(value, bool):
-            rows.append((prefix, number(value) + (f" {unit}" if unit else "")))
-        elif isinstance(value, str):
-            rows.append((prefix, _shown_path(value)))
-        else:
-            rows.append((prefix, "–" if value is None else str(value)))
+        ]
+        if results["kind"] == "arm"
+        else []
+    )
+    for text in [results.get("speed_limits"), *results.get("transmissions", ())]:
+        if text and not str(text).startswith("Warning"):
+            label, _, said = str(text).partition(": ")
+            model.append((label.lower(), said, ""))
+    return [("model", *row) for row in model] + rows
 
-    for key, value in resolved.items():
-        if key in ("name", "description"):
-            continue
-        walk(key, value, UNITS.get(key, ""))
-    return rows
+
+def _source(section: str, field: str, resolved: dict[str, Any]) -> str:
+    """The source of a resolved study's field where the toolkit knows it (a catalogue entry, a scaling law)."""
+    if section != "actuators":
+        return ""
+    motor = (resolved.get("actuators") or {}).get("motor") or {}
+    try:
+        if field == "motor.reference":
+            from ..hardware.motors import get_motor
+
+            return get_motor(str(motor["reference"])).source
+        if field == "motor.scaling law":
+            from ..hardware.motors import scaling_law
+
+            return scaling_law(str(motor["scaling_law"])).source
+    except (KeyError, ValueError, LookupError, OSError):
+        return ""
+    return ""
+
+
+def _flattened(value: Any, prefix: str, unit_name: str) -> list[tuple[str, str]]:
+    """(field, text) rows of one study section; see :func:`assumption_rows`."""
+    if value is None or value == {} or value == []:
+        return []
+    if isinstance(value, dict):
+        if set(value) >= {"min", "max"} and not isinstance(value["min"], dict):
+            low, high = (_shown(value[key], unit_name, prefix) for key in ("min", "max"))
+            if " " in high and low.endswith(high.split(" ", 1)[1]):
+                low = low.split(" ", 1)[0]  # the unit once: "30 to 160 mm"
+            rows = [(prefix, f"{low} to {high}")]
+            joints = value.get("joints") or {}
+            return rows + [
+                row
+                for name, bounds in joints.items()
+                for row in _flattened(bounds, f"{prefix}, {name}", unit_name)
+            ]
+        items = [(k, v) for k, v in value.items() if v is not None and v != {} and v != []]
+        if (
+            len(items) >= 2
+            and all(isinstance(v, dict) for _, v in items)
+            and _all_equal([v for _, v in items])
+        ):
+            return _flattened(items[0][1], f"{prefix}, each of {len(items)}".strip(", "), unit_name)
+        if prefix and items and all(not isinstance(v, (dict, list)) for _, v in items):
+            if len(items) >= 2 and _all_equal([v for _, v in items]):
+                return [
+                    (
+                        prefix,
+                        _shown(items[0][1], UNITS.get(str(items[0][0]), unit_name), prefix)
+                        + f" (each of {len(items)})",
+                    )
+                ]
+            return [
+                (
+                    prefix,
+                    ", ".join(
+                        f"{str(k).replace('_', ' ')} {_shown(v, UNITS.get(str(k), unit_name), str(k))}"
+                        for k, v in items
+                    ),
+                )
+            ]
+        rows = []
+        for key, item in items:
+            field = f"{prefix}.{key}" if prefix else str(key)
+            rows += _flattened(item, field.replace("_", " "), UNITS.get(str(key), unit_name))
+        return rows
+    if isinstance(value, list):
+        if all(isinstance(v, list) for v in value) and all(
+            isinstance(x, (int, float)) for v in value for x in v
+        ):
+            zero = all(x == 0 for v in value for x in v)
+            return [] if zero else [(prefix, f"{len(value)} × {len(value[0]) if value else 0} matrix")]
+        if all(isinstance(v, (int, float, str)) and not isinstance(v, bool) for v in value):
+            if len(value) > 8:
+                return [(prefix, f"{len(value)} values")]
+            return [(prefix, ", ".join(_shown(v, unit_name, prefix) for v in value))]
+        if len(value) > 4:
+            return [(prefix, f"{len(value)} {prefix.rsplit('.', 1)[-1]} entries")]
+        return [
+            row for i, item in enumerate(value) for row in _flattened(item, f"{prefix}[{i + 1}]", unit_name)
+        ]
+    return [(prefix, _shown(value, unit_name, prefix))]
+
+
+def _all_equal(values: list[Any]) -> bool:
+    return all(v == values[0] for v in values[1:])
+
+
+def _shown(value: Any, unit_name: str, field: str) -> str:
+    """One value with its unit; motor sizes in mm, local paths as file names."""
+    if isinstance(value, str):
+        return _shown_path(value)
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return "–" if value is None else str(value)
+    if any(
+        field.endswith(name.replace("_", " ")) or name.replace("_", " ") in field for name in _MILLIMETRES
+    ):
+        return f"{mm(value)} mm"
+    return number(value) + (f" {unit(unit_name)}" if unit_name else "")
 
 
 def _velocity_summary(record: dict[str, Any]) -> dict[str, float]:
@@ -184,30 +357,200 @@ def render_html(results: dict[str, Any], rows: list[dict[str, Any]], svgs: dict[
         trim_blocks=True,
         lstrip_blocks=True,
     )
-    environment.filters["n"] = number
-    environment.filters["settled"] = settled
-    environment.filters["whole_numbers"] = whole_numbers
-    environment.filters["solved_by"] = solved_by
+    for name, function in {
+        "n": number,
+        "settled": settled,
+        "whole_numbers": whole_numbers,
+        "solved_by": solved_by,
+        "mm": mm,
+        "unit": unit,
+        "margin_cell": margin_cell,
+        "change": change,
+        "gearbox_name": gearbox_name,
+    }.items():
+        environment.filters[name] = function
     template = environment.get_template(f"{results['kind']}_report.html.j2")
     context: dict[str, Any] = {
         "results": results,
         "rows": _settled_rows(rows),
         "columns": list(rows[0]) if rows else [],
         "svgs": svgs,
-        "assumptions": _assumptions(results["resolved"]),
+        "assumptions": assumption_rows(results),
         "version": __version__,
     }
     if results["kind"] == "arm":
-        from .figures import has_duty_cycle
-        from .verdict import verdict
+        context.update(_arm_context(results))
+    return template.render(**context)
 
+
+def _arm_context(results: dict[str, Any]) -> dict[str, Any]:
+    """What the arm report's sections show beside the record: sentences, table rows, the front's cards."""
+    from .figures import has_duty_cycle
+    from .front import front_cards
+    from .verdict import (
+        domain_sentence,
+        requirement_sentence,
+        statistics_rows,
+        verdict,
+        worst_pose_sentence,
+    )
+
+    recommended = results.get("recommended") or results["chosen"]
+    domain = results.get("domain")
+    worst = recommended.get("worst_case") or {}
+    kept = (worst.get("searched") or {}).get("domain_kept")
+    catalogue = results.get("catalogue") or {}
+    return {
         # Redone from the record (the same function wrote designs.json's ``verdict``), so that a report
         # re-rendered from an edited designs.json says what its numbers say.
-        context["verdict"] = verdict(results)
-        context["duty_cycle"] = has_duty_cycle(results)
-        context["objective_units"] = _objective_units()
-        context["velocity"] = {
-            "chosen": _velocity_summary(results["chosen"]),
-            **{str(i): _velocity_summary(p) for i, p in enumerate(results["pareto"]["points"])},
+        "verdict": verdict(results),
+        "duty_cycle": has_duty_cycle(results),
+        "objective_units": _objective_units(),
+        "units": _objective_units(),
+        "requirement": requirement_sentence(
+            str(results.get("requirement", "")), (results.get("resolved") or {}).get("rating")
+        ),
+        "domain_sentence": domain_sentence(domain, float(recommended["approach_velocity"]), kept)
+        if domain and worst
+        else None,
+        "worst_pose": worst_pose_sentence(recommended),
+        "statistics": statistics_rows(recommended),
+        "velocity": _velocity_summary(recommended),
+        **_front_table(results),
+        **_transmission_table(results.get("transmission_choice")),
+        "solved": _solved(results),
+        "part_sources": _part_sources(catalogue.get("joints") or []),
+        **_tried_table(catalogue),
+        "catalogue_modules": any(j.get("module") for j in recommended["joints"]),
+        "front_cards": front_cards(results),
+    }
+
+
+def _front_table(results: dict[str, Any]) -> dict[str, Any]:
+    """The front's table: per design its objectives, actuator mass, threshold and approach velocity, and snap."""
+    from ..optimize import OBJECTIVES
+
+    pareto = results["pareto"]
+    names = list(dict.fromkeys([*pareto["objectives"], "actuator_mass"]))
+    extra = [key for key in ("threshold", "approach_velocity") if key not in names]
+    columns = [f"{n.replace('_', ' ')} [{unit(OBJECTIVES[n][1])}]" for n in names] + [
+        f"{key.replace('_', ' ')} [{unit(UNITS[key])}]" for key in extra
+    ]
+    index = (results.get("recommended") or {}).get("pareto_index")
+    snaps = (results.get("catalogue") or {}).get("pareto") or []
+    rows = []
+    for i, point in enumerate(pareto["points"]):
+        snap = snaps[i] if i < len(snaps) else None
+        text, ok = _snap_text(snap)
+        rows.append(
+            {
+                "design": f"{i}" + (" (recommended)" if i == index else ""),
+                "values": [point["objectives"].get(n) for n in names] + [point[key] for key in extra],
+                "snap": text,
+                "snap_ok": ok,
+            }
+        )
+    return {"front_columns": columns, "front_rows": rows}
+
+
+def _snap_text(snap: dict[str, Any] | None) -> tuple[str, bool]:
+    """A Pareto design's quick catalogue snap in a few words, and whether it meets the requirements."""
+    if not snap:
+        return "–", True
+    if snap.get("missing"):
+        return "no part within bounds for " + ", ".join(m["joint"] for m in snap["missing"]), False
+    said = ", ".join(dict.fromkeys(snap["parts"]))
+    if snap["feasible"]:
+        return said, True
+    shortfalls = list(snap["shortfalls"])
+    more = f" (and {len(shortfalls) - 1} more)" if len(shortfalls) > 1 else ""
+    return f"{said}; misses {shortfalls[0]}{more}", False
+
+
+def _transmission_table(tried: list[dict[str, Any]] | None) -> dict[str, Any]:
+    """Each assignment of the gearbox options tried: the option per group of joints, objective, mass."""
+    if not tried:
+        return {"transmission_groups": [], "transmission_rows": []}
+    from .verdict import _group_name
+
+    groups = list(tried[0]["assignment"])
+    rows = [
+        {
+            "options": [entry["assignment"].get(group, "–") for group in groups],
+            "objective": entry["objective"],
+            "mass": entry.get("actuator_mass"),
+            "outcome": "chosen"
+            if entry["chosen"]
+            else ("–" if entry["objective"] is not None else entry["status"]),
         }
-    return template.render(**context)
+        for entry in tried
+    ]
+    return {"transmission_groups": [_group_name(g.split(", ")) for g in groups], "transmission_rows": rows}
+
+
+def _solved(results: dict[str, Any]) -> list[tuple[str, dict[str, Any]]]:
+    """The designs of the solver table: the single-objective optimum, each Pareto design, the catalogue design."""
+    solved = [("single-objective optimum", results["chosen"])]
+    solved += [(f"Pareto {i}", point) for i, point in enumerate(results["pareto"]["points"])]
+    design = (results.get("catalogue") or {}).get("design")
+    if design is not None:
+        solved.append(("catalogue design", design))
+    return solved
+
+
+def _tried_table(catalogue: dict[str, Any]) -> dict[str, Any]:
+    """The catalogue combinations re-solved, best first: a column per group of joints that always share parts."""
+    tried = catalogue.get("tried") or []
+    joints = [j["joint"] for j in catalogue.get("joints") or []]
+    if not tried or not joints:
+        return {"tried_groups": [], "tried_rows": []}
+    from .verdict import _group_name
+
+    groups: list[list[int]] = []
+    for index in range(len(joints)):
+        if groups and all(t["parts"][index] == t["parts"][groups[-1][0]] for t in tried):
+            groups[-1].append(index)
+        else:
+            groups.append([index])
+    ranked = sorted(tried, key=lambda t: (t["objective"] is None, t["objective"] or 0.0))
+    rows = [
+        {
+            "parts": [t["parts"][group[0]] for group in groups],
+            "objective": t["objective"],
+            "outcome": "solved" if t["objective"] is not None else _why_not(str(t["status"])),
+        }
+        for t in ranked
+    ]
+    return {"tried_groups": [_group_name([joints[i] for i in group]) for group in groups], "tried_rows": rows}
+
+
+def _why_not(status: str) -> str:
+    """A refused or failed combination's reason in a few words: the quoted check, or the first shortfall."""
+    quoted = re.search(r"'([^']+)'", status)
+    if quoted:
+        return "refused: " + quoted.group(1)
+    first = status.split("; ")[0]
+    return first + (")" if "(" in first and not first.endswith(")") else "")
+
+
+def _part_sources(joints: list[dict[str, Any]]) -> list[tuple[str, str]]:
+    """Each catalogue part's source once, with its estimates (a part on several joints is cited once)."""
+    sources: dict[str, str] = {}
+    for joint in joints:
+        for part, source, cited, estimates in (
+            (
+                joint.get("motor"),
+                joint.get("source"),
+                joint.get("sources") or {},
+                joint.get("estimates") or {},
+            ),
+            (joint.get("gearbox"), joint.get("gearbox_source"), {}, joint.get("gearbox_estimates") or {}),
+        ):
+            if not part or not source or part in sources:
+                continue
+            said = [str(source)]
+            said += [f"{field.replace('_', ' ')}: {text}" for field, text in cited.items()]
+            if estimates:  # how each was estimated: the catalogue entry (crx motors --catalogue) says
+                said.append("estimated: " + ", ".join(field.replace("_", " ") for field in estimates))
+            sources[part] = "; ".join(said)
+    return list(sources.items())

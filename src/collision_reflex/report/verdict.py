@@ -1,9 +1,9 @@
-"""The verdict an arm study's report opens with, as plain sentences decided from its results record.
+"""The verdict an arm study's report opens with, and the report's other sentences, decided from its results.
 
-One place for the HTML report, ``designs.json`` (``verdict``) and ``crx run``'s closing print: the recommended
-design, the bounds and constraints that are active on each joint, how far each objective spans over the front
-(and a plain sentence when the front is flat or degenerate), the lightest design near the best impulse, the kind
-of torque requirement, warnings about oversized joints, and the design built from catalogue parts. Every
+One place for the HTML report, ``designs.json`` (``verdict``) and ``crx run``'s closing print: at most ten
+sentences, each said once: the design to build (its catalogue parts) and the continuous optimum, how sure its
+worst case is, what sizes its joints, what the design bounds decide, the front (a plain sentence when it is flat
+or degenerate), the transmission choice, and warnings. Every
 function reads plain data (the records of :func:`collision_reflex.optimize.results.design_record` and the results of
 :func:`collision_reflex.study.arm_results.arm_results`), so the verdict can be redone from a saved
 ``designs.json``.
@@ -79,53 +79,14 @@ def motor_at_smallest_size(joint: Mapping[str, Any], bounds: Mapping[str, Any]) 
     return all(p in ("lower", "fixed") for p in positions) and "lower" in positions
 
 
-def joint_limits(
-    joint: Mapping[str, Any], bounds: Mapping[str, Any], requirement: str, undecided: Sequence[str] = ()
-) -> list[str]:
-    """The bounds and constraints that are active on one joint of a design record, in words.
-
-    ``undecided``: the joint's design variables that no objective decides (the record's ``undecided``; an
-    undecided gear ratio is not called the objective's choice, :func:`undecided_sentence` says what it is).
-    """
-    name = joint["joint"]
-    size = {key: bound_position(joint[key], bounds[key][name]) for key in ("stator_diameter", "stack_length")}
-    phrases = []
-    if motor_at_smallest_size(joint, bounds):
-        phrases.append("motor at its smallest size")
-    elif all(p in ("upper", "fixed") for p in size.values()) and "upper" in size.values():
-        phrases.append("motor at its largest size")
-    else:
-        phrases += [f"{_words(key)} at its {p} bound" for key, p in size.items() if p in ("lower", "upper")]
-    for key in ("gear_ratio", "software_stiffness"):
-        position = bound_position(joint[key], bounds[key][name])
-        if position in ("lower", "upper"):
-            phrases.append(f"{_words(key)} at its {position} bound ({_g(joint[key])})")
-    if joint.get("torque_margin") is None:
-        phrases.append(
-            "no torque requirement: static gravity-only requirement is zero for this joint"
-            if requirement.startswith("static")
-            else "no torque requirement"
-        )
-    for key, constraint in MARGINS:
-        margin = joint.get(key)
-        if margin is not None and margin < ACTIVE_TOLERANCE:
-            by = joint.get("required_by") if key == "torque_margin" else None
-            phrases.append(f"sized by {constraint}" + (f" ({by})" if by else ""))
-    margin = joint.get("torque_margin")
-    chosen_ratio = "gear_ratio" not in undecided
-    if margin is not None and margin > OVERSIZED_MARGIN and motor_at_smallest_size(joint, bounds):
-        phrases.append(_smallest_motor_excess(joint, bounds["gear_ratio"][name], 1 + margin, chosen_ratio))
-    return phrases
-
-
-def _smallest_motor_excess(
+def smallest_motor_excess(
     joint: Mapping[str, Any], ratio_bounds: Sequence[float], multiple: float, chosen_ratio: bool = True
 ) -> str:
     """Why a joint at its smallest motor has ``multiple`` times its required peak torque, in words.
 
     The motor itself, or the gear ratio the objective chose: the peak torque grows with the ratio, which the
     collision reflex may want higher (a harder braking torque ``N tau_p``) than the motion needs.
-    ``chosen_ratio`` False: no objective decides the ratio (:func:`undecided_sentence` says so), so it is not
+    ``chosen_ratio`` False: no objective decides the ratio (:func:`bound_sentences` says so), so it is not
     called the objective's choice.
     """
     ratio, lowest = float(joint["gear_ratio"]), float(ratio_bounds[0])
@@ -148,73 +109,6 @@ UNDECIDED_UNITS = {"software_stiffness": " N·m/rad", "stator_diameter": " m", "
 """Units printed after an undecided variable's value (none for the gear ratio)."""
 
 
-def undecided_sentence(joint: Mapping[str, Any], undecided: Sequence[str]) -> str:
-    """That no objective decides these design variables of a joint, with their values, as a sentence.
-
-    A software stiffness that changes no impulse belongs to a joint no contact sample loads (the contact forces
-    exert no torque about its axis): said as the reason.
-    """
-    one = len(undecided) == 1
-    values = " and ".join(
-        f"{_words(key)} ({_g(joint[key])}{UNDECIDED_UNITS.get(key, '')})" for key in undecided
-    )
-    reason = ", as no contact sample loads this joint" if "software_stiffness" in undecided else ""
-    them = "it" if one else "them"
-    return (
-        f"Its {values} change{'s' if one else ''} no impulse and not the actuator mass anywhere within "
-        f"{'its' if one else 'their'} bounds{reason}: no objective decides {them}, and "
-        f"{'it is' if one else 'they are'} where the solver started; choose {them} on grounds this study does not "
-        "model."
-    )
-
-
-def design_limits(record: Mapping[str, Any], bounds: Mapping[str, Any]) -> list[str]:
-    """The global design variables (threshold, approach velocity) of a record at a bound or undecided, in words.
-
-    Undecided: named in the record's ``undecided`` (no objective changes with it).
-    """
-    undecided = {entry["variable"] for entry in record.get("undecided", ()) if entry["joint"] is None}
-    phrases = []
-    for key in ("threshold", "approach_velocity"):
-        position = bound_position(record[key], bounds[key])
-        if key in undecided:
-            phrases.append(
-                f"{_words(key)} ({_g(record[key])}) changes no objective anywhere within its bounds: no "
-                "objective decides it, the value is where the solver started"
-            )
-        elif position in ("lower", "upper"):
-            phrases.append(f"{_words(key)} at its {position} bound ({_g(record[key])})")
-    return phrases
-
-
-def design_sentence(record: Mapping[str, Any]) -> str:
-    """A design in one sentence: per joint its motor size and gear ratio; the threshold and approach velocity."""
-    joints = []
-    for joint in record["joints"]:
-        motor = f"{_g(joint['stator_diameter'] * 1e3, 3)} mm × {_g(joint['stack_length'] * 1e3, 3)} mm motor"
-        nearest = joint.get("nearest_catalogue_motor")
-        joints.append(
-            f"{joint['joint']}: {motor}"
-            + (f" (nearest catalogue motor {nearest})" if nearest else "")
-            + f" at N = {_g(joint['gear_ratio'])}"
-        )
-    threshold = f"{_g(record['threshold'])} " + (
-        "N" if record["sensing"] == "force" else "m (position error)"
-    )
-    values = {**record["objectives"]}
-    if record.get("worst_case"):  # the worst case over the contact domain as searched, not over the samples
-        values["worst_case_impulse"] = record["worst_case"]["domain"]
-    objectives = ", ".join(
-        f"{_words(name)} {_g(values[name])} {unit}"
-        for name, unit in (("worst_case_impulse", "N·s"), ("mean_impulse", "N·s"), ("actuator_mass", "kg"))
-        if name in values
-    )
-    return (
-        "; ".join(joints)
-        + f"; threshold {threshold}, approach velocity {_g(record['approach_velocity'])} m/s ({objectives})."
-    )
-
-
 def domain_sentence(domain: Mapping[str, Any], velocity: float, kept: float | None) -> str:
     """Where the worst case is taken: the contact domain's floor, its speed check and what it keeps.
 
@@ -235,95 +129,59 @@ def domain_sentence(domain: Mapping[str, Any], velocity: float, kept: float | No
     )
 
 
-def worst_case_sentences(
-    record: Mapping[str, Any],
-    domain: Mapping[str, Any] | None,
-    pareto: Mapping[str, Any],
-    exchanged: bool = True,
-) -> list[str]:
-    """The recommended design's worst case over the contact domain, where it occurs, and how sure it is.
-
-    Also names the Pareto designs whose worst case the search could not certify. ``exchanged``: the study
-    minimises or bounds the worst case, so that searched points joined its samples (else they are only
-    reported).
-    """
-    worst = record.get("worst_case")
-    if not worst or domain is None:
-        return []
-    search = worst.get("searched")
-    lines = [domain_sentence(domain, float(record["approach_velocity"]), (search or {}).get("domain_kept"))]
+def worst_pose_sentence(record: Mapping[str, Any]) -> str | None:
+    """Where the search found a design's worst case, and how hard it looked; None without a search."""
+    search = (record.get("worst_case") or {}).get("searched")
     if search is None:
-        lines.append(
-            f"Worst case {_g(worst['sampled'])} N·s over the samples; no search of the domain ran, so it is a "
-            "sampled value, not a bound."
-        )
-        return lines
+        return None
     pose = ", ".join(f"{np.degrees(v):.0f}" for v in search["q"])
     direction = ", ".join(f"{v:+.2f}" for v in search["direction"])
-    effort = f"{search['starts']} local searches, {search['evaluations']:,} impulses evaluated"
-    if worst["certified"]:
-        lines.append(
-            f"Worst case {_g(worst['domain'])} N·s, certified over the domain: {effort}, none more than "
-            f"{_g(100 * worst['tolerance'], 2)} % above the samples' worst case {_g(worst['sampled'])} N·s. The "
-            f"searched worst pose: q = [{pose}] deg, contact direction u = [{direction}]."
-        )
-    else:
-        excess = worst["domain"] / worst["sampled"] - 1
-        remedy = (
-            "more search rounds (optimizer.worst_case_search.rounds) or samples may certify it"
-            if exchanged
-            else "the worst case is no objective of this study, so the points found do not join its samples "
-            "(make worst_case_impulse an objective or a Pareto objective to bound it)"
-        )
-        lines.append(
-            f"Worst case NOT certified: the search ({effort}) found {_g(worst['domain'])} N·s, "
-            f"{_percent(100 * excess)} % above the samples' worst case {_g(worst['sampled'])} N·s, at q = [{pose}] "
-            f"deg along u = [{direction}]. Take {_g(worst['domain'])} N·s as the worst case found, not as a bound; "
-            f"{remedy}."
-        )
-    uncertified = [
-        str(point.get("label", i))
-        for i, point in enumerate(pareto.get("points", ()))
-        if point.get("worst_case")
-        and point["worst_case"].get("searched")
-        and not point["worst_case"]["certified"]
+    return (
+        f"The worst pose found: q = [{pose}] deg, contact direction u = [{direction}] ({search['starts']} local "
+        f"searches, {search['evaluations']:,} impulses evaluated)."
+    )
+
+
+def statistics_rows(record: Mapping[str, Any]) -> list[tuple[str, str, str]]:
+    """The recommended design's statistics: (statistic, on fresh samples, on the optimised samples).
+
+    Each value with its relative error (the larger half-width of a 99 % cluster-bootstrap interval).
+    """
+    fresh = (record.get("fresh") or {}).get("statistics") or {}
+    own = record.get("statistics") or {}
+    from ..optimize.objectives import CVAR_LEVEL
+
+    names = {
+        "mean_impulse": "mean impulse",
+        "cvar_impulse": f"mean of the worst {_g(100 * (1 - CVAR_LEVEL), 2)} % (CVaR)",
+        "quantile_impulse": "99th percentile",
+    }
+
+    def one(estimate: Mapping[str, Any] | None) -> str:
+        if not estimate:
+            return "–"
+        return f"{_g(estimate['value'])} N·s ± {_percent(100 * estimate['relative_error'])} %"
+
+    return [
+        (label, one(fresh.get(key)), one(own.get(key)))
+        for key, label in names.items()
+        if key in fresh or key in own
     ]
-    if uncertified:
-        lines.append(
-            "Pareto designs whose worst case the search found above their samples' (not certified): "
-            + "; ".join(uncertified)
-            + "."
-        )
-    return lines
 
 
-def statistics_sentences(
+def statistics_warnings(
     record: Mapping[str, Any], study: Mapping[str, Any], pareto: Mapping[str, Any] | None = None
 ) -> list[str]:
-    """The recommended design on fresh samples and on its own: worst case, mean and quantile with their errors.
+    """Warnings on the statistics: errors beyond the study's tolerance, Pareto designs a fresh sample beats.
 
-    Warnings when a fresh sample exceeds a design's worst case, when a fresh statistic's error exceeds the
-    study's ``samples.error_tolerance`` (naming the fresh configurations that would meet it), and when the mean
-    is an objective whose error on the optimised samples exceeds it.
+    A fresh statistic whose error exceeds ``samples.error_tolerance`` names the fresh configurations that would
+    meet it; an objective's statistic on the optimised samples names the configurations.
     """
     tolerance = float((study.get("samples") or {}).get("error_tolerance", 0.02))
     lines = []
     fresh = record.get("fresh")
     if fresh and fresh.get("largest") is not None:
-        worst = float(record["worst_case"]["domain"])
-        stats = fresh["statistics"]
-        check = (
-            f"WARNING: {_g(fresh['largest'])} N·s, {_percent(100 * (fresh['largest'] / worst - 1))} % above its "
-            f"worst case {_g(worst)} N·s, which is therefore not a bound"
-            if fresh["exceeds"]
-            else f"{_g(fresh['largest'])} N·s, within its worst case {_g(worst)} N·s"
-        )
-        lines.append(
-            f"Checked on {fresh['configurations']:,} fresh configurations of the domain ({fresh['samples']:,} "
-            f"samples it was not optimised on): largest impulse {check}; {_statistics_phrase(stats)}, 99 % "
-            "bootstrap intervals."
-        )
-        error = max(estimate["relative_error"] for estimate in stats.values())
+        error = max(estimate["relative_error"] for estimate in fresh["statistics"].values())
         if error > tolerance:
             needed = int(np.ceil(fresh["configurations"] * (error / tolerance) ** 2))
             lines.append(
@@ -337,15 +195,10 @@ def statistics_sentences(
         if (point.get("fresh") or {}).get("exceeds")
     ]
     if exceeded:
-        lines.append("Pareto designs whose worst case a fresh sample exceeds: " + "; ".join(exceeded) + ".")
-    statistics = record.get("statistics")
-    if not statistics:
-        return lines
-    mean = statistics["mean_impulse"]
-    lines.append(
-        f"On the samples it was optimised on ({mean['configurations']} configurations, {mean['samples']:,} "
-        f"samples): {_statistics_phrase(statistics)}."
-    )
+        lines.append(
+            "Warning: a fresh sample exceeds the worst case of Pareto designs " + "; ".join(exceeded) + "."
+        )
+    statistics = record.get("statistics") or {}
     objectives = study_objectives(study)
     for name in ("mean_impulse", "cvar_impulse"):
         estimate = statistics.get(name)
@@ -371,24 +224,6 @@ def study_objectives(study: Mapping[str, Any]) -> set[str]:
 _STATISTIC_NAMES = {"mean_impulse": "mean impulse", "cvar_impulse": "CVaR impulse"}
 
 
-def _statistics_phrase(statistics: Mapping[str, Any]) -> str:
-    """``mean ..., mean of the worst 5 % (CVaR) ..., 99th percentile ...``, each with its relative error."""
-
-    def one(estimate: Mapping[str, Any]) -> str:
-        return f"{_g(estimate['value'])} N·s (± {_percent(100 * estimate['relative_error'])} %)"
-
-    parts = [f"mean impulse {one(statistics['mean_impulse'])}"]
-    if "cvar_impulse" in statistics:
-        from ..optimize.objectives import CVAR_LEVEL
-
-        parts.append(
-            f"mean of the worst {_g(100 * (1 - CVAR_LEVEL), 2)} % (CVaR) {one(statistics['cvar_impulse'])}"
-        )
-    quantile = statistics["quantile_impulse"]
-    parts.append(f"{_g(100 * quantile['quantile'], 3)}th percentile {one(quantile)}")
-    return ", ".join(parts)
-
-
 def objective_spans(points: Sequence[Mapping[str, Any]], objectives: Sequence[str]) -> dict[str, float]:
     """Each objective's span over ``points`` [%].
 
@@ -406,37 +241,31 @@ def objective_spans(points: Sequence[Mapping[str, Any]], objectives: Sequence[st
 
 
 def front_sentences(pareto: Mapping[str, Any]) -> list[str]:
-    """The front's spans, and a plain sentence when it is flat or degenerate.
+    """The front's ranges and spans, and a plain sentence when it is flat or degenerate.
 
     Flat: an objective spans less than :data:`FLAT_SPAN`; degenerate: one point (every repeat merged), or every
     objective flat.
     """
-    from ..optimize.pareto import MERGE_TOLERANCE
+    from ..optimize import OBJECTIVES
 
     points, names = pareto["points"], pareto["objectives"]
     if not points:
         return []
-    merged = int(pareto.get("merged", 0))
-    lines = []
-    if merged:
-        lines.append(
-            f"{merged} solved point(s) repeated a reported design (objectives equal within {MERGE_TOLERANCE:g} "
-            "relative, the solver's tolerance) and were merged."
-        )
     if len(points) == 1:
         return [
-            *lines,
-            "Degenerate front: one design. The objectives "
+            "One design on the front: "
             + " and ".join(_words(n) for n in names)
-            + " do not trade off within these bounds; the recommended design is the only choice.",
+            + " do not trade off within these bounds."
         ]
     spans = objective_spans(points, names)
-    lines.insert(
-        0,
-        f"The front ({len(points)} designs) spans "
-        + ", ".join(f"{_percent(s)} % in {_words(n)}" for n, s in spans.items())
-        + ".",
-    )
+
+    def ranged(name: str) -> str:
+        values = [float(p["objectives"][name]) for p in points]
+        unit = OBJECTIVES[name][1].replace("*", "·")
+        low, high = _g(min(values)), _g(max(values))
+        return f"{_words(name)} {low if low == high else f'{low}–{high}'} {unit} ({_percent(spans[name])} %)"
+
+    lines = [f"Front of {len(points)} designs: " + ", ".join(ranged(n) for n in names) + "."]
     flat = [n for n in names if spans[n] < FLAT_SPAN]
     real = [n for n in names if spans[n] >= FLAT_SPAN]
     if flat and not real:
@@ -446,11 +275,12 @@ def front_sentences(pareto: Mapping[str, Any]) -> list[str]:
         )
     elif flat:
         choice = " and ".join(_words(n) for n in real)
-        lines += [
-            f"Flat front: all designs within {_g(spans[n], 2)} % of the best {_words(n)}: {choice} "
+        lines.append(
+            "Flat in "
+            + " and ".join(_words(n) for n in flat)
+            + f" (less than {FLAT_SPAN:g} % between its designs): {choice} "
             + ("is the only real choice." if len(real) == 1 else "are the only real choices.")
-            for n in flat
-        ]
+        )
     return lines
 
 
@@ -485,25 +315,17 @@ def flat_impulse_reason(
         p.get("reflected_inertia_in") for p in (resolved.get("actuators") or {}).get("joints", {}).values()
     }
     if placement == "robot" and not own - {None, "robot"}:
-        where = (
-            "the links' inertia with the actuator masses they carry; the rotors sit behind the joint springs "
-            "(reflected_inertia_in: robot)"
-        )
+        where = "the links with the actuator masses they carry (the rotors sit behind the joint springs)"
     elif placement == "finger" and not own - {None, "finger"}:
-        where = "the links' inertia with the actuator masses and the rotors (reflected_inertia_in: finger)"
+        where = "the links with the actuator masses and the rotors"
     else:
-        where = (
-            "the links' inertia with the actuator masses, and the rotors of the joints placed in the impact"
-        )
-    why = "is one design" if one else f"is flat in {_words(flat[0])}"
+        where = "the links with the actuator masses and the rotors of the joints placed in the impact"
     return [
-        f"Why the front {why}: at the recommended design the impact phase m_f v0, set by "
-        f"{where}, carries {_g(share_worst, 3)} % of the worst sample's impulse ({_g(initial[worst], 4)} of "
-        f"{_g(total[worst], 4)} N·s) and {_g(share_all, 3)} % of all samples' together. The sensing and reaction "
-        "phases, which the motors, gears and controller set, carry the rest, and the actuator masses on the links "
-        "move the impact little: actuator mass buys almost nothing here"
+        f"Why: the impact phase m_f v0, set by {where}, carries {_g(share_worst, 3)} % of the worst sample's "
+        f"impulse and {_g(share_all, 3)} % of all samples'; the motors, gears and controller set only the rest, "
+        "so actuator mass buys almost nothing here"
         + (
-            ", and what it adds to the links' mass only raises it: the lightest actuators that meet the "
+            " and what it adds to the links only raises the impact: the lightest actuators that meet the "
             "requirements are also the gentlest."
             if one
             else "."
@@ -529,35 +351,29 @@ def lightest_near_best(pareto: Mapping[str, Any], within: float = NEAR_BEST) -> 
     chosen = points[index]["objectives"]
     above = 100 * (chosen[impulse] / best - 1)
     return index, (
-        f"Lightest design within {_g(100 * within)} % of the best {_words(impulse)}: Pareto design {index}, "
+        f"The lightest within {_g(100 * within)} % of the best {_words(impulse)}: Pareto design {index}, "
         f"{_g(chosen['actuator_mass'])} kg at {_g(chosen[impulse])} N·s ({_g(above, 2)} % above the best)."
     )
 
 
 def requirement_sentence(requirement: str, rating: Mapping[str, Any] | None = None) -> str:
     """What the torque requirement is, and what it leaves out; ``rating``: the resolved study's, if any."""
+    hold = "the static hold of the arm and its payload at every sampled pose and at each joint's worst pose"
     if rating and requirement.startswith(("duty", "rated")):
         cycle = "the duty cycle (peak, RMS, speed), " if requirement.startswith("duty") else ""
         return (
-            f"Torque requirement: {cycle}the rated motion (each joint alone, either way, at its rated speed "
-            "while accelerating at its rated acceleration, and braking from its rated speed within its stopping "
-            "time), all with the rated payload at every sampled configuration, and the static hold there and at "
-            "each joint's worst pose within the joint limits; each joint's peak requirement is the largest of these (the table says which), its speed the largest rated or "
-            "cycle speed."
+            f"Requirement: per joint the largest of {cycle}the rated motion (each joint alone at its rated speed "
+            f"and acceleration, and braking from that speed within its stopping time) and {hold}, with the rated "
+            "payload; the sized-by column says which."
         )
     if requirement.startswith("static"):
         return (
-            f"Torque requirement: {requirement}. The peak torque covers gravity (and the payload) over the "
-            "sampled configurations and each joint's worst pose within the joint limits only: the motion's dynamics, RMS (thermal) torque and motor speed are not "
-            "checked; give the study a duty cycle to size for them."
+            f"Requirement: {requirement}: {hold}. The motion's dynamics, RMS (thermal) torque and motor speed "
+            "are not checked; give the study a duty cycle or a rating to size for them."
         )
     if requirement.startswith("duty"):
-        return (
-            f"Torque requirement: {requirement}, and the static hold: the arm and its rated payload held still "
-            "at every sampled configuration and at each joint's worst pose within the joint limits; each joint's "
-            "peak requirement is the larger of the two."
-        )
-    return f"Torque requirement: {requirement}."
+        return f"Requirement: per joint the larger of the {requirement} and {hold}; the sized-by column says which."
+    return f"Requirement: {requirement}."
 
 
 def oversized_warnings(record: Mapping[str, Any], bounds: Mapping[str, Any]) -> list[str]:
@@ -578,143 +394,333 @@ def oversized_warnings(record: Mapping[str, Any], bounds: Mapping[str, Any]) -> 
     return warnings
 
 
+MAX_LINES = 10
+"""The verdict's length: what to build, how sure, what sizes it, what the bounds decide, the front, warnings."""
+
+
 def verdict(results: Mapping[str, Any]) -> list[str]:
-    """The verdict of an arm study's results (:func:`collision_reflex.study.arm_results.arm_results`)."""
+    """The verdict of an arm study's results (:func:`collision_reflex.study.arm_results.arm_results`).
+
+    At most :data:`MAX_LINES` sentences, each said once: the design to build, the continuous optimum it comes
+    from, how sure its worst case is, what sizes its joints, what the design bounds decide, the front, the
+    transmission choice, and warnings (merged into one line where there would be more lines).
+    """
     recommended = results.get("recommended") or {**results["chosen"], "source": "optimum", "reason": ""}
     bounds = results.get("bounds")
-    requirement = str(results.get("requirement", "static (gravity only)"))
-    reason = str(recommended.get("reason", ""))
-    lines = [f"Recommended design ({recommended.get('source', 'optimum')}): {design_sentence(recommended)}"]
-    if reason:
-        lines.append(f"Why this design: {reason}.")
     resolved = results.get("resolved") or {}
+    catalogue = results.get("catalogue") or None
+    lines = build_sentences(recommended, catalogue)
     exchanged = "worst_case_impulse" in study_objectives(resolved) or not resolved
-    lines += worst_case_sentences(recommended, results.get("domain"), results["pareto"], exchanged)
-    lines += statistics_sentences(recommended, results.get("resolved") or {}, results.get("pareto"))
-    lines.append(requirement_sentence(requirement, resolved.get("rating")))
-    if results.get("speed_limits"):
-        lines.append(str(results["speed_limits"]))
-    lines += [str(line) for line in results.get("transmissions", ())]
+    lines += certainty_sentences(recommended, exchanged)
+    lines += sized_by_sentences(recommended, str(results.get("requirement", "static (gravity only)")))
+    if bounds is not None:
+        lines += bound_sentences(recommended, bounds)
+    lines += front_verdict(results["pareto"], recommended, resolved)
     lines += transmission_choice_sentences(results.get("transmission_choice"))
-    if bounds is not None:
-        undecided = recommended.get("undecided", ())
-        at_bound = False
-        for joint in recommended["joints"]:
-            own = [entry["variable"] for entry in undecided if entry["joint"] == joint["joint"]]
-            phrases = joint_limits(joint, bounds, requirement, own)
-            at_bound = at_bound or any(" bound" in phrase or " size" in phrase for phrase in phrases)
-            lines.append(
-                f"{joint['joint']}: "
-                + (", ".join(phrases) if phrases else "no bound or constraint active")
-                + "."
-                + (f" {undecided_sentence(joint, own)}" if own else "")
-            )
-        limits = design_limits(recommended, bounds)
-        if limits:
-            lines.append("Sensing and approach: " + ", ".join(limits) + ".")
-        if limits or at_bound:
-            lines.append(
-                "A variable at a bound of the study's design section, with no requirement named beside it, is "
-                "held there by that bound alone: the objectives would take it beyond. The bound, not the "
-                "physics, decides it; widen it to see where the design would settle."
-            )
-    lines += module_sentences(recommended)
-    lines += front_sentences(results["pareto"])
-    lines += flat_impulse_reason(results["pareto"], recommended, results.get("resolved") or {})
-    near = lightest_near_best(results["pareto"])
-    if near is not None:
-        lines.append(near[1])
-    if bounds is not None:
-        lines += oversized_warnings(recommended, bounds)
-    if results.get("catalogue"):
-        lines += catalogue_sentences(results["catalogue"])
-    return lines
+    warnings = verdict_warnings(results, recommended, bounds, catalogue)
+    room = MAX_LINES - len(lines)
+    if len(warnings) > room:
+        warnings = [*warnings[: max(room - 1, 0)], "Warnings: " + " ".join(warnings[max(room - 1, 0) :])]
+    return lines + warnings
 
 
-def transmission_choice_sentences(tried: Sequence[Mapping[str, Any]] | None) -> list[str]:
-    """The gearbox options tried per module and the one chosen, with each assignment's objective."""
-    if not tried:
-        return []
-    chosen = next(t for t in tried if t["chosen"])
+def _group_name(names: Sequence[str]) -> str:
+    """Joints that share a part, named by the first and last when more than two (a module: ``a … c``)."""
+    return (
+        names[0]
+        if len(names) == 1
+        else " and ".join(names)
+        if len(names) == 2
+        else f"{names[0]} … {names[-1]}"
+    )
 
-    def described(entry: Mapping[str, Any]) -> str:
-        parts = "; ".join(f"{joints}: {option}" for joints, option in entry["assignment"].items())
-        if entry["objective"] is None:
-            return f"{parts} (no design: {entry['status']})"
+
+def _grouped(joints: Sequence[Mapping[str, Any]], text: Any) -> str:
+    """``text(joint)`` per run of consecutive joints that it describes alike, named by :func:`_group_name`."""
+    groups: list[tuple[list[str], str]] = []
+    for joint in joints:
+        said = text(joint)
+        if groups and groups[-1][1] == said:
+            groups[-1][0].append(joint["joint"])
+        else:
+            groups.append(([joint["joint"]], said))
+    return "; ".join(f"{_group_name(names)}: {said}" for names, said in groups)
+
+
+def _sensing(record: Mapping[str, Any]) -> str:
+    unit = "N" if record["sensing"] == "force" else "m (position error)"
+    return (
+        f"threshold {_g(record['threshold'])} {unit}, approach velocity {_g(record['approach_velocity'])} m/s"
+    )
+
+
+def _motor(joint: Mapping[str, Any]) -> str:
+    return (
+        f"{_g(joint['stator_diameter'] * 1e3, 3)} mm × {_g(joint['stack_length'] * 1e3, 3)} mm motor at "
+        f"N = {_g(joint['gear_ratio'])}"
+    )
+
+
+def build_sentences(recommended: Mapping[str, Any], catalogue: Mapping[str, Any] | None) -> list[str]:
+    """What to build: the catalogue design when there is one, then the continuous optimum it was snapped from."""
+    objectives = recommended["objectives"]
+    worst = (recommended.get("worst_case") or {}).get("domain", objectives.get("worst_case_impulse"))
+    figures = ", ".join(
+        f"{_words(name)} {_g(value)} {unit}"
+        for name, value, unit in (
+            ("worst-case impulse", worst, "N·s"),
+            ("mean impulse", objectives.get("mean_impulse"), "N·s"),
+            ("actuator mass", objectives.get("actuator_mass"), "kg"),
+        )
+        if value is not None
+    )
+    source = str(recommended.get("source", "optimum"))
+    continuous = f"{_grouped(recommended['joints'], _motor)}; {_sensing(recommended)} ({figures})"
+    if catalogue is None:
+        return [f"Build: the continuous optimum ({source}): {continuous}. Its motors are scaled, not sold."]
+    if catalogue.get("design") is None:
+        return [
+            f"No design built from catalogue parts meets the requirements: the continuous optimum ({source}) is "
+            f"the best design, with scaled motors: {continuous}."
+        ]
+    design = catalogue["design"]
+    undecided = {e["joint"] for e in design.get("undecided", ()) if e["variable"] == "gear_ratio"}
+
+    def part(joint: Mapping[str, Any]) -> str:
         return (
-            f"{parts} (objective {_g(entry['objective'], 4)}, actuators {_g(entry['actuator_mass'], 4)} kg)"
+            f"{joint['motor']}"
+            + (f" + {joint['gearbox']}" if joint["gearbox"] else "")
+            + f" at N = {_g(joint['gear_ratio'])}"
+            + (" (a ratio no objective decides: the solver's start)" if joint["joint"] in undecided else "")
         )
 
-    others = [described(t) for t in tried if not t["chosen"]]
+    changes = ", ".join(
+        f"{_words(name)} {'+' if change >= 0 else '−'}{_percent(abs(change) * 100)} %"
+        for name in ("worst_case_impulse", "actuator_mass")
+        if (change := catalogue["relative_difference"].get(name)) is not None
+    )
+    values = catalogue["objectives"]
     return [
-        f"Transmissions chosen among the study's gearbox options, by the objective at each assignment's "
-        f"optimum: {described(chosen)}; also tried: " + " / ".join(others) + "."
+        f"Build from catalogue parts: {_grouped(catalogue['joints'], part)}; {_sensing(design)}: worst impulse "
+        f"over the samples {_g(values['worst_case_impulse'])} N·s, actuator mass {_g(values['actuator_mass'])} "
+        f"kg ({changes} against the continuous optimum).",
+        f"Continuous optimum ({source}): {continuous}.",
     ]
 
 
-def module_sentences(record: Mapping[str, Any]) -> list[str]:
-    """One sentence per actuator module of a design record: its joints and what sizes it."""
-    out = []
-    for joint in record["joints"]:
-        members = joint.get("module")
-        if not members or joint["joint"] != members[0]:
-            continue
-        by = joint.get("required_by") or "nothing"
-        origin = next((m for m in members if by.endswith(f" of {m}")), joint["joint"])
-        out.append(
-            f"Module {', '.join(members)}: one actuator (motor, gearbox, gear ratio) for all of them, sized for "
-            f"the most demanding, {origin} ({by.removesuffix(f' of {origin}')}); each table row gives that "
-            "requirement."
+def certainty_sentences(record: Mapping[str, Any], exchanged: bool = True) -> list[str]:
+    """How sure the recommended design's worst case is (its search), and its check on fresh samples."""
+    worst = record.get("worst_case")
+    lines = []
+    if worst:
+        search = worst.get("searched")
+        if search is None:
+            lines.append(
+                f"Worst case {_g(worst['sampled'])} N·s over the samples only: no search of the contact domain "
+                "ran, so it is a sampled value, not a bound."
+            )
+        elif worst["certified"]:
+            lines.append(
+                f"Worst case {_g(worst['domain'])} N·s, certified over the contact domain: {search['starts']} "
+                f"local searches found nothing more than {_g(100 * worst['tolerance'], 2)} % above the samples' "
+                "worst case."
+            )
+        else:
+            remedy = (
+                "more search rounds (optimizer.worst_case_search.rounds) or samples may certify it"
+                if exchanged
+                else "the worst case is no objective of this study, so the points found do not join its "
+                "samples (make worst_case_impulse an objective to bound it)"
+            )
+            excess = worst["domain"] / worst["sampled"] - 1
+            lines.append(
+                f"Warning: worst case NOT certified: the search found {_g(worst['domain'])} N·s, "
+                f"{_percent(100 * excess)} % above the samples' {_g(worst['sampled'])} N·s; take it as a worst "
+                f"case found, not a bound; {remedy}."
+            )
+    fresh = record.get("fresh")
+    if fresh and fresh.get("largest") is not None and worst:
+        bound = float(worst["domain"])
+        mean = fresh["statistics"]["mean_impulse"]
+        check = (
+            f"WARNING: largest {_g(fresh['largest'])} N·s, {_percent(100 * (fresh['largest'] / bound - 1))} % "
+            "above the worst case, which is therefore not a bound"
+            if fresh["exceeds"]
+            else f"largest {_g(fresh['largest'])} N·s, within the worst case"
         )
-    return out
+        lines.append(
+            f"On {fresh['configurations']:,} fresh configurations it was not optimised on: {check}; mean "
+            f"{_g(mean['value'])} N·s (± {_percent(100 * mean['relative_error'])} %)."
+        )
+    return lines
 
 
-def catalogue_sentences(catalogue: Mapping[str, Any]) -> list[str]:
-    """The catalogue design in one sentence, what it costs against the continuous one, and its warnings.
+def sized_by_sentences(record: Mapping[str, Any], requirement: str) -> list[str]:
+    """What sizes each joint (or module): the requirement whose constraint is active, in one sentence."""
 
-    A gear ratio that no objective decides (the design's ``undecided``) is said to be the solver's start.
+    def active(joint: Mapping[str, Any]) -> str:
+        said = []
+        for key, constraint in MARGINS:
+            margin = joint.get(key)
+            if margin is None or margin >= ACTIVE_TOLERANCE:
+                continue
+            by = str(joint.get("required_by") or constraint) if key == "torque_margin" else constraint
+            if key == "torque_margin" and joint.get("module") and " of " not in by:
+                by = f"{by} of {joint['joint']}"  # a module's members all name the joint that sizes it
+            said.append(by)
+        return ", ".join(said)
 
-    ``catalogue``: the ``catalogue`` entry of the results (:class:`collision_reflex.study.arm_results.
-    CatalogueRecord`).
-    """
-    warnings = [f"Warning: {text}." for text in catalogue["warnings"]]
-    if catalogue["design"] is None:
+    if all(joint.get("torque_margin") is None for joint in record["joints"]):
         return [
-            f"No design built from catalogue parts meets the requirements ({catalogue['method']}).",
-            *warnings,
+            f"No joint has a torque requirement ({requirement}): nothing but the impulse and the mass sizes "
+            "the actuators; give the study a rating or a duty cycle."
         ]
-    undecided = {
-        entry["joint"]
-        for entry in catalogue["design"].get("undecided", ())
-        if entry["variable"] == "gear_ratio"
-    }
-    parts = ", ".join(
-        f"{j['joint']} {j['motor']}"
-        + (f" + {j['gearbox']}" if j["gearbox"] else "")
-        + f" at N = {_g(j['gear_ratio'])}"
-        + (" (a ratio no objective decides: the solver's start)" if j["joint"] in undecided else "")
-        for j in catalogue["joints"]
-    )
-    costs = ", ".join(
-        f"{_words(name)} {'+' if change >= 0 else '−'}{_percent(abs(change) * 100)} %"
-        for name in ("worst_case_impulse", "mean_impulse", "actuator_mass")
-        if (change := catalogue["relative_difference"].get(name)) is not None
-    )
+    sized = [j for j in record["joints"] if active(j)]
+    if not sized:
+        return [f"No joint is at its torque, RMS or speed limit ({requirement}): every margin is positive."]
+    return [f"Sized by ({requirement}): {_grouped(sized, active)}."]
+
+
+def bound_sentences(record: Mapping[str, Any], bounds: Mapping[str, Any]) -> list[str]:
+    """What the study's design bounds decide, and what no objective decides: a sentence each."""
+    undecided = list(record.get("undecided", ()))
+    held: dict[str, list[str]] = {}  # what holds a variable -> the joints it holds, in joint order
+    for joint in record["joints"]:
+        name = joint["joint"]
+        chosen = not any(e["joint"] == name and e["variable"] == "gear_ratio" for e in undecided)
+        if motor_at_smallest_size(joint, bounds):
+            margin = joint.get("torque_margin")
+            excess = (
+                f" ({smallest_motor_excess(joint, bounds['gear_ratio'][name], 1 + margin, chosen)})"
+                if margin is not None and margin > OVERSIZED_MARGIN
+                else ""
+            )
+            held.setdefault(f"motor at its smallest size{excess}", []).append(name)
+        for key in ("gear_ratio", "software_stiffness"):
+            if any(e["joint"] == name and e["variable"] == key for e in undecided):
+                continue
+            position = bound_position(joint[key], bounds[key][name])
+            if position in ("lower", "upper"):
+                value = f"{_g(joint[key])}{UNDECIDED_UNITS.get(key, '')}"
+                held.setdefault(f"{_words(key)} at its {position} bound ({value})", []).append(name)
+    phrases = design_limits_at_bound(record, bounds) + [
+        f"{_group_name(names)} {what}" for what, names in held.items()
+    ]
+    lines = []
+    if phrases:
+        lines.append(
+            "Held by the design bounds, not the physics (widen them to see where the design settles): "
+            + "; ".join(phrases)
+            + "."
+        )
+    if undecided:
+        free = ", ".join(
+            f"{e['joint']} {_words(e['variable'])}" if e["joint"] else _words(e["variable"])
+            for e in undecided
+        )
+        lines.append(
+            f"No objective decides {free} anywhere within the bounds (no contact sample loads it): it is where "
+            "the solver started; choose it on grounds this study does not model."
+        )
+    return lines
+
+
+def design_limits_at_bound(record: Mapping[str, Any], bounds: Mapping[str, Any]) -> list[str]:
+    """The threshold and approach velocity where a bound holds them (undecided ones are said elsewhere)."""
+    undecided = {entry["variable"] for entry in record.get("undecided", ()) if entry["joint"] is None}
+    units = {"threshold": " N" if record.get("sensing") == "force" else " m", "approach_velocity": " m/s"}
     return [
-        f"Built from catalogue parts ({catalogue['method']}): {parts}; against the continuous design {costs}.",
-        *warnings,
+        f"{_words(key)} at its {position} bound ({_g(record[key])}{units[key]})"
+        for key in ("threshold", "approach_velocity")
+        if key not in undecided
+        and (position := bound_position(record[key], bounds[key])) in ("lower", "upper")
+    ]
+
+
+def front_verdict(
+    pareto: Mapping[str, Any], record: Mapping[str, Any], resolved: Mapping[str, Any]
+) -> list[str]:
+    """The front in one sentence: its spans (or why it is flat or one design) and its lightest good design."""
+    lines = front_sentences(pareto)
+    reason = flat_impulse_reason(pareto, record, resolved)
+    near = lightest_near_best(pareto)
+    said = " ".join(lines + reason + ([near[1]] if near else []))
+    return [said] if said else []
+
+
+def verdict_warnings(
+    results: Mapping[str, Any],
+    record: Mapping[str, Any],
+    bounds: Mapping[str, Any] | None,
+    catalogue: Mapping[str, Any] | None,
+) -> list[str]:
+    """Every warning of the verdict: oversized joints, uncertain statistics, Pareto designs the checks fail."""
+    warnings = oversized_warnings(record, bounds) if bounds is not None else []
+    pareto = results["pareto"]
+    warnings += statistics_warnings(record, results.get("resolved") or {}, pareto)
+    uncertified = [
+        str(point.get("label", i))
+        for i, point in enumerate(pareto.get("points", ()))
+        if (point.get("worst_case") or {}).get("searched") and not point["worst_case"]["certified"]
+    ]
+    if uncertified:
+        warnings.append(
+            "Warning: the worst case of Pareto designs " + "; ".join(uncertified) + " is not certified."
+        )
+    if catalogue:
+        warnings += _joint_warnings(catalogue["warnings"])
+    return warnings
+
+
+def _joint_warnings(texts: Sequence[str]) -> list[str]:
+    """``joint: what`` warnings, those that say the same of consecutive joints said once."""
+    groups: list[tuple[list[str], str]] = []
+    for text in texts:
+        name, sep, what = text.partition(": ")
+        if not sep:
+            name, what = "", text
+        if groups and groups[-1][1] == what and name:
+            groups[-1][0].append(name)
+        else:
+            groups.append(([name] if name else [], what))
+    return [f"Warning: {_group_name(names) + ': ' if names else ''}{what}." for names, what in groups]
+
+
+def transmission_choice_sentences(tried: Sequence[Mapping[str, Any]] | None) -> list[str]:
+    """The transmission chosen among the study's gearbox options, in one sentence (the report's table has all)."""
+    if not tried:
+        return []
+    chosen = next(t for t in tried if t["chosen"])
+    options = sorted(set(chosen["assignment"].values()))
+    where = (
+        f"{options[0]} at every joint"
+        if len(options) == 1
+        else "; ".join(
+            f"{_group_name(joints.split(', '))}: {option}" for joints, option in chosen["assignment"].items()
+        )
+    )
+    others = [t["objective"] for t in tried if not t["chosen"] and t["objective"] is not None]
+    runner_up = f"; the next best {_g(min(others), 4)}" if others else ""
+    return [
+        f"Transmission: {where}, the best of {len(tried)} assignments of the gearbox options by the study's "
+        f"objective ({_g(chosen['objective'], 4)}{runner_up})."
     ]
 
 
 __all__ = [
     "bound_position",
-    "catalogue_sentences",
-    "design_sentence",
+    "bound_sentences",
+    "build_sentences",
+    "certainty_sentences",
+    "domain_sentence",
     "front_sentences",
-    "joint_limits",
     "lightest_near_best",
     "objective_spans",
     "oversized_warnings",
-    "undecided_sentence",
+    "requirement_sentence",
+    "sized_by_sentences",
+    "statistics_rows",
+    "statistics_warnings",
     "verdict",
+    "worst_pose_sentence",
 ]

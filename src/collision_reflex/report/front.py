@@ -1,0 +1,135 @@
+"""The Pareto front's hover cards: each Pareto design in a few lines of designer units, for the HTML report.
+
+The report's front figure gives each design's marker the SVG id ``front-point-{i}``
+(:data:`collision_reflex.plots.design_front.POINT_ID`); its script shows the card of that id when the marker is
+hovered, focused or clicked.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from ..plots.design_front import POINT_ID
+
+
+def significant(value: float, digits: int) -> str:
+    """``value`` to ``digits`` significant digits, trailing zeros dropped, without an exponent where readable."""
+    value = float(value)
+    if not math.isfinite(value):
+        return str(value)
+    rounded = float(f"{value:.{digits}g}")
+    if rounded == 0 or 1e-4 <= abs(rounded) < 1e7:
+        return np.format_float_positional(rounded, trim="-")
+    return f"{rounded:.{digits}g}"
+
+
+def _unit(unit: str) -> str:
+    """A unit as printed for people: ``N*s`` as ``N·s``."""
+    return unit.replace("*", "·")
+
+
+def _words(name: str) -> str:
+    return name.replace("_", " ")
+
+
+def _objective_lines(objectives: Mapping[str, float], first: Sequence[str]) -> list[str]:
+    """Each objective with its unit, the front's objectives (``first``) before the others."""
+    from ..optimize import OBJECTIVES
+
+    names = [name for name in first if name in objectives] + [
+        name for name in objectives if name not in first
+    ]
+    return [
+        f"{_words(name)} {significant(objectives[name], 4)} {_unit(OBJECTIVES[name][1]) if name in OBJECTIVES else ''}".rstrip()
+        for name in names
+    ]
+
+
+def _threshold_line(record: Mapping[str, Any]) -> str:
+    threshold = float(record["threshold"])
+    if record.get("sensing") == "position":  # a position-error threshold [m]
+        return f"position-error threshold {significant(threshold * 1e3, 4)} mm"
+    return f"threshold {significant(threshold, 4)} N"
+
+
+def _joint_lines(joints: Sequence[Mapping[str, Any]]) -> list[str]:
+    """Each joint's motor, gear ratio and software stiffness; the gearbox once if every joint has the same."""
+    gearboxes = [_unit(g) if isinstance(g, str) and g else None for g in (j.get("gearbox") for j in joints)]
+    common = len(set(gearboxes)) == 1
+    lines = []
+    for joint, gearbox in zip(joints, gearboxes, strict=True):
+        line = (
+            f"{joint['joint']}: {significant(joint['stator_diameter'] * 1e3, 3)} mm × "
+            f"{significant(joint['stack_length'] * 1e3, 3)} mm motor, N = {significant(joint['gear_ratio'], 4)}, "
+            f"k_s {significant(joint['software_stiffness'], 4)} N·m/rad"
+        )
+        lines.append(f"{line}; {gearbox}" if gearbox and not common else line)
+    if common and gearboxes and gearboxes[0]:
+        lines.append(f"gearbox of every joint: {gearboxes[0]}")
+    return lines
+
+
+def _parts(parts: Sequence[str | None]) -> str:
+    """The parts in joint order, a run of joints with the same part as ``3 × part``."""
+    runs: list[list[Any]] = []
+    for part in parts:
+        if runs and runs[-1][0] == part:
+            runs[-1][1] += 1
+        else:
+            runs.append([part, 1])
+    return ", ".join(f"{count} × {part or 'none'}" if count > 1 else part or "none" for part, count in runs)
+
+
+def _catalogue_line(snap: Mapping[str, Any]) -> str:
+    """The quick catalogue snap: its part per joint and whether it meets the requirements as it is."""
+    parts = _parts(snap.get("parts") or ())
+    missing = snap.get("missing") or []
+    if missing:
+        misses = "; ".join(
+            f"{m['joint']}: no part within bounds, nearest {m['nearest']} misses {', '.join(m['misses'])}"
+            for m in missing
+        )
+    elif snap.get("feasible"):
+        return f"catalogue parts: {parts} (meets the requirements)"
+    else:
+        misses = "; ".join(_unit(s) for s in snap.get("shortfalls") or ()) or "the requirements"
+    return f"catalogue parts: {parts} (misses: {misses})"
+
+
+def front_cards(results: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """One hover card per Pareto design of a run's results (``designs.json``), in Pareto order.
+
+    Parameters
+    ----------
+    results
+        A run's results: ``results["pareto"]["points"]`` the Pareto design records; the quick catalogue snap
+        of design ``i`` from ``results["catalogue"]["pareto"][i]`` and the recommended design from
+        ``results["recommended"]["pareto_index"]``, where present.
+
+    Returns
+    -------
+    list of dict
+        ``{"id": "front-point-i", "title": "Pareto design i", "lines": [...]}``: the design's objectives,
+        threshold, approach velocity, each joint's motor (stator diameter × stack length in mm), gear ratio,
+        software stiffness and gearbox, and its catalogue snap; the recommended design's title says so.
+    """
+    pareto = results["pareto"]
+    snaps = (results.get("catalogue") or {}).get("pareto") or []
+    recommended = (results.get("recommended") or {}).get("pareto_index")
+    cards = []
+    for index, record in enumerate(pareto["points"]):
+        lines = _objective_lines(record["objectives"], pareto.get("objectives") or [])
+        lines.append(_threshold_line(record))
+        velocity = f"approach velocity {significant(record['approach_velocity'], 4)} m/s"
+        if velocity not in lines:  # an objective of the front already says it
+            lines.append(velocity)
+        lines += _joint_lines(record["joints"])
+        if index < len(snaps) and snaps[index]:
+            lines.append(_catalogue_line(snaps[index]))
+        title = f"Pareto design {index}" + (" — recommended" if index == recommended else "")
+        cards.append({"id": POINT_ID.format(index), "title": title, "lines": lines})
+    return cards
