@@ -66,8 +66,8 @@ def test_svg_says_unknown_and_motor_side(tmp_path):
         assert label in text
     assert "margins: peak none, RMS none, speed none" in text
     shoulder = plot_torque_speed(tmp_path / "g.svg", [_shoulder()]).read_text(encoding="utf-8")
-    # Peak: 2 / 2.2 - 1; RMS: 1 / 1.06 - 1; speed: 300 / 330 - 1; each rounded to whole %.
-    assert "margins: peak -9 %, RMS -6 %, speed -9 %" in shoulder
+    # Peak: 2 / 2.2 - 1; RMS: 1 / 1.06 - 1; speed: 300 / 330 - 1; each to 3 significant digits.
+    assert "margins: peak −9.09 %, RMS −5.66 %, speed −9.09 %" in shoulder
     assert "max speed 300 rad/s (2865 rpm)" in shoulder
 
 

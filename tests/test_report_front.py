@@ -284,6 +284,10 @@ class PipeBrowser:
                 pass_fds=(3, 4),
                 preexec_fn=onto_3_and_4,
             )
+        except BaseException:
+            os.close(self._commands)
+            os.close(self._replies)
+            raise
         finally:
             for fd in (commands_read, replies_write, high_read, high_write):
                 os.close(fd)
@@ -364,11 +368,15 @@ def open_page(browser: str, profile: Path, url: str) -> Iterator[tuple[PipeBrows
             deviceScaleFactor=1,
             mobile=False,
         )
-        # The blank page's own load may still be reported: wait for a load after the navigation, of this page.
         before = len(chromium.events)
         chromium.send("Page.navigate", session, url=url)
         chromium.wait_for("Page.loadEventFired", after=before)
-        assert chromium.evaluate(session, "location.href") == url
+        # The blank page's own load may have been the event: wait until this page has loaded.
+        loaded = f"document.readyState === 'complete' && location.href === {json.dumps(url)}"
+        deadline = time.monotonic() + TIMEOUT
+        while not chromium.evaluate(session, loaded):
+            assert time.monotonic() < deadline, f"{url} did not load in time"
+            time.sleep(0.05)
         yield chromium, session
     finally:
         chromium.close()

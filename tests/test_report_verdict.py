@@ -7,17 +7,20 @@ import pytest
 
 from collision_reflex.report.verdict import (
     ACTIVE_TOLERANCE,
+    MAX_LINES,
     bound_position,
-    catalogue_sentences,
-    design_limits,
+    bound_sentences,
+    build_sentences,
+    certainty_sentences,
     flat_impulse_reason,
     front_sentences,
-    joint_limits,
     lightest_near_best,
     objective_spans,
     oversized_warnings,
-    statistics_sentences,
-    undecided_sentence,
+    sized_by_sentences,
+    smallest_motor_excess,
+    statistics_rows,
+    statistics_warnings,
     verdict,
 )
 
@@ -69,32 +72,29 @@ def test_bound_position_within_the_relative_tolerance():
     assert bound_position(0.0125, [0.0125, 0.0125]) == "fixed"
 
 
-def test_active_bounds_and_constraints_per_joint():
+def test_the_bounds_that_hold_a_design_are_named_once_per_kind():
     at_bounds = joint(diameter=0.03, ratio=160.0, stiffness=50.0, margin=0.5 * ACTIVE_TOLERANCE)
-    phrases = joint_limits(at_bounds, BOUNDS, "static (gravity only)")
-    assert phrases == [
-        "motor at its smallest size",  # diameter at its lower bound, stack length fixed
-        "gear ratio at its upper bound (160)",
-        "software stiffness at its lower bound (50)",
-        "sized by peak torque",
-    ]
-    assert joint_limits(joint(diameter=0.14), BOUNDS, "static (gravity only)") == [
-        "motor at its largest size"
-    ]
-    # Inside every bound, with margin: nothing active.
-    assert joint_limits(joint(margin=2 * ACTIVE_TOLERANCE), BOUNDS, "static (gravity only)") == []
+    elbow = {**at_bounds, "joint": "elbow"}
+    (line,) = bound_sentences(record(joints=[at_bounds, elbow], threshold=1.0), BOUNDS)
+    assert line == (
+        "Held by the design bounds, not the physics (widen them to see where the design settles): threshold at "
+        "its lower bound (1 N); shoulder and elbow motor at its smallest size; shoulder and elbow gear ratio at "
+        "its upper bound (160); shoulder and elbow software stiffness at its lower bound (50 N·m/rad)."
+    )
+    # Inside every bound: nothing said.
+    assert bound_sentences(record(joints=[joint(), joint("elbow")]), BOUNDS) == []
 
 
-def test_no_requirement_and_the_duty_cycle_margins():
-    free = joint(margin=None)
-    assert joint_limits(free, BOUNDS, "static (gravity only)") == [
-        "no torque requirement: static gravity-only requirement is zero for this joint"
-    ]
-    assert joint_limits(free, BOUNDS, "duty cycle") == ["no torque requirement"]
-    cycled = joint(margin=0.3, rms_margin=0.0, speed_margin=0.2 * ACTIVE_TOLERANCE, required_rms_torque=4.0)
-    assert joint_limits(cycled, BOUNDS, "duty cycle") == ["sized by RMS torque", "sized by speed"]
-    # Margins absent (a record before duty cycles) or None (no such requirement): nothing said about them.
-    assert joint_limits(joint(margin=0.3, rms_margin=None), BOUNDS, "duty cycle") == []
+def test_what_sizes_each_joint_or_module():
+    shoulder = joint(margin=0.0, required_by="braking", module=["shoulder", "elbow"])
+    elbow = joint("elbow", margin=0.0, required_by="braking of shoulder", module=["shoulder", "elbow"])
+    (line,) = sized_by_sentences(record(joints=[shoulder, elbow]), "duty cycle (peak, RMS, speed)")
+    assert line == "Sized by (duty cycle (peak, RMS, speed)): shoulder and elbow: braking of shoulder."
+    cycled = joint(margin=0.3, rms_margin=0.0, speed_margin=0.2 * ACTIVE_TOLERANCE)
+    (line,) = sized_by_sentences(record(joints=[cycled, joint("elbow")]), "duty cycle")
+    assert line == "Sized by (duty cycle): shoulder: RMS torque, speed."
+    (line,) = sized_by_sentences(record(joints=[joint(margin=None), joint("elbow", margin=None)]), "static")
+    assert line.startswith("No joint has a torque requirement (static)")
 
 
 def test_spans_in_percent_of_the_best():
@@ -114,12 +114,14 @@ def test_the_flat_front_sentence_fires_on_a_flat_front_only():
     flat = pareto([record(0.5000, 2.0), record(0.5005, 1.0), record(0.5011, 0.11)])  # 0.22 % vs 18x in mass
     lines = front_sentences(flat)
     assert (
-        "Flat front: all designs within 0.22 % of the best worst case impulse: actuator mass is the only "
-        "real choice." in lines
+        "Flat in worst case impulse (less than 1 % between its designs): actuator mass is the only real choice."
+        in lines
     )
     trade_off = pareto([record(0.40, 2.0), record(0.46, 1.0), record(0.60, 0.2)])  # 50 % vs 900 %
     lines = front_sentences(trade_off)
-    assert lines[0] == "The front (3 designs) spans 50 % in worst case impulse, 900 % in actuator mass."
+    assert lines[0] == (
+        "Front of 3 designs: worst case impulse 0.4–0.6 N·s (50 %), actuator mass 0.2–2 kg (900 %)."
+    )
     assert not any("Flat" in line or "Degenerate" in line for line in lines)
 
 
@@ -129,21 +131,22 @@ def test_a_flat_impulse_front_says_which_phase_carries_the_impulse():
     recommended = {**record(0.5005, 1.0), "phases": phases}
     flat = pareto([record(0.5000, 2.0), recommended, record(0.5011, 0.11)])
     (line,) = flat_impulse_reason(flat, recommended, {"reflected_inertia_in": "robot"})
-    assert line.startswith("Why the front is flat in worst case impulse:")
-    assert "carries 90.9 % of the worst sample's impulse (1 of 1.1 N·s)" in line
-    assert "88.9 % of all samples' together" in line and "rotors sit behind the joint springs" in line
+    assert line.startswith("Why: the impact phase m_f v0")
+    assert "carries 90.9 % of the worst sample's impulse and 88.9 % of all samples'" in line
+    assert "rotors sit behind the joint springs" in line
     trade_off = pareto([record(0.40, 2.0), recommended, record(0.60, 0.2)])
     assert flat_impulse_reason(trade_off, recommended, {}) == []
     # A front of one design gets the same numbers and says the lightest is the gentlest.
     (line,) = flat_impulse_reason(pareto([recommended]), recommended, {"reflected_inertia_in": "robot"})
-    assert line.startswith("Why the front is one design:") and "90.9 %" in line
+    assert "90.9 %" in line
     assert line.endswith("the lightest actuators that meet the requirements are also the gentlest.")
 
 
 def test_degenerate_fronts_are_said_in_plain_words():
-    one = front_sentences(pareto([record()], merged=2))
-    assert one[0].startswith("2 solved point(s) repeated a reported design") and "merged" in one[0]
-    assert one[1].startswith("Degenerate front: one design.")
+    (one,) = front_sentences(pareto([record()], merged=2))
+    assert one == (
+        "One design on the front: worst case impulse and actuator mass do not trade off within these bounds."
+    )
     same = front_sentences(pareto([record(0.5, 1.0), record(0.5001, 0.999)]))
     assert any(line.startswith("Degenerate front: every design within 1 %") for line in same)
 
@@ -167,26 +170,32 @@ def test_oversized_joints_are_warned_unless_their_motor_is_smallest():
     assert len(warnings) == 1 and warnings[0].startswith("Warning: shoulder delivers 3.5× its required peak")
     # The smallest motor's excess is said as such, not warned about: at N = 50 it is 26x, and 26 x 10/50 = 5.2x
     # still at the lowest ratio.
-    assert (
+    ratios = BOUNDS["gear_ratio"]["elbow"]
+    assert smallest_motor_excess(smallest, ratios, 26.0) == (
         "peak torque 26× its requirement at N = 50 (5.2× at its lowest ratio, 10): even the smallest motor is "
-        "more than it needs" in joint_limits(smallest, BOUNDS, "static (gravity only)")
+        "more than it needs"
     )
+    (line,) = bound_sentences(record(joints=[joint(), smallest]), BOUNDS)
+    assert "elbow motor at its smallest size (peak torque 26× its requirement at N = 50" in line
     # At its lowest ratio already: the motor alone.
     lowest = joint("elbow", diameter=0.03, ratio=10.0, margin=25.0)
-    assert "peak torque 26× its requirement: even the smallest motor is more than it needs" in joint_limits(
-        lowest, BOUNDS, "static (gravity only)"
+    assert smallest_motor_excess(lowest, ratios, 26.0) == (
+        "peak torque 26× its requirement: even the smallest motor is more than it needs"
     )
     # 26x at N = 150 is 1.7x at N = 10: the ratio the objective chose gives the excess, not the motor.
     geared = joint("elbow", diameter=0.03, ratio=150.0, margin=25.0)
-    assert (
+    assert smallest_motor_excess(geared, ratios, 26.0) == (
         "peak torque 26× its requirement at N = 150, the ratio the objective chose (1.73× at its lowest ratio, "
         "10): the gear ratio, not the motor, gives the excess"
-        in joint_limits(geared, BOUNDS, "static (gravity only)")
+    )
+    # A ratio no objective decides is not called the objective's choice.
+    assert smallest_motor_excess(geared, ratios, 26.0, chosen_ratio=False) == (
+        "peak torque 26× its requirement at N = 150 (1.73× at its lowest ratio, 10)"
     )
     assert oversized_warnings(record(joints=[joint(margin=1.9)]), BOUNDS) == []
 
 
-def test_the_verdict_opens_with_the_recommended_design():
+def test_the_verdict_opens_with_the_design_to_build_and_stays_within_ten_lines():
     recommended = {
         **record(joints=[joint(diameter=0.03, margin=0.0), joint("elbow", margin=None)], threshold=1.0),
         "source": "Pareto design 1",
@@ -200,66 +209,28 @@ def test_the_verdict_opens_with_the_recommended_design():
         "requirement": "static (gravity only)",
     }
     lines = verdict(results)
-    assert lines[0].startswith("Recommended design (Pareto design 1): shoulder: 30 mm × 12.5 mm motor")
-    assert "at N = 50" in lines[0] and "threshold 1 N, approach velocity 0.2 m/s" in lines[0]
-    assert lines[1] == "Why this design: Pareto design 1 dominates the single-objective optimum."
-    assert lines[2].startswith("Torque requirement: static (gravity only).")
-    from collision_reflex.report.verdict import requirement_sentence
-
-    assert "the static hold" in requirement_sentence("duty cycle (peak, RMS, speed)")
-    assert "shoulder: motor at its smallest size, sized by peak torque." in lines
-    assert "elbow: no torque requirement: static gravity-only requirement is zero for this joint." in lines
-    assert "Sensing and approach: threshold at its lower bound (1)." in lines
-    assert any(line.startswith("Lightest design within 5 %") for line in lines)
-
-
-def test_variables_no_objective_decides_are_said_so_and_not_called_a_choice():
-    """A joint no sample loads (its gear ratio and software stiffness undecided): the verdict gives their values
-    as the solver's start, not the objective's choice; a decided ratio keeps its sentence."""
-    wrist = joint("elbow", diameter=0.03, ratio=67.0, stiffness=387.3, margin=93.4)
-    recommended = {
-        **record(joints=[joint(margin=0.0), wrist]),
-        "source": "optimum",
-        "reason": "",
-        "undecided": [
-            {"variable": "gear_ratio", "joint": "elbow"},
-            {"variable": "software_stiffness", "joint": "elbow"},
-        ],
-    }
-    results = {
-        "chosen": record(),
-        "recommended": recommended,
-        "pareto": pareto([]),
-        "bounds": BOUNDS,
-        "requirement": "duty cycle (peak, RMS, speed)",
-    }
-    (line,) = [line for line in verdict(results) if line.startswith("elbow:")]
-    # 94.4x at N = 67 is 14.1x at N = 10: the motor, not the ratio, is more than the joint needs.
-    assert line == (
-        "elbow: motor at its smallest size, peak torque 94.4× its requirement at N = 67 (14.1× at its lowest "
-        "ratio, 10): even the smallest motor is more than it needs. Its gear ratio (67) and software stiffness "
-        "(387.3 N·m/rad) change no impulse and not the actuator mass anywhere within their bounds, as no contact "
-        "sample loads this joint: no objective decides them, and they are where the solver started; choose them "
-        "on grounds this study does not model."
+    assert lines[0] == (
+        "Build: the continuous optimum (Pareto design 1): shoulder: 30 mm × 12.5 mm motor at N = 50; elbow: 80 mm "
+        "× 12.5 mm motor at N = 50; threshold 1 N, approach velocity 0.2 m/s (worst-case impulse 0.5 N·s, mean "
+        "impulse 0.25 N·s, actuator mass 1 kg). Its motors are scaled, not sold."
     )
-    # An undecided ratio whose excess at its lowest ratio is small: not "the ratio the objective chose".
-    geared = joint("elbow", diameter=0.03, ratio=150.0, margin=25.0)
-    decided = joint_limits(geared, BOUNDS, "static (gravity only)")
-    assert "the ratio the objective chose" in decided[-1]
-    (undecided,) = [
-        p for p in joint_limits(geared, BOUNDS, "static (gravity only)", ["gear_ratio"]) if "peak torque" in p
-    ]
-    assert undecided == "peak torque 26× its requirement at N = 150 (1.73× at its lowest ratio, 10)"
-    assert undecided_sentence(geared, ["gear_ratio"]) == (
-        "Its gear ratio (150) changes no impulse and not the actuator mass anywhere within its bounds: no "
-        "objective decides it, and it is where the solver started; choose it on grounds this study does not model."
-    )
-    # A record written before the field existed reads as nothing undecided.
-    del recommended["undecided"]
-    assert not any("no objective decides" in line for line in verdict(results))
+    assert "Sized by (static (gravity only)): shoulder: peak torque." in lines
+    assert any(line.startswith("The lightest within 5 %") or "The lightest within 5 %" in line for line in lines)
+    # Many warnings: merged into the last line, never more than MAX_LINES.
+    many = {
+        **results,
+        "catalogue": {
+            "warnings": [f"j{i}: part {i} is far from the optimum" for i in range(12)],
+            "design": None,
+            "method": "exact",
+        },
+    }
+    lines = verdict(many)
+    assert len(lines) <= MAX_LINES and lines[-1].startswith("Warnings: ")
+    assert all(f"j{i}: part {i}" in " ".join(lines) for i in range(12))
 
 
-def test_a_catalogue_gear_ratio_no_objective_decides_is_said_to_be_the_start():
+def test_a_catalogue_design_is_what_to_build_and_its_undecided_ratio_is_said():
     joints = [
         {"joint": "shoulder", "motor": "M-80", "gearbox": None, "gear_ratio": 40.0},
         {"joint": "elbow", "motor": "M-30", "gearbox": "HD-14", "gear_ratio": 59.85},
@@ -268,26 +239,28 @@ def test_a_catalogue_gear_ratio_no_objective_decides_is_said_to_be_the_start():
         "warnings": [],
         "method": "exact: enumerated 4 combinations",
         "joints": joints,
+        "objectives": {"worst_case_impulse": 0.5089, "actuator_mass": 2.74},
         "relative_difference": {"worst_case_impulse": 0.0177, "actuator_mass": 1.74},
-        "design": {"undecided": [{"variable": "gear_ratio", "joint": "elbow"}]},
+        "design": {**record(), "undecided": [{"variable": "gear_ratio", "joint": "elbow"}]},
     }
-    (sentence,) = catalogue_sentences(catalogue)
-    assert (
-        "shoulder M-80 at N = 40, elbow M-30 + HD-14 at N = 59.85 (a ratio no objective decides: the solver's "
-        "start); against the continuous design worst case impulse +1.77 %, actuator mass +174 %." in sentence
+    build, continuous = build_sentences({**record(), "source": "optimum"}, catalogue)
+    assert build == (
+        "Build from catalogue parts: shoulder: M-80 at N = 40; elbow: M-30 + HD-14 at N = 59.85 (a ratio no "
+        "objective decides: the solver's start); threshold 5 N, approach velocity 0.2 m/s: worst impulse over "
+        "the samples 0.5089 N·s, actuator mass 2.74 kg (worst case impulse +1.77 %, actuator mass +174 % against "
+        "the continuous optimum)."
     )
+    assert continuous.startswith("Continuous optimum (optimum): shoulder and elbow: 80 mm × 12.5 mm motor")
     # Written before the field existed: no claim either way.
     del catalogue["design"]["undecided"]
-    assert "no objective decides" not in catalogue_sentences(catalogue)[0]
+    assert "no objective decides" not in build_sentences(record(), catalogue)[0]
 
 
-def test_an_undecided_global_variable_is_said_so_instead_of_its_bound():
+def test_an_undecided_variable_is_said_so_instead_of_its_bound():
     undecided = {**record(threshold=1.0), "undecided": [{"variable": "threshold", "joint": None}]}
-    assert design_limits(undecided, BOUNDS) == [
-        "threshold (1) changes no objective anywhere within its bounds: no objective decides it, the value is "
-        "where the solver started"
-    ]
-    assert design_limits(record(threshold=1.0), BOUNDS) == ["threshold at its lower bound (1)"]
+    (line,) = bound_sentences(undecided, BOUNDS)
+    assert line.startswith("No objective decides threshold anywhere within the bounds")
+    assert bound_sentences(record(threshold=1.0), BOUNDS)[0].endswith("threshold at its lower bound (1 N).")
 
 
 def _estimate(value, error, configurations, samples, **extra):
@@ -320,7 +293,7 @@ def _fresh(largest, exceeds, mean_error=0.01, quantile_error=0.015):
 def test_the_fresh_check_and_its_errors_are_stated_and_warned_about():
     recommended = {
         **record(),
-        "worst_case": {"domain": 2.0},
+        "worst_case": {"domain": 2.0, "sampled": 2.0, "certified": True, "tolerance": 0.005},
         "fresh": _fresh(1.9, False),
         "statistics": {
             "mean_impulse": _estimate(0.28, 0.12, 48, 288),
@@ -329,13 +302,16 @@ def test_the_fresh_check_and_its_errors_are_stated_and_warned_about():
         },
     }
     study = {"objective": "worst_case_impulse", "samples": {"error_tolerance": 0.02}}
-    lines = statistics_sentences(recommended, study, {"points": [recommended]})
-    assert lines[0].startswith("Checked on 4,096 fresh configurations of the domain (24,000 samples")
-    assert "largest impulse 1.9 N·s, within its worst case 2 N·s" in lines[0]
-    assert "mean impulse 0.3 N·s (± 1 %), mean of the worst 5 % (CVaR) 1 N·s (± 1 %)" in lines[0]
-    assert "99th percentile 1.2 N·s (± 1.5 %)" in lines[0]
-    assert lines[1].startswith("On the samples it was optimised on (48 configurations")
-    assert len(lines) == 2  # errors within the tolerance; the mean is no objective: no warning
+    (searched, fresh) = certainty_sentences(recommended)
+    assert searched.startswith("Worst case 2 N·s over the samples only: no search")
+    assert fresh == (
+        "On 4,096 fresh configurations it was not optimised on: largest 1.9 N·s, within the worst case; mean "
+        "0.3 N·s (± 1 %)."
+    )
+    rows = statistics_rows(recommended)
+    assert rows[0] == ("mean impulse", "0.3 N·s ± 1 %", "0.28 N·s ± 12 %")
+    assert rows[2] == ("99th percentile", "1.2 N·s ± 1.5 %", "1.1 N·s ± 30 %")
+    assert statistics_warnings(recommended, study, {"points": [recommended]}) == []  # the mean is no objective
     # A fresh sample above the worst case, errors over the tolerance, the mean an objective: each is said.
     recommended["fresh"] = _fresh(2.2, True, quantile_error=0.04)
     recommended["label"] = "anchor: worst_case_impulse"
@@ -344,21 +320,19 @@ def test_the_fresh_check_and_its_errors_are_stated_and_warned_about():
         "objective": "mean_impulse",
         "pareto": {"objectives": ["cvar_impulse", "actuator_mass"]},
     }
-    lines = statistics_sentences(recommended, study, {"points": [recommended]})
-    assert "WARNING: 2.2 N·s, 10 % above its worst case 2 N·s, which is therefore not a bound" in lines[0]
+    assert "WARNING: largest 2.2 N·s, 10 % above the worst case" in certainty_sentences(recommended)[1]
+    lines = statistics_warnings(recommended, study, {"points": [recommended]})
     # 4 % against 2 %: four times the configurations.
-    assert "about 16,384 fresh configurations (samples.fresh) would meet it" in lines[1]
-    assert lines[2] == "Pareto designs whose worst case a fresh sample exceeds: anchor: worst_case_impulse."
-    assert lines[4].startswith("Warning: the mean impulse, an objective, is uncertain by 12 %")
-    assert "about 1,728 configurations (samples.configurations.random.count)" in lines[4]
+    assert "about 16,384 fresh configurations (samples.fresh) would meet it" in lines[0]
+    assert lines[1] == "Warning: a fresh sample exceeds the worst case of Pareto designs anchor: worst_case_impulse."
+    assert lines[2].startswith("Warning: the mean impulse, an objective, is uncertain by 12 %")
+    assert "about 1,728 configurations (samples.configurations.random.count)" in lines[2]
     # The CVaR, a Pareto objective, at 20 %: a hundred times the 48 configurations.
-    assert lines[5].startswith("Warning: the CVaR impulse, an objective, is uncertain by 20 %")
-    assert "about 4,800 configurations" in lines[5]
+    assert lines[3].startswith("Warning: the CVaR impulse, an objective, is uncertain by 20 %")
+    assert "about 4,800 configurations" in lines[3]
 
 
 def test_an_uncertified_worst_case_names_the_remedy_that_applies():
-    from collision_reflex.report.verdict import worst_case_sentences
-
     searched = {"q": [0.1, 0.2], "direction": [1.0, 0.0], "starts": 4, "evaluations": 900, "domain_kept": 0.8}
     recommended = {
         **record(),
@@ -370,11 +344,10 @@ def test_an_uncertified_worst_case_names_the_remedy_that_applies():
             "tolerance": 0.005,
         },
     }
-    domain = {"min_singular_value": 0.1, "reach": 1.0}
-    exchanged = worst_case_sentences(recommended, domain, {"points": []})[1]
-    assert "50 % above the samples' worst case 1 N·s" in exchanged
+    (exchanged,) = certainty_sentences(recommended)
+    assert exchanged.startswith("Warning: worst case NOT certified: the search found 1.5 N·s, 50 % above")
     assert "more search rounds (optimizer.worst_case_search.rounds)" in exchanged
     # A study whose objectives leave the worst case alone never exchanges samples: more rounds would not help.
-    reported = worst_case_sentences(recommended, domain, {"points": []}, exchanged=False)[1]
+    (reported,) = certainty_sentences(recommended, exchanged=False)
     assert "more search rounds" not in reported
     assert "the worst case is no objective of this study" in reported

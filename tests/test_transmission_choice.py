@@ -58,7 +58,7 @@ def test_the_run_goes_on_with_the_best_gearbox_per_joint(tmp_path):
     assert {j: s["gearbox"] for j, s in resolved["actuators"]["joints"].items()} == {
         j: s["gearbox"] for j, s in joints.items()
     }
-    assert any(line.startswith("Transmissions chosen among") for line in results["verdict"])
+    assert any(line.startswith("Transmission: ") for line in results["verdict"])
     # Run again: the same choice, so the run resumes from its finished work.
     again = run_study(
         _study(tmp_path, OPTIONS), tmp_path / "out", quiet=True, executor="serial", figures=False

@@ -40,13 +40,13 @@ def _objective_lines(objectives: Mapping[str, float], first: Sequence[str]) -> l
     """Each objective with its unit, the front's objectives (``first``) before the others."""
     from ..optimize import OBJECTIVES
 
-    names = [name for name in first if name in objectives] + [
-        name for name in objectives if name not in first
-    ]
-    return [
-        f"{_words(name)} {significant(objectives[name], 4)} {_unit(OBJECTIVES[name][1]) if name in OBJECTIVES else ''}".rstrip()
-        for name in names
-    ]
+    names = [name for name in first if name in objectives]
+    names += [name for name in objectives if name not in names]
+    lines = []
+    for name in names:
+        unit = _unit(OBJECTIVES[name][1]) if name in OBJECTIVES else ""
+        lines.append(f"{_words(name)} {significant(objectives[name], 4)} {unit}".rstrip())
+    return lines
 
 
 def _threshold_line(record: Mapping[str, Any]) -> str:

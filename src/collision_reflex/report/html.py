@@ -1,4 +1,4 @@
-"""The HTML sizing report: one self-contained page (inline CSS and SVG, no scripts, no network)."""
+"""The HTML sizing report: one self-contained page (inline CSS, SVG and one small script; nothing loaded)."""
 
 from __future__ import annotations
 
