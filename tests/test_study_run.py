@@ -201,7 +201,7 @@ def test_report_opens_in_headless_chromium_without_console_errors(runs, browser,
             check=False,
         )
         assert completed.returncode == 0, completed.stderr[-2000:]
-        assert 'id="pareto-table"' in completed.stdout  # the page loaded and rendered its tables
+        assert 'id="assumptions-table"' in completed.stdout  # the page loaded and rendered its tables
         console = [
             line for line in completed.stderr.splitlines() if "CONSOLE" in line or "Failed to load" in line
         ]
