@@ -215,7 +215,9 @@ def test_the_verdict_opens_with_the_design_to_build_and_stays_within_ten_lines()
         "impulse 0.25 N·s, actuator mass 1 kg). Its motors are scaled, not sold."
     )
     assert "Sized by (static (gravity only)): shoulder: peak torque." in lines
-    assert any(line.startswith("The lightest within 5 %") or "The lightest within 5 %" in line for line in lines)
+    assert any(
+        line.startswith("The lightest within 5 %") or "The lightest within 5 %" in line for line in lines
+    )
     # Many warnings: merged into the last line, never more than MAX_LINES.
     many = {
         **results,
@@ -311,7 +313,9 @@ def test_the_fresh_check_and_its_errors_are_stated_and_warned_about():
     rows = statistics_rows(recommended)
     assert rows[0] == ("mean impulse", "0.3 N·s ± 1 %", "0.28 N·s ± 12 %")
     assert rows[2] == ("99th percentile", "1.2 N·s ± 1.5 %", "1.1 N·s ± 30 %")
-    assert statistics_warnings(recommended, study, {"points": [recommended]}) == []  # the mean is no objective
+    assert (
+        statistics_warnings(recommended, study, {"points": [recommended]}) == []
+    )  # the mean is no objective
     # A fresh sample above the worst case, errors over the tolerance, the mean an objective: each is said.
     recommended["fresh"] = _fresh(2.2, True, quantile_error=0.04)
     recommended["label"] = "anchor: worst_case_impulse"
@@ -324,7 +328,10 @@ def test_the_fresh_check_and_its_errors_are_stated_and_warned_about():
     lines = statistics_warnings(recommended, study, {"points": [recommended]})
     # 4 % against 2 %: four times the configurations.
     assert "about 16,384 fresh configurations (samples.fresh) would meet it" in lines[0]
-    assert lines[1] == "Warning: a fresh sample exceeds the worst case of Pareto designs anchor: worst_case_impulse."
+    assert (
+        lines[1]
+        == "Warning: a fresh sample exceeds the worst case of Pareto designs anchor: worst_case_impulse."
+    )
     assert lines[2].startswith("Warning: the mean impulse, an objective, is uncertain by 12 %")
     assert "about 1,728 configurations (samples.configurations.random.count)" in lines[2]
     # The CVaR, a Pareto objective, at 20 %: a hundred times the 48 configurations.

@@ -152,7 +152,13 @@ def test_report_tables_hold_the_numbers_of_pareto_csv(runs, name):
     for row, (_, expected) in zip(body, table.iterrows(), strict=True):
         for index, column in columns.items():
             text, value = row[index], expected[column]
-            if isinstance(value, (bool, str)) or column in ("label", "status", "actuator", "motor", "pareto_optimal"):
+            if isinstance(value, (bool, str)) or column in (
+                "label",
+                "status",
+                "actuator",
+                "motor",
+                "pareto_optimal",
+            ):
                 assert text == str(value), column
             else:
                 # The report prints 4 significant digits: equal within half a unit of the 4th digit; a
@@ -162,7 +168,9 @@ def test_report_tables_hold_the_numbers_of_pareto_csv(runs, name):
                     1.0 if "margin[" in column else expected.get(column.replace("required_", "peak_"), 0.0)
                 )
                 noise = SOLVER_TOLERANCE * abs(scale)
-                assert float(text.replace(",", "")) == pytest.approx(float(value), rel=5e-4, abs=noise), column
+                assert float(text.replace(",", "")) == pytest.approx(float(value), rel=5e-4, abs=noise), (
+                    column
+                )
 
 
 def test_report_is_self_contained(runs):
