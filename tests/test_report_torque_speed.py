@@ -128,8 +128,8 @@ def test_the_report_shows_the_figure_with_a_motor_side_caption(runs):
     assert (folder / "figures" / "torque_speed.png").is_file()
     html = (folder / "report.html").read_text()
     figure = html.index('id="torque-speed"')
-    assert html.index('id="recommended"') < figure < html.index('id="chosen"')
-    assert "motor side" in html[figure:] and "peak torque" in html[figure:]
+    assert html.index('id="recommended"') < figure < html.index('id="confidence"')
+    assert "Motor-side" in html[figure:] and "peak-torque envelope" in html[figure:]
     assert "torque-speed-none" not in html
 
 
@@ -140,7 +140,7 @@ def test_without_a_duty_cycle_nothing_is_saved_and_the_report_says_why(runs):
     assert not (folder / "figures" / "torque_speed.png").exists()
     html = (folder / "report.html").read_text()
     assert 'id="torque-speed"' not in html
-    assert "it needs a duty cycle" in html
+    assert "the requirement has no motion to plot" in html
 
 
 def test_crx_report_redraws_the_figure_from_the_saved_data(runs, tmp_path):

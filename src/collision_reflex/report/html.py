@@ -128,7 +128,8 @@ def change(value: object) -> str:
     """A relative difference as a signed percentage (``+9.88 %``), "–" when unknown."""
     if not isinstance(value, (int, float)) or isinstance(value, bool):
         return "–"
-    return f"{100 * value:+.3g} %".replace("-", "−")
+    percent = 100 * value
+    return (f"{percent:+,.0f} %" if abs(percent) >= 100 else f"{percent:+.3g} %").replace("-", "−")
 
 
 def gearbox_name(text: object) -> str:
@@ -164,12 +165,14 @@ def assumption_rows(results: dict[str, Any]) -> list[tuple[str, str, str, str]]:
     """
     resolved = results["resolved"]
     rows: list[tuple[str, str, str, str]] = []
+    cited = {j.get("motor") for j in (results.get("catalogue") or {}).get("joints") or []}
     for key, group in ASSUMPTION_GROUPS.items():
         value = resolved.get(key)
         if key == "objective" and isinstance(value, dict):
             value = " + ".join(f"{number(w)} × {str(n).replace('_', ' ')}" for n, w in value.items())
         for field, text in _flattened(value, "", UNITS.get(key, "")):
-            rows.append((group, field or key.replace("_", " "), text, _source(key, field, resolved)))
+            source = "cited with the catalogue parts" if text in cited else _source(key, field, resolved)
+            rows.append((group, field or key.replace("_", " "), text, source))
     model = (
         [
             (
@@ -498,12 +501,16 @@ def _solved(results: dict[str, Any]) -> list[tuple[str, dict[str, Any]]]:
     return solved
 
 
+TRIED_SHOWN = 5
+"""How many catalogue combinations the report lists, best first (``designs.json`` keeps every one)."""
+
+
 def _tried_table(catalogue: dict[str, Any]) -> dict[str, Any]:
     """The catalogue combinations re-solved, best first: a column per group of joints that always share parts."""
     tried = catalogue.get("tried") or []
     joints = [j["joint"] for j in catalogue.get("joints") or []]
     if not tried or not joints:
-        return {"tried_groups": [], "tried_rows": []}
+        return {"tried_groups": [], "tried_rows": [], "tried_count": 0}
     from .verdict import _group_name
 
     groups: list[list[int]] = []
@@ -512,7 +519,7 @@ def _tried_table(catalogue: dict[str, Any]) -> dict[str, Any]:
             groups[-1].append(index)
         else:
             groups.append([index])
-    ranked = sorted(tried, key=lambda t: (t["objective"] is None, t["objective"] or 0.0))
+    ranked = sorted(tried, key=lambda t: (t["objective"] is None, t["objective"] or 0.0))[:TRIED_SHOWN]
     rows = [
         {
             "parts": [t["parts"][group[0]] for group in groups],
@@ -521,7 +528,11 @@ def _tried_table(catalogue: dict[str, Any]) -> dict[str, Any]:
         }
         for t in ranked
     ]
-    return {"tried_groups": [_group_name([joints[i] for i in group]) for group in groups], "tried_rows": rows}
+    return {
+        "tried_groups": [_group_name([joints[i] for i in group]) for group in groups],
+        "tried_rows": rows,
+        "tried_count": len(tried),
+    }
 
 
 def _why_not(status: str) -> str:

@@ -420,7 +420,8 @@ def verdict(results: Mapping[str, Any]) -> list[str]:
     warnings = verdict_warnings(results, recommended, bounds, catalogue)
     room = MAX_LINES - len(lines)
     if len(warnings) > room:
-        warnings = [*warnings[: max(room - 1, 0)], "Warnings: " + " ".join(warnings[max(room - 1, 0) :])]
+        rest = [w.removeprefix("Warning: ").removeprefix("WARNING: ") for w in warnings[max(room - 1, 0) :]]
+        warnings = [*warnings[: max(room - 1, 0)], "Warnings: " + " ".join(rest)]
     return lines + warnings
 
 

@@ -330,8 +330,8 @@ def speed_limits(setup: ArmSetup) -> str | None:
     law = scaling_law(setup.technology.scaling_law).speed
     return (
         f"Speed limits: the reference motor {motor.name} turns at most {motor.max_speed:.4g} rad/s (its "
-        f"catalogue entry gives the source, or the method where the figure is an estimate); a scaled motor's "
-        f"limit follows omega_max ∝ (l/l0)^{law.length_exponent:g} (r/r0)^{law.diameter_exponent:g}. "
+        f"catalogue entry's figure); a scaled motor's limit follows "
+        f"omega_max ∝ (l/l0)^{law.length_exponent:g} (r/r0)^{law.diameter_exponent:g}. "
         f"{law.source}"
     )
 
