@@ -53,8 +53,6 @@ def number(value: object, digits: int = 4) -> str:
         return str(value)
     if math.isinf(value):
         return "∞" if value > 0 else "−∞"
-    if isinstance(value, int) or (value.is_integer() and 1e4 <= abs(value) < 1e15):
-        return f"{int(value):,}"  # a count or a whole figure: all its digits, no exponent
     return f"{value:.{digits}g}"
 
 
@@ -190,6 +188,18 @@ def assumption_rows(results: dict[str, Any]) -> list[tuple[str, str, str, str]]:
         if results["kind"] == "arm"
         else []
     )
+    actuators = resolved.get("actuators") or {}
+    geared = actuators.get("gearbox") or any(
+        j.get("gearbox") for j in (actuators.get("joints") or {}).values()
+    )
+    if actuators.get("gearbox_inertia") is False and geared:
+        model.append(
+            (
+                "gearbox inertia",
+                "Gearbox inertia ignored, as in the paper: the reflected inertia is the rotor's alone, N² J_m",
+                "",
+            )
+        )
     for text in [results.get("speed_limits"), *results.get("transmissions", ())]:
         if text and not str(text).startswith("Warning"):
             label, _, said = str(text).partition(": ")
