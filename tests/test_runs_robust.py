@@ -265,7 +265,7 @@ def test_a_smoke_run_has_its_own_default_folder(tmp_path, monkeypatch):
         (lambda d: d.update(kind="tampered"), "field 'kind' is 'tampered'"),
         (lambda d: d.pop("study"), "field 'study' is missing"),
         (lambda d: d["recommended"].pop("joints"), "field 'joints' is missing"),
-        (lambda d: d["chosen"].update(approach_velocity="fast"), "wrong kind"),
+        (lambda d: d["recommended"].update(approach_velocity="fast"), "wrong kind"),
     ],
     ids=["kind", "study", "joints", "a string for a number"],
 )
