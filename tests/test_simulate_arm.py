@@ -221,11 +221,6 @@ def test_position_error_detects_where_the_commanded_path_says(arm, slow_v0):
     assert abs(straight / t1 - 1) > 3e-4  # the straight-line error would fail the check above
 
 
-@pytest.mark.xfail(
-    reason="fails with the dependency versions installed today (no change to simulate/ since it last passed): "
-    "the detector never reaches its 3 N threshold; under investigation",
-    strict=False,
-)
 def test_force_sensor_is_armed_when_the_pulse_stays_below_the_threshold(arm):
     """Against a soft object (a tenth of the joint stiffness) at ``v*`` the contact's elastic force never
     exceeds ``F_s`` in the impact: the default blanking (the impact pulse, derived) must not delay the

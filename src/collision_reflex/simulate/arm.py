@@ -516,9 +516,10 @@ def _time_scales(
     if dynamics.detection == "observer":
         periods.append(2 * math.pi / dynamics.observer_gain)  # the observer's time constant, as a period
     max_step = min(periods) / 16  # a sixteenth of the shortest period in play
-    # Fifty closed-form contacts (paper's reaction) and delays, and twenty of the longest periods.
+    # After the blanking (no detection can come sooner), fifty closed-form contacts (paper's reaction) and
+    # delays, and twenty of the longest periods.
     _, t2 = collision_times(eff["m_f"], eff["k"], eff["k_m"], threshold, eff["a"], approach_velocity)
-    duration = 50 * (t2 + delay) + 20 * max(periods)
+    duration = dynamics.blanking + 50 * (t2 + delay) + 20 * max(periods)
     return max_step, float(duration), finger_period
 
 
