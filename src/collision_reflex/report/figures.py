@@ -196,10 +196,6 @@ def recommended_torque_speed(results: dict[str, Any]) -> list[JointOperatingPoin
     return joints
 
 
-def _words(name: str) -> str:
-    return name.replace("_", " ")
-
-
 def _surface(
     path: FigurePath, directions: np.ndarray, config_index: np.ndarray, impulses: np.ndarray, title: str
 ) -> Path:

@@ -7,33 +7,11 @@ hovered, focused or clicked.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-import numpy as np
-
 from ..plots.design_front import POINT_ID
-
-
-def significant(value: float, digits: int) -> str:
-    """``value`` to ``digits`` significant digits, trailing zeros dropped, without an exponent where readable."""
-    value = float(value)
-    if not math.isfinite(value):
-        return str(value)
-    rounded = float(f"{value:.{digits}g}")
-    if rounded == 0 or 1e-4 <= abs(rounded) < 1e7:
-        return np.format_float_positional(rounded, trim="-")
-    return f"{rounded:.{digits}g}"
-
-
-def _unit(unit: str) -> str:
-    """A unit as printed for people: ``N*s`` as ``N·s``."""
-    return unit.replace("*", "·")
-
-
-def _words(name: str) -> str:
-    return name.replace("_", " ")
+from .wording import significant, unit, words
 
 
 def _objective_lines(objectives: Mapping[str, float], first: Sequence[str]) -> list[str]:
@@ -44,8 +22,8 @@ def _objective_lines(objectives: Mapping[str, float], first: Sequence[str]) -> l
     names += [name for name in objectives if name not in names]
     lines = []
     for name in names:
-        unit = _unit(OBJECTIVES[name][1]) if name in OBJECTIVES else ""
-        lines.append(f"{_words(name)} {significant(objectives[name], 4)} {unit}".rstrip())
+        shown = unit(OBJECTIVES[name][1]) if name in OBJECTIVES else ""
+        lines.append(f"{words(name)} {significant(objectives[name], 4)} {shown}".rstrip())
     return lines
 
 
@@ -58,7 +36,7 @@ def _threshold_line(record: Mapping[str, Any]) -> str:
 
 def _joint_lines(joints: Sequence[Mapping[str, Any]]) -> list[str]:
     """Each joint's motor, gear ratio and software stiffness; the gearbox once if every joint has the same."""
-    gearboxes = [_unit(g) if isinstance(g, str) and g else None for g in (j.get("gearbox") for j in joints)]
+    gearboxes = [unit(g) if isinstance(g, str) and g else None for g in (j.get("gearbox") for j in joints)]
     common = len(set(gearboxes)) == 1
     lines = []
     for joint, gearbox in zip(joints, gearboxes, strict=True):
@@ -96,7 +74,7 @@ def _catalogue_line(snap: Mapping[str, Any]) -> str:
     elif snap.get("feasible"):
         return f"catalogue parts: {parts} (meets the requirements)"
     else:
-        misses = "; ".join(_unit(s) for s in snap.get("shortfalls") or ()) or "the requirements"
+        misses = "; ".join(unit(s) for s in snap.get("shortfalls") or ()) or "the requirements"
     return f"catalogue parts: {parts} (misses: {misses})"
 
 

@@ -16,6 +16,8 @@ from typing import Any, Literal
 
 import numpy as np
 
+from .wording import group_name, words
+
 ACTIVE_TOLERANCE = 1e-3
 """Relative distance below which a design variable is at its bound, and a margin below which its constraint
 is active (the solver's own tolerances are far smaller: a bound or constraint this close is what set the value)."""
@@ -35,10 +37,6 @@ MARGINS = (("torque_margin", "peak torque"), ("rms_margin", "RMS torque"), ("spe
 absent or ``None`` means the design has no such requirement."""
 
 Position = Literal["lower", "upper", "fixed"] | None
-
-
-def _words(name: str) -> str:
-    return name.replace("_", " ")
 
 
 def _g(value: float, digits: int = 4) -> str:
@@ -254,7 +252,7 @@ def front_sentences(pareto: Mapping[str, Any]) -> list[str]:
     if len(points) == 1:
         return [
             "One design on the front: "
-            + " and ".join(_words(n) for n in names)
+            + " and ".join(words(n) for n in names)
             + " do not trade off within these bounds."
         ]
     spans = objective_spans(points, names)
@@ -263,7 +261,7 @@ def front_sentences(pareto: Mapping[str, Any]) -> list[str]:
         values = [float(p["objectives"][name]) for p in points]
         unit = OBJECTIVES[name][1].replace("*", "·")
         low, high = _g(min(values)), _g(max(values))
-        return f"{_words(name)} {low if low == high else f'{low}–{high}'} {unit} ({_percent(spans[name])} %)"
+        return f"{words(name)} {low if low == high else f'{low}–{high}'} {unit} ({_percent(spans[name])} %)"
 
     lines = [f"Front of {len(points)} designs: " + ", ".join(ranged(n) for n in names) + "."]
     flat = [n for n in names if spans[n] < FLAT_SPAN]
@@ -274,10 +272,10 @@ def front_sentences(pareto: Mapping[str, Any]) -> list[str]:
             "practically one."
         )
     elif flat:
-        choice = " and ".join(_words(n) for n in real)
+        choice = " and ".join(words(n) for n in real)
         lines.append(
             "Flat in "
-            + " and ".join(_words(n) for n in flat)
+            + " and ".join(words(n) for n in flat)
             + f" (less than {FLAT_SPAN:g} % between its designs): {choice} "
             + ("is the only real choice." if len(real) == 1 else "are the only real choices.")
         )
@@ -351,7 +349,7 @@ def lightest_near_best(pareto: Mapping[str, Any], within: float = NEAR_BEST) -> 
     chosen = points[index]["objectives"]
     above = 100 * (chosen[impulse] / best - 1)
     return index, (
-        f"The lightest within {_g(100 * within)} % of the best {_words(impulse)}: Pareto design {index}, "
+        f"The lightest within {_g(100 * within)} % of the best {words(impulse)}: Pareto design {index}, "
         f"{_g(chosen['actuator_mass'])} kg at {_g(chosen[impulse])} N·s ({_g(above, 2)} % above the best)."
     )
 
@@ -425,27 +423,21 @@ def verdict(results: Mapping[str, Any]) -> list[str]:
     return lines + warnings
 
 
-def _group_name(names: Sequence[str]) -> str:
-    """Joints that share a part, named by the first and last when more than two (a module: ``a … c``)."""
-    return (
-        names[0]
-        if len(names) == 1
-        else " and ".join(names)
-        if len(names) == 2
-        else f"{names[0]} … {names[-1]}"
-    )
+def _runs(named: Sequence[tuple[str, str]]) -> list[tuple[list[str], str]]:
+    """``(joint, text)`` pairs with consecutive joints of the same text gathered: ``([joints], text)``."""
+    runs: list[tuple[list[str], str]] = []
+    for name, text in named:
+        if runs and runs[-1][1] == text and name and runs[-1][0]:
+            runs[-1][0].append(name)
+        else:
+            runs.append(([name] if name else [], text))
+    return runs
 
 
 def _grouped(joints: Sequence[Mapping[str, Any]], text: Any) -> str:
-    """``text(joint)`` per run of consecutive joints that it describes alike, named by :func:`_group_name`."""
-    groups: list[tuple[list[str], str]] = []
-    for joint in joints:
-        said = text(joint)
-        if groups and groups[-1][1] == said:
-            groups[-1][0].append(joint["joint"])
-        else:
-            groups.append(([joint["joint"]], said))
-    return "; ".join(f"{_group_name(names)}: {said}" for names, said in groups)
+    """``text(joint)`` per run of consecutive joints that it describes alike, named by :func:`group_name`."""
+    runs = _runs([(joint["joint"], text(joint)) for joint in joints])
+    return "; ".join(f"{group_name(names)}: {said}" for names, said in runs)
 
 
 def _sensing(record: Mapping[str, Any]) -> str:
@@ -467,7 +459,7 @@ def build_sentences(recommended: Mapping[str, Any], catalogue: Mapping[str, Any]
     objectives = recommended["objectives"]
     worst = (recommended.get("worst_case") or {}).get("domain", objectives.get("worst_case_impulse"))
     figures = ", ".join(
-        f"{_words(name)} {_g(value)} {unit}"
+        f"{name} {_g(value)} {unit}"
         for name, value, unit in (
             ("worst-case impulse", worst, "N·s"),
             ("mean impulse", objectives.get("mean_impulse"), "N·s"),
@@ -496,7 +488,7 @@ def build_sentences(recommended: Mapping[str, Any], catalogue: Mapping[str, Any]
         )
 
     changes = ", ".join(
-        f"{_words(name)} {'+' if change >= 0 else '−'}{_percent(abs(change) * 100)} %"
+        f"{words(name)} {'+' if change >= 0 else '−'}{_percent(abs(change) * 100)} %"
         for name in ("worst_case_impulse", "actuator_mass")
         if (change := catalogue["relative_difference"].get(name)) is not None
     )
@@ -603,9 +595,9 @@ def bound_sentences(record: Mapping[str, Any], bounds: Mapping[str, Any]) -> lis
             position = bound_position(joint[key], bounds[key][name])
             if position in ("lower", "upper"):
                 value = f"{_g(joint[key])}{UNDECIDED_UNITS.get(key, '')}"
-                held.setdefault(f"{_words(key)} at its {position} bound ({value})", []).append(name)
+                held.setdefault(f"{words(key)} at its {position} bound ({value})", []).append(name)
     phrases = design_limits_at_bound(record, bounds) + [
-        f"{_group_name(names)} {what}" for what, names in held.items()
+        f"{group_name(names)} {what}" for what, names in held.items()
     ]
     lines = []
     if phrases:
@@ -616,8 +608,7 @@ def bound_sentences(record: Mapping[str, Any], bounds: Mapping[str, Any]) -> lis
         )
     if undecided:
         free = ", ".join(
-            f"{e['joint']} {_words(e['variable'])}" if e["joint"] else _words(e["variable"])
-            for e in undecided
+            f"{e['joint']} {words(e['variable'])}" if e["joint"] else words(e["variable"]) for e in undecided
         )
         lines.append(
             f"No objective decides {free} anywhere within the bounds (no contact sample loads it): it is where "
@@ -631,7 +622,7 @@ def design_limits_at_bound(record: Mapping[str, Any], bounds: Mapping[str, Any])
     undecided = {entry["variable"] for entry in record.get("undecided", ()) if entry["joint"] is None}
     units = {"threshold": " N" if record.get("sensing") == "force" else " m", "approach_velocity": " m/s"}
     return [
-        f"{_words(key)} at its {position} bound ({_g(record[key])}{units[key]})"
+        f"{words(key)} at its {position} bound ({_g(record[key])}{units[key]})"
         for key in ("threshold", "approach_velocity")
         if key not in undecided
         and (position := bound_position(record[key], bounds[key])) in ("lower", "upper")
@@ -670,21 +661,17 @@ def verdict_warnings(
         )
     if catalogue:
         warnings += _joint_warnings(catalogue["warnings"])
+    # Where the simulator validates neither placement of the reflected inertia (the study's transmissions).
+    warnings += [str(line) for line in results.get("transmissions", ()) if str(line).startswith("Warning")]
     return warnings
 
 
 def _joint_warnings(texts: Sequence[str]) -> list[str]:
     """``joint: what`` warnings, those that say the same of consecutive joints said once."""
-    groups: list[tuple[list[str], str]] = []
-    for text in texts:
-        name, sep, what = text.partition(": ")
-        if not sep:
-            name, what = "", text
-        if groups and groups[-1][1] == what and name:
-            groups[-1][0].append(name)
-        else:
-            groups.append(([name] if name else [], what))
-    return [f"Warning: {_group_name(names) + ': ' if names else ''}{what}." for names, what in groups]
+    named = [
+        (name, what) if sep else ("", text) for text in texts for name, sep, what in [text.partition(": ")]
+    ]
+    return [f"Warning: {group_name(names) + ': ' if names else ''}{what}." for names, what in _runs(named)]
 
 
 def transmission_choice_sentences(tried: Sequence[Mapping[str, Any]] | None) -> list[str]:
@@ -697,7 +684,7 @@ def transmission_choice_sentences(tried: Sequence[Mapping[str, Any]] | None) -> 
         f"{options[0]} at every joint"
         if len(options) == 1
         else "; ".join(
-            f"{_group_name(joints.split(', '))}: {option}" for joints, option in chosen["assignment"].items()
+            f"{group_name(joints.split(', '))}: {option}" for joints, option in chosen["assignment"].items()
         )
     )
     others = [t["objective"] for t in tried if not t["chosen"] and t["objective"] is not None]
