@@ -1,6 +1,6 @@
 """The command line's one name and one unit per quantity: every subcommand's help names a unit for every physical
-option; unit strings give the SI numbers; a unit of the wrong dimension is one line and exit status 2; every old
-spelling still works, with one deprecation line."""
+option; unit strings give the SI numbers; a unit of the wrong dimension is one line and exit status 2; the
+spellings of before the first release are refused (the CHANGELOG lists them)."""
 
 from __future__ import annotations
 
@@ -126,48 +126,33 @@ def _assert_same_values(first: dict, second: dict) -> None:
             assert second[key] == value, key
 
 
-# (command, old spelling, new spelling): one case per old alias.
-ALIASES = {
-    "motors-diameters": (
-        ["motors", "scale"],
-        ["--diameters", "0.01,0.06"],
-        ["--stator-diameters", "0.01,0.06"],
-    ),
-    "rv-diameters": (
-        ["sweep", "radius-velocity"],
-        ["--diameters", "0.01:0.1:4"],
-        ["--stator-diameters", "0.01:0.1:4"],
-    ),
-    "rv-k-m": (["sweep", "radius-velocity"], ["--k-m", "2000"], ["--mech-stiffness", "2000"]),
-    "rv-k-s": (["sweep", "radius-velocity"], ["--k-s", "50"], ["--soft-stiffness", "50"]),
-    "stiffness-stiffnesses": (
-        ["sweep", "stiffness"],
-        ["--stiffnesses", "100:1e4:5"],
-        ["--mech-stiffnesses", "100:1e4:5"],
-    ),
-    "stiffness-k-s": (["sweep", "stiffness"], ["--k-s", "1e4"], ["--soft-stiffness", "1e4"]),
-    "surface-motor-size-mm": (["surface"], ["--motor-size", "30"], ["--stator-diameter", "0.03"]),
-    "surface-motor-sizes-mm": (["surface"], ["--motor-sizes", "10,60"], ["--stator-diameters", "0.01,0.06"]),
-    "surface-mech-stiffness": (["surface"], ["--mech-stiffness", "300"], ["--joint-mech-stiffness", "300"]),
-    "surface-soft-stiffness": (["surface"], ["--soft-stiffness", "1e3"], ["--joint-soft-stiffness", "1e3"]),
-    "surface-output": (["surface"], ["--output", "grid.svg"], ["--plot", "grid.svg"]),
-    "surface-o": (["surface"], ["-o", "grid.svg"], ["--plot", "grid.svg"]),
-    "surface-table": (["surface"], ["--table", "s.csv"], ["--csv", "s.csv"]),
-    "fit-k-m": (["fit", "traces"], ["--k-m", "1e7"], ["--mech-stiffness", "1e7"]),
-    "simulate-trace": (["simulate"], ["--trace", "t.svg"], ["--trace-plot", "t.svg"]),
-    "schema-out": (["schema"], ["--out", "s.json"], ["--json", "s.json"]),
+# (command, spelling removed before the first release): each is refused like any unknown option.
+REMOVED = {
+    "motors-diameters": (["motors", "scale"], ["--diameters", "0.01,0.06"]),
+    "rv-diameters": (["sweep", "radius-velocity"], ["--diameters", "0.01:0.1:4"]),
+    "rv-k-m": (["sweep", "radius-velocity"], ["--k-m", "2000"]),
+    "rv-k-s": (["sweep", "radius-velocity"], ["--k-s", "50"]),
+    "stiffness-stiffnesses": (["sweep", "stiffness"], ["--stiffnesses", "100:1e4:5"]),
+    "surface-motor-size": (["surface"], ["--motor-size", "30"]),
+    "surface-motor-sizes": (["surface"], ["--motor-sizes", "10,60"]),
+    "surface-mech-stiffness": (["surface"], ["--mech-stiffness", "300"]),
+    "surface-soft-stiffness": (["surface"], ["--soft-stiffness", "1e3"]),
+    "surface-output": (["surface"], ["--output", "grid.svg"]),
+    "surface-o": (["surface"], ["-o", "grid.svg"]),
+    "surface-table": (["surface"], ["--table", "s.csv"]),
+    "fit-k-m": (["fit", "traces"], ["--k-m", "1e7"]),
+    "simulate-trace": (["simulate"], ["--trace", "t.svg"]),
+    "schema-out": (["schema"], ["--out", "s.json"]),
 }
 
 
-@pytest.mark.parametrize("command, old, new", ALIASES.values(), ids=ALIASES.keys())
-def test_old_spelling_gives_the_same_values_and_one_warning(command, old, new, capsys):
-    parser = build_parser()
-    expected = _values(parser.parse_args([*command, *new]))
-    assert capsys.readouterr().err == ""
-    _assert_same_values(expected, _values(parser.parse_args([*command, *old])))
-    lines = capsys.readouterr().err.strip().splitlines()
-    assert len(lines) == 1
-    assert f"warning: {old[0]} is deprecated; use {new[0]}" in lines[0]
+@pytest.mark.parametrize("command, removed", REMOVED.values(), ids=REMOVED.keys())
+def test_a_removed_spelling_is_refused_as_an_unknown_option(command, removed, capsys):
+    with pytest.raises(SystemExit) as exit_:
+        build_parser().parse_args([*command, *removed])
+    assert exit_.value.code == 2
+    error = capsys.readouterr().err.strip().splitlines()[-1]
+    assert removed[0] in error and ("unrecognized arguments" in error or "ambiguous option" in error)
 
 
 def _run(argv: list[str], folder: Path, capsys, monkeypatch) -> str:
@@ -185,21 +170,21 @@ def _trace_without_stiffness(folder: Path) -> None:
     (folder / TRACE.name).write_text("".join(line for line in lines if "sensor stiffness" not in line))
 
 
-# (old spellings, new spellings) of whole runs: the same printed numbers and files.
+# (SI numbers, the same with units) of whole runs: the same printed numbers and files.
 RUNS = {
     "motors scale": (
-        ["motors", "scale", "--diameters", "0.01,0.06"],
+        ["motors", "scale", "--stator-diameters", "0.01,0.06"],
         ["motors", "scale", "--stator-diameters", "1cm,6cm"],
     ),
     "sweep radius-velocity": (
         [
             "sweep",
             "radius-velocity",
-            "--diameters",
+            "--stator-diameters",
             "0.01:0.1:4",
             "--velocities",
             "0.05:1:3",
-            "--k-m",
+            "--mech-stiffness",
             "2000",
         ],
         [
@@ -214,22 +199,22 @@ RUNS = {
         ],
     ),
     "sweep stiffness": (
-        ["sweep", "stiffness", "--stiffnesses", "100:1e4:5", "--k-s", "1e4"],
+        ["sweep", "stiffness", "--mech-stiffnesses", "100:1e4:5", "--soft-stiffness", "1e4"],
         ["sweep", "stiffness", "--mech-stiffnesses", "0.1 N/mm:10 N/mm:5", "--soft-stiffness", "10 kN/m"],
     ),
     "surface": (
         [
             "surface",
             *SURFACE_FAST,
-            "--motor-size",
-            "30",
-            "--motor-sizes",
-            "10,60",
-            "--mech-stiffness",
+            "--stator-diameter",
+            "0.03",
+            "--stator-diameters",
+            "10mm,60mm",
+            "--joint-mech-stiffness",
             "300",
-            "-o",
+            "--plot",
             "grid.png",
-            "--table",
+            "--csv",
             "s.csv",
         ],
         [
@@ -247,17 +232,16 @@ RUNS = {
             "s.csv",
         ],
     ),
-    "fit": (["fit", "traces", "--k-m", "1e7"], ["fit", "traces", "--mech-stiffness", "1e4 N/mm"]),
+    "fit": (["fit", "traces", "--mech-stiffness", "1e7"], ["fit", "traces", "--mech-stiffness", "1e4 N/mm"]),
     "simulate": (
-        ["simulate", "--count", "2", "--delays", "0,0.01", "--trace", "t.svg"],
+        ["simulate", "--count", "2", "--delays", "0,0.01", "--trace-plot", "t.svg"],
         ["simulate", "--count", "2", "--delays", "0ms,10ms", "--trace-plot", "t.svg"],
     ),
-    "schema": (["schema", "--out", "s.json"], ["schema", "--json", "s.json"]),
 }
 
 
 @pytest.mark.parametrize("old, new", RUNS.values(), ids=RUNS.keys())
-def test_old_and_new_spellings_print_the_same_numbers(old, new, tmp_path, capsys, monkeypatch):
+def test_si_and_unit_spellings_print_the_same_numbers(old, new, tmp_path, capsys, monkeypatch):
     for side in ("old", "new"):
         if old[0] == "fit":
             _trace_without_stiffness(tmp_path / side / "traces")
@@ -269,7 +253,7 @@ def test_old_and_new_spellings_print_the_same_numbers(old, new, tmp_path, capsys
         assert main(argv) == 0, capsys.readouterr().err
         captured = capsys.readouterr()
         printed[side] = captured.out
-        assert ("deprecated" in captured.err) == (side == "old")
+        assert "warning" not in captured.err
     assert printed["old"] == printed["new"]
     written = sorted(p.name for p in (tmp_path / "new").iterdir())
     assert written == sorted(p.name for p in (tmp_path / "old").iterdir())
@@ -431,7 +415,7 @@ def test_unit_strings_give_the_same_impulse(capsys):
 
 
 def test_surface_stator_diameter_in_mm_matches_metres(tmp_path, capsys, monkeypatch):
-    """The motor size that used to be a bare number in mm: ``30mm`` (and the old ``--motor-size 30``) == 0.03."""
+    """The motor size that used to be a bare number in mm: ``30mm`` == 0.03."""
     argv = ["surface", *SURFACE_FAST, "--stator-diameters", "0.01,0.06", "--plot", "g.png", "--csv", "s.csv"]
     outputs = []
     for i, size in enumerate((["--stator-diameter", "0.03"], ["--stator-diameter", "30mm"])):

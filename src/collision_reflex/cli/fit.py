@@ -36,9 +36,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     add = parser.add_argument
     add("traces", nargs="+", metavar="TRACES", help="CSV files, or folders searched for *.csv")
-    options.MECH_STIFFNESS.add(
-        parser, _DEFAULT_K_M, note="the sensor's, for trials that do not give it", aliases=["--k-m"]
-    )
+    options.MECH_STIFFNESS.add(parser, _DEFAULT_K_M, note="the sensor's, for trials that do not give it")
     options.BANDWIDTH.add(parser, note="Butterworth", shown="unfiltered")
     options.APPROACH_VELOCITY.add(parser, note="for trials whose file does not give one")
     add("--system", default=None, metavar="NAME", help="system name for trials whose file gives none")

@@ -56,7 +56,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         default=REFERENCE_MOTOR_NAME,
         help="catalogue motor to scale from (default %(default)s)",
     )
-    options.STATOR_DIAMETERS.add(scale, "10mm,60mm,100mm", aliases=["--diameters"])
+    options.STATOR_DIAMETERS.add(scale, "10mm,60mm,100mm")
     options.STACK_LENGTH.add(scale, shown="the motor's own")
     scale.add_argument(
         "--law",

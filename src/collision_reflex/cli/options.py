@@ -1,7 +1,7 @@
 """Command-line options shared by every subcommand.
 
 Each quantity is declared once, with its flag, unit, parser and range check; figures, tables and folders have
-one flag each; deprecated spellings go through one mechanism.
+one flag each.
 
 Rules, the same for every subcommand:
 
@@ -14,16 +14,14 @@ Rules, the same for every subcommand:
   joint.
 - ``--plot FILE`` for a figure, ``--csv FILE`` for a table, ``--out DIR`` for an output folder (``--out FILE``
   for the one file a command exports).
-- An old spelling is a hidden alias that still works and prints one deprecation line on stderr.
 """
 
 from __future__ import annotations
 
 import argparse
 import math
-import sys
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any, Literal, NoReturn
 
 import numpy as np
@@ -102,8 +100,6 @@ class QuantityParser:
 
     ``"range"`` is ``START:STOP:N`` (N log-spaced values, both ends included) or ``v1,v2,...``; ``"list"`` is
     ``v1,v2,...`` only.
-
-    ``bare_unit`` is the unit of a bare number when it is not ``quantity.unit`` (old spellings only).
     """
 
     quantity: Quantity
@@ -111,7 +107,6 @@ class QuantityParser:
     allow_inf: bool = False
     allow_none: bool = False
     form: Form = "one"
-    bare_unit: str | None = None
 
     def __call__(self, text: str) -> Any:
         """Parse ``text``; a bad value raises ``argparse.ArgumentTypeError`` with the expected unit."""
@@ -153,8 +148,6 @@ class QuantityParser:
                 raise argparse.ArgumentTypeError(
                     f"{text!r} has no unit: {self.quantity.what} needs one, e.g. {stripped}deg or {stripped}rad"
                 )
-            if self.bare_unit is not None:
-                value = self._with_unit(f"{stripped} {self.bare_unit}")
         if not math.isfinite(value) or not self._in_bounds(value):
             raise argparse.ArgumentTypeError(f"{text!r} is not a finite number {_BOUND_TEXT[self.bound]}")
         return value
@@ -228,64 +221,6 @@ def _is_number(text: str) -> bool:
 
 
 @dataclass(frozen=True)
-class Alias:
-    """An old spelling of an option; ``bare_unit`` when its bare numbers were in another unit (``mm``)."""
-
-    flag: str
-    bare_unit: str | None = None
-
-
-class _DeprecatedSpelling(argparse.Action):
-    """Stores like the option it replaces, after one line on stderr naming the new spelling."""
-
-    def __init__(self, option_strings: list[str], dest: str, replacement: str, **kwargs: Any) -> None:
-        super().__init__(option_strings, dest, **kwargs)
-        self.replacement = replacement
-
-    def __call__(
-        self,
-        parser: argparse.ArgumentParser,
-        namespace: argparse.Namespace,
-        values: Any,
-        option_string: str | None = None,
-    ) -> None:
-        print(
-            f"{parser.prog}: warning: {option_string} is deprecated; use {self.replacement}", file=sys.stderr
-        )
-        setattr(namespace, self.dest, values)
-
-
-def add_with_aliases(
-    parser: argparse.ArgumentParser,
-    flags: Sequence[str],
-    aliases: Sequence[str | Alias] = (),
-    **kwargs: Any,
-) -> None:
-    """``parser.add_argument(*flags, **kwargs)`` plus a hidden, warning action for each old spelling."""
-    action = parser.add_argument(*flags, **kwargs)
-    parse = action.type
-    unit = f" [{parse.quantity.label}]" if isinstance(parse, QuantityParser) else ""
-    for alias in aliases:
-        alias = alias if isinstance(alias, Alias) else Alias(alias)
-        alias_kwargs = {k: v for k, v in kwargs.items() if k not in ("default", "help", "dest", "action")}
-        replacement = flags[0] + unit
-        if alias.bare_unit is not None and isinstance(parse, QuantityParser):
-            alias_kwargs["type"] = replace(parse, bare_unit=alias.bare_unit)
-            replacement += (
-                f" (its bare numbers are in {parse.quantity.label}, this one's in {alias.bare_unit})"
-            )
-        parser.add_argument(
-            alias.flag,
-            action=_DeprecatedSpelling,
-            replacement=replacement,
-            dest=action.dest,
-            default=argparse.SUPPRESS,
-            help=argparse.SUPPRESS,
-            **alias_kwargs,
-        )
-
-
-@dataclass(frozen=True)
 class Option:
     """A physical option, declared once: flag, destination, quantity, description and range."""
 
@@ -308,7 +243,6 @@ class Option:
         shown: str | None = None,
         bound: Bound | None = None,
         nargs: int | str | None = None,
-        aliases: Sequence[str | Alias] = (),
     ) -> None:
         """Add the option to ``parser``.
 
@@ -328,10 +262,8 @@ class Option:
         if isinstance(nargs, int):
             metavar = tuple("XYZ"[:nargs])
         extra: dict[str, Any] = {} if nargs is None else {"nargs": nargs}
-        add_with_aliases(
-            parser,
-            [self.flag],
-            aliases,
+        parser.add_argument(
+            self.flag,
             dest=self.dest,
             type=parse,
             default=default,
@@ -490,14 +422,11 @@ def add_plot(
     *,
     what: str = "the figure",
     flag: str = "--plot",
-    aliases: Sequence[str] = (),
 ) -> None:
     """``--plot FILE``: a figure (.png, .svg or .pdf)."""
     shown = f" (default {default})" if default else ""
-    add_with_aliases(
-        parser,
-        [flag],
-        aliases,
+    parser.add_argument(
+        flag,
         dest=flag.lstrip("-").replace("-", "_"),
         default=default,
         metavar="FILE",
@@ -510,13 +439,10 @@ def add_csv(
     default: str | None = None,
     *,
     what: str = "the numbers",
-    aliases: Sequence[str] = (),
 ) -> None:
     """``--csv FILE``: a table."""
     shown = f" (default {default})" if default else ""
-    add_with_aliases(
-        parser, ["--csv"], aliases, default=default, metavar="FILE", help=f"write {what} to FILE (CSV){shown}"
-    )
+    parser.add_argument("--csv", default=default, metavar="FILE", help=f"write {what} to FILE (CSV){shown}")
 
 
 def add_out_dir(parser: argparse.ArgumentParser, *, what: str, shown: str = "") -> None:

@@ -5,8 +5,6 @@ from __future__ import annotations
 import argparse
 import json
 
-from . import options
-
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``crx schema`` and its options to ``subparsers``."""
@@ -18,10 +16,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
             "first line '# yaml-language-server: $schema=study.schema.json'."
         ),
     )
-    options.add_with_aliases(
-        parser,
-        ["--json"],
-        ["--out"],
+    parser.add_argument(
+        "--json",
         metavar="FILE",
         default=None,
         help="write to FILE (atomically) instead of stdout",

@@ -90,7 +90,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         parser,
         what="one simulated force trace over the closed form's profile",
         flag="--trace-plot",
-        aliases=["--trace"],
     )
     options.TRACE_VELOCITY.add(parser, shown="v*")
     parser.set_defaults(run=run)

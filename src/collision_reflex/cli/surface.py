@@ -10,7 +10,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from . import options
-from .options import Alias
 
 if TYPE_CHECKING:
     from ..arm import Arm
@@ -53,8 +52,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     _add_arm_options(parser)
     _add_actuation_options(parser)
     _add_sweep_options(parser)
-    options.add_plot(parser, "reflex_surface.png", aliases=["--output", "-o"])
-    options.add_csv(parser, what="the baseline surface, one row per direction,", aliases=["--table"])
+    options.add_plot(parser, "reflex_surface.png")
+    options.add_csv(parser, what="the baseline surface, one row per direction,")
     parser.set_defaults(run=run)
 
 
@@ -105,12 +104,12 @@ def _add_arm_options(parser: argparse.ArgumentParser) -> None:
 
 def _add_actuation_options(parser: argparse.ArgumentParser) -> None:
     """The motors, joint springs, controller stiffness, threshold and approach velocity of the baseline."""
-    options.STATOR_DIAMETER.add(parser, _DEFAULTS["stator_diameter"], aliases=[Alias("--motor-size", "mm")])
+    options.STATOR_DIAMETER.add(parser, _DEFAULTS["stator_diameter"])
     options.TORQUE_REQUIRED.add(
         parser, nargs="+", note="one value or one per joint", shown="the URDF effort limits"
     )
-    options.JOINT_MECH_STIFFNESS.add(parser, _DEFAULTS["mechanical_stiffness"], aliases=["--mech-stiffness"])
-    options.JOINT_SOFT_STIFFNESS.add(parser, _DEFAULTS["software_stiffness"], aliases=["--soft-stiffness"])
+    options.JOINT_MECH_STIFFNESS.add(parser, _DEFAULTS["mechanical_stiffness"])
+    options.JOINT_SOFT_STIFFNESS.add(parser, _DEFAULTS["software_stiffness"])
     options.TASK_STIFFNESS.add(parser, _DEFAULTS["task_stiffness"])
     options.THRESHOLD.add(parser, _DEFAULTS["F_s"])
     options.APPROACH_VELOCITY.add(parser, _DEFAULTS["v0"])
@@ -140,7 +139,6 @@ def _add_sweep_options(parser: argparse.ArgumentParser) -> None:
         parser,
         _DEFAULTS["stator_diameters"],
         note="the grid's second row",
-        aliases=[Alias("--motor-sizes", "mm")],
     )
     options.APPROACH_VELOCITIES.add(parser, _DEFAULTS["velocities"], note="the grid's third row")
 

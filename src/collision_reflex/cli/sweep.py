@@ -71,7 +71,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         ),
     )
     _common(radius)
-    options.STATOR_DIAMETERS.add(radius, "5mm:200mm:60", aliases=["--diameters"])
+    options.STATOR_DIAMETERS.add(radius, "5mm:200mm:60")
     options.APPROACH_VELOCITIES.add(radius, "0.01:3:60")
     radius.add_argument(
         "--law",
@@ -81,8 +81,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     options.STACK_LENGTH.add(radius, shown="the motor's own")
     options.TORQUE_REQUIRED.add(radius, SWEEP_DEFAULTS["torque_required"])
-    options.MECH_STIFFNESS.add(radius, SWEEP_DEFAULTS["k_m"], aliases=["--k-m"])
-    options.SOFT_STIFFNESS.add(radius, SWEEP_DEFAULTS["k_s"], aliases=["--k-s"])
+    options.MECH_STIFFNESS.add(radius, SWEEP_DEFAULTS["k_m"])
+    options.SOFT_STIFFNESS.add(radius, SWEEP_DEFAULTS["k_s"])
     options.add_plot(radius, "radius_velocity.png", what="the heat map")
     options.add_csv(radius, "radius_velocity.csv", what="the grid")
     radius.set_defaults(run=run_radius_velocity)
@@ -99,10 +99,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         ),
     )
     _common(stiffness)
-    options.MECH_STIFFNESSES.add(stiffness, "100:1e5:40", aliases=["--stiffnesses"])
+    options.MECH_STIFFNESSES.add(stiffness, "100:1e5:40")
     options.APPROACH_VELOCITY.add(stiffness, 0.1)
     options.POSITION_ERROR.add(stiffness, shown="F_s / k at the middle stiffness")
-    options.SOFT_STIFFNESS.add(stiffness, math.inf, shown="inf: rigid", aliases=["--k-s"])
+    options.SOFT_STIFFNESS.add(stiffness, math.inf, shown="inf: rigid")
     options.GEAR_RATIO.add(stiffness, 1.0)
     stiffness.add_argument(
         "--reaction", choices=REACTION_MODES, default="at_rest", help="reaction model (default %(default)s)"
