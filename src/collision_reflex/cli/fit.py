@@ -9,7 +9,11 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from .._io import atomic_open
 from ..errors import CollisionReflexError
+from ..experiments import analyse_files
+from ..plots.impulse_velocity import plot_impulse_velocity
+from ..plots.trace_fit import plot_trace_fit
 from . import options
 
 if TYPE_CHECKING:
@@ -57,8 +61,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``crx fit`` with parsed ``args``; return the exit status."""
-    from ..experiments import analyse_files
-
     results = analyse_files(
         args.traces,
         time_unit=args.time_unit,
@@ -137,7 +139,6 @@ def _print_summary(results: ExperimentResults) -> None:
 
 
 def _write_outputs(out: Path, results: ExperimentResults, figures: bool) -> None:
-    from .._io import atomic_open
 
     tables = {
         "trials.csv": results.trial_table(),
@@ -151,8 +152,6 @@ def _write_outputs(out: Path, results: ExperimentResults, figures: bool) -> None
     print(f"\nwrote {', '.join(str(out / name) for name in tables)}")
     if not figures:
         return
-    from ..plots.impulse_velocity import plot_impulse_velocity
-    from ..plots.trace_fit import plot_trace_fit
 
     for trial in results.trials:
         stem = re.sub(r"[^A-Za-z0-9_.-]+", "_", f"{trial.trace.system}_{trial.trace.label}".strip("_"))

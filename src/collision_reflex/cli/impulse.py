@@ -14,6 +14,8 @@ from ..model.impulse import (
     phase_impulses,
     series_stiffness,
 )
+from ..plots import check_figure_path
+from ..plots.profile import plot_force_profile
 from . import options
 
 # Defaults: the paper's direct-drive U8 actuator in its soft setting (one-shot fit, tab:one_shot), against
@@ -56,8 +58,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run ``crx impulse`` with parsed ``args``; return the exit status."""
     if args.plot is not None:
-        from ..plots import check_figure_path
-
         check_figure_path(args.plot)  # refuse a bad name before doing any work
     if args.v_r is not None and args.reaction != "moving":
         args.reaction = "moving"  # giving a robot velocity only makes sense for the moving reaction
@@ -100,8 +100,6 @@ def run(args: argparse.Namespace) -> int:
             print("".join(f"{float(x):>{12 if i == 0 else 14}.6g}" for i, x in enumerate(row)))
 
     if args.plot is not None:
-        from ..plots.profile import plot_force_profile
-
         path = plot_force_profile(args.plot, *common, args.v0, args.reaction, args.v_r)
         print(f"\nwrote {path}")
     return 0

@@ -6,6 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from .._io import atomic_open
+from ..errors import InvalidParameter, StudyFileError
 from . import options
 
 
@@ -35,11 +37,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``crx init`` with parsed ``args``; return the exit status."""
-    from .._io import atomic_open
-    from ..errors import InvalidParameter, StudyFileError
-    from ..study import parse_study
+    from ..study import parse_study  # lazy: pydantic and yaml (the study schema)
     from ..study.prepare import describe_study
-    from ..study.starter import starter_study
+    from ..study.starter import starter_study  # lazy: pydantic and yaml (the study schema)
 
     out = Path(args.out) if args.out is not None else Path(f"{Path(args.robot).stem}.yaml")
     if out.exists() and not args.force:

@@ -158,7 +158,7 @@ class QuantityParser:
     def _with_unit(self, text: str) -> float:
         from pydantic_core import PydanticCustomError
 
-        from ..study.quantities import to_si
+        from ..study.quantities import to_si  # lazy: pydantic and yaml (the study schema)
 
         q = self.quantity
         try:
@@ -194,7 +194,7 @@ def joint_position(text: str) -> float:
     """
     from pydantic_core import PydanticCustomError
 
-    from ..study.quantities import joint_position_si
+    from ..study.quantities import joint_position_si  # lazy: pydantic and yaml (the study schema)
 
     try:
         return joint_position_si(text.strip())[0]

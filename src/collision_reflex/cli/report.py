@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import argparse
 
+from ..report import render_report
+from ..report.pdf import html_to_pdf
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``crx report`` and its options to ``subparsers``."""
@@ -21,12 +24,8 @@ def run(args: argparse.Namespace) -> int:
     """Run ``crx report`` with parsed ``args``; return the exit status."""
     from pathlib import Path
 
-    from ..report import render_report
-
     path = render_report(args.folder)
     print(path)
     if args.pdf:
-        from ..report.pdf import html_to_pdf
-
         print(html_to_pdf(path, Path(args.folder) / "report.pdf"))
     return 0

@@ -23,7 +23,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``crx robots`` with parsed ``args``; return the exit status."""
-    from ..study.starter import robot_entries
+    from ..study.starter import robot_entries  # lazy: pydantic and yaml (the study schema)
 
     entries = [entry for entry in robot_entries() if args.all or entry.startable]
     width = max(len(entry.name) for entry in entries)

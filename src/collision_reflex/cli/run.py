@@ -48,7 +48,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``crx run`` with parsed ``args``; return the exit status."""
-    from ..study.runner import run_study
+    from ..study.runner import run_study  # lazy: casadi (the optimiser)
 
     if args.workers is not None and args.workers < 1:
         print("crx run: error: --workers must be at least 1", file=sys.stderr)

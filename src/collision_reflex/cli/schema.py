@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import json
 
+from .._io import atomic_open
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``crx schema`` and its options to ``subparsers``."""
@@ -27,14 +29,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``crx schema`` with parsed ``args``; return the exit status."""
-    from ..study import study_json_schema
+    from ..study import study_json_schema  # lazy: pydantic and yaml (the study schema)
 
     text = json.dumps(study_json_schema(), indent=2) + "\n"
     if args.json is None:
         print(text, end="")
     else:
-        from .._io import atomic_open
-
         with atomic_open(args.json, "w", encoding="utf-8") as handle:
             handle.write(text)
         print(f"wrote {args.json}")

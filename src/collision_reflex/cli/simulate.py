@@ -15,10 +15,13 @@ from .._io import atomic_open
 from ..errors import InvalidParameter
 from ..model.impulse import REACTION_MODES, optimal_velocity, total_impulse
 from ..model.sensing import SENSING_SCHEMES
+from ..plots import check_figure_path
+from ..plots.simulation import plot_sweep, plot_trace
+from ..simulate import CollisionSetup, Detection, contact_damping_for_restitution, simulate, sweep
 from . import options
 
-if TYPE_CHECKING:  # the simulator is imported when the command runs, not when `crx` starts
-    from ..simulate import CollisionSetup, Detection, Sweep
+if TYPE_CHECKING:
+    from ..simulate import Sweep
 
 # Defaults: a light direct-drive finger (the getting-started example) whose robot mass the spring does push back.
 _DEFAULTS = {"m_f": 0.2, "m_r": 0.5, "k_m": 1000.0, "k_s": 100.0, "F_s": 3.0, "F_a": 10.0}
@@ -97,8 +100,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def _detection(args: argparse.Namespace) -> Detection:
     """The detector: a force threshold [N] (force, current) or a position-error threshold [m] (position)."""
-    from ..simulate import Detection
-
     kind = args.detection or ("position" if args.e_th is not None else "force")
     if kind == "position":
         if args.F_s is not None:
@@ -122,8 +123,6 @@ def _detection(args: argparse.Namespace) -> Detection:
 
 def _setup(args: argparse.Namespace) -> CollisionSetup:
     """The simulated collision at a unit approach velocity (the sweep sets the velocity)."""
-    from ..simulate import CollisionSetup, contact_damping_for_restitution
-
     contact_damping = 0.0
     if args.restitution is not None:
         if math.isinf(args.contact_stiffness):
@@ -156,12 +155,8 @@ def _setup(args: argparse.Namespace) -> CollisionSetup:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``crx simulate`` with parsed ``args``; return the exit status."""
-    from ..simulate import sweep
-
     for figure in (args.plot, args.trace_plot):
         if figure is not None:
-            from ..plots import check_figure_path
-
             check_figure_path(figure)  # refuse a bad name before doing any work
     if args.delays is not None and args.backlashes is not None:
         raise InvalidParameter(
@@ -201,8 +196,6 @@ def run(args: argparse.Namespace) -> int:
     if args.csv is not None:
         _write_csv(args.csv, parameter, rows)
     if args.plot is not None:
-        from ..plots.simulation import plot_sweep
-
         dense = np.geomspace(result.velocities.min(), result.velocities.max(), 200)
         if args.reaction == "detected":
             curve = total_impulse(
@@ -214,9 +207,6 @@ def run(args: argparse.Namespace) -> int:
         print(f"wrote {path}")
     if args.trace_plot is not None:
         from dataclasses import replace
-
-        from ..plots.simulation import plot_trace
-        from ..simulate import simulate
 
         changes: dict = {"v0": args.trace_velocity or v_star}
         if parameter is not None:

@@ -9,10 +9,17 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._io import atomic_open
+from ..arm import Arm
+from ..arm.directions import COORDINATE_PLANES, plane_directions
+from ..arm.surfaces import reflex_surface
+from ..errors import InvalidParameter
+from ..hardware.actuators import ForceThreshold
+from ..plots import check_figure_path
+from ..plots.surface import SurfaceRow, plot_planar_grid, plot_spatial_surface
 from . import options
 
 if TYPE_CHECKING:
-    from ..arm import Arm
     from ..arm.surfaces import ReflexSurface
 
 # Defaults of the paper's two-link example (fig:two_link; fig:motor_scale_modeling for stiffness and threshold):
@@ -145,10 +152,6 @@ def _add_sweep_options(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``crx surface`` with parsed ``args``; return the exit status."""
-    from ..arm.surfaces import reflex_surface
-    from ..errors import InvalidParameter
-    from ..plots import check_figure_path
-
     check_figure_path(args.plot)
     arm = _load_arm(args)
     q = _configuration(arm, args.q)
@@ -177,8 +180,6 @@ def run(args: argparse.Namespace) -> int:
 
 def _load_arm(args: argparse.Namespace) -> Arm:
     """The arm named by ``--robot``, else read from ``--urdf`` (default the paper's two-link URDF)."""
-    from ..arm import Arm
-
     if args.robot is not None:
         return Arm.from_example_robot_data(args.robot, args.frame, args.offset, locked_joints=args.lock)
     path = args.urdf if args.urdf is not None else _DEFAULT_URDF
@@ -189,8 +190,6 @@ def _load_arm(args: argparse.Namespace) -> Arm:
 
 def _check_torque(arm: Arm, torque: list[float] | None) -> None:
     """Raise :class:`InvalidParameter` unless a torque requirement [N m] is known for every joint."""
-    from ..errors import InvalidParameter
-
     if torque is None and np.any(np.isnan(arm.urdf_torque_limit)):
         raise InvalidParameter(
             "--torque",
@@ -204,8 +203,6 @@ def _check_torque(arm: Arm, torque: list[float] | None) -> None:
 
 def _actuated(arm: Arm, args: argparse.Namespace, stator_diameter: float) -> Arm:
     """``arm`` with scaled motors of ``stator_diameter`` [m], and the springs and threshold of ``args``."""
-    from ..hardware.actuators import ForceThreshold
-
     return arm.with_scaled_motors(
         stator_diameter,
         args.torque if args.torque is None or len(args.torque) > 1 else args.torque[0],
@@ -219,10 +216,6 @@ def _plot_planar_grid(
     arm: Arm, base_arm: Arm, q: np.ndarray, args: argparse.Namespace, settings: dict[str, Any]
 ) -> Path:
     """The paper's grid for a planar arm: rows over the second joint angle, the motor size and ``v0``."""
-    from ..arm.surfaces import reflex_surface
-    from ..errors import InvalidParameter
-    from ..plots.surface import SurfaceRow, plot_planar_grid
-
     if arm.nv < 2:
         raise InvalidParameter("arm", arm.name, "at least two joints for the grid's second-joint row")
     angle_row = []
@@ -250,10 +243,6 @@ def _plot_spatial(
     base_arm: Arm, baseline: ReflexSurface, q: np.ndarray, args: argparse.Namespace, settings: dict[str, Any]
 ) -> Path:
     """A spatial arm's 3D surface with its sections in the x-y, x-z and y-z planes."""
-    from ..arm.directions import COORDINATE_PLANES, plane_directions
-    from ..arm.surfaces import reflex_surface
-    from ..plots.surface import plot_spatial_surface
-
     count = args.directions or 360
     sections = {
         name: reflex_surface(
@@ -270,8 +259,6 @@ def _plot_spatial(
 
 def _configuration(arm: Arm, positions: list[float] | None) -> np.ndarray:
     """The configuration of ``positions`` [rad, prismatic joints m], else the default pose (see ``--q``)."""
-    from ..errors import InvalidParameter
-
     if positions is None:
         if arm.task_dim == 2 and not np.any(arm.reference_configuration):
             angles = np.zeros(arm.nv)
@@ -309,8 +296,6 @@ def _print_summary(arm: Arm, surface: ReflexSurface) -> None:
 def _write_table(path: str, surface: ReflexSurface) -> None:
     """Write ``surface`` as CSV, one row per direction: effective parameters and impulses in SI."""
     import csv
-
-    from .._io import atomic_open
 
     p, i = surface.parameters, surface.impulses
     columns = {

@@ -5,10 +5,13 @@ from __future__ import annotations
 import argparse
 import math
 
+from ..errors import InvalidParameter
 from ..hardware.actuators import REFLECTED_INERTIA_PLACEMENTS
 from ..hardware.motors import REFERENCE_MOTOR_NAME, SCALING_LAWS, get_motor
-from ..hardware.sweeps import SWEEP_DEFAULTS
+from ..hardware.sweeps import SWEEP_DEFAULTS, radius_velocity_sweep, stiffness_sweep
 from ..model.impulse import REACTION_MODES
+from ..plots import check_figure_path
+from ..plots.sweeps import check_heat_map_grid, plot_radius_velocity, plot_stiffness
 from . import options
 
 _PLACEMENT_HELP = (
@@ -114,9 +117,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def _check_outputs(args: argparse.Namespace) -> None:
     """Refuse bad output names before computing anything."""
-    from ..errors import InvalidParameter
-    from ..plots import check_figure_path
-
     check_figure_path(args.plot)
     if not str(args.csv).lower().endswith(".csv"):
         raise InvalidParameter("--csv", args.csv, "a file name ending in .csv")
@@ -131,9 +131,6 @@ def _print_assumptions(assumptions: dict[str, object]) -> None:
 
 def run_radius_velocity(args: argparse.Namespace) -> int:
     """Run ``crx sweep radius-velocity`` (impulse over motor size and velocity); return the exit status."""
-    from ..hardware.sweeps import radius_velocity_sweep
-    from ..plots.sweeps import check_heat_map_grid, plot_radius_velocity
-
     _check_outputs(args)
     check_heat_map_grid(args.stator_diameters.size, args.velocities.size)
     sweep = radius_velocity_sweep(
@@ -172,9 +169,6 @@ def run_radius_velocity(args: argparse.Namespace) -> int:
 
 def run_stiffness(args: argparse.Namespace) -> int:
     """Run ``crx sweep stiffness``: impulse over mechanical stiffness; return the exit status."""
-    from ..hardware.sweeps import stiffness_sweep
-    from ..plots.sweeps import plot_stiffness
-
     _check_outputs(args)
     sweep = stiffness_sweep(
         args.k_m_values,

@@ -46,7 +46,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _validate(path: str, args: argparse.Namespace) -> int:
     """Check one study file, printing its summary or its problems; return its exit status."""
-    from ..study import load_study, resolved_yaml
+    from ..study import load_study, resolved_yaml  # lazy: pydantic and yaml (the study schema)
     from ..study.prepare import describe_study
 
     try:

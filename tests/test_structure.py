@@ -1,0 +1,158 @@
+"""The source stays in small rooms a newcomer can carry: short modules and functions, imports that run one way.
+
+- no module over 600 lines, no function over 100;
+- no import loop between files (function-level imports count: a lazy import is still a dependency);
+- a function imports the package's own modules only to defer a heavy library, and says so with a ``# lazy:``
+  comment on the import (or the line above it).
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+from test_import_graph import PACKAGE, find_cycle
+
+MAX_MODULE_LINES = 600
+MAX_FUNCTION_LINES = 100
+
+
+def _sources(package: Path = PACKAGE) -> list[Path]:
+    return sorted(package.rglob("*.py"))
+
+
+def _module_name(package: Path, path: Path) -> str:
+    parts = list(path.relative_to(package.parent).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _is_package(path: Path) -> bool:
+    return path.name == "__init__.py"
+
+
+def _type_checking_nodes(tree: ast.Module) -> set[int]:
+    """The ids of the import nodes under ``if TYPE_CHECKING:`` (not run, so not a dependency)."""
+    hidden: set[int] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
+            hidden.update(id(child) for statement in node.body for child in ast.walk(statement))
+    return hidden
+
+
+def file_import_graph(package: Path = PACKAGE) -> dict[str, set[str]]:
+    """Edges between the package's files: ``graph[a]`` holds every file of the package that ``a`` imports.
+
+    ``from .pkg import name`` is an edge to the module ``pkg.name`` when there is one, else to ``pkg`` (its
+    ``__init__``, which Python runs first). The package root is not a node: it binds names lazily.
+    """
+    paths = {_module_name(package, path): path for path in _sources(package)}
+    root = package.name
+    graph: dict[str, set[str]] = {}
+    for name, path in paths.items():
+        if name == root:
+            continue
+        tree = ast.parse(path.read_text(encoding="utf-8"), str(path))
+        hidden = _type_checking_nodes(tree)
+        here = name.split(".") if _is_package(path) else name.split(".")[:-1]
+        targets: set[str] = set()
+        for node in ast.walk(tree):
+            if id(node) in hidden:
+                continue
+            if isinstance(node, ast.Import):
+                targets.update(alias.name for alias in node.names)
+            elif isinstance(node, ast.ImportFrom):
+                base = here[: len(here) - node.level + 1] if node.level else []
+                module = ".".join([*base, *(node.module.split(".") if node.module else [])])
+                for alias in node.names:
+                    targets.add(f"{module}.{alias.name}" if f"{module}.{alias.name}" in paths else module)
+        graph[name] = {t for t in targets if t in paths and t not in (root, name)}
+    return graph
+
+
+def test_no_module_is_over_600_lines():
+    long = {
+        str(path.relative_to(PACKAGE)): n
+        for path in _sources()
+        if (n := len(path.read_text(encoding="utf-8").splitlines())) > MAX_MODULE_LINES
+    }
+    assert not long, f"modules over {MAX_MODULE_LINES} lines: {long}"
+
+
+def test_no_function_is_over_100_lines():
+    long = {}
+    for path in _sources():
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+                if (n := node.end_lineno - node.lineno + 1) > MAX_FUNCTION_LINES:
+                    long[f"{path.relative_to(PACKAGE)}:{node.lineno} {node.name}"] = n
+    assert not long, f"functions over {MAX_FUNCTION_LINES} lines: {long}"
+
+
+def test_no_import_loop_between_files():
+    graph = file_import_graph()
+    assert {"collision_reflex.optimize.solve", "collision_reflex.study.runner"} <= set(graph)
+    cycle = find_cycle(graph)
+    assert cycle is None, "import loop: " + " -> ".join(cycle or [])
+
+
+def _says_lazy(lines: list[str], node: ast.stmt) -> bool:
+    """Whether ``# lazy:`` stands on the import, or above the block of imports (and comments) it belongs to."""
+    if any("# lazy:" in line for line in lines[node.lineno - 1 : node.end_lineno]):
+        return True
+    above = node.lineno - 2
+    while above >= 0 and lines[above].strip().startswith(("from ", "import ", "#", ")")):
+        if "# lazy:" in lines[above]:
+            return True
+        above -= 1
+    return False
+
+
+def test_a_function_imports_its_own_package_only_to_defer_a_heavy_library():
+    unexplained = []
+    for path in _sources():
+        lines = path.read_text(encoding="utf-8").splitlines()
+        for function in ast.walk(ast.parse("\n".join(lines))):
+            if not isinstance(function, ast.FunctionDef | ast.AsyncFunctionDef):
+                continue
+            for node in ast.walk(function):
+                own = (
+                    isinstance(node, ast.ImportFrom)
+                    and (node.level > 0 or (node.module or "").startswith("collision_reflex"))
+                ) or (
+                    isinstance(node, ast.Import)
+                    and any(a.name.startswith("collision_reflex") for a in node.names)
+                )
+                if own and not _says_lazy(lines, node):
+                    unexplained.append(f"{path.relative_to(PACKAGE)}:{node.lineno}")
+    assert not unexplained, f"function-level imports of the package without a '# lazy:' reason: {unexplained}"
+
+
+@pytest.fixture
+def loop_package(tmp_path: Path) -> Path:
+    files = {
+        "__init__.py": "from .optimize import solve\n",
+        "optimize/__init__.py": "from .solve import solve\n",
+        "optimize/solve.py": "from .feasibility import feasible\ndef solve():\n    pass\n",
+        "optimize/feasibility.py": "def feasible():\n    from .solve import solve  # hidden loop\n",
+        "optimize/types.py": "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from .solve import solve\n",
+    }
+    package = tmp_path / "collision_reflex"
+    for name, text in files.items():
+        (package / name).parent.mkdir(parents=True, exist_ok=True)
+        (package / name).write_text(text)
+    return package
+
+
+def test_the_file_graph_sees_a_loop_kept_open_by_a_function_level_import(loop_package):
+    graph = file_import_graph(loop_package)
+    assert graph["collision_reflex.optimize.types"] == set()  # TYPE_CHECKING imports do not run
+    assert graph["collision_reflex.optimize"] == {"collision_reflex.optimize.solve"}
+    cycle = find_cycle(graph)
+    assert cycle is not None and set(cycle) == {
+        "collision_reflex.optimize.solve",
+        "collision_reflex.optimize.feasibility",
+    }
+    (loop_package / "optimize/feasibility.py").write_text("def feasible():\n    pass\n")
+    assert find_cycle(file_import_graph(loop_package)) is None
