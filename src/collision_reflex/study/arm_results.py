@@ -389,7 +389,8 @@ def placement_sentences(setup: ArmSetup) -> list[str]:
 
 def transmissions(setup: ArmSetup) -> list[str]:
     """What the joints' transmissions are, for the report: scaled gearboxes, and geared joints without a model."""
-    from ..hardware.gearboxes import GEARBOX_SCALING, ScaledGearbox
+    from ..hardware.gearbox_scaling import GEARBOX_SCALING
+    from ..hardware.gearboxes import ScaledGearbox
 
     joints = list(setup.arm.joint_names)
     gearboxes = setup.technology.joint_gearboxes(len(joints))
