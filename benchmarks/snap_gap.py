@@ -22,7 +22,8 @@ from pathlib import Path
 import numpy as np
 
 import collision_reflex as cr
-from collision_reflex.optimize.snap import objective_value, snap_to_catalogue
+from collision_reflex.optimize.catalogue_search import objective_value
+from collision_reflex.optimize.snap import snap_to_catalogue
 
 ROOT = Path(__file__).resolve().parents[1]
 Case = tuple[str, Callable[[], tuple[cr.Arm, cr.DesignProblem]], int]

@@ -111,13 +111,7 @@ def test_current_threshold_grows_with_gear_ratio():
     assert geared.F_s == pytest.approx(27.0, rel=1e-14)
 
 
-def test_contact_parameters_old_keywords_warn_and_agree():
+def test_contact_parameters_keep_the_robot_mass():
     actuator = cr.Actuator(MOTOR, 4.0, mechanical_stiffness=80.0, software_stiffness=40.0)
     new = actuator.contact_parameters(0.2, m_f=0.1, m_r=0.3)
-    with pytest.warns(DeprecationWarning, match="deprecated; call it 'm_[fr]'") as record:
-        old = actuator.contact_parameters(0.2, finger_mass=0.1, robot_mass=0.3)
-    assert len(record) == 2  # one warning per old keyword
-    assert old == new
     assert new.m_r == pytest.approx(0.3 + 16 * 2e-5 / 0.04, rel=1e-15)  # the robot mass is not dropped
-    with pytest.raises(TypeError, match="both"):
-        actuator.contact_parameters(0.2, m_f=0.1, finger_mass=0.1)

@@ -14,11 +14,21 @@ import pytest
 import collision_reflex as cr
 from collision_reflex.arm import Arm
 from collision_reflex.hardware.gearboxes import load_gearbox_catalogue
+from collision_reflex.optimize import catalogue_search as searching
 from collision_reflex.optimize import snap as snapping
 from collision_reflex.optimize.active_set import solve_method
+from collision_reflex.optimize.candidates import gearbox_options, joint_candidates, motor_distance
+from collision_reflex.optimize.catalogue_search import objective_value, solve_parts
 from collision_reflex.optimize.objectives import TIE_BREAK_WEIGHT
 from collision_reflex.optimize.pareto import MERGE_TOLERANCE
-from collision_reflex.optimize.snap import objective_value, snap_to_catalogue, solve_parts
+from collision_reflex.optimize.parts import (
+    catalogue_problem,
+    covering_gear_ratios,
+    evaluate_parts,
+    matched_gear_ratio,
+)
+from collision_reflex.optimize.snap import snap_to_catalogue
+from collision_reflex.optimize.solve import warm_start
 
 ROOT = Path(__file__).resolve().parents[1]
 TWO_LINK = ROOT / "designs" / "planar_two_link.urdf"
@@ -180,12 +190,11 @@ def test_the_heuristic_is_never_worse_than_the_nearest_parts(two_link, exact):
 
 def test_candidates_are_the_nearest_within_bounds(two_link):
     _, problem, optimum = two_link
-    joints = snapping.joint_candidates(problem, optimum, _catalogue(), candidates=2)
+    joints = joint_candidates(problem, optimum, _catalogue(), candidates=2)
     design = optimum.design
     for j, joint in enumerate(joints):
         distances = sorted(
-            snapping.motor_distance(m, design.motor_peak_torque[j], design.rotor_inertia[j])
-            for m in _catalogue()
+            motor_distance(m, design.motor_peak_torque[j], design.rotor_inertia[j]) for m in _catalogue()
         )
         assert [p.distance for p in joint.parts] == pytest.approx(distances[:2])
 
@@ -238,7 +247,7 @@ def test_ctrl_c_interrupts_the_snap(two_link, monkeypatch):
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(snapping, "solve_parts", interrupted)
+    monkeypatch.setattr(searching, "solve_parts", interrupted)
     with pytest.raises(KeyboardInterrupt):
         snap_to_catalogue(problem, optimum, _catalogue(), arm=arm)
 
@@ -360,7 +369,7 @@ def test_a_gearbox_given_by_its_figures_snaps_to_catalogue_gearboxes_of_its_kind
 def test_a_quick_snap_evaluates_what_a_re_solve_finds(two_link, exact):
     # Evaluated at the re-solved design's own variables, the parts give its objectives (one model, two paths).
     _, problem, _ = two_link
-    evaluated = snapping.evaluate_parts(problem, exact.result.design, exact.parts)
+    evaluated = evaluate_parts(problem, exact.result.design, exact.parts)
     assert evaluated.feasible
     for name, value in exact.result.numpy_objectives.items():
         assert evaluated.objectives[name] == pytest.approx(value, rel=1e-9)
@@ -556,25 +565,25 @@ def test_the_warm_start_meets_the_torque_requirement_of_the_parts_own_masses(cyc
     # covered; at the covering ratios every peak-torque row of the parts' own problem holds, as CasADi builds it.
     arm, problem, optimum, catalogue = cycle_sized
     heavy = catalogue[-1]
-    joints = snapping.joint_candidates(problem, optimum, [heavy], candidates=1)
+    joints = joint_candidates(problem, optimum, [heavy], candidates=1)
     parts = [j.parts[0] for j in joints]
-    built = snapping.catalogue_problem(problem, parts, arm)
-    cold = snapping._parts_start(problem, optimum, parts, built, raised=False)
-    warm = snapping._parts_start(problem, optimum, parts, built, raised=True)
+    built = catalogue_problem(problem, parts, arm)
+    cold = searching._parts_start(problem, optimum, parts, built, raised=False)
+    warm = searching._parts_start(problem, optimum, parts, built, raised=True)
     assert _torque_shortfalls(built, cold).max() > 1e-2  # the guarded case: the matched ratios fall short
     # Within what REQUIREMENT_PASSES fixed-point passes settle (the RMS row grows with N^2 J: 2e-5 here).
     assert _torque_shortfalls(built, warm).max() <= 1e-4
-    matched = [snapping.matched_gear_ratio(p, optimum.design, j) for j, p in enumerate(parts)]
-    assert np.all(snapping.covering_gear_ratios(problem, optimum.design, parts) >= np.array(matched))
+    matched = [matched_gear_ratio(p, optimum.design, j) for j, p in enumerate(parts)]
+    assert np.all(covering_gear_ratios(problem, optimum.design, parts) >= np.array(matched))
 
 
 def test_the_warm_start_carries_the_multipliers_over_by_variable_and_row(cycle_sized):
     arm, problem, optimum, catalogue = cycle_sized
-    joints = snapping.joint_candidates(problem, optimum, catalogue, candidates=2)
+    joints = joint_candidates(problem, optimum, catalogue, candidates=2)
     parts = [j.parts[1] for j in joints]
-    built = snapping.catalogue_problem(problem, parts, arm)
-    x0 = snapping._parts_start(problem, optimum, parts, built, raised=True)
-    start = snapping.warm_start(problem, built, optimum, x0)
+    built = catalogue_problem(problem, parts, arm)
+    x0 = searching._parts_start(problem, optimum, parts, built, raised=True)
+    start = warm_start(problem, built, optimum, x0)
     lam_x, lam_g = start.multipliers
     np.testing.assert_array_equal(start.x, x0)
     bounds, rows = optimum.multipliers
@@ -592,7 +601,7 @@ def test_a_warm_re_solve_finds_the_cold_one_in_fewer_iterations(cycle_sized):
     # Every combination of two candidates per joint: the warm start reaches the cold start's optimum (or a
     # better one) in fewer iterations in total.
     arm, problem, optimum, catalogue = cycle_sized
-    joints = snapping.joint_candidates(problem, optimum, catalogue, candidates=2)
+    joints = joint_candidates(problem, optimum, catalogue, candidates=2)
     warm_iterations = cold_iterations = 0
     for parts in itertools.product(*(j.parts for j in joints)):
         warm = solve_parts(problem, optimum, parts, arm)
@@ -618,7 +627,7 @@ def test_a_warm_re_solve_on_active_sets_finds_the_cold_one_in_fewer_iterations(m
     # point and multipliers: every combination of two candidates per joint reaches the cold start's optimum
     # (or a better one), in fewer iterations in total.
     arm, problem, optimum = many_samples
-    joints = snapping.joint_candidates(problem, optimum, _catalogue(), candidates=2)
+    joints = joint_candidates(problem, optimum, _catalogue(), candidates=2)
     warm_iterations = cold_iterations = 0
     for parts in itertools.product(*(j.parts for j in joints)):
         warm = solve_parts(problem, optimum, parts, arm, active_set="always")
@@ -654,15 +663,15 @@ def test_the_descent_moves_only_for_a_gain_beyond_what_re_solving_repeats(monkey
             for c in combinations
         ]
 
-    monkeypatch.setattr(snapping, "objective_value", lambda problem, objectives: objectives["v"])
-    monkeypatch.setattr(snapping._Search, "start", lambda self: (0, 0))
-    search = snapping._Search(None, None, parts, solve_many, None)
+    monkeypatch.setattr(searching, "objective_value", lambda problem, objectives: objectives["v"])
+    monkeypatch.setattr(searching.PartsSearch, "start", lambda self: (0, 0))
+    search = searching.PartsSearch(None, None, parts, solve_many, None)
     assert search.descend() == 2
     assert search.best() == (1, 1)  # the best tried is kept either way
     assert ((0, 1) in search.tried) == moved
     # From an infeasible start (inf) a feasible part is always a move.
     value[(0, 0)] = float("inf")
-    search = snapping._Search(None, None, parts, solve_many, None)
+    search = searching.PartsSearch(None, None, parts, solve_many, None)
     search.descend()
     assert search.best() == (1, 1)
 
@@ -675,10 +684,10 @@ def test_the_descent_starts_where_every_joint_meets_its_own_requirement(monkeypa
     def evaluate(problem, design, parts):
         return SimpleNamespace(shortfalls=tuple(f"j{k}: short" for k, p in enumerate(parts) if p.index == 0))
 
-    monkeypatch.setattr(snapping, "evaluate_parts", evaluate)
+    monkeypatch.setattr(searching, "evaluate_parts", evaluate)
     parts = [tuple(SimpleNamespace(label=f"{j}{i}", index=i) for i in range(3)) for j in range(2)]
     problem = SimpleNamespace(joint_names=("j0", "j1"))
-    assert snapping._Search(problem, None, parts, None, None).start() == (1, 1)
+    assert searching.PartsSearch(problem, None, parts, None, None).start() == (1, 1)
 
 
 @pytest.mark.parametrize(
@@ -713,8 +722,8 @@ def test_the_snap_chooses_the_lightest_combination_alike_in_impulse(
             out.append(SimpleNamespace(numpy_objectives=values, status="Solve_Succeeded", iterations=1))
         return out
 
-    monkeypatch.setattr(snapping, "objective_value", lambda problem, values: values[objective])
-    search = snapping._Search(SimpleNamespace(objective={objective: 1.0}), None, parts, solve_many, None)
+    monkeypatch.setattr(searching, "objective_value", lambda problem, values: values[objective])
+    search = searching.PartsSearch(SimpleNamespace(objective={objective: 1.0}), None, parts, solve_many, None)
     search.values_of(list(table))
     assert search.least() == (0, 0)
     assert search.best() == chosen
@@ -729,10 +738,10 @@ def test_a_motor_too_slow_at_every_ratio_strong_enough_is_no_candidate(cycle_siz
     needs = float(speed[0]) * float(optimum.required_torque[0]) / motor.peak_torque
     slow = dataclasses.replace(motor, name="slow", max_speed=0.8 * needs)
     fast = dataclasses.replace(motor, name="fast", max_speed=1.01 * needs)
-    first = snapping.joint_candidates(problem, optimum, [slow], candidates=1)[0]
+    first = joint_candidates(problem, optimum, [slow], candidates=1)[0]
     assert not first.parts
     assert any("no gear ratio both strong and fast enough" in why for why in first.misses)
-    kept = snapping.joint_candidates(problem, optimum, [slow, fast], candidates=2)[0]
+    kept = joint_candidates(problem, optimum, [slow, fast], candidates=2)[0]
     assert {p.motor.name for p in kept.parts} == {"fast"}
 
 
@@ -752,9 +761,9 @@ def test_a_joint_may_take_gearboxes_of_other_kinds_in_the_catalogue_design():
         )
     }
     ratio = cr.Bounds(1.0, 200.0)
-    default, _ = snapping.gearbox_options(own, ratio, 30.0, catalogue, count=1)
+    default, _ = gearbox_options(own, ratio, 30.0, catalogue, count=1)
     assert [g.name for g, _ in default] == ["HD-a"]
-    both, _ = snapping.gearbox_options(own, ratio, 30.0, catalogue, count=1, kinds=["harmonic", "planetary"])
+    both, _ = gearbox_options(own, ratio, 30.0, catalogue, count=1, kinds=["harmonic", "planetary"])
     assert [g.name for g, _ in both] == ["HD-a", "P-50"]  # P-weak's 20 N m does not cover 30 N m
-    none, misses = snapping.gearbox_options(own, ratio, 30.0, catalogue, kinds=["cycloidal"])
+    none, misses = gearbox_options(own, ratio, 30.0, catalogue, kinds=["cycloidal"])
     assert none == [] and misses == ("no cycloidal gearbox in the gearbox catalogue",)

@@ -3,15 +3,12 @@ sensing schemes of fig:stiff-sensing-impulse."""
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 import pytest
 
 import collision_reflex as cr
 from collision_reflex.hardware.sweeps import (
     SWEEP_DEFAULTS,
-    RadiusVelocitySweep,
     radius_velocity_sweep,
     stiffness_sweep,
 )
@@ -129,65 +126,26 @@ def test_optional_gearbox_inertia_against_hand_computation():
     assert np.all(with_box.impulse[:2] > without.impulse[:2]) and with_box.impulse[2] == without.impulse[2]
 
 
-def test_old_radius_velocity_keywords_warn_and_agree():
+def test_the_contact_keywords_reach_the_radius_velocity_model():
     d, v = [0.01, 0.06], [0.2, 0.8]
     new = radius_velocity_sweep(d, v, k_m=2000.0, k_s=50.0, F_s=5.0, m_f=0.2, m_r=0.05)
-    with pytest.warns(DeprecationWarning, match="deprecated; call it") as record:
-        old = radius_velocity_sweep(
-            d,
-            v,
-            mechanical_stiffness=2000.0,
-            software_stiffness=50.0,
-            threshold=5.0,
-            finger_mass=0.2,
-            robot_mass=0.05,
-        )
-    assert {str(w.message).split("'")[1] for w in record} == {
-        "mechanical_stiffness",
-        "software_stiffness",
-        "threshold",
-        "finger_mass",
-        "robot_mass",
-    }
-    np.testing.assert_array_equal(old.impulse, new.impulse)
-    # Every renamed keyword reaches the model: the settings differ from the defaults by factors >= 2.
+    # Every contact keyword reaches the model: the settings differ from the defaults by factors >= 2.
     assert not np.allclose(new.impulse, radius_velocity_sweep(d, v).impulse, rtol=0.1)
     np.testing.assert_allclose(new.F_s, 5.0)
     np.testing.assert_allclose(new.m_r - new.reflected_inertia / LEVER**2, 0.05, rtol=1e-12)
-    with pytest.warns(DeprecationWarning, match="finger_mass is deprecated; read RadiusVelocitySweep.m_f"):
-        np.testing.assert_array_equal(new.finger_mass, new.m_f)
-    fields = {f.name: getattr(new, f.name) for f in dataclasses.fields(new)}
-    fields["robot_mass"] = fields.pop("m_r")
-    with pytest.warns(DeprecationWarning, match="'robot_mass' is deprecated; call it 'm_r'"):
-        assert RadiusVelocitySweep(**fields).m_r is new.m_r
 
 
-def test_old_default_keys_warn_and_read_the_renamed_value():
+def test_the_default_keys_are_the_paper_symbols():
     assert (
         SWEEP_DEFAULTS["F_s"] == 3.0 and SWEEP_DEFAULTS["m_f"] == 0.1
     )  # fig:motor_scale_modeling, tab:one_shot
-    with pytest.warns(DeprecationWarning, match=r"SWEEP_DEFAULTS\['threshold'\] is deprecated; read 'F_s'"):
-        assert SWEEP_DEFAULTS["threshold"] == 3.0
-    with pytest.raises(KeyError):
-        SWEEP_DEFAULTS["velocity"]
+    with pytest.raises(KeyError):  # an old spelling is no key
+        SWEEP_DEFAULTS["threshold"]
 
 
-def test_old_stiffness_sweep_keywords_warn_and_agree():
+def test_the_keywords_reach_the_stiffness_sweep():
     k = np.geomspace(100, 1e4, 4)
     new = stiffness_sweep(k, v0=0.3, F_s=4.0, e_th=0.01, k_s=1e4, m_f=0.2, m_r=0.1)
-    with pytest.warns(DeprecationWarning, match="deprecated; call it") as record:
-        old = stiffness_sweep(
-            k,
-            velocity=0.3,
-            threshold=4.0,
-            position_error=0.01,
-            software_stiffness=1e4,
-            finger_mass=0.2,
-            robot_mass=0.1,
-        )
-    assert len(record) == 6  # one warning per old keyword
-    np.testing.assert_array_equal(old.force_threshold_impulse, new.force_threshold_impulse)
-    np.testing.assert_array_equal(old.position_threshold_impulse, new.position_threshold_impulse)
     np.testing.assert_allclose(new.force_threshold, 4.0)
     # F_s = k e_th with k the series of k_m and k_s = 1e4 N/m.
     np.testing.assert_allclose(new.position_threshold, k * 1e4 / (k + 1e4) * 0.01, rtol=1e-12)

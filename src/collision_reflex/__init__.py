@@ -67,7 +67,8 @@ if TYPE_CHECKING:  # the names as type checkers and IDEs see them; at run time `
         PositionThreshold,
         gear_ratio_for,
     )
-    from .hardware.gearboxes import GEARBOX_KINDS, Gearbox
+    from .hardware.gearbox_scaling import GEARBOX_KINDS
+    from .hardware.gearboxes import Gearbox
     from .hardware.motors import (
         SCALING_LAWS,
         Motor,
@@ -190,10 +191,8 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
         "PositionThreshold",
         "gear_ratio_for",
     ),
-    ".hardware.gearboxes": (
-        "GEARBOX_KINDS",
-        "Gearbox",
-    ),
+    ".hardware.gearbox_scaling": ("GEARBOX_KINDS",),
+    ".hardware.gearboxes": ("Gearbox",),
     ".hardware.motors": (
         "SCALING_LAWS",
         "Motor",

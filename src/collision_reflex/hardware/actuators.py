@@ -25,7 +25,6 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .. import _validate
-from .._compat import renamed_keywords
 from ..errors import InvalidParameter
 from ..model import effective
 from ..model.impulse import series_stiffness
@@ -294,7 +293,6 @@ class Actuator:
         """Motor mass plus gearbox mass [kg]."""
         return self.motor.mass + (self.gearbox.mass if self.gearbox is not None else 0.0)
 
-    @renamed_keywords(finger_mass="m_f", robot_mass="m_r")
     def contact_parameters(
         self,
         lever: float,
@@ -312,8 +310,6 @@ class Actuator:
           finger mass is only ``m_f``;
         - ``"finger"``: a rigid transmission with the compliance at the contact (like the paper's geared A8,
           whose fitted finger mass was 20 kg), so ``N**2 J_m / L**2`` is added to the finger mass too.
-
-        The old keywords ``finger_mass`` and ``robot_mass`` still work, with a ``DeprecationWarning``.
 
         Parameters
         ----------

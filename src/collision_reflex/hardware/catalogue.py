@@ -21,6 +21,7 @@ from pydantic import BaseModel, ConfigDict, ValidationError, field_validator
 from .._units import QuantityError, parse_quantity
 from .._yaml import NodeProblem, check_nodes, one_line
 from ..errors import CatalogueError
+from .gearbox_scaling import GEARBOX_KINDS
 
 # Field -> the unit a plain number is taken in (SI), and the pint dimensionality a quantity string must have.
 _MOTOR_UNITS = {
@@ -171,8 +172,6 @@ class _GearboxEntry(_Cited):
     @field_validator("kind")
     @classmethod
     def _known_kind(cls, value: str) -> str:
-        from .gearboxes import GEARBOX_KINDS
-
         if value not in GEARBOX_KINDS:
             raise ValueError("expected one of " + ", ".join(GEARBOX_KINDS))
         return value

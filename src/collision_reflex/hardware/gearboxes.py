@@ -1,12 +1,11 @@
-"""Gearboxes and their scaling laws.
+"""Gearboxes scaled by their laws, catalogue gearboxes, and gearboxes scaled to their motor.
 
-The laws are Saerens et al. 2019's, as tabulated in ``tab:scaling_laws`` of "Reacting to Contact: Transparency
-and Collision Reflex in Actuation". A scaling law says how a quantity changes with the gearbox's outer diameter ``r``, length ``l`` and number of
-stages ``a``, relative to a reference gearbox: ``q = q0 (l/l0)**p (r/r0)**e (a/a0)**s``. So a gearbox is
-described by a real one (its own mass, inertia and rated torque at its size, with a source), and
-:meth:`Gearbox.scaled` moves it to another size. No reference values are built in: gearbox data vary too much
-between makers for one default to be honest, and the paper ignores gearbox inertia (as does
-:class:`~collision_reflex.hardware.actuators.Actuator` unless asked).
+The scaling laws (:mod:`collision_reflex.hardware.gearbox_scaling`, Saerens et al. 2019) say how a gearbox's
+quantities change with its size relative to a reference gearbox. So a gearbox is described by a real one (its
+own mass, inertia and rated torque at its size, with a source), and :meth:`Gearbox.scaled` moves it to another
+size. No reference values are built in: gearbox data vary too much between makers for one default to be
+honest, and the paper ignores gearbox inertia (as does :class:`~collision_reflex.hardware.actuators.Actuator`
+unless asked).
 
 Real gearboxes one can buy are :class:`CatalogueGearbox` entries of ``designs/gearboxes.yaml``
 (:func:`load_gearbox_catalogue`), each figure with its source. A :class:`ScaledGearbox` is a joint's
@@ -25,46 +24,21 @@ import numbers
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, Protocol
 
 import numpy as np
 
 from .. import _validate
 from ..errors import InvalidParameter
+from .gearbox_scaling import GEARBOX_KINDS, GEARBOX_SCALING
 
 __all__ = [
-    "GEARBOX_KINDS",
-    "GEARBOX_SCALING",
     "CatalogueGearbox",
     "Gearbox",
-    "GearboxScaling",
     "ScaledGearbox",
     "load_gearbox_catalogue",
 ]
 
-
-@dataclass(frozen=True)
-class GearboxScaling:
-    """Exponents ``(p, e, s)`` of length, diameter and stages for one quantity of one kind of gearbox."""
-
-    length: float
-    diameter: float
-    stages: float
-
-    def factor(self, length_ratio: float, diameter_ratio: float, stages_ratio: float) -> float:
-        """Scale factor ``(l/l0)**p (r/r0)**e (a/a0)**s`` for the given ratios to the reference [-]."""
-        return length_ratio**self.length * diameter_ratio**self.diameter * stages_ratio**self.stages
-
-
-# kind -> (mass, inertia, torque) exponents, from tab:scaling_laws (Saerens et al. 2019).
-GEARBOX_SCALING: dict[str, tuple[GearboxScaling, GearboxScaling, GearboxScaling]] = {
-    "parallel_shaft": (GearboxScaling(1, 2, 0), GearboxScaling(1, 4, -1), GearboxScaling(1, 2, -1)),
-    "planetary": (GearboxScaling(1, 2, 0), GearboxScaling(1, 4, -1), GearboxScaling(1, 2, -1)),
-    "harmonic": (GearboxScaling(1, 2, 0), GearboxScaling(1, 4, 0), GearboxScaling(0, 3, 0)),
-    "cycloidal": (GearboxScaling(1, 2, 0), GearboxScaling(1, 4, 0), GearboxScaling(-1, 4, 0)),
-    "ball_screw": (GearboxScaling(1, 2, 0), GearboxScaling(1, 4, 0), GearboxScaling(0, 3, 0)),
-}
-GEARBOX_KINDS: tuple[str, ...] = tuple(GEARBOX_SCALING)
 _STAGED = ("parallel_shaft", "planetary")
 
 
@@ -74,7 +48,7 @@ class Gearbox:
 
     Parameters
     ----------
-    kind: one of :data:`GEARBOX_KINDS`.
+    kind: one of :data:`~collision_reflex.hardware.gearbox_scaling.GEARBOX_KINDS`.
     stages: number of stages ``a`` (parallel shaft and planetary only; 1 for the others).
     diameter: outer diameter ``r`` [m].
     length: length ``l`` [m].
@@ -192,8 +166,34 @@ class Gearbox:
         )
 
 
+class _Range(Protocol):
+    """Bounds of a gear ratio [-] (e.g. :class:`collision_reflex.optimize.space.Bounds`)."""
+
+    lower: float
+    upper: float
+
+
+class _OfferedRatios:
+    """The ratios a gearbox is sold with: their range, and a gear-ratio range clipped to it."""
+
+    ratios: tuple[float, ...]
+
+    @property
+    def ratio_range(self) -> tuple[float, float]:
+        """The smallest and largest ratio offered [-]."""
+        return self.ratios[0], self.ratios[-1]
+
+    def clip(self, bounds: _Range) -> tuple[float, float]:
+        """The gear-ratio ``bounds`` intersected with :attr:`ratio_range`: ``(lower, upper)`` [-].
+
+        Empty (``lower > upper``) when they do not overlap: the caller says what that means for it.
+        """
+        low, high = self.ratio_range
+        return max(bounds.lower, low), min(bounds.upper, high)
+
+
 @dataclass(frozen=True)
-class CatalogueGearbox:
+class CatalogueGearbox(_OfferedRatios):
     """A gearbox one can buy: a catalogue entry's figures (SI), as its datasheet states them.
 
     Parameters
@@ -201,7 +201,7 @@ class CatalogueGearbox:
     name : str
         The catalogue key (maker's designation).
     kind : str
-        One of :data:`GEARBOX_KINDS`.
+        One of :data:`~collision_reflex.hardware.gearbox_scaling.GEARBOX_KINDS`.
     ratios : tuple of float
         The ratios offered [-], ascending; or ``(min, max)`` when ``continuous_ratio``.
     continuous_ratio : bool
@@ -244,11 +244,6 @@ class CatalogueGearbox:
     diameter: float | None = None
     length: float | None = None
 
-    @property
-    def ratio_range(self) -> tuple[float, float]:
-        """The smallest and largest ratio offered [-]."""
-        return self.ratios[0], self.ratios[-1]
-
     def reflected_inertia(self, gear_ratio: float) -> float:
         """Gearbox inertia seen at the output [kg m^2]: ``N**2 inertia``."""
         _validate.positive("gear_ratio", gear_ratio)
@@ -270,12 +265,12 @@ class ScaledFigures(NamedTuple):
 
 
 @dataclass(frozen=True)
-class ScaledGearbox:
+class ScaledGearbox(_OfferedRatios):
     """A gearbox of ``reference``'s kind sized to carry its motor's peak output torque ``N tau_p``.
 
-    The size follows the kind's law of :data:`GEARBOX_SCALING` at the reference's length and stages: the
-    output torque scales as ``d**e_T`` in the outer diameter ``d``, so a unit whose repeated peak torque is
-    ``T`` has ``d/d0 = (T/T0)**(1/e_T)``, mass ``m0 (d/d0)**e_m`` and input inertia ``J0 (d/d0)**e_J`` (a
+    The size follows the kind's law of :data:`~collision_reflex.hardware.gearbox_scaling.GEARBOX_SCALING` at
+    the reference's length and stages: the output torque scales as ``d**e_T`` in the outer diameter ``d``, so a
+    unit whose repeated peak torque is ``T`` has ``d/d0 = (T/T0)**(1/e_T)``, mass ``m0 (d/d0)**e_m`` and input inertia ``J0 (d/d0)**e_J`` (a
     strain-wave unit: mass ``∝ T**(2/3)``, inertia ``∝ T**(4/3)``); rated torque and efficiency are the
     reference's, the rated torque in proportion. Sizing it to the motor's peak output torque (not to the
     requirement) is the rule that a gearbox survives whatever its motor can apply (the collision reaction brakes
@@ -322,11 +317,6 @@ class ScaledGearbox:
         largest = self.largest
         beyond = "" if largest is None else f" (at most {largest.name}'s {largest.peak_torque:.4g} N*m)"
         return f"{self.kind} scaled from {self.reference.name}{beyond}"
-
-    @property
-    def ratio_range(self) -> tuple[float, float]:
-        """The smallest and largest ratio offered [-]."""
-        return self.ratios[0], self.ratios[-1]
 
     @property
     def efficiency(self) -> float | None:
@@ -382,7 +372,7 @@ def load_gearbox_catalogue(path: str | os.PathLike[str] | None = None) -> dict[s
     path : str or path-like, optional
         The catalogue file; default the packaged one.
     """
-    from .catalogue import packaged_catalogue_path, read_entries
+    from .catalogue import packaged_catalogue_path, read_entries  # lazy: pydantic, yaml
 
     target = Path(path) if path is not None else packaged_catalogue_path("gearboxes.yaml")
     gearboxes = {}

@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Any, NamedTuple
 
 from .. import _validate
-from ..errors import InvalidParameter
+from ..errors import InvalidParameter, UnknownMotor
 
 __all__ = [
     "CONSTANT_SURFACE_SPEED",
@@ -324,7 +324,7 @@ def load_catalogue(path: str | os.PathLike[str] | None = None) -> dict[str, Moto
     rpm"``; omitted means not known) and a ``source``. A missing or mistyped field raises
     :class:`~collision_reflex.errors.CatalogueError` naming the field, the file and the line.
     """
-    from .catalogue import read_catalogue
+    from .catalogue import read_catalogue  # lazy: pydantic, yaml
 
     target = Path(path) if path is not None else default_catalogue_path()
     entries = read_catalogue(target)
@@ -333,7 +333,7 @@ def load_catalogue(path: str | os.PathLike[str] | None = None) -> dict[str, Moto
 
 def default_catalogue_path() -> Path:
     """The packaged motor catalogue, ``designs/motors.yaml``."""
-    from .catalogue import packaged_catalogue_path
+    from .catalogue import packaged_catalogue_path  # lazy: pydantic, yaml
 
     return packaged_catalogue_path()
 
@@ -345,8 +345,6 @@ def reference_motor() -> Motor:
 
 def get_motor(name: str, path: str | os.PathLike[str] | None = None) -> Motor:
     """The motor called ``name`` in a catalogue (default: the packaged one)."""
-    from ..errors import UnknownMotor
-
     catalogue = load_catalogue(path)
     try:
         return catalogue[name]

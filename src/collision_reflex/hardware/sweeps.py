@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import math
 import os
-import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -34,7 +33,6 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .. import _validate
-from .._compat import renamed_keywords
 from .._io import atomic_open
 from ..errors import InvalidParameter
 from ..model.impulse import (
@@ -66,57 +64,18 @@ __all__ = [
     "stiffness_sweep",
 ]
 
-# Old keyword spellings of the sweeps (contact-level quantities now use the paper's symbols).
-_RENAMED_CONTACT_KEYWORDS = {
-    "mechanical_stiffness": "k_m",
-    "software_stiffness": "k_s",
-    "threshold": "F_s",
-    "finger_mass": "m_f",
-    "robot_mass": "m_r",
+SWEEP_DEFAULTS: dict[str, Any] = {
+    "torque_required": 1.3,  # N m, tab:motor_params (the reference motor's peak torque)
+    "k_m": 1000.0,  # N/m at the contact, fig:motor_scale_modeling
+    "k_s": 100.0,  # N/m at the contact, fig:motor_scale_modeling
+    "F_s": 3.0,  # N, fig:motor_scale_modeling
+    "lever": 0.1143,  # m: ASSUMPTION, the paper's 1D experiment's characteristic length
+    "m_f": 0.1,  # kg: ASSUMPTION, the paper's U8 fit in tab:one_shot
+    "m_r": 0.0,  # kg: ASSUMPTION, no unsprung mass besides the reflected inertia
+    "reflected_inertia_in": "finger",  # ASSUMPTION, see the module docstring
+    "law": DEFAULT_SCALING_LAW,
 }
-
-
-class _SweepDefaults(dict[str, Any]):
-    """The defaults by name; an old key still reads its value, with a ``DeprecationWarning``."""
-
-    def __missing__(self, key: str) -> Any:
-        if key not in _RENAMED_CONTACT_KEYWORDS:
-            raise KeyError(key)
-        new = _RENAMED_CONTACT_KEYWORDS[key]
-        warnings.warn(
-            f"SWEEP_DEFAULTS[{key!r}] is deprecated; read {new!r}", DeprecationWarning, stacklevel=2
-        )
-        return self[new]
-
-
-SWEEP_DEFAULTS: dict[str, Any] = _SweepDefaults(
-    {
-        "torque_required": 1.3,  # N m, tab:motor_params (the reference motor's peak torque)
-        "k_m": 1000.0,  # N/m at the contact, fig:motor_scale_modeling
-        "k_s": 100.0,  # N/m at the contact, fig:motor_scale_modeling
-        "F_s": 3.0,  # N, fig:motor_scale_modeling
-        "lever": 0.1143,  # m: ASSUMPTION, the paper's 1D experiment's characteristic length
-        "m_f": 0.1,  # kg: ASSUMPTION, the paper's U8 fit in tab:one_shot
-        "m_r": 0.0,  # kg: ASSUMPTION, no unsprung mass besides the reflected inertia
-        "reflected_inertia_in": "finger",  # ASSUMPTION, see the module docstring
-        "law": DEFAULT_SCALING_LAW,
-    }
-)
-"""The sweeps' default settings (contact-level ones in the paper's symbols, SI units); old keys still read."""
-
-
-def _deprecated_field(old: str, new: str) -> property:
-    """A read-only attribute ``old`` that warns (``DeprecationWarning``) and returns the field ``new``."""
-
-    def read(self: object) -> Any:
-        warnings.warn(
-            f"{type(self).__name__}.{old} is deprecated; read {type(self).__name__}.{new}",
-            DeprecationWarning,
-            stacklevel=2,
-        )
-        return getattr(self, new)
-
-    return property(read, doc=f"Deprecated spelling of :attr:`{new}`.")
+"""The sweeps' default settings (contact-level ones in the paper's symbols, SI units)."""
 
 
 @dataclass(frozen=True)
@@ -155,10 +114,6 @@ class RadiusVelocitySweep:
     assumptions: dict[str, Any] = field(default_factory=dict)
     """Every setting used, including the assumptions the paper does not state."""
 
-    finger_mass = _deprecated_field("finger_mass", "m_f")
-    robot_mass = _deprecated_field("robot_mass", "m_r")
-    threshold = _deprecated_field("threshold", "F_s")
-
     def table(self) -> pd.DataFrame:
         """The grid as a long pandas DataFrame, one row per (diameter, velocity), SI units in the headers."""
         import pandas as pd
@@ -179,12 +134,6 @@ class RadiusVelocitySweep:
     def to_csv(self, path: str | os.PathLike[str]) -> Path:
         """Write :meth:`table` to ``path`` atomically, the settings as ``#`` comment lines on top."""
         return _write_csv(path, self.table(), self.assumptions)
-
-
-# The old field spellings keep working as keywords (with a warning); `dataclasses.replace` needs the new ones.
-RadiusVelocitySweep.__init__ = renamed_keywords(  # type: ignore[method-assign]
-    finger_mass="m_f", robot_mass="m_r", threshold="F_s"
-)(RadiusVelocitySweep.__init__)
 
 
 def _contact_actuator(
@@ -266,7 +215,6 @@ class _MotorScaling:
         }
 
 
-@renamed_keywords(**_RENAMED_CONTACT_KEYWORDS)
 def radius_velocity_sweep(
     diameters: ArrayLike,
     velocities: ArrayLike,
@@ -288,8 +236,6 @@ def radius_velocity_sweep(
 
     Each diameter gets the reference motor scaled by ``law`` at ``stack_length`` and the gear ratio
     ``N = max(1, tau_req / tau_p(r))``; the actuator drives a contact at ``lever`` through a rotary joint.
-    The old keywords ``mechanical_stiffness``, ``software_stiffness``, ``threshold``, ``finger_mass`` and
-    ``robot_mass`` still work, with a ``DeprecationWarning``.
 
     Parameters
     ----------
@@ -425,7 +371,6 @@ class StiffnessSweep:
         return _write_csv(path, self.table(), self.assumptions)
 
 
-@renamed_keywords(velocity="v0", position_error="e_th", **_RENAMED_CONTACT_KEYWORDS)
 def stiffness_sweep(
     stiffnesses: ArrayLike,
     *,
@@ -442,9 +387,6 @@ def stiffness_sweep(
     reaction: str = "at_rest",
 ) -> StiffnessSweep:
     """Impulse over mechanical stiffness for two sensing schemes (``fig:stiff-sensing-impulse``).
-
-    The old keywords ``velocity``, ``threshold``, ``position_error``, ``software_stiffness``, ``finger_mass``
-    and ``robot_mass`` still work, with a ``DeprecationWarning``.
 
     Parameters
     ----------

@@ -154,9 +154,9 @@ def _within_ratio_range(
     """
     if gearbox is None:
         return bounds
-    low, high = gearbox.ratio_range
-    lower, upper = max(bounds.lower, low), min(bounds.upper, high)
+    lower, upper = gearbox.clip(bounds)
     if lower > upper:
+        low, high = gearbox.ratio_range
         raise InvalidParameter(
             f"gear_ratio bounds of {joint}",
             (bounds.lower, bounds.upper),

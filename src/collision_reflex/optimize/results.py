@@ -506,7 +506,7 @@ def nearest_catalogue_motor(catalogue: Mapping[str, Motor], peak_torque: float, 
 
     Closest in (log peak torque, log rotor inertia): the off-the-shelf part a designer would start from.
     """
-    from .snap import motor_distance
+    from .candidates import motor_distance
 
     best, best_distance = "", math.inf
     for name, motor in catalogue.items():

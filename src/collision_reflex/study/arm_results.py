@@ -34,7 +34,8 @@ if TYPE_CHECKING:
     from ..hardware.gearboxes import CatalogueGearbox
     from ..hardware.motors import Motor
     from ..optimize import DesignProblem, DesignResult, ParetoSet
-    from ..optimize.snap import CatalogueDesign, CataloguePart
+    from ..optimize.candidates import CataloguePart
+    from ..optimize.snap import CatalogueDesign
     from .load import LoadedStudy
 
 SAVED_DIGITS = 7
@@ -389,7 +390,8 @@ def placement_sentences(setup: ArmSetup) -> list[str]:
 
 def transmissions(setup: ArmSetup) -> list[str]:
     """What the joints' transmissions are, for the report: scaled gearboxes, and geared joints without a model."""
-    from ..hardware.gearboxes import GEARBOX_SCALING, ScaledGearbox
+    from ..hardware.gearbox_scaling import GEARBOX_SCALING
+    from ..hardware.gearboxes import ScaledGearbox
 
     joints = list(setup.arm.joint_names)
     gearboxes = setup.technology.joint_gearboxes(len(joints))
@@ -544,7 +546,8 @@ def catalogue_results(
     either way), on active sets of the samples as the study's ``optimizer.active_set`` says (the sweep's
     rule); each Pareto design (the chosen one without a front) by :func:`quick_snap_record`.
     """
-    from ..optimize.snap import catalogue_problem, snap_to_catalogue
+    from ..optimize.parts import catalogue_problem
+    from ..optimize.snap import snap_to_catalogue
     from .arm_setup import IPOPT_OPTIONS
 
     started = time.perf_counter()
@@ -632,7 +635,7 @@ def solve_study_parts(
     are the same on every executor.
     """
     from ..optimize.blas import single_threaded_blas
-    from ..optimize.snap import solved_or_status
+    from ..optimize.catalogue_search import solved_or_status
     from .arm_setup import IPOPT_OPTIONS
 
     with _SNAP_LOCK, single_threaded_blas():
@@ -684,7 +687,8 @@ def quick_snap_record(
     ``objectives``, ``difference``, ``relative_difference``: as in :class:`CatalogueRecord` (empty without
     parts).
     """
-    from ..optimize.snap import evaluate_parts, joint_candidates, quick_parts
+    from ..optimize.candidates import joint_candidates
+    from ..optimize.parts import evaluate_parts, quick_parts
 
     joints = joint_candidates(
         problem, result, catalogue.motors, 1, catalogue.gearboxes or None, 1, screen=False

@@ -385,7 +385,8 @@ def _joint_gearboxes(
             )
         if gearbox is not None:
             low, high = gearbox.ratio_range
-            if max(low, bounds.lower) > min(high, bounds.upper):
+            lower, upper = gearbox.clip(bounds)
+            if lower > upper:
                 problems.append(
                     loaded.problem(
                         path,

@@ -72,8 +72,8 @@ def choose_transmissions(
     import yaml
 
     from ..errors import InvalidParameter, SolverFailed, StudyFileError
+    from ..optimize.catalogue_search import objective_value
     from ..optimize.pareto import built_problem, single_optimum
-    from ..optimize.snap import objective_value
     from .arm_setup import StudyProblems, checked_setup
     from .robot import load_arm
 
