@@ -15,7 +15,7 @@ import collision_reflex as cr
 from collision_reflex.arm import Arm
 from collision_reflex.hardware.gearboxes import load_gearbox_catalogue
 from collision_reflex.optimize import snap as snapping
-from collision_reflex.optimize.active_set import solve_method
+from collision_reflex.optimize.active_set_result import solve_method
 from collision_reflex.optimize.objectives import TIE_BREAK_WEIGHT
 from collision_reflex.optimize.pareto import MERGE_TOLERANCE
 from collision_reflex.optimize.snap import objective_value, snap_to_catalogue, solve_parts

@@ -55,16 +55,15 @@ import numpy as np
 from .._interrupt import interruptible
 from ..errors import InvalidParameter, SolverFailed
 from ..hardware.gearboxes import ScaledGearbox
-from .active_set import (
-    ACTIVE_SET_CHOICES,
-    ActiveSetResult,
-    kept_problem,
-    solve_active_set,
-    uses_active_set,
-)
+from .active_set import ACTIVE_SET_CHOICES, solve_active_set, uses_active_set
+from .active_set_result import ActiveSetResult
+from .design import Design
+from .design_result import DesignResult
+from .ipopt import IpoptOptions
 from .objectives import IMPULSE_OBJECTIVES, objective_expression, objective_values
-from .solve import Design, DesignResult, IpoptOptions, solve, warm_start
+from .solve import solve, warm_start
 from .space import Bounds, module_envelope
+from .subsets import kept_problem
 
 if TYPE_CHECKING:
     from ..arm.robot import Arm
@@ -877,7 +876,7 @@ def catalogue_problem(
     bounds; the objective, constraints and the other bounds are ``problem``'s, and so are the samples unless
     ``samples`` are given (a subset of them, for an active-set round).
     """
-    from .problem import build_problem
+    from .build import build_problem
 
     technology = _parts_technology(problem, parts)
     space = replace(
@@ -965,7 +964,7 @@ def _warm_round(
     samples (the solve's first round, :func:`_catalogue_on`), started at ``x0``'s design with those samples'
     auxiliaries at their exact values.
     """
-    from .active_set import sample_subset
+    from .subsets import sample_subset
 
     subset = sample_subset(problem.samples, optimum.active_samples)
     solved_on = _subset_problem(problem, arm, subset)
@@ -981,7 +980,7 @@ def _subset_problem(problem: DesignProblem, arm: Arm, subset: ContactSamples) ->
 
     The same for every combination of one snap: one build serves all of them.
     """
-    from .problem import build_problem
+    from .build import build_problem
 
     def build() -> DesignProblem:
         return build_problem(
