@@ -188,7 +188,7 @@ def compare_fronts(full: cr.ParetoSet, active: cr.ParetoSet) -> None:
 def compare_construction(build, repeats: int = 3) -> None:
     """Solver construction and one IPOPT run, derivatives per sample against the whole NLP's; medians."""
     from collision_reflex.optimize.blas import single_threaded_blas
-    from collision_reflex.optimize.solve import DEFAULT_IPOPT_OPTIONS
+    from collision_reflex.optimize.ipopt import DEFAULT_IPOPT_OPTIONS
 
     def timed(structural: bool) -> tuple[float, float, int, float, float]:
         """Construction and IPOPT wall times, iterations, objective, CPU time; everything freed on return, so

@@ -80,11 +80,10 @@ def main() -> None:
 
 def _record_runs() -> list[tuple[str, str, int]]:
     """Record every IPOPT run of :func:`collision_reflex.optimize.solve.solve` (name, status, iterations)."""
-    import importlib
+    from collision_reflex.optimize.ipopt import IpoptRuns
 
-    module = importlib.import_module("collision_reflex.optimize.solve")
     runs: list[tuple[str, str, int]] = []
-    original = module._Attempts.run
+    original = IpoptRuns.run
 
     def run(self, name, options, start, warm=None):  # type: ignore[no-untyped-def]
         found = original(self, name, options, start, warm)
@@ -92,7 +91,7 @@ def _record_runs() -> list[tuple[str, str, int]]:
         runs.append((record.name, record.status, record.iterations))
         return found
 
-    module._Attempts.run = run
+    IpoptRuns.run = run  # type: ignore[method-assign]
     return runs
 
 

@@ -8,9 +8,11 @@ import pytest
 import collision_reflex as cr
 from collision_reflex.arm import Arm
 from collision_reflex.errors import InvalidParameter, SolverFailed
-from collision_reflex.optimize import active_set
-from collision_reflex.optimize.active_set import ActiveSetResult, sample_subset, solve_active_set
+from collision_reflex.optimize import active_samples
+from collision_reflex.optimize.active_set import solve_active_set
+from collision_reflex.optimize.active_set_result import ActiveSetResult
 from collision_reflex.optimize.evaluate import design_collision_parameters
+from collision_reflex.optimize.subsets import sample_subset
 
 # Both solves to a KKT tolerance far below the comparison's: at IPOPT's default 1e-8 the worst case of these
 # flat problems (set by the link inertia, the motors trade little against it) is only fixed to ~3e-7 relative,
@@ -124,7 +126,7 @@ def test_a_bounded_worst_case_adds_the_samples_above_the_bound(panda):
 def test_a_design_that_misses_a_row_of_the_full_problem_is_refused(panda, monkeypatch):
     samples, builder = panda
     # Without the torque check, one sample's configuration sizes the joints: the full problem's rows catch it.
-    monkeypatch.setattr(active_set, "_torque_violated", lambda *args: np.empty(0, dtype=int))
+    monkeypatch.setattr(active_samples, "_torque_violated", lambda *args: np.empty(0, dtype=int))
     with pytest.raises(SolverFailed, match="peak torque of") as raised:
         solve_active_set(builder("worst_case_impulse"), samples, initial=np.array([5]))
     assert raised.value.status == "Active_Set_Inconsistent"

@@ -11,8 +11,9 @@ import pytest
 import collision_reflex as cr
 from collision_reflex.errors import InvalidParameter
 from collision_reflex.optimize import active_set, pareto
-from collision_reflex.optimize.active_set import ActiveSetResult
+from collision_reflex.optimize.active_set_result import ActiveSetResult
 from collision_reflex.optimize.results import SweepPoint, result_from_json, result_record, result_to_json
+from collision_reflex.optimize.subsets import sample_subset
 from collision_reflex.study.runner import run_study
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -91,7 +92,7 @@ def test_a_known_optimum_on_active_sets_is_carried_to_its_anchor_with_its_last_n
     assert np.array_equal(carried.active_samples, optimum.active_samples)
     # The last NLP's multipliers, by row label, on the anchor's problem of the same samples (one more row: the
     # mass bound, loose at the anchor, at zero).
-    subset = active_set.sample_subset(samples, optimum.active_samples)
+    subset = sample_subset(samples, optimum.active_samples)
     source = pareto.subset_problem(build, NAMES[0], (), subset)
     target = pareto.subset_problem(build, NAMES[0], NAMES[1:], subset)
     assert optimum.last_round.multipliers is not None and carried.last_round.multipliers is not None
@@ -134,7 +135,7 @@ def test_an_active_set_result_round_trips_and_its_record_says_how_it_was_solved(
 
 def test_the_full_nlp_below_the_threshold_and_bad_choices_refused(panda):
     samples, build = panda
-    few = active_set.sample_subset(samples, np.arange(active_set.ACTIVE_SET_THRESHOLD // 2))
+    few = sample_subset(samples, np.arange(active_set.ACTIVE_SET_THRESHOLD // 2))
 
     def build_few(objective, bounded, chosen=few):
         return build(objective, bounded, chosen)

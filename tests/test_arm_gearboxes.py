@@ -17,7 +17,7 @@ from collision_reflex.arm import Arm
 from collision_reflex.arm.duty_cycle import DutyCycle, Payload
 from collision_reflex.errors import InvalidParameter, StudyFileError
 from collision_reflex.hardware.gearboxes import CatalogueGearbox
-from collision_reflex.optimize.solve import design_at
+from collision_reflex.optimize.design import design_at
 
 ROOT = Path(__file__).resolve().parents[1]
 TWO_LINK = ROOT / "designs" / "planar_two_link.urdf"

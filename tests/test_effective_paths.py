@@ -24,7 +24,7 @@ from collision_reflex.arm.directions import circle_directions, sphere_directions
 from collision_reflex.model.effective import finger_inertia
 from collision_reflex.model.impulse import series_stiffness
 from collision_reflex.model.sensing import threshold_force
-from collision_reflex.optimize.solve import design_at
+from collision_reflex.optimize.design import design_at
 
 TWO_LINK = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
 RTOL = 1e-12

@@ -8,10 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from collision_reflex.optimize.design import design_at
 from collision_reflex.optimize.evaluate import sample_impulses
 from collision_reflex.optimize.pareto import built_problem
 from collision_reflex.optimize.samples import ContactSamples
-from collision_reflex.optimize.solve import design_at
 from collision_reflex.study.arm_setup import StudyProblems
 from collision_reflex.study.fresh import fresh_draw, fresh_impulses, fresh_record
 from collision_reflex.study.load import load_study

@@ -9,7 +9,7 @@ import pytest
 
 import collision_reflex as cr
 from collision_reflex.arm import Arm
-from collision_reflex.optimize.solve import design_at
+from collision_reflex.optimize.design import design_at
 
 TWO_LINK = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
 SMALL = cr.Motor("small", 0.03, 0.01, 3e-6, 0.3, 0.1, 0.08, source="test motor")

@@ -11,10 +11,10 @@ import pytest
 import collision_reflex as cr
 from collision_reflex.arm import Arm
 from collision_reflex.optimize import hypervolume
+from collision_reflex.optimize.design import design_at
 from collision_reflex.optimize.evaluate import evaluate_design
 from collision_reflex.optimize.objectives import TIE_BREAK_WEIGHT
 from collision_reflex.optimize.results import undecided_variables
-from collision_reflex.optimize.solve import design_at
 
 TWO_LINK = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
 
@@ -270,7 +270,7 @@ def test_every_solver_of_a_problem_shares_one_set_of_derivatives_and_the_optimum
     arm, monkeypatch
 ):
     from collision_reflex.optimize import problem as problem_module
-    from collision_reflex.optimize.solve import DEFAULT_IPOPT_OPTIONS
+    from collision_reflex.optimize.ipopt import DEFAULT_IPOPT_OPTIONS
 
     built = []
     original = problem_module.derivative_functions

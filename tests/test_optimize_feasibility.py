@@ -11,7 +11,8 @@ import pytest
 
 import collision_reflex as cr
 from collision_reflex.arm import Arm
-from collision_reflex.optimize.solve import CONVERGED, design_at
+from collision_reflex.optimize.design import design_at
+from collision_reflex.optimize.ipopt import CONVERGED
 
 TWO_LINK = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
 MONOTONE = {"ipopt.mu_strategy": "monotone", "ipopt.mu_init": 1e-2}

@@ -1,4 +1,4 @@
-"""The screened multi-start's choice of which starts to finish (``solve._multi_start``), on a stand-in problem.
+"""The screened multi-start's choice of which starts to finish (``multistart.multi_start``), on a stand-in problem.
 
 The problem has one design variable and two known local optima, ``x = -1`` (objective 0) and ``x = +1``
 (objective 0.1), and IPOPT is replaced by a stand-in whose screening run stops part of the way to the optimum
@@ -9,16 +9,13 @@ objectives the real solver would give.
 
 from __future__ import annotations
 
-import importlib
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from collision_reflex.errors import SolverFailed
-
-# The package exports the function solve under the module's name: the module itself, by its import path.
-solve_module = importlib.import_module("collision_reflex.optimize.solve")
+from collision_reflex.optimize import multistart
 
 BETTER, WORSE = -1.0, 1.0
 """The two local optima's designs; the objective is 0 at BETTER and 0.1 at WORSE."""
@@ -56,7 +53,7 @@ def _stand_in_solver(monkeypatch, screened_at, fails_from=()):
     screened points the finishes started from, in order."""
     finished_from: list[float] = []
 
-    def solve(problem, epsilon=None, x0=None, ipopt_options=None, *, retry=True):
+    def solve_start(problem, epsilon=None, x0=None, ipopt_options=None, *, retry=True):
         start = problem.x0 if x0 is None else getattr(x0, "x", x0)
         design = float(np.asarray(start)[0])
         if ipopt_options is not None and "ipopt.tol" in ipopt_options:  # the screening run
@@ -66,7 +63,7 @@ def _stand_in_solver(monkeypatch, screened_at, fails_from=()):
             raise SolverFailed("stand-in finish failed", "Restoration_Failed", {}, [])
         return SimpleNamespace(x=np.array([BETTER if design < 0 else WORSE]))
 
-    monkeypatch.setattr(solve_module, "solve", solve)
+    monkeypatch.setattr(multistart, "solve_start", solve_start)
     return finished_from
 
 
@@ -77,8 +74,8 @@ def test_starts_screened_on_different_optima_are_both_finished(monkeypatch):
     screened = {-1.5: -0.5, 1.5: 0.9}
     finished_from = _stand_in_solver(monkeypatch, screened.__getitem__)
     assert _objective(np.array([0.9])) < _objective(np.array([-0.5]))
-    assert abs(0.9 - (-0.5)) > solve_module.SAME_PATH_DISTANCE
-    result = solve_module._multi_start(_problem(-1.5), None, None, None, 2, _Draws(1.5))
+    assert abs(0.9 - (-0.5)) > multistart.SAME_PATH_DISTANCE
+    result = multistart.multi_start(_problem(-1.5), None, None, None, 2, _Draws(1.5))
     assert sorted(finished_from) == [-0.5, 0.9]
     assert float(result.x[0]) == BETTER
 
@@ -87,17 +84,17 @@ def test_a_failed_finish_is_retried_from_the_next_start_on_its_path(monkeypatch)
     # Three starts screen within the same-path distance of each other, in the better optimum's basin; the
     # finish from the best screened one (-0.9998) fails, so the next best (-0.9996) is finished, and no further one.
     screened = {-1.5: -0.9996, -0.5: -0.9998, -0.3: -0.9994}
-    assert max(screened.values()) - min(screened.values()) < solve_module.SAME_PATH_DISTANCE
+    assert max(screened.values()) - min(screened.values()) < multistart.SAME_PATH_DISTANCE
     finished_from = _stand_in_solver(monkeypatch, screened.__getitem__, fails_from={-0.9998})
-    result = solve_module._multi_start(_problem(-1.5), None, None, None, 3, _Draws(-0.5, -0.3))
+    result = multistart.multi_start(_problem(-1.5), None, None, None, 3, _Draws(-0.5, -0.3))
     assert finished_from == [-0.9998, -0.9996]
     assert float(result.x[0]) == BETTER
 
 
 def test_every_finish_of_a_path_failing_raises(monkeypatch):
     screened = {-1.5: -0.9996, -0.5: -0.9998}
-    assert max(screened.values()) - min(screened.values()) < solve_module.SAME_PATH_DISTANCE
+    assert max(screened.values()) - min(screened.values()) < multistart.SAME_PATH_DISTANCE
     finished_from = _stand_in_solver(monkeypatch, screened.__getitem__, fails_from={-0.9996, -0.9998})
     with pytest.raises(SolverFailed, match="stand-in finish failed"):
-        solve_module._multi_start(_problem(-1.5), None, None, None, 2, _Draws(-0.5))
+        multistart.multi_start(_problem(-1.5), None, None, None, 2, _Draws(-0.5))
     assert finished_from == [-0.9998, -0.9996]

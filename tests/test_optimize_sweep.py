@@ -15,8 +15,8 @@ from collision_reflex.arm import Arm
 from collision_reflex.errors import SolverFailed
 from collision_reflex.optimize import pareto
 from collision_reflex.optimize.derivatives import derivative_functions
+from collision_reflex.optimize.ipopt import DEFAULT_IPOPT_OPTIONS, Attempt
 from collision_reflex.optimize.results import SweepPoint, result_record
-from collision_reflex.optimize.solve import DEFAULT_IPOPT_OPTIONS, Attempt
 from collision_reflex.report.outputs import split_timings
 
 TWO_LINK = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
@@ -220,9 +220,8 @@ def test_a_study_optimum_is_known_to_its_anchor_only_when_it_is_one_of_them():
 
 
 def test_a_numpy_path_that_disagrees_with_casadi_is_warned_of(build, monkeypatch):
-    import importlib
+    from collision_reflex.optimize import design_result as solving
 
-    solving = importlib.import_module("collision_reflex.optimize.solve")  # the module, not the function
     problem = build("worst_case_impulse", ())
     agreeing = cr.solve(problem)
     # The NumPy path 1e-5 off (10 x AGREEMENT_TOLERANCE) in every impulse: every impulse objective is named.

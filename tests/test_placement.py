@@ -9,8 +9,8 @@ import yaml
 import collision_reflex as cr
 from collision_reflex.arm import Arm
 from collision_reflex.errors import InvalidParameter
+from collision_reflex.optimize.design import design_at
 from collision_reflex.optimize.evaluate import collision_parameters
-from collision_reflex.optimize.solve import design_at
 from collision_reflex.optimize.technology import PLACEMENT_STIFFNESS_RATIO, placements_from_stiffness
 from collision_reflex.study.load import load_study
 from test_snap import OBJECTIVE, ROOT, TWO_LINK, _two_link_inputs, _two_link_samples

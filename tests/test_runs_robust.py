@@ -371,6 +371,7 @@ def test_an_ignored_or_handled_ctrl_c_stays_so_inside_an_interruptible_block():
 
 
 def test_solves_and_problem_builds_raise_a_ctrl_c_their_casadi_code_lost(monkeypatch):
+    from collision_reflex.optimize import nlp
     from collision_reflex.optimize import problem as problems
 
     inputs = _pendulum_inputs()
@@ -384,13 +385,13 @@ def test_solves_and_problem_builds_raise_a_ctrl_c_their_casadi_code_lost(monkeyp
     monkeypatch.setattr(problems.DesignProblem, "solver", solver)
     with pytest.raises(KeyboardInterrupt):
         cr.solve(problem)
-    original_structure = problems._sample_structure
+    original_structure = nlp._sample_structure
 
     def structure(*args, **kwargs):
         _swallowed_ctrl_c()
         return original_structure(*args, **kwargs)
 
-    monkeypatch.setattr(problems, "_sample_structure", structure)
+    monkeypatch.setattr(nlp, "_sample_structure", structure)
     built = cr.build_problem(*inputs, "worst_case_impulse")  # its CasADi graph is built on first use
     with pytest.raises(KeyboardInterrupt):
         built.nlp  # noqa: B018

@@ -16,7 +16,7 @@ from collision_reflex.arm import Arm
 from collision_reflex.hardware.gearboxes import load_gearbox_catalogue
 from collision_reflex.optimize import catalogue_search as searching
 from collision_reflex.optimize import snap as snapping
-from collision_reflex.optimize.active_set import solve_method
+from collision_reflex.optimize.active_set_result import solve_method
 from collision_reflex.optimize.candidates import gearbox_options, joint_candidates, motor_distance
 from collision_reflex.optimize.catalogue_search import objective_value, solve_parts
 from collision_reflex.optimize.objectives import TIE_BREAK_WEIGHT

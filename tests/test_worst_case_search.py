@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 from collision_reflex.arm.domain import ContactDomain, smallest_singular_values
+from collision_reflex.optimize.design import design_at
 from collision_reflex.optimize.evaluate import sample_impulses
 from collision_reflex.optimize.pareto import built_problem
 from collision_reflex.optimize.results import record_design
 from collision_reflex.optimize.samples import ContactSamples
-from collision_reflex.optimize.solve import design_at
 from collision_reflex.optimize.worst_case import search_worst_case
 from collision_reflex.study.arm_setup import StudyProblems
 from collision_reflex.study.load import load_study

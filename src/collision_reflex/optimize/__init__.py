@@ -9,13 +9,16 @@ row of a design; :mod:`.duty` turns a duty cycle into peak, RMS and speed constr
 from catalogue parts near a continuous optimum (:class:`CatalogueDesign`).
 """
 
+from .build import build_problem
 from .constraints import Constraints
+from .design import Design, design_at
+from .design_result import DesignResult
 from .objectives import OBJECTIVES
 from .pareto import ParetoSet, hypervolume, pareto_front
-from .problem import DesignProblem, build_problem
+from .problem import DesignProblem
 from .samples import ContactSamples
 from .snap import CatalogueDesign, snap_to_catalogue
-from .solve import Design, DesignResult, design_at, solve
+from .solve import solve
 from .space import Bounds, DesignSpace
 from .technology import ActuatorTechnology
 

@@ -19,7 +19,7 @@ NLP is never built (its start, bounds and scales are NumPy), and the NumPy check
 
 Sweeps, optima and studies solve on active sets through :func:`collision_reflex.optimize.pareto.solve_with`
 (``active_set="auto"`` from :data:`ACTIVE_SET_THRESHOLD` samples, ``"always"``, ``"never"``; a study's
-``optimizer.active_set``); a result says how it was solved (:func:`solve_method`).
+``optimizer.active_set``); a result says how it was solved (:func:`.active_set_result.solve_method`).
 
 Two things depend on all samples and are handled as follows, never silently:
 
@@ -34,36 +34,22 @@ Two things depend on all samples and are handled as follows, never silently:
 from __future__ import annotations
 
 import time
-from collections import OrderedDict
-from collections.abc import Callable, Hashable, Mapping
-from dataclasses import dataclass, field, fields
-from typing import TYPE_CHECKING, NamedTuple
+from collections.abc import Callable, Mapping
+from typing import NamedTuple
 
-import casadi as ca
 import numpy as np
 
 from ..errors import InvalidParameter, SolverFailed
-from .constraints import torque_requirement_rows
-from .evaluate import design_collision_parameters, evaluate_design
+from .active_samples import first_active_set, violated_samples
+from .active_set_result import ActiveSetResult, ActiveSetRound, result_fields, with_rounds
+from .design_result import DesignResult, check_agreement
+from .evaluate import evaluate_design
+from .ipopt import IpoptOptions
 from .objectives import IMPULSE_OBJECTIVES, impulse_objectives
+from .problem import DesignProblem
 from .samples import ContactSamples
-from .solve import DesignResult, IpoptOptions, check_agreement, design_at, solve
-
-if TYPE_CHECKING:
-    from .problem import DesignProblem
-    from .solve import Design
-
-__all__ = [
-    "ACTIVE_SET_CHOICES",
-    "ACTIVE_SET_THRESHOLD",
-    "ActiveSetResult",
-    "ActiveSetRound",
-    "sample_subset",
-    "solve_active_set",
-    "solve_method",
-    "uses_active_set",
-    "with_active_set",
-]
+from .solve import solve
+from .subsets import sample_subset
 
 ACTIVE_SET_THRESHOLD = 128
 """Number of samples from which ``active_set="auto"`` solves a problem on active sets.
@@ -81,98 +67,6 @@ FULL_PROBLEM_TOLERANCE = 1e-6
 """Largest violation of a row of the full NLP (rows are scaled to order one) allowed at the design found."""
 
 
-@dataclass(frozen=True)
-class ActiveSetRound:
-    """One NLP of the active-set scheme.
-
-    samples: active samples in the NLP; added: indices (into all samples) of the samples found violated at its
-        design and added for the next;
-    iterations: IPOPT iterations; solve_time: problem build, solver construction and IPOPT [s];
-    worst_active, worst_all: the worst-case impulse over the active samples and over all samples at its design
-    [N*s] (NumPy path).
-    """
-
-    samples: int
-    added: np.ndarray
-    iterations: int
-    solve_time: float
-    worst_active: float
-    worst_all: float
-
-
-@dataclass(frozen=True)
-class ActiveSetResult(DesignResult):
-    """A :class:`DesignResult` over all samples, found on an active set of them.
-
-    Its impulses, objectives and NumPy objectives are those of every sample; ``x`` is the full problem's point
-    (auxiliaries at their exact values) and ``multipliers`` None (they belong to the last subset's NLP).
-    ``iterations`` add up the rounds of the start kept, ``solve_time`` [s] is the whole solve's (every start,
-    the problem builds and the evaluations on all samples); ``status`` and ``attempts`` are the last round's.
-
-    active_samples: indices (into all samples) of the samples in the last NLP.
-    rounds: every NLP solved (:class:`ActiveSetRound`), in order.
-    method: ``"active set"``, or why all samples were solved at once.
-    last_round: the last NLP's own result (its point and multipliers), which warm-starts a solve of a problem
-        of the same variables and rows on the same samples (``solve_active_set(warm=...)``); None when all
-        samples were solved at once.
-    """
-
-    active_samples: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=int))
-    rounds: tuple[ActiveSetRound, ...] = ()
-    method: str = "active set"
-    last_round: DesignResult | None = None
-
-    def active_set_json(self) -> dict[str, object]:
-        """What the active set adds to a result, as JSON types (:func:`with_active_set` reads it back)."""
-        return {
-            "method": self.method,
-            "active_samples": [int(i) for i in self.active_samples],
-            "rounds": [
-                {
-                    "samples": r.samples,
-                    "added": [int(i) for i in r.added],
-                    "iterations": r.iterations,
-                    "solve_time": r.solve_time,
-                    "worst_active": r.worst_active,
-                    "worst_all": r.worst_all,
-                }
-                for r in self.rounds
-            ],
-        }
-
-
-def with_active_set(
-    result: DesignResult, data: Mapping[str, object], last_round: DesignResult | None = None
-) -> ActiveSetResult:
-    """``result`` with the active set written by :meth:`ActiveSetResult.active_set_json` (and its last NLP's)."""
-    rounds = data["rounds"]
-    assert isinstance(rounds, list)
-    return ActiveSetResult(
-        **_replace(result),  # type: ignore[arg-type]
-        active_samples=np.asarray(data["active_samples"], dtype=int),
-        rounds=tuple(
-            ActiveSetRound(
-                int(r["samples"]),
-                np.asarray(r["added"], dtype=int),
-                int(r["iterations"]),
-                float(r["solve_time"]),
-                float(r["worst_active"]),
-                float(r["worst_all"]),
-            )
-            for r in rounds
-        ),
-        method=str(data["method"]),
-        last_round=last_round,
-    )
-
-
-def solve_method(result: DesignResult) -> tuple[str, int]:
-    """How ``result`` was solved and on how many samples its last NLP was: ``("active set", 72)``."""
-    if isinstance(result, ActiveSetResult):
-        return result.method, int(result.active_samples.size)
-    return "full NLP", int(np.asarray(result.impulses).size)
-
-
 def uses_active_set(n_samples: int, choice: str) -> bool:
     """Whether a problem of ``n_samples`` samples is solved on an active set under ``choice``.
 
@@ -181,57 +75,6 @@ def uses_active_set(n_samples: int, choice: str) -> bool:
     if choice not in ACTIVE_SET_CHOICES:
         raise InvalidParameter("active_set", choice, "one of " + ", ".join(map(repr, ACTIVE_SET_CHOICES)))
     return choice == "always" or (choice == "auto" and n_samples >= ACTIVE_SET_THRESHOLD)
-
-
-def sample_subset(samples: ContactSamples, index: np.ndarray) -> ContactSamples:
-    """The samples at ``index`` (integer indices), with every configuration's kinematics kept.
-
-    A subset of searched samples alone (none drawn) takes its mean over them.
-    """
-    index = np.asarray(index, dtype=int)
-    assert samples.speed_cap is not None and samples.drawn is not None  # set by ContactSamples
-    drawn = samples.drawn[index]
-    return ContactSamples(
-        samples.kinematics,
-        samples.directions[index],
-        samples.config_index[index],
-        tuple(samples.labels[i] for i in index) if samples.labels else (),
-        samples.speed_cap[index],
-        drawn if np.any(drawn) else None,
-    )
-
-
-SUBSET_PROBLEMS = 4
-"""Problems on subsets of the samples kept per process (with their solvers), the last used kept longest: every
-epsilon point's first active set is the first anchor's, and every catalogue combination of a snap warm-starts
-from the continuous problem on the optimum's last active samples, so each is built once per process."""
-_SUBSETS: OrderedDict[tuple[Hashable, ...], tuple[object, DesignProblem]] = OrderedDict()
-
-
-def release_subsets() -> None:
-    """Drop the kept subset problems (:func:`kept_problem`)."""
-    _SUBSETS.clear()
-
-
-def kept_problem(
-    key: tuple[Hashable, ...],
-    samples: ContactSamples,
-    build: Callable[[], DesignProblem],
-    holds: object = None,
-) -> DesignProblem:
-    """``build()``, a problem on ``samples``, built once per process for ``key`` and those samples.
-
-    The last :data:`SUBSET_PROBLEMS` are kept. ``holds``: an object that ``key`` names by its ``id``, kept with
-    the problem so that its id is not another object's while the entry lives.
-    """
-    full_key = (*key, samples.config_index.tobytes(), samples.directions.tobytes())
-    kept = _SUBSETS.get(full_key)
-    if kept is None or kept[0] is not holds:
-        kept = _SUBSETS[full_key] = (holds, build())
-        while len(_SUBSETS) > SUBSET_PROBLEMS:
-            _SUBSETS.popitem(last=False)
-    _SUBSETS.move_to_end(full_key)
-    return kept[1]
 
 
 def solve_active_set(
@@ -305,51 +148,15 @@ def solve_active_set(
             time.perf_counter() - started,
             *[result.impulses.max()] * 2,
         )
-        return _with_rounds(result, result.impulses, np.arange(samples.size), (record,), needs_all)
+        return with_rounds(result, result.impulses, np.arange(samples.size), (record,), needs_all)
 
-    n_design = full.layout.size
     generator = rng or np.random.default_rng(0)
-    first = full.x0 if x0 is None else np.asarray(x0, dtype=float)
-    if warm is not None:
-        first = warm.x
-    designs = [first[:n_design]] + [
-        generator.uniform(full.lbx[:n_design], full.ubx[:n_design]) for _ in range(starts - 1)
-    ]
-    best: _Settled | None = None
-    failure: SolverFailed | None = None
-    for index, design in enumerate(designs):
-        # A warm start's samples were settled at its design (every row of the full NLP checked): kept as they are.
-        resumed = warm is not None and warm.last_round is not None and index == 0
-        active = (
-            warm.active_samples
-            if resumed and warm is not None
-            else _first_active_set(full, start_samples, initial, design)
-        )
-        try:
-            settled = _settle(
-                build,
-                full,
-                active,
-                design,
-                epsilon,
-                ipopt_options,
-                tolerance,
-                max_rounds,
-                retry,
-                warm.last_round if resumed and warm is not None else None,
-            )
-        except SolverFailed as error:
-            if starts == 1 or error.confirmed_infeasible:
-                raise
-            failure = error  # another start may settle
-            continue
-        if best is None or settled.value < best.value:
-            best = settled
-    if best is None:
-        assert failure is not None  # every start failed
-        raise failure
+    settings = _Settings(epsilon, ipopt_options, start_samples, tolerance, max_rounds, retry)
+    best = _best_start(
+        build, full, settings, _start_designs(full, x0, warm, starts, generator), initial, warm
+    )
     final = _full_result(full, best.result, best.x, best.impulses)
-    return _with_rounds(
+    return with_rounds(
         final,
         best.impulses,
         best.active,
@@ -375,16 +182,85 @@ class _Settled(NamedTuple):
     value: float
 
 
+class _Settings(NamedTuple):
+    """The settings of :func:`solve_active_set` every start settles its active set with."""
+
+    epsilon: Mapping[str, float] | None
+    ipopt_options: IpoptOptions | None
+    start_samples: int
+    tolerance: float
+    max_rounds: int
+    retry: bool
+
+
+def _start_designs(
+    full: DesignProblem,
+    x0: np.ndarray | None,
+    warm: ActiveSetResult | None,
+    starts: int,
+    generator: np.random.Generator,
+) -> list[np.ndarray]:
+    """The start designs (log values): ``warm``'s, ``x0``'s or the problem's, and ``starts - 1`` drawn ones."""
+    n_design = full.layout.size
+    first = full.x0 if x0 is None else np.asarray(x0, dtype=float)
+    if warm is not None:
+        first = warm.x
+    return [first[:n_design]] + [
+        generator.uniform(full.lbx[:n_design], full.ubx[:n_design]) for _ in range(starts - 1)
+    ]
+
+
+def _best_start(
+    build: Callable[[ContactSamples], DesignProblem],
+    full: DesignProblem,
+    settings: _Settings,
+    designs: list[np.ndarray],
+    initial: np.ndarray | None,
+    warm: ActiveSetResult | None,
+) -> _Settled:
+    """The best on the full NLP's objective of the active sets settled from each of ``designs``.
+
+    A failed start is skipped when another may settle (not with one start, nor when infeasibility is confirmed);
+    the last failure is raised when every start fails.
+    """
+    best: _Settled | None = None
+    failure: SolverFailed | None = None
+    for index, design in enumerate(designs):
+        # A warm start's samples were settled at its design (every row of the full NLP checked): kept as they are.
+        resumed = warm is not None and warm.last_round is not None and index == 0
+        active = (
+            warm.active_samples
+            if resumed and warm is not None
+            else first_active_set(full, settings.start_samples, initial, design)
+        )
+        try:
+            settled = _settle(
+                build,
+                full,
+                active,
+                design,
+                settings,
+                warm.last_round if resumed and warm is not None else None,
+            )
+        except SolverFailed as error:
+            if len(designs) == 1 or error.confirmed_infeasible:
+                raise
+            failure = error  # another start may settle
+            continue
+        if best is None or settled.value < best.value:
+            best = settled
+    if best is None:
+        assert failure is not None  # every start failed
+        raise failure
+    return best
+
+
 def _settle(
     build: Callable[[ContactSamples], DesignProblem],
     full: DesignProblem,
     active: np.ndarray,
     x_design: np.ndarray,
-    epsilon: Mapping[str, float] | None,
-    ipopt_options: IpoptOptions | None,
-    tolerance: float,
-    max_rounds: int,
-    retry: bool,
+    settings: _Settings,
     warm: DesignResult | None = None,
 ) -> _Settled:
     """Solve on ``active`` from the design ``x_design`` (log values), add the violated samples, repeat.
@@ -396,7 +272,7 @@ def _settle(
     SolverFailed: a round's solve failed; ``"Active_Set_Not_Settled"`` after ``max_rounds``;
         ``"Active_Set_Inconsistent"`` (see :func:`_check_full_rows`).
     """
-    n_design = full.layout.size
+    n_design, epsilon, tolerance = full.layout.size, settings.epsilon, settings.tolerance
     rounds: list[ActiveSetRound] = []
     while True:
         round_started = time.perf_counter()
@@ -406,9 +282,9 @@ def _settle(
         )
         if warm is not None and not rounds and warm.x.size == problem.x0.size:
             start = warm
-        result = solve(problem, epsilon, start, ipopt_options, retry=retry)
+        result = solve(problem, epsilon, start, settings.ipopt_options, retry=settings.retry)
         impulses = evaluate_design(full, result.design)
-        added = _violated(full, result.design, impulses, active, epsilon, tolerance)
+        added = violated_samples(full, result.design, impulses, active, epsilon, tolerance)
         rounds.append(
             ActiveSetRound(
                 active.size,
@@ -422,9 +298,9 @@ def _settle(
         x_design = result.x[:n_design]
         if added.size == 0:
             break
-        if len(rounds) == max_rounds:
+        if len(rounds) == settings.max_rounds:
             raise SolverFailed(
-                f"the active set did not settle in {max_rounds} rounds ({added.size} samples still exceed the "
+                f"the active set did not settle in {settings.max_rounds} rounds ({added.size} samples still exceed the "
                 f"worst case of {active.size}); raise max_rounds or start_samples",
                 "Active_Set_Not_Settled",
                 {},
@@ -459,115 +335,10 @@ def _needs_every_sample(problem: DesignProblem) -> str | None:
     return None
 
 
-def _first_active_set(
-    full: DesignProblem, size: int, initial: np.ndarray | None, x_design: np.ndarray
-) -> np.ndarray:
-    """The first active samples: ``initial`` or the worst at the start and a spread, and the requirement's.
-
-    ``x_design`` is the start design (log values, the first ``layout.size`` entries of ``x``).
-    """
-    n = full.samples.size
-    start = design_at(full, x_design)
-    impulses = evaluate_design(full, start)
-    if initial is not None:
-        chosen = np.asarray(initial).ravel()
-        if (
-            chosen.size == 0
-            or not np.issubdtype(chosen.dtype, np.integer)
-            or chosen.min() < 0
-            or chosen.max() >= n
-        ):
-            raise InvalidParameter("initial", initial, f"sample indices in [0, {n})")
-    elif size >= n:
-        return np.arange(n)
-    else:
-        worst = np.argsort(impulses)[::-1][: max(size // 2, 1)]
-        chosen = np.concatenate([worst, np.linspace(0, n - 1, size - worst.size).round().astype(int)])
-    return np.unique(np.concatenate([chosen, _requirement_samples(full, start, impulses)]))
-
-
-def _requirement_samples(full: DesignProblem, start: Design, impulses: np.ndarray) -> np.ndarray:
-    """Samples that carry the requirement rows of the start design: the first active set's torque and speed.
-
-    The static hold: per joint the configuration of the largest gravity demand at the start design (its worst
-    sample at the start); more are added when they bind (:func:`_torque_violated`). With a duty cycle also, per
-    joint, the sample of the largest approach joint rate, which sets the motor-speed row for every design.
-    """
-    static = _torque_violated(full, start, impulses, np.inf)
-    if full.duty is not None:
-        return np.union1d(np.abs(full.duty.approach_rates).argmax(axis=0), static)
-    return static
-
-
-def _torque_violated(
-    full: DesignProblem, design: Design, impulses: np.ndarray, tolerance: float
-) -> np.ndarray:
-    """Per configuration whose gravity demand exceeds a joint's driving torque, its worst sample.
-
-    The static hold's torque rows (with or without a duty cycle) are per sampled configuration (plus and minus
-    the gravity torque, :func:`collision_reflex.optimize.constraints.torque_requirement_rows`): a configuration
-    missing from the active samples has no row. A demand above ``(1 + tolerance)`` times the driving peak torque
-    [N m] of ``design`` flags its configuration; ``tolerance=inf`` flags, per joint, the configuration of the
-    largest demand instead. Given torques do not depend on the configurations: nothing is flagged.
-    """
-    samples = full.samples
-    if full.constraints.torque_required is not None:
-        return np.empty(0, dtype=int)
-    rows, _ = torque_requirement_rows(samples, full.constraints, full.joint_names)
-    configurations = np.repeat(np.unique(samples.config_index), 2)  # a + and a - row per configuration
-    # The rows of the searched hold poses follow; every active set's problem has them.
-    demands = np.array(
-        [base + per_motor @ design.actuator_mass for base, per_motor in rows[: configurations.size]]
-    )  # (rows, joints)
-    if np.isinf(tolerance):
-        flagged = configurations[demands.argmax(axis=0)]
-    else:
-        flagged = configurations[np.any(demands > (1 + tolerance) * design.driving_peak_torque, axis=1)]
-    picked = []
-    for configuration in np.unique(flagged):
-        of_configuration = np.flatnonzero(samples.config_index == configuration)
-        picked.append(int(of_configuration[np.argmax(impulses[of_configuration])]))
-    return np.array(picked, dtype=int)
-
-
-def _violated(
-    full: DesignProblem,
-    design: Design,
-    impulses: np.ndarray,
-    active: np.ndarray,
-    epsilon: Mapping[str, float] | None,
-    tolerance: float,
-) -> np.ndarray:
-    """Samples outside ``active`` that ``design`` violates, by more than the relative ``tolerance``.
-
-    A sample is violated when its impulse [N*s] exceeds the active worst case (or the worst case's bound), its
-    contact threshold is below the noise floor, or its configuration's gravity demand exceeds a joint's driving
-    torque.
-    """
-    inside = full.samples.inside(design.approach_velocity)  # samples in the design's contact domain
-    levels = []
-    if "worst_case_impulse" in full.objective:
-        levels.append(impulses[active][inside[active]].max(initial=0.0))
-    bound = (epsilon or {}).get("worst_case_impulse")
-    if bound is not None:
-        levels.append(bound)
-    bad = np.zeros(impulses.size, dtype=bool)
-    if levels:
-        bad |= impulses > min(levels) * (1 + tolerance)
-    floor = full.constraints.threshold_floor
-    if full.technology.sensing == "position" and floor > 0:
-        _, thresholds = design_collision_parameters(full, design)
-        bad |= thresholds < floor * (1 - tolerance)
-    bad &= inside
-    bad[_torque_violated(full, design, impulses, tolerance)] = True
-    bad[active] = False
-    return np.flatnonzero(bad)
-
-
 FULL_ROW_CHECK_SAMPLES = 2048
 """Most samples for which the full NLP's graph is built to check every row at an active set's design (and
 its objectives evaluated by CasADi beside NumPy). Beyond it building that graph costs more than the active set
-saves: the design is checked on every sample by the NumPy rules that add samples (:func:`_violated`), and
+saves: the design is checked on every sample by the NumPy rules that add samples (:func:`.active_samples.violated_samples`), and
 the subset NLPs' own CasADi and NumPy values are compared at each solve."""
 
 
@@ -588,10 +359,9 @@ def _check_full_rows(
     The rows are scaled to order one; the allowance is :data:`FULL_PROBLEM_TOLERANCE` or the last solve's own
     largest violation (a point kept at IPOPT's acceptable level), whichever is larger.
     """
-    violation = _row_violation(full, x, epsilon)
-    allowed = max(
-        FULL_PROBLEM_TOLERANCE, 1.01 * float(_row_violation(last, last_x, epsilon).max(initial=0.0))
-    )
+    violation = np.maximum(*full.row_excess(x, full.parameters(epsilon)))
+    last_violation = np.maximum(*last.row_excess(last_x, last.parameters(epsilon)))
+    allowed = max(FULL_PROBLEM_TOLERANCE, 1.01 * float(last_violation.max(initial=0.0)))
     bad = np.flatnonzero(violation > allowed)
     if bad.size:
         worst = bad[np.argsort(violation[bad])[::-1][:3]]
@@ -603,13 +373,6 @@ def _check_full_rows(
             [(full.constraint_labels[i], float(violation[i])) for i in worst],
             full,
         )
-
-
-def _row_violation(problem: DesignProblem, x: np.ndarray, epsilon: Mapping[str, float] | None) -> np.ndarray:
-    """How far each constraint row of ``problem`` is outside its bounds at ``x`` (0 or less: within)."""
-    rows = ca.Function("rows", [problem.nlp["x"], problem.nlp["p"]], [problem.nlp["g"]])
-    g = np.asarray(rows(x, problem.parameters(epsilon))).ravel()
-    return np.asarray(np.maximum(problem.lbg - g, g - problem.ubg))
 
 
 def _full_result(
@@ -625,34 +388,6 @@ def _full_result(
     if checks_full_rows(full):
         objectives = {**last.objectives, **impulse_objectives(full.evaluate(x)[0], full.samples, velocity)}
         check_agreement(objectives, numpy_objectives, IMPULSE_OBJECTIVES)
-    return _replace(last, objectives=objectives, numpy_objectives=numpy_objectives, x=x, multipliers=None)
-
-
-def _replace(result: DesignResult, **changes: object) -> dict[str, object]:
-    """The fields of ``result`` as keywords, with ``changes``."""
-    return {**{f.name: getattr(result, f.name) for f in fields(DesignResult)}, **changes}
-
-
-def _with_rounds(
-    result: DesignResult | dict[str, object],
-    impulses: np.ndarray,
-    active: np.ndarray,
-    rounds: tuple[ActiveSetRound, ...],
-    method: str,
-    total_time: float | None = None,
-    last_round: DesignResult | None = None,
-) -> ActiveSetResult:
-    """The :class:`ActiveSetResult` of ``result`` (a result or its fields) with the rounds' totals."""
-    values = result if isinstance(result, dict) else _replace(result)
-    values.update(
-        impulses=impulses,
-        iterations=sum(r.iterations for r in rounds),
-        solve_time=sum(r.solve_time for r in rounds) if total_time is None else total_time,
-    )
-    return ActiveSetResult(
-        **values,  # type: ignore[arg-type]
-        active_samples=active,
-        rounds=rounds,
-        method=method,
-        last_round=last_round,
+    return result_fields(
+        last, objectives=objectives, numpy_objectives=numpy_objectives, x=x, multipliers=None
     )

@@ -25,8 +25,8 @@ from .space import Bounds, module_envelope
 
 if TYPE_CHECKING:
     from ..hardware.gearboxes import CatalogueGearbox
+    from .design_result import DesignResult
     from .problem import DesignProblem
-    from .solve import DesignResult
 
 __all__ = [
     "BOUND_TOLERANCE",

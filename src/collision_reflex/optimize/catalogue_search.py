@@ -28,8 +28,13 @@ import numpy as np
 
 from .._interrupt import interruptible
 from ..errors import InvalidParameter, SolverFailed
-from .active_set import ActiveSetResult, kept_problem, sample_subset, solve_active_set, uses_active_set
+from .active_set import solve_active_set, uses_active_set
+from .active_set_result import ActiveSetResult
+from .build import build_problem
 from .candidates import CataloguePart
+from .design import Design
+from .design_result import DesignResult
+from .ipopt import IpoptOptions
 from .objectives import IMPULSE_OBJECTIVES, objective_expression
 from .parts import (
     REQUIREMENT_PASSES,
@@ -38,8 +43,9 @@ from .parts import (
     evaluate_parts,
     matched_gear_ratio,
 )
-from .problem import DesignProblem, build_problem
-from .solve import Design, DesignResult, IpoptOptions, solve, warm_start
+from .problem import DesignProblem
+from .solve import solve, warm_start
+from .subsets import kept_problem, sample_subset
 
 if TYPE_CHECKING:
     from ..arm.robot import Arm

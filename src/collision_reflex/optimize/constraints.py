@@ -15,13 +15,13 @@ from typing import TYPE_CHECKING
 import casadi as ca
 import numpy as np
 
+from ..arm.duty_cycle import DutyCycle
+from ..arm.rating import Rating
 from ..errors import InvalidParameter
 from .samples import ContactSamples, kinematic_term, loaded_joints
 from .technology import ActuatorTechnology
 
 if TYPE_CHECKING:
-    from ..arm.duty_cycle import DutyCycle
-    from ..arm.rating import Rating
     from ..arm.samples import ArmSamples
 
 STATIC_REQUIREMENT = "static (gravity only)"
@@ -86,8 +86,6 @@ class Constraints:
                     "torque_required", self.torque_required, "one torque >= 0 per joint [N m]"
                 )
         if self.duty_cycle is not None:
-            from ..arm.duty_cycle import DutyCycle
-
             if not isinstance(self.duty_cycle, DutyCycle):
                 raise InvalidParameter("duty_cycle", self.duty_cycle, "a DutyCycle or None")
             if self.torque_required is not None:
@@ -99,8 +97,6 @@ class Constraints:
                 )
 
         if self.rating is not None:
-            from ..arm.rating import Rating
-
             if not isinstance(self.rating, Rating):
                 raise InvalidParameter("rating", self.rating, "a Rating or None")
             if self.torque_required is not None and self.rating.moves:

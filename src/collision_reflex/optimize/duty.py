@@ -36,6 +36,7 @@ import casadi as ca
 import numpy as np
 
 from ..arm.dynamics import CycleTorques, cycle_torques, joined, max_speed
+from ..arm.rating import rated_torques
 from ..errors import InvalidParameter
 from ..hardware.motors import scaled_motor_quantities
 from .constraints import ConstraintList, binding_rows, undominated_rows
@@ -45,9 +46,9 @@ if TYPE_CHECKING:
     from ..arm.duty_cycle import DutyCycle
     from ..arm.rating import Rating
     from ..arm.robot import Arm
+    from .design import Design
     from .layout import DesignLayout, DesignQuantities
     from .problem import DesignProblem
-    from .solve import Design
     from .technology import ActuatorTechnology
 
 PEAK, RMS, SPEED = "peak torque", "RMS torque", "speed"
@@ -151,8 +152,6 @@ def duty_requirement(
     ------
     InvalidParameter: the reference motor has no maximum speed (the speed requirement needs it).
     """
-    from ..arm.rating import rated_torques
-
     moving = rating is not None and rating.moves
     if cycle is None and not moving:
         return None
@@ -507,12 +506,12 @@ def _best_margins(
             speed_need = gears[:, 0] * joint_speed
             margins = np.column_stack(
                 [
-                    _margin(efficiency * gears[:, 0] * motor.peak_torque, peak_need),
-                    _margin(efficiency * gears[:, 0] * motor.continuous_torque, rms_need),
-                    _margin(motor.max_speed * ratings, speed_need),
-                    _margin(gearbox.peak_torque[joint] * ratings, peak_need),
-                    _margin(gearbox.rated_torque[joint] * ratings, rms_need),
-                    _margin(gearbox.max_input_speed[joint] * ratings, speed_need),
+                    margin(efficiency * gears[:, 0] * motor.peak_torque, peak_need),
+                    margin(efficiency * gears[:, 0] * motor.continuous_torque, rms_need),
+                    margin(motor.max_speed * ratings, speed_need),
+                    margin(gearbox.peak_torque[joint] * ratings, peak_need),
+                    margin(gearbox.rated_torque[joint] * ratings, rms_need),
+                    margin(gearbox.max_input_speed[joint] * ratings, speed_need),
                 ]
             )
             best[:-1] = np.maximum(best[:-1], margins.max(axis=0))
@@ -520,8 +519,8 @@ def _best_margins(
     return best
 
 
-def _margin(capacity: np.ndarray, need: np.ndarray) -> np.ndarray:
-    """``capacity / need - 1``, infinite where nothing is needed."""
+def margin(capacity: np.ndarray, need: np.ndarray) -> np.ndarray:
+    """``capacity / need - 1`` [-] per joint, infinite where nothing is needed (a result record shows None)."""
     with np.errstate(divide="ignore"):
         return np.where(need > 0, capacity / np.where(need > 0, need, 1.0) - 1.0, np.inf)
 

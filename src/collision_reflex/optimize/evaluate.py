@@ -11,14 +11,15 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..arm.effective import effective_parameters
 from ..model import effective as formulas
 from ..model.impulse import series_stiffness, total_impulse
 
 if TYPE_CHECKING:
     from ..arm.effective import EffectiveParameters
+    from .design import Design
     from .problem import DesignProblem
     from .samples import ContactSamples
-    from .solve import Design
     from .technology import ActuatorTechnology
 
 
@@ -37,8 +38,6 @@ def collision_parameters(
     samples: ContactSamples, technology: ActuatorTechnology, design: Design
 ) -> tuple[EffectiveParameters, np.ndarray]:
     """:func:`design_collision_parameters` at any ``samples`` of the arm, with the design's ``technology``."""
-    from ..arm import effective_parameters
-
     in_finger = technology.finger_joints(design.reflected_inertia.size)
     params = effective_parameters(
         samples.kinematics,

@@ -21,6 +21,7 @@ import casadi as ca
 import numpy as np
 
 from ..errors import Violation
+from .design import design_at
 from .duty import duty_values
 from .objectives import OBJECTIVES, objective_values
 from .problem import DesignProblem
@@ -98,9 +99,7 @@ def solve_feasibility(
     """
     solver = feasibility_solver(problem, options)
     start = problem.exact_point(np.clip(start, problem.lbx, problem.ubx))
-    rows = _rows(problem, start, parameters)
-    low0 = np.maximum(np.where(np.isfinite(problem.lbg), problem.lbg - rows, 0.0), 0.0)
-    high0 = np.maximum(np.where(np.isfinite(problem.ubg), rows - problem.ubg, 0.0), 0.0)
+    low0, high0 = problem.row_excess(start, parameters)
     n_g = problem.lbg.size
     # A slack on a side without a bound would only loosen nothing: it is fixed at zero.
     low_upper = np.where(np.isfinite(problem.lbg), np.inf, 0.0)
@@ -116,7 +115,7 @@ def solve_feasibility(
     stats = solver.stats()
     status = str(stats.get("return_status", "unknown"))
     x = problem.exact_point(np.asarray(solution["x"]).ravel()[: problem.lbx.size])
-    violation = _row_violations(problem, _rows(problem, x, parameters))
+    violation = np.maximum(*problem.row_excess(x, parameters))
     total = float(violation.sum())
     return Feasibility(
         x=x,
@@ -146,8 +145,6 @@ def physical_violations(
     objectives = objective_values(impulses, evaluated[1], evaluated[2], problem.samples)
     duty = None
     if problem.duty is not None:
-        from .solve import design_at  # solve imports this module
-
         duty = duty_values(problem.duty, design_at(problem, x), problem.technology)
     found: dict[str, Violation] = {}
     for row in np.argsort(-violation):
@@ -177,20 +174,3 @@ def physical_violations(
             kind, unit = f"motor speed of {problem.joint_names[joint]} <= its maximum speed", "rad/s"
         found.setdefault(kind, Violation(label, float(amount), unit))
     return tuple(found.values())
-
-
-def _rows(problem: DesignProblem, x: np.ndarray, parameters: np.ndarray) -> np.ndarray:
-    """The NLP's constraint rows ``g`` at ``x`` [-, scaled]."""
-    key = "constraint rows"
-    function = problem._solvers.get(key)
-    if function is None:
-        function = ca.Function("rows", [problem.nlp["x"], problem.nlp["p"]], [problem.nlp["g"]])
-        problem._solvers[key] = function
-    return np.asarray(function(x, parameters)).ravel()
-
-
-def _row_violations(problem: DesignProblem, rows: np.ndarray) -> np.ndarray:
-    """How far each row of ``g`` lies outside its bounds [-, scaled], 0 inside."""
-    below = np.where(np.isfinite(problem.lbg), problem.lbg - rows, 0.0)
-    above = np.where(np.isfinite(problem.ubg), rows - problem.ubg, 0.0)
-    return np.maximum(np.maximum(below, above), 0.0)

@@ -6,6 +6,7 @@ NumPy path only (no derivatives), so it is independent of the CasADi model and o
 
 from __future__ import annotations
 
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -13,10 +14,10 @@ from typing import Any
 import numpy as np
 
 from ..errors import CollisionReflexError, InvalidParameter
+from .design import design_at
 from .evaluate import evaluate_design
 from .objectives import OBJECTIVES, objective_values
 from .problem import DesignProblem
-from .solve import design_at
 
 
 @dataclass(frozen=True)
@@ -55,8 +56,6 @@ def nsga2_front(
     ------
     InvalidParameter: a problem built with a duty cycle (this cross-check knows the static requirement only).
     """
-    import time
-
     if problem.duty is not None:
         raise InvalidParameter(
             "problem",

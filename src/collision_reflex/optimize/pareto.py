@@ -43,20 +43,17 @@ import numpy as np
 
 from .. import _validate
 from ..errors import InvalidParameter, SolverFailed
-from .active_set import (
-    ACTIVE_SET_CHOICES,
-    ActiveSetResult,
-    kept_problem,
-    sample_subset,
-    solve_active_set,
-    uses_active_set,
-)
+from .active_set import ACTIVE_SET_CHOICES, solve_active_set, uses_active_set
+from .active_set_result import ActiveSetResult
 from .blas import single_threaded_blas
+from .design_result import DesignResult
+from .ipopt import IpoptOptions
 from .objectives import IMPULSE_OBJECTIVES, OBJECTIVES, objective_values
 from .problem import DesignProblem
 from .results import PointFailure, SweepPoint, record_row, result_record
 from .serial import SerialExecutor
-from .solve import DesignResult, IpoptOptions, solve, warm_start
+from .solve import solve, warm_start
+from .subsets import kept_problem, sample_subset
 
 if TYPE_CHECKING:
     from pathlib import Path
@@ -495,7 +492,7 @@ def release_problems() -> None:
     For a caller that moves on to other samples (a worst-case search's exchange round): the problems on the
     samples before would otherwise stay beside the new ones, each as large as its samples.
     """
-    from .active_set import release_subsets
+    from .subsets import release_subsets
 
     built_problem.cache_clear()
     release_subsets()

@@ -16,12 +16,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .._interrupt import interruptible
+from .build import build_problem
 from .candidates import BOUND_TOLERANCE, CataloguePart, JointCandidates
+from .design import Design
 from .duty import duty_values
 from .evaluate import evaluate_design
 from .objectives import objective_values
-from .problem import DesignProblem, build_problem
-from .solve import Design
+from .problem import DesignProblem
 
 if TYPE_CHECKING:
     from ..arm.robot import Arm

@@ -18,10 +18,12 @@ import numpy as np
 
 from ..errors import InvalidParameter
 from ..model.impulse import optimal_velocity, phase_impulses, series_stiffness
-from .active_set import ActiveSetResult, solve_method, with_active_set
+from .active_set_result import ActiveSetResult, solve_method, with_active_set
 from .constraints import DUTY_REQUIREMENT, RATED_REQUIREMENT, STATIC_REQUIREMENT
+from .design import Design
+from .design_result import DesignResult
+from .ipopt import Attempt
 from .objectives import OBJECTIVES
-from .solve import Attempt, Design, DesignResult
 
 if TYPE_CHECKING:
     from ..hardware.motors import Motor
@@ -464,8 +466,8 @@ def undecided_variables(problem: DesignProblem, x: np.ndarray) -> list[tuple[str
     :data:`UNDECIDED_TOLERANCE` (NumPy path, :func:`collision_reflex.optimize.evaluate.evaluate_design`). The
     joint index is None for a global variable (threshold, approach velocity).
     """
+    from .design import design_at
     from .evaluate import evaluate_design
-    from .solve import design_at
     from .space import GLOBAL_VARIABLES
 
     x = np.asarray(x, dtype=float)

@@ -50,7 +50,8 @@ from .catalogue_search import (
     impulse_objective,
     warm_startable,
 )
-from .solve import DesignResult, IpoptOptions
+from .design_result import DesignResult
+from .ipopt import IpoptOptions
 
 if TYPE_CHECKING:
     from ..arm.robot import Arm

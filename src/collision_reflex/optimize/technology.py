@@ -272,7 +272,7 @@ class ActuatorTechnology:
 
         Zero at the other joints; NumPy arrays or CasADi columns as ``peak_torque`` [N m] is.
         """
-        import casadi as ca
+        import casadi as ca  # lazily: the package imports without CasADi's start-up cost
 
         symbolic = isinstance(peak_torque, (ca.MX, ca.SX, ca.DM))
         n = _rows(peak_torque)
@@ -363,6 +363,6 @@ def _rows(values: Any) -> int:
 
 def _column(values: np.ndarray, like: Any) -> Any:
     """Per-joint constants shaped as ``like``: a CasADi column (DM) for CasADi, an array for NumPy."""
-    import casadi as ca
+    import casadi as ca  # lazily: the package imports without CasADi's start-up cost
 
     return ca.DM(values) if isinstance(like, (ca.MX, ca.SX, ca.DM)) else values

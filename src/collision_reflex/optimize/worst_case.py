@@ -32,7 +32,7 @@ from .samples import ContactSamples, loaded_joints
 if TYPE_CHECKING:
     from ..arm import Arm, ArmSamples
     from ..arm.domain import ContactDomain
-    from .solve import Design
+    from .design import Design
     from .technology import ActuatorTechnology
 
 SEARCH_TOLERANCE = 0.005
@@ -256,7 +256,7 @@ def _local_search(
 
     Runs in its own thread; every stencil (the point and its forward differences) goes through ``lockstep``.
     """
-    from scipy.optimize import minimize
+    from scipy.optimize import minimize  # lazy: scipy
 
     nz = len(bounds)
     cache: dict[bytes, tuple[float, np.ndarray, np.ndarray, np.ndarray]] = {}

@@ -405,7 +405,7 @@ def _solve_round(
     re-solves from its last design.
     """
     from ..errors import SolverFailed, StudyRunFailed
-    from ..optimize.active_set import ActiveSetResult
+    from ..optimize.active_set_result import ActiveSetResult
     from ..optimize.pareto import OPTIMUM_STARTS, built_problem, known_optima, pareto_front, single_optimum
     from .arm_setup import IPOPT_OPTIONS
 

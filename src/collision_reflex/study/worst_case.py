@@ -22,7 +22,7 @@ from .schema import ArmStudy, SearchSpec
 
 if TYPE_CHECKING:
     from ..optimize import DesignResult
-    from ..optimize.solve import Design
+    from ..optimize.design import Design
 
 
 def exchanges_samples(study: ArmStudy) -> bool:
