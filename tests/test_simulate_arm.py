@@ -144,22 +144,6 @@ def test_bad_direction_is_refused(arm):
         simulate_arm_collision(arm, [0.3, 1.2], [0.0, 0.0], 0.1, 3.0, **JOINTS)
 
 
-def test_old_keywords_still_work(arm):
-    """``velocity`` and ``wall_stiffness`` (like ``wall_damping_ratio``) are deprecated aliases: same collision."""
-    new = simulate_arm_collision(
-        arm, [0.3, 1.2], [1.0, 0.0], approach_velocity=0.05, threshold=3.0, contact_stiffness=2e6, **JOINTS
-    )
-    with pytest.warns(DeprecationWarning) as caught:
-        old = simulate_arm_collision(
-            arm, [0.3, 1.2], [1.0, 0.0], velocity=0.05, threshold=3.0, wall_stiffness=2e6, **JOINTS
-        )
-    messages = sorted(str(w.message) for w in caught)
-    assert "'velocity' is deprecated; call it 'approach_velocity'" in messages[0]
-    assert "'wall_stiffness' is deprecated; call it 'contact_stiffness'" in messages[1]
-    assert old.impulse == new.impulse
-    assert new.approach_velocity == 0.05
-
-
 def test_configuration_at_joint_limit_is_refused(arm):
     with pytest.raises(InvalidParameter, match="joint limits"):
         simulate_arm_collision(arm, [np.pi, 1.2], [1.0, 0.0], 0.1, 3.0, detection="force", **JOINTS)
