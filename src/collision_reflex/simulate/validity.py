@@ -30,6 +30,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .. import _validate
+from ..arm.effective import effective_parameters
 from ..errors import InvalidParameter, SimulationError
 from ..model.impulse import optimal_velocity, phase_impulses, series_stiffness, sprung_reaction
 from ..model.joint_space import DETECTIONS as JOINT_SPACE_DETECTIONS
@@ -192,8 +193,6 @@ def arm_closed_form(
     contact_stiffness: stiffness of the object hit [N/m], in series with ``k`` and ``k_m``; ``inf``: rigid.
     reaction: ``"moving"`` (robot still moving at detection, as the simulation) or ``"at_rest"``.
     """
-    from ..arm import effective_parameters
-
     arm = joints.on(arm)
     _validate.choice("placement", placement, PLACEMENTS)
     _validate.choice("reaction", reaction, arm_simulation.ARM_REACTIONS)
@@ -309,35 +308,19 @@ def validity_map(
     fixed), ``error`` (why a case was refused or failed, else ``""``) and ``seconds`` (the simulation's
     wall time).
     """
-    import pandas as pd
+    import pandas as pd  # lazy: pandas
 
-    qs = np.atleast_2d(np.asarray(configurations, dtype=float))
-    us = np.atleast_2d(np.asarray(directions, dtype=float))
-    if qs.ndim != 2 or qs.shape[1] != arm.nq or not np.all(np.isfinite(qs)):
-        raise InvalidParameter(
-            "configurations", configurations, f"rows of {arm.nq} finite joint angles [rad]"
-        )
-    norms = np.linalg.norm(us, axis=-1) if us.ndim == 2 else np.zeros(1)
-    if us.ndim != 2 or us.shape[1] != arm.task_dim or not np.all(np.isfinite(norms) & (norms > 0)):
-        raise InvalidParameter("directions", directions, f"nonzero rows of {arm.task_dim} task coordinates")
-    for name, values in (("velocity_ratios", velocity_ratios), ("stiffness_ratios", stiffness_ratios)):
-        _validate.positive(name, np.asarray(values, dtype=float))
-    _validate.positive("tolerance", tolerance)
-    schemes = tuple(available_detections() if detections is None else detections)
-    for scheme in schemes:
-        _validate.choice("detection", scheme, available_detections())
-    for drive in drives:
-        _validate.choice("drive", drive, DRIVES)
-    if "impedance" in drives and not np.all(np.isfinite(np.asarray(joints.software_stiffness, dtype=float))):
-        raise InvalidParameter(
-            "joints.software_stiffness",
-            joints.software_stiffness,
-            "finite joint stiffnesses [N m/rad]",
-            "the impedance drive needs them",
-        )
-    _validate.positive("contact_damping_ratio", contact_damping_ratio)
-    for placement in placements:
-        _validate.choice("placement", placement, PLACEMENTS)
+    qs, us = _cases(arm, configurations, directions)
+    schemes = _check_map_settings(
+        joints,
+        velocity_ratios,
+        stiffness_ratios,
+        detections,
+        placements,
+        tolerance,
+        drives,
+        contact_damping_ratio,
+    )
     rows: list[dict[str, Any]] = []
     for i, q in enumerate(qs):
         for j, u in enumerate(us):
@@ -369,6 +352,54 @@ def validity_map(
                         for model in REACTION_MODELS
                     )
     return pd.DataFrame(rows)
+
+
+def _cases(
+    arm: Any, configurations: npt.ArrayLike, directions: npt.ArrayLike
+) -> tuple[np.ndarray, np.ndarray]:
+    """The map's configurations (n, nq) [rad] and directions (d, task_dim), checked."""
+    qs = np.atleast_2d(np.asarray(configurations, dtype=float))
+    us = np.atleast_2d(np.asarray(directions, dtype=float))
+    if qs.ndim != 2 or qs.shape[1] != arm.nq or not np.all(np.isfinite(qs)):
+        raise InvalidParameter(
+            "configurations", configurations, f"rows of {arm.nq} finite joint angles [rad]"
+        )
+    norms = np.linalg.norm(us, axis=-1) if us.ndim == 2 else np.zeros(1)
+    if us.ndim != 2 or us.shape[1] != arm.task_dim or not np.all(np.isfinite(norms) & (norms > 0)):
+        raise InvalidParameter("directions", directions, f"nonzero rows of {arm.task_dim} task coordinates")
+    return qs, us
+
+
+def _check_map_settings(
+    joints: JointDesign,
+    velocity_ratios: Sequence[float],
+    stiffness_ratios: Sequence[float],
+    detections: Sequence[str] | None,
+    placements: Sequence[str],
+    tolerance: float,
+    drives: Sequence[str],
+    contact_damping_ratio: float,
+) -> tuple[str, ...]:
+    """Check the map's settings (see :func:`validity_map`); the detection schemes it simulates."""
+    for name, values in (("velocity_ratios", velocity_ratios), ("stiffness_ratios", stiffness_ratios)):
+        _validate.positive(name, np.asarray(values, dtype=float))
+    _validate.positive("tolerance", tolerance)
+    schemes = tuple(available_detections() if detections is None else detections)
+    for scheme in schemes:
+        _validate.choice("detection", scheme, available_detections())
+    for drive in drives:
+        _validate.choice("drive", drive, DRIVES)
+    if "impedance" in drives and not np.all(np.isfinite(np.asarray(joints.software_stiffness, dtype=float))):
+        raise InvalidParameter(
+            "joints.software_stiffness",
+            joints.software_stiffness,
+            "finite joint stiffnesses [N m/rad]",
+            "the impedance drive needs them",
+        )
+    _validate.positive("contact_damping_ratio", contact_damping_ratio)
+    for placement in placements:
+        _validate.choice("placement", placement, PLACEMENTS)
+    return schemes
 
 
 @dataclass(frozen=True)
