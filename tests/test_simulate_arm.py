@@ -240,7 +240,8 @@ def test_force_sensor_lags_a_damped_contact_by_the_derived_share(arm):
     form's elastic object has not. 1 % of ``F_s`` allowed (the finger's ringing on the joints); a share off by
     the ratio ``k / k_c`` (the series offset's form) would be 0.7 %, off by a factor of 2, 8 %.
     """
-    from collision_reflex.simulate.validity import JointDesign, arm_closed_form, damper_share
+    from collision_reflex.simulate.design_closed_form import JointDesign, arm_closed_form
+    from collision_reflex.simulate.validity import damper_share
 
     design = JointDesign(threshold=3.0, **JOINTS)
     rigid = arm_closed_form(arm, HONEST_Q, HONEST_U, design)
