@@ -27,15 +27,8 @@ import numpy as np
 
 import collision_reflex as cr
 from collision_reflex.plots import new_figure, save_figure
-from collision_reflex.simulate.validity import (
-    DRIVES,
-    PLACEMENTS,
-    REACTION_MODELS,
-    TOLERANCE,
-    JointDesign,
-    validity_map,
-    worst_difference,
-)
+from collision_reflex.simulate.design_closed_form import PLACEMENTS, REACTION_MODELS, JointDesign
+from collision_reflex.simulate.validity import DRIVES, TOLERANCE, validity_map, worst_difference
 
 URDF = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
 

@@ -306,7 +306,7 @@ def test_sliding_pull_is_the_curvature_of_the_contact_path(arm):
 
 def test_the_validity_map_evaluates_the_model(arm):
     """The map's ``joint_space`` reaction model is this model at the configuration, both placements alike."""
-    from collision_reflex.simulate.validity import REACTION_MODELS, JointDesign, arm_closed_form
+    from collision_reflex.simulate.design_closed_form import REACTION_MODELS, JointDesign, arm_closed_form
 
     assert "joint_space" in REACTION_MODELS
     joints = JointDesign(mechanical_stiffness=K_M, reflected_inertia=ROTOR, torque_limit=TAU, threshold=F_S)

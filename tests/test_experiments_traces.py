@@ -197,21 +197,3 @@ def test_help_names_units():
     )
     for unit in ("[N/m]", "[Hz]", "[m/s]"):
         assert unit in done.stdout
-
-
-def test_velocity_is_a_deprecated_spelling_of_v0(tmp_path):
-    """Trace, read_traces and analyse_files take the old `velocity` keyword with a warning, as `v0`."""
-    with pytest.warns(DeprecationWarning, match="'velocity' is deprecated"):
-        trace = cr.experiments.Trace(np.arange(3.0), np.zeros(3), velocity=0.08)
-    assert trace.v0 == 0.08
-    with pytest.warns(DeprecationWarning, match="Trace.v0"):
-        assert trace.velocity == 0.08
-    path = write_trace(tmp_path / "plain.csv", cr.experiments.Trace(np.arange(3.0), np.zeros(3)))
-    with pytest.warns(DeprecationWarning, match="'velocity' is deprecated"):
-        (read,) = read_traces(path, velocity=0.3)
-    assert read.v0 == pytest.approx(0.3)
-    with pytest.raises(TypeError, match="both 'velocity' and 'v0'"):
-        read_traces(path, velocity=0.3, v0=0.3)
-    with pytest.warns(DeprecationWarning, match="'velocity' is deprecated"):
-        results = analyse_files([path], velocity=0.3)
-    assert results.rejected[0].reason.startswith("too short")

@@ -131,7 +131,8 @@ def test_behind_compliant_joints_the_rotors_take_no_part_in_a_hard_impact():
     # the joints' stiffness along u) at 10 v*, where the impact carries the impulse: the closed form with the
     # rotors behind the springs (robot) is the closer, the one with them in the impact (finger) overestimates.
     # The UR5 with representative harmonic-drive joints (benchmarks/validity_map.py; measured 7.2 % and -10.5 %).
-    from collision_reflex.simulate.validity import JointDesign, validity_map
+    from collision_reflex.simulate.design_closed_form import JointDesign
+    from collision_reflex.simulate.validity import validity_map
 
     arm = Arm.from_example_robot_data("ur5")
     k = np.array([5000, 5000, 3000, 800, 800, 800.0])

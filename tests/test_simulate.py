@@ -4,7 +4,6 @@ analytic effects of delay, sampling and play, a brute-force contact model, and i
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import replace
 
 import numpy as np
@@ -20,7 +19,6 @@ from collision_reflex.simulate import (
     contact_restitution,
     simulate,
 )
-from collision_reflex.simulate.setup import RENAMED_FIELDS
 
 M_F, F_S, A = 0.2, 3.0, 20.0
 # A robot mass so large that the spring's push (at most ~60 N here) is < 3e-6 of the force limit m_r a: the
@@ -308,23 +306,6 @@ def test_detection_kind_and_threshold_checked():
         Detection("smell", 1.0)
     with pytest.raises(InvalidParameter, match="detection threshold"):
         Detection("force", -1.0)
-
-
-def test_old_keywords_still_build_the_same_setup():
-    """The spelled-out keywords are deprecated aliases of the paper's symbols: same setup, one warning each."""
-    new = soft_setup()
-    old_names = {old: getattr(new, field) for old, field in RENAMED_FIELDS.items()}
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        old = CollisionSetup(detection=new.detection, **old_names)
-        with pytest.raises(TypeError, match="both 'velocity' and 'v0'"):
-            CollisionSetup(**old_names | {"v0": 1.0}, detection=new.detection)
-    assert old == new
-    deprecated = {str(w.message).split("'")[1] for w in caught if w.category is DeprecationWarning}
-    assert deprecated == set(RENAMED_FIELDS)
-    with pytest.warns(DeprecationWarning, match="'finger_mass' is deprecated; call it 'm_f'"):
-        damping = contact_damping_for_restitution(0.3, finger_mass=0.2, contact_stiffness=1e6)
-    assert damping == contact_damping_for_restitution(0.3, 0.2, 1e6)
 
 
 def test_time_scales_and_shares_against_their_textbook_forms():

@@ -144,22 +144,6 @@ def test_bad_direction_is_refused(arm):
         simulate_arm_collision(arm, [0.3, 1.2], [0.0, 0.0], 0.1, 3.0, **JOINTS)
 
 
-def test_old_keywords_still_work(arm):
-    """``velocity`` and ``wall_stiffness`` (like ``wall_damping_ratio``) are deprecated aliases: same collision."""
-    new = simulate_arm_collision(
-        arm, [0.3, 1.2], [1.0, 0.0], approach_velocity=0.05, threshold=3.0, contact_stiffness=2e6, **JOINTS
-    )
-    with pytest.warns(DeprecationWarning) as caught:
-        old = simulate_arm_collision(
-            arm, [0.3, 1.2], [1.0, 0.0], velocity=0.05, threshold=3.0, wall_stiffness=2e6, **JOINTS
-        )
-    messages = sorted(str(w.message) for w in caught)
-    assert "'velocity' is deprecated; call it 'approach_velocity'" in messages[0]
-    assert "'wall_stiffness' is deprecated; call it 'contact_stiffness'" in messages[1]
-    assert old.impulse == new.impulse
-    assert new.approach_velocity == 0.05
-
-
 def test_configuration_at_joint_limit_is_refused(arm):
     with pytest.raises(InvalidParameter, match="joint limits"):
         simulate_arm_collision(arm, [np.pi, 1.2], [1.0, 0.0], 0.1, 3.0, detection="force", **JOINTS)
@@ -256,7 +240,8 @@ def test_force_sensor_lags_a_damped_contact_by_the_derived_share(arm):
     form's elastic object has not. 1 % of ``F_s`` allowed (the finger's ringing on the joints); a share off by
     the ratio ``k / k_c`` (the series offset's form) would be 0.7 %, off by a factor of 2, 8 %.
     """
-    from collision_reflex.simulate.validity import JointDesign, arm_closed_form, damper_share
+    from collision_reflex.simulate.design_closed_form import JointDesign, arm_closed_form
+    from collision_reflex.simulate.validity import damper_share
 
     design = JointDesign(threshold=3.0, **JOINTS)
     rigid = arm_closed_form(arm, HONEST_Q, HONEST_U, design)

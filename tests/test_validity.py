@@ -17,12 +17,8 @@ from collision_reflex.arm import Arm
 from collision_reflex.errors import SimulationError, StudyFileError
 from collision_reflex.simulate import validity
 from collision_reflex.simulate.arm import simulate_arm_collision
-from collision_reflex.simulate.validity import (
-    JointDesign,
-    arm_closed_form,
-    validity_map,
-    validity_summary,
-)
+from collision_reflex.simulate.design_closed_form import JointDesign, arm_closed_form
+from collision_reflex.simulate.validity import validity_map, validity_summary
 from collision_reflex.study.runner import run_study
 
 ROOT = Path(__file__).resolve().parents[1]

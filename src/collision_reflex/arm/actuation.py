@@ -12,10 +12,12 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import InvalidParameter
+from ..hardware.actuators import Actuator, ForceThreshold, gear_ratio_for
+from ..hardware.motors import reference_motor
 from .joints import JointParameters, joint_array
 
 if TYPE_CHECKING:
-    from ..hardware.actuators import Actuator, CurrentThreshold, ForceThreshold, PositionThreshold
+    from ..hardware.actuators import CurrentThreshold, PositionThreshold
     from ..hardware.motors import Motor
 
 
@@ -68,9 +70,6 @@ def scaled_actuators(
     sensing: a sensing scheme of :mod:`collision_reflex.hardware.actuators` for every joint; default a 3 N
         force threshold.
     """
-    from ..hardware.actuators import Actuator, ForceThreshold, gear_ratio_for
-    from ..hardware.motors import reference_motor
-
     required = joint_array("torque_required", torque_required, nv)
     motor = (reference if reference is not None else reference_motor()).scaled(
         stator_diameter=stator_diameter, law=law
@@ -90,8 +89,6 @@ def sensing_options(actuators: tuple[Any, ...] | None) -> dict[str, Any]:
     and joint position errors, whose threshold is the joint torque ``k e_th`` as well), where the first
     joint to reach its threshold detects the contact.
     """
-    from ..hardware.actuators import ForceThreshold
-
     if not actuators:
         raise InvalidParameter(
             "actuators", None, "Actuator objects with sensing schemes", "give the threshold explicitly"

@@ -19,6 +19,7 @@ import numpy.typing as npt
 from .. import _validate
 from ..errors import InvalidParameter
 from ..model import effective as formulas
+from ..model.impulse import optimal_velocity, phase_impulses, series_stiffness
 from ..model.sensing import sensing_scheme, threshold_force
 from .directions import normalised_directions
 from .joints import joint_array
@@ -222,8 +223,6 @@ def _with_limits(params: EffectiveParameters, task_stiffness: Any) -> EffectiveP
         params.a[singular] = 0.0
     if task_stiffness is None:
         return params
-    from ..model.impulse import series_stiffness
-
     _validate.positive("task_stiffness", task_stiffness)
     k = np.where(singular, np.inf, series_stiffness(params.k, task_stiffness))
     return replace(params, k=k)
@@ -270,8 +269,6 @@ def collision_impulses(
         spelling of ``"current"``).
     reaction: ``"at_rest"`` (the paper's) or ``"moving"``, see :func:`collision_reflex.phase_impulses`.
     """
-    from ..model.impulse import optimal_velocity, phase_impulses
-
     sensing = sensing_scheme(sensing)
     shape = params.shape
     if sensing == "current":

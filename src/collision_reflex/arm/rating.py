@@ -26,9 +26,9 @@ import numpy as np
 
 from ..errors import InvalidParameter
 from .duty_cycle import Payload
+from .dynamics import CycleTorques, state_torques
 
 if TYPE_CHECKING:
-    from .dynamics import CycleTorques
     from .robot import Arm
     from .samples import ArmSamples
 
@@ -85,8 +85,6 @@ def rated_torques(arm: Arm, kinematics: ArmSamples, rating: Rating) -> CycleTorq
 
     None when the rating asks for no motion. See the module for the states.
     """
-    from .dynamics import state_torques
-
     if not rating.moves:
         return None
     nv = kinematics.mass_matrix.shape[-1]

@@ -14,7 +14,6 @@ from typing import Any
 
 import numpy as np
 
-from .._compat import renamed_keywords
 from ..errors import CollisionReflexError, TraceError
 from .fit import PAPER_SENSOR_STIFFNESS, PARAMETER_UNITS, PARAMETERS, OneShotFit, fit_one_shot
 from .nshot import VelocityLawFit, fit_velocity_law
@@ -228,7 +227,6 @@ def analyse_traces(traces: Iterable[Trace], **options: Any) -> ExperimentResults
     return ExperimentResults(tuple(done), tuple(rejected))
 
 
-@renamed_keywords(velocity="v0")
 def analyse_files(
     paths: Sequence[str | os.PathLike[str]],
     *,
@@ -240,7 +238,7 @@ def analyse_files(
 ) -> ExperimentResults:
     """Read every file (a folder: its ``*.csv`` files, sorted) and analyse every trial.
 
-    ``time_unit``, ``force_unit``, ``v0`` (pre-impact velocity [m/s]; ``velocity``: deprecated spelling) and
+    ``time_unit``, ``force_unit``, ``v0`` (pre-impact velocity [m/s]) and
     ``system`` are passed to :func:`read_traces`;
     the other options (``k_m``, ``bandwidth``, ``n_sigma``, ``reaction``) to :func:`analyse_trace`.
     An unreadable file is rejected as a whole; the other files are still processed.

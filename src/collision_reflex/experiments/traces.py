@@ -26,7 +26,6 @@ from __future__ import annotations
 import math
 import os
 import re
-import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -34,7 +33,6 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 import numpy as np
 
-from .._compat import renamed_keywords
 from .._io import atomic_open
 from .._table import HEADER, TableProblem, read_table
 from .._units import QuantityError, parse_quantity, si_scale
@@ -93,12 +91,6 @@ class Trace:
                 self.fail(f"{name} = {value!r} is invalid: expected a finite number > 0")
 
     @property
-    def velocity(self) -> float | None:
-        """Deprecated spelling of :attr:`v0`, the pre-impact velocity [m/s]."""
-        warnings.warn("Trace.velocity is deprecated; call it Trace.v0", DeprecationWarning, stacklevel=2)
-        return self.v0
-
-    @property
     def label(self) -> str:
         """A short name for tables and messages: the trial name, else the file's stem."""
         return self.name or (Path(self.source).stem if self.source else "trace")
@@ -138,10 +130,6 @@ class Trace:
             )
 
 
-# The old spelling keeps working (with a warning); `dataclasses.replace` needs the new one.
-Trace.__init__ = renamed_keywords(velocity="v0")(Trace.__init__)  # type: ignore[method-assign]
-
-
 def to_si(
     value: str | float, default_unit: str, what: str, source: str = "", line: int | None = None
 ) -> float:
@@ -175,7 +163,6 @@ def unit_factor(unit: str, default_unit: str, what: str, source: str = "") -> fl
         ) from None
 
 
-@renamed_keywords(velocity="v0")
 def read_traces(
     path: str | os.PathLike[str],
     *,
@@ -191,7 +178,7 @@ def read_traces(
     ----------
     path: the CSV file.
     time_unit, force_unit: units of the time and force columns when their headers name none.
-    v0: pre-impact velocity [m/s] for trials whose metadata gives none (``velocity``: deprecated spelling).
+    v0: pre-impact velocity [m/s] for trials whose metadata gives none.
     system: system name for trials whose metadata gives none (default: the file's parent folder's name).
     k_m: sensor stiffness [N/m] for trials whose metadata gives none.
 

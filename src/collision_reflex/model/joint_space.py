@@ -59,6 +59,7 @@ import numpy.typing as npt
 from .. import _validate
 from ..errors import InvalidParameter
 from .impulse import PhaseImpulses
+from .modal import MAX_SAMPLES, SAMPLES_PER_PERIOD, Modes, first_crossing, normal_modes
 
 RETREATS: tuple[str, ...] = ("along_u", "saturated")
 """The motors' push in the reaction: ``"along_u"``, ``tau = -F_a J^T u`` with ``F_a = min_i tau_max,i /
@@ -71,12 +72,6 @@ meaning); ``"spring_torque"``, the joint spring torques projected on ``u``, ``(J
 u|^2`` (joint-torque sensing without the links' inertia: it carries their oscillation differently); and
 ``"position"``, the contact point's position error times ``k``, which against the rigid wall is ``k v0 t``: the
 1D model's ``t1`` exactly."""
-
-_SAMPLES_PER_PERIOD = 32
-_MAX_SAMPLES = 20_000_000
-"""A crossing search longer than this many samples is refused (widely separated time scales): bounded run time."""
-_FREE_MODE = 1e-9
-"""A mode with ``w^2`` below this fraction of the largest is free (``w = 0``): rounding of a zero eigenvalue."""
 
 
 @dataclass(frozen=True)
@@ -118,107 +113,6 @@ class JointSpaceCollision:
     def total(self) -> float:
         """The collision's impulse on the wall [N*s]."""
         return float(self.phases.total)
-
-
-@dataclass(frozen=True)
-class _Modes:
-    """Undamped modes ``zeta_j'' + w_j^2 zeta_j = p_j + p1_j t``, ``zeta(0) = z0``, ``zeta'(0) = dz0``.
-
-    The contact force is ``h0 + h1 t + h . zeta(t)`` [N]. A mode with ``w = 0`` moves freely.
-    """
-
-    w: np.ndarray
-    z0: np.ndarray
-    dz0: np.ndarray
-    p: np.ndarray
-    p1: np.ndarray
-    h: np.ndarray
-    h1: float = 0.0
-
-    def _parts(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        tt = np.asarray(t, dtype=float)[..., None]
-        free = self.w == 0
-        w = np.where(free, 1.0, self.w)
-        mean = np.where(free, 0.0, self.p / w**2)
-        slope = np.where(free, 0.0, self.p1 / w**2)
-        return tt, w, self.z0 - mean, self.dz0 - slope
-
-    def state(self, t: Any) -> tuple[np.ndarray, np.ndarray]:
-        """``zeta(t)`` and ``zeta'(t)`` at a time [s] or an array of times (modes last)."""
-        tt, w, c, s = self._parts(np.asarray(t))
-        free = self.w == 0
-        wt = w * tt
-        osc = (self.p + self.p1 * tt) / w**2 + c * np.cos(wt) + s * np.sin(wt) / w
-        dosc = self.p1 / w**2 - c * w * np.sin(wt) + s * np.cos(wt)
-        poly = self.z0 + self.dz0 * tt + self.p * tt**2 / 2 + self.p1 * tt**3 / 6
-        dpoly = self.dz0 + self.p * tt + self.p1 * tt**2 / 2
-        return np.where(free, poly, osc), np.where(free, dpoly, dosc)
-
-    def force(self, t: Any) -> Any:
-        """The contact force at ``t`` [N] (array in, array out)."""
-        tt, w, c, s = self._parts(t)
-        free = self.w == 0
-        wt = w * tt
-        osc = (self.p + self.p1 * tt) / w**2 + c * np.cos(wt) + s * np.sin(wt) / w
-        poly = self.z0 + self.dz0 * tt + self.p * tt**2 / 2 + self.p1 * tt**3 / 6
-        return self.h1 * tt[..., 0] + np.where(free, poly, osc) @ self.h
-
-    def impulse(self, t: float) -> float:
-        """``integral_0^t force`` [N*s], exact."""
-        tt, w, c, s = self._parts(np.asarray(t))
-        free = self.w == 0
-        wt = w * tt
-        osc = (self.p * tt + self.p1 * tt**2 / 2) / w**2 + c * np.sin(wt) / w + s * (1 - np.cos(wt)) / w**2
-        poly = self.z0 * tt + self.dz0 * tt**2 / 2 + self.p * tt**3 / 6 + self.p1 * tt**4 / 24
-        return float(self.h1 * t**2 / 2 + np.where(free, poly, osc) @ self.h)
-
-    def shortest_period(self) -> float:
-        moving = self.w[self.w > 0]
-        return float(2 * np.pi / moving.max()) if moving.size else math.inf
-
-    def longest_period(self) -> float:
-        moving = self.w[(self.w > 0) & (np.abs(self.h) > 0)]
-        return float(2 * np.pi / moving.min()) if moving.size else 0.0
-
-
-def _modes(mass: np.ndarray, stiffness: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Frequencies [rad/s] and mass-normalised mode shapes (``Phi^T mass Phi = I``) of ``mass, stiffness``."""
-    from scipy.linalg import eigh
-
-    if mass.shape[0] == 0:
-        return np.zeros(0), np.zeros((0, 0))
-    w2, shapes = eigh(stiffness, mass)
-    w2 = np.where(w2 <= _FREE_MODE * max(float(np.max(np.abs(w2))), 1e-300), 0.0, w2)
-    return np.sqrt(w2), shapes
-
-
-def _first_crossing(modes: _Modes, level: float, horizon: float, rising: bool, what: str) -> float:
-    """The first time in ``(0, horizon]`` [s] where the force crosses ``level`` [N] (upward if ``rising``)."""
-    from scipy.optimize import brentq
-
-    step = min(modes.shortest_period(), horizon) / _SAMPLES_PER_PERIOD
-    count = math.ceil(horizon / step)
-    if count > _MAX_SAMPLES:
-        raise InvalidParameter(
-            what,
-            f"{count:.3g} samples",
-            f"at most {_MAX_SAMPLES:.3g} samples of the shortest period",
-            "the arm's periods and the collision's duration are too far apart for this model",
-        )
-    chunk = 8192
-    for start in range(0, count, chunk):
-        times = np.arange(start, min(start + chunk, count) + 1) * step
-        margin = modes.force(times) - level
-        hits = (margin[:-1] < 0) & (margin[1:] >= 0) if rising else (margin[:-1] > 0) & (margin[1:] <= 0)
-        found = np.flatnonzero(hits)
-        if found.size:
-            i = int(found[0])
-            return float(
-                brentq(
-                    lambda t: float(modes.force(np.array([t]))[0]) - level, times[i], times[i + 1], xtol=1e-16
-                )
-            )
-    raise InvalidParameter(what, horizon, "a crossing within the searched horizon [s]")
 
 
 def joint_space_collision(
@@ -265,6 +159,93 @@ def joint_space_collision(
     """
     _validate.choice("retreat", retreat, RETREATS)
     _validate.choice("detection", detection, DETECTIONS)
+    arm, F_s, v0, delay = _checked(
+        mass_matrix,
+        jacobian,
+        direction,
+        mechanical_stiffness,
+        reflected_inertia,
+        torque_limit,
+        software_stiffness,
+        threshold,
+        approach_velocity,
+        delay,
+    )
+    m_f, k, along_wall = arm.m_f, arm.k, arm.along_wall
+    v_ref = arm.reference * v0
+
+    # 1. Impact: the wall takes m_f v0 along u; the links keep their velocity along the wall.
+    dq_impact = v_ref - arm.m_inv_c * m_f * float(arm.lever @ v_ref)
+
+    # 2. Sensing: N^T M N eta'' + N^T K_l N eta = N^T K_l v_ref t;  f = g . (v_ref t - N eta).
+    sensing, shapes = _sensing_modes(arm, v_ref, dq_impact)
+    signal = _detection_signal(
+        sensing, detection, shapes.T @ along_wall.T, arm.series, arm.lever, v_ref, k * v0
+    )
+    # The signal is k v0 t + oscillations no larger than `swing`: it reaches F_s by (F_s + swing) / (k v0).
+    w = sensing.w
+    swing = float(np.sum(np.abs(signal.h * (signal.dz0 - signal.p1 / w**2) / w)))  # w > 0 here
+    horizon = (F_s + swing) / (k * v0) * (1 + 1e-9)
+    t_c = first_crossing(signal, F_s, horizon, True, "the detection time")
+    t_d = t_c + delay  # the reaction's start
+    lifted, margin = _around_detection(sensing, t_c, t_d, F_s)
+    pull = None
+    if normal_curvature is not None:
+        pull = _sliding_pull(normal_curvature, along_wall @ shapes, sensing, t_d, m_f, F_s)
+    zeta, dzeta = sensing.state(t_d)
+    xi, dxi = along_wall @ (shapes @ zeta), along_wall @ (shapes @ dzeta)
+    theta_ref = v_ref * t_d
+    share = arm.share
+    theta = np.where(np.isinf(arm.k_s), theta_ref, share * theta_ref + (1 - share) * xi)  # admittance (- q0)
+    dtheta = share * v_ref + (1 - share) * dxi
+
+    # 3. Reaction: coordinates x = (theta - q0, eta), mass diag(B, N^T M N), springs K_m (theta - q0 - N eta).
+    reaction = _reaction_modes(arm, _push(retreat, arm.lever, arm.tau_max), theta, dtheta, xi, dxi)
+    # Oscillations about a negative mean force: it returns to zero within a few of the longest periods.
+    horizon = 100 * max(reaction.longest_period(), reaction.shortest_period())
+    duration = first_crossing(reaction, 0.0, horizon, False, "the reaction time")
+    phases = PhaseImpulses(m_f * v0, sensing.impulse(t_d), reaction.impulse(duration))
+    return JointSpaceCollision(phases, t_c, delay, duration, lifted, margin, pull, m_f, k)
+
+
+@dataclass(frozen=True)
+class _LinearArm:
+    """The checked arm at its impact configuration, and what the three phases take from it.
+
+    Per joint (nv,) ``K_m``, ``K_s``, the rotors ``B`` and the torque
+    limits; the lever ``c = J^T u``, ``M^-1 c``, the reference rate ``J^+ u`` per unit ``v0``, the series
+    stiffness ``K_l`` and the admittance's share of the reference per joint; ``m_f`` and ``k`` along ``u``; the
+    basis ``N`` (nv, nv - 1) of the motions along the wall and the mass ``N^T M N`` there.
+    """
+
+    k_m: np.ndarray
+    k_s: np.ndarray
+    rotor: np.ndarray
+    tau_max: np.ndarray
+    lever: np.ndarray
+    m_inv_c: np.ndarray
+    reference: np.ndarray
+    series: np.ndarray
+    share: np.ndarray
+    m_f: float
+    k: float
+    along_wall: np.ndarray
+    mass_t: np.ndarray
+
+
+def _checked(
+    mass_matrix: npt.ArrayLike,
+    jacobian: npt.ArrayLike,
+    direction: npt.ArrayLike,
+    mechanical_stiffness: npt.ArrayLike,
+    reflected_inertia: npt.ArrayLike,
+    torque_limit: npt.ArrayLike,
+    software_stiffness: npt.ArrayLike,
+    threshold: float,
+    approach_velocity: float,
+    delay: float,
+) -> tuple[_LinearArm, float, float, float]:
+    """Check the inputs of :func:`joint_space_collision`: the arm, ``F_s`` [N], ``v0`` [m/s] and the delay [s]."""
     mass = _validate.real("mass_matrix", mass_matrix, "a square matrix of real numbers [kg m^2]")
     if mass.ndim != 2 or mass.shape[0] != mass.shape[1] or mass.shape[0] == 0:
         raise InvalidParameter("mass_matrix", mass.shape, "a square (nv, nv) matrix")
@@ -289,7 +270,19 @@ def joint_space_collision(
         np.linalg.cholesky(mass)
     except np.linalg.LinAlgError:
         raise InvalidParameter("mass_matrix", mass, "a positive definite matrix") from None
+    return _linearised(mass, jac, u, k_m, k_s, rotor, tau_max), F_s, v0, delay
 
+
+def _linearised(
+    mass: np.ndarray,
+    jac: np.ndarray,
+    u: np.ndarray,
+    k_m: np.ndarray,
+    k_s: np.ndarray,
+    rotor: np.ndarray,
+    tau_max: np.ndarray,
+) -> _LinearArm:
+    """The arm along ``u`` and along the wall; a direction the contact point cannot move along is refused."""
     lever = jac.T @ u  # c = J^T u
     reference = np.linalg.pinv(jac) @ u  # J^+ u: the motors' reference rate per unit v0
     if np.linalg.norm(jac @ reference - u) > 1e-6 or not np.any(lever):
@@ -304,17 +297,19 @@ def joint_space_collision(
     series = np.where(np.isinf(k_s), k_m, k_m * k_s / np.where(np.isinf(k_s), 1.0, k_m + k_s))
     share = np.where(np.isinf(k_s), 1.0, k_s / np.where(np.isinf(k_s), 1.0, k_m + k_s))  # of theta_ref
     k = 1 / float(lever @ (lever / series))
-    v_ref = reference * v0
     along_wall = _wall_basis(lever)  # N (nv, nv - 1)
-
-    # 1. Impact: the wall takes m_f v0 along u; the links keep their velocity along the wall.
-    dq_impact = v_ref - m_inv_c * m_f * float(lever @ v_ref)
-
-    # 2. Sensing: N^T M N eta'' + N^T K_l N eta = N^T K_l v_ref t;  f = g . (v_ref t - N eta).
     mass_t = along_wall.T @ mass @ along_wall
-    gain = m_f * series * m_inv_c  # f = g . (theta_ref - q)
-    w, shapes = _modes(mass_t, along_wall.T @ (series[:, None] * along_wall))
-    sensing = _Modes(
+    return _LinearArm(
+        k_m, k_s, rotor, tau_max, lever, m_inv_c, reference, series, share, m_f, k, along_wall, mass_t
+    )
+
+
+def _sensing_modes(arm: _LinearArm, v_ref: np.ndarray, dq_impact: np.ndarray) -> tuple[Modes, np.ndarray]:
+    """The contact force's modes during sensing, and the mode shapes (along the wall's basis)."""
+    along_wall, mass_t, series = arm.along_wall, arm.mass_t, arm.series
+    gain = arm.m_f * series * arm.m_inv_c  # f = g . (theta_ref - q)
+    w, shapes = normal_modes(mass_t, along_wall.T @ (series[:, None] * along_wall))
+    sensing = Modes(
         w=w,
         z0=np.zeros(w.size),
         dz0=shapes.T @ mass_t @ (along_wall.T @ dq_impact),
@@ -323,23 +318,11 @@ def joint_space_collision(
         h=-(shapes.T @ along_wall.T @ gain),
         h1=float(gain @ v_ref),
     )
-    signal = _detection_signal(sensing, detection, shapes.T @ along_wall.T, series, lever, v_ref, k * v0)
-    # The signal is k v0 t + oscillations no larger than `swing`: it reaches F_s by (F_s + swing) / (k v0).
-    swing = float(np.sum(np.abs(signal.h * (signal.dz0 - signal.p1 / w**2) / w)))  # w > 0 here
-    horizon = (F_s + swing) / (k * v0) * (1 + 1e-9)
-    t_c = _first_crossing(signal, F_s, horizon, True, "the detection time")
-    t_d = t_c + delay  # the reaction's start
-    lifted, margin = _around_detection(sensing, t_c, t_d, F_s)
-    pull = None
-    if normal_curvature is not None:
-        pull = _sliding_pull(normal_curvature, along_wall @ shapes, sensing, t_d, m_f, F_s)
-    zeta, dzeta = sensing.state(t_d)
-    xi, dxi = along_wall @ (shapes @ zeta), along_wall @ (shapes @ dzeta)
-    theta_ref = v_ref * t_d
-    theta = np.where(np.isinf(k_s), theta_ref, share * theta_ref + (1 - share) * xi)  # admittance (minus q0)
-    dtheta = share * v_ref + (1 - share) * dxi
+    return sensing, shapes
 
-    # 3. Reaction: coordinates x = (theta - q0, eta), mass diag(B, N^T M N), springs K_m (theta - q0 - N eta).
+
+def _push(retreat: str, lever: np.ndarray, tau_max: np.ndarray) -> np.ndarray:
+    """The motors' torques in the reaction (nv,) [N m], :data:`RETREATS`."""
     if retreat == "along_u":
         # A joint without lever (c_i = 0) does not limit the force along u.
         limits = np.where(lever != 0, tau_max / np.where(lever != 0, np.abs(lever), 1.0), np.inf)
@@ -348,14 +331,31 @@ def joint_space_collision(
         push = -tau_max * np.sign(lever)
     if not np.all(np.isfinite(push)):
         raise InvalidParameter("torque_limit", tau_max, "finite limits on the joints that push the contact")
+    return push
+
+
+def _reaction_modes(
+    arm: _LinearArm,
+    push: np.ndarray,
+    theta: np.ndarray,
+    dtheta: np.ndarray,
+    xi: np.ndarray,
+    dxi: np.ndarray,
+) -> Modes:
+    """The contact force's modes in the reaction, from the motors' and links' state at its start.
+
+    Motors ``theta - q0`` and links ``xi = q - q0`` [rad] with their rates; a push that does not unload the
+    contact on average is refused.
+    """
+    nv, along_wall, k_m = arm.k_m.size, arm.along_wall, arm.k_m
     coupling = k_m[:, None] * along_wall
-    mass_r = np.block([[np.diag(rotor), np.zeros((nv, nv - 1))], [np.zeros((nv - 1, nv)), mass_t]])
+    mass_r = np.block([[np.diag(arm.rotor), np.zeros((nv, nv - 1))], [np.zeros((nv - 1, nv)), arm.mass_t]])
     stiff_r = np.block([[np.diag(k_m), -coupling], [-coupling.T, along_wall.T @ coupling]])
-    w_r, shapes_r = _modes(mass_r, stiff_r)
+    w_r, shapes_r = normal_modes(mass_r, stiff_r)
     x0 = np.concatenate([theta, along_wall.T @ xi])
     dx0 = np.concatenate([dtheta, along_wall.T @ dxi])
-    gain_m = m_f * k_m * m_inv_c  # f = g_m . (theta - q0 - N eta)
-    reaction = _Modes(
+    gain_m = arm.m_f * k_m * arm.m_inv_c  # f = g_m . (theta - q0 - N eta)
+    reaction = Modes(
         w=w_r,
         z0=shapes_r.T @ mass_r @ x0,
         dz0=shapes_r.T @ mass_r @ dx0,
@@ -368,15 +368,11 @@ def joint_space_collision(
     if mean_force >= 0:
         raise InvalidParameter(
             "torque_limit",
-            tau_max,
+            arm.tau_max,
             "a push that unloads the contact",
             "the motors' push does not pull the finger off",
         )
-    # Oscillations about a negative mean force: it returns to zero within a few of the longest periods.
-    horizon = 100 * max(reaction.longest_period(), reaction.shortest_period())
-    duration = _first_crossing(reaction, 0.0, horizon, False, "the reaction time")
-    phases = PhaseImpulses(m_f * v0, sensing.impulse(t_d), reaction.impulse(duration))
-    return JointSpaceCollision(phases, t_c, delay, duration, lifted, margin, pull, m_f, k)
+    return reaction
 
 
 @dataclass(frozen=True)
@@ -419,14 +415,14 @@ class JointSpaceArm:
 
 
 def _detection_signal(
-    force: _Modes,
+    force: Modes,
     detection: str,
     to_modes: np.ndarray,
     series: np.ndarray,
     lever: np.ndarray,
     v_ref: np.ndarray,
     ramp: float,
-) -> _Modes:
+) -> Modes:
     """The detector's signal during sensing [N], as the contact force's modes with other gains.
 
     ``to_modes`` maps joint vectors to modal forces (``Phi^T N^T``); ``ramp`` is ``k v0`` [N/s].
@@ -446,17 +442,17 @@ def _wall_basis(lever: np.ndarray) -> np.ndarray:
     return vt[1:].T
 
 
-def _around_detection(sensing: _Modes, t_c: float, t_d: float, F_s: float) -> tuple[bool, float]:
+def _around_detection(sensing: Modes, t_c: float, t_d: float, F_s: float) -> tuple[bool, float]:
     """Whether the force falls to zero before the reaction starts at ``t_d``; the threshold margin.
 
     See :class:`JointSpaceCollision`. Sampled at a 32nd of the shortest period (peaks to 0.5 %) up to one
     longest period after the crossing ``t_c``.
     """
-    step = sensing.shortest_period() / _SAMPLES_PER_PERIOD
+    step = sensing.shortest_period() / SAMPLES_PER_PERIOD
     if not math.isfinite(step):  # one joint: the force is the ramp k v0 t
         return False, math.inf
     end = max(t_d, t_c + sensing.longest_period())
-    times = np.arange(1, min(math.ceil(end / step), _MAX_SAMPLES) + 1) * step
+    times = np.arange(1, min(math.ceil(end / step), MAX_SAMPLES) + 1) * step
     force = sensing.force(times)
     lifted = bool(np.any(force[times <= t_d] <= 0))
     inner = force[1:-1]
@@ -472,7 +468,7 @@ def _around_detection(sensing: _Modes, t_c: float, t_d: float, F_s: float) -> tu
 
 
 def _sliding_pull(
-    curvature: Any, to_joints: np.ndarray, sensing: _Modes, t_d: float, m_f: float, F_s: float
+    curvature: Any, to_joints: np.ndarray, sensing: Modes, t_d: float, m_f: float, F_s: float
 ) -> float:
     """``max(-m_f q'^T H q') / F_s`` over the sensing phase, ``q' = to_joints zeta'`` (sampled).
 
@@ -482,8 +478,8 @@ def _sliding_pull(
     hessian = _validate.real("normal_curvature", curvature, "a (nv, nv) matrix of real numbers [m/rad^2]")
     if hessian.shape != (nv, nv) or not np.all(np.isfinite(hessian)):
         raise InvalidParameter("normal_curvature", hessian.shape, f"a finite ({nv}, {nv}) matrix")
-    step = min(sensing.shortest_period() / _SAMPLES_PER_PERIOD, t_d)
-    times = np.linspace(0.0, t_d, min(math.ceil(t_d / step), _MAX_SAMPLES) + 1)
+    step = min(sensing.shortest_period() / SAMPLES_PER_PERIOD, t_d)
+    times = np.linspace(0.0, t_d, min(math.ceil(t_d / step), MAX_SAMPLES) + 1)
     _, rates = sensing.state(times)
     velocities = rates @ to_joints.T  # q' (samples, nv)
     pull = -m_f * np.einsum("si,ij,sj->s", velocities, (hessian + hessian.T) / 2, velocities)

@@ -58,6 +58,26 @@ def _flat_note(span: float) -> str:
     return f"flat: all designs within {rounded:.{decimals}f} %"
 
 
+def _draw_designs(ax: Any, values: np.ndarray, colours: Sequence[Any]) -> None:
+    """One marker per design, numbered, with the SVG id :data:`POINT_ID` (see :func:`plot_design_front`)."""
+    for index, ((x, y), point_colour) in enumerate(zip(values[:, :2], colours, strict=True)):
+        # One artist per design: matplotlib writes it as its own <g id="front-point-i"> in the SVG.
+        # Above the chosen star and the recommended ring, so that they do not hide it from the pointer; a wide
+        # transparent edge makes it easier to hover (the dot looks as a marker of its edge's size would).
+        ax.plot(
+            [x],
+            [y],
+            "o",
+            ms=5 if values.shape[1] == 2 else 6,
+            mfc=point_colour,
+            mec=(0.0, 0.0, 0.0, 0.0),
+            mew=HIT_WIDTH,
+            zorder=3,
+            gid=POINT_ID.format(index),
+        )
+        ax.annotate(str(index), (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
+
+
 def plot_design_front(
     path: FigurePath,
     names: Sequence[str],
@@ -97,7 +117,7 @@ def plot_design_front(
     Path
         The first figure file.
     """
-    import matplotlib
+    import matplotlib  # lazy: matplotlib
     from matplotlib.lines import Line2D
 
     values = np.asarray(values, dtype=float)
@@ -123,22 +143,7 @@ def plot_design_front(
         cmap = matplotlib.colormaps["viridis"]
         colours = [cmap(norm(z)) for z in values[:, 2]]
         fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, label=labels[2])
-    for index, ((x, y), point_colour) in enumerate(zip(values[:, :2], colours, strict=True)):
-        # One artist per design: matplotlib writes it as its own <g id="front-point-i"> in the SVG.
-        # Above the chosen star and the recommended ring, so that they do not hide it from the pointer; a wide
-        # transparent edge makes it easier to hover (the dot looks as a marker of its edge's size would).
-        ax.plot(
-            [x],
-            [y],
-            "o",
-            ms=5 if values.shape[1] == 2 else 6,
-            mfc=point_colour,
-            mec=(0.0, 0.0, 0.0, 0.0),
-            mew=HIT_WIDTH,
-            zorder=3,
-            gid=POINT_ID.format(index),
-        )
-        ax.annotate(str(index), (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
+    _draw_designs(ax, values, colours)
     if chosen is not None:
         ax.plot([chosen[0]], [chosen[1]], "*", ms=12, color="tab:red", label="single-objective optimum")
     if recommended is not None:

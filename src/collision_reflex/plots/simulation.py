@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from ..model.impulse import force_profile
 from . import new_figure, save_figure
 
 
@@ -76,8 +77,6 @@ def plot_trace(path: str | os.PathLike[str], result: Any, reaction: str = "at_re
     :func:`collision_reflex.force_profile`; the detection, reaction and contact-end times are marked and the
     rigid impacts' impulses noted.
     """
-    from ..model.impulse import force_profile
-
     setup = result.setup
     end = float(result.contact_end) if np.isfinite(result.contact_end) else float(result.t[-1])
     fig, ax = new_figure(figsize=(7, 3.6))

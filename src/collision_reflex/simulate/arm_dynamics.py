@@ -17,7 +17,7 @@ from ..errors import SimulationError
 from .contact import damping_from_ratio
 
 if TYPE_CHECKING:
-    from .arm import _ClosedForm, _Joints, _Sensing
+    from .arm_inputs import ArmJoints, ArmSensing, ImpactClosedForm
 
 
 def _link_model(arm: Any) -> tuple[Any, Any, int]:
@@ -94,11 +94,11 @@ class ArmDynamics:
     def __init__(
         self,
         arm: Any,
-        joints: _Joints,
-        closed: _ClosedForm,
+        joints: ArmJoints,
+        closed: ImpactClosedForm,
         contact_stiffness: float,
         contact_damping_ratio: float,
-        sensing: _Sensing,
+        sensing: ArmSensing,
     ) -> None:
         import pinocchio as pin
 

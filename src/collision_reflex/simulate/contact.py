@@ -7,7 +7,6 @@ import math
 import numpy as np
 
 from .. import _validate
-from .._compat import renamed_keywords
 from ..errors import InvalidParameter
 
 
@@ -47,14 +46,13 @@ def contact_restitution(damping_ratio: float) -> float:
     return -position_velocity(t_end)[1]
 
 
-@renamed_keywords(finger_mass="m_f")
 def contact_damping_for_restitution(restitution: float, m_f: float, contact_stiffness: float) -> float:
     """Contact damping [N*s/m] giving ``restitution`` (in (0, 1]) to the finger alone on the contact.
 
     Parameters
     ----------
     restitution: coefficient of restitution, ``0 < e <= 1`` (dimensionless).
-    m_f: finger mass [kg] (formerly ``finger_mass``).
+    m_f: finger mass [kg].
     contact_stiffness: contact stiffness [N/m], finite.
     """
     _validate.positive("m_f", m_f)

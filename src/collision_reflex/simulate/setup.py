@@ -3,8 +3,7 @@
 It also gives the quantities derived from them (the closed form's inputs and the time scales of the
 simulation).
 
-Contact-level quantities carry the paper's symbols (``m_f``, ``m_r``, ``k_m``, ``k_s``, ``F_a``, ``v0``); the
-older spelled-out keywords (``finger_mass``, ...) still work, with a ``DeprecationWarning``.
+Contact-level quantities carry the paper's symbols (``m_f``, ``m_r``, ``k_m``, ``k_s``, ``F_a``, ``v0``).
 """
 
 from __future__ import annotations
@@ -13,7 +12,6 @@ import math
 from dataclasses import dataclass
 
 from .. import _validate
-from .._compat import renamed_keywords
 from ..errors import InvalidParameter
 from ..model.impulse import PhaseImpulses, impact_pulse_duration, phase_impulses, series_stiffness
 from ..model.sensing import threshold_force
@@ -27,16 +25,6 @@ DETECTION_KINDS: tuple[str, ...] = ("force", "position", "current")
 ``"current"``: the actuator force, i.e. motor current times torque constant, seen at the output [N] (with the
 ideal drive: spring force plus friction plus ``m_r`` times the robot's acceleration; the ideal controller's
 impulsive force at the instant the finger stops is not counted, as a real current loop would filter it)."""
-
-RENAMED_FIELDS: dict[str, str] = {
-    "finger_mass": "m_f",
-    "robot_mass": "m_r",
-    "mechanical_stiffness": "k_m",
-    "software_stiffness": "k_s",
-    "force_limit": "F_a",
-    "velocity": "v0",
-}
-"""Deprecated keyword of :class:`CollisionSetup` -> its field."""
 
 
 def oscillation_period(mass: float, stiffness: float) -> float:
@@ -74,14 +62,13 @@ class CollisionSetup:
 
     Parameters
     ----------
-    m_f: finger (sprung) mass [kg] (formerly ``finger_mass``).
-    m_r: robot (unsprung + reflected rotor) mass [kg] (formerly ``robot_mass``).
-    k_m: mechanical spring between finger and robot mass [N/m] (formerly ``mechanical_stiffness``).
+    m_f: finger (sprung) mass [kg].
+    m_r: robot (unsprung + reflected rotor) mass [kg].
+    k_m: mechanical spring between finger and robot mass [N/m].
     k_s: controller stiffness [N/m]; ``inf`` (``drive="ideal"`` only) for an ideally velocity-controlled robot
-        mass (formerly ``software_stiffness``).
-    F_a: actuator force limit [N]; the reaction pushes with it, so ``a = F_a / m_r`` (formerly
-        ``force_limit``).
-    v0: approach velocity [m/s] (formerly ``velocity``).
+        mass.
+    F_a: actuator force limit [N]; the reaction pushes with it, so ``a = F_a / m_r``.
+    v0: approach velocity [m/s].
     detection: a :class:`Detection`.
     drive: ``"ideal"``, ``"impedance"`` or ``"free"`` (see :mod:`collision_reflex.simulate`).
     software_damping: controller damping ``d_s`` [N*s/m], ``drive="impedance"`` only.
@@ -219,11 +206,6 @@ class CollisionSetup:
             )
         k, a = self.lumped_stiffness, self.acceleration
         return phase_impulses(self.m_f, k, self.k_m, F_s, a, self.v0, reaction, v_r)
-
-
-# The old spellings keep working (with a warning); `dataclasses.replace` needs the new ones.
-_renamed = renamed_keywords(**RENAMED_FIELDS)
-CollisionSetup.__init__ = _renamed(CollisionSetup.__init__)  # type: ignore[method-assign]
 
 
 def _scalar(owner: object, name: str, value: object, label: str | None = None) -> None:

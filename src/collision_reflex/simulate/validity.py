@@ -17,8 +17,6 @@ failed row, never run for hours.
 
 from __future__ import annotations
 
-import copy
-import dataclasses
 import itertools
 import math
 import time
@@ -31,13 +29,11 @@ import numpy.typing as npt
 
 from .. import _validate
 from ..errors import InvalidParameter, SimulationError
-from ..model.impulse import optimal_velocity, phase_impulses, series_stiffness, sprung_reaction
-from ..model.joint_space import DETECTIONS as JOINT_SPACE_DETECTIONS
-from ..model.joint_space import JointSpaceArm
+from ..model.impulse import optimal_velocity, series_stiffness
 from . import arm as arm_simulation
 from .arm_detection import DETECTIONS
 from .contact import damping_from_ratio
-from .dynamics import admittance_share
+from .design_closed_form import PLACEMENTS, REACTION_MODELS, ArmClosedForm, JointDesign, arm_closed_form
 
 VELOCITY_RATIOS: tuple[float, ...] = (0.1, 0.3, 1.0, 3.0, 10.0)
 """Approach velocities swept, as multiples of the closed form's optimum ``v* = F_s / sqrt(2 k m_f)``."""
@@ -46,22 +42,11 @@ STIFFNESS_RATIOS: tuple[float, ...] = (0.1, 10.0)
 """Contact stiffness over the joints' mechanical stiffness along ``u``: 0.1 is a stiff transmission hitting a
 compliant object, 10 compliant joints hitting a stiff one."""
 
-PLACEMENTS: tuple[str, ...] = ("robot", "finger")
-"""Where the closed form puts the reflected inertia ``N^2 J_m`` (see :data:`REFLECTED_INERTIA_PLACEMENTS`)."""
-
 TOLERANCE = 0.05
 """Agreement that counts as valid: ``|I_sim / I_closed - 1| <= 5 %``."""
 
 MAX_STEPS = 200_000
 """Default work budget of one arm simulation [integrator steps] (the simulator's; tens of seconds at most)."""
-
-REACTION_MODELS: tuple[str, ...] = ("constant", "sprung", "joint_space")
-"""The closed form's reaction: ``"constant"``, the paper's constant acceleration ``a = F_a / m_r``;
-``"sprung"``, :func:`collision_reflex.model.impulse.sprung_reaction` (the compressed spring also pushes the
-robot mass away, the term the constant acceleration leaves out); ``"joint_space"``,
-:func:`collision_reflex.model.joint_space.joint_space_collision` (all three phases with the links' motion along
-the wall, linearised at ``q``; it places each inertia where the arm has it, so it is the same under both
-placements, and it takes the contact as rigid: against a compliant object it leaves the object out)."""
 
 DRIVES: tuple[str, ...] = arm_simulation.ARM_DRIVES
 """The simulated drives: ``"ideal"`` (an ideal admittance) and ``"impedance"`` (the physical impedance loop
@@ -75,174 +60,9 @@ TORQUE_DETECTION = "spring_torque"
 """The simulator's default detection: the contact force estimated from the joint spring torques."""
 
 
-@dataclass(frozen=True)
-class JointDesign:
-    """A design's joint parameters, one value per joint or one for all, and its detection threshold.
-
-    Attributes
-    ----------
-    mechanical_stiffness: joint spring between link and motor [N m/rad], finite.
-    reflected_inertia: ``N^2 J_m`` per joint [kg m^2].
-    torque_limit: output torque limit per joint [N m].
-    threshold: contact-force threshold of the detector ``F_s`` [N].
-    software_stiffness: joint software stiffness [N m/rad]; ``inf`` for ideally velocity-controlled motors.
-    motor_mass: motor (and gearbox) mass per joint [kg], carried by the parent link; None: the arm's.
-    software_damping: the impedance drive's joint damping [N m s/rad] (``drive="impedance"`` only).
-    """
-
-    mechanical_stiffness: Any
-    reflected_inertia: Any
-    torque_limit: Any
-    threshold: float
-    software_stiffness: Any = math.inf
-    motor_mass: Any = None
-    software_damping: Any = 0.0
-
-    def on(self, arm: Any) -> Any:
-        """``arm`` with this design's motor masses (the arm itself when they are the arm's)."""
-        if self.motor_mass is None:
-            return arm
-        params = arm.joint_parameters
-        mass = np.broadcast_to(np.asarray(self.motor_mass, dtype=float), params.motor_mass.shape)
-        _validate.non_negative("motor_mass", mass)
-        out = copy.copy(arm)
-        out.joint_parameters = dataclasses.replace(params, motor_mass=mass.copy())
-        return out
-
-    def simulator_keywords(self) -> dict[str, Any]:
-        """The keywords of :func:`simulate_arm_collision` that carry the joint parameters."""
-        return {
-            "mechanical_stiffness": self.mechanical_stiffness,
-            "reflected_inertia": self.reflected_inertia,
-            "torque_limit": self.torque_limit,
-            "software_stiffness": self.software_stiffness,
-            "software_damping": self.software_damping,
-        }
-
-
 def available_detections() -> tuple[str, ...]:
     """The detection schemes of the arm simulator, its default first."""
     return (TORQUE_DETECTION, *(s for s in DETECTIONS if s != TORQUE_DETECTION))
-
-
-@dataclass(frozen=True)
-class ArmClosedForm:
-    """The arm closed form at one configuration and direction, against a contact of given stiffness.
-
-    Attributes
-    ----------
-    m_f, m_r: effective finger and robot masses along ``u`` [kg]; k, k_m: lumped and mechanical stiffness along
-    ``u``, each in series with the contact [N/m]; F_a: the motors' force along ``-u`` [N]; a: reaction
-    acceleration ``F_a / m_r`` [m/s^2]; v_r: robot velocity at detection along ``u`` per unit approach velocity
-    [-]; threshold: ``F_s`` [N]; reaction: ``"moving"`` or ``"at_rest"``.
-    """
-
-    m_f: float
-    m_r: float
-    k: float
-    k_m: float
-    F_a: float
-    a: float
-    v_r: float
-    threshold: float
-    reaction: str
-    joint_space: JointSpaceArm | None = None
-
-    def impulse(self, approach_velocity: float, model: str = "constant", detection: str = "force") -> float:
-        """The closed form's impulse [N*s] at the approach velocity [m/s] with a reaction of :data:`REACTION_MODELS`.
-
-        ``detection`` (a scheme of the simulator) matters to ``"joint_space"`` only, which models the contact
-        force, spring-torque and position signals (:data:`collision_reflex.model.joint_space.DETECTIONS`) and
-        takes the contact force for the others (the observer estimates it, lagged).
-        """
-        _validate.choice("model", model, REACTION_MODELS)
-        v0 = float(approach_velocity)
-        if model == "joint_space":
-            if self.joint_space is None:
-                raise InvalidParameter("model", model, "a closed form made by arm_closed_form")
-            scheme = detection if detection in JOINT_SPACE_DETECTIONS else "force"
-            return self.joint_space.collision(self.threshold, v0, detection=scheme).total
-        robot_velocity = self.v_r * v0 if self.reaction == "moving" else None
-        phases = phase_impulses(
-            self.m_f, self.k, self.k_m, self.threshold, self.a, v0, self.reaction, robot_velocity
-        )
-        if model == "constant":
-            return float(phases.total)
-        _, reaction = sprung_reaction(self.threshold, self.k_m, self.F_a, self.m_r, robot_velocity or 0.0)
-        return float(phases.initial + phases.sensing + reaction)
-
-
-def arm_closed_form(
-    arm: Any,
-    q: npt.ArrayLike,
-    direction: npt.ArrayLike,
-    joints: JointDesign,
-    placement: str = "robot",
-    contact_stiffness: float = math.inf,
-    reaction: str = "moving",
-) -> ArmClosedForm:
-    """The arm closed form of a design at configuration ``q`` [rad] along ``direction``.
-
-    Parameters
-    ----------
-    arm: a :class:`collision_reflex.Arm`.
-    q: configuration (nq,) [rad]; direction: collision direction in task coordinates, normalised here.
-    joints: the design's joint parameters.
-    placement: ``"robot"`` or ``"finger"`` (reflected inertia also in ``m_f``).
-    contact_stiffness: stiffness of the object hit [N/m], in series with ``k`` and ``k_m``; ``inf``: rigid.
-    reaction: ``"moving"`` (robot still moving at detection, as the simulation) or ``"at_rest"``.
-    """
-    from ..arm import effective_parameters
-
-    arm = joints.on(arm)
-    _validate.choice("placement", placement, PLACEMENTS)
-    _validate.choice("reaction", reaction, arm_simulation.ARM_REACTIONS)
-    _validate.positive("contact_stiffness", contact_stiffness, allow_inf=True)
-    nv = int(arm.nv)
-    inertia = np.broadcast_to(np.asarray(joints.reflected_inertia, dtype=float), (nv,))
-    k_m = np.broadcast_to(np.asarray(joints.mechanical_stiffness, dtype=float), (nv,))
-    k_s = np.broadcast_to(np.asarray(joints.software_stiffness, dtype=float), (nv,))
-    u = np.asarray(direction, dtype=float).reshape(-1)
-    u = u / np.linalg.norm(u)
-    samples = arm.kinematics(np.asarray(q, dtype=float)[None])
-    motor_mass = np.asarray(arm.joint_parameters.motor_mass, dtype=float)
-    effective = effective_parameters(
-        samples,
-        u[None],
-        inertia,
-        series_stiffness(k_m, k_s),
-        k_m,
-        joints.torque_limit,
-        motor_mass=motor_mass if np.any(motor_mass > 0) else None,
-        finger_joint_inertia=inertia if placement == "finger" else None,
-    )
-    if bool(effective.singular[0, 0]):
-        raise InvalidParameter(
-            "direction", direction, "a direction the arm can move along at q", "q is singular"
-        )
-    jac = samples.jacobian[0]
-    v_r = float(u @ jac @ (admittance_share(k_m, k_s) * (np.linalg.pinv(jac) @ u)))
-    value = {name: float(getattr(effective, name)[0, 0]) for name in ("m_f", "m_r", "k", "k_m", "F_a", "a")}
-    return ArmClosedForm(
-        m_f=value["m_f"],
-        m_r=value["m_r"],
-        k=float(series_stiffness(value["k"], contact_stiffness)),
-        k_m=float(series_stiffness(value["k_m"], contact_stiffness)),
-        F_a=value["F_a"],
-        a=value["a"],
-        v_r=v_r,
-        threshold=float(joints.threshold),
-        reaction=reaction,
-        joint_space=JointSpaceArm(
-            samples.structure_mass_matrix(motor_mass if np.any(motor_mass > 0) else None)[0],
-            jac,
-            u,
-            k_m,
-            inertia,
-            joints.torque_limit,
-            k_s,
-        ),
-    )
 
 
 @dataclass(frozen=True)
@@ -309,35 +129,19 @@ def validity_map(
     fixed), ``error`` (why a case was refused or failed, else ``""``) and ``seconds`` (the simulation's
     wall time).
     """
-    import pandas as pd
+    import pandas as pd  # lazy: pandas
 
-    qs = np.atleast_2d(np.asarray(configurations, dtype=float))
-    us = np.atleast_2d(np.asarray(directions, dtype=float))
-    if qs.ndim != 2 or qs.shape[1] != arm.nq or not np.all(np.isfinite(qs)):
-        raise InvalidParameter(
-            "configurations", configurations, f"rows of {arm.nq} finite joint angles [rad]"
-        )
-    norms = np.linalg.norm(us, axis=-1) if us.ndim == 2 else np.zeros(1)
-    if us.ndim != 2 or us.shape[1] != arm.task_dim or not np.all(np.isfinite(norms) & (norms > 0)):
-        raise InvalidParameter("directions", directions, f"nonzero rows of {arm.task_dim} task coordinates")
-    for name, values in (("velocity_ratios", velocity_ratios), ("stiffness_ratios", stiffness_ratios)):
-        _validate.positive(name, np.asarray(values, dtype=float))
-    _validate.positive("tolerance", tolerance)
-    schemes = tuple(available_detections() if detections is None else detections)
-    for scheme in schemes:
-        _validate.choice("detection", scheme, available_detections())
-    for drive in drives:
-        _validate.choice("drive", drive, DRIVES)
-    if "impedance" in drives and not np.all(np.isfinite(np.asarray(joints.software_stiffness, dtype=float))):
-        raise InvalidParameter(
-            "joints.software_stiffness",
-            joints.software_stiffness,
-            "finite joint stiffnesses [N m/rad]",
-            "the impedance drive needs them",
-        )
-    _validate.positive("contact_damping_ratio", contact_damping_ratio)
-    for placement in placements:
-        _validate.choice("placement", placement, PLACEMENTS)
+    qs, us = _cases(arm, configurations, directions)
+    schemes = _check_map_settings(
+        joints,
+        velocity_ratios,
+        stiffness_ratios,
+        detections,
+        placements,
+        tolerance,
+        drives,
+        contact_damping_ratio,
+    )
     rows: list[dict[str, Any]] = []
     for i, q in enumerate(qs):
         for j, u in enumerate(us):
@@ -369,6 +173,54 @@ def validity_map(
                         for model in REACTION_MODELS
                     )
     return pd.DataFrame(rows)
+
+
+def _cases(
+    arm: Any, configurations: npt.ArrayLike, directions: npt.ArrayLike
+) -> tuple[np.ndarray, np.ndarray]:
+    """The map's configurations (n, nq) [rad] and directions (d, task_dim), checked."""
+    qs = np.atleast_2d(np.asarray(configurations, dtype=float))
+    us = np.atleast_2d(np.asarray(directions, dtype=float))
+    if qs.ndim != 2 or qs.shape[1] != arm.nq or not np.all(np.isfinite(qs)):
+        raise InvalidParameter(
+            "configurations", configurations, f"rows of {arm.nq} finite joint angles [rad]"
+        )
+    norms = np.linalg.norm(us, axis=-1) if us.ndim == 2 else np.zeros(1)
+    if us.ndim != 2 or us.shape[1] != arm.task_dim or not np.all(np.isfinite(norms) & (norms > 0)):
+        raise InvalidParameter("directions", directions, f"nonzero rows of {arm.task_dim} task coordinates")
+    return qs, us
+
+
+def _check_map_settings(
+    joints: JointDesign,
+    velocity_ratios: Sequence[float],
+    stiffness_ratios: Sequence[float],
+    detections: Sequence[str] | None,
+    placements: Sequence[str],
+    tolerance: float,
+    drives: Sequence[str],
+    contact_damping_ratio: float,
+) -> tuple[str, ...]:
+    """Check the map's settings (see :func:`validity_map`); the detection schemes it simulates."""
+    for name, values in (("velocity_ratios", velocity_ratios), ("stiffness_ratios", stiffness_ratios)):
+        _validate.positive(name, np.asarray(values, dtype=float))
+    _validate.positive("tolerance", tolerance)
+    schemes = tuple(available_detections() if detections is None else detections)
+    for scheme in schemes:
+        _validate.choice("detection", scheme, available_detections())
+    for drive in drives:
+        _validate.choice("drive", drive, DRIVES)
+    if "impedance" in drives and not np.all(np.isfinite(np.asarray(joints.software_stiffness, dtype=float))):
+        raise InvalidParameter(
+            "joints.software_stiffness",
+            joints.software_stiffness,
+            "finite joint stiffnesses [N m/rad]",
+            "the impedance drive needs them",
+        )
+    _validate.positive("contact_damping_ratio", contact_damping_ratio)
+    for placement in placements:
+        _validate.choice("placement", placement, PLACEMENTS)
+    return schemes
 
 
 @dataclass(frozen=True)

@@ -101,7 +101,8 @@ def simulate_design(
 ) -> DesignSimulation:
     """Simulate one design on its ``spec.samples`` worst contact samples (largest closed-form impulse)."""
     from ..optimize.evaluate import design_collision_parameters, evaluate_design
-    from ..simulate.validity import JointDesign, available_detections
+    from ..simulate.design_closed_form import JointDesign
+    from ..simulate.validity import available_detections
 
     setup = problems.setup
     design = result.design
@@ -148,7 +149,8 @@ def _sample(
 ) -> SimulatedSample:
     """Simulate sample ``s`` of the study; the closed form [N*s] is the optimiser's."""
     from ..model.impulse import optimal_velocity
-    from ..simulate.validity import MAX_STEPS, arm_closed_form, simulated_impulse
+    from ..simulate.design_closed_form import arm_closed_form
+    from ..simulate.validity import MAX_STEPS, simulated_impulse
 
     config = int(setup.samples.config_index[s])
     q = np.asarray(setup.configurations[config], dtype=float)
