@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import InvalidParameter
 from .files import ResultsDamaged
-from .outputs import objective_unit
+from .wording import objective_unit
 
 if TYPE_CHECKING:
     from ..plots import FigurePath

@@ -170,15 +170,11 @@ def render_html(results: dict[str, Any], rows: list[dict[str, Any]], svgs: dict[
 
 def _arm_context(results: dict[str, Any]) -> dict[str, Any]:
     """What the arm report's sections show beside the record: sentences, table rows, the front's cards."""
+    from .certainty import domain_sentence, statistics_rows, worst_pose_sentence
     from .figures import has_duty_cycle
     from .front import front_cards
-    from .verdict import (
-        domain_sentence,
-        requirement_sentence,
-        statistics_rows,
-        verdict,
-        worst_pose_sentence,
-    )
+    from .sizing import requirement_sentence
+    from .verdict import verdict
 
     recommended = results.get("recommended") or results["chosen"]
     domain = results.get("domain")

@@ -30,13 +30,6 @@ from .files import (
 )
 
 
-def objective_unit(name: str) -> str:
-    """The unit of an optimiser objective (from :data:`collision_reflex.optimize.OBJECTIVES`)."""
-    from ..optimize import OBJECTIVES
-
-    return OBJECTIVES[name][1]
-
-
 def pareto_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
     """The rows of ``pareto.csv``.
 
