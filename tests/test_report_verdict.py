@@ -5,24 +5,22 @@ from __future__ import annotations
 
 import pytest
 
-from collision_reflex.report.verdict import (
-    ACTIVE_TOLERANCE,
-    MAX_LINES,
-    bound_position,
-    bound_sentences,
-    build_sentences,
-    certainty_sentences,
+from collision_reflex.report.certainty import certainty_sentences, statistics_rows, statistics_warnings
+from collision_reflex.report.front_verdict import (
     flat_impulse_reason,
     front_sentences,
     lightest_near_best,
     objective_spans,
+)
+from collision_reflex.report.sizing import (
+    ACTIVE_TOLERANCE,
+    bound_position,
+    bound_sentences,
     oversized_warnings,
     sized_by_sentences,
     smallest_motor_excess,
-    statistics_rows,
-    statistics_warnings,
-    verdict,
 )
+from collision_reflex.report.verdict import MAX_LINES, build_sentences, verdict
 
 BOUNDS = {
     "stator_diameter": {"shoulder": [0.03, 0.14], "elbow": [0.03, 0.14]},

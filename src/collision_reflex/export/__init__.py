@@ -6,13 +6,16 @@ armature companion :mod:`.armature`) or MJCF (:mod:`.mjcf`, needs the ``mujoco``
 
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
 
 from .._io import atomic_open
 from ..errors import CollisionReflexError, InvalidParameter
 from .armature import armature_record, companion_path, set_armature
+from .mjcf import design_mjcf
 from .run_design import DESIGN_CHOICES, RunDesign, read_run_design
+from .urdf import design_urdf
 
 FORMATS = ("urdf", "mjcf")
 """The export formats."""
@@ -60,15 +63,9 @@ def export_design(
     if out.parent.exists() and not out.parent.is_dir():
         raise ExportUnwritable(f"cannot write {out}: {out.parent} is a file, not a folder")
     chosen = read_run_design(run_dir, design)
-    from .urdf import design_urdf
-
     urdf = design_urdf(chosen, out)
     if format == "mjcf":
-        from .mjcf import design_mjcf
-
         return [_write(out, design_mjcf(chosen, urdf))]
-    import json
-
     companion = json.dumps(armature_record(chosen, out.name), indent=1) + "\n"
     return [_write(out, urdf), _write(companion_path(out), companion)]
 

@@ -16,7 +16,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import CollisionReflexError, InvalidParameter
+from ..hardware.gearboxes import load_gearbox_catalogue
+from ..hardware.motors import scaled_motor_quantities
 from ..report.files import DESIGNS, ResultsDamaged, ResultsMissing, read_json
+from ..study.load import parse_study
+from ..study.prepare import check_motors
+from ..study.robot import load_arm
+from ..study.schema import ArmStudy
 
 if TYPE_CHECKING:
     from ..arm import Arm
@@ -176,12 +182,6 @@ def _run_design(
     results: Mapping[str, Any], record: Mapping[str, Any], label: str, resolved: Path
 ) -> RunDesign:
     """The :class:`RunDesign` of a design record, with the arm and motors of the resolved study."""
-    from ..hardware.motors import scaled_motor_quantities
-    from ..study.load import parse_study
-    from ..study.prepare import check_motors
-    from ..study.robot import load_arm
-    from ..study.schema import ArmStudy
-
     loaded = parse_study(resolved.read_text(encoding="utf-8"), str(resolved), resolved.parent)
     study = loaded.study
     if not isinstance(study, ArmStudy):
@@ -243,8 +243,6 @@ def _gearbox_catalogue(joints: Any) -> Mapping[str, Any]:
     """The gearbox catalogue by name where a joint has a gearbox (empty otherwise: no file read)."""
     if not any(j.get("gearbox") for j in joints):
         return {}
-    from ..hardware.gearboxes import load_gearbox_catalogue
-
     return load_gearbox_catalogue()
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from ..hardware.motors import get_motor, scaling_law
 from .wording import mm, number, shown_path, unit
 
 UNITS = {
@@ -117,12 +118,8 @@ def _source(section: str, field: str, resolved: dict[str, Any]) -> str:
     motor = (resolved.get("actuators") or {}).get("motor") or {}
     try:
         if field == "motor.reference":
-            from ..hardware.motors import get_motor
-
             return get_motor(str(motor["reference"])).source
         if field == "motor.scaling law":
-            from ..hardware.motors import scaling_law
-
             return scaling_law(str(motor["scaling_law"])).source
     except (KeyError, ValueError, LookupError, OSError):
         return ""

@@ -12,17 +12,20 @@ import functools
 import re
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from ..errors import InvalidParameter
+from ..plots import FigurePath
+from ..plots.design_front import plot_design_front
+from ..plots.impulse_directions import plot_impulse_directions
+from ..plots.phase_breakdown import plot_phase_breakdown
+from ..plots.torque_speed import JointOperatingPoints, plot_torque_speed
+from ..plots.velocity_sweep import plot_velocity_sweep
+from ..plots.worst_pose import plot_worst_pose
 from .files import ResultsDamaged
-from .outputs import objective_unit
-
-if TYPE_CHECKING:
-    from ..plots import FigurePath
-    from ..plots.torque_speed import JointOperatingPoints
+from .wording import objective_unit
 
 TORQUE_SPEED_FIELD = "recommended.torque_speed"
 """Where ``designs.json`` holds the recommended design's torque-speed data (duty-cycle studies only)."""
@@ -35,7 +38,7 @@ def _unique_svg_ids(name: str) -> Iterator[None]:
     Matplotlib names SVG elements by hashes salted with ``svg.hashsalt``; a salt per figure keeps ids unique
     when several figures are inlined in one HTML page (and identical between runs).
     """
-    import matplotlib
+    import matplotlib  # lazy: matplotlib
 
     with matplotlib.rc_context({"svg.hashsalt": name}):
         yield
@@ -63,9 +66,6 @@ def draw_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
 
 
 def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -> dict[str, str]:
-    from ..plots.design_front import plot_design_front
-    from ..plots.phase_breakdown import plot_phase_breakdown
-
     svgs: dict[str, str] = {}
     samples = results["samples"]
     directions = np.asarray(samples["sample_directions"])
@@ -98,7 +98,7 @@ def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
         "impulse_directions",
         formats,
         functools.partial(
-            _surface,
+            plot_impulse_directions,
             directions=directions,
             config_index=config_index,
             impulses=np.asarray(recommended["impulses"]),
@@ -107,8 +107,6 @@ def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
     )
     pose = (results.get("recommended") or {}).get("worst_case", {}).get("pose")
     if pose is not None:
-        from ..plots.worst_pose import plot_worst_pose
-
         worst = results["recommended"]["worst_case"]
         svgs["worst_pose"] = _draw(
             directory,
@@ -125,8 +123,6 @@ def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
         )
     joints = recommended_torque_speed(results)
     if joints is not None:
-        from ..plots.torque_speed import plot_torque_speed
-
         svgs["torque_speed"] = _draw(
             directory, "torque_speed", formats, lambda path: plot_torque_speed(path, joints)
         )
@@ -152,7 +148,7 @@ def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
 
 def has_duty_cycle(results: dict[str, Any]) -> bool:
     """Whether the recommended design was sized by a motion: a duty cycle or a rated motion (its ``requirement``)."""
-    from ..optimize.constraints import DUTY_REQUIREMENT, RATED_REQUIREMENT
+    from ..optimize.constraints import DUTY_REQUIREMENT, RATED_REQUIREMENT  # lazy: casadi
 
     recommended = results.get("recommended")
     return isinstance(recommended, dict) and recommended.get("requirement") in (
@@ -172,8 +168,6 @@ def recommended_torque_speed(results: dict[str, Any]) -> list[JointOperatingPoin
         The study has a duty cycle and :data:`TORQUE_SPEED_FIELD` is missing, or an entry is not a joint's
         data as the run writes it (the message names the field).
     """
-    from ..plots.torque_speed import JointOperatingPoints
-
     recommended = results.get("recommended")
     saved = recommended.get("torque_speed") if isinstance(recommended, dict) else None
     if saved is None:
@@ -196,18 +190,7 @@ def recommended_torque_speed(results: dict[str, Any]) -> list[JointOperatingPoin
     return joints
 
 
-def _surface(
-    path: FigurePath, directions: np.ndarray, config_index: np.ndarray, impulses: np.ndarray, title: str
-) -> Path:
-    from ..plots.impulse_directions import plot_impulse_directions
-
-    return plot_impulse_directions(path, directions, config_index, impulses, title)
-
-
 def _actuator_figures(directory: Path, results: dict[str, Any], formats: list[str]) -> dict[str, str]:
-    from ..plots.phase_breakdown import plot_phase_breakdown
-    from ..plots.velocity_sweep import plot_velocity_sweep
-
     candidates = results["candidates"]
     svgs = {
         "sweep": _draw(

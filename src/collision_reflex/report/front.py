@@ -16,7 +16,7 @@ from .wording import significant, unit, words
 
 def _objective_lines(objectives: Mapping[str, float], first: Sequence[str]) -> list[str]:
     """Each objective with its unit, the front's objectives (``first``) before the others."""
-    from ..optimize import OBJECTIVES
+    from ..optimize import OBJECTIVES  # lazy: casadi
 
     names = [name for name in first if name in objectives]
     names += [name for name in objectives if name not in names]

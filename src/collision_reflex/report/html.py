@@ -8,7 +8,13 @@ import statistics
 from typing import Any
 
 from .. import __version__
+from ..plots import margin_text
 from .assumptions import UNITS, assumption_rows
+from .certainty import domain_sentence, statistics_rows, worst_pose_sentence
+from .figures import has_duty_cycle
+from .front import front_cards
+from .sizing import requirement_sentence
+from .verdict import verdict
 from .wording import group_name, mm, number, unit
 
 SOLVER_TOLERANCE = 1e-5
@@ -57,8 +63,6 @@ def margin_cell(value: object) -> Any:
     """
     import markupsafe
 
-    from ..plots import margin_text
-
     if not isinstance(value, (int, float)) or isinstance(value, bool):
         return markupsafe.Markup("<td>–</td>")
     value = float(settled(value))  # type: ignore[arg-type]
@@ -94,7 +98,7 @@ def _velocity_summary(record: dict[str, Any]) -> dict[str, float]:
 
 def _objective_units() -> dict[str, str]:
     """Each optimiser objective's unit, by name (the catalogue section's columns)."""
-    from ..optimize import OBJECTIVES
+    from ..optimize import OBJECTIVES  # lazy: casadi
 
     return {name: unit for name, (_, unit, _) in OBJECTIVES.items()}
 
@@ -170,16 +174,6 @@ def render_html(results: dict[str, Any], rows: list[dict[str, Any]], svgs: dict[
 
 def _arm_context(results: dict[str, Any]) -> dict[str, Any]:
     """What the arm report's sections show beside the record: sentences, table rows, the front's cards."""
-    from .figures import has_duty_cycle
-    from .front import front_cards
-    from .verdict import (
-        domain_sentence,
-        requirement_sentence,
-        statistics_rows,
-        verdict,
-        worst_pose_sentence,
-    )
-
     recommended = results.get("recommended") or results["chosen"]
     domain = results.get("domain")
     worst = recommended.get("worst_case") or {}
@@ -212,7 +206,7 @@ def _arm_context(results: dict[str, Any]) -> dict[str, Any]:
 
 def _front_table(results: dict[str, Any]) -> dict[str, Any]:
     """The front's table: per design its objectives, actuator mass, threshold and approach velocity, and snap."""
-    from ..optimize import OBJECTIVES
+    from ..optimize import OBJECTIVES  # lazy: casadi
 
     pareto = results["pareto"]
     names = list(dict.fromkeys([*pareto["objectives"], "actuator_mass"]))

@@ -8,15 +8,20 @@ alone.
 from __future__ import annotations
 
 import contextlib
+import csv
 import math
 import os
 import re
 import time
+import warnings
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any, TypeVar
 
+from .._interrupt import interruptible
+from .._io import atomic_open
 from ..errors import CollisionReflexError
+from .figures import draw_figures
 from .files import (
     DESIGNS,
     PARETO,
@@ -28,13 +33,8 @@ from .files import (
     write_json,
     write_text,
 )
-
-
-def objective_unit(name: str) -> str:
-    """The unit of an optimiser objective (from :data:`collision_reflex.optimize.OBJECTIVES`)."""
-    from ..optimize import OBJECTIVES
-
-    return OBJECTIVES[name][1]
+from .html import render_html
+from .pdf import html_to_pdf
 
 
 def pareto_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
@@ -43,7 +43,7 @@ def pareto_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
     One row per Pareto design (arm studies; the chosen design if there is no front) or per candidate actuator
     (actuator studies).
     """
-    from ..optimize.results import record_row
+    from ..optimize.results import record_row  # lazy: casadi
 
     if results["kind"] == "actuator":
         return _actuator_rows(results)
@@ -99,8 +99,6 @@ class StageTimes:
     @contextlib.contextmanager
     def stage(self, name: str) -> Iterator[None]:
         """Time the body of the ``with`` block as stage ``name``; a Ctrl-C in it is never lost (:mod:`.._interrupt`)."""
-        from .._interrupt import interruptible
-
         wall, cpu = time.perf_counter(), time.process_time()
         try:
             with interruptible():
@@ -194,10 +192,6 @@ def _write_csv(path: Path, rows: list[dict[str, Any]]) -> None:
     writes these rows (the same bytes for the shipped studies' results), without the cost of importing pandas
     in a study run.
     """
-    import csv
-
-    from .._io import atomic_open
-
     columns = list(dict.fromkeys(key for row in rows for key in row))
     with atomic_open(path, "w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle, lineterminator="\n")
@@ -248,8 +242,6 @@ def render_report(
     """
     import jinja2  # lazily, like every heavy library: importing the package stays quick
 
-    from .html import render_html
-
     folder = Path(folder)
     stages = stages if stages is not None else StageTimes()
     saved = results is None
@@ -276,14 +268,10 @@ def render_report(
         raise ResultsDamaged(f"{folder / DESIGNS}: {_unusable(error)}; run the study again") from None
     write_text(folder / REPORT, html)
     if pdf:
-        from .pdf import html_to_pdf
-
         try:
             with stages.stage("pdf"):
                 html_to_pdf(folder / REPORT, folder / "report.pdf")
         except CollisionReflexError as error:
-            import warnings
-
             warnings.warn(f"report.pdf not written: {error}", stacklevel=2)
     return folder / REPORT
 
@@ -311,8 +299,6 @@ REPORT_KINDS = ("arm", "actuator")
 
 
 def _figures(folder: Path, results: dict[str, Any], figures: bool) -> dict[str, str]:
-    from .figures import draw_figures
-
     return (
         draw_figures(folder / "figures", results, results["resolved"]["outputs"]["figures"])
         if figures
@@ -322,7 +308,7 @@ def _figures(folder: Path, results: dict[str, Any], figures: bool) -> dict[str, 
 
 def _unusable(error: Exception) -> str:
     """What a render error says about the saved results, on one line."""
-    import jinja2
+    import jinja2  # lazy, as in render_report
 
     if isinstance(error, KeyError):
         return f"field {error.args[0]!r} is missing"

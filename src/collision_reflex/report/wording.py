@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import PurePath
+from typing import Any
 
 import numpy as np
 
@@ -58,3 +59,39 @@ def shown_path(value: str) -> str:
     """An absolute local path as its file name: a report names no folder of the machine it was made on."""
     path = PurePath(value)
     return path.name if path.is_absolute() or re.match(r"^[A-Za-z]:[\\/]", value) else value
+
+
+def general(value: float, digits: int = 4) -> str:
+    """``value`` to ``digits`` significant digits in Python's general format (``{:.4g}``), as sentences say it."""
+    return f"{value:.{digits}g}"
+
+
+def percent(value: float) -> str:
+    """A percentage to 3 significant digits, without exponents (``< 0.001``, ``0.354``, ``12.3``, ``1,750``)."""
+    if value < 1e-3:
+        return "< 0.001" if value > 0 else "0"
+    return f"{value:,.0f}" if value >= 100 else f"{value:.3g}"
+
+
+def joint_runs(named: Sequence[tuple[str, str]]) -> list[tuple[list[str], str]]:
+    """``(joint, text)`` pairs with consecutive joints of the same text gathered: ``([joints], text)``."""
+    runs: list[tuple[list[str], str]] = []
+    for name, text in named:
+        if runs and runs[-1][1] == text and name and runs[-1][0]:
+            runs[-1][0].append(name)
+        else:
+            runs.append(([name] if name else [], text))
+    return runs
+
+
+def grouped(joints: Sequence[Mapping[str, Any]], text: Any) -> str:
+    """``text(joint)`` per run of consecutive joints that it describes alike, named by :func:`group_name`."""
+    runs = joint_runs([(joint["joint"], text(joint)) for joint in joints])
+    return "; ".join(f"{group_name(names)}: {said}" for names, said in runs)
+
+
+def objective_unit(name: str) -> str:
+    """The unit of an optimiser objective (from :data:`collision_reflex.optimize.OBJECTIVES`)."""
+    from ..optimize import OBJECTIVES  # lazy: casadi
+
+    return OBJECTIVES[name][1]
