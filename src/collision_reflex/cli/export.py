@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 
-from ..export import export_design
 from . import options
 
 FORMATS = (
@@ -43,6 +42,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``crx export`` with parsed ``args``; return the exit status."""
+    from ..export import export_design  # lazy: pydantic and yaml (the run's study)
+
     for path in export_design(args.run_dir, args.design, args.format, args.out):
         print(path)
     return 0
