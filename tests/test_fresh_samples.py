@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from collision_reflex.optimize.evaluate import sample_impulses
-from collision_reflex.optimize.pareto import built_problem
+from collision_reflex.optimize.pieces import built_problem
 from collision_reflex.optimize.samples import ContactSamples
 from collision_reflex.optimize.solve import design_at
 from collision_reflex.study.arm_setup import StudyProblems

@@ -16,8 +16,8 @@ from collision_reflex.arm import Arm
 from collision_reflex.hardware.gearboxes import load_gearbox_catalogue
 from collision_reflex.optimize import snap as snapping
 from collision_reflex.optimize.active_set import solve_method
+from collision_reflex.optimize.dominance import MERGE_TOLERANCE
 from collision_reflex.optimize.objectives import TIE_BREAK_WEIGHT
-from collision_reflex.optimize.pareto import MERGE_TOLERANCE
 from collision_reflex.optimize.snap import objective_value, snap_to_catalogue, solve_parts
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -696,7 +696,7 @@ def test_the_snap_chooses_the_lightest_combination_alike_in_impulse(
 ):
     from types import SimpleNamespace
 
-    from collision_reflex.optimize.pareto import RESOLUTION
+    from collision_reflex.optimize.recommend import RESOLUTION
 
     assert 1.0005 - 1 < RESOLUTION < 1.002 - 1
     # (impulse, actuator mass) by combination; the search value is the study objective's own.

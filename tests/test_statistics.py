@@ -11,7 +11,7 @@ import pytest
 from collision_reflex.errors import InvalidParameter
 from collision_reflex.optimize.evaluate import sample_impulses
 from collision_reflex.optimize.objectives import CVAR_LEVEL
-from collision_reflex.optimize.pareto import built_problem
+from collision_reflex.optimize.pieces import built_problem
 from collision_reflex.optimize.samples import ContactSamples
 from collision_reflex.optimize.solve import design_at
 from collision_reflex.optimize.statistics import QUANTILE, impulse_statistics

@@ -10,7 +10,7 @@ import pytest
 
 from collision_reflex.arm.domain import ContactDomain, smallest_singular_values
 from collision_reflex.optimize.evaluate import sample_impulses
-from collision_reflex.optimize.pareto import built_problem
+from collision_reflex.optimize.pieces import built_problem
 from collision_reflex.optimize.results import record_design
 from collision_reflex.optimize.samples import ContactSamples
 from collision_reflex.optimize.solve import design_at

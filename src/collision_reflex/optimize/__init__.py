@@ -10,8 +10,9 @@ from catalogue parts near a continuous optimum (:class:`CatalogueDesign`).
 """
 
 from .constraints import Constraints
+from .dominance import hypervolume
 from .objectives import OBJECTIVES
-from .pareto import ParetoSet, hypervolume, pareto_front
+from .pareto import ParetoSet, pareto_front
 from .problem import DesignProblem, build_problem
 from .samples import ContactSamples
 from .snap import CatalogueDesign, snap_to_catalogue

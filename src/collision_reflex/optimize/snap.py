@@ -625,7 +625,7 @@ def snap_to_catalogue(
     if best is not None and _warm_startable(problem, optimum, active_set):
         search.confirm(best)
     if best != least:
-        from .pareto import RESOLUTION
+        from .recommend import RESOLUTION
 
         assert best is not None and least is not None  # best is least without a feasible combination
         name = str(_impulse_objective(problem)).replace("_", " ")
@@ -771,7 +771,7 @@ class _Search:
         re-solves for nothing a design would show. The best combination tried is kept either way
         (:meth:`best`).
         """
-        from .pareto import MERGE_TOLERANCE
+        from .dominance import MERGE_TOLERANCE
 
         current = self.start()
         (value,) = self.values_of([current])
@@ -835,7 +835,7 @@ class _Search:
         design (:func:`collision_reflex.optimize.pareto.recommend`): a smaller difference ranks no design, and
         the lighter is the better build.
         """
-        from .pareto import lightest_alike
+        from .recommend import lightest_alike
 
         least = self.least()
         name = _impulse_objective(self.problem)

@@ -72,7 +72,8 @@ def choose_transmissions(
     import yaml
 
     from ..errors import InvalidParameter, SolverFailed, StudyFileError
-    from ..optimize.pareto import built_problem, single_optimum
+    from ..optimize.optimum import single_optimum
+    from ..optimize.pieces import built_problem
     from ..optimize.snap import objective_value
     from .arm_setup import StudyProblems, checked_setup
     from .robot import load_arm
