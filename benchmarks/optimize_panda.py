@@ -40,8 +40,10 @@ import numpy as np
 
 import collision_reflex as cr
 from collision_reflex.arm import Arm
-from collision_reflex.optimize import hypervolume, pareto
+from collision_reflex.optimize import hypervolume
+from collision_reflex.optimize.epsilon import epsilon_grid, solve_anchor, solve_point
 from collision_reflex.optimize.nsga import nsga2_front
+from collision_reflex.optimize.pieces import built_problem
 
 
 def main() -> None:
@@ -153,7 +155,7 @@ def timed_front(build, points: int, label: str, repeats: int = 3) -> cr.ParetoSe
     """
     times, cpus, load = [], [], os.getloadavg()[0]
     for _ in range(repeats):
-        pareto.built_problem.cache_clear()  # each repeat builds its problems and solvers
+        built_problem.cache_clear()  # each repeat builds its problems and solvers
         started, cpu = time.perf_counter(), time.process_time()
         front = cr.pareto_front(build, ("worst_case_impulse", "actuator_mass"), points=points)
         times.append(time.perf_counter() - started)
@@ -268,13 +270,13 @@ def compare_duty_cycle(
 def compare_warm_starts(build, names: tuple[str, ...], points: int) -> None:
     """Solve the same epsilon points from the first anchor's point and multipliers (the sweep's policy) and from
     its point alone (the earlier policy); print time, iterations and agreement."""
-    pieces = {name: pareto.solve_anchor(build, name, names, None) for name in names}
+    pieces = {name: solve_anchor(build, name, names, None) for name in names}
     anchors = {name: piece.result for name, piece in pieces.items()}
-    grid = pareto.epsilon_grid(anchors, names[1:], points - len(names))
+    grid = epsilon_grid(anchors, names[1:], points - len(names))
     start = pieces[names[0]].start
-    primary = pareto.built_problem(build, names[0], names[1:])
+    primary = built_problem(build, names[0], names[1:])
     started = time.perf_counter()
-    warm = [pareto.solve_point(build, names, e, start, None).result for e in grid]
+    warm = [solve_point(build, names, e, start, None).result for e in grid]
     warm_time = time.perf_counter() - started
     started = time.perf_counter()
     cold = [cr.solve(primary, epsilon=epsilon, x0=start.x) for epsilon in grid]

@@ -68,6 +68,7 @@ def compare_fronts(
 ) -> None:
     """Median wall time of the study's front through each executor, its breakdown, the load and the agreement."""
     from collision_reflex.optimize.pareto import pareto_front
+    from collision_reflex.optimize.sweep import Runner
     from collision_reflex.study.arm_setup import IPOPT_OPTIONS, StudyProblems
     from collision_reflex.study.executors import open_executor
     from collision_reflex.study.load import load_study
@@ -94,7 +95,7 @@ def compare_fronts(
                     objectives,
                     points,
                     IPOPT_OPTIONS,
-                    executor=executor,
+                    runner=Runner(executor),
                     active_set=problems.active_set,  # as the study's run sweeps it
                 )
                 ended = time.time()
@@ -194,9 +195,9 @@ def _timed(fn: Callable[..., Any], args: tuple, kwargs: dict) -> tuple[Any, dict
 def _count_construction() -> list[float]:
     """``[CPU seconds]`` this process spent in ``built_problem`` and ``DesignProblem.solver`` (counted from the
     first call; kept on the module, since a Dask worker receives this benchmark's functions by value)."""
-    from collision_reflex.optimize import pareto, problem
+    from collision_reflex.optimize import epsilon, pieces, problem
 
-    counter: list[float] | None = getattr(pareto, "_benchmark_construction_cpu", None)
+    counter: list[float] | None = getattr(pieces, "_benchmark_construction_cpu", None)
     if counter is not None:
         return counter
     total = [0.0]
@@ -216,9 +217,11 @@ def _count_construction() -> list[float]:
         call.cache_clear = getattr(function, "cache_clear", None)  # type: ignore[attr-defined]
         return call
 
-    pareto.built_problem = counted(pareto.built_problem)  # type: ignore[assignment]
+    built = counted(pieces.built_problem)
+    pieces.built_problem = built  # type: ignore[assignment]
+    epsilon.built_problem = built  # type: ignore[assignment]  # the anchors and points call it from there
     problem.DesignProblem.solver = counted(problem.DesignProblem.solver)  # type: ignore[method-assign]
-    pareto._benchmark_construction_cpu = total  # type: ignore[attr-defined]
+    pieces._benchmark_construction_cpu = total  # type: ignore[attr-defined]
     return total
 
 
@@ -326,7 +329,7 @@ def compare_runs(study: str, smoke: bool, workers: int, kinds: tuple[str, ...]) 
 
 
 def _clear_solver_cache() -> None:
-    from collision_reflex.optimize.pareto import built_problem
+    from collision_reflex.optimize.pieces import built_problem
 
     clear = getattr(built_problem, "cache_clear", None)
     if clear is not None:

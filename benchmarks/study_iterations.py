@@ -4,7 +4,7 @@
 
 By default ``studies/panda.yaml`` and ``studies/ur5.yaml``. In this process, serially, each study's problems are
 built first (as a run's workers build them), then the stage "optimum" (the multi-start of ``crx run``:
-``pareto.single_optimum`` from ``OPTIMUM_STARTS`` starts) and the stage "pareto" (``pareto.pareto_front``, the
+``optimum.single_optimum`` from ``OPTIMUM_STARTS`` starts) and the stage "pareto" (``pareto.pareto_front``, the
 anchor of the study's objective taking the optimum when the optimum stage ran) run as ``crx run`` runs them. It
 prints per stage the IPOPT iterations of every run (retries and the multi-start's screening runs included), their
 sum, the CPU time, and the optimum's scaled objective or the front's objective values, with the load average
@@ -18,7 +18,9 @@ import os
 import time
 from pathlib import Path
 
-from collision_reflex.optimize import pareto
+from collision_reflex.optimize.optimum import OPTIMUM_STARTS, known_optima, single_optimum
+from collision_reflex.optimize.pareto import pareto_front
+from collision_reflex.optimize.pieces import built_problem
 from collision_reflex.study.arm_setup import IPOPT_OPTIONS, StudyProblems
 from collision_reflex.study.load import load_study
 from collision_reflex.study.resolve import resolved_yaml
@@ -39,27 +41,27 @@ def main() -> None:
         setup = problems.setup
         print(f"{Path(study).name}: load average {os.getloadavg()[0]:.2f}", flush=True)
         names = tuple(setup.study.pareto.objectives) if setup.study.pareto is not None else ()
-        pareto.built_problem(problems, problems.objective, ())
+        built_problem(problems, problems.objective, ())
         for name in names:
-            pareto.built_problem(problems, name, tuple(other for other in names if other != name))
+            built_problem(problems, name, tuple(other for other in names if other != name))
         result = None
         if "optimum" in stages:
             runs.clear()
             cpu = time.process_time()
-            result, _ = pareto.single_optimum(
+            result, _ = single_optimum(
                 problems,
                 problems.objective,
                 IPOPT_OPTIONS,
-                starts=pareto.OPTIMUM_STARTS,
+                starts=OPTIMUM_STARTS,
                 active_set=problems.active_set,
             )
             cpu = time.process_time() - cpu
-            value = pareto.built_problem(problems, problems.objective, ()).objective_value(result.x)
+            value = built_problem(problems, problems.objective, ()).objective_value(result.x)
             _print_stage("optimum", runs, cpu, f"scaled objective {value:.10g}")
         if "pareto" in stages and setup.study.pareto is not None:
             runs.clear()
             cpu = time.process_time()
-            front = pareto.pareto_front(
+            front = pareto_front(
                 problems,
                 names,
                 setup.study.pareto.points,
@@ -68,7 +70,7 @@ def main() -> None:
                 active_set=problems.active_set,
                 known=None
                 if result is None
-                else pareto.known_optima(problems.objective, result, setup.study.pareto.anchor_starts),
+                else known_optima(problems.objective, result, setup.study.pareto.anchor_starts),
             )
             cpu = time.process_time() - cpu
             values = "; ".join(", ".join(f"{v:.9g}" for v in row) for row in front.values())

@@ -10,8 +10,11 @@ import pytest
 
 import collision_reflex as cr
 from collision_reflex.errors import InvalidParameter
-from collision_reflex.optimize import active_set, pareto
+from collision_reflex.optimize import active_set
 from collision_reflex.optimize.active_set_result import ActiveSetResult
+from collision_reflex.optimize.epsilon import anchor_start, solve_anchor, solve_point
+from collision_reflex.optimize.optimum import single_optimum
+from collision_reflex.optimize.pieces import subset_problem
 from collision_reflex.optimize.results import SweepPoint, result_from_json, result_record, result_to_json
 from collision_reflex.optimize.subsets import sample_subset
 from collision_reflex.study.runner import run_study
@@ -24,7 +27,7 @@ OBJECTIVE_TOLERANCE = 1e-6
 """Relative agreement of a point's minimised objective with the full NLP's under the same bounds: the scheme is
 exact, this covers the solves' accuracy (1e-10) and the tie-break's pull toward the active samples' mean, which
 tests/test_active_set.py measures below 1e-9 in the objective; a lexicographic anchor's bound holds the first
-objective only within pareto.ANCHOR_SLACK (1e-6), along which the second moves by up to ~1e-3 relative on this
+objective only within epsilon.ANCHOR_SLACK (1e-6), along which the second moves by up to ~1e-3 relative on this
 flat front, so the anchors are compared at their own recorded bounds."""
 
 
@@ -63,15 +66,15 @@ def test_the_active_set_front_is_the_full_nlp_front(panda, active_front):
 
 def test_an_epsilon_point_warm_started_from_the_anchors_last_nlp_is_the_cold_point(panda):
     _, build = panda
-    anchor = pareto.solve_anchor(build, NAMES[0], NAMES, TIGHT, 1, "always")
+    anchor = solve_anchor(build, NAMES[0], NAMES, TIGHT, 1, "always")
     start = anchor.start
     assert isinstance(start, ActiveSetResult) and start.last_round is not None
     assert start.last_round.multipliers is not None
     # The mass bound halfway to the lightest design's: a binding bound.
     epsilon = {"actuator_mass": 0.6 * start.numpy_objectives["actuator_mass"]}
     args = (build, NAMES, epsilon)
-    warm = pareto.solve_point(*args, start, TIGHT, "always", start.active_samples).result
-    cold = pareto.solve_point(*args, start.x, TIGHT, "always", start.active_samples).result
+    warm = solve_point(*args, start, TIGHT, "always", start.active_samples).result
+    cold = solve_point(*args, start.x, TIGHT, "always", start.active_samples).result
     assert isinstance(warm, ActiveSetResult) and isinstance(cold, ActiveSetResult)
     assert set(start.active_samples) <= set(warm.active_samples)
     worst = "worst_case_impulse"
@@ -84,27 +87,27 @@ def test_an_epsilon_point_warm_started_from_the_anchors_last_nlp_is_the_cold_poi
 
 def test_a_known_optimum_on_active_sets_is_carried_to_its_anchor_with_its_last_nlp(panda):
     samples, build = panda
-    optimum, _ = pareto.single_optimum(build, NAMES[0], TIGHT, starts=1, active_set="always")
+    optimum, _ = single_optimum(build, NAMES[0], TIGHT, starts=1, active_set="always")
     assert isinstance(optimum, ActiveSetResult) and optimum.last_round is not None
-    carried = pareto.anchor_start(build, NAMES[0], NAMES[1:], optimum)
+    carried = anchor_start(build, NAMES[0], NAMES[1:], optimum)
     assert isinstance(carried, ActiveSetResult) and carried.last_round is not None
     assert np.array_equal(carried.x, optimum.x)
     assert np.array_equal(carried.active_samples, optimum.active_samples)
     # The last NLP's multipliers, by row label, on the anchor's problem of the same samples (one more row: the
     # mass bound, loose at the anchor, at zero).
     subset = sample_subset(samples, optimum.active_samples)
-    source = pareto.subset_problem(build, NAMES[0], (), subset)
-    target = pareto.subset_problem(build, NAMES[0], NAMES[1:], subset)
+    source = subset_problem(build, NAMES[0], (), subset)
+    target = subset_problem(build, NAMES[0], NAMES[1:], subset)
     assert optimum.last_round.multipliers is not None and carried.last_round.multipliers is not None
     rows = dict(zip(source.constraint_labels, optimum.last_round.multipliers[1], strict=True))
     lam_g = carried.last_round.multipliers[1]
     assert lam_g.size == target.lbg.size == source.lbg.size + 1
     assert [rows.get(label, 0.0) for label in target.constraint_labels] == list(lam_g)
     # An epsilon point warm-started from it is the point warm-started from the anchor's own solve.
-    own = pareto.solve_anchor(build, NAMES[0], NAMES, TIGHT, 1, "always").start
+    own = solve_anchor(build, NAMES[0], NAMES, TIGHT, 1, "always").start
     epsilon = {"actuator_mass": 0.6 * optimum.numpy_objectives["actuator_mass"]}
     points = [
-        pareto.solve_point(build, NAMES, epsilon, start, TIGHT, "always", start.active_samples).result
+        solve_point(build, NAMES, epsilon, start, TIGHT, "always", start.active_samples).result
         for start in (carried, own)
     ]
     worst = [point.numpy_objectives["worst_case_impulse"] for point in points]
@@ -140,12 +143,12 @@ def test_the_full_nlp_below_the_threshold_and_bad_choices_refused(panda):
     def build_few(objective, bounded, chosen=few):
         return build(objective, bounded, chosen)
 
-    result, _ = pareto.single_optimum(build_few, "worst_case_impulse", starts=1)  # auto: the full NLP
+    result, _ = single_optimum(build_few, "worst_case_impulse", starts=1)  # auto: the full NLP
     assert not isinstance(result, ActiveSetResult)
     assert result_record(result, "p")["solver"]["method"] == "full NLP"
     # From the threshold on, auto solves on active sets.
     assert samples.size >= active_set.ACTIVE_SET_THRESHOLD
-    result, _ = pareto.single_optimum(build, "worst_case_impulse", starts=1)
+    result, _ = single_optimum(build, "worst_case_impulse", starts=1)
     assert isinstance(result, ActiveSetResult) and result.method == "active set"
     with pytest.raises(InvalidParameter, match="active_set"):
         cr.pareto_front(build, NAMES, active_set="sometimes")
@@ -154,7 +157,7 @@ def test_the_full_nlp_below_the_threshold_and_bad_choices_refused(panda):
         return build(objective, bounded)
 
     with pytest.raises(InvalidParameter, match="builder taking the samples"):
-        pareto.single_optimum(without_samples, "worst_case_impulse", active_set="always")
+        single_optimum(without_samples, "worst_case_impulse", active_set="always")
 
 
 def test_the_threshold_in_the_study_schema_is_the_optimisers():

@@ -10,7 +10,7 @@ import pytest
 
 from collision_reflex.optimize.design import design_at
 from collision_reflex.optimize.evaluate import sample_impulses
-from collision_reflex.optimize.pareto import built_problem
+from collision_reflex.optimize.pieces import built_problem
 from collision_reflex.optimize.samples import ContactSamples
 from collision_reflex.study.arm_setup import StudyProblems
 from collision_reflex.study.fresh import fresh_draw, fresh_impulses, fresh_record

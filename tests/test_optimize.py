@@ -15,6 +15,7 @@ from collision_reflex.optimize.design import design_at
 from collision_reflex.optimize.evaluate import evaluate_design
 from collision_reflex.optimize.objectives import TIE_BREAK_WEIGHT
 from collision_reflex.optimize.results import undecided_variables
+from collision_reflex.optimize.sweep import Runner
 
 TWO_LINK = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
 
@@ -600,7 +601,8 @@ def test_dominating_matches_brute_force_dominance():
 
 def test_failed_solves_are_recorded_in_one_vocabulary(arm, monkeypatch):
     from collision_reflex.errors import SolverFailed
-    from collision_reflex.optimize import pareto
+    from collision_reflex.optimize import pieces
+    from collision_reflex.optimize.pareto import pareto_front
     from collision_reflex.optimize.results import PointFailure
 
     samples = _samples(arm, 2, 3)
@@ -616,7 +618,7 @@ def test_failed_solves_are_recorded_in_one_vocabulary(arm, monkeypatch):
     def build(objective, bounded):
         return cr.build_problem(arm, samples, space, technology, objective, cr.Constraints(), bounded)
 
-    original, calls = pareto.solve, []
+    original, calls = pieces.solve, []
 
     def fail_some(problem, epsilon=None, *args, **kwargs):
         calls.append(dict(epsilon or {}))
@@ -627,8 +629,8 @@ def test_failed_solves_are_recorded_in_one_vocabulary(arm, monkeypatch):
             raise SolverFailed("no way", "Infeasible_Problem_Detected", {}, [])
         return original(problem, epsilon, *args, **kwargs)
 
-    monkeypatch.setattr(pareto, "solve", fail_some)
-    front = pareto.pareto_front(build, names, points=5)
+    monkeypatch.setattr(pieces, "solve", fail_some)
+    front = pareto_front(build, names, points=5)
     lexicographic, point = front.failed
     assert lexicographic == PointFailure(
         "actuator_mass", calls[1], "Infeasible_Problem_Detected", "no way"
@@ -646,7 +648,7 @@ def test_failed_solves_are_recorded_in_one_vocabulary(arm, monkeypatch):
         ("points", 1),
         ("anchor_starts", 0),
         ("anchor_starts", 1.5),
-        ("in_flight", 0),
+        ("runner", Runner(in_flight=0)),
         ("objectives", ("mass",)),
     ],
 )

@@ -7,15 +7,10 @@ from types import SimpleNamespace
 
 import pytest
 
-from collision_reflex.optimize.pareto import (
-    ANCHOR_SLACK,
-    MERGE_TOLERANCE,
-    RESOLUTION,
-    ParetoSet,
-    merge_repeats,
-    recommend,
-    same_point,
-)
+from collision_reflex.optimize.dominance import MERGE_TOLERANCE, merge_repeats, same_point
+from collision_reflex.optimize.epsilon import ANCHOR_SLACK
+from collision_reflex.optimize.pareto import ParetoSet
+from collision_reflex.optimize.recommend import RESOLUTION, recommend
 
 NAMES = ("worst_case_impulse", "actuator_mass")
 
@@ -126,7 +121,7 @@ def test_the_recommendation_is_never_dominated_brute_force(objective):
 @pytest.mark.parametrize("starts", [0, 1.5, True])
 def test_single_optimum_refuses_a_bad_start_count_before_building(starts):
     from collision_reflex.errors import InvalidParameter
-    from collision_reflex.optimize.pareto import single_optimum
+    from collision_reflex.optimize.optimum import single_optimum
 
     with pytest.raises(InvalidParameter, match="starts"):
         single_optimum(None, "worst_case_impulse", starts=starts)  # type: ignore[arg-type]

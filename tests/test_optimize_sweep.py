@@ -13,9 +13,14 @@ import pytest
 import collision_reflex as cr
 from collision_reflex.arm import Arm
 from collision_reflex.errors import SolverFailed
-from collision_reflex.optimize import pareto
+from collision_reflex.optimize import epsilon
 from collision_reflex.optimize.derivatives import derivative_functions
+from collision_reflex.optimize.dominance import MERGE_TOLERANCE
+from collision_reflex.optimize.epsilon import anchor_start, epsilon_grid, solve_anchor
 from collision_reflex.optimize.ipopt import DEFAULT_IPOPT_OPTIONS, Attempt
+from collision_reflex.optimize.optimum import OPTIMUM_STARTS, known_optima, single_optimum
+from collision_reflex.optimize.pareto import pareto_front
+from collision_reflex.optimize.pieces import built_problem
 from collision_reflex.optimize.results import SweepPoint, result_record
 from collision_reflex.report.outputs import split_timings
 
@@ -23,7 +28,7 @@ TWO_LINK = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.ur
 NAMES = ("worst_case_impulse", "actuator_mass")
 AGREEMENT = 1e-6
 """Relative agreement of one optimum reached from two starts: IPOPT stops at ``tol = 1e-8`` on its scaled
-optimality error, which repeats objective values to about 1e-7 (see ``pareto.MERGE_TOLERANCE``)."""
+optimality error, which repeats objective values to about 1e-7 (see ``dominance.MERGE_TOLERANCE``)."""
 
 
 @pytest.fixture(scope="module")
@@ -76,9 +81,9 @@ def test_solvers_share_one_structured_nlp_and_match_casadis_own(build):
 
 
 def test_epsilon_points_start_from_the_anchor_and_match_cold_solves(build):
-    front = pareto.pareto_front(build, NAMES, points=6)
+    front = pareto_front(build, NAMES, points=6)
     assert not front.failed
-    problem = pareto.built_problem(build, NAMES[0], NAMES[1:])
+    problem = built_problem(build, NAMES[0], NAMES[1:])
     warm = cold = 0
     for result, label in zip(front.points, front.labels, strict=True):
         if not label.startswith("epsilon"):
@@ -94,13 +99,13 @@ def test_epsilon_points_start_from_the_anchor_and_match_cold_solves(build):
 
 def test_a_lexicographic_step_at_its_cap_is_recorded_and_keeps_the_anchor(build, monkeypatch):
     monkeypatch.setattr(
-        pareto, "LEXICOGRAPHIC_OPTIONS", {**pareto.LEXICOGRAPHIC_OPTIONS, "ipopt.max_iter": 1}
+        epsilon, "LEXICOGRAPHIC_OPTIONS", {**epsilon.LEXICOGRAPHIC_OPTIONS, "ipopt.max_iter": 1}
     )
-    pareto.built_problem.cache_clear()  # fresh problems: the capped solver is built for this test
+    built_problem.cache_clear()  # fresh problems: the capped solver is built for this test
     try:
-        front = pareto.pareto_front(build, NAMES, points=3)
+        front = pareto_front(build, NAMES, points=3)
     finally:
-        pareto.built_problem.cache_clear()
+        built_problem.cache_clear()
     assert sorted(f.objective for f in front.failed) == sorted(NAMES)
     assert {f.status for f in front.failed} == {"Maximum_Iterations_Exceeded"}
     # Each anchor is its first solve's result, which the capped step did not replace.
@@ -157,26 +162,26 @@ def test_a_front_that_collapses_to_a_point_has_no_epsilon_points():
             worst_case_impulse=0.3, actuator_mass=0.4 * (1 - 1e-7), approach_velocity=0.5
         ),
     }
-    assert pareto.epsilon_grid(same, ("actuator_mass",), 6) == []
+    assert epsilon_grid(same, ("actuator_mass",), 6) == []
     # With a third objective that does span a front, only it is bounded.
-    grid = pareto.epsilon_grid(same, ("actuator_mass", "approach_velocity"), 3)
+    grid = epsilon_grid(same, ("actuator_mass", "approach_velocity"), 3)
     assert [set(g) for g in grid] == [{"approach_velocity"}] * 3
     assert [g["approach_velocity"] for g in grid] == pytest.approx([0.35, 0.4, 0.45], rel=1e-12)
 
 
 def test_an_anchor_takes_a_known_optimum_as_its_first_solve(build, monkeypatch):
-    optimum, _ = pareto.single_optimum(build, NAMES[0], starts=2)
-    own = pareto.pareto_front(build, NAMES, points=5)
+    optimum, _ = single_optimum(build, NAMES[0], starts=2)
+    own = pareto_front(build, NAMES, points=5)
     first_solves = []
-    solve_with = pareto.solve_with
+    solve_with = epsilon.solve_with  # as the anchors call it
 
     def counted(build, objective, bounded, active_set, epsilon=None, **kwargs):
         if not epsilon:
             first_solves.append(objective)
         return solve_with(build, objective, bounded, active_set, epsilon, **kwargs)
 
-    monkeypatch.setattr(pareto, "solve_with", counted)
-    front = pareto.pareto_front(build, NAMES, points=5, known={NAMES[0]: optimum})
+    monkeypatch.setattr(epsilon, "solve_with", counted)
+    front = pareto_front(build, NAMES, points=5, known={NAMES[0]: optimum})
     assert first_solves == [NAMES[1]]  # the known objective's anchor did not solve again
     assert not front.failed and len(front.points) == len(own.points)
     # The same front as the anchor's own solve found (this problem has one optimum): equal as the sweep merges
@@ -185,12 +190,12 @@ def test_an_anchor_takes_a_known_optimum_as_its_first_solve(build, monkeypatch):
     for mine, theirs in zip(front.points, own.points, strict=True):
         for name in NAMES:
             assert mine.numpy_objectives[name] == pytest.approx(
-                theirs.numpy_objectives[name], rel=pareto.MERGE_TOLERANCE
+                theirs.numpy_objectives[name], rel=MERGE_TOLERANCE
             )
     # The optimum's multipliers carried to the anchor's problem by row: its objective bound (loose at the
     # anchor) at zero, every other row the optimum's own.
-    source, target = build(NAMES[0], ()), pareto.built_problem(build, NAMES[0], NAMES[1:])
-    carried = pareto.anchor_start(build, NAMES[0], NAMES[1:], optimum)
+    source, target = build(NAMES[0], ()), built_problem(build, NAMES[0], NAMES[1:])
+    carried = anchor_start(build, NAMES[0], NAMES[1:], optimum)
     assert carried is not None and carried.multipliers is not None and optimum.multipliers is not None
     assert np.array_equal(carried.x, optimum.x)
     lam_x, lam_g = carried.multipliers
@@ -204,19 +209,19 @@ def test_an_anchor_takes_a_known_optimum_as_its_first_solve(build, monkeypatch):
 def test_a_known_optimum_of_other_variables_is_solved_again(build):
     # Bounding the worst case adds its epigraph variable: the mass optimum is not a point of that problem.
     optimum = cr.solve(build("actuator_mass", ()))
-    assert pareto.anchor_start(build, "actuator_mass", ("worst_case_impulse",), optimum) is None
-    point = pareto.solve_anchor(build, "actuator_mass", NAMES, None, known=optimum)
+    assert anchor_start(build, "actuator_mass", ("worst_case_impulse",), optimum) is None
+    point = solve_anchor(build, "actuator_mass", NAMES, None, known=optimum)
     assert point.result is not None and not point.failures
-    assert point.result.x.size == pareto.built_problem(build, "actuator_mass", NAMES[:1]).x0.size
+    assert point.result.x.size == built_problem(build, "actuator_mass", NAMES[:1]).x0.size
 
 
 def test_a_study_optimum_is_known_to_its_anchor_only_when_it_is_one_of_them():
     optimum = object()
-    assert pareto.known_optima("mean_impulse", optimum, 1) == {"mean_impulse": optimum}
-    assert pareto.known_optima("mean_impulse", optimum, pareto.OPTIMUM_STARTS) == {"mean_impulse": optimum}
+    assert known_optima("mean_impulse", optimum, 1) == {"mean_impulse": optimum}
+    assert known_optima("mean_impulse", optimum, OPTIMUM_STARTS) == {"mean_impulse": optimum}
     # More starts asked of the anchors than the optimum had, or a weighted objective: the anchors solve.
-    assert pareto.known_optima("mean_impulse", optimum, pareto.OPTIMUM_STARTS + 1) == {}
-    assert pareto.known_optima((("actuator_mass", 0.1), ("worst_case_impulse", 1.0)), optimum, 1) == {}
+    assert known_optima("mean_impulse", optimum, OPTIMUM_STARTS + 1) == {}
+    assert known_optima((("actuator_mass", 0.1), ("worst_case_impulse", 1.0)), optimum, 1) == {}
 
 
 def test_a_numpy_path_that_disagrees_with_casadi_is_warned_of(build, monkeypatch):
@@ -244,5 +249,5 @@ def test_a_known_optimum_of_another_problem_is_refused(build):
         optimum, objectives={**optimum.objectives, "actuator_mass": 2 * optimum.objectives["actuator_mass"]}
     )
     with pytest.raises(cr.InvalidParameter, match="known optimum of worst_case_impulse"):
-        pareto.anchor_start(build, NAMES[0], NAMES[1:], stranger)
-    assert pareto.anchor_start(build, NAMES[0], NAMES[1:], optimum) is not None
+        anchor_start(build, NAMES[0], NAMES[1:], stranger)
+    assert anchor_start(build, NAMES[0], NAMES[1:], optimum) is not None

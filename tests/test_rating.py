@@ -12,7 +12,8 @@ from collision_reflex.arm import Arm
 from collision_reflex.arm.duty_cycle import Payload
 from collision_reflex.arm.rating import BRAKING, RATED_MOTION, Rating, rated_torques
 from collision_reflex.errors import InvalidParameter, StudyFileError
-from collision_reflex.optimize.pareto import built_problem, single_optimum
+from collision_reflex.optimize.optimum import single_optimum
+from collision_reflex.optimize.pieces import built_problem
 from collision_reflex.optimize.results import design_record
 from collision_reflex.study.arm_setup import StudyProblems
 from collision_reflex.study.load import load_study

@@ -14,7 +14,7 @@ import pytest
 from collision_reflex.cli import main
 from collision_reflex.optimize.design import Design
 from collision_reflex.optimize.duty import torque_speed_points
-from collision_reflex.optimize.pareto import built_problem
+from collision_reflex.optimize.pieces import built_problem
 from collision_reflex.optimize.results import _DESIGN_ARRAYS, _GEARBOX_ARRAYS
 from collision_reflex.plots.torque_speed import JointOperatingPoints
 from collision_reflex.study.arm_results import SAVED_DIGITS, JointTorqueSpeed

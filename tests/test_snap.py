@@ -19,8 +19,8 @@ from collision_reflex.optimize import snap as snapping
 from collision_reflex.optimize.active_set_result import solve_method
 from collision_reflex.optimize.candidates import gearbox_options, joint_candidates, motor_distance
 from collision_reflex.optimize.catalogue_search import objective_value, solve_parts
+from collision_reflex.optimize.dominance import MERGE_TOLERANCE
 from collision_reflex.optimize.objectives import TIE_BREAK_WEIGHT
-from collision_reflex.optimize.pareto import MERGE_TOLERANCE
 from collision_reflex.optimize.parts import (
     catalogue_problem,
     covering_gear_ratios,
@@ -705,7 +705,7 @@ def test_the_snap_chooses_the_lightest_combination_alike_in_impulse(
 ):
     from types import SimpleNamespace
 
-    from collision_reflex.optimize.pareto import RESOLUTION
+    from collision_reflex.optimize.recommend import RESOLUTION
 
     assert 1.0005 - 1 < RESOLUTION < 1.002 - 1
     # (impulse, actuator mass) by combination; the search value is the study objective's own.

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from collision_reflex.arm.dynamics import peak
-from collision_reflex.optimize.pareto import built_problem, single_optimum
+from collision_reflex.optimize.optimum import single_optimum
+from collision_reflex.optimize.pieces import built_problem
 from collision_reflex.optimize.results import design_record
 from collision_reflex.study.arm_setup import StudyProblems
 from collision_reflex.study.load import load_study

@@ -12,7 +12,7 @@ from collision_reflex.errors import InvalidParameter
 from collision_reflex.optimize.design import design_at
 from collision_reflex.optimize.evaluate import sample_impulses
 from collision_reflex.optimize.objectives import CVAR_LEVEL
-from collision_reflex.optimize.pareto import built_problem
+from collision_reflex.optimize.pieces import built_problem
 from collision_reflex.optimize.samples import ContactSamples
 from collision_reflex.optimize.statistics import QUANTILE, impulse_statistics
 from collision_reflex.study.arm_setup import StudyProblems

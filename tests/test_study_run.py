@@ -23,8 +23,12 @@ import yaml
 
 from collision_reflex.cli import main
 from collision_reflex.errors import StudyFileError
-from collision_reflex.optimize import pareto as sweep
-from collision_reflex.optimize.pareto import MERGE_TOLERANCE, RESOLUTION
+from collision_reflex.optimize import pareto, pieces
+from collision_reflex.optimize.dominance import MERGE_TOLERANCE
+from collision_reflex.optimize.optimum import OPTIMUM_STARTS, known_optima, single_optimum
+from collision_reflex.optimize.pareto import pareto_front
+from collision_reflex.optimize.recommend import RESOLUTION
+from collision_reflex.optimize.results import SweepPoint
 from collision_reflex.report.html import SOLVER_TOLERANCE
 from collision_reflex.report.pdf import find_browser, headless_flags
 from collision_reflex.study.runner import run_study
@@ -228,7 +232,7 @@ def test_same_study_gives_the_same_numbers(runs, tmp_path):
 
 def test_interrupted_run_resumes_from_finished_points(runs, tmp_path, monkeypatch):
     folder = tmp_path / "interrupted"
-    original = sweep.solve_point
+    original = pareto.solve_point  # as pareto_front submits it
     calls = {"n": 0}
 
     def interrupt_second_point(*args, **kwargs):
@@ -237,7 +241,7 @@ def test_interrupted_run_resumes_from_finished_points(runs, tmp_path, monkeypatc
             raise KeyboardInterrupt  # as Ctrl-C in the middle of the sweep
         return original(*args, **kwargs)
 
-    monkeypatch.setattr(sweep, "solve_point", interrupt_second_point)
+    monkeypatch.setattr(pareto, "solve_point", interrupt_second_point)
     with pytest.raises(KeyboardInterrupt):
         run_study(TWO_LINK, folder, quiet=True, smoke=True, executor="serial")
     assert json.loads((folder / "run.json").read_text())["status"] == "interrupted"
@@ -246,7 +250,7 @@ def test_interrupted_run_resumes_from_finished_points(runs, tmp_path, monkeypatc
     # The first point solved is kept, the interrupted one is not (points go out from the far end of the grid).
     assert len([name for name in finished if name.startswith("point-")]) == 1, finished
 
-    monkeypatch.setattr(sweep, "solve_point", original)
+    monkeypatch.setattr(pareto, "solve_point", original)
     result = run_study(TWO_LINK, folder, quiet=True, smoke=True, executor="serial")
     assert result.resumed and result.reused == len(finished) and result.computed >= 1
     pd.testing.assert_frame_equal(_numbers(folder), _numbers(runs["two_link_paper"]))
@@ -508,16 +512,16 @@ def test_study_sweep_is_the_library_sweep(runs, name):
         (folder / "points").glob("round-*-optimum*.json"), key=lambda p: int(p.name.split("-")[1])
     )
     if rounds:  # an exchange round's optimum starts from the last round's: the run's own is the known one
-        optimum = sweep.SweepPoint.from_json(json.loads(rounds[-1].read_text())).result
+        optimum = SweepPoint.from_json(json.loads(rounds[-1].read_text())).result
     else:
-        optimum, _ = sweep.single_optimum(problems, problems.objective, IPOPT_OPTIONS)
-    front = sweep.pareto_front(
+        optimum, _ = single_optimum(problems, problems.objective, IPOPT_OPTIONS)
+    front = pareto_front(
         problems,
         spec["objectives"],
         spec["points"],
         IPOPT_OPTIONS,
         anchor_starts=spec["anchor_starts"],
-        known=sweep.known_optima(problems.objective, optimum, spec["anchor_starts"]),
+        known=known_optima(problems.objective, optimum, spec["anchor_starts"]),
     )
     assert len(front.points) == len(saved["points"]) >= 1
     # Repeats of a point are merged and dominated points set aside (the smoke Panda front is one design): the
@@ -597,20 +601,20 @@ def test_a_study_asks_for_multi_start_anchors(tmp_path, monkeypatch):
     data["actuators"]["gearbox"] = data["actuators"]["gearbox"][-1]  # one gearbox: no choice solves them
     study.write_text(yaml.safe_dump(data))
     starts = []
-    original = sweep.solve
+    original = pieces.solve  # every solve of a run goes through it
 
     def spy(problem, *args, **kwargs):
         starts.append(kwargs.get("starts", 1))
         return original(problem, *args, **kwargs)
 
-    monkeypatch.setattr(sweep, "solve", spy)
+    monkeypatch.setattr(pieces, "solve", spy)
     result = run_study(study, tmp_path / "out", quiet=True, smoke=True, executor="serial")
     results = json.loads((result.folder / "designs.json").read_text())
     assert results["resolved"]["pareto"]["anchor_starts"] == 2
     # The study's optimum from OPTIMUM_STARTS starts (at least the 2 asked), which is the anchor of the study's
     # objective (worst case impulse), so only the other anchor is started twice; then one lexicographic step
     # each and two points from one start.
-    assert sorted(starts) == sorted([1, 1, 1, 1, 2, sweep.OPTIMUM_STARTS])
+    assert sorted(starts) == sorted([1, 1, 1, 1, 2, OPTIMUM_STARTS])
     assert results["pareto"]["points"][0]["label"] == "anchor: worst_case_impulse"
 
 

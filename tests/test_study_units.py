@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from collision_reflex.model.impulse import phase_impulses, series_stiffness
-from collision_reflex.optimize.pareto import epsilon_grid, non_dominated
+from collision_reflex.optimize.dominance import non_dominated
+from collision_reflex.optimize.epsilon import epsilon_grid
 from collision_reflex.report.wording import number
 from collision_reflex.study.actuator_study import sensing_scheme
 from collision_reflex.study.executors import SerialExecutor, open_executor

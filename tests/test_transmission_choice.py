@@ -9,7 +9,8 @@ import yaml
 
 from collision_reflex.errors import StudyFileError
 from collision_reflex.optimize.catalogue_search import objective_value
-from collision_reflex.optimize.pareto import built_problem, single_optimum
+from collision_reflex.optimize.optimum import single_optimum
+from collision_reflex.optimize.pieces import built_problem
 from collision_reflex.study.arm_setup import StudyProblems
 from collision_reflex.study.load import load_study
 from collision_reflex.study.resolve import resolved_yaml

@@ -11,7 +11,7 @@ import pytest
 from collision_reflex.arm.domain import ContactDomain, smallest_singular_values
 from collision_reflex.optimize.design import design_at
 from collision_reflex.optimize.evaluate import sample_impulses
-from collision_reflex.optimize.pareto import built_problem
+from collision_reflex.optimize.pieces import built_problem
 from collision_reflex.optimize.results import record_design
 from collision_reflex.optimize.samples import ContactSamples
 from collision_reflex.optimize.worst_case import search_worst_case

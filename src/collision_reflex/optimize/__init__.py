@@ -13,8 +13,9 @@ from .build import build_problem
 from .constraints import Constraints
 from .design import Design, design_at
 from .design_result import DesignResult
+from .dominance import hypervolume
 from .objectives import OBJECTIVES
-from .pareto import ParetoSet, hypervolume, pareto_front
+from .pareto import ParetoSet, pareto_front
 from .problem import DesignProblem
 from .samples import ContactSamples
 from .snap import CatalogueDesign, snap_to_catalogue

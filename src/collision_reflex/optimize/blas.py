@@ -16,7 +16,7 @@ def single_threaded_blas() -> contextlib.AbstractContextManager[object]:
     thread everywhere, every executor gives the same numbers, bitwise in practice (parallelism comes from the
     executor's processes).
     """
-    import threadpoolctl
+    import threadpoolctl  # lazy: needed only once a solve runs
 
     if not _CASADI_BLAS_REGISTERED:
         threadpoolctl.register(_casadi_openblas_controller())
@@ -31,7 +31,7 @@ def _load_casadi_openblas() -> None:
     CasADi loads them with the first solver; without this, a first solve spins two BLAS threads, whose
     contention costs kernel time on the small matrices here.
     """
-    import casadi
+    import casadi  # lazy: casadi
     import threadpoolctl
 
     if all(info["internal_api"] != "casadi_openblas" for info in threadpoolctl.threadpool_info()):
@@ -39,7 +39,7 @@ def _load_casadi_openblas() -> None:
 
 
 def _casadi_openblas_controller() -> type:
-    from threadpoolctl import OpenBLASController
+    from threadpoolctl import OpenBLASController  # lazy: needed only once a solve runs
 
     class CasadiOpenBLAS(OpenBLASController):
         """CasADi's bundled OpenBLAS, which threadpoolctl does not know by its file name."""

@@ -349,7 +349,7 @@ class PartsSearch:
         re-solves for nothing a design would show. The best combination tried is kept either way
         (:meth:`best`).
         """
-        from .pareto import MERGE_TOLERANCE
+        from .dominance import MERGE_TOLERANCE
 
         current = self.start()
         (value,) = self.values_of([current])
@@ -413,7 +413,7 @@ class PartsSearch:
         design (:func:`collision_reflex.optimize.pareto.recommend`): a smaller difference ranks no design, and
         the lighter is the better build.
         """
-        from .pareto import lightest_alike
+        from .recommend import lightest_alike
 
         least = self.least()
         name = impulse_objective(self.problem)

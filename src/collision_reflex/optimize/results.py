@@ -20,10 +20,13 @@ from ..errors import InvalidParameter
 from ..model.impulse import optimal_velocity, phase_impulses, series_stiffness
 from .active_set_result import ActiveSetResult, solve_method, with_active_set
 from .constraints import DUTY_REQUIREMENT, RATED_REQUIREMENT, STATIC_REQUIREMENT
-from .design import Design
+from .design import Design, design_at
 from .design_result import DesignResult
+from .evaluate import design_collision_parameters, evaluate_design
 from .ipopt import Attempt
 from .objectives import OBJECTIVES
+from .space import GLOBAL_VARIABLES
+from .statistics import QUANTILE, impulse_statistics
 
 if TYPE_CHECKING:
     from ..hardware.motors import Motor
@@ -374,9 +377,6 @@ def design_record(
     its required peak torque (``required_by``, :func:`required_by`) and
     its nearest catalogue motor.
     """
-    from .evaluate import design_collision_parameters
-    from .statistics import QUANTILE, impulse_statistics
-
     record = result_record(result, label)
     design = result.design
     reaction = problem.technology.reaction
@@ -466,10 +466,6 @@ def undecided_variables(problem: DesignProblem, x: np.ndarray) -> list[tuple[str
     :data:`UNDECIDED_TOLERANCE` (NumPy path, :func:`collision_reflex.optimize.evaluate.evaluate_design`). The
     joint index is None for a global variable (threshold, approach velocity).
     """
-    from .design import design_at
-    from .evaluate import evaluate_design
-    from .space import GLOBAL_VARIABLES
-
     x = np.asarray(x, dtype=float)
 
     def outcome(point: np.ndarray) -> tuple[np.ndarray, float]:

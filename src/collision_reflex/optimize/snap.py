@@ -185,7 +185,7 @@ def snap_to_catalogue(
     if best is not None and warm_startable(problem, optimum, active_set):
         search.confirm(best)
     if best != least:
-        from .pareto import RESOLUTION
+        from .recommend import RESOLUTION
 
         assert best is not None and least is not None  # best is least without a feasible combination
         name = str(impulse_objective(problem)).replace("_", " ")

@@ -152,7 +152,7 @@ def evaluate_actuator_study(loaded: LoadedStudy) -> dict[str, Any]:
                 "an actuator with non-finite contact parameters",
                 "finite stiffness, inertia and torque",
             )
-    from ..optimize.pareto import dominated_mask
+    from ..optimize.dominance import dominated_mask
     from .resolve import resolved_study
 
     # Pareto-optimal: no other candidate has both a lower minimum impulse and a lower mass (exact comparison).

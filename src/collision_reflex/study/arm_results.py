@@ -20,8 +20,10 @@ from typing import TYPE_CHECKING, Any, NotRequired, TypedDict
 
 import numpy as np
 
+from ..optimize.dominance import MERGE_TOLERANCE
 from ..optimize.duty import torque_speed_points
-from ..optimize.pareto import MERGE_TOLERANCE, built_problem, recommend
+from ..optimize.pieces import built_problem
+from ..optimize.recommend import recommend
 from ..optimize.results import design_record, undecided_variables
 from ..optimize.space import GLOBAL_VARIABLES, PER_JOINT_VARIABLES
 from ..optimize.worst_case import SEARCH_TOLERANCE, WorstCase

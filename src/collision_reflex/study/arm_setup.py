@@ -528,7 +528,7 @@ def checked_setup(loaded: LoadedStudy, resolved_text: str) -> ArmSetup:
     here, located in the study file, before a run writes anything.
     """
     from ..errors import InvalidParameter
-    from ..optimize.pareto import built_problem
+    from ..optimize.pieces import built_problem
 
     setup = arm_setup(loaded)  # located errors for the robot, motors and names
     unreachable = _torque_out_of_reach(loaded, setup)

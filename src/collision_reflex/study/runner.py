@@ -322,7 +322,7 @@ def _run_arm(
     ``transmissions``: the gearbox assignments tried before (:func:`.transmission_choice.choose_transmissions`),
     kept in the results.
     """
-    from ..optimize.pareto import release_problems
+    from ..optimize.pieces import release_problems
     from ..report.verdict import verdict
     from .arm_setup import StudyProblems
     from .worst_case import exchanges_samples, search_designs, violators
@@ -376,7 +376,7 @@ def _run_arm(
     if transmissions is not None:
         results["transmission_choice"] = transmissions
     if study.simulate is not None:
-        from ..optimize.pareto import recommend
+        from ..optimize.recommend import recommend
         from .simulate_design import simulate_designs
 
         recommended = recommend(optimum, front, problems.objective).result
@@ -406,7 +406,10 @@ def _solve_round(
     """
     from ..errors import SolverFailed, StudyRunFailed
     from ..optimize.active_set_result import ActiveSetResult
-    from ..optimize.pareto import OPTIMUM_STARTS, built_problem, known_optima, pareto_front, single_optimum
+    from ..optimize.optimum import OPTIMUM_STARTS, known_optima, single_optimum
+    from ..optimize.pareto import pareto_front
+    from ..optimize.pieces import built_problem
+    from ..optimize.sweep import Runner
     from .arm_setup import IPOPT_OPTIONS
 
     starts, x0, initial = OPTIMUM_STARTS, None, None
@@ -430,10 +433,12 @@ def _solve_round(
             problems,
             problems.objective,
             IPOPT_OPTIONS,
-            progress.counter("optimum of the study's objective"),
-            executor=pool,
-            finished=finished,
-            save=save,
+            runner=Runner(
+                pool,
+                finished=finished,
+                save=save,
+                progress=progress.counter("optimum of the study's objective"),
+            ),
             starts=starts,
             active_set=problems.active_set,
             x0=x0,
@@ -450,12 +455,8 @@ def _solve_round(
                 tuple(study.pareto.objectives),
                 study.pareto.points,
                 IPOPT_OPTIONS,
-                progress=progress.counter("Pareto sweep"),
                 anchor_starts=study.pareto.anchor_starts,
-                executor=pool,
-                in_flight=window,
-                finished=finished,
-                save=save,
+                runner=Runner(pool, window, finished, save, progress=progress.counter("Pareto sweep")),
                 active_set=problems.active_set,
                 known=known_optima(problems.objective, optimum, study.pareto.anchor_starts),
             )

@@ -72,7 +72,7 @@ def simulate_designs(
 
     Each design's simulations are saved in ``folder`` as they finish and found again when the run resumes.
     """
-    from ..optimize.pareto import built_problem
+    from ..optimize.pieces import built_problem
 
     problem = built_problem(problems, problems.objective)
     out: dict[str, Any] = {"recommended": None, "pareto": []}

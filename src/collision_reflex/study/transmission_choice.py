@@ -73,7 +73,8 @@ def choose_transmissions(
 
     from ..errors import InvalidParameter, SolverFailed, StudyFileError
     from ..optimize.catalogue_search import objective_value
-    from ..optimize.pareto import built_problem, single_optimum
+    from ..optimize.optimum import single_optimum
+    from ..optimize.pieces import built_problem
     from .arm_setup import StudyProblems, checked_setup
     from .robot import load_arm
 

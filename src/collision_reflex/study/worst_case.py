@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..optimize.pareto import one_at_a_time
+from ..optimize.pieces import one_at_a_time
 from ..optimize.worst_case import WorstCase, search_worst_case
 from .arm_setup import ExtraSamples, StudyProblems
 from .schema import ArmStudy, SearchSpec
