@@ -54,7 +54,7 @@ def main() -> None:
                             for f, t, n in zip(fit.values, true_values, NAMES, strict=True)
                         ]
                     )
-                    phases = cr.phase_impulses(truth.m_f, truth.k, truth.k_m, truth.F_s, truth.a, v0)
+                    phases = cr.model.phase_impulses(truth.m_f, truth.k, truth.k_m, truth.F_s, truth.a, v0)
                     phase_errors.append(
                         [float(getattr(fit.phases, p)) / getattr(phases, p) - 1 for p in PHASES]
                     )

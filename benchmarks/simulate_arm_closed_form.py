@@ -36,7 +36,7 @@ RATIOS = (0.1, 0.3, 1.0, 3.0)
 def finger_closed_form(arm: cr.Arm, result: ArmCollision) -> float:
     """The closed form with the reflected inertia in the finger mass [N*s], at the simulated robot velocity."""
     samples = arm.kinematics(np.asarray(result.q)[None])
-    eff = cr.effective_parameters(
+    eff = cr.arm.effective_parameters(
         samples, result.direction[None], 2.2e-3, 50.0, 50.0, 1.3, finger_joint_inertia=2.2e-3
     )
     return float(

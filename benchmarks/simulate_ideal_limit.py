@@ -29,7 +29,7 @@ def main() -> None:
         f"m_f = {M_F} kg, F_s = {F_S} N, a = {A} m/s^2, m_r = {ROBOT_MASS:g} kg (F_a = m_r a), rigid plastic wall"
     )
     for name, (k_s, k_m, reaction, consistent) in VARIANTS.items():
-        k = cr.series_stiffness(k_m, k_s)
+        k = cr.model.series_stiffness(k_m, k_s)
         v_star = float(cr.optimal_velocity(M_F, k, F_S))
         worst, worst_at, elapsed = 0.0, 0.0, []
         for ratio in np.geomspace(0.1, 10.0, 41):

@@ -32,7 +32,7 @@ Case = tuple[str, Callable[[], tuple[cr.Arm, cr.DesignProblem]], int]
 def two_link(objective: str | dict[str, float]) -> tuple[cr.Arm, cr.DesignProblem]:
     arm = cr.Arm.from_urdf(ROOT / "designs" / "planar_two_link.urdf", "tip")
     q = np.array([[0.0, a] for a in np.deg2rad([30, 45, 60, 90, 120])])
-    samples = cr.ContactSamples.grid(arm.kinematics(q), cr.circle_directions(16))
+    samples = cr.ContactSamples.grid(arm.kinematics(q), cr.arm.circle_directions(16))
     space = cr.DesignSpace(
         stator_diameter=(0.01, 0.1),
         gear_ratio=(1, 100),
@@ -48,7 +48,7 @@ def two_link(objective: str | dict[str, float]) -> tuple[cr.Arm, cr.DesignProble
 def double_pendulum() -> tuple[cr.Arm, cr.DesignProblem]:
     arm = cr.Arm.from_example_robot_data("double_pendulum")
     kinematics = arm.kinematics(arm.sample_configurations(8, np.random.default_rng(1)))
-    samples = cr.ContactSamples.grid(kinematics, cr.circle_directions(8))
+    samples = cr.ContactSamples.grid(kinematics, cr.arm.circle_directions(8))
     space = cr.DesignSpace(
         stator_diameter=(0.02, 0.12),
         gear_ratio=(1, 50),
@@ -79,7 +79,7 @@ def panda_smoke() -> tuple[cr.Arm, cr.DesignProblem]:
 def run(name: str, build: Callable[[], tuple[cr.Arm, cr.DesignProblem]], k: int) -> None:
     arm, problem = build()
     optimum = cr.solve(problem, starts=4)
-    motors = cr.load_catalogue()
+    motors = cr.hardware.load_catalogue()
     started = time.perf_counter()
     exact = snap_to_catalogue(problem, optimum, motors, arm=arm, candidates=k, max_combinations=10**6)
     exact_time = time.perf_counter() - started

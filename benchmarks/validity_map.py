@@ -27,8 +27,9 @@ import numpy as np
 
 import collision_reflex as cr
 from collision_reflex.plots import new_figure, save_figure
-from collision_reflex.simulate.design_closed_form import PLACEMENTS, REACTION_MODELS, JointDesign
-from collision_reflex.simulate.validity import DRIVES, TOLERANCE, validity_map, worst_difference
+from collision_reflex.simulate.design_closed_form import REACTION_MODELS, JointDesign
+from collision_reflex.simulate.validity import TOLERANCE, validity_map, worst_difference
+from collision_reflex.vocabulary import ARM_DRIVES, REFLECTED_INERTIA_PLACEMENTS
 
 URDF = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
 
@@ -83,7 +84,7 @@ def _run(name: str) -> tuple[Any, float, float, int, int]:
     arm, joints, configurations, directions = ARMS[name]()
     start, cpu = time.perf_counter(), time.process_time()
     table = validity_map(
-        arm, joints, configurations, directions, stiffness_ratios=STIFFNESS_RATIOS, drives=DRIVES
+        arm, joints, configurations, directions, stiffness_ratios=STIFFNESS_RATIOS, drives=ARM_DRIVES
     )
     return (
         table,
@@ -104,7 +105,7 @@ def main(figure_path: str | None) -> None:
     tables = {}
     for name, (table, elapsed, cpu, n_configurations, n_directions) in runs.items():
         tables[name] = table
-        per_case = len(PLACEMENTS) * len(REACTION_MODELS)
+        per_case = len(REFLECTED_INERTIA_PLACEMENTS) * len(REACTION_MODELS)
         simulations = len(table) // per_case
         failed = int((table["error"] != "").sum()) // per_case
         seconds = table["seconds"].to_numpy()[::per_case]

@@ -21,18 +21,22 @@ def test_reflected_inertia_scales_with_n_squared(gear):
 
 
 def test_gear_ratio_for():
-    assert cr.gear_ratio_for(1.3, 0.65) == 2.0
-    assert cr.gear_ratio_for(1.3, 2.6) == 1.0  # a motor strong enough is direct drive
-    np.testing.assert_array_equal(cr.gear_ratio_for(1.0, np.array([0.1, 1.0, 4.0])), [10.0, 1.0, 1.0])
+    assert cr.hardware.gear_ratio_for(1.3, 0.65) == 2.0
+    assert cr.hardware.gear_ratio_for(1.3, 2.6) == 1.0  # a motor strong enough is direct drive
+    np.testing.assert_array_equal(
+        cr.hardware.gear_ratio_for(1.0, np.array([0.1, 1.0, 4.0])), [10.0, 1.0, 1.0]
+    )
     with pytest.raises(cr.InvalidParameter, match="peak_torque"):
-        cr.gear_ratio_for(1.0, 0.0)
+        cr.hardware.gear_ratio_for(1.0, 0.0)
 
 
 def test_stiffness_is_series_and_mass_adds_gearbox():
     actuator = cr.Actuator(MOTOR, mechanical_stiffness=300.0, software_stiffness=600.0)
     assert actuator.stiffness == pytest.approx(200.0, rel=1e-15)  # 1/(1/300 + 1/600)
     assert cr.Actuator(MOTOR).stiffness == math.inf
-    gearbox = cr.Gearbox("harmonic", diameter=0.05, length=0.03, mass=0.25, inertia=1e-6, rated_torque=20.0)
+    gearbox = cr.hardware.Gearbox(
+        "harmonic", diameter=0.05, length=0.03, mass=0.25, inertia=1e-6, rated_torque=20.0
+    )
     geared = cr.Actuator(MOTOR, 30.0, gearbox=gearbox)
     assert geared.mass == pytest.approx(0.65, rel=1e-15)
     assert (
@@ -42,7 +46,7 @@ def test_stiffness_is_series_and_mass_adds_gearbox():
 
 
 def test_gearbox_inertia_is_optional():
-    gearbox = cr.Gearbox("planetary", 2, 0.04, 0.03, 0.2, 3e-7, 10.0)
+    gearbox = cr.hardware.Gearbox("planetary", 2, 0.04, 0.03, 0.2, 3e-7, 10.0)
     off = cr.Actuator(MOTOR, 9.0, gearbox=gearbox)
     on = cr.Actuator(MOTOR, 9.0, gearbox=gearbox, gearbox_inertia=True)
     assert off.reflected_inertia == pytest.approx(81 * 2e-5, rel=1e-15)  # the paper's default: rotor only
@@ -75,18 +79,20 @@ def test_contact_parameters_map_through_the_lever():
 def test_sensing_thresholds():
     lever = 0.1
     base = dict(motor=MOTOR, gear_ratio=10.0, mechanical_stiffness=50.0, software_stiffness=50.0)
-    force = cr.Actuator(**base, sensing=cr.ForceThreshold(3.0)).contact_parameters(lever, 0.1)
+    force = cr.Actuator(**base, sensing=cr.hardware.ForceThreshold(3.0)).contact_parameters(lever, 0.1)
     assert force.F_s == 3.0
     # position error 0.02 rad on a 25 N m/rad joint: 0.5 N m at the joint, 5 N at 0.1 m
-    position = cr.Actuator(**base, sensing=cr.PositionThreshold(0.02)).contact_parameters(lever, 0.1)
+    position = cr.Actuator(**base, sensing=cr.hardware.PositionThreshold(0.02)).contact_parameters(lever, 0.1)
     assert position.F_s == pytest.approx(25.0 * 0.02 / lever, rel=1e-15)
     # motor-side 0.01 N m through N = 10, plus 0.05 N m joint friction: 0.15 N m, 1.5 N at 0.1 m
-    current = cr.Actuator(**base, sensing=cr.CurrentThreshold(0.01, 0.05)).contact_parameters(lever, 0.1)
+    current = cr.Actuator(**base, sensing=cr.hardware.CurrentThreshold(0.01, 0.05)).contact_parameters(
+        lever, 0.1
+    )
     assert current.F_s == pytest.approx((10 * 0.01 + 0.05) / lever, rel=1e-15)
 
 
 def test_contact_parameters_refuse_impossible_setups():
-    rigid = cr.Actuator(MOTOR, sensing=cr.PositionThreshold(0.01))
+    rigid = cr.Actuator(MOTOR, sensing=cr.hardware.PositionThreshold(0.01))
     with pytest.raises(cr.InvalidParameter, match="mechanical_stiffness"):
         rigid.contact_parameters(0.1, m_f=0.1)  # rigid joint on a rigid constraint: infinite force
     with pytest.raises(cr.InvalidParameter, match="stiffness"):
@@ -100,7 +106,7 @@ def test_contact_parameters_refuse_impossible_setups():
 def test_current_threshold_grows_with_gear_ratio():
     # The paper's A8 (U8 + 9:1) detects at ~40 N against ~3 N for the U8: a motor-side threshold is N times
     # larger at the joint. Same motor-side threshold, N = 1 vs 9: exactly 9x the contact force.
-    sensing = cr.CurrentThreshold(3.0 * 0.1143)
+    sensing = cr.hardware.CurrentThreshold(3.0 * 0.1143)
     direct = cr.Actuator(MOTOR, 1.0, mechanical_stiffness=10.0, sensing=sensing).contact_parameters(
         0.1143, 0.1
     )

@@ -29,7 +29,7 @@ def _write(tmp_path, text):
 
 
 def test_units_converted_to_si(tmp_path):
-    motor = cr.load_catalogue(_write(tmp_path, GOOD))["small"]
+    motor = cr.hardware.load_catalogue(_write(tmp_path, GOOD))["small"]
     assert motor.stator_diameter == pytest.approx(0.030, rel=1e-12)
     assert motor.rotor_inertia == pytest.approx(12e-3 * 1e-4, rel=1e-12)  # 12 g cm^2 = 1.2e-6 kg m^2
     assert motor.mass == pytest.approx(0.080, rel=1e-12)
@@ -38,7 +38,7 @@ def test_units_converted_to_si(tmp_path):
 
 def test_plain_exponent_numbers_are_si(tmp_path):
     # YAML 1.1 reads 1e-6 (no dot) as text; it must still be the SI number, not a unit error.
-    motor = cr.load_catalogue(_write(tmp_path, GOOD.replace("12 g*cm^2", "1e-6")))["small"]
+    motor = cr.hardware.load_catalogue(_write(tmp_path, GOOD.replace("12 g*cm^2", "1e-6")))["small"]
     assert motor.rotor_inertia == 1e-6
 
 
@@ -54,19 +54,19 @@ def test_plain_exponent_numbers_are_si(tmp_path):
 )
 def test_max_speed_read_with_units(tmp_path, text, rad_per_s):
     entry = GOOD.replace("    source:", f"    max_speed: {text}\n    source:")
-    motor = cr.load_catalogue(_write(tmp_path, entry))["small"]
+    motor = cr.hardware.load_catalogue(_write(tmp_path, entry))["small"]
     assert motor.max_speed == pytest.approx(rad_per_s, rel=1e-12)
 
 
 def test_max_speed_optional(tmp_path):
-    motor = cr.load_catalogue(_write(tmp_path, GOOD))["small"]
+    motor = cr.hardware.load_catalogue(_write(tmp_path, GOOD))["small"]
     assert motor.max_speed is None
     with pytest.raises(cr.InvalidParameter, match="no speed limit known for motor 'small'"):
         motor.speed_limit()
 
 
 def test_packaged_catalogue_cites_sources():
-    catalogue = cr.load_catalogue()
+    catalogue = cr.hardware.load_catalogue()
     assert "OPN-060-013-A" in catalogue
     assert all(motor.source for motor in catalogue.values())
 
@@ -159,8 +159,8 @@ BAD = {
 @pytest.mark.parametrize("text, line, field, words", BAD.values(), ids=BAD.keys())
 def test_bad_catalogue_names_field_and_line(tmp_path, text, line, field, words):
     path = _write(tmp_path, text)
-    with pytest.raises(cr.CatalogueError) as info:
-        cr.load_catalogue(path)
+    with pytest.raises(cr.errors.CatalogueError) as info:
+        cr.hardware.load_catalogue(path)
     error = info.value
     assert isinstance(error, ValueError)
     assert error.line == line
@@ -172,7 +172,7 @@ def test_bad_catalogue_names_field_and_line(tmp_path, text, line, field, words):
 def test_unknown_motor_lists_the_catalogue():
     from collision_reflex.hardware.motors import get_motor
 
-    with pytest.raises(cr.UnknownMotor, match="OPN-060-013-A"):
+    with pytest.raises(cr.errors.UnknownMotor, match="OPN-060-013-A"):
         get_motor("OPN-999")
 
 
@@ -210,7 +210,7 @@ def test_reference_motor_estimates_are_marked():
 
 
 def test_reference_motor_unchanged():
-    motor = cr.load_catalogue()["OPN-060-013-A"]
+    motor = cr.hardware.load_catalogue()["OPN-060-013-A"]
     expected = (0.060, 0.0125, 2.21e-5, 1.3, 0.524, 0.195, 492.6)
     got = (
         motor.stator_diameter,
@@ -226,10 +226,10 @@ def test_reference_motor_unchanged():
 
 def test_torque_constant_read_with_units(tmp_path):
     entry = GOOD.replace("    source:", "    torque_constant: 75 mN*m/A\n    source:")
-    assert cr.load_catalogue(_write(tmp_path, entry))["small"].torque_constant == pytest.approx(
+    assert cr.hardware.load_catalogue(_write(tmp_path, entry))["small"].torque_constant == pytest.approx(
         0.075, rel=1e-12
     )
-    assert cr.load_catalogue(_write(tmp_path, GOOD))["small"].torque_constant is None
+    assert cr.hardware.load_catalogue(_write(tmp_path, GOOD))["small"].torque_constant is None
 
 
 PROVENANCE_BAD = {
@@ -266,8 +266,8 @@ PROVENANCE_BAD = {
 @pytest.mark.parametrize("text, line, field, words", PROVENANCE_BAD.values(), ids=PROVENANCE_BAD.keys())
 def test_bad_provenance_names_field_and_line(tmp_path, text, line, field, words):
     path = _write(tmp_path, text)
-    with pytest.raises(cr.CatalogueError) as info:
-        cr.load_catalogue(path)
+    with pytest.raises(cr.errors.CatalogueError) as info:
+        cr.hardware.load_catalogue(path)
     assert info.value.line == line and info.value.field == field
     assert f"{path}:{line}" in str(info.value) and words in str(info.value)
 
@@ -279,5 +279,5 @@ def test_descriptive_fields_are_text_apart_from_the_numbers(tmp_path):
     entry = read_entries(_write(tmp_path, text), "motors")["small"]
     assert entry.description == {"maker": "Acme", "construction": "frameless"}
     assert "maker" not in entry.provenance and "construction" not in entry.fields
-    assert cr.load_catalogue(_write(tmp_path, text))["small"].mass == pytest.approx(0.080, rel=1e-12)
+    assert cr.hardware.load_catalogue(_write(tmp_path, text))["small"].mass == pytest.approx(0.080, rel=1e-12)
     assert read_entries(_write(tmp_path, GOOD), "motors")["small"].description == {}

@@ -23,7 +23,7 @@ KG_CM2 = 1e-4  # kg m^2 per kg cm^2
 
 @pytest.fixture(scope="module")
 def motors():
-    return cr.load_catalogue()
+    return cr.hardware.load_catalogue()
 
 
 @pytest.fixture(scope="module")

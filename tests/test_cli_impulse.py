@@ -33,12 +33,12 @@ def test_prints_phases_total_and_optimum(capsys):
         == 0
     )
     out = capsys.readouterr().out
-    k = cr.series_stiffness(1000.0, 100.0)
-    phases = cr.phase_impulses(0.2, k, 1000.0, 3.0, 20.0, 0.1)
+    k = cr.model.series_stiffness(1000.0, 100.0)
+    phases = cr.model.phase_impulses(0.2, k, 1000.0, 3.0, 20.0, 0.1)
     assert f"{phases.total:.6g}" in out
     assert f"{phases.sensing:.6g}" in out
     assert f"v* = {cr.optimal_velocity(0.2, k, 3.0):.6g}" in out
-    assert f"I* = {cr.minimum_impulse(0.2, k, 1000.0, 3.0, 20.0):.6g}" in out
+    assert f"I* = {cr.model.minimum_impulse(0.2, k, 1000.0, 3.0, 20.0):.6g}" in out
 
 
 def test_velocity_sweep_table(capsys):
@@ -46,7 +46,7 @@ def test_velocity_sweep_table(capsys):
     lines = capsys.readouterr().out.strip().splitlines()
     table = [line.split() for line in lines[-3:]]
     assert [float(row[0]) for row in table] == pytest.approx([0.01, 0.1, 1.0])
-    total_at_1 = cr.total_impulse(0.1, cr.series_stiffness(2e7, 440.0), 2e7, 3.0, 4.7e-5, 1.0)
+    total_at_1 = cr.total_impulse(0.1, cr.model.series_stiffness(2e7, 440.0), 2e7, 3.0, 4.7e-5, 1.0)
     assert float(table[-1][-1]) == pytest.approx(total_at_1, rel=1e-5)
 
 

@@ -410,7 +410,7 @@ def test_unit_strings_give_the_same_impulse(capsys):
     out = capsys.readouterr().out
     assert main([*command, *si]) == 0
     assert capsys.readouterr().out == out
-    total = cr.total_impulse(0.2, cr.series_stiffness(1000.0, 100.0), 1000.0, 3.0, 20.0, 0.1)
+    total = cr.total_impulse(0.2, cr.model.series_stiffness(1000.0, 100.0), 1000.0, 3.0, 20.0, 0.1)
     assert f"{total:.6g}" in out
 
 
@@ -466,7 +466,7 @@ def test_wrong_dimension_is_one_line_and_exit_2(argv, option, value, unit, capsy
 def test_simulate_position_error_is_metres_and_threshold_newtons(capsys):
     """The detection threshold's unit no longer depends on --detection: F_s = k e_th from --position-error."""
     assert main(["simulate", "--count", "2", "--position-error", "3mm"]) == 0
-    k = cr.series_stiffness(1000.0, 100.0)
+    k = cr.model.series_stiffness(1000.0, 100.0)
     assert f"(F_s = {k * 0.003:g} N)" in capsys.readouterr().out
     assert main(["simulate", "--count", "2", "--detection", "position", "--threshold", "0.003"]) == 2
     err = capsys.readouterr().err.strip().splitlines()

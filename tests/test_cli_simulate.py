@@ -30,7 +30,7 @@ def test_csv_matches_simulator_and_closed_form(tmp_path, capsys):
     out = capsys.readouterr().out
     rows = list(csv.DictReader(target.open()))
     assert len(rows) == 4
-    k = cr.series_stiffness(1000.0, 100.0)
+    k = cr.model.series_stiffness(1000.0, 100.0)
     for row in rows:
         v0, delay = float(row["v0_m_per_s"]), float(row["delay"])
         setup = CollisionSetup(0.2, 0.5, 1000.0, 100.0, 10.0, v0, Detection("force", 3.0), delay=delay)

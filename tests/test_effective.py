@@ -18,7 +18,7 @@ import pytest
 from collision_reflex.arm import Arm, JointParameters, collision_impulses, effective_parameters
 from collision_reflex.arm.directions import circle_directions, sphere_directions, unit_directions
 from collision_reflex.errors import InvalidParameter
-from collision_reflex.model import impulse, sensing
+from collision_reflex.model import impulse
 
 TWO_LINK = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
 
@@ -220,15 +220,12 @@ def test_current_threshold_is_the_first_joint_to_trip(panda, panda_samples):
         collision_impulses(effective_parameters(panda_samples, u, **PANDA_JOINTS), 0.2, sensing="current")
 
 
-def test_joint_torque_is_a_deprecated_spelling_of_current(panda_samples, monkeypatch):
-    monkeypatch.setattr(sensing, "_warned", set())
+@pytest.mark.parametrize("scheme", ["joint_torque", "torque"])
+def test_an_unknown_sensing_scheme_is_refused(panda_samples, scheme):
+    # "joint_torque" was the current scheme's name before the first release: refused like any other.
     params = effective_parameters(panda_samples, sphere_directions(4), **PANDA_JOINTS, joint_threshold=2.0)
-    with pytest.warns(DeprecationWarning, match="'current'"):
-        old = collision_impulses(params, 0.2, sensing="joint_torque")
-    new = collision_impulses(params, 0.2, sensing="current")
-    np.testing.assert_array_equal(old.total, new.total)
     with pytest.raises(InvalidParameter, match="sensing"):
-        collision_impulses(params, 0.2, threshold=1.0, sensing="torque")
+        collision_impulses(params, 0.2, threshold=1.0, sensing=scheme)
 
 
 @pytest.mark.parametrize(

@@ -41,7 +41,7 @@ def test_one_shot_fit_recovers_parameters_and_phase_impulses(system, v0, bandwid
         assert abs(got - expected) <= 4 * fit.stderr[name], name
         # ... and within 6 % (a of the stiff U8, whose reaction lasts only ~23 samples, has ~3 % stderr).
         assert got == pytest.approx(expected, rel=0.06), name
-    true_phases = cr.phase_impulses(truth.m_f, truth.k, truth.k_m, truth.F_s, truth.a, v0)
+    true_phases = cr.model.phase_impulses(truth.m_f, truth.k, truth.k_m, truth.F_s, truth.a, v0)
     for name in ("initial", "sensing", "reaction", "total"):
         # Phases to a few percent: the worst seen over the Monte Carlo was 2 % (the stiff U8's short phases).
         assert float(getattr(fit.phases, name)) == pytest.approx(getattr(true_phases, name), rel=0.03), name
@@ -63,7 +63,7 @@ def test_fit_needs_the_velocity():
     truth = PAPER_SYSTEMS["U8 soft"]
     trace = synthetic_trace(truth, 0.1, SensorModel(RATE), np.random.default_rng(1))
     anonymous = cr.experiments.Trace(trace.time, trace.force, source="trial.csv")
-    with pytest.raises(cr.TraceError, match="no pre-impact velocity"):
+    with pytest.raises(cr.errors.TraceError, match="no pre-impact velocity"):
         fit_one_shot(anonymous, find_contact(anonymous))
 
 
@@ -73,7 +73,7 @@ NSHOT = {name.replace(" ", "-").lower(): truth for name, truth in PAPER_SYSTEMS.
 
 @pytest.mark.parametrize("truth", NSHOT.values(), ids=NSHOT.keys())
 def test_nshot_fit_recovers_coefficients_and_v_star(truth):
-    coefficients = cr.velocity_coefficients(truth.m_f, truth.k, truth.k_m, truth.F_s, truth.a)
+    coefficients = cr.model.velocity_coefficients(truth.m_f, truth.k, truth.k_m, truth.F_s, truth.a)
     v_star = cr.optimal_velocity(truth.m_f, truth.k, truth.F_s)
     velocity = v_star * np.geomspace(0.1, 3.0, 9)
     exact = cr.total_impulse(truth.m_f, truth.k, truth.k_m, truth.F_s, truth.a, velocity)
@@ -81,7 +81,7 @@ def test_nshot_fit_recovers_coefficients_and_v_star(truth):
     np.testing.assert_allclose((fit.A, fit.B, fit.C), coefficients, rtol=1e-8)
     assert fit.v_star == pytest.approx(v_star, rel=1e-8)
     assert fit.minimum_impulse == pytest.approx(
-        cr.minimum_impulse(truth.m_f, truth.k, truth.k_m, truth.F_s, truth.a), rel=1e-8
+        cr.model.minimum_impulse(truth.m_f, truth.k, truth.k_m, truth.F_s, truth.a), rel=1e-8
     )
 
     # With 1 % noise on each impulse, stated as the uncertainty: each coefficient and v* within 4 stderr.
@@ -116,7 +116,7 @@ def test_software_stiffness_inverts_series_stiffness(k_s):
     from collision_reflex.experiments.fit import _software_stiffness
 
     k_m = 2e7
-    k = cr.series_stiffness(k_m, k_s)
+    k = cr.model.series_stiffness(k_m, k_s)
     # Two divisions and a subtraction of 1/k - 1/k_m; cancellation grows as k_s/k_m, so the bound is relative
     # to that ratio (a wrong inverse, e.g. k itself, is off by k_s/k = 1 + k_s/k_m >= 1.00005).
     assert _software_stiffness(k, k_m) == pytest.approx(k_s, rel=1e-12 * (1 + k_s / k_m))

@@ -36,7 +36,7 @@ def test_interval_means_match_brute_force_averaging(truth, v0):
     # Independent check of the Gauss-Legendre splitting: average force_profile over 40000 points per sample.
     # The pulse ends with a jump of m_f v0 w, so the brute-force mean itself is good to ~(jump / 40000).
     sensor = SensorModel(RATE)
-    _, t2 = cr.collision_times(*_model(truth, v0))
+    _, t2 = cr.model.collision_times(*_model(truth, v0))
     impact = 0.00337
     times = np.arange(int((impact + t2) * RATE) + 5) / RATE
     fast = model_samples(times, *_model(truth, v0), impact, sensor)
@@ -45,7 +45,7 @@ def test_interval_means_match_brute_force_averaging(truth, v0):
     for i in np.linspace(0, times.size - 1, 40).astype(int).tolist() + list(
         range(int(impact * RATE) - 1, int(impact * RATE) + 8)
     ):
-        brute = cr.force_profile(times[i] - impact + offsets / RATE, *_model(truth, v0)).mean()
+        brute = cr.model.force_profile(times[i] - impact + offsets / RATE, *_model(truth, v0)).mean()
         assert fast[i] == pytest.approx(brute, abs=2 * jump / 40000 + 1e-9)
 
 
@@ -55,7 +55,7 @@ def test_samples_keep_the_model_impulse(truth, v0, bandwidth):
     # Interval means preserve area exactly and the low-pass has unit DC gain, so sum(samples) T equals the
     # model's total impulse (eq:total_impulse) once the filter has settled (0.05 s after the contact).
     sensor = SensorModel(RATE, bandwidth)
-    _, t2 = cr.collision_times(*_model(truth, v0))
+    _, t2 = cr.model.collision_times(*_model(truth, v0))
     times = np.arange(int((0.01 + t2 + 0.05) * RATE)) / RATE
     samples = model_samples(times, *_model(truth, v0), 0.01 + 0.3 / RATE, sensor)
     assert samples.sum() / RATE == pytest.approx(cr.total_impulse(*_model(truth, v0)), rel=1e-9)
@@ -74,7 +74,7 @@ def test_quadrature_of_noiseless_trace_matches_total_impulse(truth, v0):
     assert abs(estimate.value - exact) <= estimate.uncertainty + 1e-12
     # The interpolant's error is confined to the one or two samples holding the impact pulse: a PCHIP cubic
     # through a one-sample spike holds up to ~15 % more area than the spike's interval mean.
-    assert abs(estimate.value - exact) <= 0.2 * cr.phase_impulses(*_model(truth, v0)).initial
+    assert abs(estimate.value - exact) <= 0.2 * cr.model.phase_impulses(*_model(truth, v0)).initial
 
 
 def test_quadrature_of_smooth_pulse_matches_analytic_integral():
@@ -110,7 +110,7 @@ def test_contact_window_brackets_the_collision():
     truth, v0 = CASES["u8-soft"]
     trace = synthetic_trace(truth, v0, SensorModel(RATE), np.random.default_rng(5), impact_time=0.02)
     window = find_contact(trace)
-    _, t2 = cr.collision_times(*_model(truth, v0))
+    _, t2 = cr.model.collision_times(*_model(truth, v0))
     # The window opens within two samples before the impact and closes within three after the contact ends
     # (noise at the floor decides the exact sample); the floor is the noise's: sigma 0.05 N from ~70 samples.
     assert 0.02 - 2 / RATE <= trace.time[window.start] <= 0.02

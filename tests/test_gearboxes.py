@@ -21,7 +21,7 @@ TABLE = {
 @pytest.mark.parametrize("kind", TABLE, ids=TABLE.keys())
 def test_gearbox_scaling_by_hand(kind):
     staged = kind in ("parallel_shaft", "planetary")
-    gearbox = cr.Gearbox(kind, 2 if staged else 1, **BASE)
+    gearbox = cr.hardware.Gearbox(kind, 2 if staged else 1, **BASE)
     new_stages = 3 if staged else 1
     scaled = gearbox.scaled(diameter=0.1, length=0.06, stages=new_stages)  # r x2, l x1.5, a x1.5 (staged)
     a_ratio = new_stages / gearbox.stages
@@ -37,18 +37,18 @@ def test_gearbox_scaling_by_hand(kind):
 
 @pytest.mark.parametrize("kind", TABLE, ids=TABLE.keys())
 def test_reflected_gearbox_inertia(kind):
-    gearbox = cr.Gearbox(kind, **BASE)
+    gearbox = cr.hardware.Gearbox(kind, **BASE)
     expected = 2e-6 if kind == "ball_screw" else 49 * 2e-6  # the table: l r^4 (ball screw) vs l r^4 N^2
     assert gearbox.reflected_inertia(7.0) == pytest.approx(expected, rel=1e-15)
 
 
 def test_gearbox_needs_reference_figures_and_valid_stages():
     with pytest.raises(cr.InvalidParameter, match="datasheet"):
-        cr.Gearbox("planetary")
+        cr.hardware.Gearbox("planetary")
     with pytest.raises(cr.InvalidParameter, match="stages"):
-        cr.Gearbox("harmonic", 2, **BASE)
+        cr.hardware.Gearbox("harmonic", 2, **BASE)
     with pytest.raises(cr.InvalidParameter, match="kind"):
-        cr.Gearbox("worm", **BASE)
+        cr.hardware.Gearbox("worm", **BASE)
 
 
 GEARBOX = """\
@@ -98,7 +98,9 @@ def test_packaged_gearboxes_match_their_datasheets():
     nps = gearboxes["NPS015-MF-1"]
     assert (nps.rated_torque, nps.peak_torque, nps.mass) == (17.0, 32.0, 1.8)
     assert nps.inertia == pytest.approx(0.25e-4, rel=1e-12) and nps.efficiency == 0.97
-    assert all(g.kind in cr.GEARBOX_KINDS and g.rated_torque <= g.peak_torque for g in gearboxes.values())
+    assert all(
+        g.kind in cr.vocabulary.GEARBOX_KINDS and g.rated_torque <= g.peak_torque for g in gearboxes.values()
+    )
 
 
 GEARBOX_BAD = {
@@ -150,7 +152,7 @@ GEARBOX_BAD = {
 @pytest.mark.parametrize("text, line, field, words", GEARBOX_BAD.values(), ids=GEARBOX_BAD.keys())
 def test_bad_gearbox_catalogue_names_field_and_line(tmp_path, text, line, field, words):
     path, load = _catalogue(tmp_path, text)
-    with pytest.raises(cr.CatalogueError) as info:
+    with pytest.raises(cr.errors.CatalogueError) as info:
         load()
     assert info.value.line == line and field in info.value.field
     assert f"{path}:{line}" in str(info.value) and words in str(info.value)

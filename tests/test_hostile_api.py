@@ -61,11 +61,13 @@ def test_wrong_types_name_the_argument(bad: object) -> None:
     m_f, k, k_m, _, a, v0 = ARGS
     for call in (
         lambda: cr.total_impulse(m_f, k, k_m, bad, a, v0),
-        lambda: cr.phase_impulses(m_f, k, k_m, bad, a, v0),
-        lambda: cr.collision_times(m_f, k, k_m, bad, a, v0),
-        lambda: cr.minimum_impulse(m_f, k, k_m, bad, a),
+        lambda: cr.model.phase_impulses(m_f, k, k_m, bad, a, v0),
+        lambda: cr.model.collision_times(m_f, k, k_m, bad, a, v0),
+        lambda: cr.model.minimum_impulse(m_f, k, k_m, bad, a),
         lambda: cr.optimal_velocity(m_f, k, bad),
-        lambda: cr.CollisionSetup(m_f, 1.0, k_m, 100.0, 10.0, v0, cr.Detection("force", bad)),
+        lambda: cr.simulate.CollisionSetup(
+            m_f, 1.0, k_m, 100.0, 10.0, v0, cr.simulate.Detection("force", bad)
+        ),
     ):
         with pytest.raises(InvalidParameter, match=r"^(F_s|detection threshold) = "):
             call()
@@ -79,11 +81,13 @@ def test_complex_input_is_refused() -> None:
 
 
 def test_setup_fields_become_floats() -> None:
-    setup = cr.CollisionSetup(np.int16(2), 1, 1000, 100, 10, np.float32(0.25), cr.Detection("force", 3))
+    setup = cr.simulate.CollisionSetup(
+        np.int16(2), 1, 1000, 100, 10, np.float32(0.25), cr.simulate.Detection("force", 3)
+    )
     assert all(type(value) is float for value in (setup.m_f, setup.m_r, setup.k_m, setup.v0))
     assert type(setup.detection.threshold) is float
     with pytest.raises(InvalidParameter, match=r"^m_r = "):
-        cr.CollisionSetup(0.2, [1.0, 2.0], 1000, 100, 10, 0.3, cr.Detection("force", 3))
+        cr.simulate.CollisionSetup(0.2, [1.0, 2.0], 1000, 100, 10, 0.3, cr.simulate.Detection("force", 3))
 
 
 LOG_MAGNITUDE = st.floats(-300.0, 300.0)
@@ -111,9 +115,9 @@ def test_wide_range_calls_are_finite_or_refused(exponents: list[float], reaction
 def test_times_minimum_and_optimum_are_finite_or_refused(exponents: list[float]) -> None:
     m_f, k, k_m, F_s, a, v0, v_r = (10.0**e for e in exponents)
     for call in (
-        lambda: cr.collision_times(m_f, k, k_m, F_s, a, v0, "moving", v_r),
-        lambda: cr.phase_impulses(m_f, k, k_m, F_s, a, v0),
-        lambda: (cr.minimum_impulse(m_f, k, k_m, F_s, a),),
+        lambda: cr.model.collision_times(m_f, k, k_m, F_s, a, v0, "moving", v_r),
+        lambda: cr.model.phase_impulses(m_f, k, k_m, F_s, a, v0),
+        lambda: (cr.model.minimum_impulse(m_f, k, k_m, F_s, a),),
         lambda: (cr.optimal_velocity(m_f, k, F_s),),
     ):
         try:
@@ -143,7 +147,9 @@ def test_an_unrepresentable_result_names_the_quantity() -> None:
 def test_collision_setups_are_valid_or_refused(exponents: list[float], drive: str, kind: str) -> None:
     m_f, m_r, k_m, k_s, F_a, v0 = (10.0**e for e in exponents)
     try:
-        setup = cr.CollisionSetup(m_f, m_r, k_m, k_s, F_a, v0, cr.Detection(kind, 1.0), drive=drive)
+        setup = cr.simulate.CollisionSetup(
+            m_f, m_r, k_m, k_s, F_a, v0, cr.simulate.Detection(kind, 1.0), drive=drive
+        )
         phases = setup.closed_form()
     except InvalidParameter:
         return
@@ -216,7 +222,7 @@ def test_moving_optimum_is_finite_or_refused(exponents: list[float]) -> None:
     m_f, k, k_m, F_s, a = (10.0**e for e in exponents)
     try:
         v_opt = cr.optimal_velocity(m_f, k, F_s, "moving", k_m, a)
-        impulse = cr.minimum_impulse(m_f, k, k_m, F_s, a, "moving")
+        impulse = cr.model.minimum_impulse(m_f, k, k_m, F_s, a, "moving")
     except InvalidParameter:
         return
     assert 0 < v_opt <= cr.optimal_velocity(m_f, k, F_s) * (1 + 1e-12)

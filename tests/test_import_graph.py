@@ -129,34 +129,21 @@ def test_nodes_are_top_level_names(module, node):
     assert _unit(module) == node
 
 
-# Public names of the subpackages that the root deliberately does not re-export, and why.
-NOT_AT_ROOT = {
-    "design_at": "an NLP-point helper of the solver; users get designs from solve()",
-    "Sweep": "exported as SimulationSweep (Sweep alone would be ambiguous next to the Pareto sweep)",
-    "simulate": "exported as simulate_collision",
-    "sweep": "exported as simulation_sweep",
-    "pareto_rows": "the rows of pareto.csv, written by a study run",
-    "write_outputs": "a study run's file writer; render_report is the user's entry point",
-}
-
-
-def test_the_root_exports_every_public_name_of_the_user_facing_subpackages():
+def test_the_root_holds_the_workflow_each_name_from_the_subpackage_that_exports_it():
     import importlib
 
     import collision_reflex as cr
 
-    assert all(hasattr(cr, name) for name in cr.__all__)
-    for subpackage in ("arm", "optimize", "simulate", "report"):
-        module = importlib.import_module(f"collision_reflex.{subpackage}")
-        missing = set(module.__all__) - set(cr.__all__) - set(NOT_AT_ROOT)
-        assert not missing, (
-            f"collision_reflex.{subpackage} names not exported by the package: {sorted(missing)}"
-        )
-    for name in (
-        "SENSING_SCHEMES",
-        "threshold_force",
-        "current_threshold_torque",
-        "result_to_json",
-        "render_report",
-    ):
-        assert name in cr.__all__
+    assert len(cr.__all__) <= 25 and len(set(cr.__all__)) == len(cr.__all__)
+    for package, names in cr._WORKFLOW.items():
+        module = importlib.import_module(package, "collision_reflex")
+        for name in names:
+            assert getattr(cr, name) is getattr(module, name), name
+            assert name in getattr(module, "__all__", dir(module)), f"{name} is not public in {package}"
+    # The common workflow is there; everything else is one subpackage away.
+    assert {"load_study", "run_study", "build_problem", "solve", "pareto_front", "snap_to_catalogue"} <= set(
+        cr.__all__
+    )
+    assert {"export_design", "render_report", "Arm", "Actuator", "InvalidParameter"} <= set(cr.__all__)
+    assert cr.arm.effective_mass is importlib.import_module("collision_reflex.arm.metrics").effective_mass
+    assert cr.vocabulary.SENSING_SCHEMES == ("force", "position", "current")

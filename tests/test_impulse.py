@@ -21,23 +21,23 @@ CASES = {
 
 
 def test_series_stiffness_hand_values():
-    assert cr.series_stiffness(1000.0, 100.0) == pytest.approx(1000 * 100 / 1100, rel=1e-15)
-    assert cr.series_stiffness(np.inf, 250.0) == 250.0  # a rigid structure leaves the software spring
-    assert cr.series_stiffness(np.inf, np.inf) == np.inf
-    np.testing.assert_allclose(cr.series_stiffness(np.array([1.0, 2.0]), 2.0), [2 / 3, 1.0], rtol=1e-15)
+    assert cr.model.series_stiffness(1000.0, 100.0) == pytest.approx(1000 * 100 / 1100, rel=1e-15)
+    assert cr.model.series_stiffness(np.inf, 250.0) == 250.0  # a rigid structure leaves the software spring
+    assert cr.model.series_stiffness(np.inf, np.inf) == np.inf
+    np.testing.assert_allclose(cr.model.series_stiffness(np.array([1.0, 2.0]), 2.0), [2 / 3, 1.0], rtol=1e-15)
 
 
 def test_phases_against_hand_derivation():
     # m_f=0.5, k=200, k_m=800, F_s=4, a=2, v0=0.25:
     # I1 = 0.125; t1 = 4/(200*0.25) = 0.08, I2 = 0.5*4*0.08 = 0.16;
     # tau = sqrt(2*4/(2*800)) = sqrt(0.005); I3 = 4*tau - 800*2*tau^3/6 = (2/3)*4*tau.
-    phases = cr.phase_impulses(0.5, 200.0, 800.0, 4.0, 2.0, 0.25)
+    phases = cr.model.phase_impulses(0.5, 200.0, 800.0, 4.0, 2.0, 0.25)
     tau = np.sqrt(0.005)
     assert phases.initial == pytest.approx(0.125, rel=1e-15)
     assert phases.sensing == pytest.approx(0.16, rel=1e-15)
     assert phases.reaction == pytest.approx(8 / 3 * tau, rel=1e-14)
     assert phases.total == pytest.approx(0.125 + 0.16 + 8 / 3 * tau, rel=1e-14)
-    t1, t2 = cr.collision_times(0.5, 200.0, 800.0, 4.0, 2.0, 0.25)
+    t1, t2 = cr.model.collision_times(0.5, 200.0, 800.0, 4.0, 2.0, 0.25)
     assert (t1, t2) == pytest.approx((0.08, 0.08 + tau), rel=1e-14)
 
 
@@ -45,8 +45,8 @@ def test_phases_against_hand_derivation():
 def test_reaction_matches_paper_closed_form(case):
     # eq:reaction: I3 = sqrt(8 F_s^3 / (9 a k_m)); the code integrates the general moving-robot form at v_r=0.
     expected = np.sqrt(8 * case["F_s"] ** 3 / (9 * case["a"] * case["k_m"]))
-    assert cr.phase_impulses(**case, v0=0.3).reaction == pytest.approx(expected, rel=1e-12)
-    assert cr.phase_impulses(**case, v0=0.3, reaction="moving", v_r=0.0).reaction == pytest.approx(
+    assert cr.model.phase_impulses(**case, v0=0.3).reaction == pytest.approx(expected, rel=1e-12)
+    assert cr.model.phase_impulses(**case, v0=0.3, reaction="moving", v_r=0.0).reaction == pytest.approx(
         expected, rel=1e-12
     )
 
@@ -55,12 +55,12 @@ def test_moving_reaction_hand_value():
     # k_m=1000, F_s=2 -> x1=0.002; v_r=0.1, a=10: tau_e = (0.1 + sqrt(0.01 + 0.04))/10
     tau = (0.1 + np.sqrt(0.05)) / 10
     expected = 1000 * (0.002 * tau + 0.1 * tau**2 / 2 - 10 * tau**3 / 6)
-    got = cr.phase_impulses(0.1, 500.0, 1000.0, 2.0, 10.0, 0.3, reaction="moving", v_r=0.1).reaction
+    got = cr.model.phase_impulses(0.1, 500.0, 1000.0, 2.0, 10.0, 0.3, reaction="moving", v_r=0.1).reaction
     assert got == pytest.approx(expected, rel=1e-14)
     # default v_r is v0, and a moving robot always adds impulse
-    moving = cr.phase_impulses(0.1, 500.0, 1000.0, 2.0, 10.0, 0.1, reaction="moving")
+    moving = cr.model.phase_impulses(0.1, 500.0, 1000.0, 2.0, 10.0, 0.1, reaction="moving")
     assert moving.reaction == pytest.approx(got, rel=1e-14)
-    assert moving.reaction > cr.phase_impulses(0.1, 500.0, 1000.0, 2.0, 10.0, 0.1).reaction
+    assert moving.reaction > cr.model.phase_impulses(0.1, 500.0, 1000.0, 2.0, 10.0, 0.1).reaction
 
 
 @pytest.mark.parametrize("case", CASES.values(), ids=CASES.keys())
@@ -72,7 +72,7 @@ def test_optimal_velocity_is_numerical_minimum(case):
         tol=1e-12,
     )
     assert np.exp(found.x) == pytest.approx(v_star, rel=1e-6)
-    assert cr.minimum_impulse(**case) == pytest.approx(cr.total_impulse(**case, v0=v_star), rel=1e-12)
+    assert cr.model.minimum_impulse(**case) == pytest.approx(cr.total_impulse(**case, v0=v_star), rel=1e-12)
 
 
 @pytest.mark.parametrize("case", CASES.values(), ids=CASES.keys())
@@ -101,7 +101,7 @@ def test_moving_optimum_is_below_paper_optimum_and_minimal():
     grid = np.linspace(0.2 * v_moving, 3 * v_moving, 20001)
     brute = grid[np.argmin(cr.total_impulse(**case, v0=grid, reaction="moving"))]
     assert v_moving == pytest.approx(brute, rel=1e-3)  # grid spacing is 1.4e-4 relative
-    assert cr.minimum_impulse(**case, reaction="moving") <= cr.total_impulse(
+    assert cr.model.minimum_impulse(**case, reaction="moving") <= cr.total_impulse(
         **case, v0=brute, reaction="moving"
     ) * (1 + 1e-12)
 
@@ -110,11 +110,11 @@ def test_moving_optimum_is_below_paper_optimum_and_minimal():
 @pytest.mark.parametrize("case", CASES.values(), ids=CASES.keys())
 def test_force_profile_integrates_to_total(case, reaction):
     v0 = 0.7 * cr.optimal_velocity(case["m_f"], case["k"], case["F_s"])
-    t1, t2 = cr.collision_times(**case, v0=v0, reaction=reaction)
+    t1, t2 = cr.model.collision_times(**case, v0=v0, reaction=reaction)
     t_impact = np.pi / 2 * np.sqrt(case["m_f"] / case["k_m"])
 
     def force(t):
-        return float(cr.force_profile(t, **case, v0=v0, reaction=reaction))
+        return float(cr.model.force_profile(t, **case, v0=v0, reaction=reaction))
 
     # integrate piecewise between the profile's kinks so quadrature converges to its tolerance
     breaks = sorted({0.0, min(t_impact, t2), t1, t2})
@@ -153,16 +153,16 @@ def test_casadi_matches_numpy_and_finite_differences(sym, reaction):
         assert grad[i] == pytest.approx(fd, rel=1e-6, abs=1e-12), name
     # the other public functions build symbolically as well
     t = sym.sym("t")
-    profile = ca.Function("F", [t, x], [cr.force_profile(t, *args, reaction=reaction)])
+    profile = ca.Function("F", [t, x], [cr.model.force_profile(t, *args, reaction=reaction)])
     assert float(profile(0.01, point)) == pytest.approx(
-        float(cr.force_profile(0.01, *point, reaction=reaction)), rel=1e-13
+        float(cr.model.force_profile(0.01, *point, reaction=reaction)), rel=1e-13
     )
     v_star = ca.Function("v", [x], [cr.optimal_velocity(args[0], args[1], args[3])])
     assert float(v_star(point)) == pytest.approx(cr.optimal_velocity(0.2, 90.0, 3.0), rel=1e-14)
 
 
 def test_velocity_coefficients():
-    A, B, C = cr.velocity_coefficients(0.2, 90.0, 1000.0, 3.0, 20.0)
+    A, B, C = cr.model.velocity_coefficients(0.2, 90.0, 1000.0, 3.0, 20.0)
     for v0 in (0.05, 0.5):
         assert A * v0 + B / v0 + C == pytest.approx(
             cr.total_impulse(0.2, 90.0, 1000.0, 3.0, 20.0, v0), rel=1e-14
@@ -200,8 +200,8 @@ def test_bad_input_names_parameter(name, value):
 
 def test_bad_reaction_mode_lists_options():
     with pytest.raises(cr.InvalidParameter, match="'at_rest', 'moving'"):
-        cr.phase_impulses(**GOOD, reaction="bounce")
+        cr.model.phase_impulses(**GOOD, reaction="bounce")
     with pytest.raises(cr.InvalidParameter, match="v_r"):
-        cr.phase_impulses(**GOOD, v_r=0.1)  # a robot velocity needs the moving reaction
+        cr.model.phase_impulses(**GOOD, v_r=0.1)  # a robot velocity needs the moving reaction
     with pytest.raises(cr.InvalidParameter, match="v_r"):
-        cr.phase_impulses(**GOOD, reaction="moving", v_r=-0.1)
+        cr.model.phase_impulses(**GOOD, reaction="moving", v_r=-0.1)

@@ -7,8 +7,6 @@ Tolerances: 1e-12 relative where an explicit inverse replaces a solve on matrice
 
 from __future__ import annotations
 
-import warnings
-
 import casadi as ca
 import numpy as np
 import pytest
@@ -16,6 +14,7 @@ import pytest
 from collision_reflex.errors import InvalidParameter
 from collision_reflex.hardware.motors import reference_motor
 from collision_reflex.model import effective, sensing
+from collision_reflex.vocabulary import SENSING_SCHEMES
 
 
 @pytest.fixture
@@ -126,13 +125,10 @@ def test_sensing_thresholds():
         sensing.threshold_force("current", 1.0, k)
 
 
-def test_sensing_vocabulary_and_its_deprecated_spelling(monkeypatch):
-    assert sensing.SENSING_SCHEMES == ("force", "position", "current")
-    monkeypatch.setattr(sensing, "_warned", set())
-    with pytest.warns(DeprecationWarning, match="'joint_torque' is deprecated"):
-        assert sensing.sensing_scheme("joint_torque") == "current"
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")  # once: the second use is silent
-        assert sensing.sensing_scheme("joint_torque") == "current"
+def test_sensing_vocabulary():
+    assert SENSING_SCHEMES == ("force", "position", "current")
+    assert sensing.sensing_scheme("current") == "current"
+    with pytest.raises(InvalidParameter, match="sensing"):
+        sensing.sensing_scheme("joint_torque")  # the current scheme's name before the first release
     with pytest.raises(InvalidParameter, match="sensing"):
         sensing.sensing_scheme("current", ("force", "position"))

@@ -22,7 +22,7 @@ PAPER_ROWS = {
 @pytest.mark.parametrize("row", PAPER_ROWS.values(), ids=PAPER_ROWS.keys())
 def test_tab_motor_params_reproduced(row):
     motor = cr.reference_motor().scaled(row["diameter"], law="haddadin")
-    gear = cr.gear_ratio_for(1.3, motor.peak_torque)
+    gear = cr.hardware.gear_ratio_for(1.3, motor.peak_torque)
     actuator = cr.Actuator(motor, gear_ratio=gear)
     # The paper prints 3-4 significant figures; 1% covers its rounding (the tolerance).
     got = {
@@ -56,7 +56,7 @@ LAW_EXPONENTS = {  # tab:scaling_laws: (mass, inertia, torque) exponents of r
 def test_scaling_laws_against_hand_computation(name):
     reference = cr.Motor("ref", 0.05, 0.02, 1e-5, 2.0, 1.0, 0.3)
     mass_e, inertia_e, torque_e = LAW_EXPONENTS[name]
-    law = cr.scaling_law(name)
+    law = cr.hardware.scaling_law(name)
     assert (law.mass_exponent, law.inertia_exponent, law.torque_exponent) == (mass_e, inertia_e, torque_e)
     # Twice the diameter, 1.5x the length: q = q0 * 1.5 * 2**e, written out by hand.
     scaled = reference.scaled(0.10, 0.03, law=name)
@@ -68,18 +68,18 @@ def test_scaling_laws_against_hand_computation(name):
 
 def test_paper_inertia_torque_exponents():
     # The paper's text: J ∝ tau (isometric), tau^1.6 (electrical & thermal), tau^1.5 (quadruped).
-    assert cr.scaling_law("isometric").inertia_torque_exponent == 1.0
-    assert cr.scaling_law("haddadin").inertia_torque_exponent == 1.6
-    assert cr.scaling_law("quadruped").inertia_torque_exponent == 1.5
+    assert cr.hardware.scaling_law("isometric").inertia_torque_exponent == 1.0
+    assert cr.hardware.scaling_law("haddadin").inertia_torque_exponent == 1.6
+    assert cr.hardware.scaling_law("quadruped").inertia_torque_exponent == 1.5
 
 
 def test_scaled_quantities_backends_agree():
     reference = cr.reference_motor()
     diameters = np.array([0.01, 0.03, 0.1])
     lengths = np.array([0.01, 0.0125, 0.05])
-    numeric = cr.scaled_motor_quantities(reference, diameters, lengths, "empirical")
+    numeric = cr.hardware.scaled_motor_quantities(reference, diameters, lengths, "empirical")
     for sym_r, sym_l in ((ca.SX.sym("r", 3), ca.SX.sym("l", 3)), (ca.MX.sym("r", 3), ca.MX.sym("l", 3))):
-        symbolic = cr.scaled_motor_quantities(reference, sym_r, sym_l, "empirical")
+        symbolic = cr.hardware.scaled_motor_quantities(reference, sym_r, sym_l, "empirical")
         f = ca.Function("f", [sym_r, sym_l], list(symbolic))
         for got, expected in zip(f(diameters, lengths), numeric, strict=True):
             np.testing.assert_allclose(np.asarray(got).ravel(), expected, rtol=1e-14)
@@ -91,7 +91,7 @@ def test_scaled_quantities_backends_agree():
 
 def test_stack_length_defaults_to_reference():
     reference = cr.reference_motor()
-    got = cr.scaled_motor_quantities(reference, 0.03)
+    got = cr.hardware.scaled_motor_quantities(reference, 0.03)
     assert got.rotor_inertia == pytest.approx(2.21e-5 * 0.5**4, rel=1e-14)
 
 
@@ -142,15 +142,15 @@ def test_max_speed_keeps_the_rotor_surface_speed(name):
 
 
 def test_speed_scaling_both_exponents_against_hand_and_casadi():
-    law = cr.ScalingLaw("test", 2.0, 4.0, 2.5, "test", speed=SpeedScaling(0.5, -1.5, "test law"))
+    law = cr.hardware.ScalingLaw("test", 2.0, 4.0, 2.5, "test", speed=SpeedScaling(0.5, -1.5, "test law"))
     reference = _fast_motor()
     diameters, lengths = np.array([0.025, 0.05, 0.2]), np.array([0.08, 0.02, 0.005])
     # omega = 300 (l/l0)^0.5 (r/r0)^-1.5: (4^0.5 0.5^-1.5, 1, 0.25^0.5 4^-1.5) = (5.657, 1, 0.0625) x 300
     hand = 300.0 * np.array([2.0 * 2**1.5, 1.0, 0.5 / 8.0])
-    numeric = cr.scaled_motor_quantities(reference, diameters, lengths, law)
+    numeric = cr.hardware.scaled_motor_quantities(reference, diameters, lengths, law)
     np.testing.assert_allclose(numeric.max_speed, hand, rtol=1e-14)
     for sym_r, sym_l in ((ca.SX.sym("r", 3), ca.SX.sym("l", 3)), (ca.MX.sym("r", 3), ca.MX.sym("l", 3))):
-        symbolic = cr.scaled_motor_quantities(reference, sym_r, sym_l, law).max_speed
+        symbolic = cr.hardware.scaled_motor_quantities(reference, sym_r, sym_l, law).max_speed
         got = ca.Function("f", [sym_r, sym_l], [symbolic])(diameters, lengths)
         np.testing.assert_allclose(np.asarray(got).ravel(), hand, rtol=1e-14)
 
@@ -158,8 +158,8 @@ def test_speed_scaling_both_exponents_against_hand_and_casadi():
 def test_unknown_max_speed_stays_unknown():
     reference = _fast_motor(max_speed=None)
     assert reference.scaled(0.1, 0.03).max_speed is None
-    assert cr.scaled_motor_quantities(reference, np.array([0.01, 0.1])).max_speed is None
-    assert cr.scaled_motor_quantities(reference, ca.SX.sym("r")).max_speed is None
+    assert cr.hardware.scaled_motor_quantities(reference, np.array([0.01, 0.1])).max_speed is None
+    assert cr.hardware.scaled_motor_quantities(reference, ca.SX.sym("r")).max_speed is None
     with pytest.raises(cr.InvalidParameter, match="no speed limit known for motor 'fast'"):
         reference.speed_limit()
     assert _fast_motor().speed_limit() == 300.0
@@ -170,7 +170,7 @@ def test_reference_max_speed_is_a_marked_estimate():
     # The catalogue's estimate: 10 m/s at the 40.6 mm rotor OD of tab:motor_params, rounded to 4 figures.
     assert motor.max_speed == pytest.approx(10.0 / 0.0203, rel=1e-4)
     assert "estimate" in motor.source.lower()
-    assert "surface speed" in cr.scaling_law("haddadin").speed.source
+    assert "surface speed" in cr.hardware.scaling_law("haddadin").speed.source
 
 
 def test_max_speed_and_speed_scaling_validated():
@@ -181,4 +181,4 @@ def test_max_speed_and_speed_scaling_validated():
     with pytest.raises(cr.InvalidParameter, match="diameter_exponent"):
         SpeedScaling(0.0, float("nan"), "x")
     with pytest.raises(cr.InvalidParameter, match=r"ScalingLaw\.speed"):
-        cr.ScalingLaw("x", 2.0, 4.0, 2.5, speed=-1.0)  # type: ignore[arg-type]
+        cr.hardware.ScalingLaw("x", 2.0, 4.0, 2.5, speed=-1.0)  # type: ignore[arg-type]

@@ -424,7 +424,7 @@ def test_infeasible_torque_requirement_names_the_constraint(arm):
         _technology(),
         constraints=cr.Constraints(torque_required=[50.0, 1.0]),
     )
-    with pytest.raises(cr.SolverFailed) as info:
+    with pytest.raises(cr.errors.SolverFailed) as info:
         cr.solve(problem, ipopt_options={"ipopt.max_iter": 200})
     assert "peak torque of joint1" in str(info.value)
     assert info.value.violated and info.value.violated[0][0].startswith("peak torque of joint1")
@@ -514,7 +514,7 @@ def test_multi_start_returns_the_best_of_its_starts_each_solved_alone():
     # apart, so a screening that dropped the best start's path would miss it by far more than the tolerance.
     arm = cr.Arm.from_example_robot_data("double_pendulum")
     kin = arm.kinematics(arm.sample_configurations(8, np.random.default_rng(1)))
-    samples = cr.ContactSamples.grid(kin, cr.circle_directions(8))
+    samples = cr.ContactSamples.grid(kin, cr.arm.circle_directions(8))
     space = cr.DesignSpace(
         stator_diameter=(0.02, 0.12),
         gear_ratio=(1, 50),
@@ -541,7 +541,7 @@ def test_multi_start_returns_the_best_of_its_starts_each_solved_alone():
 def test_solver_failed_message_and_pickling():
     import pickle
 
-    error = cr.SolverFailed(
+    error = cr.errors.SolverFailed(
         "could not meet x", "Infeasible_Problem_Detected", {"iter_count": 3}, [("x", 1.0)], problem=object()
     )
     assert str(error) == "could not meet x"

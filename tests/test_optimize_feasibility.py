@@ -97,7 +97,7 @@ def test_a_scan_of_random_feasible_problems_has_no_failure(pendulum, robot):
             continue
         try:
             result = cr.solve(problem, ipopt_options=MONOTONE)
-        except cr.SolverFailed as error:
+        except cr.errors.SolverFailed as error:
             failures.append(error.status)
             continue
         solved += 1
@@ -134,7 +134,7 @@ def test_a_requirement_above_the_strongest_actuator_is_confirmed_infeasible(two_
     problem = _small_problem(two_link, cr.Constraints(torque_required=[50.0, 0.5]))
     strongest = design_at(problem, problem.ubx).peak_torque  # largest motor at the largest ratio [N*m]
     assert strongest[0] < 50.0 and strongest[1] > 0.5  # joint1 cannot be sized, joint2 can
-    with pytest.raises(cr.SolverFailed) as info:
+    with pytest.raises(cr.errors.SolverFailed) as info:
         cr.solve(problem)
     error = info.value
     assert error.status == "Infeasible" and error.confirmed_infeasible
@@ -152,7 +152,7 @@ def test_a_requirement_above_the_strongest_actuator_is_confirmed_infeasible(two_
 def test_an_objective_bound_below_the_lightest_design_is_confirmed_infeasible(two_link):
     problem = _small_problem(two_link, cr.Constraints(torque_required=[0.1, 0.1]), ("actuator_mass",))
     lightest = float(design_at(problem, problem.lbx).motor_mass.sum())  # smallest motors [kg]
-    with pytest.raises(cr.SolverFailed) as info:
+    with pytest.raises(cr.errors.SolverFailed) as info:
         cr.solve(problem, epsilon={"actuator_mass": 0.5 * lightest})
     (violation,) = info.value.violated
     assert info.value.status == "Infeasible"
@@ -163,7 +163,7 @@ def test_an_objective_bound_below_the_lightest_design_is_confirmed_infeasible(tw
 
 def test_an_iteration_cap_is_never_reported_as_infeasible(pendulum):
     problem = _reproduction(pendulum)
-    with pytest.raises(cr.SolverFailed) as info:
+    with pytest.raises(cr.errors.SolverFailed) as info:
         cr.solve(problem, ipopt_options={"ipopt.max_iter": 2})
     error = info.value
     assert error.status == "Maximum_Iterations_Exceeded" and not error.confirmed_infeasible

@@ -52,7 +52,7 @@ def ideal_setup(k_s: float, k_m: float, v0: float, **changes) -> CollisionSetup:
 
 
 def v_star(k_s: float, k_m: float) -> float:
-    return float(cr.optimal_velocity(M_F, cr.series_stiffness(k_m, k_s), F_S))
+    return float(cr.optimal_velocity(M_F, cr.model.series_stiffness(k_m, k_s), F_S))
 
 
 @pytest.mark.parametrize("case", list(IDEAL_CASES), ids=list(IDEAL_CASES))
@@ -68,7 +68,7 @@ def test_ideal_limit_reproduces_closed_form(case, ratio):
     # Phase by phase: the impact and sensing impulses up to detection are exact (plastic impact, linear ramp).
     assert result.impulse_to_detection == pytest.approx(closed.initial + closed.sensing, rel=1e-8)
     assert result.impacts[0] == (0.0, pytest.approx(M_F * setup.v0, rel=1e-14))
-    t1, t2 = cr.collision_times(
+    t1, t2 = cr.model.collision_times(
         M_F,
         setup.lumped_stiffness,
         k_m,
@@ -101,7 +101,7 @@ def test_ideal_limit_error_shrinks_with_the_force_limit():
 
 def soft_setup(**changes) -> CollisionSetup:
     """A light direct-drive robot where the spring does push the robot back (F_a = 10 N)."""
-    k = cr.series_stiffness(1000.0, 100.0)
+    k = cr.model.series_stiffness(1000.0, 100.0)
     base = CollisionSetup(
         m_f=M_F,
         m_r=0.5,
@@ -317,7 +317,7 @@ def test_time_scales_and_shares_against_their_textbook_forms():
     assert oscillation_period(0.2, 1000.0) == pytest.approx(2 * math.pi * math.sqrt(0.2 / 1000.0), rel=1e-15)
     # The admittance follows k_s / (k_s + k_m) of the reference: the series stiffness over k_m.
     share = admittance_share(np.array([1000.0, 1000.0]), np.array([100.0, math.inf]))
-    np.testing.assert_allclose(share, [cr.series_stiffness(1000.0, 100.0) / 1000.0, 1.0], rtol=1e-15)
+    np.testing.assert_allclose(share, [cr.model.series_stiffness(1000.0, 100.0) / 1000.0, 1.0], rtol=1e-15)
     assert damping_from_ratio(1.0, 0.2, 1e6) == pytest.approx(2 * math.sqrt(0.2e6), rel=1e-15)  # critical
     # An undamped contact lasts half a period of the finger on it.
     assert soft_setup(contact_stiffness=1e6).contact_time == pytest.approx(

@@ -46,7 +46,9 @@ RATIOS = (0.1, 1.0, 3.0)
 
 def _phases(eff, v0, v_r, *, m_f_scale=1.0, a_scale=1.0):
     """Closed-form impact+sensing and sprung reaction impulses [N s], with an optional mutation of m_f or a."""
-    phases = cr.phase_impulses(eff["m_f"] * m_f_scale, eff["k"], eff["k_m"], 3.0, eff["a"] * a_scale, v0)
+    phases = cr.model.phase_impulses(
+        eff["m_f"] * m_f_scale, eff["k"], eff["k_m"], 3.0, eff["a"] * a_scale, v0
+    )
     # a = F_a / m_r: doubling a at the same m_r doubles the motors' force.
     _, reaction = sprung_reaction(3.0, eff["k_m"], eff["F_a"] * a_scale, eff["m_r"], v_r)
     return float(phases.initial + phases.sensing), float(reaction)
@@ -86,7 +88,7 @@ def test_arm_phases_match_closed_form(arm, honest_runs):
     """
     eff, runs = honest_runs
     samples = arm.kinematics(np.array(HONEST_Q)[None])
-    ref = cr.effective_parameters(samples, HONEST_U[None], 2.2e-3, 50.0, 50.0, 1.3)
+    ref = cr.arm.effective_parameters(samples, HONEST_U[None], 2.2e-3, 50.0, 50.0, 1.3)
     assert eff["m_f"] == pytest.approx(float(ref.m_f[0, 0]), rel=1e-12)
     assert eff["a"] == pytest.approx(float(ref.a[0, 0]), rel=1e-12)
     for ratio, result in runs.items():
@@ -117,7 +119,7 @@ def test_constant_acceleration_reaction_overestimates(honest_runs):
     """
     eff, runs = honest_runs
     result = runs[0.1]
-    phases = cr.phase_impulses(
+    phases = cr.model.phase_impulses(
         eff["m_f"],
         eff["k"],
         eff["k_m"],

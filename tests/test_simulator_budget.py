@@ -16,7 +16,7 @@ import collision_reflex as cr
 from collision_reflex.errors import InvalidParameter, SimulationError
 from collision_reflex.simulate import budget, integrator
 
-BASE = cr.CollisionSetup(0.2, 1.0, 1000.0, 100.0, 10.0, 0.3, cr.Detection("force", 3.0))
+BASE = cr.simulate.CollisionSetup(0.2, 1.0, 1000.0, 100.0, 10.0, 0.3, cr.simulate.Detection("force", 3.0))
 IMPEDANCE = replace(BASE, drive="impedance")
 
 # setting -> words the refusal must contain (the time scale at fault or the change to make)
@@ -35,7 +35,7 @@ def test_hopeless_settings_are_refused_at_once(name: str) -> None:
     setup, hint = HOPELESS[name]
     start = time.perf_counter()
     with pytest.raises(SimulationError, match="integrator steps, beyond the budget max_steps") as error:
-        cr.simulate_collision(setup)
+        cr.simulate.simulate(setup)
     assert time.perf_counter() - start < 1.0
     assert hint in str(error.value)
     assert "\n" not in str(error.value)
@@ -51,7 +51,7 @@ def test_ordinary_runs_stay_well_inside_the_budget() -> None:
     ):
         steps = budget.estimated_steps(setup)
         assert 50 < steps < setup.max_steps / 10
-        cr.simulate_collision(setup)
+        cr.simulate.simulate(setup)
 
 
 def test_estimate_scales_with_span_over_time_scale() -> None:
@@ -75,7 +75,7 @@ def test_the_run_stops_when_the_budget_is_used_up(monkeypatch: pytest.MonkeyPatc
     monkeypatch.setattr(integrator, "check_work", lambda setup: None)
     start = time.perf_counter()
     with pytest.raises(SimulationError, match="used up its budget of max_steps = 2000 integrator steps"):
-        cr.simulate_collision(replace(BASE, m_r=1e-9, max_steps=2000))
+        cr.simulate.simulate(replace(BASE, m_r=1e-9, max_steps=2000))
     assert time.perf_counter() - start < 3.0
 
 
@@ -94,5 +94,5 @@ def test_max_steps_is_a_whole_number(bad: object) -> None:
 
 def test_step_below_float_spacing_is_explained() -> None:
     with pytest.raises(SimulationError, match="below the resolution of double precision") as error:
-        cr.simulate_collision(replace(BASE, v0=1e-15))
+        cr.simulate.simulate(replace(BASE, v0=1e-15))
     assert "raise v0" in str(error.value)

@@ -263,7 +263,7 @@ def test_a_study_run_snaps_reports_and_resumes_without_redoing_it(tmp_path, monk
     assert catalogue["design"]["undecided"] == [] and designs["recommended"]["undecided"] == []
     gearboxes = load_gearbox_catalogue()
     for joint in catalogue["joints"]:
-        assert joint["motor"] in cr.load_catalogue() and joint["source"]
+        assert joint["motor"] in cr.hardware.load_catalogue() and joint["source"]
         # The study's gearboxes are scaled units: the catalogue design takes a unit of the catalogue, at a
         # ratio it is sold with.
         assert joint["gearbox"] in gearboxes and joint["gear_ratio"] in gearboxes[joint["gearbox"]].ratios
@@ -760,7 +760,7 @@ def test_a_joint_may_take_gearboxes_of_other_kinds_in_the_catalogue_design():
             weak,
         )
     }
-    ratio = cr.Bounds(1.0, 200.0)
+    ratio = cr.optimize.Bounds(1.0, 200.0)
     default, _ = gearbox_options(own, ratio, 30.0, catalogue, count=1)
     assert [g.name for g, _ in default] == ["HD-a"]
     both, _ = gearbox_options(own, ratio, 30.0, catalogue, count=1, kinds=["harmonic", "planetary"])

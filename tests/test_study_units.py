@@ -200,7 +200,8 @@ def test_report_number_format(value, text):
 
 
 def test_every_pair_of_objectives_is_a_valid_pareto_spec():
-    from collision_reflex.study.schema import OBJECTIVE_NAMES, ParetoSpec
+    from collision_reflex.study.schema import ParetoSpec
+    from collision_reflex.vocabulary import OBJECTIVE_NAMES
 
     for pair in itertools.combinations(OBJECTIVE_NAMES, 2):
         assert ParetoSpec(objectives=list(pair)).points == 20

@@ -115,7 +115,9 @@ def test_bad_sweep_input(kwargs, name):
 def test_optional_gearbox_inertia_against_hand_computation():
     # A harmonic drive (figures of a test unit: 50 mm, J_g = 1e-6 kg m^2 at the input) scaled to each geared
     # motor's diameter: J_g(r) = 1e-6 (r/0.05)^4 at its own length, reflected N^2 (J_m + J_g) in the finger.
-    gearbox = cr.Gearbox("harmonic", diameter=0.05, length=0.03, mass=0.2, inertia=1e-6, rated_torque=30.0)
+    gearbox = cr.hardware.Gearbox(
+        "harmonic", diameter=0.05, length=0.03, mass=0.2, inertia=1e-6, rated_torque=30.0
+    )
     d, v = np.array([0.01, 0.03, 0.08]), np.array([0.5])
     with_box = radius_velocity_sweep(d, v, gearbox=gearbox)
     ratio = d / 0.060

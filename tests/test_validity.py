@@ -101,7 +101,7 @@ def test_map_rows_are_the_simulation_and_the_closed_form(arm, tiny_map):
     """Each row's numbers are a direct simulation and the 1D formula with the effective parameters in series."""
     row = _cell(tiny_map, 0, "spring_torque", 0.1, "robot")
     samples = arm.kinematics(np.array(Q)[None])
-    ref = cr.effective_parameters(samples, np.array(U)[None], 2.2e-3, 50.0, 50.0, 1.3)
+    ref = cr.arm.effective_parameters(samples, np.array(U)[None], 2.2e-3, 50.0, 50.0, 1.3)
     m_f, k, k_m, a = (float(getattr(ref, name)[0, 0]) for name in ("m_f", "k", "k_m", "a"))
     v0 = 0.1 * 3.0 / math.sqrt(2 * k * m_f)
     k_c = 10 * k_m

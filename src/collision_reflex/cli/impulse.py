@@ -7,7 +7,6 @@ import argparse
 import numpy as np
 
 from ..model.impulse import (
-    REACTION_MODES,
     collision_times,
     minimum_impulse,
     optimal_velocity,
@@ -16,6 +15,7 @@ from ..model.impulse import (
 )
 from ..plots import check_figure_path
 from ..plots.profile import plot_force_profile
+from ..vocabulary import REACTION_MODES
 from . import options
 
 # Defaults: the paper's direct-drive U8 actuator in its soft setting (one-shot fit, tab:one_shot), against

@@ -13,11 +13,11 @@ import numpy as np
 
 from .._io import atomic_open
 from ..errors import InvalidParameter
-from ..model.impulse import REACTION_MODES, optimal_velocity, total_impulse
-from ..model.sensing import SENSING_SCHEMES
+from ..model.impulse import optimal_velocity, total_impulse
 from ..plots import check_figure_path
 from ..plots.simulation import plot_sweep, plot_trace
 from ..simulate import CollisionSetup, Detection, contact_damping_for_restitution, simulate, sweep
+from ..vocabulary import REACTION_MODES, SENSING_SCHEMES
 from . import options
 
 if TYPE_CHECKING:

@@ -6,12 +6,11 @@ import argparse
 import math
 
 from ..errors import InvalidParameter
-from ..hardware.actuators import REFLECTED_INERTIA_PLACEMENTS
 from ..hardware.motors import REFERENCE_MOTOR_NAME, SCALING_LAWS, get_motor
 from ..hardware.sweeps import SWEEP_DEFAULTS, radius_velocity_sweep, stiffness_sweep
-from ..model.impulse import REACTION_MODES
 from ..plots import check_figure_path
 from ..plots.sweeps import check_heat_map_grid, plot_radius_velocity, plot_stiffness
+from ..vocabulary import REACTION_MODES, REFLECTED_INERTIA_PLACEMENTS
 from . import options
 
 _PLACEMENT_HELP = (

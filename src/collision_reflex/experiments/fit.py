@@ -50,13 +50,13 @@ import numpy as np
 from .. import _validate
 from ..errors import FitFailed
 from ..model.impulse import (
-    REACTION_MODES,
     PhaseImpulses,
     impact_pulse_duration,
     phase_impulses,
     reaction_duration,
     series_stiffness,
 )
+from ..vocabulary import REACTION_MODES
 from .sensor import SensorModel, model_samples
 from .traces import Trace
 from .window import ContactWindow

@@ -29,11 +29,11 @@ from ..errors import InvalidParameter
 from ..model import effective
 from ..model.impulse import series_stiffness
 from ..model.sensing import current_threshold_torque, threshold_force
+from ..vocabulary import REFLECTED_INERTIA_PLACEMENTS
 from .gearboxes import Gearbox
 from .motors import Motor
 
 __all__ = [
-    "REFLECTED_INERTIA_PLACEMENTS",
     "Actuator",
     "CollisionParameters",
     "CurrentThreshold",
@@ -42,9 +42,6 @@ __all__ = [
     "SensingScheme",
     "gear_ratio_for",
 ]
-
-REFLECTED_INERTIA_PLACEMENTS: tuple[str, ...] = ("finger", "robot")
-"""Where the reflected inertia ``N**2 J_m`` sits in the 1D model (see :meth:`Actuator.contact_parameters`)."""
 
 
 def gear_ratio_for(torque_required: ArrayLike, peak_torque: ArrayLike) -> float | np.ndarray:

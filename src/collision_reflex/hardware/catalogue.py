@@ -21,7 +21,7 @@ from pydantic import BaseModel, ConfigDict, ValidationError, field_validator
 from .._units import QuantityError, parse_quantity
 from .._yaml import NodeProblem, check_nodes, one_line
 from ..errors import CatalogueError
-from .gearbox_scaling import GEARBOX_KINDS
+from ..vocabulary import GEARBOX_KINDS
 
 # Field -> the unit a plain number is taken in (SI), and the pint dimensionality a quantity string must have.
 _MOTOR_UNITS = {

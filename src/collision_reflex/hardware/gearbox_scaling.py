@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["GEARBOX_KINDS", "GEARBOX_SCALING", "GearboxScaling"]
+__all__ = ["GEARBOX_SCALING", "GearboxScaling"]
 
 
 @dataclass(frozen=True)
@@ -35,4 +35,3 @@ GEARBOX_SCALING: dict[str, tuple[GearboxScaling, GearboxScaling, GearboxScaling]
     "cycloidal": (GearboxScaling(1, 2, 0), GearboxScaling(1, 4, 0), GearboxScaling(-1, 4, 0)),
     "ball_screw": (GearboxScaling(1, 2, 0), GearboxScaling(1, 4, 0), GearboxScaling(0, 3, 0)),
 }
-GEARBOX_KINDS: tuple[str, ...] = tuple(GEARBOX_SCALING)

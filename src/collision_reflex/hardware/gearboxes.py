@@ -30,7 +30,8 @@ import numpy as np
 
 from .. import _validate
 from ..errors import InvalidParameter
-from .gearbox_scaling import GEARBOX_KINDS, GEARBOX_SCALING
+from ..vocabulary import GEARBOX_KINDS
+from .gearbox_scaling import GEARBOX_SCALING
 
 __all__ = [
     "CatalogueGearbox",

@@ -35,21 +35,9 @@ from numpy.typing import ArrayLike
 from .. import _validate
 from .._io import atomic_open
 from ..errors import InvalidParameter
-from ..model.impulse import (
-    REACTION_MODES,
-    minimum_impulse,
-    optimal_velocity,
-    phase_impulses,
-    series_stiffness,
-)
-from .actuators import (
-    REFLECTED_INERTIA_PLACEMENTS,
-    Actuator,
-    CollisionParameters,
-    ForceThreshold,
-    PositionThreshold,
-    gear_ratio_for,
-)
+from ..model.impulse import minimum_impulse, optimal_velocity, phase_impulses, series_stiffness
+from ..vocabulary import REACTION_MODES, REFLECTED_INERTIA_PLACEMENTS
+from .actuators import Actuator, CollisionParameters, ForceThreshold, PositionThreshold, gear_ratio_for
 from .gearboxes import Gearbox
 from .motors import DEFAULT_SCALING_LAW, Motor, reference_motor, scaling_law
 

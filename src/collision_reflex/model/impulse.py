@@ -34,10 +34,7 @@ import numpy as np
 from .. import _validate
 from .._backend import is_symbolic, sin, sqrt, where
 from ..errors import InvalidParameter
-
-REACTION_MODES: tuple[str, ...] = ("at_rest", "moving")
-"""``"at_rest"``: the paper's reaction, robot mass at rest at detection (its default).
-``"moving"``: robot mass still moving toward the constraint at ``v_r`` at detection."""
+from ..vocabulary import REACTION_MODES
 
 
 @dataclass(frozen=True)

@@ -17,35 +17,14 @@ The formulas are plain arithmetic, so they take floats, NumPy arrays and CasADi 
 
 from __future__ import annotations
 
-import warnings
 from typing import Any
 
 from .. import _validate
-
-SENSING_SCHEMES: tuple[str, ...] = ("force", "position", "current")
-"""The sensing schemes, see the module docstring."""
-
-DEPRECATED_SCHEMES: dict[str, str] = {"joint_torque": "current"}
-"""Old spellings still accepted (with a ``DeprecationWarning``, once per spelling) and their new names."""
-
-_warned: set[str] = set()
+from ..vocabulary import SENSING_SCHEMES
 
 
 def sensing_scheme(name: str, allowed: tuple[str, ...] = SENSING_SCHEMES) -> str:
-    """The scheme called ``name``, checked against ``allowed``.
-
-    A deprecated spelling is mapped to its new name with a warning (once per process and spelling).
-    """
-    if name in DEPRECATED_SCHEMES:
-        new = DEPRECATED_SCHEMES[name]
-        if name not in _warned:
-            _warned.add(name)
-            warnings.warn(
-                f"the sensing scheme {name!r} is deprecated; call it {new!r}",
-                DeprecationWarning,
-                stacklevel=3,
-            )
-        name = new
+    """The scheme called ``name``, checked against ``allowed``."""
     _validate.choice("sensing", name, allowed)
     return name
 

@@ -40,12 +40,13 @@ from typing import NamedTuple
 import numpy as np
 
 from ..errors import InvalidParameter, SolverFailed
+from ..vocabulary import ACTIVE_SET_CHOICES, IMPULSE_OBJECTIVES
 from .active_samples import first_active_set, violated_samples
 from .active_set_result import ActiveSetResult, ActiveSetRound, result_fields, with_rounds
 from .design_result import DesignResult, check_agreement
 from .evaluate import evaluate_design
 from .ipopt import IpoptOptions
-from .objectives import IMPULSE_OBJECTIVES, impulse_objectives
+from .objectives import impulse_objectives
 from .problem import DesignProblem
 from .samples import ContactSamples
 from .solve import solve
@@ -59,9 +60,6 @@ Chosen from one solve of each method, each in a fresh process, on the Panda benc
 (``benchmarks/optimize_samples_scaling.py --threshold`` measures them): with few samples the two are alike (the
 active set then holds most samples), with more the full NLP's cost grows much faster than the active set's."""
 
-ACTIVE_SET_CHOICES = ("auto", "always", "never")
-"""How a problem's samples are solved: ``auto`` on an active set from :data:`ACTIVE_SET_THRESHOLD` samples,
-``always`` on an active set, ``never`` all at once (the full NLP)."""
 
 FULL_PROBLEM_TOLERANCE = 1e-6
 """Largest violation of a row of the full NLP (rows are scaled to order one) allowed at the design found."""

@@ -28,6 +28,7 @@ import numpy as np
 
 from .._interrupt import interruptible
 from ..errors import InvalidParameter, SolverFailed
+from ..vocabulary import IMPULSE_OBJECTIVES
 from .active_set import solve_active_set, uses_active_set
 from .active_set_result import ActiveSetResult
 from .build import build_problem
@@ -35,7 +36,7 @@ from .candidates import CataloguePart
 from .design import Design
 from .design_result import DesignResult
 from .ipopt import IpoptOptions
-from .objectives import IMPULSE_OBJECTIVES, objective_expression
+from .objectives import objective_expression
 from .parts import (
     REQUIREMENT_PASSES,
     catalogue_problem,

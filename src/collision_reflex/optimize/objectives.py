@@ -28,8 +28,6 @@ A worst case leaves the samples that do not bind it, and the joints that do not 
 small pull toward a lower mean picks a definite design among the equals and pins the per-sample auxiliary
 variables, at a cost of about this relative amount in the main objective."""
 
-IMPULSE_OBJECTIVES = ("worst_case_impulse", "mean_impulse", "cvar_impulse")
-"""The objectives that are statistics of the per-sample collision impulses (:func:`impulse_objectives`)."""
 
 CVAR_LEVEL = 0.95
 """Level of the ``cvar_impulse`` objective: the mean impulse of the worst 5 % of the drawn samples. A 1 % tail

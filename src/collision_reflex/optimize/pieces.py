@@ -17,7 +17,8 @@ import numpy as np
 
 from .. import _validate
 from ..errors import InvalidParameter
-from .active_set import ACTIVE_SET_CHOICES, solve_active_set, uses_active_set
+from ..vocabulary import ACTIVE_SET_CHOICES
+from .active_set import solve_active_set, uses_active_set
 from .active_set_result import ActiveSetResult
 from .blas import single_threaded_blas
 from .design_result import DesignResult

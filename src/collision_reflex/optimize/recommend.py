@@ -9,8 +9,9 @@ from collections.abc import Callable, Hashable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, TypeVar, cast
 
+from ..vocabulary import IMPULSE_OBJECTIVES
 from .dominance import MERGE_TOLERANCE, same_point
-from .objectives import IMPULSE_OBJECTIVES, OBJECTIVES
+from .objectives import OBJECTIVES
 
 if TYPE_CHECKING:
     from .design_result import DesignResult

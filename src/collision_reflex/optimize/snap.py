@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 from ..errors import InvalidParameter
-from .active_set import ACTIVE_SET_CHOICES
+from ..vocabulary import ACTIVE_SET_CHOICES
 from .candidates import (
     DEFAULT_CANDIDATES,
     DEFAULT_GEARBOX_CANDIDATES,

@@ -15,11 +15,6 @@ PER_JOINT_VARIABLES = ("stator_diameter", "stack_length", "gear_ratio", "softwar
 MODULE_VARIABLES = ("stator_diameter", "stack_length", "gear_ratio")
 """The per-joint variables that make an actuator: joints of one module share them (:class:`DesignSpace`)."""
 GLOBAL_VARIABLES = ("threshold", "approach_velocity")
-OPTIMIZED_SENSING_SCHEMES: tuple[str, ...] = ("force", "position")
-"""The schemes of :data:`collision_reflex.model.sensing.SENSING_SCHEMES` the optimiser handles: a
-contact-force threshold ``F_s`` [N] or a contact-point position-error threshold ``e_th`` [m] with
-``F_s = k(u) e_th``. A motor-current threshold (``"current"``) makes the contact threshold a minimum over joints,
-which is evaluated but not optimised."""
 
 
 SUPPORTED_RANGES: dict[str, tuple[float, float]] = {

@@ -21,13 +21,11 @@ import numpy as np
 
 from .. import _validate
 from ..errors import InvalidParameter
-from ..hardware.actuators import REFLECTED_INERTIA_PLACEMENTS
 from ..hardware.gearboxes import CatalogueGearbox, ScaledGearbox
 from ..hardware.motors import Motor, MotorQuantities, scaled_motor_quantities
 from ..model.effective import reflected_inertia
-from ..model.impulse import REACTION_MODES
 from ..model.sensing import sensing_scheme
-from .space import OPTIMIZED_SENSING_SCHEMES
+from ..vocabulary import OPTIMIZED_SENSING_SCHEMES, REACTION_MODES, REFLECTED_INERTIA_PLACEMENTS
 
 
 @dataclass(frozen=True)

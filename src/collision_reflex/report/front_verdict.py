@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from ..vocabulary import IMPULSE_OBJECTIVES
 from .wording import general, group_name, objective_unit, percent, words
 
 FLAT_SPAN = 1.0
@@ -87,8 +88,6 @@ def flat_impulse_reason(
     The impact phase ``m_f v0`` is the links' (and, with ``reflected_inertia_in: finger``, the rotors'); the
     sensing and reaction phases are what the actuators set. Empty unless an impulse objective is flat.
     """
-    from ..optimize.objectives import IMPULSE_OBJECTIVES  # lazy: casadi
-
     points, names = pareto.get("points") or [], pareto.get("objectives") or []
     phases = record.get("phases")
     if not points or not phases:
@@ -133,8 +132,6 @@ def lightest_near_best(pareto: Mapping[str, Any], within: float = NEAR_BEST) -> 
 
     None when the front does not trade an impulse objective against the actuator mass, or is one design.
     """
-    from ..optimize.objectives import IMPULSE_OBJECTIVES  # lazy: casadi
-
     names = pareto["objectives"]
     impulse = next((n for n in IMPULSE_OBJECTIVES if n in names), None)
     points = pareto["points"]

@@ -49,12 +49,10 @@ from .arm import ArmCollision, simulate_arm_collision
 from .contact import contact_damping_for_restitution, contact_restitution
 from .integrator import simulate
 from .result import SimulationResult
-from .setup import DETECTION_KINDS, DRIVES, CollisionSetup, Detection
+from .setup import CollisionSetup, Detection
 from .sweeps import SWEEP_PARAMETERS, Sweep, sweep
 
 __all__ = [
-    "DETECTION_KINDS",
-    "DRIVES",
     "SWEEP_PARAMETERS",
     "ArmCollision",
     "CollisionSetup",

@@ -57,16 +57,12 @@ from typing import Any
 import numpy as np
 
 from .. import _validate
+from ..vocabulary import ARM_DRIVES, REACTION_MODES
 from .arm_detection import DETECTIONS
 from .arm_dynamics import ArmDynamics
 from .arm_inputs import ArmJoints, ImpactClosedForm, arm_joints, arm_sensing, impact_closed_form
 from .arm_integration import ArmTrace, integrate_arm_collision
 
-ARM_REACTIONS: tuple[str, ...] = ("at_rest", "moving")
-ARM_DRIVES: tuple[str, ...] = ("ideal", "impedance")
-"""``"ideal"``: velocity-controlled motors with the software stiffness as an ideal admittance (massless).
-``"impedance"``: the 1D simulator's impedance drive per joint, motor torque ``k_s (theta_ref - theta) + d_s
-(theta_ref' - theta')`` saturated at the torque limit, the rotor inertia integrated."""
 RETREATS: tuple[str, ...] = ("along_u", "saturated")
 """``"along_u"``: the motors push with ``tau = -F_a J^T n``, each joint at most at its limit and the first at
 it, the closed form's reaction. ``"saturated"``: a retreat command saturates every joint, ``tau_i = -tau_max,i
@@ -236,7 +232,7 @@ def _check_settings(
     blanking: float | None,
 ) -> None:
     """Check the simulation's choices and the controller's settings (see :func:`simulate_arm_collision`)."""
-    _validate.choice("reaction", reaction, ARM_REACTIONS)
+    _validate.choice("reaction", reaction, REACTION_MODES)
     _validate.choice("detection", detection, DETECTIONS)
     _validate.choice("retreat", retreat, RETREATS)
     _validate.choice("drive", drive, ARM_DRIVES)

@@ -22,11 +22,8 @@ from ..errors import InvalidParameter
 from ..model.impulse import phase_impulses, series_stiffness, sprung_reaction
 from ..model.joint_space import DETECTIONS as JOINT_SPACE_DETECTIONS
 from ..model.joint_space import JointSpaceArm
-from .arm import ARM_REACTIONS
+from ..vocabulary import REACTION_MODES, REFLECTED_INERTIA_PLACEMENTS
 from .dynamics import admittance_share
-
-PLACEMENTS: tuple[str, ...] = ("robot", "finger")
-"""Where the closed form puts the reflected inertia ``N^2 J_m`` (see :data:`REFLECTED_INERTIA_PLACEMENTS`)."""
 
 REACTION_MODELS: tuple[str, ...] = ("constant", "sprung", "joint_space")
 """The closed form's reaction: ``"constant"``, the paper's constant acceleration ``a = F_a / m_r``;
@@ -150,8 +147,8 @@ def arm_closed_form(
     reaction: ``"moving"`` (robot still moving at detection, as the simulation) or ``"at_rest"``.
     """
     arm = joints.on(arm)
-    _validate.choice("placement", placement, PLACEMENTS)
-    _validate.choice("reaction", reaction, ARM_REACTIONS)
+    _validate.choice("placement", placement, REFLECTED_INERTIA_PLACEMENTS)
+    _validate.choice("reaction", reaction, REACTION_MODES)
     _validate.positive("contact_stiffness", contact_stiffness, allow_inf=True)
     nv = int(arm.nv)
     inertia = np.broadcast_to(np.asarray(joints.reflected_inertia, dtype=float), (nv,))

@@ -159,7 +159,7 @@ class HybridCollision:
         return dy
 
     def measurement(self, t: float, y: np.ndarray, start: np.ndarray) -> float:
-        """What the detector sees (see :data:`DETECTION_KINDS`)."""
+        """What the detector sees (see :data:`~collision_reflex.vocabulary.SENSING_SCHEMES`)."""
         y = self.resolved(y)
         kind = self.s.detection.kind
         if kind == "force":

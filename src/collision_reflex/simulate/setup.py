@@ -15,16 +15,7 @@ from .. import _validate
 from ..errors import InvalidParameter
 from ..model.impulse import PhaseImpulses, impact_pulse_duration, phase_impulses, series_stiffness
 from ..model.sensing import threshold_force
-
-DRIVES: tuple[str, ...] = ("ideal", "impedance", "free")
-"""Robot-side drive during the approach: see :mod:`collision_reflex.simulate`."""
-
-DETECTION_KINDS: tuple[str, ...] = ("force", "position", "current")
-"""``"force"``: the mechanical spring's force (a force sensor measures its own deflection) [N];
-``"position"``: the output (finger) position lag behind the reference, beyond its pre-contact value [m];
-``"current"``: the actuator force, i.e. motor current times torque constant, seen at the output [N] (with the
-ideal drive: spring force plus friction plus ``m_r`` times the robot's acceleration; the ideal controller's
-impulsive force at the instant the finger stops is not counted, as a real current loop would filter it)."""
+from ..vocabulary import DRIVES, SENSING_SCHEMES
 
 
 def oscillation_period(mass: float, stiffness: float) -> float:
@@ -38,7 +29,12 @@ class Detection:
 
     Parameters
     ----------
-    kind: one of :data:`DETECTION_KINDS`.
+    kind: one of :data:`~collision_reflex.vocabulary.SENSING_SCHEMES`: ``"force"`` watches the mechanical
+        spring's force (a force sensor measures its own deflection) [N]; ``"position"`` the output (finger)
+        position lag behind the reference, beyond its pre-contact value [m]; ``"current"`` the actuator force,
+        i.e. motor current times torque constant, seen at the output [N] (with the ideal drive: spring force
+        plus friction plus ``m_r`` times the robot's acceleration; the ideal controller's impulsive force at
+        the instant the finger stops is not counted, as a real current loop would filter it).
     threshold: detection threshold: a force [N] for ``"force"`` and ``"current"``, a position error ``e_th``
         [m] for ``"position"``.
     """
@@ -47,7 +43,7 @@ class Detection:
     threshold: float
 
     def __post_init__(self) -> None:
-        _validate.choice("detection kind", self.kind, DETECTION_KINDS)
+        _validate.choice("detection kind", self.kind, SENSING_SCHEMES)
         _scalar(
             self,
             "threshold",

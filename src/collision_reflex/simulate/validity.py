@@ -30,10 +30,11 @@ import numpy.typing as npt
 from .. import _validate
 from ..errors import InvalidParameter, SimulationError
 from ..model.impulse import optimal_velocity, series_stiffness
+from ..vocabulary import ARM_DRIVES, REFLECTED_INERTIA_PLACEMENTS
 from . import arm as arm_simulation
 from .arm_detection import DETECTIONS
 from .contact import damping_from_ratio
-from .design_closed_form import PLACEMENTS, REACTION_MODELS, ArmClosedForm, JointDesign, arm_closed_form
+from .design_closed_form import REACTION_MODELS, ArmClosedForm, JointDesign, arm_closed_form
 
 VELOCITY_RATIOS: tuple[float, ...] = (0.1, 0.3, 1.0, 3.0, 10.0)
 """Approach velocities swept, as multiples of the closed form's optimum ``v* = F_s / sqrt(2 k m_f)``."""
@@ -47,10 +48,6 @@ TOLERANCE = 0.05
 
 MAX_STEPS = 200_000
 """Default work budget of one arm simulation [integrator steps] (the simulator's; tens of seconds at most)."""
-
-DRIVES: tuple[str, ...] = arm_simulation.ARM_DRIVES
-"""The simulated drives: ``"ideal"`` (an ideal admittance) and ``"impedance"`` (the physical impedance loop
-with the rotor inertia; a finite software stiffness needed)."""
 
 CONTACT_DAMPING_RATIO = 2.0
 """The simulated contact's damping, as a ratio of critical for the finger mass (the simulator's default: a
@@ -73,7 +70,7 @@ class ValidityCase:
     ----------
     configuration, direction: indices into the map's configurations and directions.
     velocity_ratio: ``v0 / v*``; stiffness_ratio: contact over joint stiffness along ``u``; detection: scheme;
-    drive: :data:`DRIVES`.
+    drive: :data:`~collision_reflex.vocabulary.ARM_DRIVES`.
     """
 
     configuration: int
@@ -93,7 +90,7 @@ def validity_map(
     velocity_ratios: Sequence[float] = VELOCITY_RATIOS,
     stiffness_ratios: Sequence[float] = STIFFNESS_RATIOS,
     detections: Sequence[str] | None = None,
-    placements: Sequence[str] = PLACEMENTS,
+    placements: Sequence[str] = REFLECTED_INERTIA_PLACEMENTS,
     tolerance: float = TOLERANCE,
     reaction: str = "moving",
     max_steps: float = MAX_STEPS,
@@ -114,7 +111,7 @@ def validity_map(
     tolerance: relative agreement that counts as valid [-].
     reaction: the closed form's reaction variant (``"moving"``: the robot's velocity at detection).
     max_steps: work budget of one simulation [integrator steps]; a case beyond it is refused and recorded.
-    drives: the simulated drives (:data:`DRIVES`); ``"impedance"`` needs a finite software stiffness.
+    drives: the simulated drives (:data:`~collision_reflex.vocabulary.ARM_DRIVES`); ``"impedance"`` needs a finite software stiffness.
     contact_damping_ratio: the contact's damping as a ratio of critical for the finger mass (dimensionless).
 
     Returns
@@ -209,7 +206,7 @@ def _check_map_settings(
     for scheme in schemes:
         _validate.choice("detection", scheme, available_detections())
     for drive in drives:
-        _validate.choice("drive", drive, DRIVES)
+        _validate.choice("drive", drive, ARM_DRIVES)
     if "impedance" in drives and not np.all(np.isfinite(np.asarray(joints.software_stiffness, dtype=float))):
         raise InvalidParameter(
             "joints.software_stiffness",
@@ -219,7 +216,7 @@ def _check_map_settings(
         )
     _validate.positive("contact_damping_ratio", contact_damping_ratio)
     for placement in placements:
-        _validate.choice("placement", placement, PLACEMENTS)
+        _validate.choice("placement", placement, REFLECTED_INERTIA_PLACEMENTS)
     return schemes
 
 
@@ -260,7 +257,7 @@ def simulated_impulse(
     approach_velocity: [m/s]; contact_stiffness: the wall's stiffness [N/m].
     detection: a scheme of :func:`available_detections`; reaction: the closed-form variant the simulator
         reports beside (``"moving"`` or ``"at_rest"``); max_steps: the work budget [integrator steps].
-    drive: :data:`DRIVES`; contact_damping_ratio: the contact's damping, a ratio of critical for the finger.
+    drive: :data:`~collision_reflex.vocabulary.ARM_DRIVES`; contact_damping_ratio: the contact's damping, a ratio of critical for the finger.
     """
     start = time.perf_counter()
     try:

@@ -1,0 +1,63 @@
+"""The closed sets of names the toolkit speaks in, each written once.
+
+The study schema, the optimiser, the simulator and the command line import them from here: a name added or
+renamed here is added or renamed everywhere. Each is a ``Literal`` type (for the schema and type checkers) and
+the tuple of its values, in the order the outputs list them.
+"""
+
+from __future__ import annotations
+
+from typing import Literal, get_args
+
+SensingScheme = Literal["force", "position", "current"]
+"""``"force"``: a contact-force threshold [N]; ``"position"``: a position-error threshold [m] at the contact
+point; ``"current"``: a motor-current (joint-torque) threshold [N·m] per joint."""
+SENSING_SCHEMES: tuple[SensingScheme, ...] = get_args(SensingScheme)
+
+OptimizedSensingScheme = Literal["force", "position"]
+"""The sensing schemes the optimiser handles: a current threshold makes the contact threshold a minimum over
+joints, which is evaluated but not optimised."""
+OPTIMIZED_SENSING_SCHEMES: tuple[OptimizedSensingScheme, ...] = get_args(OptimizedSensingScheme)
+
+ObjectiveName = Literal[
+    "worst_case_impulse", "mean_impulse", "cvar_impulse", "actuator_mass", "approach_velocity"
+]
+"""The design objectives (their sense, unit and meaning: :data:`collision_reflex.optimize.objectives.OBJECTIVES`)."""
+OBJECTIVE_NAMES: tuple[ObjectiveName, ...] = get_args(ObjectiveName)
+
+ImpulseObjective = Literal["worst_case_impulse", "mean_impulse", "cvar_impulse"]
+"""The objectives that are statistics of the per-sample collision impulses."""
+IMPULSE_OBJECTIVES: tuple[ImpulseObjective, ...] = get_args(ImpulseObjective)
+
+ScalingLawName = Literal["haddadin", "isometric", "empirical", "quadruped"]
+"""The motor scaling laws (:data:`collision_reflex.hardware.motors.SCALING_LAWS`)."""
+SCALING_LAW_NAMES: tuple[ScalingLawName, ...] = get_args(ScalingLawName)
+
+GearboxKind = Literal["planetary", "parallel_shaft", "harmonic", "cycloidal", "ball_screw"]
+"""The gearbox kinds with a scaling law (:data:`collision_reflex.hardware.gearboxes.GEARBOX_SCALING`)."""
+GEARBOX_KINDS: tuple[GearboxKind, ...] = get_args(GearboxKind)
+
+ExecutorName = Literal["serial", "processes", "dask"]
+"""Where a study's solves run: in the calling process, a local process pool, or a Dask cluster."""
+EXECUTORS: tuple[ExecutorName, ...] = get_args(ExecutorName)
+
+ReactionMode = Literal["at_rest", "moving"]
+"""The closed form's reaction: the robot mass at rest at detection (the paper's), or still moving."""
+REACTION_MODES: tuple[ReactionMode, ...] = get_args(ReactionMode)
+
+Placement = Literal["robot", "finger"]
+"""Where the reflected rotor inertia ``N² J_m`` counts: with the finger (a stiff transmission) or with the robot
+behind the mechanical spring."""
+REFLECTED_INERTIA_PLACEMENTS: tuple[Placement, ...] = get_args(Placement)
+
+Drive = Literal["ideal", "impedance", "free"]
+"""The 1D simulator's robot-side drive during the approach (:mod:`collision_reflex.simulate`)."""
+DRIVES: tuple[Drive, ...] = get_args(Drive)
+
+ArmDrive = Literal["ideal", "impedance"]
+"""The drives the arm simulator has (the 1D ``"free"`` drive has no arm counterpart)."""
+ARM_DRIVES: tuple[ArmDrive, ...] = get_args(ArmDrive)
+
+ActiveSetMode = Literal["auto", "always", "never"]
+"""Whether the optimiser solves on an active set of samples: by sample count, always, or never."""
+ACTIVE_SET_CHOICES: tuple[ActiveSetMode, ...] = get_args(ActiveSetMode)
