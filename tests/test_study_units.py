@@ -18,7 +18,7 @@ from collision_reflex.report.wording import number
 from collision_reflex.study.actuator_study import sensing_scheme
 from collision_reflex.study.executors import SerialExecutor, open_executor
 from collision_reflex.study.runner import smoke_study
-from collision_reflex.study.schema import SensingSpec
+from collision_reflex.study.actuator_specs import SensingSpec
 from collision_reflex.study.store import OutputFolderInUse, RunFolder
 
 
@@ -199,7 +199,8 @@ def test_report_number_format(value, text):
 
 
 def test_every_pair_of_objectives_is_a_valid_pareto_spec():
-    from collision_reflex.study.schema import OBJECTIVE_NAMES, ParetoSpec
+    from collision_reflex.study.design_specs import OBJECTIVE_NAMES
+    from collision_reflex.study.run_specs import ParetoSpec
 
     for pair in itertools.combinations(OBJECTIVE_NAMES, 2):
         assert ParetoSpec(objectives=list(pair)).points == 20

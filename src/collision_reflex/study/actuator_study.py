@@ -18,7 +18,8 @@ from ..errors import CollisionReflexError
 from ..model.impulse import minimum_impulse, optimal_velocity, phase_impulses, series_stiffness
 from .load import LoadedStudy
 from .prepare import check_motors, gearbox_for, motor_for
-from .schema import ActuatorCandidate, ActuatorStudy, SensingSpec
+from .actuator_specs import SensingSpec
+from .schema import ActuatorCandidate, ActuatorStudy
 
 
 def check_actuator_study(loaded: LoadedStudy) -> dict[str, Any]:

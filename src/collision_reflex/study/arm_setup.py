@@ -25,7 +25,9 @@ from .load import LoadedStudy, parse_study
 from .prepare import check_motors, gearbox_for, joint_actuators, per_joint_bounds
 from .robot import load_arm
 from .samples import configuration_samples, contact_domain, direction_samples, domain_draw
-from .schema import DIRECT_DRIVE, PER_JOINT_DESIGN_VARIABLES, ArmStudy, PlacementRuleSpec, ScaledGearboxSpec
+from .actuator_specs import DIRECT_DRIVE, PlacementRuleSpec, ScaledGearboxSpec
+from .design_specs import PER_JOINT_DESIGN_VARIABLES
+from .schema import ArmStudy
 from .source import PathKey
 
 if TYPE_CHECKING:

@@ -23,7 +23,8 @@ from ..arm.duty_cycle import DutyCycle, Payload
 from ..arm.rating import Rating
 from ..errors import InvalidParameter, StudyFileError, StudyProblem, TrajectoryError
 from .load import LoadedStudy
-from .schema import ArmStudy, DutyCycleSpec
+from .motion_specs import DutyCycleSpec
+from .schema import ArmStudy
 
 if TYPE_CHECKING:
     from ..arm import Arm

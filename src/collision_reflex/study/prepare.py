@@ -14,14 +14,9 @@ from typing import TYPE_CHECKING, Any
 from ..errors import StudyFileError, StudyProblem
 from .duty import describe_duty_cycle, prismatic_joints, static_requirement, study_duty_cycle
 from .load import LoadedStudy
-from .schema import (
-    MODULE_DESIGN_VARIABLES,
-    PER_JOINT_DESIGN_VARIABLES,
-    ActuatorStudy,
-    ArmStudy,
-    GearboxSpec,
-    MotorSpec,
-)
+from .actuator_specs import GearboxSpec, MotorSpec
+from .design_specs import MODULE_DESIGN_VARIABLES, PER_JOINT_DESIGN_VARIABLES
+from .schema import ActuatorStudy, ArmStudy
 from .source import PathKey, excerpt
 
 if TYPE_CHECKING:

@@ -11,7 +11,8 @@ from typing import TYPE_CHECKING
 
 from ..errors import FrameNotFound, InvalidParameter, StudyFileError, StudyProblem, UrdfError
 from .load import LoadedStudy
-from .schema import PER_JOINT_DESIGN_VARIABLES, ArmStudy
+from .design_specs import PER_JOINT_DESIGN_VARIABLES
+from .schema import ArmStudy
 from .source import PathKey, excerpt
 
 if TYPE_CHECKING:

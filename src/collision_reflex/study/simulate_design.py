@@ -25,7 +25,7 @@ import numpy as np
 if TYPE_CHECKING:
     from ..optimize import DesignProblem, DesignResult, ParetoSet
     from .arm_setup import StudyProblems
-    from .schema import SimulateSpec
+    from .run_specs import SimulateSpec
     from .store import RunFolder
 
 

@@ -13,7 +13,7 @@ import copy
 import itertools
 from typing import TYPE_CHECKING, Any
 
-from .schema import DIRECT_DRIVE
+from .actuator_specs import DIRECT_DRIVE
 
 if TYPE_CHECKING:
     from .load import LoadedStudy

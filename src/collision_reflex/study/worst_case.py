@@ -18,7 +18,8 @@ import numpy as np
 from ..optimize.pareto import one_at_a_time
 from ..optimize.worst_case import WorstCase, search_worst_case
 from .arm_setup import ExtraSamples, StudyProblems
-from .schema import ArmStudy, SearchSpec
+from .run_specs import SearchSpec
+from .schema import ArmStudy
 
 if TYPE_CHECKING:
     from ..optimize import DesignResult
