@@ -15,10 +15,10 @@ import pytest
 from collision_reflex.model.impulse import phase_impulses, series_stiffness
 from collision_reflex.optimize.pareto import epsilon_grid, non_dominated
 from collision_reflex.report.wording import number
+from collision_reflex.study.actuator_specs import SensingSpec
 from collision_reflex.study.actuator_study import sensing_scheme
 from collision_reflex.study.executors import SerialExecutor, open_executor
-from collision_reflex.study.runner import smoke_study
-from collision_reflex.study.actuator_specs import SensingSpec
+from collision_reflex.study.resolve import smoke_study
 from collision_reflex.study.store import OutputFolderInUse, RunFolder
 
 

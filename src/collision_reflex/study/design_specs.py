@@ -65,6 +65,12 @@ def _variable_model(name: str, quantity: Any, doc: str) -> type[Spec]:
             assert self.min is not None and self.max is not None  # guaranteed by _bounds
             return (self.min, self.max)
 
+        @property
+        def free(self) -> bool:
+            """Whether the optimiser may change it (its bounds differ)."""
+            lower, upper = self.bounds
+            return bool(lower < upper)
+
     Bound.__name__ = Bound.__qualname__ = f"{name}Bounds"
     Bound.__doc__ = doc
     return Bound
