@@ -41,7 +41,9 @@ def test_a_run_parses_its_study_once_and_its_workers_get_the_object(tmp_path, mo
 
     monkeypatch.setattr(pool, "submit", recorded)
     study = ROOT / "studies" / "two_link_planetary.yaml"
-    run = run_study(study, tmp_path / "out", quiet=True, smoke=True, executor=executor, workers=1, figures=False)
+    run = run_study(
+        study, tmp_path / "out", quiet=True, smoke=True, executor=executor, workers=1, figures=False
+    )
     assert parsed == [str(study)]  # once, in this process
     text = (run.folder / "study.resolved.yaml").read_text(encoding="utf-8")
     assert not any(isinstance(item, str) and item == text for item in received)

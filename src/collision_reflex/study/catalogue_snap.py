@@ -18,17 +18,10 @@ from typing import TYPE_CHECKING, Any
 from ..hardware.catalogue import packaged_catalogue_path, read_entries
 from ..hardware.gearboxes import load_gearbox_catalogue
 from ..hardware.motors import Motor
+from ..optimize import snap as snapping  # by module: a test replaces its functions
 from ..optimize.blas import single_threaded_blas
 from ..optimize.pareto import built_problem, recommend
 from ..optimize.results import design_record
-from ..optimize.snap import (
-    catalogue_problem,
-    evaluate_parts,
-    joint_candidates,
-    quick_parts,
-    snap_to_catalogue,
-    solved_or_status,
-)
 from .arm_results import CatalogueRecord, undecided
 from .load import LoadedStudy
 from .problems import IPOPT_OPTIONS, StudyProblems
@@ -125,7 +118,7 @@ def catalogue_results(
     started = time.perf_counter()
     problem = built_problem(problems, problems.objective)
     recommendation = recommend(chosen, front, problems.objective)
-    snap = snap_to_catalogue(
+    snap = snapping.snap_to_catalogue(
         problem,
         recommendation.result,
         catalogue.motors,
@@ -143,7 +136,7 @@ def catalogue_results(
     design = None
     if snap.result is not None and snap.parts is not None:
         design = design_record(problem, snap.result, "catalogue design", catalogue.motors)
-        parts_problem = catalogue_problem(problem, snap.parts, problems.setup.arm)
+        parts_problem = snapping.catalogue_problem(problem, snap.parts, problems.setup.arm)
         design["undecided"] = undecided(problems, parts_problem, snap.result)
     results = front.points if front is not None and front.points else (chosen,)
     return {
@@ -208,7 +201,7 @@ def solve_study_parts(
     """
     with _SNAP_LOCK, single_threaded_blas():
         problem = built_problem(problems, problems.objective)
-        return solved_or_status(
+        return snapping.solved_or_status(
             problem, optimum, parts, problems.setup.arm, IPOPT_OPTIONS, problems.active_set, warm
         )
 
@@ -255,13 +248,13 @@ def quick_snap_record(
     ``objectives``, ``difference``, ``relative_difference``: as in :class:`CatalogueRecord` (empty without
     parts).
     """
-    joints = joint_candidates(
+    joints = snapping.joint_candidates(
         problem, result, catalogue.motors, 1, catalogue.gearboxes or None, 1, screen=False
     )
     missing = [
         {"joint": j.joint, "nearest": j.nearest, "misses": list(j.misses)} for j in joints if not j.parts
     ]
-    parts = quick_parts(joints, result.design)
+    parts = snapping.quick_parts(joints, result.design)
     record: dict[str, Any] = {
         "parts": [j.parts[0].label if j.parts else None for j in joints]
         if parts is None
@@ -275,7 +268,7 @@ def quick_snap_record(
     }
     if parts is None:
         return record
-    evaluated = evaluate_parts(problem, result.design, parts)
+    evaluated = snapping.evaluate_parts(problem, result.design, parts)
     continuous = result.numpy_objectives
     difference = {k: v - continuous[k] for k, v in evaluated.objectives.items()}
     record.update(

@@ -38,6 +38,7 @@ from ..optimize.pareto import (
 from ..report import write_outputs
 from ..report.outputs import StageTimes
 from ..report.verdict import verdict
+from . import simulate_design
 from .actuator_study import check_actuator_study, evaluate_actuator_study
 from .arm_results import CatalogueRecord, arm_results
 from .arm_setup import ExtraSamples
@@ -48,7 +49,6 @@ from .problems import IPOPT_OPTIONS, StudyProblems, checked_setup
 from .progress import RunProgress
 from .resolve import ResolvedStudy, resolve_study
 from .schema import ArmStudy
-from .simulate_design import simulate_designs
 from .store import OutputFolderUnusable, RunFolder
 from .transmission_choice import choose_transmissions
 from .worst_case import exchanges_samples, search_designs, violators
@@ -258,7 +258,7 @@ def _run_arm(
         results["transmission_choice"] = transmissions
     if study.simulate is not None:
         recommended = recommend(optimum, front, problems.objective).result
-        results["simulation"] = stages.timed("simulation", simulate_designs)(
+        results["simulation"] = stages.timed("simulation", simulate_design.simulate_designs)(
             problems, recommended, front, study.simulate, folder
         )
     results["verdict"] = stages.timed("results", verdict)(results)
