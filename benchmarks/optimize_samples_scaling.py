@@ -83,12 +83,12 @@ UR5_DIRECTIONS = 14
 
 def ur5_builder(n_config: int):
     """``studies/ur5.yaml`` with ``n_config`` random configurations: all samples and the problem on given ones."""
-    from collision_reflex.study.arm_setup import StudyProblems
     from collision_reflex.study.load import parse_study
-    from collision_reflex.study.resolve import resolved_yaml
+    from collision_reflex.study.problems import StudyProblems
+    from collision_reflex.study.resolve import resolve_study
 
     text = UR5_STUDY.read_text().replace("count: 24, seed: 5", f"count: {n_config}, seed: 5")
-    problems = StudyProblems(resolved_yaml(parse_study(text, str(UR5_STUDY))))
+    problems = StudyProblems(resolve_study(parse_study(text, str(UR5_STUDY), UR5_STUDY.parent)))
 
     def build(chosen: cr.ContactSamples) -> cr.DesignProblem:
         return problems(problems.objective, (), chosen)

@@ -63,16 +63,10 @@ def double_pendulum() -> tuple[cr.Arm, cr.DesignProblem]:
 
 
 def panda_smoke() -> tuple[cr.Arm, cr.DesignProblem]:
-    import yaml
+    from collision_reflex.study.problems import StudyProblems
+    from collision_reflex.study.resolve import resolve_study
 
-    from collision_reflex.study.arm_setup import StudyProblems
-    from collision_reflex.study.load import parse_study
-    from collision_reflex.study.resolve import resolved_study, resolved_yaml
-    from collision_reflex.study.runner import smoke_study
-
-    loaded = cr.load_study(ROOT / "studies" / "panda.yaml")
-    small = parse_study(yaml.safe_dump(smoke_study(resolved_study(loaded))), "panda smoke", loaded.directory)
-    problems = StudyProblems(resolved_yaml(small))
+    problems = StudyProblems(resolve_study(cr.load_study(ROOT / "studies" / "panda.yaml"), smoke=True))
     return problems.setup.arm, problems(problems.objective)
 
 

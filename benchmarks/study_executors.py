@@ -39,7 +39,6 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
-import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 EXECUTORS = ("serial", "processes", "dask")
@@ -69,14 +68,15 @@ def compare_fronts(
     """Median wall time of the study's front through each executor, its breakdown, the load and the agreement."""
     from collision_reflex.optimize.pareto import pareto_front
     from collision_reflex.optimize.sweep import Runner
-    from collision_reflex.study.arm_setup import IPOPT_OPTIONS, StudyProblems
     from collision_reflex.study.executors import open_executor
     from collision_reflex.study.load import load_study
-    from collision_reflex.study.resolve import resolved_study
+    from collision_reflex.study.problems import IPOPT_OPTIONS, StudyProblems
+    from collision_reflex.study.resolve import ResolvedStudy, resolved_study
 
-    resolved = resolved_study(load_study(study))
+    loaded = load_study(study)
+    resolved = resolved_study(loaded)
     resolved["pareto"]["points"] = points
-    problems = StudyProblems(yaml.safe_dump(resolved, sort_keys=False))
+    problems = StudyProblems(ResolvedStudy.of(loaded, resolved))
     problems.setup  # noqa: B018 - the study's setup, built once in this process, as a run builds it to check
     objectives = tuple(resolved["pareto"]["objectives"])
     runs: dict[str, list[dict[str, float]]] = {kind: [] for kind in kinds}

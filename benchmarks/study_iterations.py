@@ -21,9 +21,9 @@ from pathlib import Path
 from collision_reflex.optimize.optimum import OPTIMUM_STARTS, known_optima, single_optimum
 from collision_reflex.optimize.pareto import pareto_front
 from collision_reflex.optimize.pieces import built_problem
-from collision_reflex.study.arm_setup import IPOPT_OPTIONS, StudyProblems
 from collision_reflex.study.load import load_study
-from collision_reflex.study.resolve import resolved_yaml
+from collision_reflex.study.problems import IPOPT_OPTIONS, StudyProblems
+from collision_reflex.study.resolve import resolve_study
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_STUDIES = (ROOT / "studies" / "panda.yaml", ROOT / "studies" / "ur5.yaml")
@@ -37,7 +37,7 @@ def main() -> None:
     stages = args.stages.split(",")
     runs = _record_runs()
     for study in args.studies:
-        problems = StudyProblems(resolved_yaml(load_study(Path(study))))
+        problems = StudyProblems(resolve_study(load_study(Path(study))))
         setup = problems.setup
         print(f"{Path(study).name}: load average {os.getloadavg()[0]:.2f}", flush=True)
         names = tuple(setup.study.pareto.objectives) if setup.study.pareto is not None else ()

@@ -29,7 +29,7 @@ import collision_reflex as cr
 from collision_reflex.plots import new_figure, save_figure
 from collision_reflex.simulate.design_closed_form import REACTION_MODELS, JointDesign
 from collision_reflex.simulate.validity import TOLERANCE, validity_map, worst_difference
-from collision_reflex.vocabulary import ARM_DRIVES, REFLECTED_INERTIA_PLACEMENTS
+from collision_reflex.vocabulary import CONTROLLED_DRIVES, REFLECTED_INERTIA_PLACEMENTS
 
 URDF = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
 
@@ -84,7 +84,7 @@ def _run(name: str) -> tuple[Any, float, float, int, int]:
     arm, joints, configurations, directions = ARMS[name]()
     start, cpu = time.perf_counter(), time.process_time()
     table = validity_map(
-        arm, joints, configurations, directions, stiffness_ratios=STIFFNESS_RATIOS, drives=ARM_DRIVES
+        arm, joints, configurations, directions, stiffness_ratios=STIFFNESS_RATIOS, drives=CONTROLLED_DRIVES
     )
     return (
         table,

@@ -34,13 +34,12 @@ def main() -> None:
     from collision_reflex.optimize.evaluate import sample_impulses
     from collision_reflex.optimize.results import record_design
     from collision_reflex.optimize.samples import ContactSamples
-    from collision_reflex.study.arm_setup import StudyProblems
-    from collision_reflex.study.load import parse_study
-    from collision_reflex.study.resolve import resolved_yaml
+    from collision_reflex.study.load import load_study
+    from collision_reflex.study.problems import study_setup
+    from collision_reflex.study.resolve import resolve_study
 
     results = json.loads((args.run / "designs.json").read_text())
-    text = resolved_yaml(parse_study(_yaml(results["resolved"]), "resolved study"))
-    setup = StudyProblems(text).setup
+    setup = study_setup(resolve_study(load_study(args.run / "study.resolved.yaml")))
     arm, technology = setup.arm, setup.technology
     record = results["pareto"]["points"][int(args.design)] if args.design.isdigit() else results[args.design]
     design = record_design(record, setup.technology.sensing)
@@ -75,12 +74,6 @@ def main() -> None:
         f"fresh without the domain {float(np.nanmax(impulses)):.6g} N*s: ratio "
         f"{float(np.nanmax(impulses)) / reported:.3f}  ({time.perf_counter() - started:.1f} s)"
     )
-
-
-def _yaml(data: dict) -> str:
-    import yaml
-
-    return yaml.safe_dump(data, sort_keys=False)
 
 
 if __name__ == "__main__":

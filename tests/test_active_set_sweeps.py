@@ -161,7 +161,7 @@ def test_the_full_nlp_below_the_threshold_and_bad_choices_refused(panda):
 
 
 def test_the_threshold_in_the_study_schema_is_the_optimisers():
-    from collision_reflex.study.schema import OptimizerSpec
+    from collision_reflex.study.run_specs import OptimizerSpec
 
     described = OptimizerSpec.model_fields["active_set"].description
     assert f"from {active_set.ACTIVE_SET_THRESHOLD} samples" in described

@@ -12,10 +12,10 @@ from collision_reflex.optimize.design import design_at
 from collision_reflex.optimize.evaluate import sample_impulses
 from collision_reflex.optimize.pieces import built_problem
 from collision_reflex.optimize.samples import ContactSamples
-from collision_reflex.study.arm_setup import StudyProblems
 from collision_reflex.study.fresh import fresh_draw, fresh_impulses, fresh_record
 from collision_reflex.study.load import load_study
-from collision_reflex.study.resolve import resolved_yaml
+from collision_reflex.study.problems import StudyProblems
+from collision_reflex.study.resolve import resolve_study
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -46,7 +46,7 @@ def two_link(tmp_path_factory):
     """A planar 2R study with random configurations and joint speed limits that bind in part of its domain."""
     study = tmp_path_factory.mktemp("fresh") / "fresh.yaml"
     study.write_text(STUDY.format(urdf=(ROOT / "designs" / "planar_two_link.urdf").as_posix()))
-    problems = StudyProblems(resolved_yaml(load_study(study)))
+    problems = StudyProblems(resolve_study(load_study(study)))
     setup = problems.setup
     problem = built_problem(problems, problems.objective)
     return setup, design_at(problem, problem.x0)

@@ -145,6 +145,6 @@ def test_a_modules_shared_variables_count_once_in_the_study_summary():
 
 def test_the_study_layer_names_the_shared_variables_as_the_optimiser_does():
     from collision_reflex.optimize.space import MODULE_VARIABLES
-    from collision_reflex.study.schema import MODULE_DESIGN_VARIABLES
+    from collision_reflex.study.design_specs import MODULE_DESIGN_VARIABLES
 
     assert MODULE_DESIGN_VARIABLES == MODULE_VARIABLES

@@ -78,8 +78,8 @@ def _study(tmp_path, **changes):
 
 
 def test_a_study_places_each_rotor_by_the_rule_and_a_joint_may_say_otherwise(tmp_path):
-    from collision_reflex.study.arm_results import placement_sentences
     from collision_reflex.study.arm_setup import arm_setup
+    from collision_reflex.study.setup_notes import placement_sentences
 
     study = yaml.safe_load((ROOT / "studies" / "two_link_paper.yaml").read_text())
     actuators = study["actuators"]
@@ -116,8 +116,8 @@ def test_a_study_places_each_rotor_by_the_rule_and_a_joint_may_say_otherwise(tmp
 
 
 def test_a_contact_as_stiff_as_the_transmission_is_warned_about(tmp_path):
-    from collision_reflex.study.arm_results import placement_sentences
     from collision_reflex.study.arm_setup import arm_setup
+    from collision_reflex.study.setup_notes import placement_sentences
 
     setup = arm_setup(load_study(_study(tmp_path, reflected_inertia_in={"contact_stiffness": "2e4 N/m"})))
     ratios = setup.placement_ratios

@@ -15,9 +15,9 @@ from collision_reflex.errors import InvalidParameter, StudyFileError
 from collision_reflex.optimize.optimum import single_optimum
 from collision_reflex.optimize.pieces import built_problem
 from collision_reflex.optimize.results import design_record
-from collision_reflex.study.arm_setup import StudyProblems
 from collision_reflex.study.load import load_study
-from collision_reflex.study.resolve import resolved_yaml
+from collision_reflex.study.problems import StudyProblems
+from collision_reflex.study.resolve import resolve_study
 from test_arm_dynamics import GRAVITY, TWO_LINK, _closed_form_torques
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -115,7 +115,7 @@ RATING = {
 
 
 def test_the_rated_motion_sizes_the_joints_of_a_study(tmp_path):
-    problems = StudyProblems(resolved_yaml(load_study(_rated_study(tmp_path, RATING))))
+    problems = StudyProblems(resolve_study(load_study(_rated_study(tmp_path, RATING))))
     optimum, _ = single_optimum(problems, problems.objective, starts=1)
     problem, design = built_problem(problems, problems.objective), optimum.design
     setup = problems.setup
@@ -144,7 +144,7 @@ def test_the_rated_motion_sizes_the_joints_of_a_study(tmp_path):
 def test_a_rating_naming_no_joint_is_refused_where_it_is(tmp_path):
     path = _rated_study(tmp_path, {**RATING, "joint_accelerations": {"joint1": 10, "shoulder": 20}})
     with pytest.raises(StudyFileError, match=r"rating\.joint_accelerations") as error:
-        _ = StudyProblems(resolved_yaml(load_study(path))).setup
+        _ = StudyProblems(resolve_study(load_study(path))).setup
     assert "shoulder" in str(error.value) and "joint2" in str(error.value)
     path = _rated_study(tmp_path, {"payload": "3 kg", "stopping_time": "0.1 s"})
     with pytest.raises(StudyFileError, match="stopping_time needs the joint_speeds"):
@@ -162,7 +162,7 @@ def test_the_shipped_studies_ask_for_the_real_robots_torques(study):
     # reference (the UR5's first module and the Panda's sit near 2x, so a doubled requirement fails). Both
     # studies build their arms, as the robots are built, of two actuator modules, each sized for the most
     # demanding of its joints: a last joint alone, its axis through the point payload, needs almost nothing.
-    problems = StudyProblems(resolved_yaml(load_study(ROOT / "studies" / f"{study}.yaml")))
+    problems = StudyProblems(resolve_study(load_study(ROOT / "studies" / f"{study}.yaml")))
     optimum, _ = single_optimum(problems, problems.objective, starts=1)
     ratio = optimum.required_torque / np.array(REAL_TORQUES[study])
     assert np.all((ratio > 1 / 3) & (ratio < 3)), ratio
@@ -179,7 +179,7 @@ def test_a_rating_no_gearbox_of_the_catalogue_meets_is_refused_before_solving(tm
     study.pop("pareto")
     path = tmp_path / "heavy.yaml"
     path.write_text(yaml.safe_dump(study))
-    problems = StudyProblems(resolved_yaml(load_study(path)))
+    problems = StudyProblems(resolve_study(load_study(path)))
     with pytest.raises(InvalidParameter) as error:
         built_problem(problems, problems.objective)
     message = str(error.value)

@@ -94,9 +94,9 @@ def reports(tmp_path_factory) -> dict[str, Path]:
     report's length: sample counts only change its numbers), printed to PDF."""
     if find_browser() is None or shutil.which("pdftotext") is None:
         pytest.skip("printing needs Chromium and pdftotext (apt-get install chromium poppler-utils)")
-    from collision_reflex.study import runner
+    from collision_reflex.study import resolve
 
-    shrink = runner.smoke_study
+    shrink = resolve.smoke_study
 
     def smoke_keeping_the_front(data):
         shrunk = shrink(data)
@@ -104,7 +104,7 @@ def reports(tmp_path_factory) -> dict[str, Path]:
 
     folders = {}
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(runner, "smoke_study", smoke_keeping_the_front)
+        patch.setattr(resolve, "smoke_study", smoke_keeping_the_front)
         for name, study in STUDIES.items():
             folder = tmp_path_factory.mktemp(name) / "out"
             assert (

@@ -18,7 +18,7 @@ from collision_reflex.optimize.pieces import built_problem
 from collision_reflex.optimize.results import _DESIGN_ARRAYS, _GEARBOX_ARRAYS
 from collision_reflex.plots.torque_speed import JointOperatingPoints
 from collision_reflex.study.arm_results import SAVED_DIGITS, JointTorqueSpeed
-from collision_reflex.study.arm_setup import StudyProblems
+from collision_reflex.study.problems import StudyProblems
 
 ROOT = Path(__file__).resolve().parents[1]
 TWO_LINK = ROOT / "studies" / "two_link_paper.yaml"

@@ -11,15 +11,15 @@ from collision_reflex.arm.dynamics import peak
 from collision_reflex.optimize.optimum import single_optimum
 from collision_reflex.optimize.pieces import built_problem
 from collision_reflex.optimize.results import design_record
-from collision_reflex.study.arm_setup import StudyProblems
 from collision_reflex.study.load import load_study
-from collision_reflex.study.resolve import resolved_yaml
+from collision_reflex.study.problems import StudyProblems
+from collision_reflex.study.resolve import resolve_study
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def _solved(name: str):
-    problems = StudyProblems(resolved_yaml(load_study(ROOT / "studies" / f"{name}.yaml")))
+    problems = StudyProblems(resolve_study(load_study(ROOT / "studies" / f"{name}.yaml")))
     optimum, _ = single_optimum(problems, problems.objective, starts=1)
     return problems, built_problem(problems, problems.objective), optimum
 

@@ -15,9 +15,9 @@ from collision_reflex.optimize.objectives import CVAR_LEVEL
 from collision_reflex.optimize.pieces import built_problem
 from collision_reflex.optimize.samples import ContactSamples
 from collision_reflex.optimize.statistics import QUANTILE, impulse_statistics
-from collision_reflex.study.arm_setup import StudyProblems
 from collision_reflex.study.load import load_study
-from collision_reflex.study.resolve import resolved_yaml
+from collision_reflex.study.problems import StudyProblems
+from collision_reflex.study.resolve import resolve_study
 
 ROOT = Path(__file__).resolve().parents[1]
 DIRECTIONS = np.column_stack([np.cos(a := np.arange(8) * np.pi / 4 + 0.1), np.sin(a)])
@@ -25,7 +25,7 @@ DIRECTIONS = np.column_stack([np.cos(a := np.arange(8) * np.pi / 4 + 0.1), np.si
 
 @pytest.fixture(scope="module")
 def impulses_of():
-    problems = StudyProblems(resolved_yaml(load_study(ROOT / "studies" / "two_link_paper.yaml")))
+    problems = StudyProblems(resolve_study(load_study(ROOT / "studies" / "two_link_paper.yaml")))
     setup = problems.setup
     problem = built_problem(problems, problems.objective)
     design = design_at(problem, problem.x0)

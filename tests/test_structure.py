@@ -17,7 +17,6 @@ from test_import_graph import PACKAGE, find_cycle
 
 MAX_MODULE_LINES = 600
 MAX_FUNCTION_LINES = 100
-SPLITTING = pytest.mark.xfail(reason="the modules are being split (issue 30)", strict=False)
 
 
 def _sources(package: Path = PACKAGE) -> list[Path]:
@@ -72,7 +71,6 @@ def file_import_graph(package: Path = PACKAGE) -> dict[str, set[str]]:
     return graph
 
 
-@SPLITTING
 def test_no_module_is_over_600_lines():
     long = {
         str(path.relative_to(PACKAGE)): n
@@ -82,7 +80,6 @@ def test_no_module_is_over_600_lines():
     assert not long, f"modules over {MAX_MODULE_LINES} lines: {long}"
 
 
-@SPLITTING
 def test_no_function_is_over_100_lines():
     long = {}
     for path in _sources():
@@ -93,7 +90,6 @@ def test_no_function_is_over_100_lines():
     assert not long, f"functions over {MAX_FUNCTION_LINES} lines: {long}"
 
 
-@SPLITTING
 def test_no_import_loop_between_files():
     graph = file_import_graph()
     assert {"collision_reflex.optimize.solve", "collision_reflex.study.runner"} <= set(graph)
@@ -113,7 +109,6 @@ def _says_lazy(lines: list[str], node: ast.stmt) -> bool:
     return False
 
 
-@SPLITTING
 def test_a_function_imports_its_own_package_only_to_defer_a_heavy_library():
     unexplained = []
     for path in _sources():
@@ -161,3 +156,64 @@ def test_the_file_graph_sees_a_loop_kept_open_by_a_function_level_import(loop_pa
     }
     (loop_package / "optimize/feasibility.py").write_text("def feasible():\n    pass\n")
     assert find_cycle(file_import_graph(loop_package)) is None
+
+
+def _vocabularies() -> dict[str, frozenset[str]]:
+    from collision_reflex import vocabulary
+
+    return {
+        name: frozenset(value)
+        for name, value in vars(vocabulary).items()
+        if name.isupper() and isinstance(value, tuple) and all(isinstance(v, str) for v in value)
+    }
+
+
+def _string_sets(tree: ast.AST) -> list[tuple[int, frozenset[str]]]:
+    """Every literal tuple, list, set or ``Literal[...]`` of two or more strings, with its line."""
+    found = []
+    for node in ast.walk(tree):
+        elements = None
+        if isinstance(node, ast.Tuple | ast.List | ast.Set):
+            elements = node.elts
+        elif isinstance(node, ast.Subscript) and ast.unparse(node.value).endswith("Literal"):
+            elements = node.slice.elts if isinstance(node.slice, ast.Tuple) else [node.slice]
+        if elements and len(elements) >= 2:
+            if all(isinstance(e, ast.Constant) and isinstance(e.value, str) for e in elements):
+                found.append((node.lineno, frozenset(e.value for e in elements)))
+    return found
+
+
+def test_each_vocabulary_is_written_once():
+    vocabularies = _vocabularies()
+    assert {"SENSING_SCHEMES", "OBJECTIVE_NAMES", "GEARBOX_KINDS", "SCALING_LAW_NAMES", "EXECUTORS"} <= set(
+        vocabularies
+    )
+    copies = []
+    for path in _sources():
+        if path.name == "vocabulary.py":
+            continue
+        for line, values in _string_sets(ast.parse(path.read_text(encoding="utf-8"))):
+            copies += [
+                f"{path.relative_to(PACKAGE)}:{line} {name}"
+                for name, v in vocabularies.items()
+                if v == values
+            ]
+    assert not copies, f"vocabularies written again outside collision_reflex/vocabulary.py: {copies}"
+
+
+def test_the_tables_keyed_by_a_vocabulary_cover_it_exactly():
+    from collision_reflex.hardware.gearbox_scaling import GEARBOX_SCALING
+    from collision_reflex.hardware.motors import SCALING_LAWS
+    from collision_reflex.optimize.objectives import OBJECTIVES
+    from collision_reflex.vocabulary import GEARBOX_KINDS, OBJECTIVE_NAMES, SCALING_LAW_NAMES
+
+    assert set(GEARBOX_SCALING) == set(GEARBOX_KINDS)
+    assert set(SCALING_LAWS) == set(SCALING_LAW_NAMES)
+    assert tuple(OBJECTIVES) == OBJECTIVE_NAMES
+
+
+def test_the_vocabulary_check_finds_a_copy():
+    tree = ast.parse('KINDS = ("current", "force", "position")\nx: Literal["dask", "serial", "processes"]\n')
+    vocabularies = _vocabularies()
+    sets = [values for _, values in _string_sets(tree)]
+    assert vocabularies["SENSING_SCHEMES"] in sets and vocabularies["EXECUTORS"] in sets

@@ -502,7 +502,7 @@ def test_study_sweep_is_the_library_sweep(runs, name):
 
     As the run does, the anchor of the study's own objective takes the study's optimum (``known_optima``).
     """
-    from collision_reflex.study.arm_setup import IPOPT_OPTIONS, StudyProblems
+    from collision_reflex.study.problems import IPOPT_OPTIONS, StudyProblems
 
     folder = runs[name]
     results = json.loads((folder / "designs.json").read_text())
@@ -624,8 +624,7 @@ def test_saved_arm_results_have_the_declared_record_types(runs, name):
     # means the declaration and designs.json have drifted apart.
     from typing import get_type_hints
 
-    from collision_reflex.study.arm_results import ArmResults, ParetoRecord
-    from collision_reflex.study.arm_setup import SampleLayout
+    from collision_reflex.study.arm_results import ArmResults, ParetoRecord, SampleLayout
 
     results = json.loads((runs[name] / "designs.json").read_text())
     for record, declared in (

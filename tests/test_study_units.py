@@ -16,10 +16,10 @@ from collision_reflex.model.impulse import phase_impulses, series_stiffness
 from collision_reflex.optimize.dominance import non_dominated
 from collision_reflex.optimize.epsilon import epsilon_grid
 from collision_reflex.report.wording import number
+from collision_reflex.study.actuator_specs import SensingSpec
 from collision_reflex.study.actuator_study import sensing_scheme
 from collision_reflex.study.executors import SerialExecutor, open_executor
-from collision_reflex.study.runner import smoke_study
-from collision_reflex.study.schema import SensingSpec
+from collision_reflex.study.resolve import smoke_study
 from collision_reflex.study.store import OutputFolderInUse, RunFolder
 
 
@@ -200,7 +200,7 @@ def test_report_number_format(value, text):
 
 
 def test_every_pair_of_objectives_is_a_valid_pareto_spec():
-    from collision_reflex.study.schema import ParetoSpec
+    from collision_reflex.study.run_specs import ParetoSpec
     from collision_reflex.vocabulary import OBJECTIVE_NAMES
 
     for pair in itertools.combinations(OBJECTIVE_NAMES, 2):

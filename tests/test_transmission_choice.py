@@ -11,9 +11,9 @@ from collision_reflex.errors import StudyFileError
 from collision_reflex.optimize.catalogue_search import objective_value
 from collision_reflex.optimize.optimum import single_optimum
 from collision_reflex.optimize.pieces import built_problem
-from collision_reflex.study.arm_setup import StudyProblems
 from collision_reflex.study.load import load_study
-from collision_reflex.study.resolve import resolved_yaml
+from collision_reflex.study.problems import StudyProblems
+from collision_reflex.study.resolve import resolve_study
 from collision_reflex.study.runner import run_study
 from test_snap import ROOT, TWO_LINK
 
@@ -32,7 +32,7 @@ def _study(tmp_path, gearbox, name="study.yaml", **changes):
 
 
 def _objective(path):
-    problems = StudyProblems(resolved_yaml(load_study(path)))
+    problems = StudyProblems(resolve_study(load_study(path)))
     optimum, _ = single_optimum(problems, problems.objective, starts=1)
     return objective_value(built_problem(problems, problems.objective), optimum.numpy_objectives)
 

@@ -15,9 +15,9 @@ from collision_reflex.optimize.pieces import built_problem
 from collision_reflex.optimize.results import record_design
 from collision_reflex.optimize.samples import ContactSamples
 from collision_reflex.optimize.worst_case import search_worst_case
-from collision_reflex.study.arm_setup import StudyProblems
 from collision_reflex.study.load import load_study
-from collision_reflex.study.resolve import resolved_yaml
+from collision_reflex.study.problems import StudyProblems
+from collision_reflex.study.resolve import resolve_study
 from collision_reflex.study.runner import run_study
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -26,7 +26,7 @@ FLOOR = 0.01  # [m]: near the folded pose the finger mass along the singular dir
 
 @pytest.fixture(scope="module")
 def case():
-    problems = StudyProblems(resolved_yaml(load_study(ROOT / "studies" / "two_link_paper.yaml")))
+    problems = StudyProblems(resolve_study(load_study(ROOT / "studies" / "two_link_paper.yaml")))
     setup = problems.setup
     problem = built_problem(problems, problems.objective)
     design = design_at(problem, problem.x0)

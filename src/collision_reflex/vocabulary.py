@@ -54,9 +54,10 @@ Drive = Literal["ideal", "impedance", "free"]
 """The 1D simulator's robot-side drive during the approach (:mod:`collision_reflex.simulate`)."""
 DRIVES: tuple[Drive, ...] = get_args(Drive)
 
-ArmDrive = Literal["ideal", "impedance"]
-"""The drives the arm simulator has (the 1D ``"free"`` drive has no arm counterpart)."""
-ARM_DRIVES: tuple[ArmDrive, ...] = get_args(ArmDrive)
+ControlledDrive = Literal["ideal", "impedance"]
+"""The drives with a controller: the arm simulator's, and what ``crx simulate`` offers (``"free"`` applies no
+actuator force, for energy bookkeeping only)."""
+CONTROLLED_DRIVES: tuple[ControlledDrive, ...] = get_args(ControlledDrive)
 
 ActiveSetMode = Literal["auto", "always", "never"]
 """Whether the optimiser solves on an active set of samples: by sample count, always, or never."""

@@ -14,6 +14,7 @@ from ..errors import CollisionReflexError
 from ..experiments import analyse_files
 from ..plots.impulse_velocity import plot_impulse_velocity
 from ..plots.trace_fit import plot_trace_fit
+from ..vocabulary import REACTION_MODES
 from . import options
 
 if TYPE_CHECKING:
@@ -49,7 +50,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     options.NOISE_SIGMAS.add(parser, 5.0)
     add(
         "--reaction",
-        choices=("at_rest", "moving"),
+        choices=REACTION_MODES,
         default="at_rest",
         help="reaction model fitted (default %(default)s, the paper's)",
     )

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from ..vocabulary import EXECUTORS
 from . import options
 
 
@@ -31,7 +32,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument(
         "--executor",
-        choices=("serial", "processes", "dask"),
+        choices=EXECUTORS,
         default=None,
         help="override the study's executor",
     )

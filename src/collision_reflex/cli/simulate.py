@@ -17,7 +17,7 @@ from ..model.impulse import optimal_velocity, total_impulse
 from ..plots import check_figure_path
 from ..plots.simulation import plot_sweep, plot_trace
 from ..simulate import CollisionSetup, Detection, contact_damping_for_restitution, simulate, sweep
-from ..vocabulary import REACTION_MODES, SENSING_SCHEMES
+from ..vocabulary import CONTROLLED_DRIVES, REACTION_MODES, SENSING_SCHEMES
 from . import options
 
 if TYPE_CHECKING:
@@ -57,7 +57,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     options.POSITION_ERROR.add(parser, note="position detection")
     add(
         "--drive",
-        choices=("ideal", "impedance"),
+        choices=CONTROLLED_DRIVES,
         default="ideal",
         help="ideal velocity-controlled robot (the closed form's) or a physical impedance controller "
         "(default %(default)s)",

@@ -20,7 +20,7 @@ from __future__ import annotations
 from typing import Any
 
 from .. import _validate
-from ..vocabulary import SENSING_SCHEMES
+from ..vocabulary import OPTIMIZED_SENSING_SCHEMES, SENSING_SCHEMES
 
 
 def sensing_scheme(name: str, allowed: tuple[str, ...] = SENSING_SCHEMES) -> str:
@@ -44,7 +44,7 @@ def threshold_force(sensing: str, threshold: Any, stiffness: Any) -> Any:
     -------
     ``F_s`` [N] (or the joint torque [N m] for joint units): ``threshold`` itself, or ``k e_th``.
     """
-    _validate.choice("sensing", sensing, ("force", "position"))
+    _validate.choice("sensing", sensing, OPTIMIZED_SENSING_SCHEMES)
     return threshold if sensing == "force" else stiffness * threshold
 
 

@@ -35,6 +35,7 @@ from .build import build_problem
 from .candidates import CataloguePart
 from .design import Design
 from .design_result import DesignResult
+from .dominance import MERGE_TOLERANCE
 from .ipopt import IpoptOptions
 from .objectives import objective_expression
 from .parts import (
@@ -45,6 +46,7 @@ from .parts import (
     matched_gear_ratio,
 )
 from .problem import DesignProblem
+from .recommend import lightest_alike
 from .solve import solve, warm_start
 from .subsets import kept_problem, sample_subset
 
@@ -350,8 +352,6 @@ class PartsSearch:
         re-solves for nothing a design would show. The best combination tried is kept either way
         (:meth:`best`).
         """
-        from .dominance import MERGE_TOLERANCE
-
         current = self.start()
         (value,) = self.values_of([current])
         passes, improved = 0, True
@@ -414,8 +414,6 @@ class PartsSearch:
         design (:func:`collision_reflex.optimize.pareto.recommend`): a smaller difference ranks no design, and
         the lighter is the better build.
         """
-        from .recommend import lightest_alike
-
         least = self.least()
         name = impulse_objective(self.problem)
         if least is None or name is None:

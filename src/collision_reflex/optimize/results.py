@@ -19,6 +19,7 @@ import numpy as np
 from ..errors import InvalidParameter
 from ..model.impulse import optimal_velocity, phase_impulses, series_stiffness
 from .active_set_result import ActiveSetResult, solve_method, with_active_set
+from .candidates import motor_distance
 from .constraints import DUTY_REQUIREMENT, RATED_REQUIREMENT, STATIC_REQUIREMENT
 from .design import Design, design_at
 from .design_result import DesignResult
@@ -504,8 +505,6 @@ def nearest_catalogue_motor(catalogue: Mapping[str, Motor], peak_torque: float, 
 
     Closest in (log peak torque, log rotor inertia): the off-the-shelf part a designer would start from.
     """
-    from .candidates import motor_distance
-
     best, best_distance = "", math.inf
     for name, motor in catalogue.items():
         distance = motor_distance(motor, peak_torque, rotor_inertia)

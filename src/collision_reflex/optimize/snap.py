@@ -52,6 +52,7 @@ from .catalogue_search import (
 )
 from .design_result import DesignResult
 from .ipopt import IpoptOptions
+from .recommend import RESOLUTION
 
 if TYPE_CHECKING:
     from ..arm.robot import Arm
@@ -185,8 +186,6 @@ def snap_to_catalogue(
     if best is not None and warm_startable(problem, optimum, active_set):
         search.confirm(best)
     if best != least:
-        from .recommend import RESOLUTION
-
         assert best is not None and least is not None  # best is least without a feasible combination
         name = str(impulse_objective(problem)).replace("_", " ")
         masses = [search.results[c].numpy_objectives["actuator_mass"] for c in (best, least)]

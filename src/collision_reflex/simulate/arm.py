@@ -57,7 +57,7 @@ from typing import Any
 import numpy as np
 
 from .. import _validate
-from ..vocabulary import ARM_DRIVES, REACTION_MODES
+from ..vocabulary import CONTROLLED_DRIVES, REACTION_MODES
 from .arm_detection import DETECTIONS
 from .arm_dynamics import ArmDynamics
 from .arm_inputs import ArmJoints, ImpactClosedForm, arm_joints, arm_sensing, impact_closed_form
@@ -192,7 +192,7 @@ def simulate_arm_collision(
         schemes (their signal passes through the joints or a filter; an observer with ``K m_f v0 > F_s`` does
         detect the impact itself).
     drive: ``"ideal"`` (default) or ``"impedance"`` (finite ``software_stiffness`` needed), see
-        :data:`ARM_DRIVES`.
+        :data:`CONTROLLED_DRIVES`.
     software_damping: the impedance drive's joint damping ``d_s`` [N m s/rad], >= 0 (scalar or (nv,)).
     max_steps: the work budget [integrator steps]: a setting expected to need more is refused at once, and a
         run that takes four times as many right-hand-side evaluations as the budget allows is stopped.
@@ -235,7 +235,7 @@ def _check_settings(
     _validate.choice("reaction", reaction, REACTION_MODES)
     _validate.choice("detection", detection, DETECTIONS)
     _validate.choice("retreat", retreat, RETREATS)
-    _validate.choice("drive", drive, ARM_DRIVES)
+    _validate.choice("drive", drive, CONTROLLED_DRIVES)
     _validate.positive("observer_gain", observer_gain)
     _validate.positive("max_steps", max_steps)
     if sample_rate is not None:

@@ -30,7 +30,7 @@ import numpy.typing as npt
 from .. import _validate
 from ..errors import InvalidParameter, SimulationError
 from ..model.impulse import optimal_velocity, series_stiffness
-from ..vocabulary import ARM_DRIVES, REFLECTED_INERTIA_PLACEMENTS
+from ..vocabulary import CONTROLLED_DRIVES, REFLECTED_INERTIA_PLACEMENTS
 from . import arm as arm_simulation
 from .arm_detection import DETECTIONS
 from .contact import damping_from_ratio
@@ -70,7 +70,7 @@ class ValidityCase:
     ----------
     configuration, direction: indices into the map's configurations and directions.
     velocity_ratio: ``v0 / v*``; stiffness_ratio: contact over joint stiffness along ``u``; detection: scheme;
-    drive: :data:`~collision_reflex.vocabulary.ARM_DRIVES`.
+    drive: :data:`~collision_reflex.vocabulary.CONTROLLED_DRIVES`.
     """
 
     configuration: int
@@ -111,7 +111,7 @@ def validity_map(
     tolerance: relative agreement that counts as valid [-].
     reaction: the closed form's reaction variant (``"moving"``: the robot's velocity at detection).
     max_steps: work budget of one simulation [integrator steps]; a case beyond it is refused and recorded.
-    drives: the simulated drives (:data:`~collision_reflex.vocabulary.ARM_DRIVES`); ``"impedance"`` needs a finite software stiffness.
+    drives: the simulated drives (:data:`~collision_reflex.vocabulary.CONTROLLED_DRIVES`); ``"impedance"`` needs a finite software stiffness.
     contact_damping_ratio: the contact's damping as a ratio of critical for the finger mass (dimensionless).
 
     Returns
@@ -206,7 +206,7 @@ def _check_map_settings(
     for scheme in schemes:
         _validate.choice("detection", scheme, available_detections())
     for drive in drives:
-        _validate.choice("drive", drive, ARM_DRIVES)
+        _validate.choice("drive", drive, CONTROLLED_DRIVES)
     if "impedance" in drives and not np.all(np.isfinite(np.asarray(joints.software_stiffness, dtype=float))):
         raise InvalidParameter(
             "joints.software_stiffness",
@@ -257,7 +257,7 @@ def simulated_impulse(
     approach_velocity: [m/s]; contact_stiffness: the wall's stiffness [N/m].
     detection: a scheme of :func:`available_detections`; reaction: the closed-form variant the simulator
         reports beside (``"moving"`` or ``"at_rest"``); max_steps: the work budget [integrator steps].
-    drive: :data:`~collision_reflex.vocabulary.ARM_DRIVES`; contact_damping_ratio: the contact's damping, a ratio of critical for the finger.
+    drive: :data:`~collision_reflex.vocabulary.CONTROLLED_DRIVES`; contact_damping_ratio: the contact's damping, a ratio of critical for the finger.
     """
     start = time.perf_counter()
     try:

@@ -15,10 +15,14 @@ from typing import Any
 import numpy as np
 
 from ..errors import CollisionReflexError
+from ..hardware.actuators import Actuator, CurrentThreshold, ForceThreshold, PositionThreshold
 from ..model.impulse import minimum_impulse, optimal_velocity, phase_impulses, series_stiffness
+from ..optimize.dominance import dominated_mask
+from .actuator_specs import SensingSpec
 from .load import LoadedStudy
 from .prepare import check_motors, gearbox_for, motor_for
-from .schema import ActuatorCandidate, ActuatorStudy, SensingSpec
+from .resolve import resolved_study
+from .schema import ActuatorCandidate, ActuatorStudy
 
 
 def check_actuator_study(loaded: LoadedStudy) -> dict[str, Any]:
@@ -45,8 +49,6 @@ def check_actuator_study(loaded: LoadedStudy) -> dict[str, Any]:
 def _actuator(
     candidate: ActuatorCandidate, sensing: SensingSpec, lever: float, catalogue: dict[str, Any]
 ) -> Any:
-    from ..hardware.actuators import Actuator
-
     return Actuator(
         motor_for(candidate.motor, catalogue),
         gear_ratio=candidate.gear_ratio,
@@ -63,8 +65,6 @@ def sensing_scheme(sensing: SensingSpec, lever: float) -> Any:
 
     A contact position error ``e`` [m] is the joint error ``e / L`` [rad] at the lever ``L`` [m].
     """
-    from ..hardware.actuators import CurrentThreshold, ForceThreshold, PositionThreshold
-
     if sensing.scheme == "force":
         return ForceThreshold(sensing.value)
     if sensing.scheme == "position":
@@ -152,8 +152,6 @@ def evaluate_actuator_study(loaded: LoadedStudy) -> dict[str, Any]:
                 "an actuator with non-finite contact parameters",
                 "finite stiffness, inertia and torque",
             )
-    from ..optimize.dominance import dominated_mask
-    from .resolve import resolved_study
 
     # Pareto-optimal: no other candidate has both a lower minimum impulse and a lower mass (exact comparison).
     values = np.array([[c["minimum_impulse"], c["mass"]] for c in candidates]).reshape(-1, 2)

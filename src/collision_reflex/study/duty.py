@@ -20,10 +20,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..arm.duty_cycle import DutyCycle, Payload
+from ..arm.kinematic_tree import joint_kinematics
 from ..arm.rating import Rating
 from ..errors import InvalidParameter, StudyFileError, StudyProblem, TrajectoryError
 from .load import LoadedStudy
-from .schema import ArmStudy, DutyCycleSpec
+from .motion_specs import DutyCycleSpec
+from .schema import ArmStudy
 
 if TYPE_CHECKING:
     from ..arm import Arm
@@ -99,8 +101,6 @@ def static_requirement(study: ArmStudy) -> str:
 
 def prismatic_joints(arm: Arm) -> list[str]:
     """The arm's prismatic joints (positions in m, speeds in m/s); the others are revolute."""
-    from ..arm.kinematic_tree import joint_kinematics
-
     kinds = joint_kinematics(arm.model, arm.name)
     return [name for name, joint in zip(arm.joint_names, kinds, strict=True) if not joint.revolute]
 
@@ -174,8 +174,6 @@ def _position_limits(arm: Arm) -> tuple[np.ndarray, np.ndarray]:
     As :meth:`~collision_reflex.arm.Arm.joint_limits` reads them, without its stand-in full turn for a revolute
     joint without limits (continuous, or limits that are empty or huge): a via point may be anywhere there.
     """
-    from ..arm.kinematic_tree import joint_kinematics
-
     lower, upper = np.full(arm.nv, -np.inf), np.full(arm.nv, np.inf)
     low, high = arm.model.lowerPositionLimit, arm.model.upperPositionLimit
     real, _ = arm.joint_limits()

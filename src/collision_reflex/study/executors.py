@@ -22,9 +22,10 @@ from collections.abc import Iterator
 from concurrent.futures import Executor, ProcessPoolExecutor
 
 from ..errors import CollisionReflexError, InvalidParameter
+from ..optimize.blas import single_threaded_blas
 from ..optimize.serial import SerialExecutor
+from ..vocabulary import EXECUTORS
 
-EXECUTORS = ("serial", "processes", "dask")
 __all__ = ["EXECUTORS", "DaskUnavailable", "SerialExecutor", "open_executor"]
 
 
@@ -95,7 +96,7 @@ def _stop(pool: ProcessPoolExecutor) -> None:
         process.join(timeout=5)
 
 
-WARM_MODULES = ("collision_reflex.optimize.pareto", "collision_reflex.study.arm_setup", "pinocchio")
+WARM_MODULES = ("collision_reflex.optimize.pareto", "collision_reflex.study.problems", "pinocchio")
 """What a worker imports when it starts: the pieces of a sweep, a study's problems, and the robot models'
 library (with CasADi, NumPy and SciPy behind them), which the first piece would otherwise import."""
 
@@ -108,8 +109,6 @@ def warm_worker() -> None:
     for module in WARM_MODULES:
         with contextlib.suppress(ImportError):
             importlib.import_module(module)
-    from ..optimize.blas import single_threaded_blas
-
     with single_threaded_blas():  # loads CasADi's IPOPT and registers its OpenBLAS
         pass
 

@@ -1,8 +1,9 @@
 """Loading and validating study files: YAML → schema → cross-field checks, every problem reported at once.
 
 :func:`load_study` reads a file and returns a validated :data:`~.schema.Study` (or raises
-:class:`~collision_reflex.errors.StudyFileError` listing every problem with its line). Checks that need the robot
-model (frames, joint names, configuration sizes) are in :mod:`.robot` and run when a study is prepared.
+:class:`~collision_reflex.errors.StudyFileError` listing every problem with its line). The checks across fields
+are in :mod:`.checks`; those that need the robot model (frames, joint names, configuration sizes) are in
+:mod:`.robot` and run when a study is prepared.
 """
 
 from __future__ import annotations
@@ -19,12 +20,8 @@ from typing import Any
 from pydantic import BaseModel, ValidationError
 
 from ..errors import StudyFileError, StudyProblem
-from .schema import (
-    STUDY_KINDS,
-    ActuatorStudy,
-    ArmStudy,
-    Study,
-)
+from .checks import cross_checks
+from .schema import STUDY_KINDS, Study
 from .source import StudySource, excerpt, parse_study_source, read_study_source
 
 _FOUND_LIMIT = 60
@@ -74,6 +71,17 @@ def parse_study(
     return _validated(parse_study_source(text, file, Path(directory) if directory is not None else None))
 
 
+def study_from_data(
+    data: Any, file: str = "<data>", directory: str | os.PathLike[str] | None = None
+) -> LoadedStudy:
+    """Validate a study given as plain data (as :func:`parse_study`, without YAML).
+
+    For a study derived from a validated one (shrunk for a smoke run, a gearbox option assigned): its problems
+    are told at ``file`` without a line.
+    """
+    return _validated(StudySource(file, Path(directory) if directory is not None else Path.cwd(), data, {}))
+
+
 def _validated(source: StudySource) -> LoadedStudy:
     problems = [
         source.problem(path, f"the key {excerpt(path[-1])} more than once", "each key once in a mapping")
@@ -97,7 +105,7 @@ def _validated(source: StudySource) -> LoadedStudy:
         problems += [_problem_from_pydantic(source, model, item) for item in error.errors()]
         raise StudyFileError(source.file, problems) from None
     loaded = LoadedStudy(study, source)
-    problems += _cross_checks(loaded)
+    problems += cross_checks(loaded)
     if problems:
         raise StudyFileError(source.file, problems)
     return loaded
@@ -171,164 +179,3 @@ def _unwrapped(annotation: Any) -> list[Any]:
 
 def _models_in(annotation: Any) -> list[type[BaseModel]]:
     return [c for c in _unwrapped(annotation) if isinstance(c, type) and issubclass(c, BaseModel)]
-
-
-# --- checks across fields (no robot model needed) ---------------------------------------------------------------
-
-
-def _cross_checks(loaded: LoadedStudy) -> list[StudyProblem]:
-    study = loaded.study
-    if isinstance(study, ArmStudy):
-        return _arm_checks(loaded, study)
-    if isinstance(study, ActuatorStudy):
-        return _actuator_checks(loaded, study)
-    return []  # pragma: no cover - the kinds are exhaustive
-
-
-def _arm_checks(loaded: LoadedStudy, study: ArmStudy) -> list[StudyProblem]:
-    problems: list[StudyProblem] = []
-    scheme = study.sensing.scheme
-    if scheme == "current":
-        problems.append(
-            loaded.problem(
-                ("sensing", "scheme"),
-                "'current'",
-                "'force' or 'position' for an arm study: a motor-current threshold makes the contact threshold "
-                "a minimum over joints, which the optimiser does not handle; compare current sensing in an "
-                "actuator study (kind: actuator)",
-            )
-        )
-    design = study.design
-    if design.threshold is not None and scheme != "force":
-        problems.append(
-            loaded.problem(
-                ("design", "threshold"),
-                f"a contact-force threshold with sensing scheme {scheme!r}",
-                "design.position_error for position sensing (or sensing.scheme: force)",
-            )
-        )
-    if design.position_error is not None and scheme != "position":
-        problems.append(
-            loaded.problem(
-                ("design", "position_error"),
-                f"a position-error threshold with sensing scheme {scheme!r}",
-                "design.threshold for force sensing (or sensing.scheme: position)",
-            )
-        )
-    if study.pareto is not None:
-        for index, name in enumerate(study.pareto.objectives):
-            if name == "approach_velocity" and (
-                design.approach_velocity is None or _fixed(design.approach_velocity)
-            ):
-                problems.append(
-                    loaded.problem(
-                        ("pareto", "objectives", index),
-                        "'approach_velocity' while the velocity is fixed",
-                        "free bounds design.approach_velocity: {min, max} to trade it off",
-                    )
-                )
-    robot = study.robot
-    if robot.urdf is not None and not _is_file(loaded.path(robot.urdf)):
-        problems.append(
-            loaded.problem(("robot", "urdf"), f"{excerpt(robot.urdf)} (no such file)", _relative_hint(loaded))
-        )
-    for index, directory in enumerate(robot.package_dirs):
-        if not _is_dir(loaded.path(directory)):
-            problems.append(
-                loaded.problem(
-                    ("robot", "package_dirs", index),
-                    f"{excerpt(directory)} (no such directory)",
-                    _relative_hint(loaded),
-                )
-            )
-    trajectory = study.samples.configurations.trajectory
-    if trajectory is not None and not _is_file(loaded.path(trajectory.file)):
-        problems.append(
-            loaded.problem(
-                ("samples", "configurations", "trajectory", "file"),
-                f"{excerpt(trajectory.file)} (no such file)",
-                _relative_hint(loaded),
-            )
-        )
-    problems += _duty_cycle_checks(loaded, study)
-    lengths = {len(q) for q in study.samples.configurations.list or []}
-    if len(lengths) > 1:
-        problems.append(
-            loaded.problem(
-                ("samples", "configurations", "list"),
-                f"configurations of sizes {sorted(lengths)}",
-                "every configuration with the same number of joint positions",
-            )
-        )
-    directions = study.samples.directions.list or []
-    if len({len(u) for u in directions}) > 1:
-        problems.append(
-            loaded.problem(
-                ("samples", "directions", "list"),
-                "vectors of different sizes",
-                "every direction with the same number of components (2 for a planar arm, else 3)",
-            )
-        )
-    return problems
-
-
-def _duty_cycle_checks(loaded: LoadedStudy, study: ArmStudy) -> list[StudyProblem]:
-    """The trajectory file exists; the payload is given once (``duty_cycle.payload`` or ``constraints.payload``)."""
-    cycle = study.duty_cycle
-    if cycle is None:
-        return []
-    problems = []
-    if cycle.file is not None and not _is_file(loaded.path(cycle.file)):
-        problems.append(
-            loaded.problem(
-                ("duty_cycle", "file"), f"{excerpt(cycle.file)} (no such file)", _relative_hint(loaded)
-            )
-        )
-    if cycle.payload is not None and study.constraints.payload != 0:
-        problems.append(
-            loaded.problem(
-                ("constraints", "payload"),
-                f"a payload of {study.constraints.payload:g} kg here and another in duty_cycle.payload",
-                "the payload once: remove constraints.payload (duty_cycle.payload loads the static "
-                "requirement too)",
-            )
-        )
-    return problems
-
-
-def _is_file(path: Path) -> bool:
-    """Whether ``path`` is a regular file; False for a path the system refuses (too long, a NUL)."""
-    try:
-        return path.is_file()
-    except (OSError, ValueError):
-        return False
-
-
-def _is_dir(path: Path) -> bool:
-    """Whether ``path`` is a directory; False for a path the system refuses."""
-    try:
-        return path.is_dir()
-    except (OSError, ValueError):
-        return False
-
-
-def _fixed(variable: Any) -> bool:
-    lower, upper = variable.bounds
-    return bool(lower == upper)
-
-
-def _relative_hint(loaded: LoadedStudy) -> str:
-    return "a path relative to the study file's folder"
-
-
-def _actuator_checks(loaded: LoadedStudy, study: ActuatorStudy) -> list[StudyProblem]:
-    problems: list[StudyProblem] = []
-    if not study.velocities.min <= study.approach_velocity <= study.velocities.max:
-        problems.append(
-            loaded.problem(
-                ("approach_velocity",),
-                f"{study.approach_velocity:g} m/s",
-                f"a velocity within velocities [{study.velocities.min:g}, {study.velocities.max:g}] m/s",
-            )
-        )
-    return problems

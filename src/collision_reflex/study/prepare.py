@@ -12,16 +12,15 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from ..errors import StudyFileError, StudyProblem
+from ..hardware.gearboxes import Gearbox
+from ..hardware.motors import load_catalogue
+from .actuator_specs import GearboxSpec, MotorSpec
+from .design_specs import MODULE_DESIGN_VARIABLES, PER_JOINT_DESIGN_VARIABLES
 from .duty import describe_duty_cycle, prismatic_joints, static_requirement, study_duty_cycle
 from .load import LoadedStudy
-from .schema import (
-    MODULE_DESIGN_VARIABLES,
-    PER_JOINT_DESIGN_VARIABLES,
-    ActuatorStudy,
-    ArmStudy,
-    GearboxSpec,
-    MotorSpec,
-)
+from .robot import load_arm
+from .samples import sample_counts
+from .schema import ActuatorStudy, ArmStudy
 from .source import PathKey, excerpt
 
 if TYPE_CHECKING:
@@ -42,8 +41,6 @@ def _motor_specs(study: ArmStudy | ActuatorStudy) -> Iterator[tuple[PathKey, Mot
 
 def check_motors(loaded: LoadedStudy, catalogue: dict[str, Motor] | None = None) -> dict[str, Motor]:
     """The motor catalogue, after checking that every motor the study names is in it."""
-    from ..hardware.motors import load_catalogue
-
     catalogue = catalogue if catalogue is not None else load_catalogue()
     problems: list[StudyProblem] = []
     names = sorted(catalogue)
@@ -84,8 +81,6 @@ def gearbox_for(spec: GearboxSpec | None) -> Gearbox | None:
     """The :class:`collision_reflex.hardware.actuators.Gearbox` of a spec (``None`` for direct drive)."""
     if spec is None:
         return None
-    from ..hardware.gearboxes import Gearbox
-
     return Gearbox(
         spec.kind,
         stages=spec.stages,
@@ -156,17 +151,12 @@ def free_variables(study: ArmStudy, n_joints: int, joint_names: list[str] | None
             shared = [
                 j in sharing and name in MODULE_DESIGN_VARIABLES for j in joint_names or [""] * len(bounds)
             ]
-            free = sum(_is_free(b) for b, s in zip(bounds, shared, strict=True) if not s)
+            free = sum(b.free for b, s in zip(bounds, shared, strict=True) if not s)
         else:
-            free = int(_is_free(spec))
+            free = int(spec.free)
         if free:
             counts[name] = free
     return counts
-
-
-def _is_free(spec: Any) -> bool:
-    lower, upper = spec.bounds
-    return bool(lower < upper)
 
 
 def _per_joint_bounds(spec: Any, n_joints: int, joint_names: list[str] | None) -> list[Any]:
@@ -199,9 +189,6 @@ def describe_study(loaded: LoadedStudy, load_robot: bool = True) -> str:
     text = f"arm study {study.name!r} on {robot}"
     n_joints = None
     if load_robot:
-        from .robot import load_arm
-        from .samples import sample_counts
-
         check_motors(loaded)
         arm = load_arm(loaded)
         n_joints = len(arm.joint_names)

@@ -217,3 +217,65 @@ SafetyFactor = quantity_type("", "a dimensionless number", "1.5", 1.0, 100.0)
 NoiseFloor = quantity_type("N", "a force", "0.5 N", 0.0, 1e4)
 # Floors on a contact Jacobian's smallest singular value: 0 (none) up to a reach no arm has.
 SingularValueFloor = quantity_type("m", "a length", "0.08 m", 0.0, 100.0)
+
+# A gearbox's input speed: from a slow hand crank (1e-3 rad/s) to beyond the fastest spindles (1e5 rad/s).
+AngularSpeed = quantity_type("rad/s", "an angular speed", "3000 rpm", 1e-3, 1e5)
+# Sampling rates of a via-point motion: 1 Hz to 10 kHz (a servo loop's rate).
+Rate = quantity_type("Hz", "a sampling rate", "500 Hz", 1.0, 1e4)
+
+
+def per_item_quantity_type(
+    unit: str, what: str, example: str, collection: type, minimum: str, maximum: float
+) -> Any:
+    """A quantity for every item (a number or a string with units), or a ``collection`` of them, in ``unit``.
+
+    ``collection`` is ``dict`` (by joint name) or ``list`` (one per item); ``minimum`` is ``"> 0"`` or
+    ``">= 0"``; ``maximum`` [``unit``] the largest physical value. One validator for both forms, so that a bad
+    value gives one located problem.
+    """
+
+    def one(value: Any) -> float:
+        number = to_si(value, unit, what, example, (-maximum, maximum))
+        if not (number > 0 or (minimum == ">= 0" and number == 0)):
+            raise PydanticCustomError(
+                "quantity", "{expected}", {"expected": f"{what} {minimum} (found {number:g})"}
+            )
+        return number
+
+    def validate(value: Any) -> Any:
+        if isinstance(value, dict) and collection is dict:
+            return {str(key): one(item) for key, item in value.items()}
+        if isinstance(value, list) and collection is list:
+            return [one(item) for item in value]
+        return one(value)
+
+    bound = "exclusiveMinimum" if minimum == "> 0" else "minimum"
+    quantity = {"anyOf": [{"type": "number", bound: 0, "maximum": maximum}, {"type": "string"}]}
+    many = (
+        {"type": "object", "additionalProperties": quantity}
+        if collection is dict
+        else {"type": "array", "items": quantity}
+    )
+    form = "a mapping by joint name naming every joint" if collection is dict else "a list, one per via point"
+    return Annotated[
+        (float | dict[str, float]) if collection is dict else (float | list[float]),
+        BeforeValidator(validate),
+        WithJsonSchema(
+            {
+                "anyOf": [quantity, many],
+                "description": f"{what} [{unit}] {minimum}, e.g. {example!r}: one for all, or {form}",
+            }
+        ),
+    ]
+
+
+# Limits a joint could physically reach (1000 rad/s is ~10,000 rpm at the output; 1e6 rad/s^2 ~ 100 g at 0.01
+# m), and an hour at rest: beyond these a duty cycle is a typing error.
+JointSpeed = per_item_quantity_type(
+    "rad/s", "a joint speed (m/s for a prismatic joint)", "90 deg/s", dict, "> 0", 1e3
+)
+JointAcceleration = per_item_quantity_type(
+    "rad/s^2", "a joint acceleration (m/s^2 for a prismatic joint)", "300 deg/s^2", dict, "> 0", 1e6
+)
+Dwell = per_item_quantity_type("s", "a time at rest", "0.5 s", list, ">= 0", 3600.0)
+StoppingTime = per_item_quantity_type("s", "a stopping time", "0.25 s", dict, "> 0", 60.0)

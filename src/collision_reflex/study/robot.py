@@ -7,15 +7,16 @@ the study file that names them.
 from __future__ import annotations
 
 import difflib
-from typing import TYPE_CHECKING
 
+from ..arm import Arm
 from ..errors import FrameNotFound, InvalidParameter, StudyFileError, StudyProblem, UrdfError
+from .design_specs import PER_JOINT_DESIGN_VARIABLES
+from .duty import prismatic_joints
 from .load import LoadedStudy
-from .schema import PER_JOINT_DESIGN_VARIABLES, ArmStudy
+from .quantities import joint_position_si
+from .resolve import JOINT_POSITION_PATHS, at_path
+from .schema import ArmStudy
 from .source import PathKey, excerpt
-
-if TYPE_CHECKING:
-    from ..arm import Arm
 
 
 def example_robot_names() -> list[str]:
@@ -37,8 +38,6 @@ def load_arm(loaded: LoadedStudy) -> Arm:
     if not isinstance(study, ArmStudy):
         raise TypeError("load_arm needs an arm study")
     spec = study.robot
-    from ..arm import Arm
-
     offset = None if spec.contact_offset is None else list(spec.contact_offset)
     locked = list(spec.locked_joints)
     try:
@@ -179,10 +178,6 @@ def check_against_arm(loaded: LoadedStudy, arm: Arm) -> list[StudyProblem]:
 
 def _position_units(loaded: LoadedStudy, arm: Arm) -> list[StudyProblem]:
     """An angle for each revolute joint, a length for each prismatic one, in the study's joint positions."""
-    from .duty import prismatic_joints
-    from .quantities import joint_position_si
-    from .resolve import JOINT_POSITION_PATHS, at_path
-
     prismatic = prismatic_joints(arm)
     units = ["m" if name in prismatic else "rad" for name in arm.joint_names]
     problems = []

@@ -5,38 +5,52 @@ write the results and the report.
 
 A run restarted with the same command finds its finished pieces in ``OUT/points`` and does only the rest; the
 same study (and seed) gives the same numbers whatever the executor, because every piece of work is a pure
-function of the resolved study and its own inputs.
+function of the resolved study (:class:`~.resolve.ResolvedStudy`, resolved once per run) and its own inputs.
 """
 
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import os
 import time
-from collections.abc import Callable
 from concurrent.futures import Executor
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, cast
+from typing import Any, cast
 
 import numpy as np
 
+from .. import __version__
 from .._interrupt import caused_by_interrupt
+from ..errors import SolverFailed, StudyRunFailed
+from ..optimize import DesignResult, ParetoSet
+from ..optimize.active_set_result import ActiveSetResult
+from ..optimize.optimum import OPTIMUM_STARTS, known_optima, single_optimum
+from ..optimize.pareto import pareto_front
+from ..optimize.pieces import built_problem, release_problems
+from ..optimize.recommend import recommend
+from ..optimize.sweep import Runner
+from ..report import write_outputs
 from ..report.outputs import StageTimes
-from .arm_results import CatalogueRecord, SnapCatalogue, arm_results, catalogue_results, study_catalogue
+from ..report.verdict import verdict
+from . import simulate_design
+from .actuator_study import check_actuator_study, evaluate_actuator_study
+from .arm_results import CatalogueRecord, arm_results
 from .arm_setup import ExtraSamples
+from .catalogue_snap import SnapCatalogue, catalogue_results, study_catalogue
 from .executors import open_executor
-from .load import LoadedStudy, load_study, parse_study
-from .resolve import fingerprint, resolved_study, resolved_yaml
-from .schema import ActuatorStudy, ArmStudy
+from .load import LoadedStudy, load_study
+from .problems import IPOPT_OPTIONS, StudyProblems, checked_setup
+from .progress import RunProgress
+from .resolve import ResolvedStudy, resolve_study
+from .schema import ArmStudy
 from .store import OutputFolderUnusable, RunFolder
-
-if TYPE_CHECKING:
-    from ..optimize import DesignResult, ParetoSet
-    from .arm_setup import StudyProblems
+from .transmission_choice import choose_transmissions
+from .worst_case import exchanges_samples, search_designs, violators
 
 SMOKE_ENVIRONMENT = "CRX_SMOKE"
-"""Set to 1 to run every study with small sample counts (tests, quick checks): see :func:`smoke_study`."""
+"""Set to 1 to run every study with small sample counts (tests, quick checks): see :func:`.resolve.smoke_study`."""
 
 
 @dataclass(frozen=True)
@@ -59,58 +73,6 @@ class RunResult:
     def report(self) -> Path:
         """The run's HTML report."""
         return self.folder / "report.html"
-
-
-def smoke_study(data: dict[str, Any]) -> dict[str, Any]:
-    """A resolved study shrunk for a quick run.
-
-    A few configurations, directions, fresh configurations, Pareto points and velocities, and a lighter
-    worst-case search. The shrunk study is what the run records as its resolved study.
-    """
-    data = {**data}
-    if data.get("kind") == "actuator":
-        data["velocities"] = {**data["velocities"], "count": min(data["velocities"]["count"], 12)}
-        return data
-    samples = {**data["samples"]}
-    configurations = {**samples["configurations"]}
-    if configurations.get("random"):
-        configurations["random"] = {
-            **configurations["random"],
-            "count": min(configurations["random"]["count"], 3),
-        }
-    if configurations.get("list"):
-        configurations["list"] = configurations["list"][:2]
-    if configurations.get("trajectory"):
-        configurations["trajectory"] = {
-            **configurations["trajectory"],
-            "every": max(configurations["trajectory"]["every"], 50),
-        }
-    directions = {**samples["directions"]}
-    for key in ("circle", "sphere"):
-        if directions.get(key):
-            directions[key] = min(directions[key], 6)
-    for key in ("named", "list"):
-        if directions.get(key):
-            directions[key] = directions[key][:4]
-    data["samples"] = {
-        **samples,
-        "configurations": configurations,
-        "directions": directions,
-        "fresh": min(samples.get("fresh", 0), 64),
-    }
-    optimizer = {**data.get("optimizer", {})}
-    search = {**optimizer.get("worst_case_search", {})}
-    if search:  # a lighter search: a few starts, two rounds
-        search.update(
-            starts=min(search["starts"], 3),
-            random_starts=min(search["random_starts"], 2),
-            rounds=min(search["rounds"], 2),
-        )
-        data["optimizer"] = {**optimizer, "worst_case_search": search}
-    data.pop("simulate", None)  # the time-domain simulation is no quick check
-    if data.get("pareto"):
-        data["pareto"] = {**data["pareto"], "points": min(data["pareto"]["points"], 4)}
-    return data
 
 
 def default_output_folder(loaded: LoadedStudy, smoke: bool = False) -> Path:
@@ -149,65 +111,34 @@ def run_study(
     StudyFileError: a bad study, with its lines; every input is checked before the output folder is touched,
         so nothing is written then.
     """
-    from .. import __version__
-
     started = time.perf_counter()
     stages = StageTimes()
-    with stages.stage("load"):
-        loaded = load_study(path)
-        smoke = bool(os.environ.get(SMOKE_ENVIRONMENT, "")) if smoke is None else smoke
-        resolved = resolved_study(loaded)
-        as_written = loaded
-        if smoke:
-            resolved = smoke_study(resolved)
-            loaded = parse_study(_dump(resolved), str(path), loaded.directory)
-        text = resolved_yaml(loaded)
-    transmissions = None
-    if isinstance(loaded.study, ArmStudy) and isinstance(loaded.study.actuators.gearbox, list):
-        from .transmission_choice import choose_transmissions
-
-        with stages.stage("transmissions"):  # the best gearbox option per module, by the study's objective
-            resolved, transmissions = choose_transmissions(as_written, resolved)  # located as written
-            loaded = parse_study(_dump(resolved), str(path), loaded.directory)
-            text = resolved_yaml(loaded)
-    # Robot, motors, samples and the problem build: every problem is raised here, located in the file as
-    # written, before any output.
-    with stages.stage("prepare"):
-        _prepare(as_written, text)
-        catalogue = study_catalogue(loaded) if isinstance(loaded.study, ArmStudy) else None
-    folder = RunFolder(Path(out) if out is not None else default_output_folder(loaded, smoke))
-    execution = resolved.get("execution", {})
+    smoke = bool(os.environ.get(SMOKE_ENVIRONMENT, "")) if smoke is None else smoke
+    study, catalogue, transmissions = _prepared(path, smoke, stages)
+    folder = RunFolder(Path(out) if out is not None else default_output_folder(study.loaded, smoke))
+    execution = study.data.get("execution", {})
     kind = executor or execution.get("executor", "serial")
     if scheduler is None and kind == "dask":
         scheduler = execution.get("scheduler")
+    details = {"study": study.study.name, "study_file": str(path), "smoke": smoke, "version": __version__}
     resumed = folder.claim(
-        fingerprint(resolved),
-        text,
-        {
-            "study": loaded.study.name,
-            "study_file": str(path),
-            "smoke": smoke,
-            "version": __version__,
-            "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
-        },
+        study.fingerprint, study.text, {**details, "started": time.strftime("%Y-%m-%dT%H:%M:%S%z")}
     )
-    progress = _Progress(quiet)
+    progress = RunProgress(quiet)
     try:
         n_workers = workers or execution.get("workers", 2)
         # Work in flight: one at a time in-process; a few per worker for a pool (so that finished work is saved
         # while the rest runs); everything at once for a Dask cluster, whose size is its own business.
         window = 1 if kind == "serial" and scheduler is None else (10**6 if scheduler else 2 * n_workers)
         with open_executor(kind, n_workers, scheduler) as pool:
-            if isinstance(loaded.study, ArmStudy):
+            if isinstance(study.study, ArmStudy):
                 results, counts = _run_arm(
-                    loaded.study, text, folder, pool, progress, window, stages, catalogue, transmissions
+                    study, folder, pool, progress, window, stages, catalogue, transmissions
                 )
             else:
                 with stages.stage("actuators"):
-                    results, counts = _run_actuators(loaded, folder, progress)
+                    results, counts = _run_actuators(study.loaded, folder, progress)
         progress.stop()
-        from ..report import write_outputs
-
         write_outputs(folder.path, results, figures=figures, stages=stages)
     except OSError as error:  # a full disk, a folder made read-only meanwhile: finished pieces are kept
         progress.stop()
@@ -226,85 +157,34 @@ def run_study(
     return RunResult(folder.path, resumed, counts[0], counts[1], elapsed, tuple(results.get("verdict", ())))
 
 
-def _dump(data: dict[str, Any]) -> str:
-    import yaml
+def _prepared(
+    path: str | os.PathLike[str], smoke: bool, stages: StageTimes
+) -> tuple[ResolvedStudy, SnapCatalogue | None, list[dict[str, Any]] | None]:
+    """The study a run solves (resolved once), its catalogue and the gearbox assignments tried, all checked.
 
-    return yaml.safe_dump(data, sort_keys=False)
-
-
-def _prepare(loaded: LoadedStudy, text: str) -> None:
-    """Check everything a run needs.
-
-    Problems are located in ``loaded`` (the file as written), while the problem is built from ``text`` (the
-    resolved study that runs).
+    Every problem (robot, motors, samples, the problem build) is raised here, located in the file as written,
+    before any output.
     """
-    if isinstance(loaded.study, ArmStudy):
-        from .arm_setup import checked_setup
-
-        checked_setup(loaded, text)
-    else:
-        from .actuator_study import check_actuator_study
-
+    with stages.stage("load"):
+        loaded = load_study(path)
+        study = resolve_study(loaded, smoke)
+    transmissions = None
+    if isinstance(loaded.study, ArmStudy) and isinstance(loaded.study.actuators.gearbox, list):
+        with stages.stage("transmissions"):  # the best gearbox option per module, by the study's objective
+            study, transmissions = choose_transmissions(loaded, study)  # located as written
+    with stages.stage("prepare"):
+        if isinstance(loaded.study, ArmStudy):
+            checked_setup(loaded, study)
+            return study, study_catalogue(study.loaded), transmissions
         check_actuator_study(loaded)
-
-
-class _Progress:
-    """Rich progress bars on stderr (none when quiet).
-
-    Drawn from the first bar on: the bars' refresh thread starts then, after the run's executor has started
-    its workers (a local pool forks them: :data:`~collision_reflex.study.executors.START_METHOD`).
-    """
-
-    def __init__(self, quiet: bool) -> None:
-        self._bar: Any = None
-        if not quiet:
-            from rich.console import Console
-            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-
-            self._bar = Progress(
-                TextColumn("{task.description}"),
-                BarColumn(),
-                MofNCompleteColumn(),
-                TimeElapsedColumn(),
-                console=Console(stderr=True),
-            )
-
-    def _add(self, description: str, **counts: int) -> Any:
-        if not self._bar.live.is_started:
-            self._bar.start()
-        return self._bar.add_task(description, **counts)
-
-    def stage(self, description: str, total: int, done: int = 0) -> Callable[[], None]:
-        if self._bar is None:
-            return lambda: None
-        task = self._add(description, total=total, completed=done)
-        return lambda: self._bar.advance(task)
-
-    def counter(self, description: str) -> Callable[[int, int], None]:
-        """A ``progress(done, total)`` callback drawing one bar."""
-        state: dict[str, Any] = {}
-
-        def update(done: int, total: int) -> None:
-            if self._bar is None:
-                return
-            if "task" not in state:
-                state["task"] = self._add(description, total=total)
-            self._bar.update(state["task"], completed=done, total=total)
-
-        return update
-
-    def stop(self) -> None:
-        if self._bar is not None:
-            self._bar.stop()
-            self._bar = None
+    return study, None, transmissions
 
 
 def _run_arm(
-    study: ArmStudy,
-    text: str,
+    resolved: ResolvedStudy,
     folder: RunFolder,
     pool: Executor,
-    progress: _Progress,
+    progress: RunProgress,
     window: int,
     stages: StageTimes,
     catalogue: SnapCatalogue | None = None,
@@ -317,16 +197,13 @@ def _run_arm(
     the next round solves on them, until none is found or ``optimizer.worst_case_search.rounds`` is reached.
 
     Then, with a ``catalogue``, the recommended design and every Pareto design snapped to it
-    (:func:`.arm_results.catalogue_results`). Each piece is saved as it finishes and found again when the run
+    (:func:`.catalogue_snap.catalogue_results`). Each piece is saved as it finishes and found again when the run
     resumes (the snap as ``catalogue``, reused while the catalogue file and the settings are the same).
     ``transmissions``: the gearbox assignments tried before (:func:`.transmission_choice.choose_transmissions`),
     kept in the results.
     """
-    from ..optimize.pieces import release_problems
-    from ..report.verdict import verdict
-    from .arm_setup import StudyProblems
-    from .worst_case import exchanges_samples, search_designs, violators
-
+    study = resolved.study
+    assert isinstance(study, ArmStudy)
     search = study.optimizer.worst_case_search
     extra: ExtraSamples = ()
     computed = reused = 0
@@ -334,7 +211,7 @@ def _run_arm(
     for round_ in range(search.rounds if search.enabled else 1):
         if round_:  # the last round's problems, on fewer samples, are not solved again
             release_problems()
-        problems = StudyProblems(text, extra)
+        problems = StudyProblems(resolved, extra)
         prefix = f"round-{round_}-{_digest(extra)}-" if extra else ""
         optimum, front, counts = _solve_round(
             problems, study, folder, pool, progress, window, stages, prefix, optimum
@@ -370,17 +247,14 @@ def _run_arm(
         "kind": "arm",
         "study": study.name,
         "description": study.description,
-        "resolved": resolved_study(parse_study(text, "resolved study")),
+        "resolved": resolved.data,
         **stages.timed("results", arm_results)(problems, optimum, front, snapped, searches, search.tolerance),
     }
     if transmissions is not None:
         results["transmission_choice"] = transmissions
     if study.simulate is not None:
-        from ..optimize.recommend import recommend
-        from .simulate_design import simulate_designs
-
         recommended = recommend(optimum, front, problems.objective).result
-        results["simulation"] = stages.timed("simulation", simulate_designs)(
+        results["simulation"] = stages.timed("simulation", simulate_design.simulate_designs)(
             problems, recommended, front, study.simulate, folder
         )
     results["verdict"] = stages.timed("results", verdict)(results)
@@ -392,7 +266,7 @@ def _solve_round(
     study: ArmStudy,
     folder: RunFolder,
     pool: Executor,
-    progress: _Progress,
+    progress: RunProgress,
     window: int,
     stages: StageTimes,
     prefix: str,
@@ -404,14 +278,6 @@ def _solve_round(
     samples but the ones a search added since) with its active samples and the added ones: the exchange method
     re-solves from its last design.
     """
-    from ..errors import SolverFailed, StudyRunFailed
-    from ..optimize.active_set_result import ActiveSetResult
-    from ..optimize.optimum import OPTIMUM_STARTS, known_optima, single_optimum
-    from ..optimize.pareto import pareto_front
-    from ..optimize.pieces import built_problem
-    from ..optimize.sweep import Runner
-    from .arm_setup import IPOPT_OPTIONS
-
     starts, x0, initial = OPTIMUM_STARTS, None, None
     if before is not None:
         full = built_problem(problems, problems.objective)
@@ -468,17 +334,12 @@ def _solve_round(
 
 def _digest(extra: ExtraSamples) -> str:
     """A short digest of searched samples: the pieces solved on them are saved under it."""
-    import hashlib
-
     return hashlib.sha256(repr(extra).encode()).hexdigest()[:10]
 
 
 def _run_actuators(
-    loaded: LoadedStudy, folder: RunFolder, progress: _Progress
+    loaded: LoadedStudy, folder: RunFolder, progress: RunProgress
 ) -> tuple[dict[str, Any], tuple[int, int]]:
-    from .actuator_study import evaluate_actuator_study
-
-    assert isinstance(loaded.study, ActuatorStudy)
     saved = folder.finished("actuators")
     if saved is None:
         advance = progress.stage("actuators", 1)
@@ -489,4 +350,4 @@ def _run_actuators(
     return saved, (0, 1)
 
 
-__all__ = ["RunResult", "run_study", "smoke_study"]
+__all__ = ["RunResult", "run_study"]

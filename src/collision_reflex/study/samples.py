@@ -20,7 +20,8 @@ from ..arm.duty_cycle import joint_positions
 from ..errors import InvalidParameter, StudyFileError, StudyProblem, TrajectoryError
 from .duty import per_joint_values, prismatic_joints
 from .load import LoadedStudy
-from .schema import ArmStudy, ConfigurationSamples, DirectionSamples
+from .sample_specs import ConfigurationSamples, DirectionSamples
+from .schema import ArmStudy
 from .source import excerpt
 
 if TYPE_CHECKING:

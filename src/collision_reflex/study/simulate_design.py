@@ -22,10 +22,16 @@ from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
 
+from ..model.impulse import optimal_velocity
+from ..optimize.evaluate import design_collision_parameters, evaluate_design
+from ..optimize.pieces import built_problem
+from ..simulate.design_closed_form import JointDesign, arm_closed_form
+from ..simulate.validity import MAX_STEPS, available_detections, simulated_impulse
+
 if TYPE_CHECKING:
     from ..optimize import DesignProblem, DesignResult, ParetoSet
-    from .arm_setup import StudyProblems
-    from .schema import SimulateSpec
+    from .problems import StudyProblems
+    from .run_specs import SimulateSpec
     from .store import RunFolder
 
 
@@ -72,8 +78,6 @@ def simulate_designs(
 
     Each design's simulations are saved in ``folder`` as they finish and found again when the run resumes.
     """
-    from ..optimize.pieces import built_problem
-
     problem = built_problem(problems, problems.objective)
     out: dict[str, Any] = {"recommended": None, "pareto": []}
     jobs: list[tuple[str, DesignResult]] = []
@@ -100,10 +104,6 @@ def simulate_design(
     problems: StudyProblems, problem: DesignProblem, result: DesignResult, spec: SimulateSpec, name: str
 ) -> DesignSimulation:
     """Simulate one design on its ``spec.samples`` worst contact samples (largest closed-form impulse)."""
-    from ..optimize.evaluate import design_collision_parameters, evaluate_design
-    from ..simulate.design_closed_form import JointDesign
-    from ..simulate.validity import available_detections
-
     setup = problems.setup
     design = result.design
     detection = spec.detection or available_detections()[0]
@@ -148,10 +148,6 @@ def _sample(
     reaction: str,
 ) -> SimulatedSample:
     """Simulate sample ``s`` of the study; the closed form [N*s] is the optimiser's."""
-    from ..model.impulse import optimal_velocity
-    from ..simulate.design_closed_form import arm_closed_form
-    from ..simulate.validity import MAX_STEPS, simulated_impulse
-
     config = int(setup.samples.config_index[s])
     q = np.asarray(setup.configurations[config], dtype=float)
     u = np.asarray(setup.samples.directions[s], dtype=float)

@@ -17,7 +17,11 @@ from typing import Any
 
 import numpy as np
 
+from ..arm import Arm
+from ..arm.robots import ROBOT_DEFAULTS, example_robot, load_urdf
+from ..arm.static_hold import hold_torques
 from ..errors import InvalidParameter
+from ..hardware.gearboxes import load_gearbox_catalogue
 
 SAFETY_FACTOR = 1.5
 """The torque safety factor the written study asks for (as the shipped UR5 and Panda studies)."""
@@ -76,8 +80,6 @@ def robot_entries() -> list[RobotEntry]:
     """Every robot of example-robot-data, in name order."""
     from example_robot_data.robots_loader import ROBOTS
 
-    from ..arm.robots import example_robot
-
     entries = []
     for name in sorted(ROBOTS):
         try:
@@ -93,8 +95,6 @@ def robot_entries() -> list[RobotEntry]:
 
 def robot_entry(name: str, model: Any, frame: str | None = None) -> RobotEntry:
     """The entry of ``model`` (a Pinocchio model), its contact frame ``frame`` or the one chosen for it."""
-    from ..arm.robots import ROBOT_DEFAULTS
-
     floating = model.njoints > 1 and model.joints[1].nq == 7
     joints = sum(1 for j in range(1, model.njoints) if model.joints[j].nv == 1)
     if frame is None:
@@ -178,9 +178,6 @@ def starter_study(robot: str, out: Path, frame: str | None = None, payload: floa
     InvalidParameter: an unknown robot, a frame it does not have, a robot with a floating base or with fewer than
         two revolute joints to its contact frame.
     """
-    from ..arm import Arm
-    from ..arm.robots import example_robot, load_urdf
-
     urdf = Path(robot) if robot.endswith(".urdf") or Path(robot).is_file() else None
     if urdf is not None:
         model, name = load_urdf(urdf), urdf.stem
@@ -231,8 +228,6 @@ def _contact_offset(name: str, model: Any, frame: str) -> tuple[np.ndarray | Non
     A frame at its joint's origin does not move with that joint, so no contact there can be reflexed by it:
     the robot's known tip, else twice the link's centre of mass (the end of a uniform link), is used.
     """
-    from ..arm.robots import ROBOT_DEFAULTS
-
     defaults = ROBOT_DEFAULTS.get(name, {})
     if defaults.get("contact_frame") == frame and defaults.get("contact_offset") is not None:
         return np.asarray(defaults["contact_offset"], dtype=float), "the robot's tip (its package default)"
@@ -307,8 +302,6 @@ def _hold_torques(figures: _Figures) -> np.ndarray:
     The designed actuators' own masses are left out (:func:`collision_reflex.arm.static_hold.hold_torques`
     with none).
     """
-    from ..arm.static_hold import hold_torques
-
     nv = figures.limits.shape[1]
     return np.max(np.abs(hold_torques(figures.poses, figures.payload, np.zeros(nv))), axis=0)
 
@@ -416,8 +409,6 @@ def _heavy_joints(
     factor and :data:`ACTUATOR_WEIGHT_MARGIN`. The scaled strain-wave gearing stops at the catalogue's strongest
     CSF unit.
     """
-    from ..hardware.gearboxes import load_gearbox_catalogue
-
     strongest = max(unit.peak_torque for unit in load_gearbox_catalogue().values() if unit.kind == "harmonic")
     torque = dict(zip(names, hold * SAFETY_FACTOR * ACTUATOR_WEIGHT_MARGIN, strict=True))
     heavy = [name for group in groups if max(torque[name] for name in group) > strongest for name in group]

@@ -11,12 +11,17 @@ from __future__ import annotations
 
 import copy
 import itertools
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
-from .schema import DIRECT_DRIVE
-
-if TYPE_CHECKING:
-    from .load import LoadedStudy
+from ..errors import InvalidParameter, SolverFailed, StudyFileError
+from ..optimize.catalogue_search import objective_value
+from ..optimize.optimum import single_optimum
+from ..optimize.pieces import built_problem
+from .actuator_specs import DIRECT_DRIVE
+from .load import LoadedStudy
+from .problems import StudyProblems, checked_setup
+from .resolve import ResolvedStudy
+from .robot import load_arm
 
 MAX_ASSIGNMENTS = 16
 """Most assignments of gearbox options tried (each one solve of the study's optimum)."""
@@ -56,9 +61,11 @@ def option_name(option: Any) -> str:
 
 
 def choose_transmissions(
-    loaded: LoadedStudy, resolved: dict[str, Any]
-) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    loaded: LoadedStudy, resolved: ResolvedStudy
+) -> tuple[ResolvedStudy, list[dict[str, Any]]]:
     """The resolved study with the best assignment of its gearbox options, and every assignment tried.
+
+    ``loaded``: the study as written, where problems are located; ``resolved``: what the run solves.
 
     Each entry: ``assignment`` (per group of joints the option's name), ``objective`` (the study's objective at
     the optimum, None without one), ``actuator_mass`` [kg] (None without one), ``status`` and ``chosen``.
@@ -69,17 +76,8 @@ def choose_transmissions(
         assignment's own refusal when every one is refused, located in the file; else at ``actuators.gearbox``).
     KeyboardInterrupt: Ctrl-C, from any solve.
     """
-    import yaml
-
-    from ..errors import InvalidParameter, SolverFailed, StudyFileError
-    from ..optimize.catalogue_search import objective_value
-    from ..optimize.optimum import single_optimum
-    from ..optimize.pieces import built_problem
-    from .arm_setup import StudyProblems, checked_setup
-    from .robot import load_arm
-
-    options = resolved["actuators"]["gearbox"]
-    groups = gearbox_groups(resolved, list(load_arm(loaded).joint_names))
+    options = resolved.data["actuators"]["gearbox"]
+    groups = gearbox_groups(resolved.data, list(load_arm(loaded).joint_names))
     assignments = list(itertools.product(range(len(options)), repeat=len(groups)))
     if len(assignments) > MAX_ASSIGNMENTS:
         raise loaded.fail(
@@ -87,10 +85,11 @@ def choose_transmissions(
             f"{len(options)} gearbox options for {len(groups)} modules or joints: {len(assignments)} assignments",
             f"at most {MAX_ASSIGNMENTS}: group joints into actuators.modules, or list fewer options",
         )
-    tried, variants = [], []
+    tried: list[dict[str, Any]] = []
+    studies: list[ResolvedStudy | None] = []  # each assignment's, None where it is refused as data
     refusals: list[Exception] = []
     for assignment in assignments:
-        variant = copy.deepcopy(resolved)
+        variant = copy.deepcopy(resolved.data)
         variant["actuators"]["gearbox"] = None
         for group, k in zip(groups, assignment, strict=True):
             for joint in group:
@@ -103,10 +102,11 @@ def choose_transmissions(
             "actuator_mass": None,
             "chosen": False,
         }
-        text = yaml.safe_dump(variant, sort_keys=False)
+        study = None
         try:
-            checked_setup(loaded, text)  # every problem of this assignment, located in the file as written
-            problems = StudyProblems(text)
+            study = ResolvedStudy.of(loaded, variant)
+            checked_setup(loaded, study)  # every problem of this assignment, located in the file as written
+            problems = StudyProblems(study)
             optimum, _ = single_optimum(problems, problems.objective, starts=1)
             entry["objective"] = objective_value(
                 built_problem(problems, problems.objective), optimum.numpy_objectives
@@ -119,7 +119,7 @@ def choose_transmissions(
             entry["status"] = f"refused: {error}"
             refusals.append(error)
         tried.append(entry)
-        variants.append(variant)
+        studies.append(study)
     feasible = [i for i, entry in enumerate(tried) if entry["objective"] is not None]
     if not feasible and len(refusals) == len(tried) and isinstance(refusals[0], StudyFileError):
         raise refusals[0]  # as a study of one gearbox would be refused, at its lines
@@ -131,4 +131,6 @@ def choose_transmissions(
         )
     best = min(feasible, key=lambda i: tried[i]["objective"])
     tried[best]["chosen"] = True
-    return variants[best], tried
+    chosen = studies[best]
+    assert chosen is not None  # it has a design
+    return chosen, tried

@@ -17,8 +17,11 @@ import numpy as np
 
 from ..optimize.pieces import one_at_a_time
 from ..optimize.worst_case import WorstCase, search_worst_case
-from .arm_setup import ExtraSamples, StudyProblems
-from .schema import ArmStudy, SearchSpec
+from .arm_setup import ExtraSamples
+from .problems import StudyProblems, study_setup
+from .resolve import ResolvedStudy
+from .run_specs import SearchSpec
+from .schema import ArmStudy
 
 if TYPE_CHECKING:
     from ..optimize import DesignResult
@@ -37,7 +40,7 @@ def exchanges_samples(study: ArmStudy) -> bool:
 
 @one_at_a_time
 def _search_one(
-    resolved_text: str,
+    study: ResolvedStudy,
     design: Design,
     start_q: np.ndarray,
     start_directions: np.ndarray,
@@ -49,7 +52,7 @@ def _search_one(
     The search needs the arm, its domain and the technology, which the searched samples do not change: the
     study's own setup serves every round (built once per process).
     """
-    setup = StudyProblems(resolved_text).setup
+    setup = study_setup(study)
     return search_worst_case(
         setup.arm,
         setup.domain,
@@ -91,7 +94,7 @@ def search_designs(
         start_q, start_directions = worst_samples(problems, result.impulses, spec.starts)
         futures[label] = executor.submit(
             _search_one,
-            problems.resolved_text,
+            problems.study,
             result.design,
             start_q,
             start_directions,
