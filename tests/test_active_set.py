@@ -12,6 +12,8 @@ from collision_reflex.optimize import active_set
 from collision_reflex.optimize.active_set import ActiveSetResult, sample_subset, solve_active_set
 from collision_reflex.optimize.evaluate import design_collision_parameters
 
+pytestmark = pytest.mark.xdist_group("test_active_set")  # one pytest-xdist worker: set-ups made once
+
 # Both solves to a KKT tolerance far below the comparison's: at IPOPT's default 1e-8 the worst case of these
 # flat problems (set by the link inertia, the motors trade little against it) is only fixed to ~3e-7 relative,
 # by either solve.

@@ -14,6 +14,8 @@ from collision_reflex.study.arm_setup import StudyProblems
 from collision_reflex.study.load import load_study
 from collision_reflex.study.resolve import resolved_yaml
 
+pytestmark = pytest.mark.xdist_group("test_static_hold")  # one pytest-xdist worker: set-ups made once
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
