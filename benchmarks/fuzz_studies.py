@@ -1,9 +1,11 @@
 """A long fuzz run over the shipped studies and catalogues: the CI test's mutants, in larger numbers.
 
 The mutants are those of ``tests/test_fuzz_studies.py`` (seeded, each rebuilt from its index), from ``--first``
-on; the CI test checks the first 10,000. Prints the count of each outcome (valid or a located error, by kind of
-mutation), the slowest mutant's time and index, the process's peak memory and its growth over the run. A
-mutant that is neither valid nor a one-line located error stops the run with its index.
+on; the test checks the first ``N_MUTANTS`` (1,500), this script by default the 100,000 after them. Prints the
+count of each outcome (valid or a located error, by kind of mutation), the slowest mutant's time and index, the
+process's peak memory and its growth over the run. A mutant that is neither valid nor a one-line located error
+stops the run with its index; a run that fails the test's check (every kind of outcome reached, no mutant
+slower than ``MAX_SECONDS``, peak memory within ``MAX_PEAK_GROWTH_MB``) ends with exit status 1.
 
 Run: ``PYTHONPATH=src python benchmarks/fuzz_studies.py [--mutants N] [--first I]``.
 """
@@ -19,13 +21,15 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 
-from test_fuzz_studies import SOURCES, fuzz  # noqa: E402  (the test module holds the mutators)
+from test_fuzz_studies import N_MUTANTS, SOURCES, check_fuzz_report, fuzz  # noqa: E402  (the test holds the mutators)
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--mutants", type=int, default=100_000, help="number of mutants (default 100,000)")
-    parser.add_argument("--first", type=int, default=10_000, help="index of the first (default: after CI's)")
+    parser.add_argument(
+        "--first", type=int, default=N_MUTANTS, help="index of the first (default: after the test's)"
+    )
     args = parser.parse_args()
     print(
         f"{args.mutants} mutants from index {args.first} of {len(SOURCES)} files: "
@@ -45,6 +49,10 @@ def main() -> None:
     )
     print(f"slowest mutant: {elapsed * 1e3:.0f} ms (index {index})")
     print(f"peak memory: {peak_mb:.0f} MB, {report.peak_growth_mb:.0f} MB more than before the first mutant")
+    try:
+        check_fuzz_report(report, args.mutants)
+    except AssertionError as error:
+        sys.exit(f"FAILED: {error}")
 
 
 if __name__ == "__main__":

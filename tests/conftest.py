@@ -1,5 +1,11 @@
-"""Shared test settings and set-ups: figures render off-screen; the Panda case of the active-set tests."""
+"""Shared test settings and set-ups: figures render off-screen; the Panda case of the active-set tests; one smoke
+run of each shipped study, shared by every test (and every pytest-xdist worker) that reads one."""
 
+import contextlib
+import os
+import shutil
+from collections.abc import Callable, Iterator, Mapping
+from pathlib import Path
 from typing import NamedTuple
 
 import matplotlib
@@ -7,8 +13,16 @@ import numpy as np
 import pytest
 
 import collision_reflex as cr
+from collision_reflex.cli import main
 
 matplotlib.use("Agg")
+
+STUDIES = Path(__file__).resolve().parents[1] / "studies"
+
+try:
+    import fcntl
+except ImportError:  # not POSIX: each worker makes its own copy of a shared set-up
+    fcntl = None
 
 
 class DesignCase(NamedTuple):
@@ -47,3 +61,70 @@ def panda_case():
         return DesignCase(arm, samples, space, technology, constraints)
 
     return case
+
+
+@contextlib.contextmanager
+def _locked(path: Path) -> Iterator[None]:
+    """Hold an exclusive lock on ``path`` (a file next to what it guards) while the block runs."""
+    with open(path, "w") as lock:
+        if fcntl is not None:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+        yield
+
+
+@pytest.fixture(scope="session")
+def shared_folder(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str, Callable[[Path], None]], Path]:
+    """``shared_folder(key, make)``: a folder filled once by ``make(folder)`` and shared by the whole test run.
+
+    Under pytest-xdist the workers share it: the first to ask makes it, the others wait for it and read it; after
+    a ``make`` that failed, the next asker starts again. Tests must not change the folder: copy it first.
+    """
+    base = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER") and fcntl is not None:
+        base = base.parent  # the run's temporary folder, above each worker's own
+    root = base / "shared"
+    root.mkdir(exist_ok=True)
+
+    def folder(key: str, make: Callable[[Path], None]) -> Path:
+        path, done = root / key, root / f"{key}.done"
+        with _locked(root / f"{key}.lock"):
+            if not done.exists():
+                shutil.rmtree(path, ignore_errors=True)
+                path.mkdir()
+                make(path)
+                done.touch()
+        return path
+
+    return folder
+
+
+class SmokeRuns(Mapping):
+    """The shipped studies' smoke runs by study name (the file's stem), each run when first looked up."""
+
+    def __init__(self, shared_folder: Callable[[str, Callable[[Path], None]], Path]) -> None:
+        self._shared_folder = shared_folder
+        self._names = sorted(path.stem for path in STUDIES.glob("*.yaml"))
+
+    def __getitem__(self, study: str) -> Path:
+        if study not in self._names:
+            raise KeyError(study)
+
+        def make(folder: Path) -> None:
+            command = ["run", str(STUDIES / f"{study}.yaml"), "--out", str(folder / "out"), "--quiet"]
+            assert main([*command, "--smoke", "--executor", "serial"]) == 0
+
+        return self._shared_folder(f"smoke-{study}", make) / "out"
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._names)
+
+    def __len__(self) -> int:
+        return len(self._names)
+
+
+@pytest.fixture(scope="session")
+def smoke_runs(shared_folder) -> SmokeRuns:
+    """``smoke_runs[study]``: the output folder of ``studies/<study>.yaml`` run once at smoke size, serial and
+    in-process, as ``crx run STUDY --out FOLDER --quiet --smoke --executor serial`` runs it. Read-only: a test
+    that changes a run's files works on a copy (``shutil.copytree``)."""
+    return SmokeRuns(shared_folder)

@@ -14,6 +14,8 @@ from collision_reflex.optimize.active_set_result import ActiveSetResult
 from collision_reflex.optimize.evaluate import design_collision_parameters
 from collision_reflex.optimize.subsets import sample_subset
 
+pytestmark = pytest.mark.xdist_group("test_active_set")  # one pytest-xdist worker: set-ups made once
+
 # Both solves to a KKT tolerance far below the comparison's: at IPOPT's default 1e-8 the worst case of these
 # flat problems (set by the link inertia, the motors trade little against it) is only fixed to ~3e-7 relative,
 # by either solve.

@@ -19,6 +19,8 @@ from collision_reflex.optimize.results import SweepPoint, result_from_json, resu
 from collision_reflex.optimize.subsets import sample_subset
 from collision_reflex.study.runner import run_study
 
+pytestmark = pytest.mark.xdist_group("test_active_set_sweeps")  # one pytest-xdist worker: set-ups made once
+
 ROOT = Path(__file__).resolve().parents[1]
 NAMES = ("worst_case_impulse", "actuator_mass")
 # As tests/test_active_set.py: both methods to a KKT tolerance far below the comparison's.

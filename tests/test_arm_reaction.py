@@ -22,6 +22,8 @@ from collision_reflex.errors import InvalidParameter
 from collision_reflex.model.impulse import phase_impulses, sprung_reaction
 from collision_reflex.model.joint_space import joint_space_collision
 
+pytestmark = pytest.mark.xdist_group("test_arm_reaction")  # one pytest-xdist worker: set-ups made once
+
 URDF = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
 K_M, ROTOR, TAU, F_S = 50.0, 2.2e-3, 1.3, 3.0
 

@@ -92,24 +92,11 @@ def synthetic_run(folder: Path, study: Path, seed: int, gearbox: str = "") -> Pa
 
 
 @pytest.fixture(scope="module")
-def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+def runs(tmp_path_factory: pytest.TempPathFactory, smoke_runs) -> dict[str, Path]:
     """A real smoke run of the planar two-link study and synthetic runs of the UR5 and Panda studies."""
     root = tmp_path_factory.mktemp("runs")
-    assert (
-        main(
-            [
-                "run",
-                str(REPO / "studies" / "two_link_paper.yaml"),
-                "--smoke",
-                "--quiet",
-                "--out",
-                str(root / "planar"),
-            ]
-        )
-        == 0
-    )
     return {
-        "planar": root / "planar",
+        "planar": smoke_runs["two_link_paper"],
         "ur5": synthetic_run(root / "ur5", REPO / "studies" / "ur5.yaml", 1, gearbox="NPS015-MF-1"),
         "panda": synthetic_run(root / "panda", REPO / "studies" / "panda.yaml", 2),
     }

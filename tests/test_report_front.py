@@ -411,14 +411,9 @@ _HOVERABLE = """(() => {
 
 
 @pytest.fixture(scope="module")
-def report(tmp_path_factory) -> Path:
-    """The two-link study run (smoke size) into a fresh folder: its report.html and designs.json."""
-    from collision_reflex.cli import main
-
-    folder = tmp_path_factory.mktemp("front") / "run"
-    command = ["run", str(TWO_LINK), "--out", str(folder), "--quiet", "--smoke", "--executor", "serial"]
-    assert main(command) == 0
-    return folder
+def report(smoke_runs) -> Path:
+    """The two-link study run (smoke size): its report.html and designs.json."""
+    return smoke_runs[TWO_LINK.stem]
 
 
 def test_hovering_a_point_shows_its_design(report, tmp_path):

@@ -88,12 +88,9 @@ def printed_tables(html: str) -> _PrintedTables:
     return parser
 
 
-@pytest.fixture(scope="module")
-def reports(tmp_path_factory) -> dict[str, Path]:
-    """Every shipped study run at smoke size but with its full Pareto front and simulation (what sets the
-    report's length: sample counts only change its numbers), printed to PDF."""
-    if find_browser() is None or shutil.which("pdftotext") is None:
-        pytest.skip("printing needs Chromium and pdftotext (apt-get install chromium poppler-utils)")
+def _printed_report(study: Path, folder: Path) -> None:
+    """``study`` run at smoke size but with its full Pareto front and simulation (what sets the report's length:
+    sample counts only change its numbers) into ``folder / "out"``, printed to PDF."""
     from collision_reflex.study import resolve
 
     shrink = resolve.smoke_study
@@ -102,18 +99,31 @@ def reports(tmp_path_factory) -> dict[str, Path]:
         shrunk = shrink(data)
         return {**shrunk, **{key: data[key] for key in ("pareto", "simulate") if key in data}}
 
-    folders = {}
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(resolve, "smoke_study", smoke_keeping_the_front)
-        for name, study in STUDIES.items():
-            folder = tmp_path_factory.mktemp(name) / "out"
-            assert (
-                main(["run", str(study), "--out", str(folder), "--quiet", "--smoke", "--executor", "serial"])
-                == 0
+        out = folder / "out"
+        assert main(["run", str(study), "--out", str(out), "--quiet", "--smoke", "--executor", "serial"]) == 0
+        assert main(["report", str(out), "--pdf"]) == 0
+
+
+@pytest.fixture(scope="module")
+def reports(shared_folder) -> dict[str, Path]:
+    """Every shipped study's printed report (:func:`_printed_report`), made when a test first asks for it."""
+    if find_browser() is None or shutil.which("pdftotext") is None:
+        pytest.skip("printing needs Chromium and pdftotext (apt-get install chromium poppler-utils)")
+
+    class Printed(dict):
+        def __missing__(self, name: str) -> Path:
+            self[name] = (
+                shared_folder(f"pdf-{name}", lambda folder: _printed_report(STUDIES[name], folder)) / "out"
             )
-            assert main(["report", str(folder), "--pdf"]) == 0
-            folders[name] = folder
-    return folders
+            return self[name]
+
+    return Printed()
+
+
+# Each study's tests on one pytest-xdist worker, which prints its report once.
+PER_STUDY = [pytest.param(name, marks=pytest.mark.xdist_group(f"pdf-{name}")) for name in STUDIES]
 
 
 def _pdf_text(folder: Path) -> str:
@@ -158,7 +168,7 @@ def visible(html: str) -> _Visible:
     return parser
 
 
-@pytest.mark.parametrize("name", list(STUDIES))
+@pytest.mark.parametrize("name", PER_STUDY)
 def test_each_report_is_within_its_budget_and_says_each_paragraph_once(reports, name):
     folder = reports[name]
     seen = visible((folder / "report.html").read_text())
@@ -172,7 +182,7 @@ def test_each_report_is_within_its_budget_and_says_each_paragraph_once(reports, 
     assert paragraphs and not repeated, repeated
 
 
-@pytest.mark.parametrize("name", list(STUDIES))
+@pytest.mark.parametrize("name", PER_STUDY)
 def test_margins_print_as_percentages_or_plain_multiples(reports, name):
     cells = printed_tables((reports[name] / "report.html").read_text()).labelled
     margins = [cell for column, _, cell in cells if "margin" in column and cell != "–"]
@@ -181,7 +191,7 @@ def test_margins_print_as_percentages_or_plain_multiples(reports, name):
     assert not re.search(r"\de[+-]\d+ %", html)  # never "8.37e+04 %"
 
 
-@pytest.mark.parametrize("kind", list(STUDIES))
+@pytest.mark.parametrize("kind", PER_STUDY)
 def test_every_table_number_is_in_the_pdf(reports: dict[str, Path], kind: str) -> None:
     folder = reports[kind]
     tables = printed_tables((folder / "report.html").read_text())
@@ -211,6 +221,7 @@ def test_pareto_rows_settle_required_torques_and_margins() -> None:
     assert _settled_rows([row]) == [{**row, "required_torque[j1] [N*m]": 0.0, "torque_margin[j1] [-]": 0.0}]
 
 
+@pytest.mark.xdist_group(f"pdf-{ARM}")
 def test_printed_margins_and_torques_carry_no_solver_noise(reports: dict[str, Path]) -> None:
     cells = printed_tables((reports[ARM] / "report.html").read_text()).labelled
     margins = [
@@ -231,7 +242,7 @@ def test_printed_margins_and_torques_carry_no_solver_noise(reports: dict[str, Pa
     assert not noise
 
 
-@pytest.mark.parametrize("kind", list(STUDIES))
+@pytest.mark.parametrize("kind", PER_STUDY)
 def test_one_unit_per_quantity_across_tables(reports: dict[str, Path], kind: str) -> None:
     headers = printed_tables((reports[kind] / "report.html").read_text()).headers
     for quantity in ("stator diameter", "stack length", "gear ratio", "reflected inertia", "peak torque"):
@@ -243,7 +254,7 @@ def test_one_unit_per_quantity_across_tables(reports: dict[str, Path], kind: str
         assert len(units) <= 1, (quantity, units)
 
 
-@pytest.mark.parametrize("kind", list(STUDIES))
+@pytest.mark.parametrize("kind", PER_STUDY)
 def test_no_local_path_in_the_report(reports: dict[str, Path], kind: str) -> None:
     html = (reports[kind] / "report.html").read_text()
     for folder in (ROOT, reports[kind], Path.home()):

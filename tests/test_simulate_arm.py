@@ -20,6 +20,8 @@ from collision_reflex.errors import InvalidParameter, SimulationError
 from collision_reflex.model.impulse import sprung_reaction
 from collision_reflex.simulate.arm import simulate_arm_collision
 
+pytestmark = pytest.mark.xdist_group("test_simulate_arm")  # one pytest-xdist worker: set-ups made once
+
 URDF = Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf"
 # Joint springs of 50 N m/rad, a direct-drive rotor with a 10:1 reduction (100 x 2.21e-5 kg m^2) and the URDF's
 # 1.3 N m effort limits; ideally velocity-controlled motors (k_s = inf), a 3 N threshold.

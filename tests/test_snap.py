@@ -6,6 +6,7 @@ import dataclasses
 import itertools
 import json
 import re
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -29,6 +30,8 @@ from collision_reflex.optimize.parts import (
 )
 from collision_reflex.optimize.snap import snap_to_catalogue
 from collision_reflex.optimize.solve import warm_start
+
+pytestmark = pytest.mark.xdist_group("test_snap")  # one pytest-xdist worker: set-ups made once
 
 ROOT = Path(__file__).resolve().parents[1]
 TWO_LINK = ROOT / "designs" / "planar_two_link.urdf"
@@ -252,9 +255,10 @@ def test_ctrl_c_interrupts_the_snap(two_link, monkeypatch):
         snap_to_catalogue(problem, optimum, _catalogue(), arm=arm)
 
 
-def test_a_study_run_snaps_reports_and_resumes_without_redoing_it(tmp_path, monkeypatch):
+def test_a_study_run_snaps_reports_and_resumes_without_redoing_it(smoke_runs, tmp_path, monkeypatch):
     folder = tmp_path / "out"
-    first = cr.run_study(TWO_LINK_STUDY, folder, quiet=True, smoke=True, executor="serial")
+    shutil.copytree(smoke_runs[TWO_LINK_STUDY.stem], folder)  # a finished smoke run
+    first = json.loads((folder / "run.json").read_text())  # its pieces of work: computed and reused
     designs = json.loads((folder / "designs.json").read_text())
     catalogue = designs["catalogue"]
     assert catalogue["method"].startswith("exact: enumerated")
@@ -290,7 +294,7 @@ def test_a_study_run_snaps_reports_and_resumes_without_redoing_it(tmp_path, monk
 
     monkeypatch.setattr(snapping, "snap_to_catalogue", not_again)
     again = cr.run_study(TWO_LINK_STUDY, folder, quiet=True, smoke=True, executor="serial")
-    assert again.resumed and again.computed == 0 and again.reused == first.computed + first.reused
+    assert again.resumed and again.computed == 0 and again.reused == first["computed"] + first["reused"]
     assert json.loads((folder / "designs.json").read_text())["catalogue"] == catalogue
 
 
@@ -447,9 +451,8 @@ def test_a_catalogue_with_no_part_within_bounds_is_reported_in_the_files(tmp_pat
     assert not table["catalogue_feasible"].any()
 
 
-def test_the_snap_gives_the_same_catalogue_design_through_a_process_pool(tmp_path):
-    serial, pool = tmp_path / "serial", tmp_path / "pool"
-    cr.run_study(TWO_LINK_STUDY, serial, quiet=True, smoke=True, executor="serial")
+def test_the_snap_gives_the_same_catalogue_design_through_a_process_pool(smoke_runs, tmp_path):
+    serial, pool = smoke_runs[TWO_LINK_STUDY.stem], tmp_path / "pool"
     cr.run_study(TWO_LINK_STUDY, pool, quiet=True, smoke=True, executor="processes", workers=2)
     entries = [json.loads((folder / "designs.json").read_text())["catalogue"] for folder in (serial, pool)]
     assert entries[0] == entries[1]

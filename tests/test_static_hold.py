@@ -15,6 +15,8 @@ from collision_reflex.study.load import load_study
 from collision_reflex.study.problems import StudyProblems
 from collision_reflex.study.resolve import resolve_study
 
+pytestmark = pytest.mark.xdist_group("test_static_hold")  # one pytest-xdist worker: set-ups made once
+
 ROOT = Path(__file__).resolve().parents[1]
 
 

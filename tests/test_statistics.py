@@ -19,6 +19,8 @@ from collision_reflex.study.load import load_study
 from collision_reflex.study.problems import StudyProblems
 from collision_reflex.study.resolve import resolve_study
 
+pytestmark = pytest.mark.xdist_group("test_statistics")  # one pytest-xdist worker: set-ups made once
+
 ROOT = Path(__file__).resolve().parents[1]
 DIRECTIONS = np.column_stack([np.cos(a := np.arange(8) * np.pi / 4 + 0.1), np.sin(a)])
 

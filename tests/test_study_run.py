@@ -41,16 +41,9 @@ SOLVER_COLUMNS = ("solve_time [s]",)  # wall times differ between runs; everythi
 
 
 @pytest.fixture(scope="module")
-def runs(tmp_path_factory):
+def runs(smoke_runs):
     """Each example study run once (smoke size), shared by the tests that inspect the outputs."""
-    out = {}
-    for path in STUDIES:
-        folder = tmp_path_factory.mktemp(path.stem) / "out"
-        assert (
-            main(["run", str(path), "--out", str(folder), "--quiet", "--smoke", "--executor", "serial"]) == 0
-        )
-        out[path.stem] = folder
-    return out
+    return smoke_runs
 
 
 @pytest.mark.parametrize("name", [p.stem for p in STUDIES], ids=[p.stem for p in STUDIES])

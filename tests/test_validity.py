@@ -21,6 +21,8 @@ from collision_reflex.simulate.design_closed_form import JointDesign, arm_closed
 from collision_reflex.simulate.validity import validity_map, validity_summary
 from collision_reflex.study.runner import run_study
 
+pytestmark = pytest.mark.xdist_group("test_validity")  # one pytest-xdist worker: set-ups made once
+
 ROOT = Path(__file__).resolve().parents[1]
 URDF = ROOT / "designs" / "planar_two_link.urdf"
 # The planar arm of benchmarks/simulate_arm_closed_form.py: 50 N m/rad joint springs, a 2.2e-3 kg m^2 reflected
