@@ -41,11 +41,11 @@ class Parser(argparse.ArgumentParser):
 
 
 def add_subcommand(
-    subparsers: argparse._SubParsersAction, name: str, *, help: str, description: str
+    subparsers: argparse._SubParsersAction, name: str, help: str, description: str, *, units: bool = True
 ) -> argparse.ArgumentParser:
-    """A subcommand's parser, with the unit rules in its ``--help``."""
+    """A subcommand's parser; with ``units`` (a command with physical options), the unit rules in its ``--help``."""
     parser: argparse.ArgumentParser = subparsers.add_parser(
-        name, help=help, description=description, epilog=UNITS_EPILOG
+        name, help=help, description=description, epilog=UNITS_EPILOG if units else None
     )
     return parser
 

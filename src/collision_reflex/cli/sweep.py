@@ -49,28 +49,36 @@ def _common(parser: argparse.ArgumentParser) -> None:
     )
 
 
+_HELP = "the paper's 1D actuator sweeps: motor size x velocity, stiffness x sensing"
+_DESCRIPTION = "One-dimensional actuator design sweeps of the paper (section 'Actuator Selection')."
+_RADIUS_VELOCITY_HELP = "impulse over motor stator diameter x approach velocity (fig:motor_scale_modeling)"
+_RADIUS_VELOCITY_DESCRIPTION = """
+Impulse of a 1D collision over motor stator diameter x approach velocity. Each motor is the reference
+scaled by a law and geared with N = max(1, tau_req / tau_p) to meet the torque requirement; a rotary joint
+drives a contact at lever L (mass J/L^2, stiffness k/L^2, force tau/L). Defaults are the paper's
+fig:motor_scale_modeling: k_m = 1000 N/m, k_s = 100 N/m, F_s = 3 N, Omni+ reference, Haddadin law,
+1.3 N m. The lever, finger mass and the placement of the reflected inertia are assumptions the paper does
+not state; they are printed with the result. Writes a heat map (log axes, optimum marked) and a CSV of the
+grid.
+"""
+_STIFFNESS_HELP = (
+    "impulse over mechanical stiffness, force vs position-error threshold (fig:stiff-sensing-impulse)"
+)
+_STIFFNESS_DESCRIPTION = """
+Impulse over mechanical stiffness for two sensing schemes: a fixed force threshold F_s (impulse falls with
+stiffness) and a position-error threshold e_th, F_s = k e_th (impulse rises). The software spring is rigid
+by default so that the swept stiffness is the whole joint's; e_th defaults to F_s / k at the middle of the
+range, where both schemes detect at the same force.
+"""
+
+
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``crx sweep`` and its options to ``subparsers``."""
-    parser = subparsers.add_parser(
-        "sweep",
-        help="the paper's 1D actuator sweeps: motor size x velocity, stiffness x sensing",
-        description="One-dimensional actuator design sweeps of the paper (section 'Actuator Selection').",
-    )
+    parser = options.add_subcommand(subparsers, "sweep", _HELP, _DESCRIPTION, units=False)
     kinds = parser.add_subparsers(dest="sweep_command", metavar="SWEEP", required=True)
 
     radius = options.add_subcommand(
-        kinds,
-        "radius-velocity",
-        help="impulse over motor stator diameter x approach velocity (fig:motor_scale_modeling)",
-        description=(
-            "Impulse of a 1D collision over motor stator diameter x approach velocity. Each motor is the "
-            "reference scaled by a law and geared with N = max(1, tau_req / tau_p) to meet the torque "
-            "requirement; a rotary joint drives a contact at lever L (mass J/L^2, stiffness k/L^2, force "
-            "tau/L). Defaults are the paper's fig:motor_scale_modeling: k_m = 1000 N/m, k_s = 100 N/m, "
-            "F_s = 3 N, Omni+ reference, Haddadin law, 1.3 N m. The lever, finger mass and the placement of "
-            "the reflected inertia are assumptions the paper does not state; they are printed with the result. "
-            "Writes a heat map (log axes, optimum marked) and a CSV of the grid."
-        ),
+        kinds, "radius-velocity", _RADIUS_VELOCITY_HELP, _RADIUS_VELOCITY_DESCRIPTION
     )
     _common(radius)
     options.STATOR_DIAMETERS.add(radius, "5mm:200mm:60")
@@ -89,17 +97,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     options.add_csv(radius, "radius_velocity.csv", what="the grid")
     radius.set_defaults(run=run_radius_velocity)
 
-    stiffness = options.add_subcommand(
-        kinds,
-        "stiffness",
-        help="impulse over mechanical stiffness, force vs position-error threshold (fig:stiff-sensing-impulse)",
-        description=(
-            "Impulse over mechanical stiffness for two sensing schemes: a fixed force threshold F_s (impulse "
-            "falls with stiffness) and a position-error threshold e_th, F_s = k e_th (impulse rises). The "
-            "software spring is rigid by default so that the swept stiffness is the whole joint's; e_th "
-            "defaults to F_s / k at the middle of the range, where both schemes detect at the same force."
-        ),
-    )
+    stiffness = options.add_subcommand(kinds, "stiffness", _STIFFNESS_HELP, _STIFFNESS_DESCRIPTION)
     _common(stiffness)
     options.MECH_STIFFNESSES.add(stiffness, "100:1e5:40")
     options.APPROACH_VELOCITY.add(stiffness, 0.1)
