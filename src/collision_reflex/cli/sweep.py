@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+from typing import Any
 
 from ..errors import InvalidParameter
 from ..hardware.motors import REFERENCE_MOTOR_NAME, SCALING_LAWS, get_motor
@@ -112,6 +113,22 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     stiffness.set_defaults(run=run_stiffness)
 
 
+def _common_values(args: argparse.Namespace) -> dict[str, Any]:
+    """The values of the options :func:`_common` adds (but the motor), as the sweep functions' keywords."""
+    return {
+        "F_s": args.F_s,
+        "lever": args.lever,
+        "m_f": args.m_f,
+        "m_r": args.m_r,
+        "reflected_inertia_in": args.reflected_inertia_in,
+    }
+
+
+def _digest(size: int) -> range:
+    """The rows of a sweep printed: about twelve, a readable digest (the CSV has every point)."""
+    return range(0, size, max(1, size // 12))
+
+
 def _check_outputs(args: argparse.Namespace) -> None:
     """Refuse bad output names before computing anything."""
     check_figure_path(args.plot)
@@ -138,18 +155,13 @@ def run_radius_velocity(args: argparse.Namespace) -> int:
         torque_required=args.torque,
         k_m=args.k_m,
         k_s=args.k_s,
-        F_s=args.F_s,
-        lever=args.lever,
-        m_f=args.m_f,
-        m_r=args.m_r,
-        reflected_inertia_in=args.reflected_inertia_in,
         stack_length=args.stack_length,
+        **_common_values(args),
     )
     _print_assumptions(sweep.assumptions)
     print()
     print(f"{'diameter [mm]':>14}{'N':>9}{'N^2 J_m':>12}{'m_f [kg]':>11}{'v* [m/s]':>10}{'I* [N s]':>11}")
-    step = max(1, sweep.diameters.size // 12)  # a readable digest; the CSV has every point
-    for i in range(0, sweep.diameters.size, step):
+    for i in _digest(sweep.diameters.size):
         print(
             f"{sweep.diameters[i] * 1e3:>14.4g}{sweep.gear_ratio[i]:>9.4g}{sweep.reflected_inertia[i]:>12.4g}"
             f"{sweep.m_f[i]:>11.4g}{sweep.optimal_velocity[i]:>10.4g}{sweep.minimum_impulse[i]:>11.4g}"
@@ -170,24 +182,19 @@ def run_stiffness(args: argparse.Namespace) -> int:
     sweep = stiffness_sweep(
         args.k_m_values,
         v0=args.v0,
-        F_s=args.F_s,
         e_th=args.e_th,
         k_s=args.k_s,
         motor=get_motor(args.motor, args.catalogue),
         gear_ratio=args.gear_ratio,
-        lever=args.lever,
-        m_f=args.m_f,
-        m_r=args.m_r,
-        reflected_inertia_in=args.reflected_inertia_in,
         reaction=args.reaction,
+        **_common_values(args),
     )
     _print_assumptions(sweep.assumptions)
     print()
     print(
         f"{'k_m [N/m]':>12}{'F_s force':>11}{'I force [N s]':>15}{'F_s position':>14}{'I position [N s]':>18}"
     )
-    step = max(1, sweep.stiffnesses.size // 12)
-    for i in range(0, sweep.stiffnesses.size, step):
+    for i in _digest(sweep.stiffnesses.size):
         print(
             f"{sweep.stiffnesses[i]:>12.4g}{sweep.force_threshold[i]:>11.4g}{sweep.force_threshold_impulse[i]:>15.4g}"
             f"{sweep.position_threshold[i]:>14.4g}{sweep.position_threshold_impulse[i]:>18.4g}"
