@@ -12,21 +12,21 @@ FORMATS = (
 )  # as collision_reflex.export.FORMATS, kept here so that `crx --help` imports nothing
 
 
+_HELP = "write a run's design as URDF (motor masses, transmissions, limits) or MJCF (armature, motors)"
+_DESCRIPTION = """
+Write the arm of a `crx run` output folder with the actuators of one of its designs. URDF: each motor (and
+gearbox) as a point mass on its parent link at the joint origin (a link JOINT_actuator on a fixed joint),
+a transmission per joint with the gear ratio and rotor inertia, effort limits N tau_p [N*m] and velocity
+limits omega_max / N [rad/s], and beside it FILE.armature.json with the armature N^2 (J_m + J_g) [kg*m^2]
+per joint for Pinocchio's model.armature. MJCF (needs the 'mujoco' extra): the same arm with the armature,
+a geared motor actuator per joint and its torque ranges. Exit status 2 if the folder, the design or the
+output is unusable.
+"""
+
+
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``crx export`` and its options to ``subparsers``."""
-    parser = subparsers.add_parser(
-        "export",
-        help="write a run's design as URDF (motor masses, transmissions, limits) or MJCF (armature, motors)",
-        description=(
-            "Write the arm of a `crx run` output folder with the actuators of one of its designs. URDF: each "
-            "motor (and gearbox) as a point mass on its parent link at the joint origin (a link JOINT_actuator "
-            "on a fixed joint), a transmission per joint with the gear ratio and rotor inertia, effort limits "
-            "N tau_p [N*m] and velocity limits omega_max / N [rad/s], and beside it FILE.armature.json with the "
-            "armature N^2 (J_m + J_g) [kg*m^2] per joint for Pinocchio's model.armature. MJCF (needs the "
-            "'mujoco' extra): the same arm with the armature, a geared motor actuator per joint and its torque "
-            "ranges. Exit status 2 if the folder, the design or the output is unusable."
-        ),
-    )
+    parser = options.add_subcommand(subparsers, "export", _HELP, _DESCRIPTION, units=False)
     parser.add_argument("run_dir", metavar="RUN_DIR", help="output folder of `crx run` (an arm study)")
     parser.add_argument(
         "--design",

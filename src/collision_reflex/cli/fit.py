@@ -23,22 +23,21 @@ if TYPE_CHECKING:
 _DEFAULT_K_M = 2e7  # N/m, the paper's ATI Mini40 along its sensing axis
 
 
+_HELP = "impulse and model fit of measured force-time traces (CSV)"
+_DESCRIPTION = """
+For each trial in the CSV files: find the contact above the noise floor, integrate the impulse (adaptive
+Gauss-Kronrod quadrature, trapezoid cross-check, uncertainty), and fit the model's force profile (m_f,
+k_s, F_s, a and the impact time, with k_m given). Then per system: mean and std of the fitted parameters
+(as the paper's table of one-shot fits) and the fit I(v) = A v + B/v + C with v*. Bad traces are reported
+with the reason; the others are still processed. Files: '# velocity: 100 mm/s', '# system: NAME' and '#
+sensor stiffness: 2e7 N/m' comment lines, then 'time [ms],force [N]' columns (a 'trial' column for many
+trials per file).
+"""
+
+
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``crx fit`` and its options to ``subparsers``."""
-    parser = options.add_subcommand(
-        subparsers,
-        "fit",
-        help="impulse and model fit of measured force-time traces (CSV)",
-        description=(
-            "For each trial in the CSV files: find the contact above the noise floor, integrate the impulse "
-            "(adaptive Gauss-Kronrod quadrature, trapezoid cross-check, uncertainty), and fit the model's force "
-            "profile (m_f, k_s, F_s, a and the impact time, with k_m given). Then per system: mean and std of "
-            "the fitted parameters (as the paper's table of one-shot fits) and the fit I(v) = A v + B/v + C with v*. Bad traces are "
-            "reported with the reason; the others are still processed. Files: '# velocity: 100 mm/s', "
-            "'# system: NAME' and '# sensor stiffness: 2e7 N/m' comment lines, then 'time [ms],force [N]' "
-            "columns (a 'trial' column for many trials per file)."
-        ),
-    )
+    parser = options.add_subcommand(subparsers, "fit", _HELP, _DESCRIPTION)
     add = parser.add_argument
     add("traces", nargs="+", metavar="TRACES", help="CSV files, or folders searched for *.csv")
     options.MECH_STIFFNESS.add(parser, _DEFAULT_K_M, note="the sensor's, for trials that do not give it")

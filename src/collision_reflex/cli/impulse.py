@@ -23,19 +23,18 @@ from . import options
 _DEFAULTS = {"m_f": 0.1, "k_m": 2e7, "k_s": 440.0, "F_s": 3.0, "a": 4.7e-5, "v0": 0.1}
 
 
+_HELP = "phase impulses, total, v* and I* of a 1D collision"
+_DESCRIPTION = """
+Collision reflex of a finger-spring-robot system hitting a rigid constraint: impulse of the impact,
+sensing and reaction phases, their total, the optimal approach velocity v* and the minimum impulse I*.
+Defaults are the paper's direct-drive U8 actuator (soft setting, the paper's one-shot fit) against a force
+sensor of stiffness 2e7 N/m.
+"""
+
+
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``crx impulse`` and its options to ``subparsers``."""
-    parser = options.add_subcommand(
-        subparsers,
-        "impulse",
-        help="phase impulses, total, v* and I* of a 1D collision",
-        description=(
-            "Collision reflex of a finger-spring-robot system hitting a rigid constraint: impulse of the "
-            "impact, sensing and reaction phases, their total, the optimal approach velocity v* and the "
-            "minimum impulse I*. Defaults are the paper's direct-drive U8 actuator (soft setting, the paper's one-shot fit) "
-            "against a force sensor of stiffness 2e7 N/m."
-        ),
-    )
+    parser = options.add_subcommand(subparsers, "impulse", _HELP, _DESCRIPTION)
     options.FINGER_MASS.add(parser, _DEFAULTS["m_f"])
     options.MECH_STIFFNESS.add(parser, _DEFAULTS["k_m"], note="the spring left during the reaction")
     options.SOFT_STIFFNESS.add(parser, _DEFAULTS["k_s"], note="in series with k_m while sensing")

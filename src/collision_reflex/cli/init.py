@@ -10,21 +10,20 @@ from .._io import atomic_open
 from ..errors import InvalidParameter, StudyFileError
 from . import options
 
+_HELP = "write a starting design study for a robot (a name crx robots lists, or a URDF file)"
+_DESCRIPTION = """
+Write a commented design study for ROBOT: an example-robot-data name (crx robots lists them) or a URDF
+file. Its actuated joints are the revolute joints from the base to the contact frame (the others are
+locked); its motor-size bounds follow the URDF's effort limits, its rated joint speeds the URDF's velocity
+limits, its rated payload what those effort limits hold, and its duty cycle stays within the joint limits.
+Every figure not read from the robot is marked ESTIMATE (with how it was made) or SET (yours to give). The
+study is checked before it is written.
+"""
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``crx init`` and its options to ``subparsers``."""
-    parser = subparsers.add_parser(
-        "init",
-        help="write a starting design study for a robot (a name crx robots lists, or a URDF file)",
-        description=(
-            "Write a commented design study for ROBOT: an example-robot-data name (crx robots lists them) or a "
-            "URDF file. Its actuated joints are the revolute joints from the base to the contact frame (the "
-            "others are locked); its motor-size bounds follow the URDF's effort limits, its rated joint speeds "
-            "the URDF's velocity limits, its rated payload what those effort limits hold, and its duty cycle "
-            "stays within the joint limits. Every figure not read from the robot is marked ESTIMATE (with how it "
-            "was made) or SET (yours to give). The study is checked before it is written."
-        ),
-    )
+    parser = options.add_subcommand(subparsers, "init", _HELP, _DESCRIPTION, units=False)
     parser.add_argument("robot", metavar="ROBOT", help="an example-robot-data name, or a URDF file")
     parser.add_argument("--frame", default=None, help="the contact frame (default: the robot's tool or tip)")
     parser.add_argument(

@@ -19,18 +19,23 @@ from ..hardware.motors import (
 )
 from . import options
 
+_HELP = "list the motor catalogue; 'motors scale' scales a motor (the paper's motor-parameter table)"
+_DESCRIPTION = """
+List the motors of a catalogue (default: the packaged one, with the paper's reference motor, Celera Motion
+Omni+ OPN-060-013-A). Quantities in SI units.
+"""
+_SCALE_HELP = "scale a motor to other stator diameters and gear it to a torque requirement"
+_SCALE_DESCRIPTION = """
+Scale a catalogue motor to other stator diameters (and stack length) by a scaling law of the paper's table
+of scaling laws, and pick the gear ratio N = max(1, tau_req / tau_p) that meets a torque requirement. The
+defaults reproduce the paper's table of motor parameters (M1, M2, M3): the Omni+ scaled to 10, 60 and 100
+mm by the Haddadin law with 1.3 N m required.
+"""
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``crx motors`` and its options to ``subparsers``."""
-    parser = options.add_subcommand(
-        subparsers,
-        "motors",
-        help="list the motor catalogue; 'motors scale' scales a motor (the paper's motor-parameter table)",
-        description=(
-            "List the motors of a catalogue (default: the packaged one, with the paper's reference motor, "
-            "Celera Motion Omni+ OPN-060-013-A). Quantities in SI units."
-        ),
-    )
+    parser = options.add_subcommand(subparsers, "motors", _HELP, _DESCRIPTION)
     options.add_catalogue(parser)
     parser.add_argument(
         "--gearboxes",
@@ -39,17 +44,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.set_defaults(run=run_list)
     actions = parser.add_subparsers(dest="motors_command", metavar="ACTION")
-    scale = options.add_subcommand(
-        actions,
-        "scale",
-        help="scale a motor to other stator diameters and gear it to a torque requirement",
-        description=(
-            "Scale a catalogue motor to other stator diameters (and stack length) by a scaling law of the "
-            "paper's table of scaling laws, and pick the gear ratio N = max(1, tau_req / tau_p) that meets a torque "
-            "requirement. The defaults reproduce the paper's table of motor parameters (M1, M2, M3): the Omni+ scaled "
-            "to 10, 60 and 100 mm by the Haddadin law with 1.3 N m required."
-        ),
-    )
+    scale = options.add_subcommand(actions, "scale", _SCALE_HELP, _SCALE_DESCRIPTION)
     options.add_catalogue(scale)
     scale.add_argument(
         "--motor",

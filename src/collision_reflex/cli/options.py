@@ -21,7 +21,7 @@ from __future__ import annotations
 import argparse
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Literal, NoReturn
 
 import numpy as np
@@ -41,11 +41,11 @@ class Parser(argparse.ArgumentParser):
 
 
 def add_subcommand(
-    subparsers: argparse._SubParsersAction, name: str, *, help: str, description: str
+    subparsers: argparse._SubParsersAction, name: str, help: str, description: str, *, units: bool = True
 ) -> argparse.ArgumentParser:
-    """A subcommand's parser, with the unit rules in its ``--help``."""
+    """A subcommand's parser; with ``units`` (a command with physical options), the unit rules in its ``--help``."""
     parser: argparse.ArgumentParser = subparsers.add_parser(
-        name, help=help, description=description, epilog=UNITS_EPILOG
+        name, help=help, description=description, epilog=UNITS_EPILOG if units else None
     )
     return parser
 
@@ -92,6 +92,7 @@ NUMBER = Quantity("", "a pure number", "0.5", "X", shown="-")
 Bound = Literal["positive", "non-negative", "any"]
 Form = Literal["one", "range", "list"]
 _BOUND_TEXT = {"positive": "> 0", "non-negative": ">= 0", "any": ""}
+_RANGE_HINT = "START:STOP:N (N log-spaced values) or v1,v2,..."
 
 
 @dataclass(frozen=True)
@@ -272,8 +273,12 @@ class Option:
             **extra,
         )
 
+    def values(
+        self, flag: str, dest: str, what: str, *, form: Form = "range", hint: str = _RANGE_HINT
+    ) -> Option:
+        """The option of many values of the same quantity and range: a ``"range"`` (the default) or a ``"list"``."""
+        return replace(self, flag=flag, dest=dest, what=what, form=form, hint=hint)
 
-_RANGE_HINT = "START:STOP:N (N log-spaced values) or v1,v2,..."
 
 # Contact-level quantities (1D, along the contact direction): the paper's symbols as destinations.
 FINGER_MASS = Option("--finger-mass", "m_f", MASS, "finger (sprung) mass m_f at the contact")
@@ -284,13 +289,8 @@ RATED_PAYLOAD = Option(
 MECH_STIFFNESS = Option(
     "--mech-stiffness", "k_m", LINEAR_STIFFNESS, "mechanical stiffness k_m at the contact"
 )
-MECH_STIFFNESSES = Option(
-    "--mech-stiffnesses",
-    "k_m_values",
-    LINEAR_STIFFNESS,
-    "mechanical stiffnesses k_m at the contact",
-    form="range",
-    hint=_RANGE_HINT,
+MECH_STIFFNESSES = MECH_STIFFNESS.values(
+    "--mech-stiffnesses", "k_m_values", "mechanical stiffnesses k_m at the contact"
 )
 SOFT_STIFFNESS = Option(
     "--soft-stiffness",
@@ -334,9 +334,7 @@ FORCE_LIMIT = Option(
     hint="the reaction is a = F_a / m_r",
 )
 APPROACH_VELOCITY = Option("--velocity", "v0", VELOCITY, "approach (pre-impact) velocity v0")
-APPROACH_VELOCITIES = Option(
-    "--velocities", "velocities", VELOCITY, "approach velocities", form="range", hint=_RANGE_HINT
-)
+APPROACH_VELOCITIES = APPROACH_VELOCITY.values("--velocities", "velocities", "approach velocities")
 TRACE_VELOCITY = Option(
     "--trace-velocity", "trace_velocity", VELOCITY, "approach velocity of the --trace-plot simulation"
 )
@@ -351,19 +349,9 @@ SOFT_DAMPING = Option("--soft-damping", "d_s", DAMPING, "software damping d_s", 
 COULOMB = Option("--coulomb", "coulomb", FORCE, "Coulomb friction on the robot mass", bound="non-negative")
 VISCOUS = Option("--viscous", "viscous", DAMPING, "viscous friction on the robot mass", bound="non-negative")
 BACKLASH = Option("--backlash", "backlash", LENGTH, "backlash", bound="non-negative")
-BACKLASHES = Option(
-    "--backlashes",
-    "backlashes",
-    LENGTH,
-    "backlash values",
-    bound="non-negative",
-    form="list",
-    hint="b1,b2,...",
-)
+BACKLASHES = BACKLASH.values("--backlashes", "backlashes", "backlash values", form="list", hint="b1,b2,...")
 DELAY = Option("--delay", "delay", TIME, "sensing delay", bound="non-negative")
-DELAYS = Option(
-    "--delays", "delays", TIME, "sensing delays", bound="non-negative", form="list", hint="d1,d2,..."
-)
+DELAYS = DELAY.values("--delays", "delays", "sensing delays", form="list", hint="d1,d2,...")
 RESTITUTION = Option("--restitution", "restitution", NUMBER, "coefficient of restitution", hint="in (0, 1]")
 TOLERANCE = Option("--tolerance", "tolerance", NUMBER, "relative difference counted as parting")
 CONTROL_RATE = Option("--control-rate", "control_rate", FREQUENCY, "rate of the sampled control")
@@ -379,13 +367,8 @@ LEVER = Option("--lever", "lever", LENGTH, "joint axis to contact distance L")
 
 # Joint- and actuator-level quantities: spelled-out names in joint units.
 STATOR_DIAMETER = Option("--stator-diameter", "stator_diameter", LENGTH, "motor stator outer diameter")
-STATOR_DIAMETERS = Option(
-    "--stator-diameters",
-    "stator_diameters",
-    LENGTH,
-    "motor stator outer diameters",
-    form="range",
-    hint=_RANGE_HINT,
+STATOR_DIAMETERS = STATOR_DIAMETER.values(
+    "--stator-diameters", "stator_diameters", "motor stator outer diameters"
 )
 STACK_LENGTH = Option("--stack-length", "stack_length", LENGTH, "motor stack length")
 TORQUE_REQUIRED = Option("--torque", "torque", TORQUE, "output torque requirement tau_req")

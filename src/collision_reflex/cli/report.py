@@ -6,15 +6,15 @@ import argparse
 
 from ..report import render_report
 from ..report.pdf import html_to_pdf
+from . import options
+
+_HELP = "re-render figures and report.html from a run's saved results"
+_DESCRIPTION = "Redraw the figures and rewrite report.html of an output folder from its designs.json."
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``crx report`` and its options to ``subparsers``."""
-    parser = subparsers.add_parser(
-        "report",
-        help="re-render figures and report.html from a run's saved results",
-        description="Redraw the figures and rewrite report.html of an output folder from its designs.json.",
-    )
+    parser = options.add_subcommand(subparsers, "report", _HELP, _DESCRIPTION, units=False)
     parser.add_argument("folder", metavar="DIR", help="output folder of `crx run`")
     parser.add_argument("--pdf", action="store_true", help="also print report.pdf with headless Chromium")
     parser.set_defaults(run=run)

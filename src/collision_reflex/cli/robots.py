@@ -4,19 +4,20 @@ from __future__ import annotations
 
 import argparse
 
+from . import options
+
+_HELP = "list the robots a study can name, with their joints and contact frames"
+_DESCRIPTION = """
+List the robots of example-robot-data that a study's robot: {example_robot_data: NAME} can name: base
+(fixed or floating), joints, the contact frame a study would use (the robot's default, or the tip of its
+longest chain of revolute joints) and how many revolute joints lead to it. 'init' marks those crx init
+writes a study for (a fixed base and two or more joints to the contact frame).
+"""
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``crx robots`` to ``subparsers``."""
-    parser = subparsers.add_parser(
-        "robots",
-        help="list the robots a study can name, with their joints and contact frames",
-        description=(
-            "List the robots of example-robot-data that a study's robot: {example_robot_data: NAME} can name: "
-            "base (fixed or floating), joints, the contact frame a study would use (the robot's default, or the "
-            "tip of its longest chain of revolute joints) and how many revolute joints lead to it. 'init' marks "
-            "those crx init writes a study for (a fixed base and two or more joints to the contact frame)."
-        ),
-    )
+    parser = options.add_subcommand(subparsers, "robots", _HELP, _DESCRIPTION, units=False)
     parser.add_argument("--all", action="store_true", help="also list the robots crx init cannot start from")
     parser.set_defaults(run=run)
 

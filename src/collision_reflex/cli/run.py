@@ -8,19 +8,18 @@ import sys
 from ..vocabulary import EXECUTORS
 from . import options
 
+_HELP = "run a design study (YAML) end to end: designs, Pareto front, figures, report.html"
+_DESCRIPTION = """
+Run a design study: check it (nothing is written if the study has a problem), solve the designs through
+the study's executor, and write the resolved study, pareto.csv, designs.json, figures (PNG and SVG) and
+report.html to the output folder. Run the same command again after an interruption to resume from the
+finished Pareto points.
+"""
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``crx run`` and its options to ``subparsers``."""
-    parser = subparsers.add_parser(
-        "run",
-        help="run a design study (YAML) end to end: designs, Pareto front, figures, report.html",
-        description=(
-            "Run a design study: check it (nothing is written if the study has a problem), solve the designs "
-            "through the study's executor, and write the resolved study, pareto.csv, designs.json, figures (PNG "
-            "and SVG) and report.html to the output folder. Run the same command again after an interruption to "
-            "resume from the finished Pareto points."
-        ),
-    )
+    parser = options.add_subcommand(subparsers, "run", _HELP, _DESCRIPTION, units=False)
     parser.add_argument("study", metavar="STUDY", help="study file (YAML)")
     options.add_out_dir(parser, what="the results and the report", shown="results/NAME")
     parser.add_argument("--quiet", action="store_true", help="no progress bars; print only the report's path")

@@ -6,18 +6,18 @@ import argparse
 import json
 
 from .._io import atomic_open
+from . import options
+
+_HELP = "print the JSON Schema of study files"
+_DESCRIPTION = """
+Print the JSON Schema of design-study files. Save it and point your editor at it, e.g. with the first line
+'# yaml-language-server: $schema=study.schema.json'.
+"""
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``crx schema`` and its options to ``subparsers``."""
-    parser = subparsers.add_parser(
-        "schema",
-        help="print the JSON Schema of study files",
-        description=(
-            "Print the JSON Schema of design-study files. Save it and point your editor at it, e.g. with the "
-            "first line '# yaml-language-server: $schema=study.schema.json'."
-        ),
-    )
+    parser = options.add_subcommand(subparsers, "schema", _HELP, _DESCRIPTION, units=False)
     parser.add_argument(
         "--json",
         metavar="FILE",

@@ -27,19 +27,18 @@ if TYPE_CHECKING:
 _DEFAULTS = {"m_f": 0.2, "m_r": 0.5, "k_m": 1000.0, "k_s": 100.0, "F_s": 3.0, "F_a": 10.0}
 
 
+_HELP = "time-domain simulation against the closed form, over approach velocity"
+_DESCRIPTION = """
+Simulate the finger-spring-robot collision in time (event-driven integration) over a range of approach
+velocities, optionally also over delays or backlash, and compare the impulse with the closed form; points
+where they part by more than --tolerance are marked. The ideal drive with a rigid wall and no delay is the
+closed form's own idealisation.
+"""
+
+
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``crx simulate`` and its options to ``subparsers``."""
-    parser = options.add_subcommand(
-        subparsers,
-        "simulate",
-        help="time-domain simulation against the closed form, over approach velocity",
-        description=(
-            "Simulate the finger-spring-robot collision in time (event-driven integration) over a range of "
-            "approach velocities, optionally also over delays or backlash, and compare the impulse with the "
-            "closed form; points where they part by more than --tolerance are marked. The ideal drive with a "
-            "rigid wall and no delay is the closed form's own idealisation."
-        ),
-    )
+    parser = options.add_subcommand(subparsers, "simulate", _HELP, _DESCRIPTION)
     add = parser.add_argument
     options.FINGER_MASS.add(parser, _DEFAULTS["m_f"])
     options.ROBOT_MASS.add(parser, _DEFAULTS["m_r"], note="with the reflected rotor inertia")

@@ -41,21 +41,20 @@ _DEFAULTS = {
 }
 
 
+_HELP = "collision-reflex surfaces of a URDF arm (impulse over contact directions)"
+_DESCRIPTION = f"""
+The collision impulse of a URDF arm swept over contact directions at one configuration. A planar arm gets
+the paper's grid (fig:two_link): rows varying the second joint angle, the motor size and the approach
+velocity, with the arm drawn under each polar surface; a spatial arm gets a 3D surface and its x-y, x-z
+and y-z sections. Every joint gets the Omni+ OPN-060-013-A scaled to --stator-diameter (Haddadin law) and
+geared to the joint's torque requirement (N = max(1, tau_req / tau_p)). Default arm: {_DEFAULT_URDF}
+(relative to the current directory), contact frame 'tip'.
+"""
+
+
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``crx surface`` and its options to ``subparsers``."""
-    parser = options.add_subcommand(
-        subparsers,
-        "surface",
-        help="collision-reflex surfaces of a URDF arm (impulse over contact directions)",
-        description=(
-            "The collision impulse of a URDF arm swept over contact directions at one configuration. A planar "
-            "arm gets the paper's grid (fig:two_link): rows varying the second joint angle, the motor size and "
-            "the approach velocity, with the arm drawn under each polar surface; a spatial arm gets a 3D surface "
-            "and its x-y, x-z and y-z sections. Every joint gets the Omni+ OPN-060-013-A scaled to --stator-diameter "
-            "(Haddadin law) and geared to the joint's torque requirement (N = max(1, tau_req / tau_p)). "
-            f"Default arm: {_DEFAULT_URDF} (relative to the current directory), contact frame 'tip'."
-        ),
-    )
+    parser = options.add_subcommand(subparsers, "surface", _HELP, _DESCRIPTION)
     _add_arm_options(parser)
     _add_actuation_options(parser)
     _add_sweep_options(parser)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+from typing import Any
 
 from ..errors import InvalidParameter
 from ..hardware.motors import REFERENCE_MOTOR_NAME, SCALING_LAWS, get_motor
@@ -49,28 +50,36 @@ def _common(parser: argparse.ArgumentParser) -> None:
     )
 
 
+_HELP = "the paper's 1D actuator sweeps: motor size x velocity, stiffness x sensing"
+_DESCRIPTION = "One-dimensional actuator design sweeps of the paper (section 'Actuator Selection')."
+_RADIUS_VELOCITY_HELP = "impulse over motor stator diameter x approach velocity (fig:motor_scale_modeling)"
+_RADIUS_VELOCITY_DESCRIPTION = """
+Impulse of a 1D collision over motor stator diameter x approach velocity. Each motor is the reference
+scaled by a law and geared with N = max(1, tau_req / tau_p) to meet the torque requirement; a rotary joint
+drives a contact at lever L (mass J/L^2, stiffness k/L^2, force tau/L). Defaults are the paper's
+fig:motor_scale_modeling: k_m = 1000 N/m, k_s = 100 N/m, F_s = 3 N, Omni+ reference, Haddadin law,
+1.3 N m. The lever, finger mass and the placement of the reflected inertia are assumptions the paper does
+not state; they are printed with the result. Writes a heat map (log axes, optimum marked) and a CSV of the
+grid.
+"""
+_STIFFNESS_HELP = (
+    "impulse over mechanical stiffness, force vs position-error threshold (fig:stiff-sensing-impulse)"
+)
+_STIFFNESS_DESCRIPTION = """
+Impulse over mechanical stiffness for two sensing schemes: a fixed force threshold F_s (impulse falls with
+stiffness) and a position-error threshold e_th, F_s = k e_th (impulse rises). The software spring is rigid
+by default so that the swept stiffness is the whole joint's; e_th defaults to F_s / k at the middle of the
+range, where both schemes detect at the same force.
+"""
+
+
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``crx sweep`` and its options to ``subparsers``."""
-    parser = subparsers.add_parser(
-        "sweep",
-        help="the paper's 1D actuator sweeps: motor size x velocity, stiffness x sensing",
-        description="One-dimensional actuator design sweeps of the paper (section 'Actuator Selection').",
-    )
+    parser = options.add_subcommand(subparsers, "sweep", _HELP, _DESCRIPTION, units=False)
     kinds = parser.add_subparsers(dest="sweep_command", metavar="SWEEP", required=True)
 
     radius = options.add_subcommand(
-        kinds,
-        "radius-velocity",
-        help="impulse over motor stator diameter x approach velocity (fig:motor_scale_modeling)",
-        description=(
-            "Impulse of a 1D collision over motor stator diameter x approach velocity. Each motor is the "
-            "reference scaled by a law and geared with N = max(1, tau_req / tau_p) to meet the torque "
-            "requirement; a rotary joint drives a contact at lever L (mass J/L^2, stiffness k/L^2, force "
-            "tau/L). Defaults are the paper's fig:motor_scale_modeling: k_m = 1000 N/m, k_s = 100 N/m, "
-            "F_s = 3 N, Omni+ reference, Haddadin law, 1.3 N m. The lever, finger mass and the placement of "
-            "the reflected inertia are assumptions the paper does not state; they are printed with the result. "
-            "Writes a heat map (log axes, optimum marked) and a CSV of the grid."
-        ),
+        kinds, "radius-velocity", _RADIUS_VELOCITY_HELP, _RADIUS_VELOCITY_DESCRIPTION
     )
     _common(radius)
     options.STATOR_DIAMETERS.add(radius, "5mm:200mm:60")
@@ -89,17 +98,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     options.add_csv(radius, "radius_velocity.csv", what="the grid")
     radius.set_defaults(run=run_radius_velocity)
 
-    stiffness = options.add_subcommand(
-        kinds,
-        "stiffness",
-        help="impulse over mechanical stiffness, force vs position-error threshold (fig:stiff-sensing-impulse)",
-        description=(
-            "Impulse over mechanical stiffness for two sensing schemes: a fixed force threshold F_s (impulse "
-            "falls with stiffness) and a position-error threshold e_th, F_s = k e_th (impulse rises). The "
-            "software spring is rigid by default so that the swept stiffness is the whole joint's; e_th "
-            "defaults to F_s / k at the middle of the range, where both schemes detect at the same force."
-        ),
-    )
+    stiffness = options.add_subcommand(kinds, "stiffness", _STIFFNESS_HELP, _STIFFNESS_DESCRIPTION)
     _common(stiffness)
     options.MECH_STIFFNESSES.add(stiffness, "100:1e5:40")
     options.APPROACH_VELOCITY.add(stiffness, 0.1)
@@ -112,6 +111,22 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     options.add_plot(stiffness, "stiffness.png")
     options.add_csv(stiffness, "stiffness.csv", what="the table")
     stiffness.set_defaults(run=run_stiffness)
+
+
+def _common_values(args: argparse.Namespace) -> dict[str, Any]:
+    """The values of the options :func:`_common` adds (but the motor), as the sweep functions' keywords."""
+    return {
+        "F_s": args.F_s,
+        "lever": args.lever,
+        "m_f": args.m_f,
+        "m_r": args.m_r,
+        "reflected_inertia_in": args.reflected_inertia_in,
+    }
+
+
+def _digest(size: int) -> range:
+    """The rows of a sweep printed: about twelve, a readable digest (the CSV has every point)."""
+    return range(0, size, max(1, size // 12))
 
 
 def _check_outputs(args: argparse.Namespace) -> None:
@@ -140,18 +155,13 @@ def run_radius_velocity(args: argparse.Namespace) -> int:
         torque_required=args.torque,
         k_m=args.k_m,
         k_s=args.k_s,
-        F_s=args.F_s,
-        lever=args.lever,
-        m_f=args.m_f,
-        m_r=args.m_r,
-        reflected_inertia_in=args.reflected_inertia_in,
         stack_length=args.stack_length,
+        **_common_values(args),
     )
     _print_assumptions(sweep.assumptions)
     print()
     print(f"{'diameter [mm]':>14}{'N':>9}{'N^2 J_m':>12}{'m_f [kg]':>11}{'v* [m/s]':>10}{'I* [N s]':>11}")
-    step = max(1, sweep.diameters.size // 12)  # a readable digest; the CSV has every point
-    for i in range(0, sweep.diameters.size, step):
+    for i in _digest(sweep.diameters.size):
         print(
             f"{sweep.diameters[i] * 1e3:>14.4g}{sweep.gear_ratio[i]:>9.4g}{sweep.reflected_inertia[i]:>12.4g}"
             f"{sweep.m_f[i]:>11.4g}{sweep.optimal_velocity[i]:>10.4g}{sweep.minimum_impulse[i]:>11.4g}"
@@ -172,24 +182,19 @@ def run_stiffness(args: argparse.Namespace) -> int:
     sweep = stiffness_sweep(
         args.k_m_values,
         v0=args.v0,
-        F_s=args.F_s,
         e_th=args.e_th,
         k_s=args.k_s,
         motor=get_motor(args.motor, args.catalogue),
         gear_ratio=args.gear_ratio,
-        lever=args.lever,
-        m_f=args.m_f,
-        m_r=args.m_r,
-        reflected_inertia_in=args.reflected_inertia_in,
         reaction=args.reaction,
+        **_common_values(args),
     )
     _print_assumptions(sweep.assumptions)
     print()
     print(
         f"{'k_m [N/m]':>12}{'F_s force':>11}{'I force [N s]':>15}{'F_s position':>14}{'I position [N s]':>18}"
     )
-    step = max(1, sweep.stiffnesses.size // 12)
-    for i in range(0, sweep.stiffnesses.size, step):
+    for i in _digest(sweep.stiffnesses.size):
         print(
             f"{sweep.stiffnesses[i]:>12.4g}{sweep.force_threshold[i]:>11.4g}{sweep.force_threshold_impulse[i]:>15.4g}"
             f"{sweep.position_threshold[i]:>14.4g}{sweep.position_threshold_impulse[i]:>18.4g}"

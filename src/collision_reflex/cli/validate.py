@@ -7,23 +7,22 @@ import contextlib
 import sys
 
 from ..errors import StudyFileError
-from . import start_up
+from . import options, start_up
+
+_HELP = "check study files (schema, units, robot, frames, joints, duty cycle); every problem with its line"
+_DESCRIPTION = """
+Check design-study files without running them: the schema (unknown keys, units of the right dimension,
+bounds), and for arm studies the robot, its contact frame, joint names and sizes, and the duty cycle (a
+trajectory file's problems quote its own line: found cycle.csv:17: ...). A valid arm study's summary ends
+with its duty cycle (duration, samples, peak joint speed) or says that its torque requirement is the
+static one. Every problem is printed as FILE:LINE:COLUMN: FIELD: found ...; expected ... . Exit status 2
+if any file has a problem.
+"""
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``crx validate`` and its options to ``subparsers``."""
-    parser = subparsers.add_parser(
-        "validate",
-        help="check study files (schema, units, robot, frames, joints, duty cycle); every problem with its line",
-        description=(
-            "Check design-study files without running them: the schema (unknown keys, units of the right "
-            "dimension, bounds), and for arm studies the robot, its contact frame, joint names and sizes, and "
-            "the duty cycle (a trajectory file's problems quote its own line: found cycle.csv:17: ...). A valid "
-            "arm study's summary ends with its duty cycle (duration, samples, peak joint speed) or says that its "
-            "torque requirement is the static one. Every problem is printed as FILE:LINE:COLUMN: FIELD: found "
-            "...; expected ... . Exit status 2 if any file has a problem."
-        ),
-    )
+    parser = options.add_subcommand(subparsers, "validate", _HELP, _DESCRIPTION, units=False)
     parser.add_argument("studies", nargs="+", metavar="STUDY", help="study file(s) (YAML)")
     parser.add_argument(
         "--schema-only",

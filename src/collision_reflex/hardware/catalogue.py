@@ -89,6 +89,26 @@ def _positive(value: float | None) -> float | None:
     return value
 
 
+def _quantity_validators(units: dict[str, str], optional: dict[str, str]) -> tuple[Any, Any]:
+    """An entry's validators of its quantities: each read in SI (see ``_to_si``), then a finite number > 0.
+
+    ``units`` and ``optional`` map each field to its unit; an ``optional`` field may be None.
+    """
+    every = {**units, **optional}
+
+    def si(cls: type, value: Any, info: Any) -> Any:
+        if value is None and info.field_name in optional:
+            return None
+        return _to_si(value, every[info.field_name])
+
+    def physical(cls: type, value: float | None) -> float | None:
+        return _positive(value)
+
+    return field_validator(*every, mode="before")(classmethod(si)), field_validator(*every)(
+        classmethod(physical)
+    )
+
+
 class _Cited(BaseModel):
     """The provenance every entry carries: a default source, and per-field sources and estimates."""
 
@@ -127,17 +147,7 @@ class _MotorEntry(_Cited):
     torque_constant: float | None = None
     construction: Literal["frameless", "housed"] | None = None
 
-    @field_validator(*_MOTOR_UNITS, *_MOTOR_OPTIONAL_UNITS, mode="before")
-    @classmethod
-    def _si(cls, value: Any, info: Any) -> Any:
-        if value is None and info.field_name in _MOTOR_OPTIONAL_UNITS:
-            return None
-        return _to_si(value, {**_MOTOR_UNITS, **_MOTOR_OPTIONAL_UNITS}[info.field_name])
-
-    @field_validator(*_MOTOR_UNITS, *_MOTOR_OPTIONAL_UNITS)
-    @classmethod
-    def _physical(cls, value: float | None) -> float | None:
-        return _positive(value)
+    _si, _physical = _quantity_validators(_MOTOR_UNITS, _MOTOR_OPTIONAL_UNITS)
 
 
 class _GearboxEntry(_Cited):
@@ -157,17 +167,7 @@ class _GearboxEntry(_Cited):
     diameter: float | None = None
     length: float | None = None
 
-    @field_validator(*_GEARBOX_UNITS, *_GEARBOX_OPTIONAL_UNITS, mode="before")
-    @classmethod
-    def _si(cls, value: Any, info: Any) -> Any:
-        if value is None and info.field_name in _GEARBOX_OPTIONAL_UNITS:
-            return None
-        return _to_si(value, {**_GEARBOX_UNITS, **_GEARBOX_OPTIONAL_UNITS}[info.field_name])
-
-    @field_validator(*_GEARBOX_UNITS, *_GEARBOX_OPTIONAL_UNITS)
-    @classmethod
-    def _physical(cls, value: float | None) -> float | None:
-        return _positive(value)
+    _si, _physical = _quantity_validators(_GEARBOX_UNITS, _GEARBOX_OPTIONAL_UNITS)
 
     @field_validator("kind")
     @classmethod

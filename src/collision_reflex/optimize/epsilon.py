@@ -34,7 +34,7 @@ from .design_result import DesignResult
 from .dominance import MERGE_TOLERANCE, same_point
 from .ipopt import IpoptOptions
 from .objectives import OBJECTIVES, objective_values
-from .pieces import ProblemBuilder, built_problem, one_at_a_time, solve_with, subset_problem
+from .pieces import ProblemBuilder, built_problem, one_at_a_time, solve_with, solved_point, subset_problem
 from .results import PointFailure, SweepPoint
 from .solve import warm_start
 from .subsets import sample_subset
@@ -279,22 +279,17 @@ def solve_point(
     else:
         x0 = velocity_within_bound(built_problem(build, objectives[0], objectives[1:]), start, epsilon)
         options = {**POINT_START_OPTIONS, **(ipopt_options or {})}
-    try:
-        result = solve_with(
-            build,
-            objectives[0],
-            objectives[1:],
-            active_set,
-            epsilon=epsilon,
-            x0=x0,
-            ipopt_options=options,
-            initial=initial,
-        )
-    except SolverFailed as error:
-        return SweepPoint(
-            label, None, (PointFailure(objectives[0], epsilon, error.status, str(error.args[0])),)
-        )
-    return SweepPoint(label, result)
+    return solved_point(
+        label,
+        build,
+        objectives[0],
+        objectives[1:],
+        active_set,
+        epsilon,
+        x0=x0,
+        ipopt_options=options,
+        initial=initial,
+    )
 
 
 def _bound_text(name: str, value: float) -> str:

@@ -9,8 +9,8 @@ import numpy as np
 from ..errors import SolverFailed
 from .design_result import DesignResult
 from .ipopt import IpoptOptions
-from .pieces import ProblemBuilder, check_active_set, one_at_a_time, solve_with
-from .results import PointFailure, SweepPoint
+from .pieces import ProblemBuilder, check_active_set, one_at_a_time, solved_point
+from .results import SweepPoint
 from .sweep import Runner, check_count
 
 OPTIMUM_STARTS = 4
@@ -81,19 +81,14 @@ def solve_alone(
     ``objective``: a name, or what ``build`` takes for a weighted one; ``starts``: start points (multi-start);
     ``active_set``, ``x0`` and ``initial``: see :func:`~.pieces.solve_with`.
     """
-    try:
-        result = solve_with(
-            build,
-            objective,
-            (),
-            active_set,
-            x0=x0,
-            ipopt_options=ipopt_options,
-            starts=starts,
-            initial=initial,
-        )
-    except SolverFailed as error:
-        return SweepPoint(
-            "optimum", None, (PointFailure(str(objective), {}, error.status, str(error.args[0])),)
-        )
-    return SweepPoint("optimum", result)
+    return solved_point(
+        "optimum",
+        build,
+        objective,
+        (),
+        active_set,
+        x0=x0,
+        ipopt_options=ipopt_options,
+        starts=starts,
+        initial=initial,
+    )

@@ -11,18 +11,19 @@ import inspect
 import threading
 import warnings
 from collections.abc import Callable, Hashable, Mapping
-from typing import TYPE_CHECKING, ParamSpec, Protocol, TypeVar
+from typing import TYPE_CHECKING, Any, ParamSpec, Protocol, TypeVar
 
 import numpy as np
 
 from .. import _validate
-from ..errors import InvalidParameter
+from ..errors import InvalidParameter, SolverFailed
 from ..vocabulary import ACTIVE_SET_CHOICES
 from .active_set import solve_active_set, uses_active_set
 from .active_set_result import ActiveSetResult
 from .blas import single_threaded_blas
 from .design_result import DesignResult
 from .ipopt import IpoptOptions
+from .results import PointFailure, SweepPoint
 from .solve import solve
 from .subsets import kept_problem, release_subsets
 
@@ -167,3 +168,21 @@ def solve_with(
             warm=x0 if isinstance(x0, ActiveSetResult) else None,
         )
     return solve(problem, epsilon, x0, ipopt_options, starts=starts, retry=retry)
+
+
+def solved_point(
+    label: str,
+    build: ProblemBuilder,
+    objective: Hashable,
+    bounded: tuple[str, ...],
+    active_set: str,
+    epsilon: Mapping[str, float] | None = None,
+    **options: Any,
+) -> SweepPoint:
+    """The sweep point ``label`` of :func:`solve_with`'s design, or of its failure (``options`` as there)."""
+    try:
+        result = solve_with(build, objective, bounded, active_set, epsilon, **options)
+    except SolverFailed as error:
+        failure = PointFailure(str(objective), epsilon or {}, error.status, str(error.args[0]))
+        return SweepPoint(label, None, (failure,))
+    return SweepPoint(label, result)

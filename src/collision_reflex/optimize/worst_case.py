@@ -327,24 +327,74 @@ def search_worst_case(
     # Every BLAS on one thread, SciPy's too: a threaded BLAS sums in another order, and SLSQP's path (so the
     # maximum found) would depend on whether SciPy's BLAS was loaded before a caller limited the threads.
     with single_threaded_blas():
-        return _search(
-            arm, domain, technology, design, start_q, start_directions, random_starts, rng, max_iter
+        started = time.perf_counter()
+        start_q, start_directions, kept = _starts(
+            arm, domain, design.approach_velocity, start_q, start_directions, random_starts, rng
+        )
+        task_dim = int(arm.task_dim)
+        theta_starts = np.clip(arm.joint_coordinates(start_q), domain.lower, domain.upper)
+        joint_bounds = list(zip(domain.lower, domain.upper, strict=True))
+        angle_bounds = [(-np.pi, np.pi)] if task_dim == 2 else [(-np.pi, np.pi), (-1.55, 1.55)]
+        bases = [_basis(d / np.linalg.norm(d)) for d in start_directions]
+        objective = _Objective(arm, domain, technology, design, bases)
+        owners = np.arange(len(bases))
+        first, _ = objective(np.hstack([theta_starts, np.zeros((len(bases), task_dim - 1))]), owners)
+        scales = np.where(np.isfinite(first) & (first > 0), first, 1.0)
+        lockstep = _Lockstep(objective, len(bases))
+        constrained = bool(objective.speed_rows.size) or domain.min_singular_value > 0
+        threads = [
+            threading.Thread(
+                target=_local_search,
+                args=(
+                    lockstep,
+                    k,
+                    theta_starts[k],
+                    joint_bounds + angle_bounds,
+                    scales[k],
+                    max_iter,
+                    constrained,
+                ),
+                daemon=True,
+            )
+            for k in owners
+        ]
+        for thread in threads:
+            thread.start()
+        try:
+            lockstep.serve()
+        finally:
+            for thread in threads:
+                thread.join()
+        maxima = [best for best in objective.best if np.isfinite(best[0])]
+        maxima.sort(key=lambda m: -m[0])
+        if not maxima:
+            raise InvalidParameter(
+                "starts", start_q.shape[0], "starts from which the search reaches the domain"
+            )
+        return WorstCase(
+            impulse=maxima[0][0],
+            q=maxima[0][1],
+            direction=maxima[0][2],
+            maxima_q=np.array([m[1] for m in maxima]),
+            maxima_directions=np.array([m[2] for m in maxima]),
+            maxima_impulse=np.array([m[0] for m in maxima]),
+            starts=len(theta_starts),
+            evaluations=objective.evaluations,
+            elapsed=time.perf_counter() - started,
+            domain_kept=kept,
         )
 
 
-def _search(
+def _starts(
     arm: Arm,
     domain: ContactDomain,
-    technology: ActuatorTechnology,
-    design: Design,
+    velocity: float,
     start_q: np.ndarray,
     start_directions: np.ndarray,
     random_starts: int,
     rng: np.random.Generator | None,
-    max_iter: int,
-) -> WorstCase:
-    """:func:`search_worst_case` with every BLAS on one thread."""
-    started = time.perf_counter()
+) -> tuple[np.ndarray, np.ndarray, float | None]:
+    """The search's starts, ``random_starts`` of them drawn in ``domain`` at ``velocity``, and the share kept."""
     generator = rng if rng is not None else np.random.default_rng(0)
     start_q = np.atleast_2d(np.asarray(start_q, dtype=float))
     start_directions = np.atleast_2d(np.asarray(start_directions, dtype=float))
@@ -356,7 +406,7 @@ def _search(
             if task_dim == 3
             else np.column_stack([np.cos(a := np.linspace(0, 2 * np.pi, 16, endpoint=False)), np.sin(a)])
         )
-        draw = domain.draw(arm, random_starts, pool, design.approach_velocity, generator)
+        draw = domain.draw(arm, random_starts, pool, velocity, generator)
         picks = [pool[generator.choice(np.flatnonzero(row))] for row in draw.feasible]
         kept = draw.samples_kept
         start_q = np.vstack([start_q, draw.q]) if start_q.size else draw.q
@@ -367,52 +417,4 @@ def _search(
             (start_q.shape, start_directions.shape),
             f"k configurations and k directions of {task_dim}",
         )
-    theta_starts = np.clip(arm.joint_coordinates(start_q), domain.lower, domain.upper)
-    joint_bounds = list(zip(domain.lower, domain.upper, strict=True))
-    angle_bounds = [(-np.pi, np.pi)] if task_dim == 2 else [(-np.pi, np.pi), (-1.55, 1.55)]
-    bases = [_basis(d / np.linalg.norm(d)) for d in start_directions]
-    objective = _Objective(arm, domain, technology, design, bases)
-    owners = np.arange(len(bases))
-    first, _ = objective(np.hstack([theta_starts, np.zeros((len(bases), task_dim - 1))]), owners)
-    scales = np.where(np.isfinite(first) & (first > 0), first, 1.0)
-    lockstep = _Lockstep(objective, len(bases))
-    constrained = bool(objective.speed_rows.size) or domain.min_singular_value > 0
-    threads = [
-        threading.Thread(
-            target=_local_search,
-            args=(
-                lockstep,
-                k,
-                theta_starts[k],
-                joint_bounds + angle_bounds,
-                scales[k],
-                max_iter,
-                constrained,
-            ),
-            daemon=True,
-        )
-        for k in owners
-    ]
-    for thread in threads:
-        thread.start()
-    try:
-        lockstep.serve()
-    finally:
-        for thread in threads:
-            thread.join()
-    maxima = [best for best in objective.best if np.isfinite(best[0])]
-    maxima.sort(key=lambda m: -m[0])
-    if not maxima:
-        raise InvalidParameter("starts", start_q.shape[0], "starts from which the search reaches the domain")
-    return WorstCase(
-        impulse=maxima[0][0],
-        q=maxima[0][1],
-        direction=maxima[0][2],
-        maxima_q=np.array([m[1] for m in maxima]),
-        maxima_directions=np.array([m[2] for m in maxima]),
-        maxima_impulse=np.array([m[0] for m in maxima]),
-        starts=len(theta_starts),
-        evaluations=objective.evaluations,
-        elapsed=time.perf_counter() - started,
-        domain_kept=kept,
-    )
+    return start_q, start_directions, kept

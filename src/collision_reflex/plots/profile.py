@@ -56,33 +56,14 @@ def plot_force_profile(
     ax.plot(t, force, color="black", lw=1.4, label="F(t)")
     # Stack the shading so each area is its phase's impulse: the impact pulse sits on top of the sensing ramp.
     ramp = np.where((t >= 0) & (t < t1), sensing_force(t, k, v0), 0.0)
-    in_sensing = (t >= 0) & (t <= t1)
-    in_impact = (t >= 0) & (t <= t_impact)
-    in_reaction = (t >= t1) & (t <= t2)
-    ax.fill_between(
-        t[in_impact],
-        ramp[in_impact],
-        force[in_impact],
-        color="tab:orange",
-        alpha=0.4,
-        label=f"I: impact  {phases.initial:.3g} N·s",
+    shaded = (  # (where, lower curve or 0, upper curve, colour, opacity, label)
+        ((t >= 0) & (t <= t_impact), ramp, force, "tab:orange", 0.4, f"I: impact  {phases.initial:.3g} N·s"),
+        ((t >= 0) & (t <= t1), None, ramp, "tab:blue", 0.3, f"II: sensing  {phases.sensing:.3g} N·s"),
+        ((t >= t1) & (t <= t2), None, force, "tab:green", 0.3, f"III: reaction  {phases.reaction:.3g} N·s"),
     )
-    ax.fill_between(
-        t[in_sensing],
-        0.0,
-        ramp[in_sensing],
-        color="tab:blue",
-        alpha=0.3,
-        label=f"II: sensing  {phases.sensing:.3g} N·s",
-    )
-    ax.fill_between(
-        t[in_reaction],
-        0.0,
-        force[in_reaction],
-        color="tab:green",
-        alpha=0.3,
-        label=f"III: reaction  {phases.reaction:.3g} N·s",
-    )
+    for inside, lower, upper, color, alpha, label in shaded:
+        bottom = 0.0 if lower is None else lower[inside]
+        ax.fill_between(t[inside], bottom, upper[inside], color=color, alpha=alpha, label=label)
     ax.axhline(F_s, color="gray", ls="--", lw=0.8)
     ax.annotate("$F_s$", (t2, F_s), xytext=(4, 3), textcoords="offset points", color="gray")
     for name, time in (("$t_1$", t1), ("$t_2$", t2)):

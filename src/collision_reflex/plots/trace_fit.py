@@ -43,20 +43,11 @@ def plot_trace_fit(path: str | os.PathLike[str], trial: TrialResult) -> Path:
         t1, t2 = collision_times(fit.m_f, fit.k, fit.k_m, fit.F_s, fit.a, fit.v0, fit.reaction)
         t_impact, t1_abs, t2_abs = fit.impact_time, fit.impact_time + t1, fit.impact_time + t2
         phases = fit.phases
-        ax.axvspan(
-            t_impact * 1e3,
-            t1_abs * 1e3,
-            color="tab:blue",
-            alpha=0.12,
-            label=f"sensing {phases.sensing:.3g} N·s",
-        )
-        ax.axvspan(
-            t1_abs * 1e3,
-            t2_abs * 1e3,
-            color="tab:green",
-            alpha=0.12,
-            label=f"reaction {phases.reaction:.3g} N·s",
-        )
+        for start, end, color, label in (
+            (t_impact, t1_abs, "tab:blue", f"sensing {phases.sensing:.3g} N·s"),
+            (t1_abs, t2_abs, "tab:green", f"reaction {phases.reaction:.3g} N·s"),
+        ):
+            ax.axvspan(start * 1e3, end * 1e3, color=color, alpha=0.12, label=label)
         ax.axvline(t_impact * 1e3, color="tab:orange", lw=1, label=f"impact {phases.initial:.3g} N·s")
         ax.axhline(fit.F_s, color="gray", ls="--", lw=0.8)
         ax.annotate(

@@ -127,6 +127,14 @@ def check_against_arm(loaded: LoadedStudy, arm: Arm) -> list[StudyProblem]:
                 )
             )
 
+    def check_sizes(samples: str, size: int, found: str, expected: str) -> None:
+        """The rows of ``samples.<samples>.list`` have ``size`` entries each."""
+        for index, row in enumerate(getattr(study.samples, samples).list or []):
+            if len(row) != size:
+                problems.append(
+                    loaded.problem(("samples", samples, "list", index), found.format(len(row)), expected)
+                )
+
     for name in study.actuators.joints:
         check_joint(("actuators", "joints", name), name)
     for variable in PER_JOINT_DESIGN_VARIABLES:
@@ -135,27 +143,13 @@ def check_against_arm(loaded: LoadedStudy, arm: Arm) -> list[StudyProblem]:
             check_joint(("design", variable, "joints", name), name)
 
     nv = int(arm.nv)
-    for index, q in enumerate(study.samples.configurations.list or []):
-        if len(q) != nv:
-            problems.append(
-                loaded.problem(
-                    ("samples", "configurations", "list", index),
-                    f"{len(q)} joint angles",
-                    f"{nv}, one per joint ({', '.join(joints)}), each with its unit",
-                )
-            )
+    per_joint = f"{nv}, one per joint ({', '.join(joints)}), each with its unit"
+    check_sizes("configurations", nv, "{} joint angles", per_joint)
     problems += _position_units(loaded, arm)
     task_dim = int(arm.task_dim)
     directions = study.samples.directions
-    for index, vector in enumerate(directions.list or []):
-        if len(vector) != task_dim:
-            problems.append(
-                loaded.problem(
-                    ("samples", "directions", "list", index),
-                    f"a vector of {len(vector)} components",
-                    f"{task_dim} components ({'a planar arm' if task_dim == 2 else 'a spatial arm'})",
-                )
-            )
+    plane = "a planar arm" if task_dim == 2 else "a spatial arm"
+    check_sizes("directions", task_dim, "a vector of {} components", f"{task_dim} components ({plane})")
     if task_dim == 2 and directions.sphere is not None:
         problems.append(
             loaded.problem(

@@ -227,24 +227,12 @@ def _index(
             if key in seen:
                 duplicates.append((*path, key))
             seen.add(key)
+            _index(value_node, (*path, key), positions, duplicates, active)
             # An entry is located at its key, where a reader looks for it.
             positions[(*path, key)] = (key_node.start_mark.line + 1, key_node.start_mark.column + 1)
-            _index_children(value_node, (*path, key), positions, duplicates, active)
     elif isinstance(node, yaml.SequenceNode):
         for index, item in enumerate(node.value):
             _index(item, (*path, index), positions, duplicates, active)
-
-
-def _index_children(
-    node: yaml.Node,
-    path: PathKey,
-    positions: dict[PathKey, tuple[int, int]],
-    duplicates: list[PathKey],
-    active: set[int],
-) -> None:
-    saved = positions[path]
-    _index(node, path, positions, duplicates, active)
-    positions[path] = saved
 
 
 def _constructed_key(key_node: yaml.Node, raw: Any) -> Any:
