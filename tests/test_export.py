@@ -61,7 +61,72 @@ def _joint_record(rng: np.random.Generator, name: str, gearbox: str = "") -> dic
         "gearbox_efficiency": 0.97 if gearbox else 1.0,
         "actuator_mass": motor_mass + gearbox_mass,
         "nearest_catalogue_motor": "OPN-060-013-A",
+        **_UNREAD_JOINT,
     }
+
+
+# What a run's record holds beside what the export reads: designs.json is checked against its type when read.
+_UNREAD_JOINT = {
+    "required_torque": 1.0,
+    "torque_margin": None,
+    "mechanical_stiffness": 5000.0,
+    "software_stiffness": 500.0,
+    "stiffness": 454.5,
+    **dict.fromkeys(["required_rms_torque", "rms_margin", "max_motor_speed", "speed_limit", "speed_margin"]),
+    "required_by": None,
+}
+_UNREAD_DESIGN = {
+    "requirement": "static (gravity only)",
+    "objectives": {},
+    "casadi_objectives": {},
+    "threshold": 5.0,
+    "sensing": "force",
+    "approach_velocity": 0.25,
+    "impulses": [],
+    "solver": {
+        "status": "Solve_Succeeded",
+        "iterations": 1,
+        "epsilon": {},
+        "attempts": [],
+        "method": "full NLP",
+        "active_samples": 1,
+    },
+    "phases": {"initial": [], "sensing": [], "reaction": []},
+    "optimal_velocity": [],
+    "statistics": {},
+}
+_UNREAD_RUN = {
+    "description": "",
+    "resolved": {},
+    "samples": {
+        "configurations": [],
+        "directions": [],
+        "config_index": [],
+        "sample_directions": [],
+        "joint_names": [],
+        "task_dim": 3,
+    },
+    "domain": {
+        "min_singular_value": 0.0,
+        "reach": 1.0,
+        "joint_speed_limit": [],
+        "joint_lower": [],
+        "joint_upper": [],
+        "kept": None,
+        "sampling_velocity": 1.0,
+        "searched_samples": 0,
+        "searched": [],
+    },
+    "bounds": {
+        **{key: {} for key in ["stator_diameter", "stack_length", "gear_ratio", "software_stiffness"]},
+        "threshold": [1.0, 20.0],
+        "approach_velocity": [0.05, 1.0],
+    },
+    "requirement": "static (gravity only)",
+    "speed_limits": None,
+    "transmissions": [],
+    "verdict": [],
+}
 
 
 def synthetic_run(folder: Path, study: Path, seed: int, gearbox: str = "") -> Path:
@@ -75,12 +140,14 @@ def synthetic_run(folder: Path, study: Path, seed: int, gearbox: str = "") -> Pa
         {
             "label": f"point {p}",
             "joints": [_joint_record(rng, n, gearbox if i % 2 == 0 else "") for i, n in enumerate(names)],
+            **_UNREAD_DESIGN,
         }
         for p in range(3)
     ]
     folder.mkdir(parents=True)
     (folder / "study.resolved.yaml").write_text(resolved_yaml(loaded), encoding="utf-8")
     results = {
+        **_UNREAD_RUN,
         "kind": "arm",
         "study": loaded.study.name,
         "chosen": points[0],

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -18,7 +18,11 @@ from typing import TYPE_CHECKING, Any
 from ..errors import CollisionReflexError, InvalidParameter
 from ..hardware.gearboxes import load_gearbox_catalogue
 from ..hardware.motors import scaled_motor_quantities
-from ..report.files import DESIGNS, ResultsDamaged, ResultsMissing, read_json
+from ..record.checked import ResultsDamaged, ResultsMissing
+from ..record.design import DesignRecord, JointRecord, QuickSnap
+from ..record.read import checked_run_record, read_saved_record
+from ..record.run import ArmRunRecord
+from ..report.files import DESIGNS
 from ..study.load import parse_study
 from ..study.prepare import check_motors
 from ..study.robot import load_arm
@@ -84,7 +88,7 @@ class RunDesign:
     study: the study's name; label: which design (``"recommended design (Pareto design 0)"``); arm: the arm
     as the study loads it (locked joints removed, contact point set); joints: one :class:`JointActuator` per
     joint of the arm, in its order; parts: provenance lines (catalogue parts and their sources);
-    catalogue: the design record's ``catalogue`` entry where it has one (None otherwise).
+    catalogue: the design record's ``catalogue`` entry (its quick snap) where it has one (None otherwise).
     """
 
     study: str
@@ -92,7 +96,7 @@ class RunDesign:
     arm: Arm
     joints: tuple[JointActuator, ...]
     parts: tuple[str, ...]
-    catalogue: Any = None
+    catalogue: QuickSnap | None = None
 
 
 def read_run_design(run_dir: str | os.PathLike[str], design: str | int = "recommended") -> RunDesign:
@@ -112,25 +116,16 @@ def read_run_design(run_dir: str | os.PathLike[str], design: str | int = "recomm
     """
     folder = Path(run_dir)
     path = folder / DESIGNS
-    if not path.is_file():
-        raise ResultsMissing(f"{folder} has no {DESIGNS}: run the study first (crx run STUDY --out {folder})")
-    try:
-        results = read_json(path)
-    except (OSError, ValueError) as error:
-        raise ResultsDamaged(
-            f"{path} cannot be read ({' '.join(str(error).split())}); run the study again"
-        ) from None
-    if not isinstance(results, dict):
-        raise ResultsDamaged(
-            f"{path} holds {type(results).__name__}, not a run's results; run the study again"
-        )
-    if results.get("kind") != "arm":
+    data = read_saved_record(path)
+    if data["kind"] != "arm":
         raise InvalidParameter(
             "run_dir",
-            f"{folder} ({results.get('kind')!r} study)",
+            f"{folder} ({data['kind']!r} study)",
             "the folder of an arm study",
             "an actuator study has no arm to export",
         )
+    results = checked_run_record(data, path)
+    assert results["kind"] == "arm"  # checked above
     label, record = _pick(results, design, path)
     resolved = folder / RESOLVED
     if not resolved.is_file():
@@ -146,14 +141,9 @@ def read_run_design(run_dir: str | os.PathLike[str], design: str | int = "recomm
         raise ResultsDamaged(f"{path}: {' '.join(what.split())}; run the study again") from None
 
 
-def _pick(results: Mapping[str, Any], design: str | int, path: Path) -> tuple[str, Mapping[str, Any]]:
+def _pick(results: ArmRunRecord, design: str | int, path: Path) -> tuple[str, DesignRecord]:
     """The label and record of ``design`` in the results."""
-    try:
-        points = results["pareto"]["points"]
-        if not isinstance(points, list):
-            raise TypeError("field 'pareto.points' is not a list")
-    except (KeyError, TypeError) as error:
-        raise ResultsDamaged(f"{path}: {error}; run the study again") from None
+    points = results["pareto"]["points"]
     if isinstance(design, str) and design.isdigit():
         design = int(design)
     if isinstance(design, int) and not isinstance(design, bool):
@@ -171,16 +161,12 @@ def _pick(results: Mapping[str, Any], design: str | int, path: Path) -> tuple[st
         raise InvalidParameter(
             "design", design, f"a Pareto design number or one of {', '.join(DESIGN_CHOICES)}"
         )
-    record = results.get(design)
-    if not isinstance(record, dict):
-        raise InvalidParameter("design", design, "a design the run has", f"{path} has no {design!r} design")
+    record = results["recommended"] if design == "recommended" else results["chosen"]
     source = record.get("source") or record.get("label", "")
     return f"{design} design ({source})" if source else f"{design} design", record
 
 
-def _run_design(
-    results: Mapping[str, Any], record: Mapping[str, Any], label: str, resolved: Path
-) -> RunDesign:
+def _run_design(results: ArmRunRecord, record: DesignRecord, label: str, resolved: Path) -> RunDesign:
     """The :class:`RunDesign` of a design record, with the arm and motors of the resolved study."""
     loaded = parse_study(resolved.read_text(encoding="utf-8"), str(resolved), resolved.parent)
     study = loaded.study
@@ -239,7 +225,7 @@ def _gearbox_input_speed(name: str, gearboxes: Mapping[str, Any]) -> float | Non
     return float(speed) if speed is not None and math.isfinite(speed) else None
 
 
-def _gearbox_catalogue(joints: Any) -> Mapping[str, Any]:
+def _gearbox_catalogue(joints: Iterable[JointRecord]) -> Mapping[str, Any]:
     """The gearbox catalogue by name where a joint has a gearbox (empty otherwise: no file read)."""
     if not any(j.get("gearbox") for j in joints):
         return {}

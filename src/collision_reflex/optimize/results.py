@@ -10,14 +10,24 @@ A sweep's finished pieces (:class:`SweepPoint`) round-trip through JSON exactly 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
 from ..errors import InvalidParameter
 from ..model.impulse import optimal_velocity, phase_impulses, series_stiffness
+from ..record.design import (
+    AttemptRecord,
+    DesignRecord,
+    Estimate,
+    JointRecord,
+    PointFailureRecord,
+    QuickSnap,
+    SolvedJoint,
+    SolvedRecord,
+)
 from .active_set_result import ActiveSetResult, solve_method, with_active_set
 from .candidates import motor_distance
 from .constraints import DUTY_REQUIREMENT, RATED_REQUIREMENT, STATIC_REQUIREMENT
@@ -86,7 +96,7 @@ class PointFailure:
     status: str
     message: str
 
-    def as_dict(self) -> dict[str, Any]:
+    def as_dict(self) -> PointFailureRecord:
         """The failure as JSON types."""
         return {
             "objective": self.objective,
@@ -181,7 +191,7 @@ def result_to_json(result: DesignResult) -> dict[str, Any]:
     }
 
 
-def attempt_records(attempts: tuple[Attempt, ...]) -> list[dict[str, Any]]:
+def attempt_records(attempts: tuple[Attempt, ...]) -> list[AttemptRecord]:
     """Every IPOPT run of a solve (retries included) as JSON: name, status, iterations, ``solve_time`` [s]."""
     return [
         {
@@ -270,13 +280,13 @@ def _result_from_json(data: Mapping[str, Any], saved: Mapping[str, Any]) -> Desi
     )
 
 
-def record_design(record: Mapping[str, Any], sensing: str) -> Design:
+def record_design(record: SolvedRecord | DesignRecord, sensing: str) -> Design:
     """The :class:`~.solve.Design` a design record holds, to evaluate it anew.
 
     ``record``: as :func:`result_record` writes it (``designs.json``); ``sensing``: the study's scheme
     (``force`` or ``position``).
     """
-    joints = record["joints"]
+    joints: Sequence[Mapping[str, Any]] = record["joints"]
 
     def column(name: str) -> np.ndarray:
         return np.array([joint[name] for joint in joints], dtype=float)
@@ -296,13 +306,12 @@ def record_design(record: Mapping[str, Any], sensing: str) -> Design:
     )
 
 
-def result_record(result: DesignResult, label: str) -> dict[str, Any]:
+def result_record(result: DesignResult, label: str) -> SolvedRecord:
     """A design and its solve as plain data: objectives, per-joint quantities and margins, solver status."""
     design = result.design
     method, active = solve_method(result)
-    joints = []
+    joints: list[SolvedJoint] = []
     for i, name in enumerate(design.joint_names):
-        duty = {key: _finite_entry(getattr(result, key), i) for key in DUTY_ARRAYS}
         joints.append(
             {
                 "joint": name,
@@ -331,7 +340,11 @@ def result_record(result: DesignResult, label: str) -> dict[str, Any]:
                 "gearbox_inertia": float(design.gearbox_inertia[i]),
                 "gearbox_efficiency": float(design.gearbox_efficiency[i]),
                 "actuator_mass": float(design.actuator_mass[i]),
-                **duty,
+                "required_rms_torque": _finite_entry(result.required_rms_torque, i),
+                "rms_margin": _finite_entry(result.rms_margin, i),
+                "max_motor_speed": _finite_entry(result.max_motor_speed, i),
+                "speed_limit": _finite_entry(result.speed_limit, i),
+                "speed_margin": _finite_entry(result.speed_margin, i),
             }
         )
     return {
@@ -369,7 +382,7 @@ def design_record(
     result: DesignResult,
     label: str,
     catalogue: Mapping[str, Motor] | None = None,
-) -> dict[str, Any]:
+) -> DesignRecord:
     """:func:`result_record` with what a report shows about the collisions.
 
     That is the impulse phases [N*s] and the optimal approach velocity [m/s] per sample (from ``problem``'s
@@ -378,7 +391,7 @@ def design_record(
     its required peak torque (``required_by``, :func:`required_by`) and
     its nearest catalogue motor.
     """
-    record = result_record(result, label)
+    solved = result_record(result, label)
     design = result.design
     reaction = problem.technology.reaction
     params, threshold = design_collision_parameters(problem, design)
@@ -386,34 +399,43 @@ def design_record(
         params.m_f, params.k, params.k_m, threshold, params.a, design.approach_velocity, reaction
     )
     v_star = optimal_velocity(params.m_f, params.k, threshold, reaction, params.k_m, params.a)
-    record["phases"] = {
-        "initial": np.broadcast_to(phases.initial, params.m_f.shape).tolist(),
-        "sensing": np.broadcast_to(phases.sensing, params.m_f.shape).tolist(),
-        "reaction": np.broadcast_to(phases.reaction, params.m_f.shape).tolist(),
-    }
-    record["optimal_velocity"] = np.asarray(v_star, dtype=float).tolist()
     drawn = np.asarray(problem.samples.drawn)
-    record["statistics"] = {
-        name: estimate.to_json()
+    statistics = {
+        name: cast("Estimate", estimate.to_json())
         for name, estimate in impulse_statistics(
             np.asarray(result.impulses)[drawn], problem.samples.config_index[drawn]
         ).items()
     }
-    record["statistics"]["quantile_impulse"]["quantile"] = QUANTILE
+    statistics["quantile_impulse"]["quantile"] = QUANTILE
     sizing = required_by(problem, design, np.asarray(result.required_torque, dtype=float))
-    owner = problem.space.module_of(len(record["joints"]))
-    for i, joint in enumerate(record["joints"]):
-        joint["required_by"] = sizing[i]
-        if owner.count(owner[i]) > 1:
-            joint["module"] = [problem.joint_names[k] for k, o in enumerate(owner) if o == owner[i]]
-        joint["nearest_catalogue_motor"] = (
+    owner = problem.space.module_of(len(solved["joints"]))
+    joints: list[JointRecord] = []
+    for i, joint in enumerate(solved["joints"]):
+        nearest = (
             nearest_catalogue_motor(
                 catalogue, float(design.motor_peak_torque[i]), float(design.rotor_inertia[i])
             )
             if catalogue
             else None
         )
-    return record
+        module = [problem.joint_names[k] for k, o in enumerate(owner) if o == owner[i]]
+        if len(module) > 1:
+            joints.append(
+                {**joint, "required_by": sizing[i], "module": module, "nearest_catalogue_motor": nearest}
+            )
+        else:
+            joints.append({**joint, "required_by": sizing[i], "nearest_catalogue_motor": nearest})
+    return {
+        **solved,
+        "joints": joints,
+        "phases": {
+            "initial": np.broadcast_to(phases.initial, params.m_f.shape).tolist(),
+            "sensing": np.broadcast_to(phases.sensing, params.m_f.shape).tolist(),
+            "reaction": np.broadcast_to(phases.reaction, params.m_f.shape).tolist(),
+        },
+        "optimal_velocity": np.asarray(v_star, dtype=float).tolist(),
+        "statistics": statistics,
+    }
 
 
 def required_by(problem: DesignProblem, design: Design, required: np.ndarray) -> list[str | None]:
@@ -513,7 +535,7 @@ def nearest_catalogue_motor(catalogue: Mapping[str, Motor], peak_torque: float, 
     return best
 
 
-def record_row(record: Mapping[str, Any], index: int) -> dict[str, Any]:
+def record_row(record: SolvedRecord | DesignRecord, index: int) -> dict[str, Any]:
     """The table row of a design record, every column name with its unit.
 
     ``pareto.csv``, the report's table and :meth:`ParetoSet.to_frame` are made of these.
@@ -527,8 +549,9 @@ def record_row(record: Mapping[str, Any], index: int) -> dict[str, Any]:
         + (GEARBOX_COLUMNS if geared else ())
         + (DUTY_COLUMNS if record.get("requirement") in (DUTY_REQUIREMENT, RATED_REQUIREMENT) else ())
     )
+    joints: Sequence[Mapping[str, Any]] = record["joints"]  # the columns' keys, by name
     for key, unit in columns:
-        for joint in record["joints"]:
+        for joint in joints:
             row[f"{key}[{joint['joint']}] [{unit}]"] = joint[key]
     row[f"threshold [{threshold_unit(record['sensing'])}]"] = record["threshold"]
     row.update(catalogue_columns(record))
@@ -542,14 +565,14 @@ NO_PART = "none within bounds"
 """A catalogue-part cell of a joint with no catalogue part within the design's bounds."""
 
 
-def catalogue_columns(record: Mapping[str, Any]) -> dict[str, Any]:
+def catalogue_columns(record: SolvedRecord | DesignRecord) -> dict[str, Any]:
     """A design's catalogue snap as table columns (none when the record has no snap).
 
     Per joint the catalogue part (``catalogue_part[joint1]``, :data:`NO_PART` when none is within bounds), then
     whether the catalogue design meets every requirement as snapped and its objectives [their units], empty
     without parts (:func:`collision_reflex.study.arm_results.quick_snap_record`).
     """
-    snapped = record.get("catalogue")
+    snapped = cast("QuickSnap | None", record.get("catalogue"))  # a solved record has none
     if snapped is None:
         return {}
     row: dict[str, Any] = {}

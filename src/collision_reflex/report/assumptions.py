@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from ..hardware.motors import get_motor, scaling_law
+from ..record.run import RunRecord
 from .wording import mm, number, shown_path, unit
 
 UNITS = {
@@ -58,7 +59,7 @@ catalogue snap's and the executor's settings, are in ``study.resolved.yaml``).""
 _MILLIMETRES = {"stator_diameter", "stack_length", "contact_offset"}
 
 
-def assumption_rows(results: dict[str, Any]) -> list[tuple[str, str, str, str]]:
+def assumption_rows(results: RunRecord) -> list[tuple[str, str, str, str]]:
     """The study as run, as (part, assumption, value with unit, source) rows a designer reads.
 
     Empty fields are left out, a per-joint mapping that holds the same value for every joint is one row,
@@ -67,7 +68,8 @@ def assumption_rows(results: dict[str, Any]) -> list[tuple[str, str, str, str]]:
     """
     resolved = results["resolved"]
     rows: list[tuple[str, str, str, str]] = []
-    cited = {j.get("motor") for j in (results.get("catalogue") or {}).get("joints") or []}
+    catalogue = results.get("catalogue") if results["kind"] == "arm" else None
+    cited = {j["motor"] for j in catalogue["joints"]} if catalogue else set()
     for key, group in ASSUMPTION_GROUPS.items():
         value = resolved.get(key)
         if key == "objective" and isinstance(value, dict):
@@ -104,9 +106,10 @@ def assumption_rows(results: dict[str, Any]) -> list[tuple[str, str, str, str]]:
                 "",
             )
         )
-    for text in [results.get("speed_limits"), *results.get("transmissions", ())]:
-        if text and not str(text).startswith("Warning"):
-            label, _, said = str(text).partition(": ")
+    notes = [results["speed_limits"], *results["transmissions"]] if results["kind"] == "arm" else []
+    for note in notes:
+        if note and not note.startswith("Warning"):
+            label, _, said = note.partition(": ")
             model.append((label.lower(), said, ""))
     return [("model", *row) for row in model] + rows
 

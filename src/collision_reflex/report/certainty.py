@@ -13,10 +13,12 @@ from typing import Any
 
 import numpy as np
 
+from ..record.design import DesignRecord, Estimate
+from ..record.run import DomainRecord, ParetoRecord
 from .wording import general, percent
 
 
-def domain_sentence(domain: Mapping[str, Any], velocity: float, kept: float | None) -> str:
+def domain_sentence(domain: DomainRecord, velocity: float, kept: float | None) -> str:
     """Where the worst case is taken: the contact domain's floor, its speed check and what it keeps.
 
     ``kept``: the fraction of the joint-limit box in the domain at ``velocity`` [m/s] (None: unknown).
@@ -37,9 +39,10 @@ def domain_sentence(domain: Mapping[str, Any], velocity: float, kept: float | No
     )
 
 
-def worst_pose_sentence(record: Mapping[str, Any]) -> str | None:
+def worst_pose_sentence(record: DesignRecord) -> str | None:
     """Where the search found a design's worst case, and how hard it looked; None without a search."""
-    search = (record.get("worst_case") or {}).get("searched")
+    worst = record.get("worst_case")
+    search = worst["searched"] if worst else None
     if search is None:
         return None
     pose = ", ".join(f"{np.degrees(v):.0f}" for v in search["q"])
@@ -50,7 +53,7 @@ def worst_pose_sentence(record: Mapping[str, Any]) -> str | None:
     )
 
 
-def certainty_sentences(record: Mapping[str, Any], exchanged: bool = True) -> list[str]:
+def certainty_sentences(record: DesignRecord, exchanged: bool = True) -> list[str]:
     """How sure the recommended design's worst case is (its search), and its check on fresh samples."""
     worst = record.get("worst_case")
     lines = []
@@ -81,14 +84,15 @@ def certainty_sentences(record: Mapping[str, Any], exchanged: bool = True) -> li
                 f"worst case found, not a bound; {remedy}."
             )
     fresh = record.get("fresh")
-    if fresh and fresh.get("largest") is not None and worst:
+    largest = fresh["largest"] if fresh else None
+    if fresh and largest is not None and worst:
         bound = float(worst["domain"])
         mean = fresh["statistics"]["mean_impulse"]
         check = (
-            f"WARNING: largest {general(fresh['largest'])} N·s, {percent(100 * (fresh['largest'] / bound - 1))} % "
+            f"WARNING: largest {general(largest)} N·s, {percent(100 * (largest / bound - 1))} % "
             "above the worst case, which is therefore not a bound"
             if fresh["exceeds"]
-            else f"largest {general(fresh['largest'])} N·s, within the worst case"
+            else f"largest {general(largest)} N·s, within the worst case"
         )
         lines.append(
             f"On {fresh['configurations']:,} fresh configurations it was not optimised on: {check}; mean "
@@ -97,12 +101,13 @@ def certainty_sentences(record: Mapping[str, Any], exchanged: bool = True) -> li
     return lines
 
 
-def statistics_rows(record: Mapping[str, Any]) -> list[tuple[str, str, str]]:
+def statistics_rows(record: DesignRecord) -> list[tuple[str, str, str]]:
     """The recommended design's statistics: (statistic, on fresh samples, on the optimised samples).
 
     Each value with its relative error (the larger half-width of a 99 % cluster-bootstrap interval).
     """
-    fresh = (record.get("fresh") or {}).get("statistics") or {}
+    checked = record.get("fresh")
+    fresh = (checked.get("statistics") if checked else None) or {}
     own = record.get("statistics") or {}
     from ..optimize.objectives import CVAR_LEVEL  # lazy: casadi
 
@@ -112,7 +117,7 @@ def statistics_rows(record: Mapping[str, Any]) -> list[tuple[str, str, str]]:
         "quantile_impulse": "99th percentile",
     }
 
-    def one(estimate: Mapping[str, Any] | None) -> str:
+    def one(estimate: Estimate | None) -> str:
         if not estimate:
             return "–"
         return f"{general(estimate['value'])} N·s ± {percent(100 * estimate['relative_error'])} %"
@@ -125,7 +130,7 @@ def statistics_rows(record: Mapping[str, Any]) -> list[tuple[str, str, str]]:
 
 
 def statistics_warnings(
-    record: Mapping[str, Any], study: Mapping[str, Any], pareto: Mapping[str, Any] | None = None
+    record: DesignRecord, study: Mapping[str, Any], pareto: ParetoRecord | None = None
 ) -> list[str]:
     """Warnings on the statistics: errors beyond the study's tolerance, Pareto designs a fresh sample beats.
 
@@ -146,8 +151,8 @@ def statistics_warnings(
             )
     exceeded = [
         str(point.get("label", i))
-        for i, point in enumerate((pareto or {}).get("points", ()))
-        if (point.get("fresh") or {}).get("exceeds")
+        for i, point in enumerate(pareto["points"] if pareto else [])
+        if (checked := point.get("fresh")) and checked["exceeds"]
     ]
     if exceeded:
         lines.append(

@@ -7,12 +7,11 @@ HTML report.
 from __future__ import annotations
 
 import contextlib
-import dataclasses
 import functools
 import re
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -24,7 +23,8 @@ from ..plots.phase_breakdown import plot_phase_breakdown
 from ..plots.torque_speed import JointOperatingPoints, plot_torque_speed
 from ..plots.velocity_sweep import plot_velocity_sweep
 from ..plots.worst_pose import plot_worst_pose
-from .files import ResultsDamaged
+from ..record.checked import ResultsDamaged
+from ..record.run import ActuatorRunRecord, ArmRunRecord, RunRecord
 from .wording import objective_unit
 
 TORQUE_SPEED_FIELD = "recommended.torque_speed"
@@ -58,14 +58,14 @@ def _draw(directory: Path, name: str, formats: list[str], draw: Callable[[Figure
     return re.sub(r"<metadata>.*?</metadata>\s*", "", text[text.index("<svg") :], count=1, flags=re.S)
 
 
-def draw_figures(directory: Path, results: dict[str, Any], formats: list[str]) -> dict[str, str]:
+def draw_figures(directory: Path, results: RunRecord, formats: list[str]) -> dict[str, str]:
     """Draw every figure of a report; returns inline SVG text by figure name."""
     if results["kind"] == "actuator":
         return _actuator_figures(directory, results, formats)
     return _arm_figures(directory, results, formats)
 
 
-def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -> dict[str, str]:
+def _arm_figures(directory: Path, results: ArmRunRecord, formats: list[str]) -> dict[str, str]:
     svgs: dict[str, str] = {}
     samples = results["samples"]
     directions = np.asarray(samples["sample_directions"])
@@ -105,9 +105,10 @@ def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
             title="impulse by contact direction [N*s]: " + str(recommended.get("source", "chosen design")),
         ),
     )
-    pose = (results.get("recommended") or {}).get("worst_case", {}).get("pose")
-    if pose is not None:
-        worst = results["recommended"]["worst_case"]
+    shown = results.get("recommended")
+    worst_case = shown.get("worst_case") if shown else None
+    pose = None if worst_case is None else worst_case.get("pose")
+    if worst_case is not None and pose is not None:
         svgs["worst_pose"] = _draw(
             directory,
             "worst_pose",
@@ -117,8 +118,8 @@ def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
                 np.asarray(pose["joint_positions"]),
                 np.asarray(pose["contact_position"]),
                 np.asarray(pose["direction"]),
-                f"worst case over the contact domain: {worst['domain']:.4g} N·s"
-                + ("" if worst["certified"] else " (not certified)"),
+                f"worst case over the contact domain: {worst_case['domain']:.4g} N·s"
+                + ("" if worst_case["certified"] else " (not certified)"),
             ),
         )
     joints = recommended_torque_speed(results)
@@ -146,18 +147,15 @@ def _arm_figures(directory: Path, results: dict[str, Any], formats: list[str]) -
     return svgs
 
 
-def has_duty_cycle(results: dict[str, Any]) -> bool:
+def has_duty_cycle(results: ArmRunRecord) -> bool:
     """Whether the recommended design was sized by a motion: a duty cycle or a rated motion (its ``requirement``)."""
     from ..optimize.constraints import DUTY_REQUIREMENT, RATED_REQUIREMENT  # lazy: casadi
 
     recommended = results.get("recommended")
-    return isinstance(recommended, dict) and recommended.get("requirement") in (
-        DUTY_REQUIREMENT,
-        RATED_REQUIREMENT,
-    )
+    return recommended is not None and recommended.get("requirement") in (DUTY_REQUIREMENT, RATED_REQUIREMENT)
 
 
-def recommended_torque_speed(results: dict[str, Any]) -> list[JointOperatingPoints] | None:
+def recommended_torque_speed(results: ArmRunRecord) -> list[JointOperatingPoints] | None:
     """The recommended design's saved torque-speed data, one entry per joint; None without a duty cycle.
 
     Each entry holds :class:`~collision_reflex.plots.torque_speed.JointOperatingPoints`'s fields.
@@ -165,32 +163,27 @@ def recommended_torque_speed(results: dict[str, Any]) -> list[JointOperatingPoin
     Raises
     ------
     ResultsDamaged
-        The study has a duty cycle and :data:`TORQUE_SPEED_FIELD` is missing, or an entry is not a joint's
-        data as the run writes it (the message names the field).
+        The study has a duty cycle and :data:`TORQUE_SPEED_FIELD` is missing or empty, or an entry's arrays do
+        not fit together (the message names the field). Its fields are checked when the record is read.
     """
     recommended = results.get("recommended")
-    saved = recommended.get("torque_speed") if isinstance(recommended, dict) else None
+    saved = recommended.get("torque_speed") if recommended else None
     if saved is None:
         if has_duty_cycle(results):
             raise ResultsDamaged(f"{TORQUE_SPEED_FIELD} is missing although the study has a duty cycle")
         return None
-    if not isinstance(saved, list) or not saved:
+    if not saved:
         raise ResultsDamaged(f"{TORQUE_SPEED_FIELD} is not a list of joints' data")
-    expected = sorted(field.name for field in dataclasses.fields(JointOperatingPoints))
     joints = []
-    for index, entry in enumerate(saved):
-        where = f"{TORQUE_SPEED_FIELD}[{index}]"
-        if not isinstance(entry, dict) or sorted(entry) != expected:
-            found = sorted(entry) if isinstance(entry, dict) else type(entry).__name__
-            raise ResultsDamaged(f"{where} has fields {found}, expected {expected}")
+    for index, entry in enumerate(saved):  # its fields checked when read (collision_reflex.record.read)
         try:
-            joints.append(JointOperatingPoints(**entry))
+            joints.append(JointOperatingPoints(**cast("dict[str, Any]", entry)))
         except InvalidParameter as error:
-            raise ResultsDamaged(f"{where}: {error}") from None
+            raise ResultsDamaged(f"{TORQUE_SPEED_FIELD}[{index}]: {error}") from None
     return joints
 
 
-def _actuator_figures(directory: Path, results: dict[str, Any], formats: list[str]) -> dict[str, str]:
+def _actuator_figures(directory: Path, results: ActuatorRunRecord, formats: list[str]) -> dict[str, str]:
     candidates = results["candidates"]
     svgs = {
         "sweep": _draw(

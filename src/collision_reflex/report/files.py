@@ -8,20 +8,11 @@ from pathlib import Path
 from typing import Any
 
 from .._io import atomic_open
-from ..errors import CollisionReflexError
 
 DESIGNS = "designs.json"
 PARETO = "pareto.csv"
 REPORT = "report.html"
 TIMINGS = "timings.json"
-
-
-class ResultsMissing(CollisionReflexError, FileNotFoundError):
-    """A folder has no saved results to report on."""
-
-
-class ResultsDamaged(CollisionReflexError, ValueError):
-    """A field of the saved results is missing or not what the run writes; the message names the field."""
 
 
 def write_json(path: str | os.PathLike[str], data: object) -> None:

@@ -11,6 +11,8 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from ..plots.design_front import POINT_ID
+from ..record.design import DesignRecord, JointRecord, QuickSnap
+from ..record.run import ArmRunRecord
 from .wording import significant, unit, words
 
 
@@ -27,14 +29,14 @@ def _objective_lines(objectives: Mapping[str, float], first: Sequence[str]) -> l
     return lines
 
 
-def _threshold_line(record: Mapping[str, Any]) -> str:
+def _threshold_line(record: DesignRecord) -> str:
     threshold = float(record["threshold"])
     if record.get("sensing") == "position":  # a position-error threshold [m]
         return f"position-error threshold {significant(threshold * 1e3, 4)} mm"
     return f"threshold {significant(threshold, 4)} N"
 
 
-def _joint_lines(joints: Sequence[Mapping[str, Any]]) -> list[str]:
+def _joint_lines(joints: Sequence[JointRecord]) -> list[str]:
     """Each joint's motor, gear ratio and software stiffness; the gearbox once if every joint has the same."""
     gearboxes = [unit(g) if isinstance(g, str) and g else None for g in (j.get("gearbox") for j in joints)]
     common = len(set(gearboxes)) == 1
@@ -62,7 +64,7 @@ def _parts(parts: Sequence[str | None]) -> str:
     return ", ".join(f"{count} × {part or 'none'}" if count > 1 else part or "none" for part, count in runs)
 
 
-def _catalogue_line(snap: Mapping[str, Any]) -> str:
+def _catalogue_line(snap: QuickSnap) -> str:
     """The quick catalogue snap: its part per joint and whether it meets the requirements as it is."""
     parts = _parts(snap.get("parts") or ())
     missing = snap.get("missing") or []
@@ -78,7 +80,7 @@ def _catalogue_line(snap: Mapping[str, Any]) -> str:
     return f"catalogue parts: {parts} (misses: {misses})"
 
 
-def front_cards(results: Mapping[str, Any]) -> list[dict[str, Any]]:
+def front_cards(results: ArmRunRecord) -> list[dict[str, Any]]:
     """One hover card per Pareto design of a run's results (``designs.json``), in Pareto order.
 
     Parameters
@@ -96,8 +98,10 @@ def front_cards(results: Mapping[str, Any]) -> list[dict[str, Any]]:
         software stiffness and gearbox, and its catalogue snap; the recommended design's title says so.
     """
     pareto = results["pareto"]
-    snaps = (results.get("catalogue") or {}).get("pareto") or []
-    recommended = (results.get("recommended") or {}).get("pareto_index")
+    catalogue = results.get("catalogue")
+    snaps = catalogue["pareto"] if catalogue else []
+    chosen = results.get("recommended")
+    recommended = chosen.get("pareto_index") if chosen else None
     cards = []
     for index, record in enumerate(pareto["points"]):
         lines = _objective_lines(record["objectives"], pareto.get("objectives") or [])

@@ -8,10 +8,12 @@ Every function reads the results of :func:`collision_reflex.study.arm_results.ar
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
+from ..record.design import DesignRecord
+from ..record.run import ParetoRecord, TransmissionTried
 from ..vocabulary import IMPULSE_OBJECTIVES
 from .wording import general, group_name, objective_unit, percent, words
 
@@ -22,7 +24,7 @@ NEAR_BEST = 0.05
 """How far above the best impulse (relative) a design may be for "the lightest design within 5 % of the best"."""
 
 
-def objective_spans(points: Sequence[Mapping[str, Any]], objectives: Sequence[str]) -> dict[str, float]:
+def objective_spans(points: Sequence[DesignRecord], objectives: Sequence[str]) -> dict[str, float]:
     """Each objective's span over ``points`` [%].
 
     That is (largest - smallest) / |best|, best the value the front optimises toward (the smallest, or the
@@ -38,7 +40,7 @@ def objective_spans(points: Sequence[Mapping[str, Any]], objectives: Sequence[st
     return spans
 
 
-def front_sentences(pareto: Mapping[str, Any]) -> list[str]:
+def front_sentences(pareto: ParetoRecord) -> list[str]:
     """The front's ranges and spans, and a plain sentence when it is flat or degenerate.
 
     Flat: an objective spans less than :data:`FLAT_SPAN`; degenerate: one point (every repeat merged), or every
@@ -80,9 +82,7 @@ def front_sentences(pareto: Mapping[str, Any]) -> list[str]:
     return lines
 
 
-def flat_impulse_reason(
-    pareto: Mapping[str, Any], record: Mapping[str, Any], resolved: Mapping[str, Any]
-) -> list[str]:
+def flat_impulse_reason(pareto: ParetoRecord, record: DesignRecord, resolved: Mapping[str, Any]) -> list[str]:
     """Why an impulse objective is flat over the front, with the recommended design's impulse phases.
 
     The impact phase ``m_f v0`` is the links' (and, with ``reflected_inertia_in: finger``, the rotors'); the
@@ -127,7 +127,7 @@ def flat_impulse_reason(
     ]
 
 
-def lightest_near_best(pareto: Mapping[str, Any], within: float = NEAR_BEST) -> tuple[int, str] | None:
+def lightest_near_best(pareto: ParetoRecord, within: float = NEAR_BEST) -> tuple[int, str] | None:
     """The lightest front design within ``within`` (relative) of the best impulse, and its sentence.
 
     None when the front does not trade an impulse objective against the actuator mass, or is one design.
@@ -149,9 +149,7 @@ def lightest_near_best(pareto: Mapping[str, Any], within: float = NEAR_BEST) -> 
     )
 
 
-def front_verdict(
-    pareto: Mapping[str, Any], record: Mapping[str, Any], resolved: Mapping[str, Any]
-) -> list[str]:
+def front_verdict(pareto: ParetoRecord, record: DesignRecord, resolved: Mapping[str, Any]) -> list[str]:
     """The front in one sentence: its spans (or why it is flat or one design) and its lightest good design."""
     lines = front_sentences(pareto)
     reason = flat_impulse_reason(pareto, record, resolved)
@@ -160,7 +158,7 @@ def front_verdict(
     return [said] if said else []
 
 
-def transmission_choice_sentences(tried: Sequence[Mapping[str, Any]] | None) -> list[str]:
+def transmission_choice_sentences(tried: Sequence[TransmissionTried] | None) -> list[str]:
     """The transmission chosen among the study's gearbox options, in one sentence (the report's table has all)."""
     if not tried:
         return []
@@ -177,7 +175,7 @@ def transmission_choice_sentences(tried: Sequence[Mapping[str, Any]] | None) -> 
     runner_up = f"; the next best {general(min(others), 4)}" if others else ""
     return [
         f"Transmission: {where}, the best of {len(tried)} assignments of the gearbox options by the study's "
-        f"objective ({general(chosen['objective'], 4)}{runner_up})."
+        f"objective ({general(cast(float, chosen['objective']), 4)}{runner_up})."  # the chosen one has a design
     ]
 
 

@@ -5,10 +5,13 @@ from __future__ import annotations
 import math
 import re
 import statistics
+from collections.abc import Mapping
 from typing import Any
 
 from .. import __version__
 from ..plots import margin_text
+from ..record.design import DesignRecord, QuickSnap
+from ..record.run import ArmRunRecord, CatalogueJoint, CatalogueRecord, RunRecord, TransmissionTried
 from .assumptions import UNITS, assumption_rows
 from .certainty import domain_sentence, statistics_rows, worst_pose_sentence
 from .figures import has_duty_cycle
@@ -83,7 +86,7 @@ def gearbox_name(text: object) -> str:
     return "–" if not text else str(text).split(" (")[0]
 
 
-def _velocity_summary(record: dict[str, Any]) -> dict[str, float]:
+def _velocity_summary(record: DesignRecord) -> dict[str, float]:
     v_star = [v for v in record["optimal_velocity"] if math.isfinite(v)]
     v0 = record["approach_velocity"]
     return {
@@ -103,7 +106,7 @@ def _objective_units() -> dict[str, str]:
     return {name: unit for name, (_, unit, _) in OBJECTIVES.items()}
 
 
-def solved_by(record: dict[str, Any]) -> str:
+def solved_by(record: DesignRecord) -> str:
     """How a design record's solve treated the samples: ``full NLP: all 336 samples``, or an active set.
 
     ``active set: 72 of 4096 samples``, from its ``solver`` record's ``method`` and ``active_samples``; "–"
@@ -135,7 +138,7 @@ def whole_numbers(text: str) -> Any:
     )
 
 
-def render_html(results: dict[str, Any], rows: list[dict[str, Any]], svgs: dict[str, str]) -> str:
+def render_html(results: RunRecord, rows: list[dict[str, Any]], svgs: dict[str, str]) -> str:
     """The report page for a run's results; ``rows`` are the rows of ``pareto.csv``."""
     import jinja2
 
@@ -172,13 +175,14 @@ def render_html(results: dict[str, Any], rows: list[dict[str, Any]], svgs: dict[
     return template.render(**context)
 
 
-def _arm_context(results: dict[str, Any]) -> dict[str, Any]:
+def _arm_context(results: ArmRunRecord) -> dict[str, Any]:
     """What the arm report's sections show beside the record: sentences, table rows, the front's cards."""
     recommended = results.get("recommended") or results["chosen"]
     domain = results.get("domain")
-    worst = recommended.get("worst_case") or {}
-    kept = (worst.get("searched") or {}).get("domain_kept")
-    catalogue = results.get("catalogue") or {}
+    worst = recommended.get("worst_case")
+    search = worst["searched"] if worst else None
+    kept = search["domain_kept"] if search else None
+    catalogue = results.get("catalogue")
     return {
         # Redone from the record (the same function wrote designs.json's ``verdict``), so that a report
         # re-rendered from an edited designs.json says what its numbers say.
@@ -197,14 +201,14 @@ def _arm_context(results: dict[str, Any]) -> dict[str, Any]:
         **_front_table(results),
         **_transmission_table(results.get("transmission_choice")),
         "solved": _solved(results),
-        "part_sources": _part_sources(catalogue.get("joints") or []),
+        "part_sources": _part_sources(catalogue["joints"] if catalogue else []),
         **_tried_table(catalogue),
         "catalogue_modules": any(j.get("module") for j in recommended["joints"]),
         "front_cards": front_cards(results),
     }
 
 
-def _front_table(results: dict[str, Any]) -> dict[str, Any]:
+def _front_table(results: ArmRunRecord) -> dict[str, Any]:
     """The front's table: per design its objectives, actuator mass, threshold and approach velocity, and snap."""
     from ..optimize import OBJECTIVES  # lazy: casadi
 
@@ -214,10 +218,13 @@ def _front_table(results: dict[str, Any]) -> dict[str, Any]:
     columns = [f"{n.replace('_', ' ')} [{unit(OBJECTIVES[n][1])}]" for n in names] + [
         f"{key.replace('_', ' ')} [{unit(UNITS[key])}]" for key in extra
     ]
-    index = (results.get("recommended") or {}).get("pareto_index")
-    snaps = (results.get("catalogue") or {}).get("pareto") or []
+    recommended = results.get("recommended")
+    index = recommended.get("pareto_index") if recommended else None
+    catalogue = results.get("catalogue")
+    snaps = catalogue["pareto"] if catalogue else []
     rows = []
-    for i, point in enumerate(pareto["points"]):
+    points: list[Mapping[str, Any]] = list(pareto["points"])  # read by the columns' names
+    for i, point in enumerate(points):
         snap = snaps[i] if i < len(snaps) else None
         text, ok = _snap_text(snap)
         rows.append(
@@ -231,13 +238,13 @@ def _front_table(results: dict[str, Any]) -> dict[str, Any]:
     return {"front_columns": columns, "front_rows": rows}
 
 
-def _snap_text(snap: dict[str, Any] | None) -> tuple[str, bool]:
+def _snap_text(snap: QuickSnap | None) -> tuple[str, bool]:
     """A Pareto design's quick catalogue snap in a few words, and whether it meets the requirements."""
     if not snap:
         return "–", True
     if snap.get("missing"):
         return "no part within bounds for " + ", ".join(m["joint"] for m in snap["missing"]), False
-    said = ", ".join(dict.fromkeys(snap["parts"]))
+    said = ", ".join(dict.fromkeys(str(part) for part in snap["parts"]))  # every joint has a part
     if snap["feasible"]:
         return said, True
     shortfalls = list(snap["shortfalls"])
@@ -245,7 +252,7 @@ def _snap_text(snap: dict[str, Any] | None) -> tuple[str, bool]:
     return f"{said}; misses {shortfalls[0]}{more}", False
 
 
-def _transmission_table(tried: list[dict[str, Any]] | None) -> dict[str, Any]:
+def _transmission_table(tried: list[TransmissionTried] | None) -> dict[str, Any]:
     """Each assignment of the gearbox options tried: the option per group of joints, objective, mass."""
     if not tried:
         return {"transmission_groups": [], "transmission_rows": []}
@@ -264,11 +271,12 @@ def _transmission_table(tried: list[dict[str, Any]] | None) -> dict[str, Any]:
     return {"transmission_groups": [group_name(g.split(", ")) for g in groups], "transmission_rows": rows}
 
 
-def _solved(results: dict[str, Any]) -> list[tuple[str, dict[str, Any]]]:
+def _solved(results: ArmRunRecord) -> list[tuple[str, DesignRecord]]:
     """The designs of the solver table: the single-objective optimum, each Pareto design, the catalogue design."""
     solved = [("single-objective optimum", results["chosen"])]
     solved += [(f"Pareto {i}", point) for i, point in enumerate(results["pareto"]["points"])]
-    design = (results.get("catalogue") or {}).get("design")
+    catalogue = results.get("catalogue")
+    design = catalogue["design"] if catalogue else None
     if design is not None:
         solved.append(("catalogue design", design))
     return solved
@@ -278,10 +286,10 @@ TRIED_SHOWN = 5
 """How many catalogue combinations the report lists, best first (``designs.json`` keeps every one)."""
 
 
-def _tried_table(catalogue: dict[str, Any]) -> dict[str, Any]:
+def _tried_table(catalogue: CatalogueRecord | None) -> dict[str, Any]:
     """The catalogue combinations re-solved, best first: a column per group of joints that always share parts."""
-    tried = catalogue.get("tried") or []
-    joints = [j["joint"] for j in catalogue.get("joints") or []]
+    tried = catalogue["tried"] if catalogue else []
+    joints = [j["joint"] for j in catalogue["joints"]] if catalogue else []
     if not tried or not joints:
         return {"tried_groups": [], "tried_rows": [], "tried_count": 0}
     groups: list[list[int]] = []
@@ -315,7 +323,7 @@ def _why_not(status: str) -> str:
     return first + (")" if "(" in first and not first.endswith(")") else "")
 
 
-def _part_sources(joints: list[dict[str, Any]]) -> list[tuple[str, str]]:
+def _part_sources(joints: list[CatalogueJoint]) -> list[tuple[str, str]]:
     """Each catalogue part's source once, with its estimates (a part on several joints is cited once)."""
     sources: dict[str, str] = {}
     for joint in joints:

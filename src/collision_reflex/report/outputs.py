@@ -21,14 +21,15 @@ from typing import Any, TypeVar
 from .._interrupt import interruptible
 from .._io import atomic_open
 from ..errors import CollisionReflexError
+from ..record.checked import ResultsDamaged
+from ..record.read import read_run_record
+from ..record.run import ActuatorRunRecord, RunRecord
 from .figures import draw_figures
 from .files import (
     DESIGNS,
     PARETO,
     REPORT,
     TIMINGS,
-    ResultsDamaged,
-    ResultsMissing,
     read_json,
     write_json,
     write_text,
@@ -37,7 +38,7 @@ from .html import render_html
 from .pdf import html_to_pdf
 
 
-def pareto_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
+def pareto_rows(results: RunRecord) -> list[dict[str, Any]]:
     """The rows of ``pareto.csv``.
 
     One row per Pareto design (arm studies; the chosen design if there is no front) or per candidate actuator
@@ -53,7 +54,7 @@ def pareto_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
     return [{k: v for k, v in row.items() if k.split(" [")[0] not in TIMING_KEYS} for row in rows]
 
 
-def _actuator_rows(results: dict[str, Any]) -> list[dict[str, Any]]:
+def _actuator_rows(results: ActuatorRunRecord) -> list[dict[str, Any]]:
     candidates = results["candidates"]
     rows = []
     for candidate in candidates:
@@ -120,7 +121,7 @@ class StageTimes:
 
 def write_outputs(
     folder: str | os.PathLike[str],
-    results: dict[str, Any],
+    results: RunRecord,
     figures: bool = True,
     stages: StageTimes | None = None,
 ) -> Path:
@@ -224,7 +225,7 @@ def _unknown_timings(data: Any) -> None:
 
 def render_report(
     folder: str | os.PathLike[str],
-    results: dict[str, Any] | None = None,
+    results: RunRecord | None = None,
     figures: bool = True,
     stages: StageTimes | None = None,
 ) -> Path:
@@ -276,29 +277,18 @@ def render_report(
     return folder / REPORT
 
 
-def _read_results(folder: Path) -> dict[str, Any]:
-    """The results saved in ``folder`` (``designs.json`` with ``timings.json``'s times)."""
-    path = folder / DESIGNS
-    if not path.exists():
-        raise ResultsMissing(f"{folder} has no {DESIGNS}: run the study first (crx run STUDY --out {folder})")
+def _read_results(folder: Path) -> RunRecord:
+    """The results saved in ``folder``: ``designs.json``, checked against its type, with ``timings.json``'s times."""
+    results = read_run_record(folder / DESIGNS)
+    timings_path = folder / TIMINGS
     try:
-        results = read_json(path)
-        timings = read_json(folder / TIMINGS) if (folder / TIMINGS).exists() else {}
+        timings = read_json(timings_path) if timings_path.exists() else {}
     except ValueError as error:
-        raise ResultsMissing(f"{path} cannot be read ({error}); run the study again") from None
-    if not isinstance(results, dict) or results.get("kind") not in REPORT_KINDS:
-        kind = results.get("kind") if isinstance(results, dict) else None
-        raise ResultsDamaged(
-            f"{path}: field 'kind' is {kind!r}, expected one of {', '.join(REPORT_KINDS)}; run the study again"
-        )
-    return dict(with_timings(results, timings if isinstance(timings, dict) else {}))
+        raise ResultsDamaged(f"{timings_path} cannot be read ({error}); run the study again") from None
+    return with_timings(results, timings if isinstance(timings, dict) else {})
 
 
-REPORT_KINDS = ("arm", "actuator")
-"""The kinds of results the report knows (one template each)."""
-
-
-def _figures(folder: Path, results: dict[str, Any], figures: bool) -> dict[str, str]:
+def _figures(folder: Path, results: RunRecord, figures: bool) -> dict[str, str]:
     return (
         draw_figures(folder / "figures", results, results["resolved"]["outputs"]["figures"])
         if figures

@@ -10,6 +10,8 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any, Literal
 
+from ..record.design import DesignRecord, JointRecord
+from ..record.run import Bounds
 from .wording import general, group_name, grouped, words
 
 ACTIVE_TOLERANCE = 1e-3
@@ -20,7 +22,11 @@ OVERSIZED_MARGIN = 2.0
 """Peak-torque margin above which a joint is oversized (more than 3x its requirement) unless its motor is at its
 smallest size."""
 
-MARGINS = (("torque_margin", "peak torque"), ("rms_margin", "RMS torque"), ("speed_margin", "speed"))
+MARGINS: tuple[tuple[Literal["torque_margin", "rms_margin", "speed_margin"], str], ...] = (
+    ("torque_margin", "peak torque"),
+    ("rms_margin", "RMS torque"),
+    ("speed_margin", "speed"),
+)
 """Per-joint margins of a design record (``peak / required - 1``) and the constraint each belongs to; a margin
 absent or ``None`` means the design has no such requirement."""
 
@@ -43,7 +49,7 @@ def bound_position(value: float, bounds: Sequence[float]) -> Position:
     return None
 
 
-def motor_at_smallest_size(joint: Mapping[str, Any], bounds: Mapping[str, Any]) -> bool:
+def motor_at_smallest_size(joint: JointRecord, bounds: Bounds) -> bool:
     """Whether a joint's motor is at its smallest size.
 
     Stator diameter and stack length each at their lower bounds or fixed, and at least one of them a design
@@ -55,7 +61,7 @@ def motor_at_smallest_size(joint: Mapping[str, Any], bounds: Mapping[str, Any]) 
 
 
 def smallest_motor_excess(
-    joint: Mapping[str, Any], ratio_bounds: Sequence[float], multiple: float, chosen_ratio: bool = True
+    joint: JointRecord, ratio_bounds: Sequence[float], multiple: float, chosen_ratio: bool = True
 ) -> str:
     """Why a joint at its smallest motor has ``multiple`` times its required peak torque, in words.
 
@@ -106,10 +112,10 @@ def requirement_sentence(requirement: str, rating: Mapping[str, Any] | None = No
     return f"Requirement: {requirement}."
 
 
-def sized_by_sentences(record: Mapping[str, Any], requirement: str) -> list[str]:
+def sized_by_sentences(record: DesignRecord, requirement: str) -> list[str]:
     """What sizes each joint (or module): the requirement whose constraint is active, in one sentence."""
 
-    def active(joint: Mapping[str, Any]) -> str:
+    def active(joint: JointRecord) -> str:
         said = []
         for key, constraint in MARGINS:
             margin = joint.get(key)
@@ -132,7 +138,7 @@ def sized_by_sentences(record: Mapping[str, Any], requirement: str) -> list[str]
     return [f"Sized by ({requirement}): {grouped(sized, active)}."]
 
 
-def bound_sentences(record: Mapping[str, Any], bounds: Mapping[str, Any]) -> list[str]:
+def bound_sentences(record: DesignRecord, bounds: Bounds) -> list[str]:
     """What the study's design bounds decide, and what no objective decides: a sentence each."""
     undecided = list(record.get("undecided", ()))
     held: dict[str, list[str]] = {}  # what holds a variable -> the joints it holds, in joint order
@@ -175,7 +181,7 @@ def bound_sentences(record: Mapping[str, Any], bounds: Mapping[str, Any]) -> lis
     return lines
 
 
-def design_limits_at_bound(record: Mapping[str, Any], bounds: Mapping[str, Any]) -> list[str]:
+def design_limits_at_bound(record: DesignRecord, bounds: Bounds) -> list[str]:
     """The threshold and approach velocity where a bound holds them (undecided ones are said elsewhere)."""
     undecided = {entry["variable"] for entry in record.get("undecided", ()) if entry["joint"] is None}
     units = {"threshold": " N" if record.get("sensing") == "force" else " m", "approach_velocity": " m/s"}
@@ -187,7 +193,7 @@ def design_limits_at_bound(record: Mapping[str, Any], bounds: Mapping[str, Any])
     ]
 
 
-def oversized_warnings(record: Mapping[str, Any], bounds: Mapping[str, Any]) -> list[str]:
+def oversized_warnings(record: DesignRecord, bounds: Bounds) -> list[str]:
     """A warning for each oversized joint.
 
     Oversized: a peak-torque margin above :data:`OVERSIZED_MARGIN` while its motor could be smaller (not at its

@@ -12,9 +12,11 @@ records of :func:`collision_reflex.optimize.results.design_record` and the resul
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
-from typing import Any
+from collections.abc import Sequence
+from typing import cast
 
+from ..record.design import DesignRecord, JointRecord
+from ..record.run import ArmRunRecord, Bounds, CatalogueJoint, CatalogueRecord
 from .certainty import certainty_sentences, statistics_warnings, study_objectives
 from .front_verdict import front_verdict, transmission_choice_sentences
 from .sizing import bound_sentences, oversized_warnings, sized_by_sentences
@@ -24,7 +26,7 @@ MAX_LINES = 10
 """The verdict's length: what to build, how sure, what sizes it, what the bounds decide, the front, warnings."""
 
 
-def verdict(results: Mapping[str, Any]) -> list[str]:
+def verdict(results: ArmRunRecord) -> list[str]:
     """The verdict of an arm study's results (:func:`collision_reflex.study.arm_results.arm_results`).
 
     At most :data:`MAX_LINES` sentences, each said once: the design to build, the continuous optimum it comes
@@ -51,7 +53,7 @@ def verdict(results: Mapping[str, Any]) -> list[str]:
     return lines + warnings
 
 
-def _sensing(record: Mapping[str, Any]) -> str:
+def _sensing(record: DesignRecord) -> str:
     unit = "N" if record["sensing"] == "force" else "m (position error)"
     return (
         f"threshold {general(record['threshold'])} {unit}, approach velocity "
@@ -59,17 +61,18 @@ def _sensing(record: Mapping[str, Any]) -> str:
     )
 
 
-def _motor(joint: Mapping[str, Any]) -> str:
+def _motor(joint: JointRecord) -> str:
     return (
         f"{general(joint['stator_diameter'] * 1e3, 3)} mm × {general(joint['stack_length'] * 1e3, 3)} mm "
         f"motor at N = {general(joint['gear_ratio'])}"
     )
 
 
-def build_sentences(recommended: Mapping[str, Any], catalogue: Mapping[str, Any] | None) -> list[str]:
+def build_sentences(recommended: DesignRecord, catalogue: CatalogueRecord | None) -> list[str]:
     """What to build: the catalogue design when there is one, then the continuous optimum it was snapped from."""
     objectives = recommended["objectives"]
-    worst = (recommended.get("worst_case") or {}).get("domain", objectives.get("worst_case_impulse"))
+    worst_case = recommended.get("worst_case")
+    worst = worst_case["domain"] if worst_case else objectives.get("worst_case_impulse")
     figures = ", ".join(
         f"{name} {general(value)} {unit}"
         for name, value, unit in (
@@ -83,19 +86,19 @@ def build_sentences(recommended: Mapping[str, Any], catalogue: Mapping[str, Any]
     continuous = f"{grouped(recommended['joints'], _motor)}; {_sensing(recommended)} ({figures})"
     if catalogue is None:
         return [f"Build: the continuous optimum ({source}): {continuous}. Its motors are scaled, not sold."]
-    if catalogue.get("design") is None:
+    design = catalogue["design"]
+    if design is None:
         return [
             f"No design built from catalogue parts meets the requirements: the continuous optimum ({source}) is "
             f"the best design, with scaled motors: {continuous}."
         ]
-    design = catalogue["design"]
     undecided = {e["joint"] for e in design.get("undecided", ()) if e["variable"] == "gear_ratio"}
 
-    def part(joint: Mapping[str, Any]) -> str:
+    def part(joint: CatalogueJoint) -> str:
         return (
             f"{joint['motor']}"
             + (f" + {joint['gearbox']}" if joint["gearbox"] else "")
-            + f" at N = {general(joint['gear_ratio'])}"
+            + f" at N = {general(cast(float, joint['gear_ratio']))}"  # every joint has a part
             + (" (a ratio no objective decides: the solver's start)" if joint["joint"] in undecided else "")
         )
 
@@ -114,10 +117,10 @@ def build_sentences(recommended: Mapping[str, Any], catalogue: Mapping[str, Any]
 
 
 def verdict_warnings(
-    results: Mapping[str, Any],
-    record: Mapping[str, Any],
-    bounds: Mapping[str, Any] | None,
-    catalogue: Mapping[str, Any] | None,
+    results: ArmRunRecord,
+    record: DesignRecord,
+    bounds: Bounds | None,
+    catalogue: CatalogueRecord | None,
 ) -> list[str]:
     """Every warning of the verdict: oversized joints, uncertain statistics, Pareto designs the checks fail."""
     warnings = oversized_warnings(record, bounds) if bounds is not None else []
@@ -125,8 +128,8 @@ def verdict_warnings(
     warnings += statistics_warnings(record, results.get("resolved") or {}, pareto)
     uncertified = [
         str(point.get("label", i))
-        for i, point in enumerate(pareto.get("points", ()))
-        if (point.get("worst_case") or {}).get("searched") and not point["worst_case"]["certified"]
+        for i, point in enumerate(pareto["points"])
+        if (worst := point.get("worst_case")) and worst["searched"] and not worst["certified"]
     ]
     if uncertified:
         warnings.append(

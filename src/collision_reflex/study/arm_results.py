@@ -9,7 +9,7 @@ also holds its torque-speed data (``recommended.torque_speed``, :func:`torque_sp
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any, NotRequired, TypedDict
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -21,6 +21,15 @@ from ..optimize.recommend import recommend
 from ..optimize.results import design_record, undecided_variables
 from ..optimize.space import GLOBAL_VARIABLES, PER_JOINT_VARIABLES
 from ..optimize.worst_case import SEARCH_TOLERANCE, WorstCase
+from ..record.design import (
+    DesignRecord,
+    FreshRecord,
+    JointTorqueSpeed,
+    UndecidedVariable,
+    WorstCaseRecord,
+    WorstPose,
+)
+from ..record.run import ArmResults, Bounds, CatalogueRecord, DomainRecord, ParetoRecord, SampleLayout
 from .arm_setup import ArmSetup
 from .fresh import FreshImpulses, fresh_draw, fresh_impulses, fresh_record
 from .problems import StudyProblems
@@ -32,96 +41,6 @@ if TYPE_CHECKING:
 
 SAVED_DIGITS = 7
 """Significant digits of the saved torque-speed data: compact, and within 5e-7 relative of the computed points."""
-
-
-class ParetoRecord(TypedDict):
-    """The Pareto front as plain data: objective names, designs on the front, failed points, dominated designs.
-
-    Each design is a :func:`collision_reflex.optimize.results.design_record`; each failure a
-    :meth:`collision_reflex.optimize.results.PointFailure.as_dict`; ``merged``: solved points dropped as
-    repeats of a reported one (objectives equal within the solver tolerance).
-    """
-
-    objectives: list[str]
-    points: list[dict[str, Any]]
-    failed: list[dict[str, Any]]
-    dominated: list[dict[str, Any]]
-    merged: int
-
-
-class ArmResults(TypedDict):
-    """An arm study's own part of ``designs.json``.
-
-    The samples and the contact domain they were drawn in, the chosen and recommended designs, the Pareto
-    front, the bounds of the design variables
-    (``{variable: {joint: [lower, upper]}}`` and ``{threshold|approach_velocity: [lower, upper]}``, SI units)
-    the kind of torque requirement (:attr:`collision_reflex.optimize.Constraints.requirement`), with a duty
-    cycle or a rated motion where the motors' speed limits come from, and what the transmissions are
-    (:func:`transmissions`).
-    """
-
-    samples: SampleLayout
-    domain: dict[str, Any]
-    chosen: dict[str, Any]
-    recommended: dict[str, Any]
-    pareto: ParetoRecord
-    bounds: dict[str, Any]
-    requirement: str
-    speed_limits: str | None
-    transmissions: list[str]
-    catalogue: NotRequired[CatalogueRecord]
-
-
-class CatalogueRecord(TypedDict):
-    """The catalogue snap of a study as plain data (``designs.json``: ``catalogue``).
-
-    ``key``: a digest of the catalogue file and the snap settings, and of the searched samples when there are
-    any (a resumed run reuses a saved snap only with the same key); ``snapped``: which design was snapped
-    (``optimum`` or ``Pareto design <i>``); ``method``: how the answer was found; ``joints``: per joint the chosen part and its provenance, the candidates, and the
-    nearest part with what it misses when none is within bounds; ``objectives``, ``continuous_objectives``,
-    ``difference`` (catalogue minus continuous), ``relative_difference`` (over the continuous value; None where
-    that is zero) [each objective's unit]; ``design``: the catalogue design's record (with its ``undecided``
-    design variables, as the recommended design's), None when none was found;
-    ``tried``: every combination re-solved; ``pareto``: the quick snap of every Pareto design (the chosen
-    design's without a front), see :func:`.catalogue_snap.quick_snap_record`; ``solve_time``: the snap's wall time [s] (in
-    ``timings.json``, not ``designs.json``).
-    """
-
-    key: str
-    snapped: str
-    method: str
-    candidates: int
-    max_combinations: int
-    warnings: list[str]
-    joints: list[dict[str, Any]]
-    objectives: dict[str, float]
-    continuous_objectives: dict[str, float]
-    difference: dict[str, float]
-    relative_difference: dict[str, float | None]
-    design: dict[str, Any] | None
-    tried: list[dict[str, Any]]
-    pareto: list[dict[str, Any]]
-    solve_time: float
-
-
-class JointTorqueSpeed(TypedDict):
-    """One joint's saved torque-speed data, motor side, named as :class:`~collision_reflex.plots.torque_speed.JointOperatingPoints`'s fields.
-
-    ``speed`` [rad/s] and ``torque`` [N*m]: the duty cycle's motor speed ``N qd(t)`` and torque ``d(t) / N``
-    (signed, no safety factor); ``approach_speed`` [rad/s]: the approach's motor speed at each contact sample;
-    the envelope ``peak_torque`` and ``continuous_torque`` [N*m] and ``max_speed`` [rad/s] (None when the
-    catalogue gives none); ``rms_torque`` [N*m]: the cycle's RMS motor torque. Rounded to
-    :data:`SAVED_DIGITS` significant digits.
-    """
-
-    joint: str
-    speed: list[float]
-    torque: list[float]
-    approach_speed: list[float]
-    peak_torque: float
-    continuous_torque: float
-    max_speed: float | None
-    rms_torque: float
 
 
 def _rounded(values: Any) -> list[float]:
@@ -166,7 +85,7 @@ def torque_speed_record(problem: DesignProblem, result: DesignResult) -> list[Jo
     return out
 
 
-def design_bounds(setup: ArmSetup) -> dict[str, Any]:
+def design_bounds(setup: ArmSetup) -> Bounds:
     """The bounds every design of the study was solved within, as plain data [SI units].
 
     The design space's, as the optimiser lays it out: a joint's gear ratio within its gearbox's ratios, the force
@@ -180,7 +99,7 @@ def design_bounds(setup: ArmSetup) -> dict[str, Any]:
     for name in GLOBAL_VARIABLES:
         one = layout.bounds[name][0]
         out[name] = [one.lower, one.upper]
-    return out
+    return cast("Bounds", out)  # the variables of PER_JOINT_VARIABLES and GLOBAL_VARIABLES
 
 
 def arm_results(
@@ -274,18 +193,18 @@ class _Records:
 
     def fresh_check(
         self, result: DesignResult, worst_case: float, statistics: bool = False
-    ) -> dict[str, Any] | None:
+    ) -> FreshRecord | None:
         """What the fresh samples say of ``result`` (None without fresh samples)."""
         if self.draw is None:
             return None
         found = self.fresh.get(id(result)) or fresh_impulses(self.setup, self.draw, [result.design])[0]
-        return fresh_record(found, worst_case, self.tolerance, statistics)
+        return cast("FreshRecord", fresh_record(found, worst_case, self.tolerance, statistics))
 
-    def record(self, result: DesignResult, label: str) -> dict[str, Any]:
+    def record(self, result: DesignResult, label: str) -> DesignRecord:
         """The record of the design ``label``."""
         out = design_record(self.problem, result, label, self.setup.catalogue)
         search = self.searches.get(label)
-        out["worst_case"] = worst_case_record(result, search, self.tolerance)
+        out["worst_case"] = cast("WorstCaseRecord", worst_case_record(result, search, self.tolerance))
         if search is not None:
             out["worst_case"]["pose"] = worst_pose(self.setup, search.q, search.direction)
         out["fresh"] = self.fresh_check(result, out["worst_case"]["domain"])
@@ -299,23 +218,21 @@ def _recommended(
     chosen: DesignResult,
     front: ParetoSet | None,
     pareto: ParetoRecord,
-    chosen_record: dict[str, Any],
-) -> dict[str, Any]:
+    chosen_record: DesignRecord,
+) -> DesignRecord:
     """The recommended design's record: the Pareto design's or the chosen one's, with why and what it leaves."""
     recommendation = recommend(chosen, front, problems.objective)
-    recommended = (
-        dict(pareto["points"][recommendation.pareto_index])
-        if recommendation.pareto_index is not None
-        else {k: v for k, v in chosen_record.items() if k != "dominated_by"}
-    )
-    recommended.update(
-        source=recommendation.source,
-        pareto_index=recommendation.pareto_index,
-        reason=recommendation.reason,
-        undecided=undecided(problems, problem, recommendation.result),
-        fresh=records.fresh_check(
-            recommendation.result, recommended["worst_case"]["domain"], statistics=True
-        ),
+    if recommendation.pareto_index is not None:
+        recommended = pareto["points"][recommendation.pareto_index].copy()
+    else:
+        recommended = chosen_record.copy()
+        del recommended["dominated_by"]
+    recommended["source"] = recommendation.source
+    recommended["pareto_index"] = recommendation.pareto_index
+    recommended["reason"] = recommendation.reason
+    recommended["undecided"] = undecided(problems, problem, recommendation.result)
+    recommended["fresh"] = records.fresh_check(
+        recommendation.result, recommended["worst_case"]["domain"], statistics=True
     )
     torque_speed = torque_speed_record(problem, recommendation.result)
     if torque_speed is not None:
@@ -323,7 +240,7 @@ def _recommended(
     return recommended
 
 
-def worst_pose(setup: ArmSetup, q: np.ndarray, direction: np.ndarray) -> dict[str, Any]:
+def worst_pose(setup: ArmSetup, q: np.ndarray, direction: np.ndarray) -> WorstPose:
     """Where a worst case occurs, for the report's drawing.
 
     The joints' and the contact point's world positions [m] at configuration ``q``, and the contact direction
@@ -344,7 +261,7 @@ def worst_pose(setup: ArmSetup, q: np.ndarray, direction: np.ndarray) -> dict[st
     }
 
 
-def domain_record(problems: StudyProblems) -> dict[str, Any]:
+def domain_record(problems: StudyProblems) -> DomainRecord:
     """The study's contact domain as plain data: its settings, how much of the box it keeps, searched samples.
 
     ``kept`` is the fraction of the joint-limit box's (configuration, direction) pairs inside the domain at
@@ -353,16 +270,19 @@ def domain_record(problems: StudyProblems) -> dict[str, Any]:
     problems took them, ``[q, u]`` each (:meth:`~.problems.StudyProblems.of_run` reads them back).
     """
     setup = problems.setup
-    return {
+    domain = {
         **setup.domain.to_json(),
         "kept": setup.domain_kept,
         "sampling_velocity": setup.sampling_velocity,
         "searched_samples": setup.searched,
         "searched": [[list(q), list(u)] for q, u in problems.extra],
     }
+    return cast("DomainRecord", domain)  # the domain's own fields, as ContactDomain.to_json writes them
 
 
-def undecided(problems: StudyProblems, problem: DesignProblem, result: DesignResult) -> list[dict[str, Any]]:
+def undecided(
+    problems: StudyProblems, problem: DesignProblem, result: DesignResult
+) -> list[UndecidedVariable]:
     """The design variables of ``result`` (a solution of ``problem``) that no objective decides, as plain data.
 
     ``{"variable", "joint"}`` each, the joint's name, None for a global variable
@@ -373,22 +293,6 @@ def undecided(problems: StudyProblems, problem: DesignProblem, result: DesignRes
         {"variable": name, "joint": None if joint is None else names[joint]}
         for name, joint in undecided_variables(problem, result.x)
     ]
-
-
-class SampleLayout(TypedDict):
-    """Where each contact sample comes from, as plain data (``designs.json``: ``samples``).
-
-    ``configurations`` are joint positions [rad] (one row per configuration), ``directions`` unit contact
-    directions; sample ``i`` is configuration ``config_index[i]`` hit along ``sample_directions[i]``.
-    ``task_dim`` is the task-space dimension (2 for a planar arm, 3 otherwise).
-    """
-
-    configurations: list[list[float]]
-    directions: list[list[float]]
-    config_index: list[int]
-    sample_directions: list[list[float]]
-    joint_names: list[str]
-    task_dim: int
 
 
 def sample_layout(setup: ArmSetup) -> SampleLayout:

@@ -13,7 +13,7 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import Executor
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, TypedDict
 
 from ..hardware.catalogue import packaged_catalogue_path, read_entries
 from ..hardware.gearboxes import load_gearbox_catalogue
@@ -26,7 +26,9 @@ from ..optimize.parts import catalogue_problem, evaluate_parts, quick_parts
 from ..optimize.pieces import built_problem
 from ..optimize.recommend import recommend
 from ..optimize.results import design_record
-from .arm_results import CatalogueRecord, undecided
+from ..record.design import MissingPart, QuickSnap
+from ..record.run import CatalogueJoint, CatalogueRecord
+from .arm_results import undecided
 from .load import LoadedStudy
 from .problems import IPOPT_OPTIONS, StudyProblems
 from .schema import ArmStudy
@@ -211,7 +213,7 @@ def solve_study_parts(
         )
 
 
-def _joint_record(snap: CatalogueDesign, j: int, catalogue: SnapCatalogue) -> dict[str, Any]:
+def _joint_record(snap: CatalogueDesign, j: int, catalogue: SnapCatalogue) -> CatalogueJoint:
     """Joint ``j`` of a catalogue snap as plain data: its part and provenance, next to the continuous design."""
     candidates = snap.joints[j]
     part = snap.parts[j] if snap.parts is not None else None
@@ -231,6 +233,7 @@ def _joint_record(snap: CatalogueDesign, j: int, catalogue: SnapCatalogue) -> di
         "continuous_gear_ratio": float(continuous.gear_ratio[j]),
         "stator_diameter": None if part is None else part.motor.stator_diameter,
         "continuous_stator_diameter": float(continuous.stator_diameter[j]),
+        "source": None if part is None else part.motor.source,
         **_provenance(part, catalogue),
         "candidates": [p.label for p in candidates.parts],
         "nearest": candidates.nearest,
@@ -239,9 +242,7 @@ def _joint_record(snap: CatalogueDesign, j: int, catalogue: SnapCatalogue) -> di
     }
 
 
-def quick_snap_record(
-    problem: DesignProblem, result: DesignResult, catalogue: SnapCatalogue
-) -> dict[str, Any]:
+def quick_snap_record(problem: DesignProblem, result: DesignResult, catalogue: SnapCatalogue) -> QuickSnap:
     """A design's quick catalogue snap: the nearest candidate per joint, evaluated without a re-solve.
 
     Each joint's nearest part within bounds (:func:`collision_reflex.optimize.parts.quick_parts`) at the
@@ -256,11 +257,11 @@ def quick_snap_record(
     joints = joint_candidates(
         problem, result, catalogue.motors, 1, catalogue.gearboxes or None, 1, screen=False
     )
-    missing = [
+    missing: list[MissingPart] = [
         {"joint": j.joint, "nearest": j.nearest, "misses": list(j.misses)} for j in joints if not j.parts
     ]
     parts = quick_parts(joints, result.design)
-    record: dict[str, Any] = {
+    record: QuickSnap = {
         "parts": [j.parts[0].label if j.parts else None for j in joints]
         if parts is None
         else [p.label for p in parts],
@@ -276,26 +277,30 @@ def quick_snap_record(
     evaluated = evaluate_parts(problem, result.design, parts)
     continuous = result.numpy_objectives
     difference = {k: v - continuous[k] for k, v in evaluated.objectives.items()}
-    record.update(
-        feasible=evaluated.feasible,
-        shortfalls=list(evaluated.shortfalls),
-        objectives=evaluated.objectives,
-        difference=difference,
-        relative_difference={
-            k: _finite(d / continuous[k]) if continuous[k] != 0 else None for k, d in difference.items()
-        },
-    )
+    record["feasible"] = evaluated.feasible
+    record["shortfalls"] = list(evaluated.shortfalls)
+    record["objectives"] = evaluated.objectives
+    record["difference"] = difference
+    record["relative_difference"] = {
+        k: _finite(d / continuous[k]) if continuous[k] != 0 else None for k, d in difference.items()
+    }
     return record
 
 
-def _provenance(part: CataloguePart | None, catalogue: SnapCatalogue) -> dict[str, Any]:
-    """A part's ``source`` (its entry's), the fields with another ``sources``, and its ``estimates`` (methods)."""
+class _Provenance(TypedDict):
+    """A part's fields with a source other than its entry's (``sources``), and its estimated ones (methods)."""
+
+    sources: dict[str, str]
+    estimates: dict[str, str]
+
+
+def _provenance(part: CataloguePart | None, catalogue: SnapCatalogue) -> _Provenance:
+    """A part's fields with another source than its entry's ``sources``, and its ``estimates`` (methods)."""
     if part is None:
-        return {"source": None, "sources": {}, "estimates": {}}
+        return {"sources": {}, "estimates": {}}
     fields = catalogue.provenance.get(part.motor.name, {})
     default = f"source: {part.motor.source}"
     return {
-        "source": part.motor.source,
         "sources": {
             k: v.removeprefix("source: ")
             for k, v in fields.items()

@@ -21,7 +21,7 @@ from typing import Any
 
 from .._io import remove_temporary_files
 from ..errors import CollisionReflexError
-from ..report.files import DESIGNS, PARETO, REPORT, ResultsMissing, read_json, write_json, write_text
+from ..report.files import DESIGNS, PARETO, REPORT, read_json, write_json, write_text
 
 MANIFEST = "run.json"
 RESOLVED = "study.resolved.yaml"
@@ -33,7 +33,6 @@ __all__ = [
     "RESOLVED",
     "OutputFolderInUse",
     "OutputFolderUnusable",
-    "ResultsMissing",
     "RunFolder",
     "read_json",
     "write_json",
