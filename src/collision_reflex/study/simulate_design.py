@@ -18,13 +18,14 @@ from __future__ import annotations
 
 import hashlib
 import math
-from typing import TYPE_CHECKING, Any, TypedDict
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..model.impulse import optimal_velocity
 from ..optimize.evaluate import design_collision_parameters, evaluate_design
 from ..optimize.pieces import built_problem
+from ..record.run import DesignSimulation, SimulatedSample
 from ..simulate.design_closed_form import JointDesign, arm_closed_form
 from ..simulate.validity import MAX_STEPS, available_detections, simulated_impulse
 
@@ -33,38 +34,6 @@ if TYPE_CHECKING:
     from .problems import StudyProblems
     from .run_specs import SimulateSpec
     from .store import RunFolder
-
-
-class SimulatedSample(TypedDict):
-    """One contact sample of a design, closed form beside simulation (SI units).
-
-    sample: its index among the study's samples; configuration: its configuration index; q [rad]; u: its unit
-    direction; approach_velocity [m/s] and its ratio to the sample's ``v*``; contact_stiffness [N/m] of the
-    simulated wall; closed_form and simulated impulses [N*s] (simulated None when the simulation was refused
-    or failed, ``error`` says why); difference ``I_sim / I_closed - 1``; valid: within the tolerance.
-    """
-
-    sample: int
-    configuration: int
-    q: list[float]
-    u: list[float]
-    approach_velocity: float
-    velocity_ratio: float
-    contact_stiffness: float
-    closed_form: float
-    simulated: float | None
-    difference: float | None
-    valid: bool
-    error: str
-
-
-class DesignSimulation(TypedDict):
-    """A design's simulated samples: which design, the detection scheme simulated, the tolerance, the rows."""
-
-    design: str
-    detection: str
-    tolerance: float
-    samples: list[SimulatedSample]
 
 
 def simulate_designs(
