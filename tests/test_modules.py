@@ -141,10 +141,3 @@ def test_a_modules_shared_variables_count_once_in_the_study_summary():
     counts = free_variables(study, 6, joints)
     # Two modules: one motor size and one gear ratio each; every joint its own software stiffness.
     assert (counts["stator_diameter"], counts["gear_ratio"], counts["software_stiffness"]) == (2, 2, 6)
-
-
-def test_the_study_layer_names_the_shared_variables_as_the_optimiser_does():
-    from collision_reflex.optimize.space import MODULE_VARIABLES
-    from collision_reflex.study.design_specs import MODULE_DESIGN_VARIABLES
-
-    assert MODULE_DESIGN_VARIABLES == MODULE_VARIABLES

@@ -158,17 +158,18 @@ def test_the_file_graph_sees_a_loop_kept_open_by_a_function_level_import(loop_pa
     assert find_cycle(file_import_graph(loop_package)) is None
 
 
-def _vocabularies() -> dict[str, frozenset[str]]:
+def _vocabularies() -> dict[str, tuple[str, ...]]:
+    """Every vocabulary: the same names in another order are another list (an argument order, say)."""
     from collision_reflex import vocabulary
 
     return {
-        name: frozenset(value)
+        name: value
         for name, value in vars(vocabulary).items()
         if name.isupper() and isinstance(value, tuple) and all(isinstance(v, str) for v in value)
     }
 
 
-def _string_sets(tree: ast.AST) -> list[tuple[int, frozenset[str]]]:
+def _string_sets(tree: ast.AST) -> list[tuple[int, tuple[str, ...]]]:
     """Every literal tuple, list, set or ``Literal[...]`` of two or more strings, with its line."""
     found = []
     for node in ast.walk(tree):
@@ -179,7 +180,7 @@ def _string_sets(tree: ast.AST) -> list[tuple[int, frozenset[str]]]:
             elements = node.slice.elts if isinstance(node.slice, ast.Tuple) else [node.slice]
         if elements and len(elements) >= 2:
             if all(isinstance(e, ast.Constant) and isinstance(e.value, str) for e in elements):
-                found.append((node.lineno, frozenset(e.value for e in elements)))
+                found.append((node.lineno, tuple(e.value for e in elements)))
     return found
 
 
@@ -213,7 +214,24 @@ def test_the_tables_keyed_by_a_vocabulary_cover_it_exactly():
 
 
 def test_the_vocabulary_check_finds_a_copy():
-    tree = ast.parse('KINDS = ("current", "force", "position")\nx: Literal["dask", "serial", "processes"]\n')
+    tree = ast.parse('KINDS = ("force", "position", "current")\nx: Literal["serial", "processes", "dask"]\n')
     vocabularies = _vocabularies()
     sets = [values for _, values in _string_sets(tree)]
     assert vocabularies["SENSING_SCHEMES"] in sets and vocabularies["EXECUTORS"] in sets
+
+
+def test_no_set_of_names_is_defined_in_two_modules():
+    # A module-level tuple, list or set of two or more strings written in two modules is a vocabulary: it
+    # belongs in collision_reflex/vocabulary.py, once.
+    where: dict[frozenset[str], list[str]] = {}  # the same names in any order
+    for path in _sources():
+        for node in ast.parse(path.read_text(encoding="utf-8")).body:
+            if isinstance(node, ast.Assign | ast.AnnAssign) and node.value is not None:
+                for line, values in _string_sets(node.value):
+                    where.setdefault(frozenset(values), []).append(f"{path.relative_to(PACKAGE)}:{line}")
+    twice = {
+        ", ".join(sorted(v)): places
+        for v, places in where.items()
+        if len({p.split(":")[0] for p in places}) > 1
+    }
+    assert not twice, f"sets of names defined in more than one module: {twice}"

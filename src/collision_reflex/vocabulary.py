@@ -50,6 +50,13 @@ Placement = Literal["robot", "finger"]
 behind the mechanical spring."""
 REFLECTED_INERTIA_PLACEMENTS: tuple[Placement, ...] = get_args(Placement)
 
+Retreat = Literal["along_u", "saturated"]
+"""The motors' push in an arm's reaction: ``"along_u"``, ``tau = -F_a J^T u`` with ``F_a = min_i tau_max,i /
+|(J^T u)_i|`` (each joint at most at its limit and the first at it: the closed form's reaction); ``"saturated"``,
+``tau_i = -tau_max,i sign((J^T u)_i)`` (every joint at its limit: a real controller's retreat, more force along
+``-u`` and a push off it)."""
+RETREATS: tuple[Retreat, ...] = get_args(Retreat)
+
 Drive = Literal["ideal", "impedance", "free"]
 """The 1D simulator's robot-side drive during the approach (:mod:`collision_reflex.simulate`)."""
 DRIVES: tuple[Drive, ...] = get_args(Drive)
@@ -62,3 +69,22 @@ CONTROLLED_DRIVES: tuple[ControlledDrive, ...] = get_args(ControlledDrive)
 ActiveSetMode = Literal["auto", "always", "never"]
 """Whether the optimiser solves on an active set of samples: by sample count, always, or never."""
 ACTIVE_SET_CHOICES: tuple[ActiveSetMode, ...] = get_args(ActiveSetMode)
+
+PerJointVariable = Literal["stator_diameter", "stack_length", "gear_ratio", "software_stiffness"]
+"""The design variables each joint has (the threshold and approach velocity are one for the arm)."""
+PER_JOINT_VARIABLES: tuple[PerJointVariable, ...] = get_args(PerJointVariable)
+
+ModuleVariable = Literal["stator_diameter", "stack_length", "gear_ratio"]
+"""The per-joint variables that make an actuator: the joints of one module share them."""
+MODULE_VARIABLES: tuple[ModuleVariable, ...] = get_args(ModuleVariable)
+
+GlobalVariable = Literal["threshold", "approach_velocity"]
+"""The design variables the whole arm shares."""
+GLOBAL_VARIABLES: tuple[GlobalVariable, ...] = get_args(GlobalVariable)
+
+ExportFormat = Literal["urdf", "mjcf"]
+"""The robot formats a design is exported to."""
+EXPORT_FORMATS: tuple[ExportFormat, ...] = get_args(ExportFormat)
+
+TIME_COLUMN_NAMES: tuple[str, ...] = ("time", "t")
+"""The names a CSV file's time column may have (force traces, duty cycles), compared without case."""

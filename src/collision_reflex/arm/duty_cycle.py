@@ -32,6 +32,7 @@ import numpy as np
 from .._table import HEADER, TableProblem, read_table
 from ..errors import InvalidParameter, TraceError, TrajectoryError
 from ..experiments.traces import unit_factor
+from ..vocabulary import TIME_COLUMN_NAMES
 from .motion_profiles import trapezoidal_motion
 
 SPLINE_ORDER = 5
@@ -40,7 +41,6 @@ MIN_SAMPLES = SPLINE_ORDER + 1
 """Fewest samples an interpolating spline of :data:`SPLINE_ORDER` needs."""
 COARSE_TOLERANCE = 0.1
 """Largest relative disagreement between the quintic's and a cubic's accelerations between samples."""
-_TIME_NAMES = ("time", "t")
 
 
 @dataclass(frozen=True, eq=False)
@@ -221,7 +221,7 @@ class DutyCycle:
         header_line, table = _read_table(path)
         columns = {HEADER.match(str(c)).group("name"): str(c) for c in table.columns}  # type: ignore[union-attr]
         lowered = {name.lower(): column for name, column in columns.items()}
-        time_column = next((lowered[n] for n in _TIME_NAMES if n in lowered), None)
+        time_column = next((lowered[n] for n in TIME_COLUMN_NAMES if n in lowered), None)
         if time_column is None:
             raise TrajectoryError(
                 source, f"no time column among {list(columns.values())}; name one 'time [s]'", header_line

@@ -265,9 +265,8 @@ def collision_impulses(
     threshold: ``F_s`` [N] for ``sensing="force"``, the tracking-error threshold [m] for ``"position"``;
         unused for ``"current"`` (the joint-side threshold torques were given to :func:`effective_parameters`
         as ``joint_threshold``, and the first joint to reach its threshold detects).
-    sensing: one of :data:`collision_reflex.model.sensing.SENSING_SCHEMES` (``"joint_torque"``: deprecated
-        spelling of ``"current"``).
-    reaction: ``"at_rest"`` (the paper's) or ``"moving"``, see :func:`collision_reflex.phase_impulses`.
+    sensing: one of :data:`collision_reflex.vocabulary.SENSING_SCHEMES`.
+    reaction: ``"at_rest"`` (the paper's) or ``"moving"``, see :func:`collision_reflex.model.phase_impulses`.
     """
     sensing = sensing_scheme(sensing)
     shape = params.shape

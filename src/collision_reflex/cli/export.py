@@ -4,13 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from ..vocabulary import EXPORT_FORMATS
 from . import options
-
-FORMATS = (
-    "urdf",
-    "mjcf",
-)  # as collision_reflex.export.FORMATS, kept here so that `crx --help` imports nothing
-
 
 _HELP = "write a run's design as URDF (motor masses, transmissions, limits) or MJCF (armature, motors)"
 _DESCRIPTION = """
@@ -35,7 +30,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="the Pareto design N (the point column of pareto.csv), the recommended design, or the chosen one "
         "(the single-objective optimum); default recommended",
     )
-    parser.add_argument("--format", choices=FORMATS, required=True, help="the robot format to write")
+    parser.add_argument("--format", choices=EXPORT_FORMATS, required=True, help="the robot format to write")
     options.add_out_file(parser, what="the robot model (.urdf or MJCF .xml)")
     parser.set_defaults(run=run)
 

@@ -4,7 +4,7 @@ Fitted: finger mass ``m_f`` [kg], software stiffness ``k_s`` [N/m], sensing thre
 acceleration ``a`` [m/s^2], the time of impact on the trace's clock [s], and (a nuisance parameter) a small
 offset of the noise floor, so that the floor's uncertainty reaches the parameters' uncertainties. Given: the mechanical (sensor)
 stiffness ``k_m`` (the paper: 2e7 N/m, the ATI Mini40's) and the pre-impact velocity ``v0`` (from the trial's
-metadata). The model is :func:`collision_reflex.force_profile` seen through the sensor
+metadata). The model is :func:`collision_reflex.model.force_profile` seen through the sensor
 (:func:`~collision_reflex.experiments.model_samples`: interval means, then the sensor's low-pass), so the fit
 compares like with like even when the impact pulse is shorter than one sample.
 
@@ -35,7 +35,7 @@ and a note, rather than the tiny one a pseudo-inverse would give by dropping tha
 residual is far above the noise floor (:data:`RESIDUAL_LIMIT`) gets a note as well: the model does not
 describe the trace, and its parameters are not to be trusted. Parameters are fitted as logarithms (positive by construction, well scaled); their
 uncertainties are mapped back to linear units to first order. Phase-impulse uncertainties are propagated
-through :func:`collision_reflex.phase_impulses` the same way.
+through :func:`collision_reflex.model.phase_impulses` the same way.
 """
 
 from __future__ import annotations

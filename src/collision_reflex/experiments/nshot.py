@@ -2,7 +2,7 @@
 
 The paper's "Effect of Actuator Selection"; ``fig:1d_experiment_nshot``.
 
-The model predicts ``A = m_f``, ``B = F_s^2 / (2 k)`` and ``C = I3`` (:func:`collision_reflex.velocity_coefficients`)
+The model predicts ``A = m_f``, ``B = F_s^2 / (2 k)`` and ``C = I3`` (:func:`collision_reflex.model.velocity_coefficients`)
 and the optimal approach velocity ``v* = sqrt(B / A)``, which equals ``F_s / sqrt(2 k m_f)`` (``eq:v_star``).
 The fit is linear in ``A, B, C``: weighted least squares with each impulse's uncertainty, with the physical
 bounds ``A, B, C >= 0`` (``scipy.optimize.lsq_linear``). Uncertainties come from ``(X^T W X)^-1`` scaled by the

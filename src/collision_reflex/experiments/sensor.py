@@ -119,7 +119,7 @@ def model_samples(
     Parameters
     ----------
     times: sample times [s], shape (n,), spaced ``sensor.period`` apart (the filter assumes a fixed rate).
-    m_f, k, k_m, F_s, a, v0, reaction: the model's parameters as :func:`collision_reflex.force_profile`:
+    m_f, k, k_m, F_s, a, v0, reaction: the model's parameters as :func:`collision_reflex.model.force_profile`:
         finger mass [kg], sensing stiffness [N/m], mechanical stiffness [N/m], threshold [N], reaction
         acceleration [m/s^2], pre-impact velocity [m/s].
     impact_time: time of impact on the trace's clock [s].

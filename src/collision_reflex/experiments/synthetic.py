@@ -1,7 +1,7 @@
 """Synthetic force-time traces from the model, as a sensor would record them.
 
 Used by the tests (parameter recovery with known truth) and to make the example data set shipped with the
-toolkit. The force profile is :func:`collision_reflex.force_profile`; the sensor is
+toolkit. The force profile is :func:`collision_reflex.model.force_profile`; the sensor is
 :class:`~collision_reflex.experiments.SensorModel` (interval means, optional low-pass, optional saturation).
 On top come a constant bias and white Gaussian noise drawn from an explicit ``numpy.random.Generator``.
 """

@@ -37,6 +37,7 @@ from .._io import atomic_open
 from .._table import HEADER, TableProblem, read_table
 from .._units import QuantityError, parse_quantity, si_scale
 from ..errors import TraceError
+from ..vocabulary import TIME_COLUMN_NAMES
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -44,7 +45,6 @@ if TYPE_CHECKING:
 MIN_SAMPLES = 20
 """Fewest samples a trace may have: enough for a noise floor and a contact of a few samples."""
 
-_TIME_NAMES = ("time", "t")
 _FORCE_NAMES = ("force", "fz", "f")
 _META_COLUMNS = {"velocity": "m/s", "system": None, "sensor stiffness": "N/m"}
 _META_TARGETS = {"velocity": "v0", "sensor stiffness": "k_m"}  # metadata key -> Trace field
@@ -288,7 +288,7 @@ def _samples(
     """Time [s] and force [N] columns in SI; a non-numeric cell becomes NaN (reported by the check)."""
     import pandas as pd
 
-    time_column = _find(columns, _TIME_NAMES, "time", source)
+    time_column = _find(columns, TIME_COLUMN_NAMES, "time", source)
     force_column = _find(columns, _FORCE_NAMES, "force", source)
     time_scale = _column_factor(time_column, time_unit, "time", source)
     force_scale = _column_factor(force_column, force_unit, "force", source)

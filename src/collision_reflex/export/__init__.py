@@ -12,17 +12,14 @@ from pathlib import Path
 
 from .._io import atomic_open
 from ..errors import CollisionReflexError, InvalidParameter
+from ..vocabulary import EXPORT_FORMATS
 from .armature import armature_record, companion_path, set_armature
 from .mjcf import design_mjcf
 from .run_design import DESIGN_CHOICES, RunDesign, read_run_design
 from .urdf import design_urdf
 
-FORMATS = ("urdf", "mjcf")
-"""The export formats."""
-
 __all__ = [
     "DESIGN_CHOICES",
-    "FORMATS",
     "ExportUnwritable",
     "RunDesign",
     "companion_path",
@@ -55,8 +52,8 @@ def export_design(
     -------
     The files written.
     """
-    if format not in FORMATS:
-        raise InvalidParameter("format", format, " or ".join(FORMATS))
+    if format not in EXPORT_FORMATS:
+        raise InvalidParameter("format", format, " or ".join(EXPORT_FORMATS))
     out = Path(out)
     if out.is_dir():
         raise ExportUnwritable(f"cannot write {out}: it is a folder; give a file name")

@@ -196,7 +196,7 @@ class CollisionParameters:
     F_a: float
 
     def impulse_arguments(self) -> dict[str, Any]:
-        """Keyword arguments for :func:`collision_reflex.phase_impulses` (all but ``v0``)."""
+        """Keyword arguments for :func:`collision_reflex.model.phase_impulses` (all but ``v0``)."""
         return {"m_f": self.m_f, "k": self.k, "k_m": self.k_m, "F_s": self.F_s, "a": self.a}
 
 

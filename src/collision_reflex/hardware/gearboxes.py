@@ -49,7 +49,7 @@ class Gearbox:
 
     Parameters
     ----------
-    kind: one of :data:`~collision_reflex.hardware.gearbox_scaling.GEARBOX_KINDS`.
+    kind: one of :data:`~collision_reflex.vocabulary.GEARBOX_KINDS`.
     stages: number of stages ``a`` (parallel shaft and planetary only; 1 for the others).
     diameter: outer diameter ``r`` [m].
     length: length ``l`` [m].
@@ -202,7 +202,7 @@ class CatalogueGearbox(_OfferedRatios):
     name : str
         The catalogue key (maker's designation).
     kind : str
-        One of :data:`~collision_reflex.hardware.gearbox_scaling.GEARBOX_KINDS`.
+        One of :data:`~collision_reflex.vocabulary.GEARBOX_KINDS`.
     ratios : tuple of float
         The ratios offered [-], ascending; or ``(min, max)`` when ``continuous_ratio``.
     continuous_ratio : bool

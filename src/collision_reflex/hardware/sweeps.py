@@ -387,7 +387,7 @@ def stiffness_sweep(
         whole joint's, as the paper's figure varies a single stiffness.
     motor: the motor (default the Omni+ reference), with ``gear_ratio``.
     lever, m_f, m_r, reflected_inertia_in: as :func:`radius_velocity_sweep`.
-    reaction: reaction model of :func:`collision_reflex.phase_impulses`.
+    reaction: reaction model of :func:`collision_reflex.model.phase_impulses`.
     """
     stiffnesses = _grid("stiffnesses", stiffnesses)
     for name, value in (("v0", v0), ("F_s", F_s), ("lever", lever)):

@@ -58,13 +58,9 @@ import numpy.typing as npt
 
 from .. import _validate
 from ..errors import InvalidParameter
+from ..vocabulary import RETREATS
 from .impulse import PhaseImpulses
 from .modal import MAX_SAMPLES, SAMPLES_PER_PERIOD, Modes, first_crossing, normal_modes
-
-RETREATS: tuple[str, ...] = ("along_u", "saturated")
-"""The motors' push in the reaction: ``"along_u"``, ``tau = -F_a J^T u`` with ``F_a = min_i tau_max,i /
-|(J^T u)_i|`` (the closed form's: each joint at most at its limit); ``"saturated"``, ``tau_i = -tau_max,i
-sign((J^T u)_i)`` (every joint at its limit)."""
 
 DETECTIONS: tuple[str, ...] = ("force", "spring_torque", "position")
 """What crosses ``F_s`` at detection: ``"force"``, the contact force (a sensor at the contact: the closed form's
@@ -148,7 +144,7 @@ def joint_space_collision(
     approach_velocity: ``v0`` of the contact point along ``direction`` [m/s], > 0.
     software_stiffness: joint software stiffness ``K_s`` [N m/rad], > 0, ``inf`` (default) for ideally
         velocity-controlled motors; in series with ``K_m`` until detection, zeroed at it.
-    retreat: the reaction's motor torques, :data:`RETREATS`.
+    retreat: the reaction's motor torques, :data:`~collision_reflex.vocabulary.RETREATS`.
     delay: from the threshold crossing to the reaction [s], >= 0; the motors keep tracking the reference
         meanwhile, and its impulse counts in the sensing phase (a sensor's lag: a contact-force sensor that
         reads a spring ``k_c`` in parallel with a damper ``c`` lags the force by ``c / k_c`` on a ramp).
@@ -322,7 +318,7 @@ def _sensing_modes(arm: _LinearArm, v_ref: np.ndarray, dq_impact: np.ndarray) ->
 
 
 def _push(retreat: str, lever: np.ndarray, tau_max: np.ndarray) -> np.ndarray:
-    """The motors' torques in the reaction (nv,) [N m], :data:`RETREATS`."""
+    """The motors' torques in the reaction (nv,) [N m], :data:`~collision_reflex.vocabulary.RETREATS`."""
     if retreat == "along_u":
         # A joint without lever (c_i = 0) does not limit the force along u.
         limits = np.where(lever != 0, tau_max / np.where(lever != 0, np.abs(lever), 1.0), np.inf)

@@ -17,7 +17,7 @@ approach rate, which sets the motor-speed row, is in every active set. A last ch
 row of the full NLP at the design found, up to :data:`FULL_ROW_CHECK_SAMPLES` samples; beyond them the full
 NLP is never built (its start, bounds and scales are NumPy), and the NumPy checks on every sample decide.
 
-Sweeps, optima and studies solve on active sets through :func:`collision_reflex.optimize.pareto.solve_with`
+Sweeps, optima and studies solve on active sets through :func:`collision_reflex.optimize.pieces.solve_with`
 (``active_set="auto"`` from :data:`ACTIVE_SET_THRESHOLD` samples, ``"always"``, ``"never"``; a study's
 ``optimizer.active_set``); a result says how it was solved (:func:`.active_set_result.solve_method`).
 

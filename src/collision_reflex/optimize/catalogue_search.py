@@ -347,7 +347,7 @@ class PartsSearch:
         """Coordinate descent from the nearest parts until a pass improves nothing; the number of passes.
 
         A step solves every candidate of one joint with the others held (one batch) and moves to the best, if
-        it is better than the current design by more than :data:`collision_reflex.optimize.pareto.MERGE_TOLERANCE`
+        it is better than the current design by more than :data:`collision_reflex.optimize.dominance.MERGE_TOLERANCE`
         (relative): a smaller difference is within what re-solving repeats, and chasing it costs whole passes of
         re-solves for nothing a design would show. The best combination tried is kept either way
         (:meth:`best`).
@@ -410,8 +410,8 @@ class PartsSearch:
         """The combination chosen: :meth:`least`, or the lightest alike in an impulse objective.
 
         For an impulse objective alone, the lightest combination within
-        :data:`collision_reflex.optimize.pareto.RESOLUTION` of the least impulse, as a run recommends a continuous
-        design (:func:`collision_reflex.optimize.pareto.recommend`): a smaller difference ranks no design, and
+        :data:`collision_reflex.optimize.recommend.RESOLUTION` of the least impulse, as a run recommends a continuous
+        design (:func:`collision_reflex.optimize.recommend.recommend`): a smaller difference ranks no design, and
         the lighter is the better build.
         """
         least = self.least()

@@ -2,7 +2,7 @@
 
 Warm-start policy (one for every caller): each anchor's lexicographic steps start from the anchor found so
 far; every epsilon point starts from the first objective's anchor as solved on the sweep's own problem, its
-point and multipliers (:data:`collision_reflex.optimize.solve.WARM_START_OPTIONS`), or its point alone when
+point and multipliers (:data:`collision_reflex.optimize.ipopt.WARM_START_OPTIONS`), or its point alone when
 the approach velocity is bounded (:func:`warm_started_points`). A point's result is then a
 pure function of the problem and its bounds, whatever the executor and the order in which the points finish;
 the points run in parallel. Chaining each point from its neighbour instead leaves no parallelism and was not

@@ -19,8 +19,9 @@ from ..errors import InvalidParameter
 from ..hardware.gearboxes import CatalogueGearbox, ScaledGearbox
 from ..model import effective as formulas
 from ..model.impulse import series_stiffness
+from ..vocabulary import GLOBAL_VARIABLES, MODULE_VARIABLES, PER_JOINT_VARIABLES
 from .constraints import Constraints
-from .space import GLOBAL_VARIABLES, MODULE_VARIABLES, PER_JOINT_VARIABLES, Bounds, DesignSpace
+from .space import Bounds, DesignSpace
 from .technology import ActuatorTechnology
 
 

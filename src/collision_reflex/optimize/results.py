@@ -28,6 +28,7 @@ from ..record.design import (
     SolvedJoint,
     SolvedRecord,
 )
+from ..vocabulary import GLOBAL_VARIABLES
 from .active_set_result import ActiveSetResult, solve_method, with_active_set
 from .candidates import motor_distance
 from .constraints import DUTY_REQUIREMENT, RATED_REQUIREMENT, STATIC_REQUIREMENT
@@ -36,7 +37,6 @@ from .design_result import DesignResult
 from .evaluate import design_collision_parameters, evaluate_design
 from .ipopt import Attempt
 from .objectives import OBJECTIVES
-from .space import GLOBAL_VARIABLES
 from .statistics import QUANTILE, impulse_statistics
 
 if TYPE_CHECKING:
@@ -570,7 +570,7 @@ def catalogue_columns(record: SolvedRecord | DesignRecord) -> dict[str, Any]:
 
     Per joint the catalogue part (``catalogue_part[joint1]``, :data:`NO_PART` when none is within bounds), then
     whether the catalogue design meets every requirement as snapped and its objectives [their units], empty
-    without parts (:func:`collision_reflex.study.arm_results.quick_snap_record`).
+    without parts (:func:`collision_reflex.study.catalogue_snap.quick_snap_record`).
     """
     snapped = cast("QuickSnap | None", record.get("catalogue"))  # a solved record has none
     if snapped is None:

@@ -9,7 +9,7 @@ software stiffness, threshold, approach velocity) are re-optimised for that choi
   work (:func:`collision_reflex.optimize.candidates.joint_candidates`).
 - **Exact** when the combinations of candidates number at most ``max_combinations``: every one is re-solved
   and the best feasible by the problem's objective is kept (for an impulse objective, the lightest within
-  :data:`collision_reflex.optimize.pareto.RESOLUTION` of the least impulse).
+  :data:`collision_reflex.optimize.recommend.RESOLUTION` of the least impulse).
 - **Heuristic** beyond that: coordinate descent over joints from the nearest part of every joint; each pass
   tries, joint by joint, every other candidate of that joint with the rest held, and moves to any better
   design; it stops when a whole pass improves nothing. Its best is never worse than the nearest-part design
@@ -124,7 +124,7 @@ def snap_to_catalogue(
     problem: the continuous design problem (:func:`collision_reflex.optimize.build_problem`); each combination
         is this problem with every joint's motor fixed at a catalogue motor, its objective and constraints.
     optimum: the continuous optimum of ``problem`` (:func:`collision_reflex.optimize.solve`).
-    motors: the catalogue motors (e.g. :func:`collision_reflex.load_catalogue`), by name or as a sequence.
+    motors: the catalogue motors (e.g. :func:`collision_reflex.hardware.load_catalogue`), by name or as a sequence.
     arm: the arm ``problem`` was built for (each combination's problem is built for it).
     gearboxes: the gearbox catalogue by name (e.g. :func:`collision_reflex.hardware.gearboxes.
         load_gearbox_catalogue`), for joints whose gearbox is the study's own figures; None keeps every joint's

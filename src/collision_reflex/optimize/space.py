@@ -10,12 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InvalidParameter
-
-PER_JOINT_VARIABLES = ("stator_diameter", "stack_length", "gear_ratio", "software_stiffness")
-MODULE_VARIABLES = ("stator_diameter", "stack_length", "gear_ratio")
-"""The per-joint variables that make an actuator: joints of one module share them (:class:`DesignSpace`)."""
-GLOBAL_VARIABLES = ("threshold", "approach_velocity")
-
+from ..vocabulary import GLOBAL_VARIABLES, PER_JOINT_VARIABLES
 
 SUPPORTED_RANGES: dict[str, tuple[float, float]] = {
     "stator_diameter": (1e-6, 1e3),

@@ -37,7 +37,7 @@ class ActuatorTechnology:
     mechanical_stiffness: joint mechanical stiffness [N m/rad], one value or one per joint, finite > 0: it is
         the only spring left in the reaction phase.
     sensing: ``"force"`` (contact-force threshold) or ``"position"`` (contact position-error threshold), see
-        :data:`collision_reflex.optimize.space.OPTIMIZED_SENSING_SCHEMES`.
+        :data:`collision_reflex.vocabulary.OPTIMIZED_SENSING_SCHEMES`.
     reaction: reaction-phase model, ``"at_rest"`` (the paper's) or ``"moving"``.
     reflected_inertia_in: where the reflected rotor inertia ``N^2 J_m`` acts. ``"robot"`` (default, the paper's
         arm model): behind the joint springs, in the robot mass ``m_r`` of the reaction phase only.

@@ -33,7 +33,7 @@ def plot_force_profile(
 ) -> Path:
     """Draw ``F(t)`` with the impact, sensing and reaction phases shaded and ``t1``, ``t2``, ``F_s`` marked.
 
-    Arguments as :func:`collision_reflex.phase_impulses`; ``path`` ends in .png, .svg or .pdf.
+    Arguments as :func:`collision_reflex.model.phase_impulses`; ``path`` ends in .png, .svg or .pdf.
     """
     t1, t2 = collision_times(m_f, k, k_m, F_s, a, v0, reaction, v_r)
     phases = phase_impulses(m_f, k, k_m, F_s, a, v0, reaction, v_r)

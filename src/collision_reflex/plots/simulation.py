@@ -74,7 +74,7 @@ def plot_trace(path: str | os.PathLike[str], result: Any, reaction: str = "at_re
     """Draw a simulated force trace over the closed form's force profile for the same setup.
 
     The trace is a :class:`collision_reflex.simulate.SimulationResult` and the profile is
-    :func:`collision_reflex.force_profile`; the detection, reaction and contact-end times are marked and the
+    :func:`collision_reflex.model.force_profile`; the detection, reaction and contact-end times are marked and the
     rigid impacts' impulses noted.
     """
     setup = result.setup

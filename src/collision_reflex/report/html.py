@@ -12,6 +12,7 @@ from .. import __version__
 from ..plots import margin_text
 from ..record.design import DesignRecord, QuickSnap
 from ..record.run import ArmRunRecord, CatalogueJoint, CatalogueRecord, RunRecord, TransmissionTried
+from ..vocabulary import GLOBAL_VARIABLES
 from .assumptions import UNITS, assumption_rows
 from .certainty import domain_sentence, statistics_rows, worst_pose_sentence
 from .figures import has_duty_cycle
@@ -22,7 +23,7 @@ from .wording import group_name, mm, number, unit
 
 SOLVER_TOLERANCE = 1e-5
 """Relative tolerance to which the report trusts the optimiser's numbers (that of
-:data:`collision_reflex.optimize.pareto.MERGE_TOLERANCE`): smaller values beside their scale print as 0."""
+:data:`collision_reflex.optimize.dominance.MERGE_TOLERANCE`): smaller values beside their scale print as 0."""
 
 
 def settled(value: object, scale: object = 1.0) -> object:
@@ -214,7 +215,7 @@ def _front_table(results: ArmRunRecord) -> dict[str, Any]:
 
     pareto = results["pareto"]
     names = list(dict.fromkeys([*pareto["objectives"], "actuator_mass"]))
-    extra = [key for key in ("threshold", "approach_velocity") if key not in names]
+    extra = [key for key in GLOBAL_VARIABLES if key not in names]
     columns = [f"{n.replace('_', ' ')} [{unit(OBJECTIVES[n][1])}]" for n in names] + [
         f"{key.replace('_', ' ')} [{unit(UNITS[key])}]" for key in extra
     ]

@@ -12,6 +12,7 @@ from typing import Any, Literal
 
 from ..record.design import DesignRecord, JointRecord
 from ..record.run import Bounds
+from ..vocabulary import GLOBAL_VARIABLES
 from .wording import general, group_name, grouped, words
 
 ACTIVE_TOLERANCE = 1e-3
@@ -187,7 +188,7 @@ def design_limits_at_bound(record: DesignRecord, bounds: Bounds) -> list[str]:
     units = {"threshold": " N" if record.get("sensing") == "force" else " m", "approach_velocity": " m/s"}
     return [
         f"{words(key)} at its {position} bound ({general(record[key])}{units[key]})"
-        for key in ("threshold", "approach_velocity")
+        for key in GLOBAL_VARIABLES
         if key not in undecided
         and (position := bound_position(record[key], bounds[key])) in ("lower", "upper")
     ]

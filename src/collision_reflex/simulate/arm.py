@@ -57,16 +57,11 @@ from typing import Any
 import numpy as np
 
 from .. import _validate
-from ..vocabulary import CONTROLLED_DRIVES, REACTION_MODES
+from ..vocabulary import CONTROLLED_DRIVES, REACTION_MODES, RETREATS
 from .arm_detection import DETECTIONS
 from .arm_dynamics import ArmDynamics
 from .arm_inputs import ArmJoints, ImpactClosedForm, arm_joints, arm_sensing, impact_closed_form
 from .arm_integration import ArmTrace, integrate_arm_collision
-
-RETREATS: tuple[str, ...] = ("along_u", "saturated")
-"""``"along_u"``: the motors push with ``tau = -F_a J^T n``, each joint at most at its limit and the first at
-it, the closed form's reaction. ``"saturated"``: a retreat command saturates every joint, ``tau_i = -tau_max,i
-sign((J^T n)_i)`` (a real controller's reaction: more force along ``-n``, and a push off it)."""
 
 
 @dataclass(frozen=True)
@@ -87,7 +82,7 @@ class ArmCollision:
     closed_form: the closed form's impulse [N*s] with ``reaction`` (and ``robot_velocity`` if moving).
     reaction: the closed form's reaction variant.
     detection: the detection scheme (:data:`collision_reflex.simulate.arm_detection.DETECTIONS`).
-    retreat: the reaction's motor torques (:data:`RETREATS`).
+    retreat: the reaction's motor torques (:data:`~collision_reflex.vocabulary.RETREATS`).
     detected_impulse: the simulated impulse on the wall until detection [N*s] (impact and sensing phases).
     closed_form_sprung: the closed form with :func:`collision_reflex.model.impulse.sprung_reaction` in place
         of the constant-acceleration reaction [N*s] (the spring's push on the robot mass kept).
@@ -181,7 +176,7 @@ def simulate_arm_collision(
         least a tenth of the largest lever.
     retreat: the reaction's motor torques, ``"along_u"`` (default: the closed form's, each joint at most at
         its limit along the escape direction) or ``"saturated"`` (every joint at its limit); see
-        :data:`RETREATS`.
+        :data:`~collision_reflex.vocabulary.RETREATS`.
     blanking: how long after the impact the detector takes a crossing of its threshold for the impact
         pulse [s], >= 0. A signal that rises above the threshold within it is blanked until it falls below
         again; if it has not by the end, the contact force holds above the threshold and it detects then; a

@@ -186,7 +186,7 @@ class CollisionSetup:
         return threshold
 
     def closed_form(self, reaction: str = "at_rest", v_r: float | None = None) -> PhaseImpulses:
-        """Phase impulses of the closed form for this setup (:func:`collision_reflex.phase_impulses`) [N*s].
+        """Phase impulses of the closed form for this setup (:func:`collision_reflex.model.phase_impulses`) [N*s].
 
         Uses ``m_f``, ``k`` (series), ``k_m``, ``F_s`` (:attr:`equivalent_threshold`), ``a = F_a / m_r`` and
         ``v0``; ``reaction`` and ``v_r`` [m/s] as there (pass ``v_r=setup.detection_robot_velocity`` with

@@ -72,7 +72,7 @@ def sweep(
     parameter: ``"delay"`` [s] or ``"backlash"`` [m] to sweep as well, or None.
     values: the parameter's values (>= 0); with ``"backlash"``, half of each is open at impact unless
         ``setup.initial_play`` says otherwise (it is then capped at the backlash).
-    reaction, v_r: the closed form's reaction variant, as :func:`collision_reflex.phase_impulses`; ``v_r`` may
+    reaction, v_r: the closed form's reaction variant, as :func:`collision_reflex.model.phase_impulses`; ``v_r`` may
         also be ``"detected"``: the robot's velocity at detection in the ideal limit, ``v0 k / k_m``, per
         velocity (with ``reaction="moving"``).
     tolerance: relative difference that counts as parting, > 0.

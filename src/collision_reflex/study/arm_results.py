@@ -19,7 +19,6 @@ from ..optimize.layout import design_layout
 from ..optimize.pieces import built_problem
 from ..optimize.recommend import recommend
 from ..optimize.results import design_record, undecided_variables
-from ..optimize.space import GLOBAL_VARIABLES, PER_JOINT_VARIABLES
 from ..optimize.worst_case import SEARCH_TOLERANCE, WorstCase
 from ..record.design import (
     DesignRecord,
@@ -30,6 +29,7 @@ from ..record.design import (
     WorstPose,
 )
 from ..record.run import ArmResults, Bounds, CatalogueRecord, DomainRecord, ParetoRecord, SampleLayout
+from ..vocabulary import GLOBAL_VARIABLES, PER_JOINT_VARIABLES
 from .arm_setup import ArmSetup
 from .fresh import FreshImpulses, fresh_draw, fresh_impulses, fresh_record
 from .problems import StudyProblems
@@ -114,7 +114,7 @@ def arm_results(
 
     The chosen design (the optimum of the study's objective, as solved) records ``dominated_by``: the index of
     a Pareto design that dominates it, or None. The recommended design
-    (:func:`collision_reflex.optimize.pareto.recommend`) records ``source`` (``optimum`` or ``Pareto design
+    (:func:`collision_reflex.optimize.recommend.recommend`) records ``source`` (``optimum`` or ``Pareto design
     <i>``), ``pareto_index``, ``reason``, ``undecided`` (its design variables that no objective decides,
     :func:`collision_reflex.optimize.results.undecided_variables`: ``{"variable", "joint"}`` each, the joint None
     for a global one), and with a duty cycle its ``torque_speed`` (:func:`torque_speed_record`). With

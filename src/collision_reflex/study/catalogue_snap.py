@@ -201,7 +201,7 @@ def solve_study_parts(
 ) -> DesignResult | str:
     """One combination of a study's catalogue snap, in any process (its problem built there once).
 
-    ``warm``: as :func:`collision_reflex.optimize.snap.solve_parts` says.
+    ``warm``: as :func:`collision_reflex.optimize.catalogue_search.solve_parts` says.
 
     One solve at a time per process with single-threaded BLAS, as every piece of a sweep, so that the numbers
     are the same on every executor.

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..errors import InvalidParameter, StudyFileError, StudyProblem
 from ..hardware.motors import scaled_motor_quantities
-from .design_specs import PER_JOINT_DESIGN_VARIABLES
+from ..vocabulary import GLOBAL_VARIABLES, PER_JOINT_VARIABLES
 from .schema import ActuatorStudy, ArmStudy
 from .source import PathKey, excerpt
 
@@ -363,7 +363,7 @@ def _motion_field(study: Any, constraint: str) -> tuple[str, ...]:
 def _field_of(name: str) -> tuple[str, ...]:
     """The study field an optimiser parameter comes from (for locating its errors)."""
     root = name.split("[")[0].split(" ")[0]
-    if root in PER_JOINT_DESIGN_VARIABLES or root in ("threshold", "approach_velocity"):
+    if root in PER_JOINT_VARIABLES or root in GLOBAL_VARIABLES:
         return ("design", root)
     if root in ("payload", "safety_factor", "torque_required", "threshold_floor"):
         return ("constraints", root)

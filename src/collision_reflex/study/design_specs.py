@@ -106,11 +106,6 @@ PositionErrorVariableBounds = _variable_model(
 )
 VelocityVariableBounds = _variable_model("VelocityVariable", ApproachVelocity, "approach velocity [m/s]")
 
-PER_JOINT_DESIGN_VARIABLES = ("stator_diameter", "stack_length", "gear_ratio", "software_stiffness")
-MODULE_DESIGN_VARIABLES = ("stator_diameter", "stack_length", "gear_ratio")
-"""The optimiser's ``MODULE_VARIABLES`` (what a module's joints share), named here for the study layer, which
-loads no optimiser (tests/test_modules.py checks they agree)."""
-
 
 class DesignSpec(Spec):
     """Design variables the optimiser may change.

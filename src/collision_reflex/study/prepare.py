@@ -14,8 +14,8 @@ from typing import TYPE_CHECKING, Any
 from ..errors import StudyFileError, StudyProblem
 from ..hardware.gearboxes import Gearbox
 from ..hardware.motors import load_catalogue
+from ..vocabulary import MODULE_VARIABLES, PER_JOINT_VARIABLES
 from .actuator_specs import GearboxSpec, MotorSpec
-from .design_specs import MODULE_DESIGN_VARIABLES, PER_JOINT_DESIGN_VARIABLES
 from .duty import describe_duty_cycle, prismatic_joints, static_requirement, study_duty_cycle
 from .load import LoadedStudy
 from .robot import load_arm
@@ -142,15 +142,13 @@ def free_variables(study: ArmStudy, n_joints: int, joint_names: list[str] | None
     sharing = {
         name for group in study.actuators.modules for name in group[1:] if joint_names and name in joint_names
     }
-    for name in (*PER_JOINT_DESIGN_VARIABLES, "threshold", "position_error", "approach_velocity"):
+    for name in (*PER_JOINT_VARIABLES, "threshold", "position_error", "approach_velocity"):
         spec = getattr(design, name)
         if spec is None:
             continue
-        if name in PER_JOINT_DESIGN_VARIABLES:
+        if name in PER_JOINT_VARIABLES:
             bounds = _per_joint_bounds(spec, n_joints, joint_names)
-            shared = [
-                j in sharing and name in MODULE_DESIGN_VARIABLES for j in joint_names or [""] * len(bounds)
-            ]
+            shared = [j in sharing and name in MODULE_VARIABLES for j in joint_names or [""] * len(bounds)]
             free = sum(b.free for b, s in zip(bounds, shared, strict=True) if not s)
         else:
             free = int(spec.free)
@@ -202,7 +200,7 @@ def describe_study(loaded: LoadedStudy, load_robot: bool = True) -> str:
     free = free_variables(study, n_joints or 1, list(arm.joint_names) if load_robot else None)
 
     def count(name: str, number: int) -> str:
-        per_joint = name in PER_JOINT_DESIGN_VARIABLES and n_joints is None
+        per_joint = name in PER_JOINT_VARIABLES and n_joints is None
         return f"{name} (per joint)" if per_joint else f"{name} ({number})"
 
     text += "; free design variables: " + (

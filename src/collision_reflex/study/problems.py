@@ -100,7 +100,7 @@ class StudyProblems:
 
     @property
     def objective(self) -> Hashable:
-        """The study's own objective (for :func:`collision_reflex.optimize.pareto.built_problem`)."""
+        """The study's own objective (for :func:`collision_reflex.optimize.pieces.built_problem`)."""
         return objective_key(self.setup.study.objective)
 
     @property

@@ -10,7 +10,7 @@ import difflib
 
 from ..arm import Arm
 from ..errors import FrameNotFound, InvalidParameter, StudyFileError, StudyProblem, UrdfError
-from .design_specs import PER_JOINT_DESIGN_VARIABLES
+from ..vocabulary import PER_JOINT_VARIABLES
 from .duty import prismatic_joints
 from .load import LoadedStudy
 from .quantities import joint_position_si
@@ -137,7 +137,7 @@ def check_against_arm(loaded: LoadedStudy, arm: Arm) -> list[StudyProblem]:
 
     for name in study.actuators.joints:
         check_joint(("actuators", "joints", name), name)
-    for variable in PER_JOINT_DESIGN_VARIABLES:
+    for variable in PER_JOINT_VARIABLES:
         spec = getattr(study.design, variable)
         for name in getattr(spec, "joints", {}) or {}:
             check_joint(("design", variable, "joints", name), name)
