@@ -170,8 +170,11 @@ class Gearbox:
 class _Range(Protocol):
     """Bounds of a gear ratio [-] (e.g. :class:`collision_reflex.optimize.space.Bounds`)."""
 
-    lower: float
-    upper: float
+    @property
+    def lower(self) -> float: ...
+
+    @property
+    def upper(self) -> float: ...
 
 
 class _OfferedRatios:

@@ -116,11 +116,11 @@ def design_layout(
             layout.add(name, joint_bounds, owner)
         else:
             layout.add(name, joint_bounds)
-    for name in GLOBAL_VARIABLES:
-        bounds = space.global_bounds(name)
-        if name == "threshold" and technology.sensing == "force":
+    for shared in GLOBAL_VARIABLES:
+        bounds = space.global_bounds(shared)
+        if shared == "threshold" and technology.sensing == "force":
             bounds = _with_noise_floor(bounds, constraints.threshold_floor)
-        layout.add(name, [bounds])
+        layout.add(shared, [bounds])
     return layout
 
 

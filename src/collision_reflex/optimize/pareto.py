@@ -11,7 +11,7 @@ import os
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -31,6 +31,8 @@ if TYPE_CHECKING:
     from pathlib import Path
 
     import pandas as pd
+
+    from ..record.design import SolvedRecord
 
 
 @dataclass(frozen=True)
@@ -63,7 +65,7 @@ class ParetoSet:
         source = (lambda r: r.numpy_objectives) if numpy_path else (lambda r: r.objectives)
         return np.array([[source(r)[name] for name in self.objectives] for r in self.points])
 
-    def records(self) -> list[dict[str, Any]]:
+    def records(self) -> list[SolvedRecord]:
         """Every point as a result record (:func:`collision_reflex.optimize.results.result_record`)."""
         labels = self.labels or ("",) * len(self.points)
         return [result_record(r, label) for r, label in zip(self.points, labels, strict=True)]

@@ -183,6 +183,6 @@ def solved_point(
     try:
         result = solve_with(build, objective, bounded, active_set, epsilon, **options)
     except SolverFailed as error:
-        failure = PointFailure(str(objective), epsilon or {}, error.status, str(error.args[0]))
+        failure = PointFailure(str(objective), dict(epsilon or {}), error.status, str(error.args[0]))
         return SweepPoint(label, None, (failure,))
     return SweepPoint(label, result)

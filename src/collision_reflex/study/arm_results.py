@@ -96,9 +96,9 @@ def design_bounds(setup: ArmSetup) -> Bounds:
     out: dict[str, Any] = {}
     for name in PER_JOINT_VARIABLES:
         out[name] = {j: [b.lower, b.upper] for j, b in zip(joints, layout.bounds[name], strict=True)}
-    for name in GLOBAL_VARIABLES:
-        one = layout.bounds[name][0]
-        out[name] = [one.lower, one.upper]
+    for shared in GLOBAL_VARIABLES:
+        one = layout.bounds[shared][0]
+        out[shared] = [one.lower, one.upper]
     return cast("Bounds", out)  # the variables of PER_JOINT_VARIABLES and GLOBAL_VARIABLES
 
 
