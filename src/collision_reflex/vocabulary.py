@@ -34,7 +34,7 @@ ScalingLawName = Literal["haddadin", "isometric", "empirical", "quadruped"]
 SCALING_LAW_NAMES: tuple[ScalingLawName, ...] = get_args(ScalingLawName)
 
 GearboxKind = Literal["planetary", "parallel_shaft", "harmonic", "cycloidal", "ball_screw"]
-"""The gearbox kinds with a scaling law (:data:`collision_reflex.hardware.gearboxes.GEARBOX_SCALING`)."""
+"""The gearbox kinds with a scaling law (:data:`collision_reflex.hardware.gearbox_scaling.GEARBOX_SCALING`)."""
 GEARBOX_KINDS: tuple[GearboxKind, ...] = get_args(GearboxKind)
 
 ExecutorName = Literal["serial", "processes", "dask"]
