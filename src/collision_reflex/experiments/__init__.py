@@ -30,7 +30,7 @@ if TYPE_CHECKING:  # the names as type checkers and IDEs see them; at run time `
     from .fit import PAPER_SENSOR_STIFFNESS, PARAMETERS, OneShotFit, fit_one_shot
     from .nshot import VelocityLawFit, fit_velocity_law
     from .quadrature import ImpulseEstimate, measure_impulse
-    from .sensor import SensorModel, model_samples, pulse_duration
+    from .sensor import SensorModel, model_samples
     from .synthetic import (
         MINI40_NOISE,
         PAPER_SYSTEMS,
@@ -68,7 +68,6 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
     ".sensor": (
         "SensorModel",
         "model_samples",
-        "pulse_duration",
     ),
     ".synthetic": (
         "MINI40_NOISE",
@@ -113,7 +112,6 @@ __all__ = [
     "fit_velocity_law",
     "measure_impulse",
     "model_samples",
-    "pulse_duration",
     "read_traces",
     "synthetic_trace",
     "write_example_dataset",

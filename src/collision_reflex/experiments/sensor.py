@@ -97,11 +97,6 @@ def _butterworth(order: int, cutoff: float) -> tuple[np.ndarray, np.ndarray]:
     return b, a
 
 
-pulse_duration = impact_pulse_duration
-"""The impact pulse's duration [s], kept under this name for existing callers: it is
-:func:`collision_reflex.model.impulse.impact_pulse_duration`."""
-
-
 def model_samples(
     times: np.ndarray,
     m_f: float,
