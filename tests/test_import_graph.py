@@ -86,6 +86,15 @@ def find_cycle(graph: dict[str, set[str]]) -> list[str] | None:
     return None
 
 
+def write_package(folder: Path, files: dict[str, str]) -> Path:
+    """A package ``collision_reflex`` in ``folder`` made of ``files`` (path inside the package: source)."""
+    package = folder / "collision_reflex"
+    for name, text in files.items():
+        (package / name).parent.mkdir(parents=True, exist_ok=True)
+        (package / name).write_text(text)
+    return package
+
+
 def test_no_import_cycle_between_subpackages():
     graph = import_graph(PACKAGE)
     assert {"model", "optimize", "study", "report", "plots", "errors"} <= set(graph)
@@ -108,10 +117,7 @@ def test_the_cycle_finder_finds_the_cycles_it_must(tmp_path):
         "report/outputs.py": "from ..study.store import DESIGNS\nimport collision_reflex.errors\n",
         "errors.py": "",
     }
-    package = tmp_path / "collision_reflex"
-    for name, text in files.items():
-        (package / name).parent.mkdir(parents=True, exist_ok=True)
-        (package / name).write_text(text)
+    package = write_package(tmp_path, files)
     graph = import_graph(package)
     assert graph["optimize"] == {"plots"} and graph["plots"] == {"optimize"}
     assert graph["report"] == {"study", "errors"}

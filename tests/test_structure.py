@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from test_import_graph import PACKAGE, find_cycle
+from test_import_graph import PACKAGE, find_cycle, write_package
 
 MAX_MODULE_LINES = 600
 MAX_FUNCTION_LINES = 100
@@ -138,11 +138,7 @@ def loop_package(tmp_path: Path) -> Path:
         "optimize/feasibility.py": "def feasible():\n    from .solve import solve  # hidden loop\n",
         "optimize/types.py": "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from .solve import solve\n",
     }
-    package = tmp_path / "collision_reflex"
-    for name, text in files.items():
-        (package / name).parent.mkdir(parents=True, exist_ok=True)
-        (package / name).write_text(text)
-    return package
+    return write_package(tmp_path, files)
 
 
 def test_the_file_graph_sees_a_loop_kept_open_by_a_function_level_import(loop_package):
