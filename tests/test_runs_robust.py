@@ -240,6 +240,43 @@ def test_a_damaged_point_file_is_reported_and_recomputed(two_link_run, tmp_path,
     _same_results(folder, two_link_run)
 
 
+def test_a_resumed_run_reuses_its_gearbox_choice_and_worst_case_searches(two_link_run, tmp_path, monkeypatch):
+    """Nothing of a finished run is solved or searched again; a choice saved for another study is not reused."""
+    import json
+    import shutil
+
+    from collision_reflex.study import transmission_choice, worst_case
+
+    folder = tmp_path / "out"
+    shutil.copytree(two_link_run, folder)
+    searches = sorted((folder / "points").glob("search-*.json"))
+    assert searches  # one per design and round, each named by its inputs
+    calls = {"solves": 0, "searches": 0}
+    single_optimum, search = transmission_choice.single_optimum, worst_case.search_worst_case
+
+    def counted(key, function):
+        def call(*args, **kwargs):
+            calls[key] += 1
+            return function(*args, **kwargs)
+
+        return call
+
+    monkeypatch.setattr(transmission_choice, "single_optimum", counted("solves", single_optimum))
+    monkeypatch.setattr(worst_case, "search_worst_case", counted("searches", search))
+    assert _run(folder) == 0
+    assert calls == {"solves": 0, "searches": 0}
+    _same_results(folder, two_link_run)
+
+    saved = folder / "points" / "transmissions.json"
+    record = json.loads(saved.read_text())
+    assert [entry["chosen"] for entry in record["tried"]].count(True) == 1
+    saved.write_text(json.dumps({**record, "key": "another study"}))
+    searches[0].write_text('{"fields": ["impulse"], "values": {"impulse": 0.0}}')  # another version's
+    assert _run(folder) == 0
+    assert calls == {"solves": len(record["tried"]), "searches": 1}
+    _same_results(folder, two_link_run)
+
+
 def test_a_resumed_run_removes_stale_temporary_files(two_link_run, tmp_path):
     import shutil
 

@@ -11,6 +11,8 @@ motors, ``construction`` (``frameless`` or ``housed``) are optional, carry no nu
 
 from __future__ import annotations
 
+import hashlib
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
@@ -286,8 +288,11 @@ def read_entries(path: Path, kind: str = "motors") -> dict[str, CatalogueEntry]:
         Naming the file, the line and the field: bad YAML, a missing, unknown or mistyped field, a unit of
         the wrong dimension, a non-physical value, or an entry without a source.
     """
+    key = _cache_key(path, kind)
+    if key is not None and key in _READ:
+        return dict(_READ[key])
     try:
-        return _read_entries(path, kind)
+        entries = _read_entries(path, kind)
     except CatalogueError as error:
         texts = (str(error.path), error.field, error.reason)
         if all(text.isprintable() for text in texts):
@@ -295,6 +300,24 @@ def read_entries(path: Path, kind: str = "motors") -> dict[str, CatalogueEntry]:
         # A message quotes field names and values of the file: escape what would break or hide its line.
         path_text, field, reason = map(one_line, texts)
         raise CatalogueError(path_text, error.line, field, reason) from None
+    if key is not None:
+        _READ[key] = entries
+    return dict(entries)
+
+
+# A study reads its catalogues once per problem it builds: the validated entries of a file are kept, keyed by
+# its content (entries are frozen; callers copy their fields).
+_READ: dict[tuple[str, str, bytes], dict[str, CatalogueEntry]] = {}
+
+
+def _cache_key(path: Path, kind: str) -> tuple[str, str, bytes] | None:
+    """The key of ``path``'s entries in ``_READ``, or None for what is not a readable regular file."""
+    try:
+        if not stat.S_ISREG(Path(path).stat().st_mode):
+            return None
+        return (str(path), kind, hashlib.sha256(Path(path).read_bytes()).digest())
+    except (OSError, ValueError):
+        return None
 
 
 def _read_entries(path: Path, kind: str) -> dict[str, CatalogueEntry]:

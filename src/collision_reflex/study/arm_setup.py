@@ -8,6 +8,8 @@ design problems from it, once per process.
 from __future__ import annotations
 
 import dataclasses
+import hashlib
+import pickle
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -195,7 +197,7 @@ def _constraints(
     hold = None
     if study.constraints.torque_required is None:  # each joint's worst static pose joins the samples'
         masses = _nominal_actuator_mass(space, technology, len(arm.joint_names))
-        hold = arm.kinematics(worst_hold_poses(arm, held, masses, np.random.default_rng(0)))
+        hold = arm.kinematics(_worst_hold_poses(arm, held, masses))
     rating = study_rating(loaded, arm)
     raise_problems(loaded, requirement_problems(loaded, study, False, rating))
     return Constraints(
@@ -207,6 +209,23 @@ def _constraints(
         rating=rating,
         hold_poses=hold,
     )
+
+
+_HOLD_POSES: dict[bytes, np.ndarray] = {}
+"""Hold poses found, by :func:`_hold_key`: a run sets its study up several times (as written, as solved, per
+gearbox option), and the search is a few thousand kinematics evaluations."""
+
+
+def _worst_hold_poses(arm: Arm, payload: float, actuator_mass: np.ndarray) -> np.ndarray:
+    """:func:`~collision_reflex.arm.static_hold.worst_hold_poses` from the seed 0, found once per arm and load."""
+    key = hashlib.sha256(
+        pickle.dumps((arm.model, arm.contact_frame, np.asarray(arm.contact_offset), payload, actuator_mass))
+    ).digest()
+    if key not in _HOLD_POSES:
+        if len(_HOLD_POSES) >= 32:
+            _HOLD_POSES.pop(next(iter(_HOLD_POSES)))
+        _HOLD_POSES[key] = worst_hold_poses(arm, payload, actuator_mass, np.random.default_rng(0))
+    return _HOLD_POSES[key].copy()
 
 
 def _nominal_actuator_mass(space: DesignSpace, technology: ActuatorTechnology, n: int) -> np.ndarray:

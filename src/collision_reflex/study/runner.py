@@ -46,11 +46,14 @@ from .progress import RunProgress
 from .resolve import ResolvedStudy, resolve_study
 from .schema import ArmStudy
 from .store import OutputFolderUnusable, RunFolder
-from .transmission_choice import choose_transmissions
+from .transmission_choice import choice_record, choose_transmissions
 from .worst_case import exchanges_samples, search_designs, violators
 
 SMOKE_ENVIRONMENT = "CRX_SMOKE"
 """Set to 1 to run every study with small sample counts (tests, quick checks): see :func:`.resolve.smoke_study`."""
+
+TRANSMISSIONS = "transmissions"
+"""The run folder's piece that keeps the gearbox choice."""
 
 
 @dataclass(frozen=True)
@@ -114,8 +117,7 @@ def run_study(
     started = time.perf_counter()
     stages = StageTimes()
     smoke = bool(os.environ.get(SMOKE_ENVIRONMENT, "")) if smoke is None else smoke
-    study, catalogue, transmissions = _prepared(path, smoke, stages)
-    folder = RunFolder(Path(out) if out is not None else default_output_folder(study.loaded, smoke))
+    study, catalogue, transmissions, folder = _prepared(path, out, smoke, stages)
     execution = study.data.get("execution", {})
     kind = executor or execution.get("executor", "serial")
     if scheduler is None and kind == "dask":
@@ -124,6 +126,8 @@ def run_study(
     resumed = folder.claim(
         study.fingerprint, study.text, {**details, "started": time.strftime("%Y-%m-%dT%H:%M:%S%z")}
     )
+    if transmissions is not None:
+        folder.save(TRANSMISSIONS, transmissions)
     progress = RunProgress(quiet)
     try:
         n_workers = workers or execution.get("workers", 2)
@@ -158,26 +162,32 @@ def run_study(
 
 
 def _prepared(
-    path: str | os.PathLike[str], smoke: bool, stages: StageTimes
-) -> tuple[ResolvedStudy, SnapCatalogue | None, list[dict[str, Any]] | None]:
-    """The study a run solves (resolved once), its catalogue and the gearbox assignments tried, all checked.
+    path: str | os.PathLike[str], out: str | os.PathLike[str] | None, smoke: bool, stages: StageTimes
+) -> tuple[ResolvedStudy, SnapCatalogue | None, dict[str, Any] | None, RunFolder]:
+    """The study a run solves (resolved once), its catalogue, the gearbox choice and the run's folder, all checked.
 
     Every problem (robot, motors, samples, the problem build) is raised here, located in the file as written,
-    before any output.
+    before any output. The gearbox choice (:func:`.transmission_choice.choice_record`) is read from the folder
+    when an earlier run of the study made it.
     """
     with stages.stage("load"):
         loaded = load_study(path)
         study = resolve_study(loaded, smoke)
+    folder = RunFolder(Path(out) if out is not None else default_output_folder(loaded, smoke))
     transmissions = None
     if isinstance(loaded.study, ArmStudy) and isinstance(loaded.study.actuators.gearbox, list):
         with stages.stage("transmissions"):  # the best gearbox option per module, by the study's objective
-            study, transmissions = choose_transmissions(loaded, study)  # located as written
+            written = study
+            study, tried = choose_transmissions(
+                loaded, study, folder.peek(TRANSMISSIONS)
+            )  # located as written
+            transmissions = choice_record(written, tried)
     with stages.stage("prepare"):
         if isinstance(loaded.study, ArmStudy):
             checked_setup(loaded, study)
-            return study, study_catalogue(study.loaded), transmissions
+            return study, study_catalogue(study.loaded), transmissions, folder
         check_actuator_study(loaded)
-    return study, None, transmissions
+    return study, None, transmissions, folder
 
 
 def _run_arm(
@@ -188,7 +198,7 @@ def _run_arm(
     window: int,
     stages: StageTimes,
     catalogue: SnapCatalogue | None = None,
-    transmissions: list[dict[str, Any]] | None = None,
+    transmissions: dict[str, Any] | None = None,
 ) -> tuple[dict[str, Any], tuple[int, int]]:
     """The study's optimum (multi-started), its Pareto front by the optimiser's one sweep, and the verdict.
 
@@ -199,8 +209,8 @@ def _run_arm(
     Then, with a ``catalogue``, the recommended design and every Pareto design snapped to it
     (:func:`.catalogue_snap.catalogue_results`). Each piece is saved as it finishes and found again when the run
     resumes (the snap as ``catalogue``, reused while the catalogue file and the settings are the same).
-    ``transmissions``: the gearbox assignments tried before (:func:`.transmission_choice.choose_transmissions`),
-    kept in the results.
+    ``transmissions``: the gearbox choice made before (:func:`.transmission_choice.choice_record`), its
+    assignments kept in the results.
     """
     study = resolved.study
     assert isinstance(study, ArmStudy)
@@ -224,7 +234,7 @@ def _run_arm(
             "optimum": optimum,
             **(dict(zip(front.labels, front.points, strict=True)) if front else {}),
         }
-        searches = stages.timed("worst-case search", search_designs)(problems, designs, search, pool)
+        searches = stages.timed("worst-case search", search_designs)(problems, designs, search, pool, folder)
         added = violators(designs, searches, search.tolerance)
         if not added or not exchanges_samples(study) or round_ == search.rounds - 1:
             break
@@ -251,7 +261,7 @@ def _run_arm(
         **stages.timed("results", arm_results)(problems, optimum, front, snapped, searches, search.tolerance),
     }
     if transmissions is not None:
-        results["transmission_choice"] = transmissions
+        results["transmission_choice"] = transmissions["tried"]
     if study.simulate is not None:
         recommended = recommend(optimum, front, problems.objective).result
         results["simulation"] = stages.timed("simulation", simulate_design.simulate_designs)(

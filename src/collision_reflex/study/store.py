@@ -139,6 +139,13 @@ class RunFolder:
         print(f"warning: {path} is {reason}; computing it again", file=sys.stderr)
         return None
 
+    def peek(self, name: str) -> dict[str, Any] | None:
+        """:meth:`finished` before the folder is claimed: None where the folder or the piece cannot be read."""
+        try:
+            return self.finished(name)
+        except OSError:
+            return None
+
     def save(self, name: str, record: dict[str, Any]) -> None:
         """Keep a finished piece of work under ``name`` (atomically)."""
         write_json(self.points / f"{name}.json", record)

@@ -61,11 +61,13 @@ def option_name(option: Any) -> str:
 
 
 def choose_transmissions(
-    loaded: LoadedStudy, resolved: ResolvedStudy
+    loaded: LoadedStudy, resolved: ResolvedStudy, saved: dict[str, Any] | None = None
 ) -> tuple[ResolvedStudy, list[dict[str, Any]]]:
     """The resolved study with the best assignment of its gearbox options, and every assignment tried.
 
-    ``loaded``: the study as written, where problems are located; ``resolved``: what the run solves.
+    ``loaded``: the study as written, where problems are located; ``resolved``: what the run solves;
+    ``saved``: a :func:`choice_record` of an earlier run, reused when it was made of the same study (a resumed
+    run does not solve the assignments again).
 
     Each entry: ``assignment`` (per group of joints the option's name), ``objective`` (the study's objective at
     the optimum, None without one), ``actuator_mass`` [kg] (None without one), ``status`` and ``chosen``.
@@ -85,15 +87,23 @@ def choose_transmissions(
             f"{len(options)} gearbox options for {len(groups)} modules or joints: {len(assignments)} assignments",
             f"at most {MAX_ASSIGNMENTS}: group joints into actuators.modules, or list fewer options",
         )
-    tried: list[dict[str, Any]] = []
+
+    def variant(assignment: tuple[int, ...]) -> dict[str, Any]:
+        data = copy.deepcopy(resolved.data)
+        data["actuators"]["gearbox"] = None
+        for group, k in zip(groups, assignment, strict=True):
+            for joint in group:
+                _assign(data, joint, options[k])
+        return data
+
+    tried = _reused(saved, resolved, len(assignments))
+    if tried is not None:
+        chosen_index = next(i for i, entry in enumerate(tried) if entry["chosen"])
+        return ResolvedStudy.of(loaded, variant(assignments[chosen_index])), tried
+    tried = []
     studies: list[ResolvedStudy | None] = []  # each assignment's, None where it is refused as data
     refusals: list[Exception] = []
     for assignment in assignments:
-        variant = copy.deepcopy(resolved.data)
-        variant["actuators"]["gearbox"] = None
-        for group, k in zip(groups, assignment, strict=True):
-            for joint in group:
-                _assign(variant, joint, options[k])
         entry: dict[str, Any] = {
             "assignment": {
                 ", ".join(g): option_name(options[k]) for g, k in zip(groups, assignment, strict=True)
@@ -104,7 +114,7 @@ def choose_transmissions(
         }
         study = None
         try:
-            study = ResolvedStudy.of(loaded, variant)
+            study = ResolvedStudy.of(loaded, variant(assignment))
             checked_setup(loaded, study)  # every problem of this assignment, located in the file as written
             problems = StudyProblems(study)
             optimum, _ = single_optimum(problems, problems.objective, starts=1)
@@ -134,3 +144,20 @@ def choose_transmissions(
     chosen = studies[best]
     assert chosen is not None  # it has a design
     return chosen, tried
+
+
+def choice_record(resolved: ResolvedStudy, tried: list[dict[str, Any]]) -> dict[str, Any]:
+    """What a run folder keeps of a transmission choice: the assignments tried, for the study as it was written."""
+    return {"key": resolved.fingerprint, "tried": tried}
+
+
+def _reused(saved: dict[str, Any] | None, resolved: ResolvedStudy, count: int) -> list[dict[str, Any]] | None:
+    """The assignments tried that ``saved`` holds when it is this study's choice with one chosen, else None."""
+    if saved is None or saved.get("key") != resolved.fingerprint:
+        return None
+    tried = saved.get("tried")
+    if not isinstance(tried, list) or len(tried) != count or not all(isinstance(e, dict) for e in tried):
+        return None
+    if [entry.get("chosen") for entry in tried].count(True) != 1:
+        return None
+    return tried

@@ -9,6 +9,8 @@ again on them: the exchange method for semi-infinite programs.
 
 from __future__ import annotations
 
+import dataclasses
+import hashlib
 from collections.abc import Mapping
 from concurrent.futures import Executor
 from typing import TYPE_CHECKING, Any
@@ -26,6 +28,7 @@ from .schema import ArmStudy
 if TYPE_CHECKING:
     from ..optimize import DesignResult
     from ..optimize.design import Design
+    from .store import RunFolder
 
 
 def exchanges_samples(study: ArmStudy) -> bool:
@@ -87,21 +90,71 @@ def search_designs(
     results: Mapping[str, DesignResult],
     spec: SearchSpec,
     executor: Executor,
+    folder: RunFolder | None = None,
 ) -> dict[str, WorstCase]:
-    """Each design's searched worst case over the study's domain, by label, through ``executor``."""
-    futures = {}
+    """Each design's searched worst case over the study's domain, by label, through ``executor``.
+
+    With a run ``folder``, each search is saved as it finishes and found again by its inputs when the run resumes.
+    """
+    futures: dict[str, Any] = {}
     for index, (label, result) in enumerate(results.items()):
         start_q, start_directions = worst_samples(problems, result.impulses, spec.starts)
-        futures[label] = executor.submit(
-            _search_one,
-            problems.study,
-            result.design,
-            start_q,
-            start_directions,
-            spec.random_starts,
-            (spec.seed, index),
-        )
-    return {label: future.result() for label, future in futures.items()}
+        arguments = (result.design, start_q, start_directions, spec.random_starts, (spec.seed, index))
+        name = "search-" + _digest(np.asarray(result.x), start_q, start_directions, arguments[3:])
+        saved = _restored(folder.finished(name)) if folder is not None else None
+        if saved is not None:
+            futures[label] = saved
+        else:
+            futures[label] = (name, executor.submit(_search_one, problems.study, *arguments))
+    searches = {}
+    for label, pending in futures.items():
+        if isinstance(pending, WorstCase):
+            searches[label] = pending
+            continue
+        name, future = pending
+        searches[label] = future.result()
+        if folder is not None:
+            folder.save(name, _record(searches[label]))
+    return searches
+
+
+_FIELDS = [field.name for field in dataclasses.fields(WorstCase)]
+
+
+def _digest(*parts: Any) -> str:
+    """A short hash of a search's inputs: arrays by their bytes and shape, the rest by their text."""
+    digest = hashlib.sha256()
+    for part in parts:
+        if isinstance(part, np.ndarray):
+            digest.update(repr(part.shape).encode() + np.ascontiguousarray(part, dtype=float).tobytes())
+        else:
+            digest.update(repr(part).encode())
+    return digest.hexdigest()[:20]
+
+
+def _record(search: WorstCase) -> dict[str, Any]:
+    """A search as JSON types, every field with arrays as their shape and values (exact: floats as repr)."""
+    values = {}
+    for name in _FIELDS:
+        value = getattr(search, name)
+        if isinstance(value, np.ndarray):
+            value = {"shape": list(value.shape), "values": value.ravel().tolist()}
+        values[name] = value
+    return {"fields": _FIELDS, "values": values}
+
+
+def _restored(record: Mapping[str, Any] | None) -> WorstCase | None:
+    """The search a :func:`_record` holds; None for none, or one this version did not write (searched again)."""
+    if record is None or record.get("fields") != _FIELDS:
+        return None
+    try:
+        values = dict(record["values"])
+        for name, value in values.items():
+            if isinstance(value, dict):
+                values[name] = np.array(value["values"], dtype=float).reshape(value["shape"])
+        return WorstCase(**values)
+    except (KeyError, TypeError, ValueError):
+        return None
 
 
 def violators(
