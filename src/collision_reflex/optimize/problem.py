@@ -17,7 +17,7 @@ import numpy as np
 from ..errors import InvalidParameter
 from ..model import effective as formulas
 from .constraints import Constraints
-from .derivatives import SampleStructure, derivative_functions, structured_nlp
+from .derivatives import derivative_functions, structured_nlp
 from .design import layout_design
 from .duty import DutyRequirement
 from .evaluate import sample_impulses
@@ -129,14 +129,6 @@ class DesignProblem:
         return self.graph.evaluate
 
     @property
-    def _sample_function(self) -> ca.Function:
-        return self.graph.sample_function
-
-    @property
-    def _structure(self) -> SampleStructure:
-        return self.graph.structure
-
-    @property
     def requirement(self) -> str:
         """What sizes the actuators: ``"static (gravity only)"``, given torques, or the duty cycle's."""
         return self.constraints.requirement
@@ -154,14 +146,14 @@ class DesignProblem:
             finger_mass_directions(self.samples, masses, finger) / self.direction_scale[:, None]
         ).ravel()
         x[self.compliance_index] = np.log(reaction_compliance(self.samples, torques))
-        if impulses is None and (self.epigraph_index is not None or self.tail_index is not None):
-            impulses = self.numpy_impulses(x)
-        if self.epigraph_index is not None:
-            x[self.epigraph_index] = _epigraph_value(
-                impulses, self.samples, self.slowest_bound, self.objective_scale
-            )
-        if self.tail_index is not None:
-            x[self.tail_index] = _tail_values(impulses, self.samples, self.objective_scale)
+        if self.epigraph_index is not None or self.tail_index is not None:
+            values = self.numpy_impulses(x) if impulses is None else impulses
+            if self.epigraph_index is not None:
+                x[self.epigraph_index] = _epigraph_value(
+                    values, self.samples, self.slowest_bound, self.objective_scale
+                )
+            if self.tail_index is not None:
+                x[self.tail_index] = _tail_values(values, self.samples, self.objective_scale)
         return x
 
     def numpy_impulses(self, x: np.ndarray) -> np.ndarray:
@@ -208,7 +200,7 @@ class DesignProblem:
             joints = np.flatnonzero(loaded[s_index]).tolist()
             fractions = formulas.torque_fractions(ca.DM(w[s_index, joints]), peak_torque[joints])
             compliance = formulas.reaction_compliance(fractions)
-            impulse, *_ = self._sample_function(
+            impulse, *_ = self.graph.sample_function(
                 design_column, direction, compliance, ca.DM(self._nlp_inputs.data[:, s_index])
             )
             impulses.append(impulse)
@@ -231,8 +223,8 @@ class DesignProblem:
             else:
                 if self._structured is None:
                     self._structured = (
-                        structured_nlp(self._structure),
-                        derivative_functions(self._structure),
+                        structured_nlp(self.graph.structure),
+                        derivative_functions(self.graph.structure),
                     )
                 nlp, derivatives = self._structured
                 solver = ca.nlpsol(

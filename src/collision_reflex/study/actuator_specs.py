@@ -81,7 +81,7 @@ class GearboxSpec(Spec):
     efficiency: float | None = Field(
         None, gt=0, le=1, description="efficiency (0, 1] [-]; null: 1 (arm studies)"
     )
-    max_input_speed: AngularSpeed | None = Field(  # type: ignore[valid-type]
+    max_input_speed: AngularSpeed | None = Field(
         None, gt=0, description="maximum input speed [rad/s]; null: none (arm studies)"
     )
 

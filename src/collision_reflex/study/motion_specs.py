@@ -64,16 +64,16 @@ class DutyCycleSpec(Spec):
     via: builtins.list[builtins.list[JointPosition]] | None = Field(
         None, min_length=2, description="via configurations [rad], one position per joint, at least 2"
     )
-    max_speed: JointSpeed | None = Field(  # type: ignore[valid-type]
+    max_speed: JointSpeed | None = Field(
         None, description="joint speed limit [rad/s] (via only): one for all joints or by joint name"
     )
-    max_acceleration: JointAcceleration | None = Field(  # type: ignore[valid-type]
+    max_acceleration: JointAcceleration | None = Field(
         None, description="joint acceleration limit [rad/s^2] (via only): one for all joints or by joint name"
     )
-    dwell: Dwell | None = Field(  # type: ignore[valid-type]
+    dwell: Dwell | None = Field(
         None, description=f"rest at each via point [s] (via only; default {DEFAULT_DWELL:g} s)"
     )
-    rate: Rate | None = Field(  # type: ignore[valid-type]
+    rate: Rate | None = Field(
         None, gt=0, description=f"sampling rate [Hz] (via only; default {DEFAULT_RATE:g} Hz)"
     )
     payload: PayloadSpec | None = Field(
@@ -150,13 +150,13 @@ class RatingSpec(Spec):
         description="rated payload [kg], held still at every sampled configuration (the static hold) and carried "
         "in the rated motion; null: the payload the study carries (duty_cycle.payload or constraints.payload)",
     )
-    joint_speeds: JointSpeed | None = Field(  # type: ignore[valid-type]
+    joint_speeds: JointSpeed | None = Field(
         None, description="rated joint speeds [rad/s]: one for all joints or by joint name"
     )
-    joint_accelerations: JointAcceleration | None = Field(  # type: ignore[valid-type]
+    joint_accelerations: JointAcceleration | None = Field(
         None, description="rated joint accelerations [rad/s^2]: one for all joints or by joint name"
     )
-    stopping_time: StoppingTime | None = Field(  # type: ignore[valid-type]
+    stopping_time: StoppingTime | None = Field(
         None, description="time to stop from the rated speed [s] (needs joint_speeds): one or by joint name"
     )
 

@@ -17,7 +17,7 @@ import time
 from concurrent.futures import Executor
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, cast
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -48,6 +48,10 @@ from .schema import ArmStudy
 from .store import OutputFolderUnusable, RunFolder
 from .transmission_choice import choice_record, choose_transmissions
 from .worst_case import exchanges_samples, search_designs, violators
+
+if TYPE_CHECKING:
+    from ..optimize.worst_case import WorstCase
+    from ..record.run import RunRecord
 
 SMOKE_ENVIRONMENT = "CRX_SMOKE"
 """Set to 1 to run every study with small sample counts (tests, quick checks): see :func:`.resolve.smoke_study`."""
@@ -117,7 +121,7 @@ def run_study(
     started = time.perf_counter()
     stages = StageTimes()
     smoke = bool(os.environ.get(SMOKE_ENVIRONMENT, "")) if smoke is None else smoke
-    study, catalogue, transmissions, folder = _prepared(path, out, smoke, stages)
+    study, catalogue, transmissions, folder, chosen_before = _prepared(path, out, smoke, stages)
     execution = study.data.get("execution", {})
     kind = executor or execution.get("executor", "serial")
     if scheduler is None and kind == "dask":
@@ -142,8 +146,10 @@ def run_study(
             else:
                 with stages.stage("actuators"):
                     results, counts = _run_actuators(study.loaded, folder, progress)
+        if transmissions is not None:  # the gearbox choice is a piece of work too
+            counts = (counts[0], counts[1] + 1) if chosen_before else (counts[0] + 1, counts[1])
         progress.stop()
-        write_outputs(folder.path, results, figures=figures, stages=stages)
+        write_outputs(folder.path, cast("RunRecord", results), figures=figures, stages=stages)
     except OSError as error:  # a full disk, a folder made read-only meanwhile: finished pieces are kept
         progress.stop()
         with contextlib.suppress(OSError):
@@ -163,31 +169,30 @@ def run_study(
 
 def _prepared(
     path: str | os.PathLike[str], out: str | os.PathLike[str] | None, smoke: bool, stages: StageTimes
-) -> tuple[ResolvedStudy, SnapCatalogue | None, dict[str, Any] | None, RunFolder]:
-    """The study a run solves (resolved once), its catalogue, the gearbox choice and the run's folder, all checked.
+) -> tuple[ResolvedStudy, SnapCatalogue | None, dict[str, Any] | None, RunFolder, bool]:
+    """The study a run solves (resolved once), its catalogue, gearbox choice and folder, all checked.
 
     Every problem (robot, motors, samples, the problem build) is raised here, located in the file as written,
     before any output. The gearbox choice (:func:`.transmission_choice.choice_record`) is read from the folder
-    when an earlier run of the study made it.
+    when an earlier run of the study made it; the last element says whether it was.
     """
     with stages.stage("load"):
         loaded = load_study(path)
         study = resolve_study(loaded, smoke)
     folder = RunFolder(Path(out) if out is not None else default_output_folder(loaded, smoke))
-    transmissions = None
+    transmissions, saved = None, None
     if isinstance(loaded.study, ArmStudy) and isinstance(loaded.study.actuators.gearbox, list):
         with stages.stage("transmissions"):  # the best gearbox option per module, by the study's objective
-            written = study
-            study, tried = choose_transmissions(
-                loaded, study, folder.peek(TRANSMISSIONS)
-            )  # located as written
+            written, saved = study, folder.peek(TRANSMISSIONS)
+            study, tried = choose_transmissions(loaded, study, saved)  # located as written
             transmissions = choice_record(written, tried)
+    chosen_before = transmissions is not None and saved == transmissions
     with stages.stage("prepare"):
         if isinstance(loaded.study, ArmStudy):
             checked_setup(loaded, study)
-            return study, study_catalogue(study.loaded), transmissions, folder
+            return study, study_catalogue(study.loaded), transmissions, folder, chosen_before
         check_actuator_study(loaded)
-    return study, None, transmissions, folder
+    return study, None, transmissions, folder, chosen_before
 
 
 def _run_arm(
@@ -228,13 +233,16 @@ def _run_arm(
         )
         computed, reused = computed + counts[0], reused + counts[1]
         if not search.enabled:
-            searches = {}
+            searches: dict[str, WorstCase] = {}
             break
         designs = {
             "optimum": optimum,
             **(dict(zip(front.labels, front.points, strict=True)) if front else {}),
         }
-        searches = stages.timed("worst-case search", search_designs)(problems, designs, search, pool, folder)
+        searches, searched = stages.timed("worst-case search", search_designs)(
+            problems, designs, search, pool, folder
+        )
+        computed, reused = computed + searched[0], reused + searched[1]
         added = violators(designs, searches, search.tolerance)
         if not added or not exchanges_samples(study) or round_ == search.rounds - 1:
             break

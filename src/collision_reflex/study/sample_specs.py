@@ -84,7 +84,7 @@ class DomainSpec(Spec):
         "arm's reach (the largest base-to-contact distance); 0: no floor (near singular poses the finger mass, "
         "and so the worst case, is unbounded)",
     )
-    joint_speed_limit: JointSpeed | None = Field(  # type: ignore[valid-type]
+    joint_speed_limit: JointSpeed | None = Field(
         None,
         description="joint speed limits of the guarded move [rad/s], one for all or by joint name; null: the "
         "URDF's velocity limits (a joint without one is not limited)",

@@ -91,9 +91,10 @@ def search_designs(
     spec: SearchSpec,
     executor: Executor,
     folder: RunFolder | None = None,
-) -> dict[str, WorstCase]:
-    """Each design's searched worst case over the study's domain, by label, through ``executor``.
+) -> tuple[dict[str, WorstCase], tuple[int, int]]:
+    """Each design's searched worst case over the study's domain, by label, and the searches (run, found saved).
 
+    The searches run through ``executor``.
     With a run ``folder``, each search is saved as it finishes and found again by its inputs when the run resumes.
     """
     futures: dict[str, Any] = {}
@@ -115,7 +116,8 @@ def search_designs(
         searches[label] = future.result()
         if folder is not None:
             folder.save(name, _record(searches[label]))
-    return searches
+    reused = sum(isinstance(pending, WorstCase) for pending in futures.values())
+    return searches, (len(futures) - reused, reused)
 
 
 _FIELDS = [field.name for field in dataclasses.fields(WorstCase)]
