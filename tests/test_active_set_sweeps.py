@@ -213,7 +213,7 @@ def _designs(folder: Path) -> list[dict]:
 def test_a_study_with_many_samples_runs_on_active_sets_and_resumes(tmp_path):
     study = _study(tmp_path, "auto")  # 160 x 8 = 1,280 samples, those in the domain: above the threshold
     folder = tmp_path / "out"
-    run_study(study, folder, quiet=True, executor="serial")
+    run_study(study, folder, quiet=True, figures=False, executor="serial")
     designs = _designs(folder)
     results = json.loads((folder / "designs.json").read_text())
     count = len(results["samples"]["config_index"])  # drawn in the domain, and those the searches added
@@ -225,7 +225,7 @@ def test_a_study_with_many_samples_runs_on_active_sets_and_resumes(tmp_path):
         # is the largest of all impulses.
         assert len(design["impulses"]) == count
         assert design["objectives"]["worst_case_impulse"] == pytest.approx(max(design["impulses"]), rel=1e-12)
-    again = run_study(study, folder, quiet=True, executor="serial")
+    again = run_study(study, folder, quiet=True, figures=False, executor="serial")
     assert again.resumed and again.computed == 0
     assert _designs(folder) == designs
 
@@ -259,8 +259,8 @@ def _without_times(value):
 
 def test_a_study_on_active_sets_gives_the_serial_numbers_through_a_process_pool(tmp_path):
     study = _study(tmp_path, "always", count=40)  # 320 samples: the executors' agreement, not the scale
-    run_study(study, tmp_path / "serial", quiet=True, executor="serial")
-    run_study(study, tmp_path / "pool", quiet=True, executor="processes")
+    run_study(study, tmp_path / "serial", quiet=True, figures=False, executor="serial")
+    run_study(study, tmp_path / "pool", quiet=True, figures=False, executor="processes")
     serial, pool = _designs(tmp_path / "serial"), _designs(tmp_path / "pool")
     assert all(d["solver"]["method"] == "active set" for d in serial)
     assert _without_times(pool) == _without_times(serial)

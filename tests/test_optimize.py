@@ -155,8 +155,8 @@ def test_per_sample_derivatives_equal_casadis_of_the_whole_nlp(arm, technology, 
             ca.hessian(lagrangian, nlp["x"])[0],
         ],
     )
-    ours = derivative_functions(problem._structure)
-    split = structured_nlp(problem._structure)
+    ours = derivative_functions(problem.graph.structure)
+    split = structured_nlp(problem.graph.structure)
     values = ca.Function("values", [split["x"], split["p"]], [split["f"], split["g"]])
     original = ca.Function("original", [nlp["x"], nlp["p"]], [nlp["f"], nlp["g"]])
     for _ in range(3):  # random points: off the start, and random multipliers

@@ -61,12 +61,15 @@ def build():
 def test_solvers_share_one_structured_nlp_and_match_casadis_own(build):
     problem = build("worst_case_impulse", ("actuator_mass",))
     shared = problem.solver(DEFAULT_IPOPT_OPTIONS)
-    structured = problem._structured
+    structured = problem.graph.structured
     problem.solver({**DEFAULT_IPOPT_OPTIONS, "ipopt.mu_strategy": "adaptive"})
-    assert problem._structured is structured and len(problem._solvers) == 2
+    assert problem.graph.structured is structured and len(problem._solvers) == 2
     # Independent: CasADi expanding the NLP as built, with the same derivative functions.
     own = ca.nlpsol(
-        "own", "ipopt", problem.nlp, {**DEFAULT_IPOPT_OPTIONS, **derivative_functions(problem._structure)}
+        "own",
+        "ipopt",
+        problem.nlp,
+        {**DEFAULT_IPOPT_OPTIONS, **derivative_functions(problem.graph.structure)},
     )
     bounds = dict(lbx=problem.lbx, ubx=problem.ubx, lbg=problem.lbg, ubg=problem.ubg, p=problem.parameters())
     a, b = shared(x0=problem.x0, **bounds), own(x0=problem.x0, **bounds)

@@ -136,6 +136,7 @@ def test_an_interrupted_ipopt_run_raises_keyboard_interrupt_and_is_not_retried(m
 
 
 def test_serial_and_process_pool_runs_give_byte_identical_result_files(smoke_runs, tmp_path):
+    """Every number, the catalogue design and its snap included (designs.json), to the last bit."""
     serial = smoke_runs["two_link_paper"]  # the serial run
     completed = _crx(
         "run",
@@ -293,20 +294,16 @@ def test_a_resumed_run_removes_stale_temporary_files(two_link_run, tmp_path):
     assert fresh.exists()
 
 
-def test_output_files_get_the_umask_mode(tmp_path):
+def test_a_smoke_run_has_its_own_default_folder_and_its_files_get_the_umask_mode(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
     previous = os.umask(0o027)
     try:
-        assert _run(tmp_path / "out") == 0
+        assert main(["run", str(TWO_LINK), "--smoke", "--quiet", "--executor", "serial"]) == 0
     finally:
         os.umask(previous)
-    files = [p for p in (tmp_path / "out").rglob("*") if p.is_file()]
-    assert files and {p.stat().st_mode & 0o777 for p in files} == {0o640}
-
-
-def test_a_smoke_run_has_its_own_default_folder(tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)
-    assert main(["run", str(TWO_LINK), "--smoke", "--quiet", "--executor", "serial"]) == 0
     assert [p.name for p in (tmp_path / "results").iterdir()] == ["two-link-paper-smoke"]
+    files = [p for p in (tmp_path / "results").rglob("*") if p.is_file()]
+    assert files and {p.stat().st_mode & 0o777 for p in files} == {0o640}
 
 
 @pytest.mark.parametrize(
