@@ -61,9 +61,9 @@ def build():
 def test_solvers_share_one_structured_nlp_and_match_casadis_own(build):
     problem = build("worst_case_impulse", ("actuator_mass",))
     shared = problem.solver(DEFAULT_IPOPT_OPTIONS)
-    structured = problem.graph.structured
+    structured = problem._structured
     problem.solver({**DEFAULT_IPOPT_OPTIONS, "ipopt.mu_strategy": "adaptive"})
-    assert problem.graph.structured is structured and len(problem._solvers) == 2
+    assert problem._structured is structured and len(problem._solvers) == 2
     # Independent: CasADi expanding the NLP as built, with the same derivative functions.
     own = ca.nlpsol(
         "own",
