@@ -20,6 +20,10 @@ from collision_reflex.plots.torque_speed import JointOperatingPoints
 from collision_reflex.study.arm_results import SAVED_DIGITS, JointTorqueSpeed
 from collision_reflex.study.problems import StudyProblems
 
+pytestmark = pytest.mark.xdist_group(
+    "test_report_torque_speed"
+)  # one pytest-xdist worker: the cycle run made once
+
 ROOT = Path(__file__).resolve().parents[1]
 TWO_LINK = ROOT / "studies" / "two_link_paper.yaml"
 # A short via-point cycle with a payload, in place of the paper study's given torques (the two exclude each
