@@ -1,5 +1,13 @@
 """The collision-reflex model: plain arithmetic that works on floats, NumPy arrays and CasADi symbols alike."""
 
+from .contact import (
+    TransientContact,
+    contact_robot_mass,
+    iso_robot_mass,
+    permissible_speed,
+    reduced_mass,
+    transient_contact,
+)
 from .impulse import (
     PhaseImpulses,
     collision_times,
@@ -15,14 +23,20 @@ from .sensing import current_threshold_torque, threshold_force
 
 __all__ = [
     "PhaseImpulses",
+    "TransientContact",
     "collision_times",
+    "contact_robot_mass",
     "current_threshold_torque",
     "force_profile",
+    "iso_robot_mass",
     "minimum_impulse",
     "optimal_velocity",
+    "permissible_speed",
     "phase_impulses",
+    "reduced_mass",
     "series_stiffness",
     "threshold_force",
     "total_impulse",
+    "transient_contact",
     "velocity_coefficients",
 ]

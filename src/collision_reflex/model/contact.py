@@ -1,0 +1,150 @@
+"""Transient contacts with a compliant object: a human body region as a spring with an effective mass.
+
+A collaborative robot does not only touch rigid objects. ISO/TS 15066 (Annex A, now ISO 10218-2:2025 Annex A)
+models a body region as a linear spring ``k_c`` with an effective body mass ``m_H``, and the robot as one mass
+``m_R`` moving at ``v`` along the contact direction. Two free masses joined at contact by a linear spring exchange
+their relative kinetic energy with the spring: the reduced mass ``mu = m_R m_H / (m_R + m_H)`` compresses it by
+``v sqrt(mu / k_c)``, so the transient (peak) contact force is ``F = v sqrt(mu k_c)``, reached a quarter period
+after first touch, and the contact lasts half a period, ``pi sqrt(mu / k_c)``. The speed at which a region's
+permissible transient force ``F_T`` is just reached is ``v = F_T / sqrt(mu k_c)``.
+
+Which robot mass takes part depends on how fast the contact is against the joint's own spring. The robot is a
+finger mass ``m_f`` (structure ahead of the joint springs) and the mass behind the springs ``m_r`` (the reflected
+rotor inertia when the transmission is compliant), joined by ``k_m``. A contact much stiffer than the joint
+(``k_c >= 100 k_m``) is over before the joint spring loads: the finger alone hits, ``m_R = m_f``. A contact much
+softer (``k_c <= 0.01 k_m``) lasts long enough for the stiff joint to carry the rotor along: ``m_R = m_f + m_r``.
+In between, the first peak lies between the two (checked against the time-domain simulator,
+``tests/test_contact.py``), and the coupled mass is the conservative bound.
+
+Integrators without a dynamic model take the robot's mass as ISO/TS 15066 (Annex A) estimates it:
+``m_R = M / 2 + m_L``, half the moving mass plus the payload; :func:`iso_robot_mass` gives it for comparison.
+
+Every function accepts floats, NumPy arrays (broadcast) and CasADi symbols. SI units: kg, N/m, m/s, N, s.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .. import _validate
+from .._backend import is_symbolic, sqrt
+
+DECOUPLED_STIFFNESS_RATIO = 100.0
+"""``k_c / k_m`` at and above which the finger alone meets the contact: its first peak is within 0.1 % of the
+finger-only closed form in the simulator (``tests/test_contact.py`` checks 1 % over 100 to 10,000)."""
+COUPLED_STIFFNESS_RATIO = 0.01
+"""``k_c / k_m`` at and below which finger and rotor meet the contact as one mass (within 0.3 % in the
+simulator; ``tests/test_contact.py`` checks 1 % over 0.0001 to 0.01)."""
+
+
+@dataclass(frozen=True)
+class TransientContact:
+    """A transient contact of a robot mass with a body region (floats, arrays or CasADi expressions).
+
+    reduced_mass [kg]: ``mu = m_R m_H / (m_R + m_H)``; peak_force [N]: ``v sqrt(mu k_c)``; duration [s]: ``pi
+    sqrt(mu / k_c)``, first touch to separation; compression [m]: the spring's largest compression,
+    ``v sqrt(mu / k_c)``.
+    """
+
+    reduced_mass: Any
+    peak_force: Any
+    duration: Any
+    compression: Any
+
+
+def reduced_mass(robot_mass: Any, body_mass: Any = math.inf) -> Any:
+    """``mu = m_R m_H / (m_R + m_H)`` [kg]; an infinite ``body_mass`` (a fixed object) gives ``m_R``.
+
+    Parameters
+    ----------
+    robot_mass: the robot's effective mass along the contact direction [kg], > 0, finite.
+    body_mass: the body region's effective mass [kg], > 0 (``inf`` for a fixed, rigidly supported object).
+    """
+    m_R = _validate.positive("robot_mass", robot_mass)
+    m_H = _validate.positive("body_mass", body_mass, allow_inf=True)
+    return _plain(1 / (1 / m_R + 1 / m_H))  # an infinite body mass drops out exactly
+
+
+def transient_contact(
+    velocity: Any, robot_mass: Any, contact_stiffness: Any, body_mass: Any = math.inf
+) -> TransientContact:
+    """Peak force, duration and compression of a robot mass meeting a body region at ``velocity``.
+
+    Parameters
+    ----------
+    velocity: relative speed along the contact direction at first touch [m/s], > 0.
+    robot_mass: the robot's effective mass [kg] (:func:`contact_robot_mass` says which one).
+    contact_stiffness: the body region's spring constant ``k_c`` [N/m], > 0, finite.
+    body_mass: the region's effective mass ``m_H`` [kg] (default ``inf``: a fixed object).
+    """
+    v = _validate.positive("velocity", velocity)
+    k_c = _validate.positive("contact_stiffness", contact_stiffness)
+    mu = reduced_mass(robot_mass, body_mass)
+    return TransientContact(
+        reduced_mass=mu,
+        peak_force=_plain(v * sqrt(mu * k_c)),
+        duration=_plain(math.pi * sqrt(mu / k_c)),
+        compression=_plain(v * sqrt(mu / k_c)),
+    )
+
+
+def permissible_speed(
+    force_limit: Any, robot_mass: Any, contact_stiffness: Any, body_mass: Any = math.inf
+) -> Any:
+    """The approach speed [m/s] at which the transient contact force just reaches ``force_limit`` [N].
+
+    ``v = F_T / sqrt(mu k_c)``, the relation of ISO/TS 15066:2016 Annex A between a region's permissible force and
+    speed; the other arguments as :func:`transient_contact`.
+    """
+    F_T = _validate.positive("force_limit", force_limit)
+    k_c = _validate.positive("contact_stiffness", contact_stiffness)
+    return _plain(F_T / sqrt(reduced_mass(robot_mass, body_mass) * k_c))
+
+
+def contact_robot_mass(
+    finger_mass: Any, rotor_mass: Any, contact_stiffness: Any, mechanical_stiffness: Any
+) -> tuple[Any, Any]:
+    """The robot mass a contact meets [kg], and whether that mass is exact (``True``) or a bound.
+
+    ``finger_mass`` ``m_f`` is ahead of the joint springs ``k_m``, ``rotor_mass`` ``m_r`` (the reflected rotor
+    inertia, an effective mass) behind them. With ``k_c >= 100 k_m`` the finger alone (exact); with
+    ``k_c <= 0.01 k_m`` finger and rotor together (exact); in between ``m_f + m_r``, which bounds the first peak
+    from above (not exact). Numeric inputs only for the choice: CasADi symbols get the coupled mass and
+    ``False``.
+    """
+    m_f = _validate.positive("finger_mass", finger_mass)
+    m_r = _validate.non_negative("rotor_mass", rotor_mass)
+    k_c = _validate.positive("contact_stiffness", contact_stiffness)
+    k_m = _validate.positive("mechanical_stiffness", mechanical_stiffness, allow_inf=True)
+    coupled = m_f + m_r
+    if is_symbolic(m_f, m_r, k_c, k_m):
+        return coupled, False
+    ratio = np.asarray(k_c, dtype=float) / np.asarray(k_m, dtype=float)
+    decoupled = ratio >= DECOUPLED_STIFFNESS_RATIO
+    mass = np.where(decoupled, m_f, coupled)
+    exact = decoupled | (ratio <= COUPLED_STIFFNESS_RATIO)
+    if mass.ndim == 0:
+        return float(mass), bool(exact)
+    return mass, exact
+
+
+def iso_robot_mass(moving_mass: Any, payload: Any = 0.0) -> Any:
+    """The robot's effective mass as ISO/TS 15066 estimates it without a dynamic model [kg].
+
+    ``m_R = M / 2 + m_L`` (ISO/TS 15066:2016, Annex A): ``moving_mass`` ``M`` [kg] is the total
+    mass of the robot's moving parts, ``payload`` ``m_L`` [kg] the effective payload and tool.
+    """
+    M = _validate.positive("moving_mass", moving_mass)
+    m_L = _validate.non_negative("payload", payload)
+    return _plain(M / 2 + m_L)
+
+
+def _plain(value: Any) -> Any:
+    """A numeric scalar as a Python float; arrays and CasADi expressions as they are."""
+    if is_symbolic(value) or np.ndim(value):
+        return value
+    return float(value)
