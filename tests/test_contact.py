@@ -12,6 +12,7 @@ from collision_reflex.errors import InvalidParameter
 from collision_reflex.model import (
     contact_robot_mass,
     iso_robot_mass,
+    load_body_regions,
     permissible_speed,
     reduced_mass,
     transient_contact,
@@ -24,6 +25,10 @@ def test_the_permissible_speed_of_a_hand_is_the_hand_calculation():
     # limit of 280 N: mu = 10 * 0.6 / 10.6 = 0.56604 kg, sqrt(mu k) = sqrt(0.56604 * 75,000) = 206.04 N s/m,
     # v = 280 / 206.04 = 1.3590 m/s.
     assert permissible_speed(280.0, 10.0, 75e3, 0.6) == pytest.approx(1.3590, rel=1e-4)
+    hand = load_body_regions()["hand_finger"]  # the standard's figures, as packaged
+    assert permissible_speed(hand.transient_force, 10.0, hand.stiffness, hand.mass) == pytest.approx(
+        1.3590, rel=1e-4
+    )
     assert reduced_mass(10.0, 0.6) == pytest.approx(0.56604, rel=1e-4)
     # A fixed object (no body mass) leaves the robot mass alone: v = 280 / sqrt(10 * 75,000) = 0.32332 m/s.
     assert permissible_speed(280.0, 10.0, 75e3) == pytest.approx(0.32332, rel=1e-4)

@@ -86,5 +86,9 @@ ExportFormat = Literal["urdf", "mjcf"]
 """The robot formats a design is exported to."""
 EXPORT_FORMATS: tuple[ExportFormat, ...] = get_args(ExportFormat)
 
+DesignChoice = Literal["recommended", "chosen"]
+"""A run's designs named by word: the recommended design and the single-objective optimum as solved."""
+DESIGN_CHOICES: tuple[DesignChoice, ...] = get_args(DesignChoice)
+
 TIME_COLUMN_NAMES: tuple[str, ...] = ("time", "t")
 """The names a CSV file's time column may have (force traces, duty cycles), compared without case."""

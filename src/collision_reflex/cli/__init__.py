@@ -36,6 +36,7 @@ SUBCOMMANDS = (
     "run",
     "report",
     "export",
+    "safety",
 )
 
 

@@ -244,11 +244,13 @@ class Option:
         shown: str | None = None,
         bound: Bound | None = None,
         nargs: int | str | None = None,
+        required: bool = False,
     ) -> None:
         """Add the option to ``parser``.
 
         ``default`` is a value in the option's unit (or text, parsed like the command line); ``shown`` is how
-        the help writes it (default: the value itself); ``note`` follows the unit in the help.
+        the help writes it (default: the value itself); ``note`` follows the unit in the help; a ``required``
+        option must be given.
         """
         parse = QuantityParser(self.quantity, bound or self.bound, self.allow_inf, self.allow_none, self.form)
         text = f"{self.what} [{self.quantity.label}]"
@@ -263,6 +265,8 @@ class Option:
         if isinstance(nargs, int):
             metavar = tuple("XYZ"[:nargs])
         extra: dict[str, Any] = {} if nargs is None else {"nargs": nargs}
+        if required:
+            extra["required"] = True
         parser.add_argument(
             self.flag,
             dest=self.dest,
@@ -334,6 +338,21 @@ FORCE_LIMIT = Option(
     hint="the reaction is a = F_a / m_r",
 )
 APPROACH_VELOCITY = Option("--velocity", "v0", VELOCITY, "approach (pre-impact) velocity v0")
+# A human body region (ISO/TS 15066 Annex A): a spring with an effective mass and a force limit.
+REGION_STIFFNESS = Option(
+    "--region-stiffness", "region_stiffness", LINEAR_STIFFNESS, "the body region's spring constant k_c"
+)
+REGION_MASS = Option(
+    "--region-mass",
+    "region_mass",
+    MASS,
+    "the body region's effective mass m_H",
+    allow_inf=True,
+    hint="'inf' for a region held against something",
+)
+TRANSIENT_FORCE = Option(
+    "--transient-force", "transient_force", FORCE, "the body region's permissible transient contact force F_T"
+)
 APPROACH_VELOCITIES = APPROACH_VELOCITY.values("--velocities", "velocities", "approach velocities")
 TRACE_VELOCITY = Option(
     "--trace-velocity", "trace_velocity", VELOCITY, "approach velocity of the --trace-plot simulation"

@@ -12,10 +12,10 @@ from pathlib import Path
 
 from .._io import atomic_open
 from ..errors import CollisionReflexError, InvalidParameter
-from ..vocabulary import EXPORT_FORMATS
+from ..vocabulary import DESIGN_CHOICES, EXPORT_FORMATS
 from .armature import armature_record, companion_path, set_armature
 from .mjcf import design_mjcf
-from .run_design import DESIGN_CHOICES, RunDesign, read_run_design
+from .run_design import RunDesign, read_run_design
 from .urdf import design_urdf
 
 __all__ = [

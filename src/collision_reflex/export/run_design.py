@@ -20,7 +20,7 @@ from ..hardware.gearboxes import load_gearbox_catalogue
 from ..hardware.motors import scaled_motor_quantities
 from ..record.checked import ResultsDamaged, ResultsMissing
 from ..record.design import DesignRecord, JointRecord, QuickSnap
-from ..record.read import checked_run_record, read_saved_record
+from ..record.read import checked_run_record, pick_design, read_saved_record
 from ..record.run import ArmRunRecord
 from ..report.files import DESIGNS
 from ..study.load import parse_study
@@ -32,8 +32,6 @@ if TYPE_CHECKING:
     from ..arm import Arm
 
 RESOLVED = "study.resolved.yaml"
-DESIGN_CHOICES = ("recommended", "chosen")
-"""Designs named by word: the run's recommended design and its single-objective optimum as solved."""
 
 
 @dataclass(frozen=True)
@@ -126,7 +124,7 @@ def read_run_design(run_dir: str | os.PathLike[str], design: str | int = "recomm
         )
     results = checked_run_record(data, path)
     assert results["kind"] == "arm"  # checked above
-    label, record = _pick(results, design, path)
+    label, record = pick_design(results, design)
     resolved = folder / RESOLVED
     if not resolved.is_file():
         raise ResultsMissing(f"{folder} has no {RESOLVED}: run the study again")
@@ -139,31 +137,6 @@ def read_run_design(run_dir: str | os.PathLike[str], design: str | int = "recomm
             raise
         what = f"field {error.args[0]!r} is missing" if isinstance(error, KeyError) else str(error)
         raise ResultsDamaged(f"{path}: {' '.join(what.split())}; run the study again") from None
-
-
-def _pick(results: ArmRunRecord, design: str | int, path: Path) -> tuple[str, DesignRecord]:
-    """The label and record of ``design`` in the results."""
-    points = results["pareto"]["points"]
-    if isinstance(design, str) and design.isdigit():
-        design = int(design)
-    if isinstance(design, int) and not isinstance(design, bool):
-        if not 0 <= design < len(points):
-            raise InvalidParameter(
-                "design",
-                design,
-                f"a Pareto design 0 to {len(points) - 1}"
-                if points
-                else "'recommended' (the run has no Pareto front)",
-                f"or one of {', '.join(DESIGN_CHOICES)}",
-            )
-        return f"Pareto design {design} ({points[design].get('label', '')})", points[design]
-    if design not in DESIGN_CHOICES:
-        raise InvalidParameter(
-            "design", design, f"a Pareto design number or one of {', '.join(DESIGN_CHOICES)}"
-        )
-    record = results["recommended"] if design == "recommended" else results["chosen"]
-    source = record.get("source") or record.get("label", "")
-    return f"{design} design ({source})" if source else f"{design} design", record
 
 
 def _run_design(results: ArmRunRecord, record: DesignRecord, label: str, resolved: Path) -> RunDesign:

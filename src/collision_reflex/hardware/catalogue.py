@@ -43,6 +43,9 @@ _GEARBOX_OPTIONAL_UNITS = {
     "diameter": "m",
     "length": "m",
 }
+# A human body region (ISO/TS 15066 Annex A): a spring with an effective mass, and its force limits.
+_BODY_REGION_UNITS = {"stiffness": "N/m", "mass": "kg", "quasi_static_force": "N"}
+_BODY_REGION_OPTIONAL_UNITS = {"transient_force": "N"}  # none where no transient contact is permitted
 _PROVENANCE = ("source", "sources", "estimates")
 # Optional text fields that describe a part; returned apart from the numbers (CatalogueEntry.description).
 _DESCRIPTIVE = ("maker", "construction")
@@ -223,6 +226,17 @@ class CatalogueEntry:
     description: dict[str, str]
 
 
+class _BodyRegionEntry(_Cited):
+    """One body region; every number in SI after validation."""
+
+    stiffness: float
+    mass: float
+    quasi_static_force: float
+    transient_force: float | None = None
+
+    _si, _physical = _quantity_validators(_BODY_REGION_UNITS, _BODY_REGION_OPTIONAL_UNITS)
+
+
 # kind -> (schema, required fields, optional fields), the last two for error messages.
 _KINDS: dict[str, tuple[type[_Cited], list[str], list[str]]] = {
     "motors": (
@@ -234,6 +248,11 @@ _KINDS: dict[str, tuple[type[_Cited], list[str], list[str]]] = {
         _GearboxEntry,
         ["kind", "ratios or ratio_range", *_GEARBOX_UNITS, "source"],
         ["efficiency", "stages", *_GEARBOX_OPTIONAL_UNITS, "sources", "estimates", "maker"],
+    ),
+    "body_regions": (
+        _BodyRegionEntry,
+        [*_BODY_REGION_UNITS, "source"],
+        [*_BODY_REGION_OPTIONAL_UNITS, "sources", "estimates"],
     ),
 }
 
@@ -280,7 +299,8 @@ def read_entries(path: Path, kind: str = "motors") -> dict[str, CatalogueEntry]:
     path : Path
         The YAML file.
     kind : str
-        ``"motors"`` or ``"gearboxes"``: the file's one top-level key and the entries' schema.
+        ``"motors"``, ``"gearboxes"`` or ``"body_regions"``: the file's one top-level key and the entries'
+        schema.
 
     Raises
     ------
@@ -413,8 +433,14 @@ def _entry(file: str, kind: str, part: str, key_node: Any, entry_node: Any) -> C
         raise refuse("momentary_torque", "is below the (repeated) peak torque")
     if kind == "gearboxes":
         _check_ratios(values, fields, refuse, file, key_node, where)
-    else:
+    elif kind == "motors":
         _check_inertia(values, refuse)
+    elif values["transient_force"] is not None and values["transient_force"] < values["quasi_static_force"]:
+        raise refuse(
+            "transient_force",
+            f"{values['transient_force']:g} N is below the quasi-static force {values['quasi_static_force']:g} N "
+            "(ISO/TS 15066 allows a transient contact at least the quasi-static force)",
+        )
     description = {key: values.pop(key) for key in _DESCRIPTIVE if key in values}
     description = {key: text for key, text in description.items() if text is not None}
     given = [key for key in fields if key not in (*_PROVENANCE, *_DESCRIPTIVE)]

@@ -1,9 +1,11 @@
 """The collision-reflex model: plain arithmetic that works on floats, NumPy arrays and CasADi symbols alike."""
 
 from .contact import (
+    BodyRegion,
     TransientContact,
     contact_robot_mass,
     iso_robot_mass,
+    load_body_regions,
     permissible_speed,
     reduced_mass,
     transient_contact,
@@ -22,6 +24,7 @@ from .impulse import (
 from .sensing import current_threshold_torque, threshold_force
 
 __all__ = [
+    "BodyRegion",
     "PhaseImpulses",
     "TransientContact",
     "collision_times",
@@ -29,6 +32,7 @@ __all__ = [
     "current_threshold_torque",
     "force_profile",
     "iso_robot_mass",
+    "load_body_regions",
     "minimum_impulse",
     "optimal_velocity",
     "permissible_speed",

@@ -1,6 +1,6 @@
 """Transient contacts with a compliant object: a human body region as a spring with an effective mass.
 
-A collaborative robot does not only touch rigid objects. ISO/TS 15066 (Annex A, now ISO 10218-2:2025 Annex A)
+A collaborative robot does not only touch rigid objects. ISO/TS 15066 (Annex A, carried into ISO 10218-2:2025)
 models a body region as a linear spring ``k_c`` with an effective body mass ``m_H``, and the robot as one mass
 ``m_R`` moving at ``v`` along the contact direction. Two free masses joined at contact by a linear spring exchange
 their relative kinetic energy with the spring: the reduced mass ``mu = m_R m_H / (m_R + m_H)`` compresses it by
@@ -25,7 +25,9 @@ Every function accepts floats, NumPy arrays (broadcast) and CasADi symbols. SI u
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -39,6 +41,54 @@ finger-only closed form in the simulator (``tests/test_contact.py`` checks 1 % o
 COUPLED_STIFFNESS_RATIO = 0.01
 """``k_c / k_m`` at and below which finger and rotor meet the contact as one mass (within 0.3 % in the
 simulator; ``tests/test_contact.py`` checks 1 % over 0.0001 to 0.01)."""
+
+
+@dataclass(frozen=True)
+class BodyRegion:
+    """A human body region as ISO/TS 15066 models it: a spring with an effective mass, and its force limits.
+
+    name: what it is called; stiffness: its effective spring constant ``k_c`` [N/m]; mass: its effective mass
+    ``m_H`` [kg] (``inf`` for a region held against something); transient_force: the largest permissible
+    transient contact force ``F_T`` [N] (None where the standard permits no transient contact);
+    quasi_static_force: the largest permissible quasi-static (clamping) force [N], None when not given.
+    The standard's regions are :func:`load_body_regions`.
+    """
+
+    name: str
+    stiffness: float
+    mass: float
+    transient_force: float | None
+    quasi_static_force: float | None = None
+
+    def __post_init__(self) -> None:
+        _validate.positive("stiffness", self.stiffness)
+        _validate.positive("mass", self.mass, allow_inf=True)
+        for name in ("transient_force", "quasi_static_force"):
+            if getattr(self, name) is not None:
+                _validate.positive(name, getattr(self, name))
+
+
+def load_body_regions(path: str | os.PathLike[str] | None = None) -> dict[str, BodyRegion]:
+    """The body regions of a YAML file, by name (default: the standard's, the packaged ``designs/body_regions.yaml``).
+
+    The file has a top-level ``body_regions`` mapping from name to entry; each entry gives ``stiffness``,
+    ``mass``, ``quasi_static_force``, optionally ``transient_force``, and a ``source`` (per-field ``sources`` and
+    ``estimates`` as in the catalogues). Numbers are plain SI or strings with units (``"75 N/mm"``). Bad input
+    raises :class:`~collision_reflex.errors.CatalogueError` naming the file, the line and the field.
+    """
+    from ..hardware.catalogue import packaged_catalogue_path, read_entries  # lazy: pydantic, yaml
+
+    target = Path(path) if path is not None else packaged_catalogue_path("body_regions.yaml")
+    return {
+        name: BodyRegion(
+            name,
+            entry.fields["stiffness"],
+            entry.fields["mass"],
+            entry.fields["transient_force"],
+            entry.fields["quasi_static_force"],
+        )
+        for name, entry in read_entries(target, "body_regions").items()
+    }
 
 
 @dataclass(frozen=True)

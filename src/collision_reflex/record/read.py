@@ -14,7 +14,10 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from ..errors import InvalidParameter
+from ..vocabulary import DESIGN_CHOICES
 from .checked import ResultsDamaged, ResultsMissing
+from .design import DesignRecord
 from .run import RUN_KINDS, ActuatorRunRecord, ArmRunRecord, RunRecord
 
 if TYPE_CHECKING:
@@ -137,3 +140,33 @@ def _dotted(loc: list[Any]) -> str:
     for part in loc:
         text += f"[{part}]" if isinstance(part, int) else f".{part}" if text else str(part)
     return text
+
+
+def pick_design(results: ArmRunRecord, design: str | int) -> tuple[str, DesignRecord]:
+    """The label and record of ``design`` in a run's results.
+
+    ``design``: ``"recommended"``, ``"chosen"`` (the single-objective optimum) or the index of a Pareto design
+    (as ``pareto.csv``'s ``point`` column numbers them, also as text). Raises :class:`InvalidParameter` for
+    any other.
+    """
+    points = results["pareto"]["points"]
+    if isinstance(design, str) and design.isdigit():
+        design = int(design)
+    if isinstance(design, int) and not isinstance(design, bool):
+        if not 0 <= design < len(points):
+            raise InvalidParameter(
+                "design",
+                design,
+                f"a Pareto design 0 to {len(points) - 1}"
+                if points
+                else "'recommended' (the run has no Pareto front)",
+                f"or one of {', '.join(DESIGN_CHOICES)}",
+            )
+        return f"Pareto design {design} ({points[design].get('label', '')})", points[design]
+    if design not in DESIGN_CHOICES:
+        raise InvalidParameter(
+            "design", design, f"a Pareto design number or one of {', '.join(DESIGN_CHOICES)}"
+        )
+    record = results["recommended"] if design == "recommended" else results["chosen"]
+    source = record.get("source") or record.get("label", "")
+    return f"{design} design ({source})" if source else f"{design} design", record
