@@ -12,12 +12,12 @@ from collision_reflex.errors import InvalidParameter
 from collision_reflex.model import (
     contact_robot_mass,
     iso_robot_mass,
-    load_body_regions,
     permissible_speed,
     reduced_mass,
     transient_contact,
 )
 from collision_reflex.simulate import CollisionSetup, Detection, simulate
+from collision_reflex.study.safety import load_body_regions
 
 
 def test_the_permissible_speed_of_a_hand_is_the_hand_calculation():

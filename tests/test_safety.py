@@ -15,8 +15,8 @@ import pytest
 
 from collision_reflex.cli import main
 from collision_reflex.errors import CatalogueError, InvalidParameter
-from collision_reflex.model.contact import BodyRegion, load_body_regions
-from collision_reflex.study.safety import speed_map
+from collision_reflex.model.contact import BodyRegion
+from collision_reflex.study.safety import load_body_regions, speed_map
 
 ROOT = Path(__file__).resolve().parents[1]
 URDF = ROOT / "designs" / "planar_two_link.urdf"
@@ -255,3 +255,26 @@ def test_crx_safety_takes_a_named_region_and_refuses_one_without_a_transient_for
     assert "permits no transient contact with face" in capsys.readouterr().err
     assert main(["safety", "--list-regions"]) == 0
     assert "hand_finger: k_c 75 N/mm, m_H 0.6 kg, F_T 280 N" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("name", ["ur5", "panda"])
+def test_an_arm_study_s_run_keeps_every_region_and_its_report_shows_the_most_limiting(smoke_runs, name):
+    folder = smoke_runs[name]
+    record = json.loads((folder / "designs.json").read_text())["human_contact"]
+    regions = load_body_regions()
+    assert [row["region"] for row in record["regions"]] == [
+        n for n, r in regions.items() if r.transient_force is not None
+    ]
+    assert record["no_transient"] == ["skull_forehead", "face"]
+    chest = next(row for row in record["regions"] if row["region"] == "chest")
+    again = speed_map(folder, regions["chest"])  # what crx safety computes from the folder
+    assert chest["slowest"] == pytest.approx(float(np.min(again.speed)), rel=1e-12)
+    assert chest["iso_speed"] == pytest.approx(again.iso_speed, rel=1e-12)
+    assert chest["above_approach"] == int(np.sum(again.approach_velocity > again.speed))
+    report = (folder / "report.html").read_text()
+    section = report[
+        report.index('id="human-contact"') : report.index("</table>", report.index('id="human-contact"'))
+    ]
+    limiting = sorted(record["regions"], key=lambda row: row["slowest"])[:3]
+    assert all(row["region"].replace("_", " ") in section for row in limiting)
+    assert "M/2 + payload" in section and f"{record['samples']} contact samples" in section

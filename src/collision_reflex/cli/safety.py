@@ -8,6 +8,7 @@ import dataclasses
 
 from .._io import atomic_open
 from ..errors import InvalidParameter
+from ..model.contact import BodyRegion
 from ..vocabulary import DESIGN_CHOICES
 from . import options
 
@@ -54,7 +55,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``crx safety`` with parsed ``args``; return the exit status."""
-    from ..model.contact import BodyRegion, load_body_regions  # lazy: pydantic and yaml (the region file)
+    from ..study.safety import load_body_regions, speed_map  # lazy: casadi and pinocchio (the run's study)
 
     regions = load_body_regions(args.regions)
     if args.list_regions:
@@ -86,8 +87,6 @@ def run(args: argparse.Namespace) -> int:
         region = BodyRegion("body region", **figures)
     if args.run_dir is None:
         raise InvalidParameter("RUN_DIR", "missing", "the output folder of `crx run` of an arm study")
-    from ..study.safety import speed_map  # lazy: casadi and pinocchio (the run's study)
-
     result = speed_map(args.run_dir, region, args.design)
     for line in result.summary():
         print(line)

@@ -25,9 +25,7 @@ Every function accepts floats, NumPy arrays (broadcast) and CasADi symbols. SI u
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -51,7 +49,7 @@ class BodyRegion:
     ``m_H`` [kg] (``inf`` for a region held against something); transient_force: the largest permissible
     transient contact force ``F_T`` [N] (None where the standard permits no transient contact);
     quasi_static_force: the largest permissible quasi-static (clamping) force [N], None when not given.
-    The standard's regions are :func:`load_body_regions`.
+    The standard's regions are :func:`collision_reflex.study.safety.load_body_regions`.
     """
 
     name: str
@@ -66,29 +64,6 @@ class BodyRegion:
         for name in ("transient_force", "quasi_static_force"):
             if getattr(self, name) is not None:
                 _validate.positive(name, getattr(self, name))
-
-
-def load_body_regions(path: str | os.PathLike[str] | None = None) -> dict[str, BodyRegion]:
-    """The body regions of a YAML file, by name (default: the standard's, the packaged ``designs/body_regions.yaml``).
-
-    The file has a top-level ``body_regions`` mapping from name to entry; each entry gives ``stiffness``,
-    ``mass``, ``quasi_static_force``, optionally ``transient_force``, and a ``source`` (per-field ``sources`` and
-    ``estimates`` as in the catalogues). Numbers are plain SI or strings with units (``"75 N/mm"``). Bad input
-    raises :class:`~collision_reflex.errors.CatalogueError` naming the file, the line and the field.
-    """
-    from ..hardware.catalogue import packaged_catalogue_path, read_entries  # lazy: pydantic, yaml
-
-    target = Path(path) if path is not None else packaged_catalogue_path("body_regions.yaml")
-    return {
-        name: BodyRegion(
-            name,
-            entry.fields["stiffness"],
-            entry.fields["mass"],
-            entry.fields["transient_force"],
-            entry.fields["quasi_static_force"],
-        )
-        for name, entry in read_entries(target, "body_regions").items()
-    }
 
 
 @dataclass(frozen=True)

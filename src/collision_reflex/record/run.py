@@ -222,11 +222,54 @@ class SimulationRecord(TypedDict):
 
 
 @checked
+class RegionSpeeds(TypedDict):
+    """A design's permissible approach speeds against one body region over its run's contact samples (SI units).
+
+    region: its name; stiffness [N/m], mass [kg] and transient_force [N]: the region's figures; slowest, median
+    and fastest [m/s]: the permissible speeds; slowest_sample: where the slowest is; above_approach: the samples
+    at which the design's approach speed exceeds it; bound_samples: those whose robot mass is the
+    rotors-on-links bound; iso_speed [m/s]: the half-moving-mass-plus-payload estimate's.
+    """
+
+    region: str
+    stiffness: float
+    mass: float
+    transient_force: float
+    slowest: float
+    median: float
+    fastest: float
+    slowest_sample: int
+    above_approach: int
+    bound_samples: int
+    iso_speed: float
+
+
+@checked
+class HumanContactRecord(TypedDict):
+    """The recommended design against the standard's body regions (:mod:`collision_reflex.study.safety`).
+
+    design: which design; samples: how many contact samples; approach_velocity [m/s]: the design's; moving_mass
+    and payload [kg]: what the ISO/TS 15066 estimate takes, iso_mass [kg] the estimate; regions: one row per
+    region with a transient force; no_transient: the regions the standard permits no transient contact with.
+    """
+
+    design: str
+    samples: int
+    approach_velocity: float
+    moving_mass: float
+    payload: float
+    iso_mass: float
+    regions: list[RegionSpeeds]
+    no_transient: list[str]
+
+
+@checked
 class ArmRunRecord(ArmResults):
     """An arm study's ``designs.json``: the study as run, its results, and the verdict the report opens with.
 
     ``transmission_choice``: the gearbox assignments tried (a study with gearbox options);
-    ``simulation``: the simulated designs (a study that asks).
+    ``simulation``: the simulated designs (a study that asks); ``human_contact``: the recommended design's
+    permissible speeds against the standard's body regions.
     """
 
     kind: Literal["arm"]
@@ -235,6 +278,7 @@ class ArmRunRecord(ArmResults):
     resolved: dict[str, Any]
     transmission_choice: NotRequired[list[TransmissionTried]]
     simulation: NotRequired[SimulationRecord]
+    human_contact: NotRequired[HumanContactRecord]
     verdict: list[str]
 
 

@@ -11,7 +11,14 @@ from typing import Any
 from .. import __version__
 from ..plots import margin_text
 from ..record.design import DesignRecord, QuickSnap
-from ..record.run import ArmRunRecord, CatalogueJoint, CatalogueRecord, RunRecord, TransmissionTried
+from ..record.run import (
+    ArmRunRecord,
+    CatalogueJoint,
+    CatalogueRecord,
+    HumanContactRecord,
+    RunRecord,
+    TransmissionTried,
+)
 from ..vocabulary import GLOBAL_VARIABLES
 from .assumptions import UNITS, assumption_rows
 from .certainty import domain_sentence, statistics_rows, worst_pose_sentence
@@ -201,6 +208,7 @@ def _arm_context(results: ArmRunRecord) -> dict[str, Any]:
         "velocity": _velocity_summary(recommended),
         **_front_table(results),
         **_transmission_table(results.get("transmission_choice")),
+        "human_contact": _human_contact(results.get("human_contact")),
         "solved": _solved(results),
         "part_sources": _part_sources(catalogue["joints"] if catalogue else []),
         **_tried_table(catalogue),
@@ -251,6 +259,26 @@ def _snap_text(snap: QuickSnap | None) -> tuple[str, bool]:
     shortfalls = list(snap["shortfalls"])
     more = f" (and {len(shortfalls) - 1} more)" if len(shortfalls) > 1 else ""
     return f"{said}; misses {shortfalls[0]}{more}", False
+
+
+def _human_contact(record: HumanContactRecord | None, shown: int = 3) -> dict[str, Any] | None:
+    """The human-contact section: the ``shown`` most limiting body regions beside the half-mass estimate.
+
+    Slowest permissible speed first; every region: ``crx safety``.
+    """
+    if not record or not record["regions"]:
+        return None
+    limiting = sorted(record["regions"], key=lambda row: row["slowest"])[:shown]
+    rows = [
+        {
+            "region": row["region"].replace("_", " "),
+            "slowest": row["slowest"],
+            "iso": row["iso_speed"],
+            "ok": not row["above_approach"],
+        }
+        for row in limiting
+    ]
+    return {**record, "rows": rows}
 
 
 def _transmission_table(tried: list[TransmissionTried] | None) -> dict[str, Any]:

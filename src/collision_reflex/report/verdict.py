@@ -139,6 +139,19 @@ def verdict_warnings(
         warnings += _joint_warnings(catalogue["warnings"])
     # Where the simulator validates neither placement of the reflected inertia (the study's transmissions).
     warnings += [str(line) for line in results.get("transmissions", ()) if str(line).startswith("Warning")]
+    contact = results.get("human_contact")
+    exceeded = [row for row in contact["regions"] if row["above_approach"]] if contact else []
+    if contact and exceeded:
+        warnings.append(
+            f"Warning: the approach speed {general(contact['approach_velocity'])} m/s exceeds the ISO/TS 15066 "
+            "permissible speed against "
+            + "; ".join(
+                f"the {row['region'].replace('_', ' ')} at {row['above_approach']} of {contact['samples']} "
+                f"contact samples (slowest {general(row['slowest'])} m/s)"
+                for row in exceeded
+            )
+            + "."
+        )
     return warnings
 
 

@@ -31,6 +31,7 @@ from ..optimize.pareto import pareto_front
 from ..optimize.pieces import built_problem, release_problems
 from ..optimize.recommend import recommend
 from ..optimize.sweep import Runner
+from ..record.read import pick_design
 from ..report import write_outputs
 from ..report.outputs import StageTimes
 from ..report.verdict import verdict
@@ -44,6 +45,7 @@ from .load import LoadedStudy, load_study
 from .problems import IPOPT_OPTIONS, StudyProblems, checked_setup
 from .progress import RunProgress
 from .resolve import ResolvedStudy, resolve_study
+from .safety import human_contact_record
 from .schema import ArmStudy
 from .store import OutputFolderUnusable, RunFolder
 from .transmission_choice import choice_record, choose_transmissions
@@ -51,7 +53,7 @@ from .worst_case import exchanges_samples, search_designs, violators
 
 if TYPE_CHECKING:
     from ..optimize.worst_case import WorstCase
-    from ..record.run import RunRecord
+    from ..record.run import ArmRunRecord, RunRecord
 
 SMOKE_ENVIRONMENT = "CRX_SMOKE"
 """Set to 1 to run every study with small sample counts (tests, quick checks): see :func:`.resolve.smoke_study`."""
@@ -275,6 +277,9 @@ def _run_arm(
         results["simulation"] = stages.timed("simulation", simulate_design.simulate_designs)(
             problems, recommended, front, study.simulate, folder
         )
+    results["human_contact"] = stages.timed("results", human_contact_record)(
+        problems.setup, *reversed(pick_design(cast("ArmRunRecord", results), "recommended"))
+    )
     results["verdict"] = stages.timed("results", verdict)(results)
     return results, (computed, reused)
 

@@ -14,12 +14,13 @@ import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..arm.effective import effective_parameters
 from ..errors import InvalidParameter
+from ..hardware.catalogue import packaged_catalogue_path, read_entries
 from ..model import effective as formulas
 from ..model.contact import (
     COUPLED_STIFFNESS_RATIO,
@@ -33,6 +34,11 @@ from ..optimize.results import record_design
 from ..record.read import checked_run_record, pick_design, read_saved_record
 from ..report.files import DESIGNS
 from .problems import StudyProblems
+
+if TYPE_CHECKING:
+    from ..record.design import DesignRecord
+    from ..record.run import HumanContactRecord, RegionSpeeds
+    from .arm_setup import ArmSetup
 
 
 @dataclass(frozen=True)
@@ -139,14 +145,7 @@ def speed_map(
     InvalidParameter: an actuator study's folder, no design ``design``, or a region without a permissible
         transient force (ISO/TS 15066 gives none for the skull, forehead and face).
     """
-    if region.transient_force is None:
-        raise InvalidParameter(
-            "region",
-            region.name,
-            "a body region with a permissible transient force",
-            f"ISO/TS 15066 permits no transient contact with {region.name}: keep the robot "
-            "from moving into it",
-        )
+    _transient_force(region)
     path = Path(folder) / DESIGNS
     data = read_saved_record(path)
     if data["kind"] != "arm":
@@ -156,7 +155,57 @@ def speed_map(
     results = checked_run_record(data, path)
     assert results["kind"] == "arm"
     label, record = pick_design(results, design)
-    setup = StudyProblems.of_run(folder).setup
+    return contact_masses(StudyProblems.of_run(folder).setup, record, label).speeds(region)
+
+
+@dataclass(frozen=True)
+class ContactMasses:
+    """A design's effective masses over its run's contact samples, what every region's speeds are made of.
+
+    Fields as :class:`SpeedMap`'s of the same names.
+    """
+
+    design: str
+    approach_velocity: float
+    q: np.ndarray
+    directions: np.ndarray
+    finger_mass: np.ndarray
+    coupled_mass: np.ndarray
+    mechanical_stiffness: np.ndarray
+    moving_mass: float
+    payload: float
+
+    def speeds(self, region: BodyRegion) -> SpeedMap:
+        """The permissible speeds against ``region`` (one with a transient force)."""
+        force = _transient_force(region)
+        ratio = region.stiffness / self.mechanical_stiffness
+        decoupled = ratio >= DECOUPLED_STIFFNESS_RATIO
+        robot_mass = np.where(decoupled, self.finger_mass, self.coupled_mass)
+        speed = np.zeros_like(robot_mass)
+        movable = np.isfinite(robot_mass)  # an infinite mass (a singular direction) permits no speed
+        speed[movable] = permissible_speed(force, robot_mass[movable], region.stiffness, region.mass)
+        iso_mass = iso_robot_mass(self.moving_mass, self.payload)
+        return SpeedMap(
+            region=region,
+            design=self.design,
+            approach_velocity=self.approach_velocity,
+            q=self.q,
+            directions=self.directions,
+            finger_mass=self.finger_mass,
+            coupled_mass=self.coupled_mass,
+            mechanical_stiffness=self.mechanical_stiffness,
+            robot_mass=robot_mass,
+            exact=decoupled | (ratio <= COUPLED_STIFFNESS_RATIO),
+            speed=speed,
+            moving_mass=self.moving_mass,
+            payload=self.payload,
+            iso_mass=iso_mass,
+            iso_speed=permissible_speed(force, iso_mass, region.stiffness, region.mass),
+        )
+
+
+def contact_masses(setup: ArmSetup, record: DesignRecord, label: str) -> ContactMasses:
+    """The effective masses of the design ``record`` (called ``label``) over ``setup``'s contact samples."""
     chosen = record_design(record, setup.study.sensing.scheme)
     samples = setup.samples
     common = {
@@ -175,20 +224,7 @@ def speed_map(
         **common,
     )
     finger, coupled, k_m = (np.asarray(x, dtype=float).ravel() for x in (loose.m_f, held.m_f, loose.k_m))
-    ratio = region.stiffness / k_m
-    decoupled = ratio >= DECOUPLED_STIFFNESS_RATIO
-    robot_mass = np.where(decoupled, finger, coupled)
-    exact = decoupled | (ratio <= COUPLED_STIFFNESS_RATIO)
-    speed = np.zeros_like(robot_mass)
-    movable = np.isfinite(robot_mass)
-    speed[movable] = permissible_speed(
-        region.transient_force, robot_mass[movable], region.stiffness, region.mass
-    )
-    moving = _moving_mass(setup.arm, chosen.actuator_mass)
-    payload = float(setup.constraints.payload)
-    iso_mass = iso_robot_mass(moving, payload)
-    return SpeedMap(
-        region=region,
+    return ContactMasses(
         design=label,
         approach_velocity=float(chosen.approach_velocity),
         q=samples.kinematics.q[samples.config_index],
@@ -196,14 +232,78 @@ def speed_map(
         finger_mass=finger,
         coupled_mass=coupled,
         mechanical_stiffness=k_m,
-        robot_mass=robot_mass,
-        exact=exact,
-        speed=speed,
-        moving_mass=moving,
-        payload=payload,
-        iso_mass=iso_mass,
-        iso_speed=permissible_speed(region.transient_force, iso_mass, region.stiffness, region.mass),
+        moving_mass=_moving_mass(setup.arm, chosen.actuator_mass),
+        payload=float(setup.constraints.payload),
     )
+
+
+def load_body_regions(path: str | os.PathLike[str] | None = None) -> dict[str, BodyRegion]:
+    """The body regions of a YAML file, by name (default: the standard's, the packaged ``designs/body_regions.yaml``).
+
+    The file has a top-level ``body_regions`` mapping from name to entry; each entry gives ``stiffness``,
+    ``mass``, ``quasi_static_force``, optionally ``transient_force``, and a ``source`` (per-field ``sources`` and
+    ``estimates`` as in the catalogues). Numbers are plain SI or strings with units (``"75 N/mm"``). Bad input
+    raises :class:`~collision_reflex.errors.CatalogueError` naming the file, the line and the field.
+    """
+    target = Path(path) if path is not None else packaged_catalogue_path("body_regions.yaml")
+    return {
+        name: BodyRegion(
+            name,
+            entry.fields["stiffness"],
+            entry.fields["mass"],
+            entry.fields["transient_force"],
+            entry.fields["quasi_static_force"],
+        )
+        for name, entry in read_entries(target, "body_regions").items()
+    }
+
+
+def human_contact_record(setup: ArmSetup, record: DesignRecord, label: str) -> HumanContactRecord:
+    """What a run keeps of its design's permissible speeds against the standard's body regions (SI units)."""
+    masses = contact_masses(setup, record, label)
+    regions = load_body_regions()
+    rows: list[RegionSpeeds] = []
+    for name, region in regions.items():
+        if region.transient_force is None:
+            continue
+        speeds = masses.speeds(region)
+        rows.append(
+            {
+                "region": name,
+                "stiffness": region.stiffness,
+                "mass": region.mass,
+                "transient_force": region.transient_force,
+                "slowest": float(np.min(speeds.speed)),
+                "median": float(np.median(speeds.speed)),
+                "fastest": float(np.max(speeds.speed)),
+                "slowest_sample": int(np.argmin(speeds.speed)),
+                "above_approach": int(np.sum(masses.approach_velocity > speeds.speed)),
+                "bound_samples": int(np.sum(~speeds.exact)),
+                "iso_speed": float(speeds.iso_speed),
+            }
+        )
+    return {
+        "design": label,
+        "samples": int(masses.finger_mass.size),
+        "approach_velocity": masses.approach_velocity,
+        "moving_mass": masses.moving_mass,
+        "payload": masses.payload,
+        "iso_mass": float(iso_robot_mass(masses.moving_mass, masses.payload)),
+        "regions": rows,
+        "no_transient": [name for name, r in regions.items() if r.transient_force is None],
+    }
+
+
+def _transient_force(region: BodyRegion) -> float:
+    """The region's permissible transient force [N], or a refusal for a region the standard permits none."""
+    if region.transient_force is None:
+        raise InvalidParameter(
+            "region",
+            region.name,
+            "a body region with a permissible transient force",
+            f"ISO/TS 15066 permits no transient contact with {region.name}: keep the robot from moving into it",
+        )
+    return region.transient_force
 
 
 def _moving_mass(arm: Any, actuator_mass: np.ndarray) -> float:
