@@ -120,7 +120,7 @@ def main(figure_path: str | None) -> None:
         worst.columns = [f"{ratio:g} v*" for ratio in worst.columns]
         print(
             "largest |I_sim / I_closed - 1| [%] "
-            "(rows: detection, drive, reaction model, placement, k_contact / k_joint):"
+            "(rows: detection, drive, reaction model, placement, k_contact / k_joint, restitution):"
         )
         print(worst.round(1).to_string())
         print(f"within 5 %: {100 * table['valid'].mean():.0f} % of the cases")
@@ -150,7 +150,7 @@ def _figure(tables: dict[str, Any], path: str) -> Path:
             chosen = table[(table["detection"] == detection) & (table["reaction_model"] == FIGURE_MODEL)]
             worst = 100 * worst_difference(chosen).droplevel(["detection", "reaction_model"])
             damped = chosen.pivot_table(
-                index=["drive", "placement", "stiffness_ratio"],
+                index=["drive", "placement", "stiffness_ratio", "restitution"],
                 columns="velocity_ratio",
                 values="damper_share",
                 aggfunc="max",
@@ -164,7 +164,7 @@ def _figure(tables: dict[str, Any], path: str) -> Path:
                 weight = "bold" if np.isfinite(value) and value <= 100 * TOLERANCE else "normal"
                 ax.text(j, i, text, ha="center", va="center", fontsize=6, weight=weight)
             ax.set_xticks(range(values.shape[1]), [f"{r:g}" for r in worst.columns])
-            labels = [f"{drive}, {placement}, {ratio:g}" for drive, placement, ratio in worst.index]
+            labels = [f"{drive}, {placement}, {ratio:g}" for drive, placement, ratio, _ in worst.index]
             ax.set_yticks(range(values.shape[0]), labels if column == 0 else [], fontsize=6)
             ax.set_xlabel("approach velocity v0 / v*", fontsize=7)
             ax.set_title(f"{name}, detection: {detection}", fontsize=8)

@@ -297,3 +297,30 @@ def test_unknown_detection_in_a_study_is_a_located_error(tmp_path):
 def test_validity_module_names_the_simulator_detection():
     """Without a choice in the simulator, the only scheme is its joint-torque force estimate."""
     assert validity.TORQUE_DETECTION in validity.available_detections()
+
+
+def test_the_map_over_restitution_names_each_contact_s_restitution_and_a_slow_collision_ignores_it(arm):
+    """Rebounding contacts (a restitution of the finger alone, 0.1 and 0.5): each row names its restitution,
+    and at 0.1 v* (sensing dominates, the impact is small) the rebound changes the impulse by under 2 %."""
+    from collision_reflex.simulate.contact import contact_restitution, damping_ratio_for_restitution
+
+    for e in (0.02, 0.1, 0.5, 1.0):
+        assert contact_restitution(damping_ratio_for_restitution(e)) == pytest.approx(e, rel=1e-9)
+    table = validity_map(
+        arm,
+        JOINTS,
+        [Q],
+        [U],
+        velocity_ratios=(0.1,),
+        stiffness_ratios=(1000.0,),
+        detections=("spring_torque",),
+        placements=("robot",),
+        restitutions=(0.1, 0.5),
+    )
+    sprung = table[table["reaction_model"] == "sprung"].set_index("restitution")
+    assert sprung.index.tolist() == pytest.approx([0.1, 0.5], rel=1e-9)
+    assert (sprung["error"] == "").all()
+    low, high = sprung["simulated"].tolist()
+    assert abs(high / low - 1) < 0.02
+    with pytest.raises(cr.errors.InvalidParameter, match="restitution"):
+        validity_map(arm, JOINTS, [Q], [U], restitutions=(0.0,))

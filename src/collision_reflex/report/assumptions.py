@@ -89,7 +89,13 @@ def assumption_rows(results: RunRecord) -> list[tuple[str, str, str, str]]:
                 )
                 + " unless a joint says otherwise",
                 "Bhatia, Mason and Johnson, Reacting to Contact: Transparency and Collision Reflex in Actuation",
-            )
+            ),
+            (
+                "contact",
+                "a rigid object, a plastic impact (restitution 0); body regions as springs with masses "
+                "(Human contact)",
+                "ISO/TS 15066:2016 Annex A for the body regions",
+            ),
         ]
         if results["kind"] == "arm"
         else []

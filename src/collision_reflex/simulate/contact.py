@@ -57,6 +57,14 @@ def contact_damping_for_restitution(restitution: float, m_f: float, contact_stif
     """
     _validate.positive("m_f", m_f)
     _validate.positive("contact_stiffness", contact_stiffness)
+    return damping_from_ratio(damping_ratio_for_restitution(restitution), m_f, contact_stiffness)
+
+
+def damping_ratio_for_restitution(restitution: float) -> float:
+    """The Kelvin-Voigt contact's damping ratio (dimensionless) that gives ``restitution``, ``0 < e <= 1``.
+
+    The inverse of :func:`contact_restitution`, found by bracketing.
+    """
     if not 0 < restitution <= 1:
         raise InvalidParameter(
             "restitution", restitution, "a number in (0, 1]", "a perfectly plastic contact is a rigid wall"
@@ -72,8 +80,7 @@ def contact_damping_for_restitution(restitution: float, m_f: float, contact_stif
             raise InvalidParameter(
                 "restitution", restitution, "at least 1e-12", "use a rigid wall for a plastic contact"
             )
-    zeta = brentq(lambda z: contact_restitution(z) - restitution, 0.0, zeta_max, xtol=1e-14)
-    return damping_from_ratio(zeta, m_f, contact_stiffness)
+    return float(brentq(lambda z: contact_restitution(z) - restitution, 0.0, zeta_max, xtol=1e-14))
 
 
 def damping_from_ratio(damping_ratio: float, mass: float, stiffness: float) -> float:

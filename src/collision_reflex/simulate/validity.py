@@ -17,6 +17,7 @@ failed row, never run for hours.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 import time
@@ -33,7 +34,7 @@ from ..model.impulse import optimal_velocity, series_stiffness
 from ..vocabulary import CONTROLLED_DRIVES, REFLECTED_INERTIA_PLACEMENTS
 from . import arm as arm_simulation
 from .arm_detection import DETECTIONS
-from .contact import damping_from_ratio
+from .contact import contact_restitution, damping_from_ratio, damping_ratio_for_restitution
 from .design_closed_form import REACTION_MODELS, ArmClosedForm, JointDesign, arm_closed_form
 
 VELOCITY_RATIOS: tuple[float, ...] = (0.1, 0.3, 1.0, 3.0, 10.0)
@@ -70,7 +71,8 @@ class ValidityCase:
     ----------
     configuration, direction: indices into the map's configurations and directions.
     velocity_ratio: ``v0 / v*``; stiffness_ratio: contact over joint stiffness along ``u``; detection: scheme;
-    drive: :data:`~collision_reflex.vocabulary.CONTROLLED_DRIVES`.
+    drive: :data:`~collision_reflex.vocabulary.CONTROLLED_DRIVES`; contact_damping_ratio: the contact's damping,
+    a ratio of critical for the finger mass.
     """
 
     configuration: int
@@ -79,6 +81,7 @@ class ValidityCase:
     stiffness_ratio: float
     detection: str
     drive: str = "ideal"
+    contact_damping_ratio: float = CONTACT_DAMPING_RATIO
 
 
 def validity_map(
@@ -96,6 +99,7 @@ def validity_map(
     max_steps: float = MAX_STEPS,
     drives: Sequence[str] = ("ideal",),
     contact_damping_ratio: float = CONTACT_DAMPING_RATIO,
+    restitutions: Sequence[float] | None = None,
 ) -> Any:
     """Where the arm closed form agrees with the time-domain simulation, as a :class:`pandas.DataFrame`.
 
@@ -113,12 +117,16 @@ def validity_map(
     max_steps: work budget of one simulation [integrator steps]; a case beyond it is refused and recorded.
     drives: the simulated drives (:data:`~collision_reflex.vocabulary.CONTROLLED_DRIVES`); ``"impedance"`` needs a finite software stiffness.
     contact_damping_ratio: the contact's damping as a ratio of critical for the finger mass (dimensionless).
+    restitutions: instead, the contact's coefficients of restitution for the finger alone, each in (0, 1] (the
+        damping ratio that gives each, :func:`~collision_reflex.simulate.contact.damping_ratio_for_restitution`):
+        the closed form's plastic impact against rebounding contacts.
 
     Returns
     -------
     One row per case, placement and reaction model (:data:`REACTION_MODELS`): ``configuration``,
     ``direction`` (indices), ``q``, ``u`` (as lists), ``velocity_ratio``, ``v0`` [m/s], ``stiffness_ratio``,
-    ``contact_stiffness`` [N/m], ``detection``, ``drive``, ``placement``, ``reaction_model``, ``simulated``
+    ``contact_stiffness`` [N/m], ``restitution`` (the contact's, for the finger alone), ``detection``, ``drive``,
+    ``placement``, ``reaction_model``, ``simulated``
     and ``closed_form`` [N*s], ``difference`` (``I_sim / I_closed - 1``), ``valid`` (within ``tolerance``),
     ``damper_share`` (:func:`damper_share`: the contact's viscous force in the sensing ramp over ``F_s``, a
     force the closed form's elastic object has not), ``object_deflection`` (``F_s / k_c`` [m], the contact
@@ -139,6 +147,13 @@ def validity_map(
         drives,
         contact_damping_ratio,
     )
+    if restitutions is not None and not len(restitutions):
+        raise InvalidParameter("restitutions", restitutions, "one or more coefficients in (0, 1]")
+    dampings = (
+        [contact_damping_ratio]
+        if restitutions is None
+        else [damping_ratio_for_restitution(float(e)) for e in restitutions]
+    )
     rows: list[dict[str, Any]] = []
     for i, q in enumerate(qs):
         for j, u in enumerate(us):
@@ -147,8 +162,10 @@ def validity_map(
             for ratio_k in stiffness_ratios:
                 k_c = float(ratio_k) * reference.k_m
                 closed = {p: arm_closed_form(arm, q, u, joints, p, k_c, reaction) for p in placements}
-                for ratio_v, detection, drive in itertools.product(velocity_ratios, schemes, drives):
-                    case = ValidityCase(i, j, float(ratio_v), float(ratio_k), detection, drive)
+                for ratio_v, detection, drive, damping in itertools.product(
+                    velocity_ratios, schemes, drives, dampings
+                ):
+                    case = ValidityCase(i, j, float(ratio_v), float(ratio_k), detection, drive, damping)
                     v0 = case.velocity_ratio * v_star
                     simulated = simulated_impulse(
                         arm,
@@ -161,9 +178,9 @@ def validity_map(
                         reaction,
                         max_steps,
                         drive=drive,
-                        contact_damping_ratio=contact_damping_ratio,
+                        contact_damping_ratio=damping,
                     )
-                    share = damper_share(reference, v0, k_c, contact_damping_ratio)
+                    share = damper_share(reference, v0, k_c, damping)
                     rows.extend(
                         _row(case, q, u, v0, k_c, placement, model, form, simulated, tolerance, share)
                         for placement, form in closed.items()
@@ -328,6 +345,7 @@ def _row(
         "v0": v0,
         "stiffness_ratio": case.stiffness_ratio,
         "contact_stiffness": contact_stiffness,
+        "restitution": _restitution(case.contact_damping_ratio),
         "detection": case.detection,
         "drive": case.drive,
         "placement": placement,
@@ -343,7 +361,20 @@ def _row(
     }
 
 
-MAP_INDEX: tuple[str, ...] = ("detection", "drive", "reaction_model", "placement", "stiffness_ratio")
+@functools.lru_cache(maxsize=64)
+def _restitution(damping_ratio: float) -> float:
+    """The contact's restitution for the finger alone at ``damping_ratio`` (each case's row names it)."""
+    return contact_restitution(damping_ratio)
+
+
+MAP_INDEX: tuple[str, ...] = (
+    "detection",
+    "drive",
+    "reaction_model",
+    "placement",
+    "stiffness_ratio",
+    "restitution",
+)
 """The rows of the map's pivot tables; their columns are the velocity ratios."""
 
 
