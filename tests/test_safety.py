@@ -272,9 +272,13 @@ def test_an_arm_study_s_run_keeps_every_region_and_its_report_shows_the_most_lim
     assert chest["iso_speed"] == pytest.approx(again.iso_speed, rel=1e-12)
     assert chest["above_approach"] == int(np.sum(again.approach_velocity > again.speed))
     report = (folder / "report.html").read_text()
-    section = report[
-        report.index('id="human-contact"') : report.index("</table>", report.index('id="human-contact"'))
-    ]
-    limiting = sorted(record["regions"], key=lambda row: row["slowest"])[:3]
-    assert all(row["region"].replace("_", " ") in section for row in limiting)
-    assert "M/2 + payload" in section and f"{record['samples']} contact samples" in section
+    start = report.index('id="human-contact"')
+    section = " ".join(report[start : report.index("</figure>", start)].split())
+    limiting = min(record["regions"], key=lambda row: row["slowest"])
+    assert f"Most limiting: the {limiting['region'].replace('_', ' ')}" in section
+    assert (
+        f"{record['samples']} contact samples" in section and "half the moving mass plus payload" in section
+    )
+    assert (
+        'id="permissible-speeds"' in section and "<svg" in section
+    )  # every region, with the estimate beside

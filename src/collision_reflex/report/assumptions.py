@@ -90,12 +90,7 @@ def assumption_rows(results: RunRecord) -> list[tuple[str, str, str, str]]:
                 + " unless a joint says otherwise",
                 "Bhatia, Mason and Johnson, Reacting to Contact: Transparency and Collision Reflex in Actuation",
             ),
-            (
-                "contact",
-                "a rigid object, a plastic impact (restitution 0); body regions as springs with masses "
-                "(Human contact)",
-                "ISO/TS 15066:2016 Annex A for the body regions",
-            ),
+            ("contact", "rigid object, plastic impact (restitution 0)", ""),
         ]
         if results["kind"] == "arm"
         else []

@@ -19,6 +19,7 @@ from ..errors import InvalidParameter
 from ..plots import FigurePath
 from ..plots.design_front import plot_design_front
 from ..plots.impulse_directions import plot_impulse_directions
+from ..plots.permissible_speeds import plot_permissible_speeds
 from ..plots.phase_breakdown import plot_phase_breakdown
 from ..plots.torque_speed import JointOperatingPoints, plot_torque_speed
 from ..plots.velocity_sweep import plot_velocity_sweep
@@ -120,6 +121,24 @@ def _arm_figures(directory: Path, results: ArmRunRecord, formats: list[str]) -> 
                 np.asarray(pose["direction"]),
                 f"worst case over the contact domain: {worst_case['domain']:.4g} N·s"
                 + ("" if worst_case["certified"] else " (not certified)"),
+            ),
+        )
+    contact = results.get("human_contact")
+    if contact and contact["regions"]:
+        rows = contact["regions"]
+        svgs["permissible_speeds"] = _draw(
+            directory,
+            "permissible_speeds",
+            formats,
+            lambda path: plot_permissible_speeds(
+                path,
+                [r["region"] for r in rows],
+                [r["slowest"] for r in rows],
+                [r["median"] for r in rows],
+                [r["fastest"] for r in rows],
+                [r["iso_speed"] for r in rows],
+                contact["approach_velocity"],
+                f"ISO/TS 15066 body regions, {contact['samples']} contact samples",
             ),
         )
     joints = recommended_torque_speed(results)

@@ -261,24 +261,13 @@ def _snap_text(snap: QuickSnap | None) -> tuple[str, bool]:
     return f"{said}; misses {shortfalls[0]}{more}", False
 
 
-def _human_contact(record: HumanContactRecord | None, shown: int = 3) -> dict[str, Any] | None:
-    """The human-contact section: the ``shown`` most limiting body regions beside the half-mass estimate.
-
-    Slowest permissible speed first; every region: ``crx safety``.
-    """
+def _human_contact(record: HumanContactRecord | None) -> dict[str, Any] | None:
+    """The human-contact section: the record, and its most limiting body region (every region: the figure)."""
     if not record or not record["regions"]:
         return None
-    limiting = sorted(record["regions"], key=lambda row: row["slowest"])[:shown]
-    rows = [
-        {
-            "region": row["region"].replace("_", " "),
-            "slowest": row["slowest"],
-            "iso": row["iso_speed"],
-            "ok": not row["above_approach"],
-        }
-        for row in limiting
-    ]
-    return {**record, "rows": rows}
+    row = min(record["regions"], key=lambda row: row["slowest"])
+    limiting = {"region": row["region"].replace("_", " "), "slowest": row["slowest"], "iso": row["iso_speed"]}
+    return {**record, "limiting": limiting}
 
 
 def _transmission_table(tried: list[TransmissionTried] | None) -> dict[str, Any]:

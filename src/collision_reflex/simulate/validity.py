@@ -117,8 +117,7 @@ def validity_map(
     max_steps: work budget of one simulation [integrator steps]; a case beyond it is refused and recorded.
     drives: the simulated drives (:data:`~collision_reflex.vocabulary.CONTROLLED_DRIVES`); ``"impedance"`` needs a finite software stiffness.
     contact_damping_ratio: the contact's damping as a ratio of critical for the finger mass (dimensionless).
-    restitutions: instead, the contact's coefficients of restitution for the finger alone, each in (0, 1] (the
-        damping ratio that gives each, :func:`~collision_reflex.simulate.contact.damping_ratio_for_restitution`):
+    restitutions: instead, the contact's coefficients of restitution for the finger alone, each in (0, 1]:
         the closed form's plastic impact against rebounding contacts.
 
     Returns
@@ -147,13 +146,7 @@ def validity_map(
         drives,
         contact_damping_ratio,
     )
-    if restitutions is not None and not len(restitutions):
-        raise InvalidParameter("restitutions", restitutions, "one or more coefficients in (0, 1]")
-    dampings = (
-        [contact_damping_ratio]
-        if restitutions is None
-        else [damping_ratio_for_restitution(float(e)) for e in restitutions]
-    )
+    dampings = _damping_ratios(contact_damping_ratio, restitutions)
     rows: list[dict[str, Any]] = []
     for i, q in enumerate(qs):
         for j, u in enumerate(us):
@@ -187,6 +180,15 @@ def validity_map(
                         for model in REACTION_MODELS
                     )
     return pd.DataFrame(rows)
+
+
+def _damping_ratios(ratio: float, restitutions: Sequence[float] | None) -> list[float]:
+    """The contact damping ratios of a map: ``ratio``, or one per coefficient of restitution (the finger's)."""
+    if restitutions is None:
+        return [ratio]
+    if not len(restitutions):
+        raise InvalidParameter("restitutions", restitutions, "one or more coefficients in (0, 1]")
+    return [damping_ratio_for_restitution(float(e)) for e in restitutions]
 
 
 def _cases(
