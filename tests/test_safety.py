@@ -56,14 +56,14 @@ def _two_link_masses(q: np.ndarray, u: np.ndarray, joints: list[dict]) -> tuple[
 def test_each_sample_s_masses_and_speed_are_the_hand_calculation(run):
     result = speed_map(run, CHEST)
     joints = _recommended_joints(run)
-    assert result.speed.size == result.q.shape[0] >= 8
+    assert result.speed.size == result.masses.q.shape[0] >= 8
     for s in range(result.speed.size):
-        finger, coupled = _two_link_masses(result.q[s], result.directions[s], joints)
-        assert result.finger_mass[s] == pytest.approx(finger, rel=1e-9)
-        assert result.coupled_mass[s] == pytest.approx(coupled, rel=1e-9)
+        finger, coupled = _two_link_masses(result.masses.q[s], result.masses.directions[s], joints)
+        assert result.masses.finger_mass[s] == pytest.approx(finger, rel=1e-9)
+        assert result.masses.coupled_mass[s] == pytest.approx(coupled, rel=1e-9)
         # Rotors on the links only add mass, and the region meets the coupled mass unless it is much stiffer.
         assert coupled >= finger
-        ratio = CHEST.stiffness / result.mechanical_stiffness[s]
+        ratio = CHEST.stiffness / result.masses.mechanical_stiffness[s]
         expected = finger if ratio >= 100 else coupled
         assert result.robot_mass[s] == pytest.approx(expected, rel=1e-9)
         assert bool(result.exact[s]) == (ratio >= 100 or ratio <= 0.01)
@@ -84,18 +84,18 @@ def test_the_iso_estimate_is_half_the_moving_mass_plus_the_payload(run):
     # Every link but the fixed base, and joint 2's actuator (joint 1's sits on the base).
     moving = sum(m for name, m in links.items() if name != "base_link")
     moving += joints[1]["motor_mass"] + joints[1]["gearbox_mass"]
-    assert result.moving_mass == pytest.approx(moving, rel=1e-12)
-    assert result.iso_mass == pytest.approx(moving / 2 + result.payload, rel=1e-12)
+    assert result.masses.moving_mass == pytest.approx(moving, rel=1e-12)
+    assert result.iso_mass == pytest.approx(moving / 2 + result.masses.payload, rel=1e-12)
     mu = result.iso_mass * CHEST.mass / (result.iso_mass + CHEST.mass)
     assert result.iso_speed == pytest.approx(280.0 / math.sqrt(mu * 25e3), rel=1e-12)
 
 
 def test_a_much_stiffer_region_meets_the_finger_and_a_much_softer_one_the_coupled_mass(run):
-    k_m = speed_map(run, CHEST).mechanical_stiffness
+    k_m = speed_map(run, CHEST).masses.mechanical_stiffness
     stiff = speed_map(run, BodyRegion("stiff", 1e3 * float(np.max(k_m)), 40.0, 280.0))
     soft = speed_map(run, BodyRegion("soft", 1e-3 * float(np.min(k_m)), 40.0, 280.0))
-    assert stiff.exact.all() and np.array_equal(stiff.robot_mass, stiff.finger_mass)
-    assert soft.exact.all() and np.array_equal(soft.robot_mass, soft.coupled_mass)
+    assert stiff.exact.all() and np.array_equal(stiff.robot_mass, stiff.masses.finger_mass)
+    assert soft.exact.all() and np.array_equal(soft.robot_mass, soft.masses.coupled_mass)
     # The speed is linear in the force limit.
     doubled = speed_map(run, BodyRegion("chest", 25e3, 40.0, 560.0))
     np.testing.assert_allclose(doubled.speed, 2 * speed_map(run, CHEST).speed, rtol=1e-12)
@@ -270,7 +270,7 @@ def test_an_arm_study_s_run_keeps_every_region_and_its_report_shows_the_most_lim
     again = speed_map(folder, regions["chest"])  # what crx safety computes from the folder
     assert chest["slowest"] == pytest.approx(float(np.min(again.speed)), rel=1e-12)
     assert chest["iso_speed"] == pytest.approx(again.iso_speed, rel=1e-12)
-    assert chest["above_approach"] == int(np.sum(again.approach_velocity > again.speed))
+    assert chest["above_approach"] == int(np.sum(again.masses.approach_velocity > again.speed))
     report = (folder / "report.html").read_text()
     start = report.index('id="human-contact"')
     section = " ".join(report[start : report.index("</figure>", start)].split())

@@ -45,28 +45,17 @@ if TYPE_CHECKING:
 class SpeedMap:
     """A design's permissible approach speeds against a body region, one per contact sample of its run.
 
-    design: which design (its label); approach_velocity: the design's own approach speed [m/s]; q (n, nq) and
-    directions (n, d): each sample's configuration [rad, m] and unit direction; finger_mass: the effective mass
-    with the rotors behind the joint springs [kg]; coupled_mass: with the rotors on the links [kg];
-    mechanical_stiffness: the joints' stiffness along the direction [N/m]; robot_mass: the mass the region meets
-    [kg] and exact (False where it is the coupled bound); speed: the permissible speed [m/s] (0 where the arm
-    cannot move along the direction: an infinite mass); moving_mass and payload: what the ISO/TS 15066 estimate
-    takes [kg]; iso_mass [kg] and iso_speed [m/s]: that estimate.
+    masses: the design's effective masses over the samples (:class:`ContactMasses`); region: the body region;
+    robot_mass: the mass the region meets per sample [kg], and exact (False where it is the coupled bound);
+    speed: the permissible speed per sample [m/s] (0 where the arm cannot move along the direction: an infinite
+    mass); iso_mass [kg] and iso_speed [m/s]: the ISO/TS 15066 estimate without a dynamic model.
     """
 
+    masses: ContactMasses
     region: BodyRegion
-    design: str
-    approach_velocity: float
-    q: np.ndarray
-    directions: np.ndarray
-    finger_mass: np.ndarray
-    coupled_mass: np.ndarray
-    mechanical_stiffness: np.ndarray
     robot_mass: np.ndarray
     exact: np.ndarray
     speed: np.ndarray
-    moving_mass: float
-    payload: float
     iso_mass: float
     iso_speed: float
 
@@ -75,13 +64,13 @@ class SpeedMap:
         rows = []
         for s in range(self.speed.size):
             row: dict[str, Any] = {"sample": s}
-            row.update({f"q{j + 1} [rad]": float(v) for j, v in enumerate(self.q[s])})
-            row.update({f"u{j + 1}": float(v) for j, v in enumerate(self.directions[s])})
+            row.update({f"q{j + 1} [rad]": float(v) for j, v in enumerate(self.masses.q[s])})
+            row.update({f"u{j + 1}": float(v) for j, v in enumerate(self.masses.directions[s])})
             row.update(
                 {
-                    "finger_mass [kg]": float(self.finger_mass[s]),
-                    "coupled_mass [kg]": float(self.coupled_mass[s]),
-                    "mechanical_stiffness [N/m]": float(self.mechanical_stiffness[s]),
+                    "finger_mass [kg]": float(self.masses.finger_mass[s]),
+                    "coupled_mass [kg]": float(self.masses.coupled_mass[s]),
+                    "mechanical_stiffness [N/m]": float(self.masses.mechanical_stiffness[s]),
                     "robot_mass [kg]": float(self.robot_mass[s]),
                     "exact": bool(self.exact[s]),
                     "permissible_speed [m/s]": float(self.speed[s]),
@@ -100,15 +89,15 @@ class SpeedMap:
         r = self.region
         slowest = int(np.argmin(self.speed))
         lines = [
-            f"{self.design} against {r.name} (k_c = {r.stiffness / 1e3:g} N/mm, m_H = {r.mass:g} kg, "
+            f"{self.masses.design} against {r.name} (k_c = {r.stiffness / 1e3:g} N/mm, m_H = {r.mass:g} kg, "
             f"F_T = {r.transient_force:g} N), over {self.speed.size} contact samples of the run:",
             f"permissible speed {np.min(self.speed):.3g} to {np.max(self.speed):.3g} m/s "
             f"(median {np.median(self.speed):.3g} m/s); slowest at sample {slowest} "
-            f"(q = {', '.join(f'{v:.3g}' for v in self.q[slowest])}; robot mass {self.robot_mass[slowest]:.3g} kg)",
+            f"(q = {', '.join(f'{v:.3g}' for v in self.masses.q[slowest])}; robot mass {self.robot_mass[slowest]:.3g} kg)",
         ]
-        above = int(np.sum(self.approach_velocity > self.speed))
+        above = int(np.sum(self.masses.approach_velocity > self.speed))
         lines.append(
-            f"the design approaches at {self.approach_velocity:.3g} m/s: "
+            f"the design approaches at {self.masses.approach_velocity:.3g} m/s: "
             + (
                 f"above the permissible speed at {above} of {self.speed.size} samples"
                 if above
@@ -117,8 +106,8 @@ class SpeedMap:
         )
         ratio = self.iso_speed / np.min(self.speed)
         lines.append(
-            f"ISO/TS 15066 estimate without a dynamic model: robot mass M/2 + payload = {self.moving_mass:.3g}/2 + "
-            f"{self.payload:.3g} = {self.iso_mass:.3g} kg, permissible speed {self.iso_speed:.3g} m/s "
+            f"ISO/TS 15066 estimate without a dynamic model: robot mass M/2 + payload = {self.masses.moving_mass:.3g}/2 + "
+            f"{self.masses.payload:.3g} = {self.iso_mass:.3g} kg, permissible speed {self.iso_speed:.3g} m/s "
             f"({ratio:.3g}x the slowest pose's)"
         )
         bound = int(np.sum(~self.exact))
@@ -162,7 +151,11 @@ def speed_map(
 class ContactMasses:
     """A design's effective masses over its run's contact samples, what every region's speeds are made of.
 
-    Fields as :class:`SpeedMap`'s of the same names.
+    design: which design (its label); approach_velocity: the design's own approach speed [m/s]; q (n, nq) and
+    directions (n, d): each sample's configuration [rad, m] and unit direction; finger_mass: the effective mass
+    with the rotors behind the joint springs [kg]; coupled_mass: with the rotors on the links [kg];
+    mechanical_stiffness: the joints' stiffness along the direction [N/m]; moving_mass and payload: what the
+    ISO/TS 15066 estimate takes [kg].
     """
 
     design: str
@@ -186,19 +179,11 @@ class ContactMasses:
         speed[movable] = permissible_speed(force, robot_mass[movable], region.stiffness, region.mass)
         iso_mass = iso_robot_mass(self.moving_mass, self.payload)
         return SpeedMap(
+            masses=self,
             region=region,
-            design=self.design,
-            approach_velocity=self.approach_velocity,
-            q=self.q,
-            directions=self.directions,
-            finger_mass=self.finger_mass,
-            coupled_mass=self.coupled_mass,
-            mechanical_stiffness=self.mechanical_stiffness,
             robot_mass=robot_mass,
             exact=decoupled | (ratio <= COUPLED_STIFFNESS_RATIO),
             speed=speed,
-            moving_mass=self.moving_mass,
-            payload=self.payload,
             iso_mass=iso_mass,
             iso_speed=permissible_speed(force, iso_mass, region.stiffness, region.mass),
         )
