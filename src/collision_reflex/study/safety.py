@@ -104,11 +104,16 @@ class SpeedMap:
                 else "within the permissible speed at every sample"
             )
         )
-        ratio = self.iso_speed / np.min(self.speed)
+        slowest_speed = float(np.min(self.speed))
+        compared = (
+            f"{self.iso_speed / slowest_speed:.3g}x the slowest pose's"
+            if slowest_speed > 0
+            else "a sampled direction is singular: no speed is permissible along it"
+        )
         lines.append(
-            f"ISO/TS 15066 estimate without a dynamic model: robot mass M/2 + payload = {self.masses.moving_mass:.3g}/2 + "
-            f"{self.masses.payload:.3g} = {self.iso_mass:.3g} kg, permissible speed {self.iso_speed:.3g} m/s "
-            f"({ratio:.3g}x the slowest pose's)"
+            "ISO/TS 15066 estimate without a dynamic model: robot mass M/2 + payload = "
+            f"{self.masses.moving_mass:.3g}/2 + {self.masses.payload:.3g} = {self.iso_mass:.3g} kg, permissible "
+            f"speed {self.iso_speed:.3g} m/s ({compared})"
         )
         bound = int(np.sum(~self.exact))
         if bound:
