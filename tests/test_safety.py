@@ -28,6 +28,12 @@ def run(smoke_runs) -> Path:
     return smoke_runs["two_link_paper"]
 
 
+@pytest.fixture(scope="module")
+def chest(run):
+    """The recommended design's speeds against the chest, read from the run folder as ``crx safety`` reads it."""
+    return speed_map(run, CHEST)
+
+
 def _recommended_joints(run: Path) -> list[dict]:
     return json.loads((run / "designs.json").read_text())["recommended"]["joints"]
 
@@ -53,8 +59,8 @@ def _two_link_masses(q: np.ndarray, u: np.ndarray, joints: list[dict]) -> tuple[
     return along(mass), along(mass + rotors)
 
 
-def test_each_sample_s_masses_and_speed_are_the_hand_calculation(run):
-    result = speed_map(run, CHEST)
+def test_each_sample_s_masses_and_speed_are_the_hand_calculation(run, chest):
+    result = chest
     joints = _recommended_joints(run)
     assert result.speed.size == result.masses.q.shape[0] >= 8
     for s in range(result.speed.size):
@@ -73,8 +79,8 @@ def test_each_sample_s_masses_and_speed_are_the_hand_calculation(run):
         )
 
 
-def test_the_iso_estimate_is_half_the_moving_mass_plus_the_payload(run):
-    result = speed_map(run, CHEST)
+def test_the_iso_estimate_is_half_the_moving_mass_plus_the_payload(run, chest):
+    result = chest
     links = {
         link.get("name"): float(link.find("inertial/mass").get("value"))
         for link in ET.parse(URDF).getroot().iter("link")
@@ -90,18 +96,19 @@ def test_the_iso_estimate_is_half_the_moving_mass_plus_the_payload(run):
     assert result.iso_speed == pytest.approx(280.0 / math.sqrt(mu * 25e3), rel=1e-12)
 
 
-def test_a_much_stiffer_region_meets_the_finger_and_a_much_softer_one_the_coupled_mass(run):
-    k_m = speed_map(run, CHEST).masses.mechanical_stiffness
-    stiff = speed_map(run, BodyRegion("stiff", 1e3 * float(np.max(k_m)), 40.0, 280.0))
-    soft = speed_map(run, BodyRegion("soft", 1e-3 * float(np.min(k_m)), 40.0, 280.0))
+def test_a_much_stiffer_region_meets_the_finger_and_a_much_softer_one_the_coupled_mass(chest):
+    masses = chest.masses  # the same masses serve every region
+    k_m = masses.mechanical_stiffness
+    stiff = masses.speeds(BodyRegion("stiff", 1e3 * float(np.max(k_m)), 40.0, 280.0))
+    soft = masses.speeds(BodyRegion("soft", 1e-3 * float(np.min(k_m)), 40.0, 280.0))
     assert stiff.exact.all() and np.array_equal(stiff.robot_mass, stiff.masses.finger_mass)
     assert soft.exact.all() and np.array_equal(soft.robot_mass, soft.masses.coupled_mass)
     # The speed is linear in the force limit.
-    doubled = speed_map(run, BodyRegion("chest", 25e3, 40.0, 560.0))
-    np.testing.assert_allclose(doubled.speed, 2 * speed_map(run, CHEST).speed, rtol=1e-12)
+    doubled = masses.speeds(BodyRegion("chest", 25e3, 40.0, 560.0))
+    np.testing.assert_allclose(doubled.speed, 2 * chest.speed, rtol=1e-12)
 
 
-def test_crx_safety_prints_the_summary_and_writes_one_row_per_sample(run, tmp_path, capsys):
+def test_crx_safety_prints_the_summary_and_writes_one_row_per_sample(run, chest, tmp_path, capsys):
     table = tmp_path / "chest.csv"
     args = [
         "safety",
@@ -115,7 +122,7 @@ def test_crx_safety_prints_the_summary_and_writes_one_row_per_sample(run, tmp_pa
     ]
     assert main([*args, "--transient-force", "280 N", "--csv", str(table)]) == 0
     printed = capsys.readouterr().out
-    result = speed_map(run, CHEST)
+    result = chest
     assert f"permissible speed {np.min(result.speed):.3g} to {np.max(result.speed):.3g} m/s" in printed
     assert f"permissible speed {result.iso_speed:.3g} m/s" in printed and "ISO/TS 15066" in printed
     rows = list(csv.DictReader(table.open()))
