@@ -18,6 +18,8 @@ from collision_reflex.errors import CatalogueError, InvalidParameter
 from collision_reflex.model.contact import BodyRegion
 from collision_reflex.study.safety import load_body_regions, speed_map
 
+pytestmark = pytest.mark.xdist_group("test_safety")  # one pytest-xdist worker: the speed map read once
+
 ROOT = Path(__file__).resolve().parents[1]
 URDF = ROOT / "designs" / "planar_two_link.urdf"
 CHEST = BodyRegion("chest", 25e3, 40.0, 280.0)  # 25 N/mm, 40 kg, 280 N: the standard's chest
