@@ -266,6 +266,12 @@ class ArmDynamics:
         position, _ = self.contact_kinematics(y[: self.nv])
         return float(self.normal @ (position - self.p0))
 
+    def motor_approach(self, y: np.ndarray) -> float:
+        """The motors' velocity toward the wall [m/s]: the motor rates through the contact Jacobian, along ``n``."""
+        nv = self.nv
+        _, jac = self.contact_kinematics(y[:nv])
+        return float(self.normal @ (jac @ y[3 * nv : 4 * nv]))
+
     def wall_forces(self, solution: Any) -> np.ndarray:
         """Wall force [N] at each step of a solution but the first."""
         nv = self.nv

@@ -217,15 +217,32 @@ def _react(
     def touched(t: float, y: np.ndarray) -> float:
         return dynamics.penetration(y)
 
+    def retreated(t: float, y: np.ndarray) -> float:
+        return dynamics.motor_approach(y) + dynamics.approach_velocity
+
     separated.terminal, separated.direction = True, -1  # type: ignore[attr-defined]
     touched.terminal, touched.direction = True, 1  # type: ignore[attr-defined]
+    retreated.terminal, retreated.direction = True, -1  # type: ignore[attr-defined]
 
-    for _ in range(_MAX_REBOUNDS):
-        solution = solve_ivp(dynamics.rhs, (t, duration), y, events=separated, **options)
+    in_contact = dynamics.penetration(y) > 0
+    if not in_contact:
+        # A rebound left the finger off the wall before detection: its contact is over once the motors retreat
+        # as fast as they came (pushing on until the finger next leaves the wall would swing the arm round into
+        # it again), unless it touches first.
+        solution = solve_ivp(dynamics.rhs, (t, duration), y, events=[retreated, touched], **options)
         trace.add(solution, dynamics)
         y, t = solution.y[:, -1].copy(), float(solution.t[-1])
         if solution.status != 1:
-            raise SimulationError(f"the contact had not ended after {duration:.3g} s; lengthen it")
+            raise SimulationError(f"the motors had not retreated after {duration:.3g} s; lengthen it")
+        in_contact = solution.t_events[1].size > 0
+    for _ in range(_MAX_REBOUNDS):
+        if in_contact:
+            solution = solve_ivp(dynamics.rhs, (t, duration), y, events=separated, **options)
+            trace.add(solution, dynamics)
+            y, t = solution.y[:, -1].copy(), float(solution.t[-1])
+            if solution.status != 1:
+                raise SimulationError(f"the contact had not ended after {duration:.3g} s; lengthen it")
+        in_contact = True
         trace.contact_end = t
         dynamics.torque = np.zeros(dynamics.nv)
         coast = solve_ivp(dynamics.rhs, (t, t + watch), y, events=touched, **options)
