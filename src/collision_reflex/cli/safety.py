@@ -79,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
     elif None in figures.values():
         raise InvalidParameter(
             "--region",
-            None,
+            "missing",
             "a body region's name",
             "or all of --region-stiffness, --region-mass and --transient-force",
         )
