@@ -52,7 +52,7 @@ MAX_STEPS = 200_000
 
 CONTACT_DAMPING_RATIO = 2.0
 """The simulated contact's damping, as a ratio of critical for the finger mass (the simulator's default: a
-plastic impact, restitution 0.02)."""
+plastic impact, restitution 0.048 of the finger alone)."""
 
 TORQUE_DETECTION = "spring_torque"
 """The simulator's default detection: the contact force estimated from the joint spring torques."""
