@@ -137,6 +137,7 @@ class ArmDynamics:
         self.reacting = False
         self.torque = np.zeros(self.nv)  # motor torques of the reaction [N m]
         self.push = self.torque  # the reaction's torques, kept for a rebound
+        self.brake_speed: float | None = None  # set once the reflex is over: the motors brake to a stop
 
     def contact_kinematics(self, qs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Contact point position [m] (3,) and translational Jacobian (3, nv), world-aligned."""
@@ -196,6 +197,8 @@ class ArmDynamics:
         out[2 * nv : 3 * nv] = dtheta
         if self.reacting or self.drive == "impedance":
             torque = self.torque if self.reacting else self.impedance_torque(t, theta, dtheta)
+            if self.brake_speed is not None:
+                torque = self.brake_torque(dtheta)
             out[3 * nv : 4 * nv] = (torque - spring) / self.inertia
         if self.detection == "observer":
             coriolis = self.pin.computeCoriolisMatrix(self.model, self.data, qs, dq)
@@ -265,6 +268,24 @@ class ArmDynamics:
         """Depth of the contact point beyond the wall [m]."""
         position, _ = self.contact_kinematics(y[: self.nv])
         return float(self.normal @ (position - self.p0))
+
+    def brake(self, y: np.ndarray | None) -> None:
+        """Once the reflex is over (``y``: the state then) the motors brake to a stop; ``None``: push again.
+
+        Braking opposes each motor's velocity with its torque limit (the push's size where the limit is
+        infinite), smoothed below 5 % of the fastest motor's speed when it starts, so that the motors come to
+        rest instead of coasting with the speed the push gave them.
+        """
+        if y is None:
+            self.brake_speed, self.torque = None, self.push
+            return
+        self.brake_speed = 0.05 * float(np.max(np.abs(y[3 * self.nv : 4 * self.nv]))) + 1e-9
+
+    def brake_torque(self, dtheta: np.ndarray) -> np.ndarray:
+        """The braking motor torques (nv,) [N m] at motor velocities ``dtheta`` [rad/s] (see :meth:`brake`)."""
+        assert self.brake_speed is not None
+        limit = np.where(np.isfinite(self.tau_max), self.tau_max, np.abs(self.push))
+        return -limit * np.tanh(dtheta / self.brake_speed)
 
     def motor_approach(self, y: np.ndarray) -> float:
         """The motors' velocity toward the wall [m/s]: the motor rates through the contact Jacobian, along ``n``."""

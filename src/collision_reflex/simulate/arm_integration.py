@@ -203,11 +203,11 @@ def _react(
     watch: float,
     options: dict[str, Any],
 ) -> None:
-    """Push until the finger leaves the wall; then the reflex is over: the motors stop pushing and coast away.
+    """Push until the finger leaves the wall; then the reflex is over: the motors brake to a stop.
 
-    Watch ``watch`` [s] for a rebound into the wall before stopping (a constant torque kept on would spin the
-    arm round into the wall again, which is no part of the reflex), and push again from the moment it touches
-    again, until it leaves again.
+    Watch ``watch`` [s] for a rebound into the wall before stopping (a constant torque kept on, or motors left to
+    coast with the speed the push gave them, would swing the arm round into the wall again, which is no part of
+    the reflex), and push again from the moment it touches again, until it leaves again.
     """
     from scipy.integrate import solve_ivp
 
@@ -244,13 +244,13 @@ def _react(
                 raise SimulationError(f"the contact had not ended after {duration:.3g} s; lengthen it")
         in_contact = True
         trace.contact_end = t
-        dynamics.torque = np.zeros(dynamics.nv)
+        dynamics.brake(y)
         coast = solve_ivp(dynamics.rhs, (t, t + watch), y, events=touched, **options)
         trace.add(coast, dynamics)
         y, t = coast.y[:, -1].copy(), float(coast.t[-1])
         if coast.status != 1:  # no new touch within the watch
             break
-        dynamics.torque = dynamics.push
+        dynamics.brake(None)
     else:
         raise SimulationError(
             f"the finger kept hitting the wall again after the reaction ({_MAX_REBOUNDS} rebounds)"
