@@ -56,8 +56,7 @@ def _two_masses_on_a_spring(m_R: float, m_H: float, k: float, v: float) -> tuple
     )
     times = np.linspace(0, solution.t_events[0][0], 20001)
     compression = solution.sol(times)[0]
-    peak = np.max(compression)
-    # Refine the peak where the rate crosses zero.
+    # The peak where the rate crosses zero, bracketed by the largest sampled compression.
     from scipy.optimize import brentq
 
     i = int(np.argmax(compression))

@@ -12,7 +12,6 @@ motors, ``construction`` (``frameless`` or ``housed``) are optional, carry no nu
 from __future__ import annotations
 
 import hashlib
-import stat
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
@@ -308,11 +307,11 @@ def read_entries(path: Path, kind: str = "motors") -> dict[str, CatalogueEntry]:
         Naming the file, the line and the field: bad YAML, a missing, unknown or mistyped field, a unit of
         the wrong dimension, a non-physical value, or an entry without a source.
     """
-    key = _cache_key(path, kind)
-    if key is not None and key in _READ:
-        return dict(_READ[key])
     try:
-        entries = _read_entries(path, kind)
+        data = _file_bytes(path)
+        key = (str(path), kind, hashlib.sha256(data).digest())
+        if key not in _READ:
+            _READ[key] = _parsed_entries(str(path), data, kind)
     except CatalogueError as error:
         texts = (str(error.path), error.field, error.reason)
         if all(text.isprintable() for text in texts):
@@ -320,9 +319,7 @@ def read_entries(path: Path, kind: str = "motors") -> dict[str, CatalogueEntry]:
         # A message quotes field names and values of the file: escape what would break or hide its line.
         path_text, field, reason = map(one_line, texts)
         raise CatalogueError(path_text, error.line, field, reason) from None
-    if key is not None:
-        _READ[key] = entries
-    return dict(entries)
+    return dict(_READ[key])
 
 
 # A study reads its catalogues once per problem it builds: the validated entries of a file are kept, keyed by
@@ -330,23 +327,17 @@ def read_entries(path: Path, kind: str = "motors") -> dict[str, CatalogueEntry]:
 _READ: dict[tuple[str, str, bytes], dict[str, CatalogueEntry]] = {}
 
 
-def _cache_key(path: Path, kind: str) -> tuple[str, str, bytes] | None:
-    """The key of ``path``'s entries in ``_READ``, or None for what is not a readable regular file."""
+def _file_bytes(path: Path) -> bytes:
+    """The file's bytes, or a :class:`CatalogueError` saying why they cannot be read."""
     try:
-        if not stat.S_ISREG(Path(path).stat().st_mode):
-            return None
-        return (str(path), kind, hashlib.sha256(Path(path).read_bytes()).digest())
-    except (OSError, ValueError):
-        return None
-
-
-def _read_entries(path: Path, kind: str) -> dict[str, CatalogueEntry]:
-    name = str(path)
-    try:
-        data = Path(path).read_bytes()
+        return Path(path).read_bytes()
     except (OSError, ValueError) as error:  # ValueError: a NUL byte in the path
         reason = getattr(error, "strerror", None) or str(error)
-        raise CatalogueError(name, None, "", f"cannot read the file ({reason})") from None
+        raise CatalogueError(str(path), None, "", f"cannot read the file ({reason})") from None
+
+
+def _parsed_entries(name: str, data: bytes, kind: str) -> dict[str, CatalogueEntry]:
+    """The validated entries of file ``name``'s ``data`` (see :func:`read_entries`)."""
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as error:
