@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 
 import numpy as np
 
+from ..model.contact import rebound, rebound_impulse, settled_rebound_speed
 from ..model.impulse import (
     collision_times,
     minimum_impulse,
@@ -50,6 +52,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     options.ROBOT_VELOCITY.add(parser, note="with --reaction moving", shown="v0")
     options.APPROACH_VELOCITIES.add(parser, note="also tabulate I(v0) over them")
+    dataclasses.replace(options.RESTITUTION, hint="in [0, 1)").add(
+        parser,
+        note="of a rigid object that rebounds: adds its impulse (a finger that settles before detection)",
+        shown="0, plastic",
+        bound="non-negative",
+    )
     options.add_plot(parser, what="the force-time profile with the phases shaded")
     parser.set_defaults(run=run)
 
@@ -66,6 +74,16 @@ def run(args: argparse.Namespace) -> int:
     t1, t2 = collision_times(*common, args.v0, args.reaction, args.v_r)
     v_star = optimal_velocity(args.m_f, k, args.F_s, args.reaction, args.k_m, args.a)
     i_star = minimum_impulse(*common, args.reaction)
+    rows = [
+        ("I   impact", phases.initial),
+        ("II  sensing", phases.sensing),
+        ("III reaction", phases.reaction),
+    ]
+    total = phases.total
+    if args.restitution:
+        added = rebound_impulse(args.m_f, k, args.F_s, args.v0, args.restitution)
+        rows.append((f"    rebound (e = {args.restitution:g})", added))
+        total = total + added
 
     print(
         f"m_f = {args.m_f:g} kg, k = {k:g} N/m (k_m = {args.k_m:g}, "
@@ -74,14 +92,9 @@ def run(args: argparse.Namespace) -> int:
     )
     print()
     print(f"{'phase':<22}{'impulse [N*s]':>16}{'share':>9}")
-    rows = (
-        ("I   impact", phases.initial),
-        ("II  sensing", phases.sensing),
-        ("III reaction", phases.reaction),
-    )
     for name, value in rows:
-        print(f"{name:<22}{float(value):>16.6g}{float(value / phases.total):>9.1%}")
-    print(f"{'total I':<22}{float(phases.total):>16.6g}")
+        print(f"{name:<22}{float(value):>16.6g}{float(value / total):>9.1%}")
+    print(f"{'total I':<22}{float(total):>16.6g}")
     print()
     print(f"detection t1 = {float(t1):.6g} s, contact ends t2 = {float(t2):.6g} s")
     print(f"optimal velocity v* = {float(v_star):.6g} m/s, minimum impulse I* = {float(i_star):.6g} N*s")
@@ -90,15 +103,33 @@ def run(args: argparse.Namespace) -> int:
 
     if args.velocities is not None:
         sweep = phase_impulses(*common, args.velocities, args.reaction, args.v_r)
+        v = np.asarray(args.velocities, dtype=float)
+        names = ["v0 [m/s]", "I impact", "II sensing", "III reaction"]
+        columns = [v, *np.broadcast_arrays(sweep.initial, sweep.sensing, sweep.reaction)]
+        total = sweep.total
+        if args.restitution:  # NaN where the finger still rebounds at detection: printed as "simulate"
+            settled = v <= settled_rebound_speed(args.m_f, k, args.F_s, args.restitution)
+            extra = np.where(settled, rebound(args.restitution).excess * args.m_f * v, np.nan)
+            names.append("rebound")
+            columns.append(extra)
+            total = total + extra
+        names.append("total I")
+        columns.append(np.broadcast_to(total, v.shape))
         print()
-        print(f"{'v0 [m/s]':>12}{'I impact':>14}{'II sensing':>14}{'III reaction':>14}{'total I':>14}")
-        columns = np.broadcast_arrays(
-            args.velocities, sweep.initial, sweep.sensing, sweep.reaction, sweep.total
-        )
+        print(f"{names[0]:>12}" + "".join(f"{name:>14}" for name in names[1:]))
         for row in zip(*columns, strict=True):
-            print("".join(f"{float(x):>{12 if i == 0 else 14}.6g}" for i, x in enumerate(row)))
+            print("".join(_cell(x, 12 if i == 0 else 14) for i, x in enumerate(row)))
+        if args.restitution and not settled.all():
+            print(
+                "simulate: the finger still rebounds when the contact is detected (crx simulate --restitution)"
+            )
 
     if args.plot is not None:
         path = plot_force_profile(args.plot, *common, args.v0, args.reaction, args.v_r)
         print(f"\nwrote {path}")
     return 0
+
+
+def _cell(value: float, width: int) -> str:
+    """A number of the sweep's table, or ``simulate`` where the closed form has none (NaN)."""
+    return f"{'simulate':>{width}}" if np.isnan(value) else f"{float(value):>{width}.6g}"

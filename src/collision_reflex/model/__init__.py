@@ -2,11 +2,15 @@
 
 from .contact import (
     BodyRegion,
+    Rebound,
     TransientContact,
     contact_robot_mass,
     iso_robot_mass,
     permissible_speed,
+    rebound,
+    rebound_impulse,
     reduced_mass,
+    settled_rebound_speed,
     transient_contact,
 )
 from .impulse import (
@@ -25,6 +29,7 @@ from .sensing import current_threshold_torque, threshold_force
 __all__ = [
     "BodyRegion",
     "PhaseImpulses",
+    "Rebound",
     "TransientContact",
     "collision_times",
     "contact_robot_mass",
@@ -35,8 +40,11 @@ __all__ = [
     "optimal_velocity",
     "permissible_speed",
     "phase_impulses",
+    "rebound",
+    "rebound_impulse",
     "reduced_mass",
     "series_stiffness",
+    "settled_rebound_speed",
     "threshold_force",
     "total_impulse",
     "transient_contact",

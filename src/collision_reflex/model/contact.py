@@ -19,11 +19,25 @@ In between, the first peak lies between the two (checked against the time-domain
 Integrators without a dynamic model take the robot's mass as ISO/TS 15066 (Annex A) estimates it:
 ``m_R = M / 2 + m_L``, half the moving mass plus the payload; :func:`iso_robot_mass` gives it for comparison.
 
-Every function accepts floats, NumPy arrays (broadcast) and CasADi symbols. SI units: kg, N/m, m/s, N, s.
+A rigid object that returns part of the finger's momentum (coefficient of restitution ``e``) adds to the plastic
+closed form an impulse that has one closed form where the finger has settled on the object before the contact is
+detected. With the reference moving on at ``v0`` and the finger on the lumped spring ``k``, time in units of
+``1 / w_s`` (``w_s = sqrt(k / m_f)``) and positions in ``v0 / w_s`` leave ``e`` as the only parameter: each
+flight after an impact is a sine arc of the free oscillator, the finger lands again at the root of one equation,
+and the flights shorten geometrically until it rests at ``w_s T(e)``. The spring then carries what it would have
+carried had the finger stuck, plus the integral of its extra stretch, ``G(e) m_f v0`` (:func:`rebound`); ``G(e)
+= 1.5 e^2`` for small ``e``. Detection waits for it if the plastic detection time ``F_s / (k v0)`` is at least
+``T(e) / w_s``, i.e. up to ``v0 = F_s / (T(e) sqrt(k m_f)) = sqrt(2) v* / T(e)`` (:func:`settled_rebound_speed`);
+beyond, the sensing and reaction overlap the rebound and only the simulator
+(:mod:`collision_reflex.simulate`, ``contact_damping_for_restitution``) gives the impulse.
+
+Every function accepts floats, NumPy arrays (broadcast) and CasADi symbols, except the rebound's (numeric
+only). SI units: kg, N/m, m/s, N, s.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -32,6 +46,7 @@ import numpy as np
 
 from .. import _validate
 from .._backend import is_symbolic, sqrt
+from ..errors import InvalidParameter
 
 DECOUPLED_STIFFNESS_RATIO = 100.0
 """``k_c / k_m`` at and above which the finger alone meets the contact: its first peak is within 0.1 % of the
@@ -166,6 +181,125 @@ def iso_robot_mass(moving_mass: Any, payload: Any = 0.0) -> Any:
     M = _validate.positive("moving_mass", moving_mass)
     m_L = _validate.non_negative("payload", payload)
     return _plain(M / 2 + m_L)
+
+
+@dataclass(frozen=True)
+class Rebound:
+    """How a finger that rebounds from a rigid object settles on it, pushed by the spring behind it.
+
+    restitution: the contact's coefficient of restitution ``e`` for the finger alone; excess: ``G(e)``, the
+    impulse the rebound adds to the plastic closed form, over ``m_f v0``; settling: ``T(e)``, the time from first
+    touch until the finger rests on the object, over ``1 / w_s`` with ``w_s = sqrt(k / m_f)``; impacts: how many
+    flights were followed exactly before the geometric tail (dimensionless all).
+    """
+
+    restitution: float
+    excess: float
+    settling: float
+    impacts: int
+
+
+MAX_REBOUNDS = 100_000
+"""Flights followed before a rebound is refused as not settling (``e = 0.999`` needs about 6,800)."""
+
+
+def rebound(restitution: float) -> Rebound:
+    """The rebound of a finger pushed against a rigid object by a spring whose far end moves on at ``v0``.
+
+    Scaled (time ``w_s t``, position ``x w_s / v0``, toward the object positive) the finger flies
+    ``x(s) = t (1 - cos s) + s - (1 + e u) sin s`` after an impact at time ``t`` with speed ``u``, lands at the
+    first root ``s > 0`` (within one period), and the spring's extra stretch ``-x`` integrates in closed form.
+    Flights shorter than 1e-4 are parabolic to 1e-8: their geometric tail (ratio ``e``) is summed at once.
+
+    Parameters
+    ----------
+    restitution: ``e`` in [0, 1), dimensionless (0 is the plastic impact: nothing added).
+    """
+    e = _validate.real("restitution", restitution, "a number in [0, 1)")
+    if e.ndim or not 0 <= e < 1:
+        raise InvalidParameter(
+            "restitution", restitution, "one number in [0, 1)", "a contact with e >= 1 never settles"
+        )
+    return _settle(float(e))
+
+
+@functools.lru_cache(maxsize=256)
+def _settle(e: float) -> Rebound:
+    """:func:`rebound` of a checked ``e``."""
+    t, u, excess, impacts = 0.0, 1.0, 0.0, 0
+    while e > 0:
+        kick = 1 + e * u  # the finger's speed away from the spring's far end just after the impact
+
+        def position(s: float, t: float = t, kick: float = kick) -> float:
+            return t * _one_minus_cos(s) + s - kick * math.sin(s)
+
+        # The flight's length to third order in s: -e u s + t s^2 / 2 + kick s^3 / 6 = 0.
+        guess = min(2 * e * u / (t / 2 + math.sqrt(t * t / 4 + 2 * kick * e * u / 3)), math.pi)
+        if t > 0 and guess < 1e-4:
+            break
+        if impacts == MAX_REBOUNDS:
+            raise InvalidParameter(
+                "restitution", e, "a contact that settles within 100,000 impacts", "simulate it instead"
+            )
+        step, end = guess / 16, guess / 16
+        while position(end) < 0:  # negative just after the impact, positive after one period at most
+            end += step
+        from scipy.optimize import brentq  # lazy: scipy.optimize is slow to import
+
+        s = brentq(position, end - step, end, xtol=1e-14 * guess, rtol=1e-15)
+        excess += kick * _one_minus_cos(s) - t * (s - math.sin(s)) - s * s / 2
+        u = 1 + t * math.sin(s) - kick * math.cos(s)
+        t += s
+        impacts += 1
+    if e > 0:  # the parabolic tail: flights 2 e u / t long, each impact e times the last
+        lift = e * u
+        excess += 2 * lift**3 / (3 * t * t * (1 - e**3))
+        t += 2 * lift / (t * (1 - e))
+    return Rebound(e, excess, t, impacts)
+
+
+def settled_rebound_speed(finger_mass: Any, stiffness: Any, threshold: Any, restitution: float) -> Any:
+    """The fastest approach [m/s] at which a rebounding finger rests on the object before it is detected.
+
+    ``F_s / (T(e) sqrt(k m_f))`` (:func:`rebound`; ``inf`` for a plastic contact). Parameters: ``finger_mass``
+    ``m_f`` [kg], ``stiffness`` the lumped ``k`` [N/m], ``threshold`` the force at detection ``F_s`` [N], and the
+    coefficient of restitution.
+    """
+    m_f = _validate.positive("finger_mass", finger_mass)
+    k = _validate.positive("stiffness", stiffness)
+    F_s = _validate.positive("threshold", threshold)
+    settling = rebound(restitution).settling
+    with np.errstate(divide="ignore"):
+        return _plain(np.divide(F_s, settling * np.sqrt(k * m_f)))
+
+
+def rebound_impulse(
+    finger_mass: Any, stiffness: Any, threshold: Any, velocity: Any, restitution: float
+) -> Any:
+    """The impulse [N*s] a rebounding contact adds to the plastic closed form, ``G(e) m_f v0``.
+
+    Exact for the paper's model (the far end of the spring moving on at ``v0`` until detection) where the
+    finger settles before it is detected, i.e. ``velocity <= settled_rebound_speed(...)``; beyond it the rebound
+    overlaps the sensing and :class:`~collision_reflex.errors.InvalidParameter` says to simulate it. Arguments
+    as :func:`settled_rebound_speed`, ``velocity`` ``v0`` [m/s] > 0.
+    """
+    v0 = _validate.positive("velocity", velocity)
+    fastest = settled_rebound_speed(finger_mass, stiffness, threshold, restitution)
+    beyond = np.asarray(v0 > fastest * (1 + 1e-12))
+    if beyond.any():
+        raise InvalidParameter(
+            "velocity",
+            velocity,
+            f"at most the settled-rebound speed {np.min(fastest):.4g} m/s (restitution {restitution:g})",
+            "faster, the finger is still rebounding when the contact is detected: simulate it "
+            "(crx simulate --restitution)",
+        )
+    return _plain(rebound(restitution).excess * np.asarray(finger_mass, dtype=float) * v0)
+
+
+def _one_minus_cos(s: float) -> float:
+    """``1 - cos s`` without the cancellation of small ``s``."""
+    return 2 * math.sin(s / 2) ** 2
 
 
 def _plain(value: Any) -> Any:
