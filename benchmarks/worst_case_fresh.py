@@ -1,6 +1,7 @@
 """Does a run's reported worst case hold on fresh samples it was not optimised on?
 
     PYTHONPATH=src python benchmarks/worst_case_fresh.py RUN_FOLDER [--samples 20000] [--seed 1] [--design recommended]
+        [--region thigh_knee]
 
 Reads the run's ``designs.json`` (the design, the contact domain it reports and the study), draws ``--samples``
 configurations uniformly within the joint limits and directions uniformly on the sphere (the circle for a planar
@@ -8,7 +9,9 @@ arm) with its own generator, keeps the pairs inside the reported domain (smalles
 Jacobian at least the floor; the guarded move ``J^+ u v0`` within the joint speed limits at the design's approach
 velocity) and evaluates the design's impulse there (NumPy path). It prints the fraction of the box the domain
 keeps, the largest fresh impulse against the reported worst case (``worst_case.domain``) and their ratio, and the
-same without the domain (every fresh pair), to show what the domain excludes.
+same without the domain (every fresh pair), to show what the domain excludes. With ``--region`` it also prints the
+slowest permissible speed against that ISO/TS 15066 body region over the fresh pairs in the domain (rotors on the
+links, as a study's ``constraints.body_region`` takes it) against the design's approach velocity.
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ def main() -> None:
     parser.add_argument("--samples", type=int, default=20_000)
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--design", default="recommended", help="recommended, chosen, or a Pareto index")
+    parser.add_argument("--region", help="an ISO/TS 15066 body region (crx safety --list-regions)")
     args = parser.parse_args()
 
     from collision_reflex.arm.domain import smallest_singular_values, unit_speed_joint_rates
@@ -74,6 +78,19 @@ def main() -> None:
         f"fresh without the domain {float(np.nanmax(impulses)):.6g} N*s: ratio "
         f"{float(np.nanmax(impulses)) / reported:.3f}  ({time.perf_counter() - started:.1f} s)"
     )
+    if args.region:
+        from collision_reflex.optimize.body_region import region_speeds
+        from collision_reflex.study.body_regions import load_body_regions
+
+        region = load_body_regions()[args.region]
+        chosen = np.flatnonzero(inside)
+        fresh_samples = ContactSamples(kinematics, u[chosen], chosen)
+        speeds = region_speeds(fresh_samples, design, region)
+        print(
+            f"{args.region}: slowest permissible speed over the fresh pairs in the domain {speeds.min():.6g} m/s "
+            f"against the approach {design.approach_velocity:.6g} m/s (ratio {speeds.min() / design.approach_velocity:.4f}); "
+            f"{int(np.sum(design.approach_velocity > speeds * (1 + 1e-6)))} of {chosen.size} pairs below it"
+        )
 
 
 if __name__ == "__main__":

@@ -17,7 +17,7 @@ from collision_reflex.model import (
     transient_contact,
 )
 from collision_reflex.simulate import CollisionSetup, Detection, simulate
-from collision_reflex.study.safety import load_body_regions
+from collision_reflex.study.body_regions import load_body_regions
 
 
 def test_the_permissible_speed_of_a_hand_is_the_hand_calculation():

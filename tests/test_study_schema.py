@@ -85,6 +85,7 @@ def test_defaults_are_explicit_in_the_resolved_study():
         "safety_factor": 1.0,
         "threshold_floor": 0.0,
         "torque_required": None,
+        "body_region": None,
     }
     assert resolved["execution"] == {"executor": "serial", "workers": 2, "scheduler": None}
     assert resolved["robot"]["contact_offset"] is None  # the robot's default contact point

@@ -55,7 +55,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``crx safety`` with parsed ``args``; return the exit status."""
-    from ..study.safety import load_body_regions, speed_map  # lazy: casadi and pinocchio (the run's study)
+    from ..study.body_regions import load_body_regions  # lazy: the catalogue reader
+    from ..study.safety import speed_map  # lazy: casadi and pinocchio (the run's study)
 
     regions = load_body_regions(args.regions)
     if args.list_regions:

@@ -64,7 +64,7 @@ class BodyRegion:
     ``m_H`` [kg] (``inf`` for a region held against something); transient_force: the largest permissible
     transient contact force ``F_T`` [N] (None where the standard permits no transient contact);
     quasi_static_force: the largest permissible quasi-static (clamping) force [N], None when not given.
-    The standard's regions are :func:`collision_reflex.study.safety.load_body_regions`.
+    The standard's regions are :func:`collision_reflex.study.body_regions.load_body_regions`.
     """
 
     name: str

@@ -12,6 +12,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..errors import InvalidParameter
+from .body_region import region_violations
 from .constraints import torque_requirement_rows
 from .design import Design, design_at
 from .evaluate import design_collision_parameters, evaluate_design
@@ -100,8 +101,8 @@ def violated_samples(
     """Samples outside ``active`` that ``design`` violates, by more than the relative ``tolerance``.
 
     A sample is violated when its impulse [N*s] exceeds the active worst case (or the worst case's bound), its
-    contact threshold is below the noise floor, or its configuration's gravity demand exceeds a joint's driving
-    torque.
+    contact threshold is below the noise floor, the approach exceeds its permissible speed against the problem's
+    body region, or its configuration's gravity demand exceeds a joint's driving torque.
     """
     inside = full.samples.inside(design.approach_velocity)  # samples in the design's contact domain
     levels = []
@@ -118,6 +119,9 @@ def violated_samples(
         _, thresholds = design_collision_parameters(full, design)
         bad |= thresholds < floor * (1 - tolerance)
     bad &= inside
+    region = full.constraints.body_region
+    if region is not None:
+        bad |= region_violations(full.samples, design, region, full.slowest_bound, tolerance)
     bad[_torque_violated(full, design, impulses, tolerance)] = True
     bad[active] = False
     return np.flatnonzero(bad)

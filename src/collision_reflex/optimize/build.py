@@ -57,8 +57,8 @@ def build_problem(
     objective: an objective name of :data:`.objectives.OBJECTIVES` or a weighted sum ``{name: weight}``; each objective is
         divided by its value at the start point, so weights compare relative changes.
     constraints: torque requirement (gravity over the samples + payload, times a safety factor, or given
-        values, or a duty cycle's peak, RMS and speed requirements: :mod:`collision_reflex.optimize.duty`) and
-        the threshold noise floor.
+        values, or a duty cycle's peak, RMS and speed requirements: :mod:`collision_reflex.optimize.duty`), the
+        threshold noise floor and a body region's permissible speed (:mod:`.body_region`).
     bounded_objectives: objectives that may be bounded per solve (epsilon-constraint Pareto sweeps).
 
     Raises
@@ -78,11 +78,9 @@ def build_problem(
         arm, samples, constraints.duty_cycle, constraints.rating, technology, constraints.safety_factor
     )
     named = set(weights) | set(bounded)
-    slices = variable_slices(
-        layout.size, samples.size, n_joints, "worst_case_impulse" in named, "cvar_impulse" in named
-    )
-    epigraph_index, tail_index, compliance_index, direction_index = slices
-    x = ca.MX.sym("x", direction_index.stop)
+    slices = variable_slices(layout.size, samples.size, n_joints, named, constraints.body_region is not None)
+    epigraph_index, tail_index, compliance_index, direction_index, coupled_index = slices
+    x = ca.MX.sym("x", (coupled_index or direction_index).stop)
     k_mech = technology.joint_mechanical_stiffness(n_joints)
     design = design_quantities(layout, x[: layout.size], technology, k_mech)
     joint_numbers = design.joint_function(x)
@@ -101,7 +99,7 @@ def build_problem(
         duty_rows,
         duty,
     )
-    direction_scale, start_impulses, scale = _start_scales(
+    direction_scale, coupled_scale, start_impulses, scale = _start_scales(
         layout, technology, joint_names, samples, joint_numbers, x0
     )
     p = ca.MX.sym("p", len(bounded))
@@ -126,6 +124,8 @@ def build_problem(
         compliance_index=compliance_index,
         direction_index=direction_index,
         direction_scale=direction_scale,
+        coupled_index=coupled_index,
+        coupled_scale=coupled_scale if coupled_index is not None else None,
         build_time=0.0,
         duty=duty,
         slowest_bound=float(layout.values(lbx[: layout.size])["approach_velocity"][0]),
@@ -187,18 +187,20 @@ def _start_scales(
     samples: ContactSamples,
     joint_numbers: ca.Function,
     x0: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray, dict[str, float]]:
-    """The start design's finger-mass direction scales, impulses [N*s] and objectives [their units].
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict[str, float]]:
+    """The start design's finger- and coupled-mass direction scales, impulses [N*s] and objectives [their units].
 
     The NLP divides each objective by its value at the start ``x0``; the impulses are checked finite. The
     finger-mass directions span orders of magnitude across samples: each sample's is scaled by its largest
-    entry at the start.
+    entry at the start, and so are the coupled-mass directions (the rotors on the links).
     """
-    start_mass, _, start_finger = (np.asarray(v).ravel() for v in joint_numbers(x0))
-    directions = finger_mass_directions(samples, start_mass, start_finger)
-    direction_scale = np.maximum(np.abs(directions).max(axis=1), 1e-300)
+    start_mass, _, start_finger, start_reflected = (np.asarray(v).ravel() for v in joint_numbers(x0))
+    direction_scale, coupled_scale = (
+        np.maximum(np.abs(finger_mass_directions(samples, start_mass, inertia)).max(axis=1), 1e-300)
+        for inertia in (start_finger, start_reflected)
+    )
     start_impulses = numpy_impulses(layout, technology, joint_names, samples, x0)
     check_finite(start_impulses, "impulse at the start point", samples)
     velocity = layout.values(x0[: layout.size])["approach_velocity"][0]
     scale = objective_values(start_impulses, float(np.sum(start_mass)), velocity, samples)
-    return direction_scale, start_impulses, scale
+    return direction_scale, coupled_scale, start_impulses, scale

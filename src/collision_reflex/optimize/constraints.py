@@ -18,6 +18,7 @@ import numpy as np
 from ..arm.duty_cycle import DutyCycle
 from ..arm.rating import Rating
 from ..errors import InvalidParameter
+from ..model.contact import BodyRegion
 from .samples import ContactSamples, kinematic_term, loaded_joints
 from .technology import ActuatorTechnology
 
@@ -62,6 +63,10 @@ class Constraints:
         (:class:`collision_reflex.arm.rating.Rating`): the rated motion's and the braking's states at every
         sampled configuration add to the peak requirement and the rated speeds to the speed requirement, as a
         duty cycle's samples do (:mod:`collision_reflex.optimize.duty`); ``torque_required`` must be left unset.
+    body_region: a human body region (:class:`collision_reflex.model.BodyRegion`, one with a permissible
+        transient force) whose transient-force limit the approach must keep at every sample in the contact
+        domain, the robot mass taken with its rotors on the links (:mod:`collision_reflex.optimize.body_region`);
+        None for none.
     """
 
     payload: float = 0.0
@@ -71,8 +76,18 @@ class Constraints:
     duty_cycle: DutyCycle | None = None
     rating: Rating | None = None
     hold_poses: ArmSamples | None = None
+    body_region: BodyRegion | None = None
 
     def __post_init__(self) -> None:
+        if self.body_region is not None and (
+            not isinstance(self.body_region, BodyRegion) or self.body_region.transient_force is None
+        ):
+            raise InvalidParameter(
+                "body_region",
+                self.body_region,
+                "a BodyRegion with a permissible transient force, or None",
+                "ISO/TS 15066 permits no transient contact with a region without one",
+            )
         if not (math.isfinite(self.payload) and self.payload >= 0):
             raise InvalidParameter("payload", self.payload, "a finite mass >= 0 [kg]")
         if not (math.isfinite(self.safety_factor) and self.safety_factor >= 1):

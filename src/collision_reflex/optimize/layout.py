@@ -198,9 +198,10 @@ class DesignQuantities(NamedTuple):
         """CasADi function of ``x`` giving the joint numbers.
 
         Outputs (n_joints each): actuator (motor and gearbox) masses [kg], peak torques ``N tau_p`` [N m],
-        finger inertias [kg m^2].
+        finger inertias and reflected inertias [kg m^2].
         """
-        return ca.Function("joint_numbers", [x], [self.actuator_mass, self.peak_torque, self.finger_inertia])
+        outputs = [self.actuator_mass, self.peak_torque, self.finger_inertia, self.reflected_inertia]
+        return ca.Function("joint_numbers", [x], outputs)
 
 
 def design_quantities(

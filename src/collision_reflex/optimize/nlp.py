@@ -39,6 +39,7 @@ import casadi as ca
 import numpy as np
 
 from .._interrupt import interruptible
+from .body_region import add_body_region_constraints
 from .constraints import (
     ConstraintList,
     ModelTerms,
@@ -48,7 +49,7 @@ from .constraints import (
 )
 from .derivatives import SampleStructure, dense_dm
 from .duty import add_duty_constraints, add_gearbox_duty_constraints
-from .layout import DesignLayout, DesignQuantities
+from .layout import DesignQuantities
 from .objectives import add_epigraph, add_objective_bounds, add_tail, objective_expression, objective_terms
 from .samples import ContactSamples, sample_function
 from .technology import ActuatorTechnology
@@ -97,9 +98,11 @@ def nlp_graph(problem: DesignProblem, inputs: NlpInputs) -> NlpGraph:
     """The NLP's CasADi side: the per-sample terms, the rows, the objective and their split."""
     x, design, samples, technology = inputs.x, inputs.design, problem.samples, problem.technology
     compliance_index, direction_index = problem.compliance_index, problem.direction_index
+    coupled_index, coupled_scale = problem.coupled_index, problem.coupled_scale
     per_sample = _sample_terms(
         x[direction_index],
         x[compliance_index],
+        None if coupled_index is None or coupled_scale is None else (x[coupled_index], coupled_scale),
         design,
         samples,
         technology,
@@ -126,6 +129,13 @@ def nlp_graph(problem: DesignProblem, inputs: NlpInputs) -> NlpGraph:
     if duty is not None:
         add_duty_constraints(g, duty, design, inputs.duty_rows, inputs.torque_scale, joint_names)
         add_gearbox_duty_constraints(g, duty, design, inputs.duty_rows, technology, joint_names)
+    region = constraints.body_region
+    if region is not None:
+        velocity = design.values["approach_velocity"]
+        slowest = _slowest_approach(problem, inputs.p)
+        masses, normalisation = per_sample.coupled_masses, per_sample.coupled_normalisation
+        add_body_region_constraints(g, region, velocity, masses, normalisation, samples, slowest)
+    split = per_sample.split(region is not None)
     scale = problem.objective_scale
     add_objective_bounds(g, problem.bounded_objectives, expressions, scale, inputs.p)
     nlp = {
@@ -141,7 +151,7 @@ def nlp_graph(problem: DesignProblem, inputs: NlpInputs) -> NlpGraph:
         g.labels,
         evaluate,
         per_sample.function,
-        _sample_structure(nlp, problem.layout, design, per_sample, compliance_index, direction_index),
+        _sample_structure(nlp, problem, design, per_sample, split),
     )
 
 
@@ -156,22 +166,23 @@ def _add_worst_case_terms(
 
     Each only where the problem has its variables (an objective or a bound names it).
     """
-    x, scale, samples, bounded = (
-        inputs.x,
-        problem.objective_scale,
-        problem.samples,
-        problem.bounded_objectives,
-    )
+    x, scale, samples = inputs.x, problem.objective_scale, problem.samples
     if problem.epigraph_index is not None:
-        slowest: ca.MX | float = problem.slowest_bound
-        if "approach_velocity" in bounded:  # the epsilon bound on the approach velocity, an NLP parameter
-            bound = -inputs.p[bounded.index("approach_velocity")] * scale["approach_velocity"]
-            slowest = ca.fmax(problem.slowest_bound, bound)
+        slowest = _slowest_approach(problem, inputs.p)
         expressions["worst_case_impulse"] = add_epigraph(
             g, x, problem.epigraph_index, impulses, scale, samples, slowest
         )
     if problem.tail_index is not None:
         expressions["cvar_impulse"] = add_tail(g, x, problem.tail_index, impulses, scale, samples)
+
+
+def _slowest_approach(problem: DesignProblem, p: ca.MX) -> ca.MX | float:
+    """The least approach velocity a solve allows [m/s]: its lower bound, or its epsilon bound (an NLP parameter)."""
+    bounded = problem.bounded_objectives
+    if "approach_velocity" not in bounded:
+        return problem.slowest_bound
+    bound = -p[bounded.index("approach_velocity")] * problem.objective_scale["approach_velocity"]
+    return ca.fmax(problem.slowest_bound, bound)
 
 
 class _SampleTerms(NamedTuple):
@@ -184,11 +195,19 @@ class _SampleTerms(NamedTuple):
     thresholds: ca.MX
     normalisation: ca.MX
     parameters: ca.MX
+    coupled_masses: ca.MX
+    coupled_normalisation: ca.MX
+
+    def split(self, body_region: bool) -> list[ca.MX]:
+        """The outputs the outer part takes from each sample (see :func:`_sample_structure`)."""
+        outputs = [self.impulses, self.thresholds, self.normalisation]
+        return [*outputs, self.coupled_masses, self.coupled_normalisation] if body_region else outputs
 
 
 def _sample_terms(
     scaled_directions: ca.MX,
     log_compliance: ca.MX,
+    coupled: tuple[ca.MX, np.ndarray] | None,
     design: DesignQuantities,
     samples: ContactSamples,
     technology: ActuatorTechnology,
@@ -199,7 +218,9 @@ def _sample_terms(
 
     ``scaled_directions`` are the finger-mass directions ``x_s`` (n_joints * n_samples) divided by their size
     at the start, ``direction_scale`` (across samples they span orders of magnitude). ``log_compliance`` is
-    ``log(1/F_a)`` per sample; ``data`` the samples' data columns (:func:`.samples.sample_data`).
+    ``log(1/F_a)`` per sample; ``coupled`` the coupled-mass directions ``y_s`` so scaled and their scales (None
+    without a body region: the coupled outputs are then those of ``y = 0``, unused); ``data`` the samples' data
+    columns (:func:`.samples.sample_data`).
     """
     n_samples = samples.size
     n_joints = int(scaled_directions.numel()) // n_samples
@@ -210,29 +231,44 @@ def _sample_terms(
         np.tile(direction_scale, (n_joints, 1))
     )
     compliance = ca.exp(ca.transpose(log_compliance))
-    outputs = function.map(n_samples)(design.design_column, directions, compliance, dense_dm(data))
+    if coupled is None:
+        coupled_directions = ca.MX.zeros(n_joints, n_samples)
+    else:
+        scaled, coupled_scale = coupled
+        coupled_directions = ca.reshape(scaled, n_joints, n_samples) * dense_dm(
+            np.tile(coupled_scale, (n_joints, 1))
+        )
+    outputs = function.map(n_samples)(
+        design.design_column, directions, compliance, dense_dm(data), coupled_directions
+    )
     return _SampleTerms(function, data, direction_scale, *outputs)
 
 
 def _sample_structure(
     nlp: dict[str, ca.MX],
-    layout: DesignLayout,
+    problem: DesignProblem,
     design: DesignQuantities,
     per_sample: _SampleTerms,
-    compliance_index: slice,
-    direction_index: slice,
+    replaced: list[ca.MX],
 ) -> SampleStructure:
     """The NLP split into the per-sample function and the outer part (see :mod:`.derivatives`).
 
-    A sample's variables are the design's log values, its ``log(1/F_a)`` and its scaled finger-mass direction;
-    its outputs the impulse, the force threshold and ``w^T x``, the per-sample terms ``f`` and ``g`` use.
-    ``design`` holds the NLP's design quantities (functions of the design part of ``nlp["x"]``).
+    A sample's variables are the design's log values, its ``log(1/F_a)``, its scaled finger-mass direction and
+    (with a body region) its scaled coupled-mass direction; its outputs ``replaced``
+    (:meth:`_SampleTerms.split`), the per-sample terms ``f`` and ``g`` use. ``design`` holds the NLP's design
+    quantities (functions of the design part of ``nlp["x"]``).
     """
-    n_design, n_samples = layout.size, per_sample.data.shape[1]
+    compliance_index, direction_index, coupled_index = (
+        problem.compliance_index,
+        problem.direction_index,
+        problem.coupled_index,
+    )
+    n_design, n_samples = problem.layout.size, per_sample.data.shape[1]
     n_joints = (direction_index.stop - direction_index.start) // n_samples
+    n_directions = n_joints * (1 if coupled_index is None else 2)
     # The NLP's own design column, taken as a function of x (only its design part enters): not built again.
     design_column = ca.Function("design_column", [nlp["x"]], [design.design_column]).expand()
-    local = ca.SX.sym("v", n_design + 1 + n_joints)
+    local = ca.SX.sym("v", n_design + 1 + n_directions)
     # Data the same for every sample (most motor-mass influence entries are zero) become constants: fewer
     # operations in the per-sample Hessian.
     varying = np.flatnonzero(np.any(per_sample.data != per_sample.data[:, :1], axis=1))
@@ -240,25 +276,30 @@ def _sample_structure(
     column_data = ca.SX(ca.DM(per_sample.data[:, 0]))
     for position, row in enumerate(varying):
         column_data[int(row)] = data[position]
-    scale = ca.SX.sym("scale", n_joints)
+    scale = ca.SX.sym("scale", n_directions)
     column = design_column(ca.vertcat(local[:n_design], ca.SX.zeros(nlp["x"].numel() - n_design)))
-    outputs = per_sample.function(column, local[n_design + 1 :] * scale, ca.exp(local[n_design]), column_data)
-    sample = ca.Function("sample", [local, data, scale], [ca.vertcat(*outputs[:3])])
+    scaled = local[n_design + 1 :] * scale
+    coupled = ca.SX.zeros(n_joints) if coupled_index is None else scaled[n_joints:]
+    outputs = per_sample.function(column, scaled[:n_joints], ca.exp(local[n_design]), column_data, coupled)
+    impulse, threshold, normalisation, _, coupled_mass, coupled_normalisation = outputs
+    kept = [impulse, threshold, normalisation, coupled_mass, coupled_normalisation][: len(replaced)]
+    sample = ca.Function("sample", [local, data, scale], [ca.vertcat(*kept)])
 
-    y = ca.MX.sym("Y", 3, n_samples)
-    replaced = [per_sample.impulses, per_sample.thresholds, per_sample.normalisation]
-    f, g = ca.graph_substitute([nlp["f"], nlp["g"]], replaced, [y[0, :], y[1, :], y[2, :]])
+    y = ca.MX.sym("Y", len(replaced), n_samples)
+    f, g = ca.graph_substitute([nlp["f"], nlp["g"]], replaced, [y[i, :] for i in range(len(replaced))])
     outer = ca.Function("outer", [nlp["x"], y, nlp["p"]], [f, g]).expand()
     samples = np.arange(n_samples)
-    variables = np.vstack(
-        [
-            np.repeat(np.arange(n_design)[:, None], n_samples, axis=1),
-            compliance_index.start + samples[None, :],
-            direction_index.start + n_joints * samples[None, :] + np.arange(n_joints)[:, None],
-        ]
-    )
-    scales = np.tile(per_sample.direction_scale, (n_joints, 1))
-    return SampleStructure(outer, sample, variables, per_sample.data[varying], scales)
+    rows = [
+        np.repeat(np.arange(n_design)[:, None], n_samples, axis=1),
+        compliance_index.start + samples[None, :],
+        direction_index.start + n_joints * samples[None, :] + np.arange(n_joints)[:, None],
+    ]
+    scales = [np.tile(per_sample.direction_scale, (n_joints, 1))]
+    if coupled_index is not None and problem.coupled_scale is not None:
+        rows.append(coupled_index.start + n_joints * samples[None, :] + np.arange(n_joints)[:, None])
+        scales.append(np.tile(problem.coupled_scale, (n_joints, 1)))
+    variables = np.vstack(rows)
+    return SampleStructure(outer, sample, variables, per_sample.data[varying], np.vstack(scales))
 
 
 def _model_terms(log_compliance: ca.MX, design: DesignQuantities, per_sample: _SampleTerms) -> ModelTerms:

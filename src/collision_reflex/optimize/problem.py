@@ -82,6 +82,8 @@ class DesignProblem:
     compliance_index: slice
     direction_index: slice
     direction_scale: np.ndarray
+    coupled_index: slice | None
+    coupled_scale: np.ndarray | None
     build_time: float
     duty: DutyRequirement | None
     slowest_bound: float
@@ -136,15 +138,19 @@ class DesignProblem:
     def exact_point(self, x: np.ndarray, impulses: np.ndarray | None = None) -> np.ndarray:
         """Give ``x`` with the auxiliary variables set to their exact values for the design in ``x``.
 
-        The auxiliaries are the finger-mass directions, reaction compliances and the epigraph ``t``;
+        The auxiliaries are the finger- and coupled-mass directions, reaction compliances and the epigraph ``t``;
         evaluating at the result gives the model's values to machine precision. ``impulses``: the design's
         impulses [N*s] (:meth:`numpy_impulses`) when known, not evaluated again.
         """
         x = np.array(x, dtype=float)
-        masses, torques, finger = (np.asarray(v).ravel() for v in self._joint_numbers(x))
+        masses, torques, finger, reflected = (np.asarray(v).ravel() for v in self._joint_numbers(x))
         x[self.direction_index] = (
             finger_mass_directions(self.samples, masses, finger) / self.direction_scale[:, None]
         ).ravel()
+        if self.coupled_index is not None and self.coupled_scale is not None:
+            x[self.coupled_index] = (
+                finger_mass_directions(self.samples, masses, reflected) / self.coupled_scale[:, None]
+            ).ravel()
         x[self.compliance_index] = np.log(reaction_compliance(self.samples, torques))
         if self.epigraph_index is not None or self.tail_index is not None:
             values = self.numpy_impulses(x) if impulses is None else impulses
@@ -201,7 +207,7 @@ class DesignProblem:
             fractions = formulas.torque_fractions(ca.DM(w[s_index, joints]), peak_torque[joints])
             compliance = formulas.reaction_compliance(fractions)
             impulse, *_ = self.graph.sample_function(
-                design_column, direction, compliance, ca.DM(self._nlp_inputs.data[:, s_index])
+                design_column, direction, compliance, ca.DM(self._nlp_inputs.data[:, s_index]), ca.DM.zeros(n)
             )
             impulses.append(impulse)
         return ca.Function("design_impulses", [z], [ca.horzcat(*impulses)], ["z"], ["impulses"])

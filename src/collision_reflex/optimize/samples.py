@@ -180,13 +180,17 @@ def sample_function(
 
     Inputs: the design column (motor masses, reflected inertias, joint stiffnesses (n each), threshold,
     approach velocity), the finger-mass direction ``x`` (n, with ``w^T x = 1``), the reaction compliance ``c``
-    (``1/F_a`` [1/N]) and the sample's data (``w = J^T u`` (n), ``M_bb0`` (n*n), motor-mass influence matrices
-    (n*n*n), effective mechanical stiffness). Outputs: the impulse [N*s], the contact-force threshold [N],
-    ``w^T x`` and the effective parameters ``(m_f, m_r, k, k_m, a)`` of :mod:`collision_reflex.model.effective`.
+    (``1/F_a`` [1/N]), the sample's data (``w = J^T u`` (n), ``M_bb0`` (n*n), motor-mass influence matrices
+    (n*n*n), effective mechanical stiffness) and the coupled-mass direction ``y`` (n, with ``w^T y = 1``).
+    Outputs: the impulse [N*s], the contact-force threshold [N], ``w^T x``, the effective parameters
+    ``(m_f, m_r, k, k_m, a)`` of :mod:`collision_reflex.model.effective`, the coupled mass
+    ``y^T (M_f + diag(N^2 J)) y`` [kg] (every rotor on the links: the robot mass a body region meets,
+    :func:`collision_reflex.model.contact_robot_mass`'s bound; exact at the optimal ``y``) and ``w^T y``.
     """
     n = n_joints
     design = ca.SX.sym("design", 3 * n + 2)
     direction = ca.SX.sym("x", n)
+    coupled_direction = ca.SX.sym("y", n)
     compliance = ca.SX.sym("c")
     data = ca.SX.sym("data", n + n * n + n**3 + 1)
     mass, inertia, stiffness = (design[i * n : (i + 1) * n] for i in range(3))
@@ -212,10 +216,21 @@ def sample_function(
     acceleration = formulas.reaction_acceleration(robot_compliance, compliance)
     impulse = phase_impulses(finger_mass, k, k_mech, force_threshold, acceleration, velocity, reaction).total
     parameters = ca.vertcat(finger_mass, 1 / robot_compliance, k, k_mech, acceleration)
+    behind = ca.DM([0.0 if placed else 1.0 for placed in finger_joints])  # the rotors not yet in M_f
+    coupled_mass = formulas.finger_mass(coupled_direction, finger_matrix) + ca.dot(
+        behind * inertia, coupled_direction * coupled_direction
+    )
     return ca.Function(
         "sample_impulse",
-        [design, direction, compliance, data],
-        [impulse, force_threshold, ca.dot(w, direction), parameters],
+        [design, direction, compliance, data, coupled_direction],
+        [
+            impulse,
+            force_threshold,
+            ca.dot(w, direction),
+            parameters,
+            coupled_mass,
+            ca.dot(w, coupled_direction),
+        ],
     )
 
 

@@ -21,29 +21,36 @@ from .technology import ActuatorTechnology
 
 
 def variable_slices(
-    n_design: int, n_samples: int, n_joints: int, with_epigraph: bool, with_tail: bool
-) -> tuple[int | None, slice | None, slice, slice]:
+    n_design: int, n_samples: int, n_joints: int, named: set[str], with_region: bool
+) -> tuple[int | None, slice | None, slice, slice, slice | None]:
     """Where the auxiliaries sit in ``x``: epigraph, CVaR's value at risk and slacks, ``g``, directions.
 
-    ``g = log(1/F_a)`` per sample, ``x_s`` the finger-mass directions.
+    ``g = log(1/F_a)`` per sample, ``x_s`` the finger-mass directions, ``y_s`` the coupled-mass directions
+    (the rotors on the links, for a body region's rows: :mod:`.body_region`).
 
     The layout is: design (log values) | epigraph ``t`` (if needed) | value at risk and one slack per sample
-    (if needed) | ``g`` (n_samples) | finger-mass directions (n_joints * n_samples).
+    (if needed) | ``g`` (n_samples) | finger-mass directions (n_joints * n_samples) | coupled-mass directions
+    (n_joints * n_samples, if needed). ``named``: the objectives named as objective or bound (the worst case
+    needs the epigraph, the CVaR the tail).
     """
+    with_epigraph, with_tail = "worst_case_impulse" in named, "cvar_impulse" in named
     epigraph_index = n_design if with_epigraph else None
     tail_start = n_design + (epigraph_index is not None)
     tail_index = slice(tail_start, tail_start + 1 + n_samples) if with_tail else None
     compliance_start = tail_start if tail_index is None else tail_index.stop
     compliance_index = slice(compliance_start, compliance_start + n_samples)
     direction_index = slice(compliance_index.stop, compliance_index.stop + n_joints * n_samples)
-    return epigraph_index, tail_index, compliance_index, direction_index
+    coupled_index = (
+        slice(direction_index.stop, direction_index.stop + n_joints * n_samples) if with_region else None
+    )
+    return epigraph_index, tail_index, compliance_index, direction_index, coupled_index
 
 
 def bounds_and_start(
     x: ca.MX,
     design: DesignQuantities,
     joint_numbers: ca.Function,
-    slices: tuple[int | None, slice | None, slice, slice],
+    slices: tuple[int | None, slice | None, slice, slice, slice | None],
     layout: DesignLayout,
     samples: ContactSamples,
     constraints: Constraints,
@@ -58,7 +65,7 @@ def bounds_and_start(
     cycle's peak); the auxiliaries start at 0, the epigraph and the CVaR's slacks bounded below by 0 and each
     ``log(1/F_a)`` by :func:`compliance_bounds`, the others unbounded.
     """
-    epigraph_index, tail_index, compliance_index, _ = slices
+    epigraph_index, tail_index, compliance_index, *_ = slices
     lbx, ubx, x0 = (np.full(x.shape[0], value) for value in (-np.inf, np.inf, 0.0))
     lbx[: layout.size], ubx[: layout.size], x0[: layout.size] = layout.log_bounds()
     efficiency = technology.gearbox_figures(len(joint_names)).efficiency
@@ -96,7 +103,7 @@ def _feasible_gear_start(
     With 10 % to spare and within their bounds: IPOPT converges much faster from a torque-feasible start.
     ``efficiency`` is each joint's gearbox efficiency [-].
     """
-    masses, peak, _ = (np.asarray(v).ravel() for v in joint_numbers(x0))
+    masses, peak, *_ = (np.asarray(v).ravel() for v in joint_numbers(x0))
     torques = efficiency * peak
     rows, _ = torque_requirement_rows(samples, constraints, joint_names)
     required = np.max([base + per_motor @ masses for base, per_motor in rows], axis=0)

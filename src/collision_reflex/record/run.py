@@ -245,12 +245,33 @@ class RegionSpeeds(TypedDict):
 
 
 @checked
+class HeldToRegion(TypedDict):
+    """The region a study held its designs to, and whether the recommended design keeps it on fresh poses.
+
+    region: its name; fresh_samples: the fresh configurations' pairs inside the design's domain, each with the
+    study's directions and its heaviest one (0 without fresh configurations); slowest [m/s]: the least
+    permissible speed among them (None without); below: how many are below the design's approach velocity;
+    robot_mass, link_mass [kg] and links_speed [m/s]: at the slowest pose, the design's robot mass, the links'
+    own, and the permissible speed with the links alone, which no actuators could exceed (None without).
+    """
+
+    region: str
+    fresh_samples: int
+    slowest: float | None
+    below: int
+    robot_mass: float | None
+    link_mass: float | None
+    links_speed: float | None
+
+
+@checked
 class HumanContactRecord(TypedDict):
     """The recommended design against the standard's body regions (:mod:`collision_reflex.study.safety`).
 
     design: which design; samples: how many contact samples; approach_velocity [m/s]: the design's; moving_mass
     and payload [kg]: what the ISO/TS 15066 estimate takes, iso_mass [kg] the estimate; regions: one row per
-    region with a transient force; no_transient: the regions the standard permits no transient contact with.
+    region with a transient force; no_transient: the regions the standard permits no transient contact with;
+    held_to: the region the study held its designs to (``constraints.body_region``), and the search's check.
     """
 
     design: str
@@ -261,6 +282,7 @@ class HumanContactRecord(TypedDict):
     iso_mass: float
     regions: list[RegionSpeeds]
     no_transient: list[str]
+    held_to: NotRequired[HeldToRegion]
 
 
 @checked

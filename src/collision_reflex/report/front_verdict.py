@@ -13,7 +13,7 @@ from typing import Any, cast
 import numpy as np
 
 from ..record.design import DesignRecord
-from ..record.run import ParetoRecord, TransmissionTried
+from ..record.run import HumanContactRecord, ParetoRecord, TransmissionTried
 from ..vocabulary import IMPULSE_OBJECTIVES
 from .wording import general, group_name, objective_unit, percent, words
 
@@ -149,13 +149,41 @@ def lightest_near_best(pareto: ParetoRecord, within: float = NEAR_BEST) -> tuple
     )
 
 
-def front_verdict(pareto: ParetoRecord, record: DesignRecord, resolved: Mapping[str, Any]) -> list[str]:
-    """The front in one sentence: its spans (or why it is flat or one design) and its lightest good design."""
+def front_verdict(
+    pareto: ParetoRecord,
+    record: DesignRecord,
+    resolved: Mapping[str, Any],
+    contact: HumanContactRecord | None = None,
+) -> list[str]:
+    """The front in one sentence: its spans (or why it is flat or one design) and its lightest good design.
+
+    Also what caps the approach of a study held to a body region (``contact``: the run's human-contact record).
+    """
     lines = front_sentences(pareto)
-    reason = flat_impulse_reason(pareto, record, resolved)
+    reason = flat_impulse_reason(pareto, record, resolved) + held_region_reason(contact)
     near = lightest_near_best(pareto)
     said = " ".join(lines + reason + ([near[1]] if near else []))
     return [said] if said else []
+
+
+def held_region_reason(contact: HumanContactRecord | None) -> list[str]:
+    """What caps the permissible approach of a design held to a body region: the links' own mass at its slowest pose.
+
+    Empty unless the run held its designs to a region and checked them on fresh poses.
+    """
+    held = contact.get("held_to") if contact else None
+    if not held:
+        return []
+    speed, mass, links, slowest = (held[k] for k in ("links_speed", "robot_mass", "link_mass", "slowest"))
+    if speed is None or mass is None or links is None or slowest is None:
+        return []
+    gain = 100 * (speed / slowest - 1)
+    return [
+        f"What caps the speed: at its slowest fresh pose the robot meets the {held['region'].replace('_', ' ')} "
+        f"with {general(mass, 3)} kg along its heaviest direction, {general(links, 3)} kg of it the links' own; "
+        f"with the links alone it would permit {general(speed, 3)} m/s there, {general(gain, 2)} % above this "
+        f"design's {general(slowest, 3)} m/s: no choice of actuators gains more."
+    ]
 
 
 def transmission_choice_sentences(tried: Sequence[TransmissionTried] | None) -> list[str]:

@@ -43,7 +43,7 @@ def verdict(results: ArmRunRecord) -> list[str]:
     lines += sized_by_sentences(recommended, str(results.get("requirement", "static (gravity only)")))
     if bounds is not None:
         lines += bound_sentences(recommended, bounds)
-    lines += front_verdict(results["pareto"], recommended, resolved)
+    lines += front_verdict(results["pareto"], recommended, resolved, results.get("human_contact"))
     lines += transmission_choice_sentences(results.get("transmission_choice"))
     warnings = verdict_warnings(results, recommended, bounds, catalogue)
     room = MAX_LINES - len(lines)
@@ -151,6 +151,14 @@ def verdict_warnings(
                 for row in exceeded
             )
             + "."
+        )
+    held = contact.get("held_to") if contact else None
+    if held and held["below"] and held["slowest"] is not None:
+        warnings.append(
+            f"Warning: held to the {held['region'].replace('_', ' ')} on its samples, the design approaches faster "
+            f"than it permits at {held['below']} of {held['fresh_samples']} fresh poses (slowest "
+            f"{general(held['slowest'])} m/s): more rounds of the search (optimizer.worst_case_search.rounds) or "
+            "more samples close the gap."
         )
     return warnings
 

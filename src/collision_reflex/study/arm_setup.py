@@ -20,6 +20,7 @@ from ..hardware.gearboxes import ScaledGearbox, load_gearbox_catalogue
 from ..optimize import ActuatorTechnology, Bounds, Constraints, ContactSamples, DesignSpace
 from ..optimize.technology import placements_from_stiffness
 from .actuator_specs import DIRECT_DRIVE, PlacementRuleSpec, ScaledGearboxSpec
+from .body_regions import transient_regions
 from .checks import (
     gearbox_ratio_problems,
     module_problems,
@@ -208,6 +209,9 @@ def _constraints(
         duty_cycle=duty_cycle,
         rating=rating,
         hold_poses=hold,
+        body_region=None
+        if study.constraints.body_region is None
+        else transient_regions()[study.constraints.body_region],
     )
 
 

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 from ..errors import InvalidParameter, StudyFileError, StudyProblem
 from ..hardware.motors import scaled_motor_quantities
 from ..vocabulary import GLOBAL_VARIABLES, PER_JOINT_VARIABLES
+from .body_regions import load_body_regions, transient_regions
 from .schema import ActuatorStudy, ArmStudy
 from .source import PathKey, excerpt
 
@@ -84,6 +85,7 @@ def _arm_checks(loaded: LoadedStudy, study: ArmStudy) -> list[StudyProblem]:
                         "free bounds design.approach_velocity: {min, max} to trade it off",
                     )
                 )
+    problems += _body_region_checks(loaded, study)
     robot = study.robot
     if robot.urdf is not None and not _is_file(loaded.path(robot.urdf)):
         problems.append(
@@ -337,6 +339,25 @@ def torque_out_of_reach(loaded: LoadedStudy, setup: ArmSetup) -> list[StudyProbl
                 )
             )
     return problems
+
+
+def _body_region_checks(loaded: LoadedStudy, study: ArmStudy) -> list[StudyProblem]:
+    """The body region a study holds its approach to: one of the standard's that permits transient contact."""
+    name = study.constraints.body_region
+    if name is None:
+        return []
+    regions = transient_regions()
+    if name in regions:
+        return []
+    forbidden = name in load_body_regions()
+    return [
+        loaded.problem(
+            ("constraints", "body_region"),
+            f"{excerpt(name)}"
+            + (" (ISO/TS 15066 permits no transient contact with it)" if forbidden else ""),
+            "one of " + ", ".join(regions),
+        )
+    ]
 
 
 def located_refusal(loaded: LoadedStudy, error: InvalidParameter) -> StudyFileError:

@@ -124,7 +124,7 @@ class DesignSpec(Spec):
 
 
 class ConstraintsSpec(Spec):
-    """Design constraints: payload [kg], torque safety factor, threshold noise floor [N], torques [N m]."""
+    """Design constraints: payload [kg], torque safety factor, threshold noise floor [N], torques [N m], a body region."""
 
     payload: Payload = Field(
         0.0,
@@ -138,4 +138,9 @@ class ConstraintsSpec(Spec):
     threshold_floor: NoiseFloor = Field(0.0, ge=0, description="sensing noise floor [N]")
     torque_required: list[JointTorque] | None = Field(
         None, description="required torque per joint [N m]; null: gravity (+ payload) over the samples"
+    )
+    body_region: str | None = Field(
+        None,
+        description="an ISO/TS 15066 body region (crx safety --list-regions) whose transient-force limit the "
+        "approach keeps at every contact sample, the rotors counted on the links (arm studies)",
     )

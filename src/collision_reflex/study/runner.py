@@ -44,6 +44,7 @@ from .executors import open_executor
 from .load import LoadedStudy, load_study
 from .problems import IPOPT_OPTIONS, StudyProblems, checked_setup
 from .progress import RunProgress
+from .region_search import search_draw, search_region
 from .resolve import ResolvedStudy, resolve_study
 from .safety import human_contact_record
 from .schema import ArmStudy
@@ -211,7 +212,9 @@ def _run_arm(
 
     Each stage is timed into ``stages``. After each round of solves, every design's worst case is searched
     over the contact domain (:mod:`.worst_case`); with a worst-case objective the violators join the samples and
-    the next round solves on them, until none is found or ``optimizer.worst_case_search.rounds`` is reached.
+    the next round solves on them, until none is found or ``optimizer.worst_case_search.rounds`` is reached. A
+    study held to a body region adds the poses a search draw finds beyond its permissible speed likewise
+    (:mod:`.region_search`).
 
     Then, with a ``catalogue``, the recommended design and every Pareto design snapped to it
     (:func:`.catalogue_snap.catalogue_results`). Each piece is saved as it finishes and found again when the run
@@ -225,6 +228,7 @@ def _run_arm(
     extra: ExtraSamples = ()
     computed = reused = 0
     optimum: DesignResult | None = None  # the last round's, which the next one starts from
+    draw = None
     for round_ in range(search.rounds if search.enabled else 1):
         if round_:  # the last round's problems, on fewer samples, are not solved again
             release_problems()
@@ -245,8 +249,14 @@ def _run_arm(
             problems, designs, search, pool, folder
         )
         computed, reused = computed + searched[0], reused + searched[1]
-        added = violators(designs, searches, search.tolerance)
-        if not added or not exchanges_samples(study) or round_ == search.rounds - 1:
+        added = violators(designs, searches, search.tolerance) if exchanges_samples(study) else ()
+        draw = draw or search_draw(problems.setup)
+        if draw is not None:
+            found = stages.timed("region search", search_region)(
+                problems.setup, draw, {k: v.design for k, v in designs.items()}, search.tolerance
+            )
+            added = tuple(dict.fromkeys(added + tuple(p for f in found.values() for p in f.added)))
+        if not added or round_ == search.rounds - 1:
             break
         extra = extra + added
     assert optimum is not None  # at least one round ran

@@ -20,7 +20,6 @@ import numpy as np
 
 from ..arm.effective import effective_parameters
 from ..errors import InvalidParameter
-from ..hardware.catalogue import packaged_catalogue_path, read_entries
 from ..model import effective as formulas
 from ..model.contact import (
     COUPLED_STIFFNESS_RATIO,
@@ -31,9 +30,13 @@ from ..model.contact import (
 )
 from ..model.impulse import series_stiffness
 from ..optimize.results import record_design
+from ..optimize.samples import SPEED_CAP_TOLERANCE
 from ..record.read import checked_run_record, pick_design, read_saved_record
 from ..report.files import DESIGNS
+from .body_regions import load_body_regions
+from .fresh import fresh_draw
 from .problems import StudyProblems
+from .region_search import search_region
 
 if TYPE_CHECKING:
     from ..record.design import DesignRecord
@@ -80,6 +83,15 @@ class SpeedMap:
             rows.append(row)
         return rows
 
+    @property
+    def above_approach(self) -> np.ndarray:
+        """Per sample, whether the design's approach exceeds the permissible speed, (n,) bool.
+
+        Beyond a relative 1e-6 (:data:`~collision_reflex.optimize.samples.SPEED_CAP_TOLERANCE`): a design a study
+        held to the region's limit sits on it, to the solver's tolerance.
+        """
+        return np.asarray(self.masses.approach_velocity > self.speed * (1 + SPEED_CAP_TOLERANCE))
+
     def summary(self) -> list[str]:
         """The lines a designer reads first.
 
@@ -95,7 +107,7 @@ class SpeedMap:
             f"(median {np.median(self.speed):.3g} m/s); slowest at sample {slowest} "
             f"(q = {', '.join(f'{v:.3g}' for v in self.masses.q[slowest])}; robot mass {self.robot_mass[slowest]:.3g} kg)",
         ]
-        above = int(np.sum(self.masses.approach_velocity > self.speed))
+        above = int(np.sum(self.above_approach))
         lines.append(
             f"the design approaches at {self.masses.approach_velocity:.3g} m/s: "
             + (
@@ -227,29 +239,12 @@ def contact_masses(setup: ArmSetup, record: DesignRecord, label: str) -> Contact
     )
 
 
-def load_body_regions(path: str | os.PathLike[str] | None = None) -> dict[str, BodyRegion]:
-    """The body regions of a YAML file, by name (default: the standard's, the packaged ``designs/body_regions.yaml``).
-
-    The file has a top-level ``body_regions`` mapping from name to entry; each entry gives ``stiffness``,
-    ``mass``, ``quasi_static_force``, optionally ``transient_force``, and a ``source`` (per-field ``sources`` and
-    ``estimates`` as in the catalogues). Numbers are plain SI or strings with units (``"75 N/mm"``). Bad input
-    raises :class:`~collision_reflex.errors.CatalogueError` naming the file, the line and the field.
-    """
-    target = Path(path) if path is not None else packaged_catalogue_path("body_regions.yaml")
-    return {
-        name: BodyRegion(
-            name,
-            entry.fields["stiffness"],
-            entry.fields["mass"],
-            entry.fields["transient_force"],
-            entry.fields["quasi_static_force"],
-        )
-        for name, entry in read_entries(target, "body_regions").items()
-    }
-
-
 def human_contact_record(setup: ArmSetup, record: DesignRecord, label: str) -> HumanContactRecord:
-    """What a run keeps of its design's permissible speeds against the standard's body regions (SI units)."""
+    """What a run keeps of its design's permissible speeds against the standard's body regions (SI units).
+
+    A study held to a body region also keeps whether the limit holds on the fresh configurations
+    (:func:`.fresh.fresh_draw`), which no round of the solves has seen, searched as :mod:`.region_search` does.
+    """
     masses = contact_masses(setup, record, label)
     regions = load_body_regions()
     rows: list[RegionSpeeds] = []
@@ -267,12 +262,12 @@ def human_contact_record(setup: ArmSetup, record: DesignRecord, label: str) -> H
                 "median": float(np.median(speeds.speed)),
                 "fastest": float(np.max(speeds.speed)),
                 "slowest_sample": int(np.argmin(speeds.speed)),
-                "above_approach": int(np.sum(masses.approach_velocity > speeds.speed)),
+                "above_approach": int(np.sum(speeds.above_approach)),
                 "bound_samples": int(np.sum(~speeds.exact)),
                 "iso_speed": float(speeds.iso_speed),
             }
         )
-    return {
+    out: HumanContactRecord = {
         "design": label,
         "samples": int(masses.finger_mass.size),
         "approach_velocity": masses.approach_velocity,
@@ -282,6 +277,26 @@ def human_contact_record(setup: ArmSetup, record: DesignRecord, label: str) -> H
         "regions": rows,
         "no_transient": [name for name, r in regions.items() if r.transient_force is None],
     }
+    held = setup.constraints.body_region
+    if held is not None:
+        draw = fresh_draw(setup)
+        found = (
+            None
+            if draw is None
+            else search_region(
+                setup, draw, {label: record_design(record, setup.study.sensing.scheme)}, SPEED_CAP_TOLERANCE
+            )[label]
+        )
+        out["held_to"] = {
+            "region": held.name,
+            "fresh_samples": 0 if found is None else found.samples,
+            "slowest": None if found is None else found.slowest,
+            "below": 0 if found is None else found.below,
+            "robot_mass": None if found is None else found.robot_mass,
+            "link_mass": None if found is None else found.link_mass,
+            "links_speed": None if found is None else found.links_speed,
+        }
+    return out
 
 
 def _transient_force(region: BodyRegion) -> float:

@@ -1,0 +1,158 @@
+"""A study held to a body region's permissible speed: the poses its samples missed, found and added.
+
+The optimiser's rows hold the approach within the region's permissible speed at the study's samples only; between
+them the arm's effective mass can be larger (near-singular poses, directions along a heavy link). After each round
+of solves, a search draw of :data:`SEARCH_CONFIGURATIONS` configurations in the contact domain (an independent
+stream of the study's seed, each with the study's directions feasible there) is evaluated for every design, the
+robot mass with its rotors on the links as the rows take it, along the study's directions and along each pose's
+heaviest direction (an eigenvector of the operational-space inertia); the poses where a design's approach exceeds the
+permissible speed join the samples (the :data:`ADDED_PER_DESIGN` slowest per design, distinct configurations) and
+the next round solves on them, as the worst case's violators do (:mod:`.worst_case`). What the last draw finds is
+kept in the run's record; the fresh configurations (:mod:`.fresh`) check the recommended design independently.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..model.contact import permissible_speed
+from ..model.effective import finger_mass_matrix
+from ..optimize.body_region import region_speeds
+from ..optimize.samples import ContactSamples
+from .arm_setup import ArmSetup, ExtraSamples
+
+if TYPE_CHECKING:
+    from ..arm.domain import DomainDraw
+    from ..arm.samples import ArmSamples
+    from ..optimize import Design
+
+SEARCH_STREAM = 0x5AFE
+"""Spawn key of the search draw's generator under the study's seed, apart from the samples' and the fresh ones'."""
+
+SEARCH_CONFIGURATIONS = 4096
+"""Configurations the search draws: the slowest pose of 4,096 is within the slowest 0.07 % of the domain with
+95 % confidence (``1 - 0.9993^4096``), whatever the arm."""
+
+ADDED_PER_DESIGN = 8
+"""Most poses a design adds to the samples per round: its slowest, at distinct configurations."""
+
+
+@dataclass(frozen=True)
+class RegionSearch:
+    """What the search draw says of one design against the study's body region.
+
+    samples: the (configuration, direction) pairs of the draw inside the design's domain; slowest: the least
+    permissible speed among them [m/s]; below: how many are below the design's approach velocity; added: the
+    poses that join the samples, as :data:`~.arm_setup.ExtraSamples`; robot_mass and link_mass [kg]: at the
+    slowest pose, the design's coupled effective mass and the links' own (no actuator on them) along its
+    direction; links_speed [m/s]: the permissible speed there with the links' mass alone, which no actuators
+    could exceed.
+    """
+
+    samples: int
+    slowest: float
+    below: int
+    added: ExtraSamples
+    robot_mass: float
+    link_mass: float
+    links_speed: float
+
+
+def search_draw(setup: ArmSetup) -> DomainDraw | None:
+    """The search's configurations in the contact domain, or None without random configurations to seed it."""
+    random = setup.study.samples.configurations.random
+    if random is None or setup.constraints.body_region is None:
+        return None
+    rng = np.random.default_rng(np.random.SeedSequence(random.seed, spawn_key=(SEARCH_STREAM,)))
+    slowest = float(setup.space.global_bounds("approach_velocity").lower)
+    return setup.domain.draw(setup.arm, SEARCH_CONFIGURATIONS, setup.directions, slowest, rng)
+
+
+def search_region(
+    setup: ArmSetup, draw: DomainDraw, designs: Mapping[str, Design], tolerance: float
+) -> dict[str, RegionSearch]:
+    """Each design's permissible speeds over ``draw`` (inside its domain), and the poses it adds.
+
+    At each configuration the study's directions feasible there are checked, and the direction of the design's
+    largest coupled effective mass (:func:`heaviest_directions`) where it lies in the design's domain. A pose is
+    added where the design's approach exceeds its permissible speed by more than ``tolerance`` (relative).
+    """
+    region = setup.constraints.body_region
+    assert region is not None
+    config_index, direction_index = np.nonzero(draw.feasible)
+    kinematics = setup.arm.kinematics(draw.q)
+    found = {}
+    for label, design in designs.items():
+        coupled = _coupled_matrix(kinematics, design)
+        heaviest = heaviest_directions(kinematics, coupled)
+        caps = setup.domain.speed_caps(kinematics.jacobian, heaviest)
+        samples = ContactSamples(
+            kinematics,
+            np.vstack([setup.directions[direction_index], heaviest]),
+            np.concatenate([config_index, np.arange(draw.q.shape[0])]),
+            speed_cap=np.concatenate([draw.speed_cap[config_index, direction_index], caps]),
+        )
+        inside = np.flatnonzero(samples.inside(design.approach_velocity))
+        kept = ContactSamples(kinematics, samples.directions[inside], samples.config_index[inside])
+        speeds = region_speeds(kept, design, region)
+        below = np.flatnonzero(design.approach_velocity > speeds * (1 + tolerance))
+        added: list[tuple[tuple[float, ...], tuple[float, ...]]] = []
+        seen: set[int] = set()
+        for row in below[np.argsort(speeds[below])]:
+            config = int(kept.config_index[row])
+            if config not in seen and len(added) < ADDED_PER_DESIGN:
+                seen.add(config)
+                added.append((tuple(map(float, draw.q[config])), tuple(map(float, kept.directions[row]))))
+        slowest = int(np.argmin(speeds))
+        config, direction = int(kept.config_index[slowest]), kept.directions[slowest]
+        masses = [
+            effective_mass(kinematics, config, direction, matrix)
+            for matrix in (kinematics.mass_matrix[config], coupled[config])
+        ]
+        assert region.transient_force is not None
+        found[label] = RegionSearch(
+            int(inside.size),
+            float(speeds[slowest]),
+            int(below.size),
+            tuple(added),
+            robot_mass=masses[1],
+            link_mass=masses[0],
+            links_speed=float(
+                permissible_speed(region.transient_force, masses[0], region.stiffness, region.mass)
+            ),
+        )
+    return found
+
+
+def effective_mass(kinematics: ArmSamples, config: int, direction: np.ndarray, matrix: np.ndarray) -> float:
+    """``1 / (u^T J A^-1 J^T u)`` [kg] at configuration ``config`` along ``direction`` for the mass matrix ``A``."""
+    arm = kinematics.jacobian[config].T @ direction
+    return float(1 / (arm @ np.linalg.solve(matrix, arm)))
+
+
+def _coupled_matrix(kinematics: ArmSamples, design: Design) -> np.ndarray:
+    """``M_f + diag(N^2 J)`` per configuration: the links, the actuator masses they carry and the rotors."""
+    return np.asarray(
+        finger_mass_matrix(
+            kinematics.mass_matrix,
+            kinematics.motor_mass_influence,
+            design.actuator_mass,
+            design.reflected_inertia,
+        )
+    )
+
+
+def heaviest_directions(kinematics: ArmSamples, matrix: np.ndarray) -> np.ndarray:
+    """Per configuration, the unit direction of the largest effective mass for the mass matrices ``matrix``.
+
+    The effective mass along ``u`` is ``1 / (u^T J A^-1 J^T u)``: largest along the eigenvector of the smallest
+    eigenvalue of ``J A^-1 J^T`` (either sign: the mass is the same). ``matrix``: (n, nv, nv) [kg m^2].
+    """
+    jacobian = kinematics.jacobian
+    mobility = jacobian @ np.linalg.solve(matrix, np.swapaxes(jacobian, -1, -2))
+    _, vectors = np.linalg.eigh(mobility)
+    return np.asarray(vectors[..., :, 0])
