@@ -127,9 +127,11 @@ PER_STUDY = [pytest.param(name, marks=pytest.mark.xdist_group(f"pdf-{name}")) fo
 
 
 def _pdf_text(folder: Path) -> str:
-    return subprocess.run(
+    text = subprocess.run(
         ["pdftotext", "-layout", str(folder / "report.pdf"), "-"], capture_output=True, text=True, check=True
     ).stdout
+    # pdftotext drops the thin space between a number and its unit ("1 N" comes out "1N"): put it back.
+    return re.sub(r"(\d)(?=[A-DF-Za-df-zΩ°µ]|[eE](?![+−-]?\d))", r"\1 ", text)
 
 
 class _Visible(HTMLParser):

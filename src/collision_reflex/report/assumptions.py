@@ -118,10 +118,7 @@ def assumption_rows(results: RunRecord) -> list[tuple[str, str, str, str]]:
 def _source(section: str, field: str, resolved: dict[str, Any]) -> str:
     """The source of a resolved study's field where the toolkit knows it (a catalogue entry, a scaling law)."""
     if section == "constraints" and field == "body region":
-        return (
-            "ISO/TS 15066:2016, Annex A: the approach within the region's transient-force limit at every sample, "
-            "the rotors counted on the links"
-        )
+        return "ISO/TS 15066:2016 Annex A, rotors on links"
     if section != "actuators":
         return ""
     motor = (resolved.get("actuators") or {}).get("motor") or {}

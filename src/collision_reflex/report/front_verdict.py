@@ -179,10 +179,9 @@ def held_region_reason(contact: HumanContactRecord | None) -> list[str]:
         return []
     gain = 100 * (speed / slowest - 1)
     return [
-        f"What caps the speed: at its slowest fresh pose the robot meets the {held['region'].replace('_', ' ')} "
-        f"with {general(mass, 3)} kg along its heaviest direction, {general(links, 3)} kg of it the links' own; "
-        f"with the links alone it would permit {general(speed, 3)} m/s there, {general(gain, 2)} % above this "
-        f"design's {general(slowest, 3)} m/s: no choice of actuators gains more."
+        f"What caps the speed: its slowest fresh pose meets the {held['region'].replace('_', ' ')} with "
+        f"{general(mass, 3)} kg, {general(links, 3)} kg of it the links'; the links alone would permit "
+        f"{general(speed, 3)} m/s there, {general(gain, 2)} % above this design: no actuators gain more."
     ]
 
 

@@ -132,9 +132,12 @@ def verdict_warnings(
         if (worst := point.get("worst_case")) and worst["searched"] and not worst["certified"]
     ]
     if uncertified:
-        warnings.append(
-            "Warning: the worst case of Pareto designs " + "; ".join(uncertified) + " is not certified."
+        named = (
+            "; ".join(uncertified)
+            if len(uncertified) <= 2
+            else f"{len(uncertified)} of {len(pareto['points'])}"
         )
+        warnings.append(f"Warning: the worst case of Pareto designs {named} is not certified.")
     if catalogue:
         warnings += _joint_warnings(catalogue["warnings"])
     # Where the simulator validates neither placement of the reflected inertia (the study's transmissions).
@@ -155,10 +158,9 @@ def verdict_warnings(
     held = contact.get("held_to") if contact else None
     if held and held["below"] and held["slowest"] is not None:
         warnings.append(
-            f"Warning: held to the {held['region'].replace('_', ' ')} on its samples, the design approaches faster "
-            f"than it permits at {held['below']} of {held['fresh_samples']} fresh poses (slowest "
-            f"{general(held['slowest'])} m/s): more rounds of the search (optimizer.worst_case_search.rounds) or "
-            "more samples close the gap."
+            f"Warning: held to the {held['region'].replace('_', ' ')} on its samples, the design is faster than it "
+            f"permits at {held['below']} of {held['fresh_samples']:,} fresh poses (slowest "
+            f"{general(held['slowest'])} m/s); more search rounds (optimizer.worst_case_search.rounds) add them."
         )
     return warnings
 
