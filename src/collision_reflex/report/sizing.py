@@ -158,8 +158,9 @@ def bound_sentences(record: DesignRecord, bounds: Bounds) -> list[str]:
             if any(e["joint"] == name and e["variable"] == key for e in undecided):
                 continue
             position = bound_position(joint[key], bounds[key][name])
-            if position in ("lower", "upper"):
-                value = f"{general(joint[key])}{UNDECIDED_UNITS.get(key, '')}"
+            if position in ("lower", "upper"):  # the bound it sits on, not the solver's last digits
+                bound = bounds[key][name][0 if position == "lower" else 1]
+                value = f"{general(bound)}{UNDECIDED_UNITS.get(key, '')}"
                 held.setdefault(f"{words(key)} at its {position} bound ({value})", []).append(name)
     phrases = design_limits_at_bound(record, bounds) + [
         f"{group_name(names)} {what}" for what, names in held.items()
@@ -187,7 +188,7 @@ def design_limits_at_bound(record: DesignRecord, bounds: Bounds) -> list[str]:
     undecided = {entry["variable"] for entry in record.get("undecided", ()) if entry["joint"] is None}
     units = {"threshold": " N" if record.get("sensing") == "force" else " m", "approach_velocity": " m/s"}
     return [
-        f"{words(key)} at its {position} bound ({general(record[key])}{units[key]})"
+        f"{words(key)} at its {position} bound ({general(bounds[key][0 if position == 'lower' else 1])}{units[key]})"
         for key in GLOBAL_VARIABLES
         if key not in undecided
         and (position := bound_position(record[key], bounds[key])) in ("lower", "upper")

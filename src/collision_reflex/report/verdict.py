@@ -158,9 +158,8 @@ def verdict_warnings(
     held = contact.get("held_to") if contact else None
     if held and held["below"] and held["slowest"] is not None:
         warnings.append(
-            f"Warning: held to the {held['region'].replace('_', ' ')} on its samples, the design is faster than it "
-            f"permits at {held['below']} of {held['fresh_samples']:,} fresh poses (slowest "
-            f"{general(held['slowest'])} m/s); more search rounds (optimizer.worst_case_search.rounds) add them."
+            f"Warning: held to the {held['region'].replace('_', ' ')} at its samples, the design is faster than it "
+            f"permits at {held['below']} of {held['fresh_samples']:,} fresh poses (slowest {general(held['slowest'])} m/s)."
         )
     return warnings
 

@@ -40,6 +40,9 @@ SEARCH_CONFIGURATIONS = 4096
 ADDED_PER_DESIGN = 8
 """Most poses a design adds to the samples per round: its slowest, at distinct configurations."""
 
+REFINED = 4
+"""Slowest configurations of the draw climbed locally per design and round (:func:`_refined_pose`)."""
+
 
 @dataclass(frozen=True)
 class RegionSearch:
@@ -73,13 +76,15 @@ def search_draw(setup: ArmSetup) -> DomainDraw | None:
 
 
 def search_region(
-    setup: ArmSetup, draw: DomainDraw, designs: Mapping[str, Design], tolerance: float
+    setup: ArmSetup, draw: DomainDraw, designs: Mapping[str, Design], tolerance: float, refine: bool = True
 ) -> dict[str, RegionSearch]:
     """Each design's permissible speeds over ``draw`` (inside its domain), and the poses it adds.
 
     At each configuration the study's directions feasible there are checked, and the direction of the design's
-    largest coupled effective mass (:func:`heaviest_directions`) where it lies in the design's domain. A pose is
-    added where the design's approach exceeds its permissible speed by more than ``tolerance`` (relative).
+    largest coupled effective mass (:func:`heaviest_directions`) where it lies in the design's domain. With
+    ``refine``, the :data:`REFINED` slowest configurations are then climbed locally toward a larger mass
+    (:func:`_refined_pose`): random draws miss the narrow tail near the domain's edge. A pose is added where the
+    design's approach exceeds its permissible speed by more than ``tolerance`` (relative).
     """
     region = setup.constraints.body_region
     assert region is not None
@@ -99,6 +104,8 @@ def search_region(
         inside = np.flatnonzero(samples.inside(design.approach_velocity))
         kept = ContactSamples(kinematics, samples.directions[inside], samples.config_index[inside])
         speeds = region_speeds(kept, design, region)
+        if refine:
+            kept, speeds = _with_refined(setup, design, kept, speeds)
         below = np.flatnonzero(design.approach_velocity > speeds * (1 + tolerance))
         added: list[tuple[tuple[float, ...], tuple[float, ...]]] = []
         seen: set[int] = set()
@@ -106,12 +113,15 @@ def search_region(
             config = int(kept.config_index[row])
             if config not in seen and len(added) < ADDED_PER_DESIGN:
                 seen.add(config)
-                added.append((tuple(map(float, draw.q[config])), tuple(map(float, kept.directions[row]))))
+                added.append(
+                    (tuple(map(float, kept.kinematics.q[config])), tuple(map(float, kept.directions[row])))
+                )
         slowest = int(np.argmin(speeds))
-        config, direction = int(kept.config_index[slowest]), kept.directions[slowest]
+        pose = setup.arm.kinematics(kept.kinematics.q[kept.config_index[slowest]][None, :])
+        direction = kept.directions[slowest]
         masses = [
-            effective_mass(kinematics, config, direction, matrix)
-            for matrix in (kinematics.mass_matrix[config], coupled[config])
+            effective_mass(pose, 0, direction, matrix[0])
+            for matrix in (pose.mass_matrix, _coupled_matrix(pose, design))
         ]
         assert region.transient_force is not None
         found[label] = RegionSearch(
@@ -156,3 +166,62 @@ def heaviest_directions(kinematics: ArmSamples, matrix: np.ndarray) -> np.ndarra
     mobility = jacobian @ np.linalg.solve(matrix, np.swapaxes(jacobian, -1, -2))
     _, vectors = np.linalg.eigh(mobility)
     return np.asarray(vectors[..., :, 0])
+
+
+def _with_refined(
+    setup: ArmSetup, design: Design, kept: ContactSamples, speeds: np.ndarray
+) -> tuple[ContactSamples, np.ndarray]:
+    """``kept`` and its ``speeds`` with the refined poses of its :data:`REFINED` slowest configurations appended."""
+    order = np.argsort(speeds)
+    starts = list(dict.fromkeys(int(kept.config_index[row]) for row in order))[:REFINED]
+    poses = [_refined_pose(setup, design, kept.kinematics.q[config]) for config in starts]
+    found = [pose for pose in poses if pose is not None]
+    if not found:
+        return kept, speeds
+    q = np.array([pose[0] for pose in found])
+    u = np.array([pose[1] for pose in found])
+    refined = ContactSamples(setup.arm.kinematics(q), u, np.arange(q.shape[0]))
+    region = setup.constraints.body_region
+    assert region is not None
+    extra = region_speeds(refined, design, region)
+    both = ContactSamples(
+        setup.arm.kinematics(np.vstack([kept.kinematics.q, q])),
+        np.vstack([kept.directions, u]),
+        np.concatenate([kept.config_index, kept.kinematics.q.shape[0] + np.arange(q.shape[0])]),
+    )
+    return both, np.concatenate([speeds, extra])
+
+
+def _refined_pose(setup: ArmSetup, design: Design, q0: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """A pose near ``q0`` (rad) of larger coupled effective mass along its heaviest direction, inside the domain.
+
+    Nelder-Mead on the joint coordinates (a derivative-free climb: the mass is Pinocchio's, numeric), a point
+    outside the joint limits, below the singular-value floor or with its heaviest direction beyond the joint
+    speed limits at the design's approach scoring nothing; 200 evaluations at most. None if it leaves the start
+    no better.
+    """
+    from scipy.optimize import minimize  # lazy: scipy.optimize is slow to import
+
+    domain, arm = setup.domain, setup.arm
+    angles0 = arm.configuration_space.joint_coordinates(q0[None, :])[0]
+
+    def negative_mass(angles: np.ndarray) -> float:
+        if np.any(angles < domain.lower) or np.any(angles > domain.upper):
+            return 0.0
+        kinematics = arm.kinematics(arm.configuration(angles)[None, :])
+        matrix = _coupled_matrix(kinematics, design)
+        u = heaviest_directions(kinematics, matrix)
+        jacobian = kinematics.jacobian
+        if domain.configuration_margin(jacobian)[0] < 0 or np.any(
+            domain.speed_margin(jacobian, u, design.approach_velocity) < 0
+        ):
+            return 0.0
+        return -effective_mass(kinematics, 0, u[0], matrix[0])
+
+    start = negative_mass(angles0)
+    best = minimize(negative_mass, angles0, method="Nelder-Mead", options={"maxfev": 200, "xatol": 1e-4})
+    if not best.fun < start:
+        return None
+    kinematics = arm.kinematics(arm.configuration(best.x)[None, :])
+    u = heaviest_directions(kinematics, _coupled_matrix(kinematics, design))
+    return kinematics.q[0], u[0]
