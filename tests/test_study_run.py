@@ -57,8 +57,14 @@ def test_every_example_study_runs(runs, name):
     assert not [p for p in folder.rglob(".*") if p.is_file()]  # no temporary files left behind
     table = pd.read_csv(folder / "pareto.csv")
     assert len(table) >= 1
-    numbers = table.select_dtypes("number").to_numpy()
-    assert (numbers == numbers).all()  # no NaN anywhere in the results
+    # A margin is empty (None) only where nothing is required of the joint (a rating without a cycle: no RMS).
+    margins = {"rms_margin": "required_rms_torque", "speed_margin": "max_motor_speed"}
+    for column in [c for c in table if c.split("[")[0] in margins]:
+        name, joint = column.split("[")[0], column[column.index("[") : column.index("]") + 1]
+        required = next(c for c in table if c.startswith(margins[name] + joint))
+        assert (table[column].notna() | (table[required] == 0)).all(), column
+    numbers = table.drop(columns=[c for c in table if c.split("[")[0] in margins]).select_dtypes("number")
+    assert (numbers.to_numpy() == numbers.to_numpy()).all()  # no NaN anywhere else in the results
 
 
 @pytest.mark.parametrize("name", [p.stem for p in STUDIES], ids=[p.stem for p in STUDIES])
@@ -691,14 +697,14 @@ def test_recommended_design_has_no_oversized_joint_unless_at_the_smallest_motor(
 
 
 @pytest.mark.parametrize("name", ARM_STUDIES, ids=ARM_STUDIES)
-def test_torque_speed_figure_exactly_for_duty_cycle_studies(runs, name):
-    from collision_reflex.optimize.constraints import DUTY_REQUIREMENT
+def test_torque_speed_figure_exactly_where_a_motion_sizes_the_joints(runs, name):
+    from collision_reflex.optimize.constraints import DUTY_REQUIREMENT, RATED_REQUIREMENT
 
     folder = runs[name]
     results = json.loads((folder / "designs.json").read_text())
     html = (folder / "report.html").read_text()
     recommended = results["recommended"]
-    if results["requirement"] == DUTY_REQUIREMENT:
+    if results["requirement"] in (DUTY_REQUIREMENT, RATED_REQUIREMENT):  # a motion sizes the joints
         saved = recommended["torque_speed"]
         assert [e["joint"] for e in saved] == [j["joint"] for j in recommended["joints"]]
         # The record's margins are the saved points' (motor side: peak torque over the largest torque of the
@@ -722,16 +728,16 @@ def test_torque_speed_figure_exactly_for_duty_cycle_studies(runs, name):
 
 
 @pytest.mark.parametrize("name", ARM_STUDIES, ids=ARM_STUDIES)
-def test_the_speed_limit_assumption_is_stated_exactly_when_a_duty_cycle_uses_it(runs, name):
+def test_the_speed_limit_assumption_is_stated_exactly_when_a_motion_uses_it(runs, name):
     """Stated once, in the assumptions, not in the verdict."""
     from collision_reflex.hardware.motors import CONSTANT_SURFACE_SPEED
-    from collision_reflex.optimize.constraints import DUTY_REQUIREMENT
+    from collision_reflex.optimize.constraints import DUTY_REQUIREMENT, RATED_REQUIREMENT
 
     results = json.loads((runs[name] / "designs.json").read_text())
     html = unescape((runs[name] / "report.html").read_text())
     assumptions = html[html.index('id="assumptions"') :]
     assert not any("Speed limits" in line for line in results["verdict"])
-    if results["requirement"] == DUTY_REQUIREMENT:
+    if results["requirement"] in (DUTY_REQUIREMENT, RATED_REQUIREMENT):  # a motion's speeds bound the motors
         assert "the reference motor" in assumptions and CONSTANT_SURFACE_SPEED.source[:60] in assumptions
         assert html.count(CONSTANT_SURFACE_SPEED.source[:60]) == 1
     else:
