@@ -180,8 +180,8 @@ def held_region_reason(contact: HumanContactRecord | None) -> list[str]:
     gain = 100 * (speed / slowest - 1)
     return [
         f"What caps the speed: its slowest fresh pose meets the {held['region'].replace('_', ' ')} with "
-        f"{general(mass, 3)} kg, {general(links, 3)} kg of it the links'; the links alone would permit "
-        f"{general(speed, 3)} m/s there, {general(gain, 2)} % above this design: no actuators gain more."
+        f"{general(mass, 3)} kg, {general(links, 3)} kg the links'; with the links alone "
+        f"{general(speed, 3)} m/s, {general(gain, 2)} % faster: no actuators gain more."
     ]
 
 
