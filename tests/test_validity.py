@@ -62,6 +62,12 @@ def _cell(table, configuration, detection, ratio, placement, model="constant"):
     return row
 
 
+def test_the_map_marks_where_the_compliant_contact_s_robot_mass_is_only_a_bound(tiny_map):
+    """At 10 x the joints' stiffness the contact is neither much stiffer (100 x) nor much softer (0.01 x): the
+    compliant contact's closed form has the coupled mass as a bound there, not exactly."""
+    assert not tiny_map["transient_exact"].any()
+
+
 def test_map_reproduces_the_known_cases(tiny_map):
     """The issue's cases and the folded arm's, closed form (constant reaction) against simulation.
 
@@ -319,6 +325,7 @@ def test_the_map_over_restitution_names_each_contact_s_restitution_and_a_slow_co
     )
     sprung = table[table["reaction_model"] == "sprung"].set_index("restitution")
     assert sprung.index.tolist() == pytest.approx([0.1, 0.5], rel=1e-9)
+    assert sprung["transient_exact"].all()  # 1000 x the joints: the finger alone meets it, the closed form's mass
     assert (sprung["error"] == "").all()
     low, high = sprung["simulated"].tolist()
     assert abs(high / low - 1) < 0.02

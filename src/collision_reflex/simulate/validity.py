@@ -30,6 +30,7 @@ import numpy.typing as npt
 
 from .. import _validate
 from ..errors import InvalidParameter, SimulationError
+from ..model.contact import COUPLED_STIFFNESS_RATIO, DECOUPLED_STIFFNESS_RATIO
 from ..model.impulse import optimal_velocity, series_stiffness
 from ..vocabulary import CONTROLLED_DRIVES, REFLECTED_INERTIA_PLACEMENTS
 from . import arm as arm_simulation
@@ -124,7 +125,10 @@ def validity_map(
     -------
     One row per case, placement and reaction model (:data:`REACTION_MODELS`): ``configuration``,
     ``direction`` (indices), ``q``, ``u`` (as lists), ``velocity_ratio``, ``v0`` [m/s], ``stiffness_ratio``,
-    ``contact_stiffness`` [N/m], ``restitution`` (the contact's, for the finger alone), ``detection``, ``drive``,
+    ``contact_stiffness`` [N/m], ``restitution`` (the contact's, for the finger alone), ``transient_exact``
+    (whether the compliant contact's closed form, ``F = v sqrt(mu k_c)``, has its robot mass exactly: a contact at
+    least 100 times stiffer or at most 0.01 times as stiff as the joints along ``u``; in between it is the coupled
+    bound, :func:`collision_reflex.model.contact_robot_mass`), ``detection``, ``drive``,
     ``placement``, ``reaction_model``, ``simulated``
     and ``closed_form`` [N*s], ``difference`` (``I_sim / I_closed - 1``), ``valid`` (within ``tolerance``),
     ``damper_share`` (:func:`damper_share`: the contact's viscous force in the sensing ramp over ``F_s``, a
@@ -348,6 +352,10 @@ def _row(
         "stiffness_ratio": case.stiffness_ratio,
         "contact_stiffness": contact_stiffness,
         "restitution": _restitution(case.contact_damping_ratio),
+        "transient_exact": bool(
+            case.stiffness_ratio >= DECOUPLED_STIFFNESS_RATIO
+            or case.stiffness_ratio <= COUPLED_STIFFNESS_RATIO
+        ),
         "detection": case.detection,
         "drive": case.drive,
         "placement": placement,
