@@ -258,7 +258,7 @@ def test_urdf_limits_transmissions_and_companion(runs, robot, tmp_path):
     for saved in record["joints"]:
         name, ratio = saved["joint"], saved["gear_ratio"]
         limit = joints[name].find("limit")
-        assert float(limit.get("effort")) == saved["peak_torque"]
+        assert float(limit.get("effort")) == pytest.approx(_effort(saved), rel=1e-12)
         if (
             saved["stator_diameter"] == reference.stator_diameter
             and saved["stack_length"] == reference.stack_length
@@ -280,6 +280,48 @@ def test_urdf_limits_transmissions_and_companion(runs, robot, tmp_path):
     if robot == "panda":  # the locked fingers are fixed joints
         assert joints["panda_finger_joint1"].get("type") == "fixed"
         assert all(m.get("filename").startswith("package://") for m in root.iter("mesh"))
+
+
+def _effort(saved) -> float:
+    """A joint's driving peak output torque: eta N tau_p, at most its catalogue gearbox's repeated peak [N m]."""
+    from collision_reflex.hardware.gearboxes import load_gearbox_catalogue
+
+    driving = saved.get("gearbox_efficiency", 1.0) * saved["peak_torque"]
+    gearbox = load_gearbox_catalogue().get(saved.get("gearbox") or "")
+    return driving if gearbox is None else min(driving, gearbox.peak_torque)
+
+
+def test_the_catalogue_design_exports_with_its_parts_and_loads(smoke_runs, tmp_path):
+    """``--design catalogue``: the parts the snap chose, each named with its source, efforts within the gearbox's
+    repeated peak, the motor's own speed limit; Pinocchio and MuJoCo load the files; no NumPy repr leaks."""
+    import mujoco
+    import pinocchio as pin
+
+    from collision_reflex.hardware.motors import load_catalogue
+
+    run = smoke_runs["ur5"]
+    catalogue = json.loads((run / "designs.json").read_text())["catalogue"]
+    out = tmp_path / "built.urdf"
+    export_design(run, "catalogue", "urdf", out)
+    text = out.read_text()
+    assert "catalogue design (from " in text and "np.float64" not in text
+    root = ET.parse(out).getroot()
+    joints = {j.get("name"): j for j in root.findall("joint")}
+    motors = load_catalogue()
+    for chosen, saved in zip(catalogue["joints"], catalogue["design"]["joints"], strict=True):
+        assert f"catalogue motor {chosen['motor']}: {motors[chosen['motor']].source[:40]}" in text
+        limit = joints[saved["joint"]].find("limit")
+        assert float(limit.get("effort")) == pytest.approx(_effort(saved), rel=1e-12)
+        speed = motors[chosen["motor"]].max_speed
+        if speed is not None:
+            assert float(limit.get("velocity")) <= speed / saved["gear_ratio"] * (1 + 1e-12)
+    pin.buildModelFromUrdf(str(out))
+    mjcf = tmp_path / "built.xml"
+    export_design(run, "catalogue", "mjcf", mjcf)
+    model = mujoco.MjModel.from_xml_path(str(mjcf))
+    for saved in catalogue["design"]["joints"]:
+        joint = model.joint(saved["joint"])
+        assert model.jnt_actfrcrange[joint.id][1] == pytest.approx(_effort(saved), rel=1e-12)
 
 
 def test_the_documented_armature_loop_is_set_armature(runs, tmp_path):
@@ -331,7 +373,9 @@ def test_mjcf_full_inertia_is_the_same_matrix_with_armature(runs, robot, tmp_pat
             model.actuator_ctrlrange[actuator], [-joint.motor_peak_torque, joint.motor_peak_torque]
         )
         jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint.joint)
-        np.testing.assert_array_equal(model.jnt_actfrcrange[jid], [-joint.peak_torque, joint.peak_torque])
+        driving = joint.driving_peak_torque  # eta N tau_p, within the catalogue gearbox's repeated peak
+        assert driving == min(joint.gearbox_efficiency * joint.peak_torque, joint.gearbox_peak_torque or np.inf)
+        np.testing.assert_array_equal(model.jnt_actfrcrange[jid], [-driving, driving])
 
 
 def test_no_absolute_path_in_the_exported_files(runs, tmp_path):

@@ -325,7 +325,9 @@ def test_the_map_over_restitution_names_each_contact_s_restitution_and_a_slow_co
     )
     sprung = table[table["reaction_model"] == "sprung"].set_index("restitution")
     assert sprung.index.tolist() == pytest.approx([0.1, 0.5], rel=1e-9)
-    assert sprung["transient_exact"].all()  # 1000 x the joints: the finger alone meets it, the closed form's mass
+    assert sprung[
+        "transient_exact"
+    ].all()  # 1000 x the joints: the finger alone meets it, the closed form's mass
     assert (sprung["error"] == "").all()
     low, high = sprung["simulated"].tolist()
     assert abs(high / low - 1) < 0.02

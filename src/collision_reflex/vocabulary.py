@@ -86,8 +86,9 @@ ExportFormat = Literal["urdf", "mjcf"]
 """The robot formats a design is exported to."""
 EXPORT_FORMATS: tuple[ExportFormat, ...] = get_args(ExportFormat)
 
-DesignChoice = Literal["recommended", "chosen"]
-"""A run's designs named by word: the recommended design and the single-objective optimum as solved."""
+DesignChoice = Literal["catalogue", "recommended", "chosen"]
+"""A run's designs named by word: the design built from catalogue parts (the recommended design snapped to the
+catalogues), the recommended design and the single-objective optimum as solved."""
 DESIGN_CHOICES: tuple[DesignChoice, ...] = get_args(DesignChoice)
 
 TIME_COLUMN_NAMES: tuple[str, ...] = ("time", "t")

@@ -23,13 +23,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``crx export`` and its options to ``subparsers``."""
     parser = options.add_subcommand(subparsers, "export", _HELP, _DESCRIPTION, units=False)
     parser.add_argument("run_dir", metavar="RUN_DIR", help="output folder of `crx run` (an arm study)")
-    parser.add_argument(
-        "--design",
-        default="recommended",
-        metavar="N|recommended|chosen",
-        help="the Pareto design N (the point column of pareto.csv), the recommended design, or the chosen one "
-        "(the single-objective optimum); default recommended",
-    )
+    options.add_design(parser)
     parser.add_argument("--format", choices=EXPORT_FORMATS, required=True, help="the robot format to write")
     options.add_out_file(parser, what="the robot model (.urdf or MJCF .xml)")
     parser.set_defaults(run=run)

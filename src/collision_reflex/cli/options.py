@@ -26,6 +26,8 @@ from typing import Any, Literal, NoReturn
 
 import numpy as np
 
+from ..vocabulary import DESIGN_CHOICES
+
 UNITS_EPILOG = (
     "A bare number is in the unit shown in brackets (SI); an angle needs its unit (30deg, 0.5rad). Any physical "
     "value may carry a unit instead: 60mm, '2e7 N/m', 10ms, '1.3 N*m' (quote values with spaces)."
@@ -445,6 +447,17 @@ def add_csv(
     """``--csv FILE``: a table."""
     shown = f" (default {default})" if default else ""
     parser.add_argument("--csv", default=default, metavar="FILE", help=f"write {what} to FILE (CSV){shown}")
+
+
+def add_design(parser: argparse.ArgumentParser) -> None:
+    """``--design``: one design of a run folder, by Pareto number or by word (:data:`DESIGN_CHOICES`)."""
+    parser.add_argument(
+        "--design",
+        default="recommended",
+        metavar="N|" + "|".join(DESIGN_CHOICES),
+        help="the design built from catalogue parts, the Pareto design N (the point column of pareto.csv), the "
+        "recommended design, or the chosen one (the single-objective optimum); default recommended",
+    )
 
 
 def add_out_dir(parser: argparse.ArgumentParser, *, what: str, shown: str = "") -> None:

@@ -9,7 +9,6 @@ import dataclasses
 from .._io import atomic_open
 from ..errors import InvalidParameter
 from ..model.contact import BodyRegion
-from ..vocabulary import DESIGN_CHOICES
 from . import options
 
 _HELP = "permissible approach speeds of a run's design against a human body region (ISO/TS 15066)"
@@ -42,13 +41,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     options.REGION_STIFFNESS.add(parser, note="overrides the named region's")
     options.REGION_MASS.add(parser, note="overrides the named region's")
     options.TRANSIENT_FORCE.add(parser, note="overrides the named region's")
-    parser.add_argument(
-        "--design",
-        default="recommended",
-        metavar="N|" + "|".join(DESIGN_CHOICES),
-        help="the Pareto design N (the point column of pareto.csv), the recommended design, or the chosen one "
-        "(the single-objective optimum); default recommended",
-    )
+    options.add_design(parser)
     options.add_csv(parser, what="one row per contact sample")
     parser.set_defaults(run=run)
 

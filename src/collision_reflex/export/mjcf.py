@@ -110,7 +110,7 @@ def _header(design: RunDesign) -> str:
         f"Exported by collision-reflex from study {design.study!r}, {design.label}.",
         *design.parts,
         "Per joint: armature = N^2 (J_m + J_g) [kg m^2]; motor actuator with gear = N, control = motor torque "
-        "[N m] within the motor's peak torque; actuatorfrcrange = peak output torque N tau_p [N m].",
+        "[N m] within the motor's peak torque; actuatorfrcrange = driving peak output torque eta N tau_p [N m].",
         "Motor (and gearbox) masses: bodies JOINT_actuator welded to the parent link at the joint origin.",
         "Meshes are left out (see the exported URDF for them); velocity limits are in the URDF only.",
     ]
@@ -157,7 +157,7 @@ def _joint(mujoco: Any, model: Any, joint: int, body: ET.Element, actuators: dic
         attributes["range"] = _vector(model.jnt_range[joint])
     actuator = actuators.get(name)
     if actuator is not None:
-        torque = number(actuator.peak_torque)
+        torque = number(actuator.driving_peak_torque)
         attributes["armature"] = number(actuator.reflected_inertia)
         attributes["actuatorfrcrange"] = f"-{torque} {torque}"
     ET.SubElement(body, "joint", attributes)

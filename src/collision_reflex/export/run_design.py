@@ -44,7 +44,9 @@ class JointActuator:
     motor_peak_torque ``tau_p`` [N m]; motor_mass, gearbox_mass [kg]; gearbox: its catalogue name ("" for
     none); gearbox_efficiency [-]; motor_max_speed ``omega_max`` [rad/s] (None when the catalogue gives none);
     gearbox_max_speed: the catalogue gearbox's maximum input speed [rad/s] (None for none or not known);
-    stator_diameter, stack_length [m]; nearest_motor: the nearest catalogue motor ("" for none).
+    stator_diameter, stack_length [m]; nearest_motor: the nearest catalogue motor ("" for none); motor: the
+    catalogue motor the joint is built from ("" for a motor scaled from the reference); gearbox_peak_torque: the
+    catalogue gearbox's repeated peak torque [N m] (None for none or a gearbox the catalogue lacks).
     """
 
     joint: str
@@ -63,6 +65,17 @@ class JointActuator:
     stator_diameter: float
     stack_length: float
     nearest_motor: str
+    motor: str = ""
+    gearbox_peak_torque: float | None = None
+
+    @property
+    def driving_peak_torque(self) -> float:
+        """The peak torque the joint delivers at its output [N m]: ``eta N tau_p``, as the optimiser sizes it.
+
+        At most the catalogue gearbox's repeated peak torque, which the optimiser also holds the requirement to.
+        """
+        driving = self.gearbox_efficiency * self.peak_torque
+        return driving if self.gearbox_peak_torque is None else min(driving, self.gearbox_peak_torque)
 
     @property
     def actuator_mass(self) -> float:
@@ -103,8 +116,9 @@ def read_run_design(run_dir: str | os.PathLike[str], design: str | int = "recomm
     Parameters
     ----------
     run_dir: the output folder of ``crx run`` of an arm study.
-    design: ``"recommended"``, ``"chosen"`` (the single-objective optimum) or the index of a Pareto design
-        (as ``pareto.csv``'s ``point`` column numbers them).
+    design: ``"catalogue"`` (the design built from catalogue parts), ``"recommended"``, ``"chosen"`` (the
+        single-objective optimum) or the index of a Pareto design (as ``pareto.csv``'s ``point`` column numbers
+        them).
 
     Raises
     ------
@@ -129,7 +143,7 @@ def read_run_design(run_dir: str | os.PathLike[str], design: str | int = "recomm
     if not resolved.is_file():
         raise ResultsMissing(f"{folder} has no {RESOLVED}: run the study again")
     try:
-        return _run_design(results, record, label, resolved)
+        return _run_design(results, record, label, resolved, design == "catalogue")
     except ResultsDamaged as error:
         raise ResultsDamaged(f"{path}: {error}; run the study again") from None
     except (KeyError, TypeError, ValueError, AttributeError) as error:
@@ -139,8 +153,14 @@ def read_run_design(run_dir: str | os.PathLike[str], design: str | int = "recomm
         raise ResultsDamaged(f"{path}: {' '.join(what.split())}; run the study again") from None
 
 
-def _run_design(results: ArmRunRecord, record: DesignRecord, label: str, resolved: Path) -> RunDesign:
-    """The :class:`RunDesign` of a design record, with the arm and motors of the resolved study."""
+def _run_design(
+    results: ArmRunRecord, record: DesignRecord, label: str, resolved: Path, built: bool
+) -> RunDesign:
+    """The :class:`RunDesign` of a design record, with the arm and motors of the resolved study.
+
+    ``built``: the record is the catalogue design, each joint's motor the catalogue part it names (its own
+    maximum speed), not a motor scaled from the reference.
+    """
     loaded = parse_study(resolved.read_text(encoding="utf-8"), str(resolved), resolved.parent)
     study = loaded.study
     if not isinstance(study, ArmStudy):
@@ -158,7 +178,14 @@ def _run_design(results: ArmRunRecord, record: DesignRecord, label: str, resolve
     for name in arm.joint_names:
         saved = by_name[name]
         diameter, stack = float(saved["stator_diameter"]), float(saved["stack_length"])
-        speed = scaled_motor_quantities(reference, diameter, stack, law).max_speed
+        motor = str(saved.get("nearest_catalogue_motor") or "") if built else ""
+        if built and motor not in catalogue:
+            raise ResultsDamaged(f"the catalogue design's motor {motor!r} of {name} is in no motor catalogue")
+        speed = (
+            catalogue[motor].max_speed
+            if built
+            else scaled_motor_quantities(reference, diameter, stack, law).max_speed
+        )
         rotor, ratio = float(saved["rotor_inertia"]), float(saved["gear_ratio"])
         reflected = float(saved["reflected_inertia"])
         joints.append(
@@ -176,10 +203,16 @@ def _run_design(results: ArmRunRecord, record: DesignRecord, label: str, resolve
                 gearbox=str(saved.get("gearbox") or ""),
                 gearbox_efficiency=float(saved.get("gearbox_efficiency", 1.0)),
                 motor_max_speed=None if speed is None or not math.isfinite(speed) else float(speed),
-                gearbox_max_speed=_gearbox_input_speed(str(saved.get("gearbox") or ""), gearboxes),
+                gearbox_max_speed=_gearbox_figure(
+                    str(saved.get("gearbox") or ""), gearboxes, "max_input_speed"
+                ),
                 stator_diameter=diameter,
                 stack_length=stack,
                 nearest_motor=str(saved.get("nearest_catalogue_motor") or ""),
+                motor=motor,
+                gearbox_peak_torque=_gearbox_figure(
+                    str(saved.get("gearbox") or ""), gearboxes, "peak_torque"
+                ),
             )
         )
     return RunDesign(
@@ -192,10 +225,10 @@ def _run_design(results: ArmRunRecord, record: DesignRecord, label: str, resolve
     )
 
 
-def _gearbox_input_speed(name: str, gearboxes: Mapping[str, Any]) -> float | None:
-    """A catalogue gearbox's maximum input speed [rad/s]; None without a gearbox, or one the catalogue lacks."""
-    speed = getattr(gearboxes.get(name), "max_input_speed", None) if name else None
-    return float(speed) if speed is not None and math.isfinite(speed) else None
+def _gearbox_figure(name: str, gearboxes: Mapping[str, Any], figure: str) -> float | None:
+    """A catalogue gearbox's ``figure`` (SI); None without a gearbox, one the catalogue lacks, or no figure."""
+    value = getattr(gearboxes.get(name), figure, None) if name else None
+    return float(value) if value is not None and math.isfinite(value) else None
 
 
 def _gearbox_catalogue(joints: Iterable[JointRecord]) -> Mapping[str, Any]:
@@ -212,13 +245,22 @@ def _parts(
     reference: str,
     law: str,
 ) -> tuple[str, ...]:
-    """Provenance lines: the reference motor, each nearest catalogue motor and gearbox, with their sources."""
-    lines = [f"motors scaled from {reference} by the {law} law; {reference}: {catalogue[reference].source}"]
-    nearest = {
-        j.nearest_motor for j in joints if j.nearest_motor in catalogue and j.nearest_motor != reference
-    }
-    for name in sorted(nearest):
-        lines.append(f"nearest catalogue motor {name}: {catalogue[name].source}")
+    """Provenance lines of the motors and gearboxes, with their sources.
+
+    The catalogue motors a catalogue design is built from, or else the reference motor and each nearest
+    catalogue motor; then each gearbox.
+    """
+    built = sorted({j.motor for j in joints if j.motor})
+    if built:
+        lines = [f"catalogue motor {name}: {catalogue[name].source}" for name in built]
+    else:
+        lines = [
+            f"motors scaled from {reference} by the {law} law; {reference}: {catalogue[reference].source}"
+        ]
+        nearest = {
+            j.nearest_motor for j in joints if j.nearest_motor in catalogue and j.nearest_motor != reference
+        }
+        lines += [f"nearest catalogue motor {name}: {catalogue[name].source}" for name in sorted(nearest)]
     for name in sorted({j.gearbox for j in joints if j.gearbox}):
         source = getattr(gearboxes.get(name), "source", "") or "figures given in the study"
         lines.append(f"gearbox {name}: {source}")

@@ -20,7 +20,6 @@ What the optimiser models, written into the robot's own URDF:
 
 from __future__ import annotations
 
-import json
 import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -84,32 +83,48 @@ def _header(design: RunDesign, locked: list[str]) -> str:
     lines = [
         f"Exported by collision-reflex from study {design.study!r}, {design.label}.",
         f"Robot: {design.arm.name}; contact frame {design.arm.contact_frame!r}"
-        + (f" at {list(design.arm.contact_offset)} m" if any(design.arm.contact_offset) else "")
+        + (
+            f" at [{', '.join(number(v) for v in design.arm.contact_offset)}] m"
+            if any(design.arm.contact_offset)
+            else ""
+        )
         + ".",
         *design.parts,
         "Each motor (and gearbox) is a point mass on its parent link at the joint origin: link JOINT_actuator, "
         "fixed to the parent link, as the optimiser models it.",
         "Rotor inertia: transmissions (mechanicalReduction = N, drake:rotor_inertia = J_m + J_g); the armature "
         "N^2 (J_m + J_g) per joint is in the companion FILE.armature.json (set it as model.armature).",
-        "Joint effort = the design's peak output torque N tau_p [N m]; velocity = the motor's maximum speed (or the "
-        "gearbox's maximum input speed, if lower) / N [rad/s].",
+        "Joint effort = the design's driving peak output torque eta N tau_p [N m] (eta the gearbox efficiency; at "
+        "most the catalogue gearbox's repeated peak torque); "
+        "velocity = the motor's maximum speed (or the gearbox's maximum input speed, if lower) / N [rad/s].",
     ]
     if locked:
         lines.append("Joints locked by the study (fixed here at 0): " + ", ".join(locked) + ".")
     for actuator in design.joints:
         lines.append(_joint_summary(actuator))
-    if design.catalogue is not None:
-        lines.append(f"Catalogue selection of the design: {json.dumps(design.catalogue)}")
+    parts = design.catalogue["parts"] if design.catalogue else []
+    if any(parts):
+        lines.append(
+            "Nearest catalogue parts of the design (quick snap): "
+            + "; ".join(p or "none" for p in parts)
+            + "."
+        )
     return "\n  " + "\n  ".join(line.replace("--", "- -") for line in lines) + "\n"
 
 
 def _joint_summary(actuator: JointActuator) -> str:
     """One line describing a joint's actuator."""
     gearbox = f", gearbox {actuator.gearbox} ({actuator.gearbox_mass:.4g} kg)" if actuator.gearbox else ""
-    nearest = f" (nearest catalogue motor {actuator.nearest_motor})" if actuator.nearest_motor else ""
+    if actuator.motor:
+        motor = f"catalogue motor {actuator.motor}"
+    else:
+        nearest = f" (nearest catalogue motor {actuator.nearest_motor})" if actuator.nearest_motor else ""
+        motor = (
+            f"motor {actuator.stator_diameter * 1e3:.4g} mm x {actuator.stack_length * 1e3:.4g} mm{nearest}"
+        )
     return (
-        f"{actuator.joint}: motor {actuator.stator_diameter * 1e3:.4g} mm x {actuator.stack_length * 1e3:.4g} mm"
-        f"{nearest}, {actuator.motor_mass:.4g} kg, N = {actuator.gear_ratio:.6g}{gearbox}"
+        f"{actuator.joint}: {motor}, {actuator.motor_mass:.4g} kg, N = {actuator.gear_ratio:.6g}{gearbox}, "
+        f"effort {actuator.driving_peak_torque:.6g} N m"
     )
 
 
@@ -122,11 +137,11 @@ def _lock(joint: ET.Element) -> None:
 
 
 def _set_limits(joint: ET.Element, actuator: JointActuator) -> None:
-    """Effort limit ``N tau_p`` [N m]; velocity limit ``omega_max / N`` [rad/s] where the motor's is known."""
+    """Effort limit ``eta N tau_p`` [N m]; velocity limit ``omega_max / N`` [rad/s] where the motor's is known."""
     limit = joint.find("limit")
     if limit is None:
         limit = ET.SubElement(joint, "limit")
-    limit.set("effort", number(actuator.peak_torque))
+    limit.set("effort", number(actuator.driving_peak_torque))
     if actuator.max_speed is not None:
         limit.set("velocity", number(actuator.max_speed))
     elif limit.get("velocity") is None:

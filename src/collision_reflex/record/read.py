@@ -145,9 +145,10 @@ def _dotted(loc: list[Any]) -> str:
 def pick_design(results: ArmRunRecord, design: str | int) -> tuple[str, DesignRecord]:
     """The label and record of ``design`` in a run's results.
 
-    ``design``: ``"recommended"``, ``"chosen"`` (the single-objective optimum) or the index of a Pareto design
-    (as ``pareto.csv``'s ``point`` column numbers them, also as text). Raises :class:`InvalidParameter` for
-    any other.
+    ``design``: ``"catalogue"`` (the recommended design built from catalogue parts), ``"recommended"``,
+    ``"chosen"`` (the single-objective optimum) or the index of a Pareto design (as ``pareto.csv``'s ``point``
+    column numbers them, also as text). Raises :class:`InvalidParameter` for any other, and for
+    ``"catalogue"`` in a run without a catalogue design.
     """
     points = results["pareto"]["points"]
     if isinstance(design, str) and design.isdigit():
@@ -167,6 +168,18 @@ def pick_design(results: ArmRunRecord, design: str | int) -> tuple[str, DesignRe
         raise InvalidParameter(
             "design", design, f"a Pareto design number or one of {', '.join(DESIGN_CHOICES)}"
         )
+    if design == "catalogue":
+        snapped = results.get("catalogue")
+        built = snapped.get("design") if snapped else None
+        if not snapped or built is None:
+            raise InvalidParameter(
+                "design",
+                design,
+                "a design of the run",
+                "the run has no catalogue design (catalogue.snap off, or no part within the bounds): "
+                "name 'recommended' or a Pareto design",
+            )
+        return f"catalogue design (from {snapped['snapped']})", built
     record = results["recommended"] if design == "recommended" else results["chosen"]
     source = record.get("source") or record.get("label", "")
     return f"{design} design ({source})" if source else f"{design} design", record
