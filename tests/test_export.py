@@ -211,7 +211,9 @@ def _pinocchio_matrices(model, arm, q: np.ndarray, directions: np.ndarray) -> tu
 def test_urdf_gives_the_optimisers_mass_matrix_and_finger_mass(runs, robot, tmp_path):
     out = tmp_path / f"{robot}.urdf"
     written = export_design(runs[robot], "recommended", "urdf", out)
-    assert written == [out, companion_path(out)]
+    assert written[:2] == [out, companion_path(out)]
+    meshes = {m.get("filename") for m in ET.parse(out).getroot().iter("mesh")}
+    assert {p.relative_to(tmp_path).as_posix() for p in written[2:]} == meshes  # every mesh copied beside it
     design = read_run_design(runs[robot], "recommended")
     arm = design.arm
     motor_mass, armature = _design_arrays(design)
@@ -279,7 +281,7 @@ def test_urdf_limits_transmissions_and_companion(runs, robot, tmp_path):
         )
     if robot == "panda":  # the locked fingers are fixed joints
         assert joints["panda_finger_joint1"].get("type") == "fixed"
-        assert all(m.get("filename").startswith("package://") for m in root.iter("mesh"))
+        assert all(m.get("filename").startswith("panda_meshes/") for m in root.iter("mesh"))
 
 
 def _effort(saved) -> float:
@@ -315,7 +317,8 @@ def test_the_catalogue_design_exports_with_its_parts_and_loads(smoke_runs, tmp_p
         speed = motors[chosen["motor"]].max_speed
         if speed is not None:
             assert float(limit.get("velocity")) <= speed / saved["gear_ratio"] * (1 + 1e-12)
-    pin.buildModelFromUrdf(str(out))
+    pin.buildModelsFromUrdf(str(out), str(tmp_path))  # with its meshes, copied beside it
+    assert mujoco.MjModel.from_xml_path(str(out)).nmesh > 0  # MuJoCo reads the URDF as written
     mjcf = tmp_path / "built.xml"
     export_design(run, "catalogue", "mjcf", mjcf)
     model = mujoco.MjModel.from_xml_path(str(mjcf))
@@ -374,7 +377,9 @@ def test_mjcf_full_inertia_is_the_same_matrix_with_armature(runs, robot, tmp_pat
         )
         jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint.joint)
         driving = joint.driving_peak_torque  # eta N tau_p, within the catalogue gearbox's repeated peak
-        assert driving == min(joint.gearbox_efficiency * joint.peak_torque, joint.gearbox_peak_torque or np.inf)
+        assert driving == min(
+            joint.gearbox_efficiency * joint.peak_torque, joint.gearbox_peak_torque or np.inf
+        )
         np.testing.assert_array_equal(model.jnt_actfrcrange[jid], [-driving, driving])
 
 
@@ -389,11 +394,12 @@ def test_no_absolute_path_in_the_exported_files(runs, tmp_path):
         except MujocoMissing:
             pass  # the mujoco extra is not installed: the URDF is checked
     for path in written:
-        text = path.read_text()
-        assert not [f for f in forbidden if f in text], path
+        if path.suffix in (".urdf", ".xml", ".json"):  # the models, not the copied meshes
+            text = path.read_text()
+            assert not [f for f in forbidden if f in text], path
 
 
-def test_a_relative_mesh_path_is_rewritten_relative_to_the_output(tmp_path):
+def test_a_mesh_is_copied_beside_the_output_or_its_reference_kept_when_missing(tmp_path):
     robot = tmp_path / "robot"
     robot.mkdir()
     urdf = (REPO / "designs" / "planar_two_link.urdf").read_text()
@@ -405,7 +411,17 @@ def test_a_relative_mesh_path_is_rewritten_relative_to_the_output(tmp_path):
     (tmp_path / "out").mkdir()
     export_design(run, "recommended", "urdf", tmp_path / "out" / "arm.urdf")
     (written,) = ET.parse(tmp_path / "out" / "arm.urdf").getroot().iter("mesh")
-    assert written.get("filename") == "../robot/meshes/link1.stl"
+    assert written.get("filename") == "../robot/meshes/link1.stl"  # not there: the reference is kept
+    assert (
+        "Meshes not found, references kept: meshes/link1.stl" in (tmp_path / "out" / "arm.urdf").read_text()
+    )
+    (robot / "meshes").mkdir()
+    (robot / "meshes" / "link1.stl").write_bytes(b"solid link1\nendsolid link1\n")
+    files = export_design(run, "recommended", "urdf", tmp_path / "out" / "arm.urdf")
+    (written,) = ET.parse(tmp_path / "out" / "arm.urdf").getroot().iter("mesh")
+    assert written.get("filename") == "arm_meshes/link1.stl"  # copied beside the URDF
+    assert tmp_path / "out" / "arm_meshes" / "link1.stl" in files
+    assert (tmp_path / "out" / "arm_meshes" / "link1.stl").read_bytes() == b"solid link1\nendsolid link1\n"
 
 
 def _one_line_error(argv: list[str], capsys: pytest.CaptureFixture[str]) -> str:

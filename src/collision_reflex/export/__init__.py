@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 from pathlib import Path
 
 from .._io import atomic_open
@@ -60,11 +61,24 @@ def export_design(
     if out.parent.exists() and not out.parent.is_dir():
         raise ExportUnwritable(f"cannot write {out}: {out.parent} is a file, not a folder")
     chosen = read_run_design(run_dir, design)
-    urdf = design_urdf(chosen, out)
+    urdf, meshes = design_urdf(chosen, out)
     if format == "mjcf":
         return [_write(out, design_mjcf(chosen, urdf))]
     companion = json.dumps(armature_record(chosen, out.name), indent=1) + "\n"
-    return [_write(out, urdf), _write(companion_path(out), companion)]
+    return [_write(out, urdf), _write(companion_path(out), companion), *_copy_meshes(meshes)]
+
+
+def _copy_meshes(meshes: dict[Path, Path]) -> list[Path]:
+    """Copy each mesh file to its place beside the URDF; an unwritable place is :class:`ExportUnwritable`."""
+    written = []
+    for source, destination in meshes.items():
+        try:
+            destination.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(source, destination)
+        except OSError as error:
+            raise ExportUnwritable(f"cannot write {destination}: {error.strerror or error}") from None
+        written.append(destination)
+    return written
 
 
 def _write(path: Path, text: str) -> Path:

@@ -100,6 +100,8 @@ def _mujoco_urdf(urdf_text: str) -> str:
                 link.remove(collision)
     for transmission in root.findall("transmission"):
         root.remove(transmission)
+    for extension in root.findall("mujoco"):  # the exported URDF's own, for its meshes: replaced
+        root.remove(extension)
     extension = ET.SubElement(root, "mujoco")
     ET.SubElement(extension, "compiler", fusestatic="false", discardvisual="true", balanceinertia="false")
     return ET.tostring(root, encoding="unicode")

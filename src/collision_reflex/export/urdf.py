@@ -14,8 +14,12 @@ What the optimiser models, written into the robot's own URDF:
 - the joint's effort limit is the design's peak output torque ``N tau_p``, its velocity limit the motor's
   maximum speed over N (the URDF's own velocity limit is kept where the catalogue gives no motor speed);
 - joints the study locks (gripper fingers) become fixed joints at their locked position, zero;
-- mesh references: ``package://`` references are kept (resolve them with the robot's package directory);
-  any other path is rewritten relative to the output file, so the file names no absolute local path.
+- meshes: every mesh the URDF references (``package://`` ones resolved through the robot's package
+  directories) is copied beside the output, into ``<name>_meshes/``, and referenced there by a relative path,
+  so the file loads unmodified wherever it is taken and names no absolute local path; a mesh that cannot be
+  found keeps its reference (``package://``, or a path relative to the output) and the header names it;
+- a ``<mujoco>`` block tells MuJoCo's URDF reader to keep those relative paths and to skip the visual meshes
+  (MuJoCo reads no COLLADA); other readers ignore it.
 """
 
 from __future__ import annotations
@@ -40,8 +44,11 @@ def number(value: float) -> str:
     return repr(float(value))
 
 
-def design_urdf(design: RunDesign, out: str | os.PathLike[str]) -> str:
-    """The URDF text of ``design``'s arm with its actuators, to be written at ``out`` (mesh paths relative to it).
+def design_urdf(design: RunDesign, out: str | os.PathLike[str]) -> tuple[str, dict[Path, Path]]:
+    """The URDF text of ``design``'s arm with its actuators, to be written at ``out``, and the meshes to copy.
+
+    The meshes map each mesh file the text references to where it goes (``<out stem>_meshes/...``, beside
+    ``out``).
 
     Raises
     ------
@@ -66,19 +73,23 @@ def design_urdf(design: RunDesign, out: str | os.PathLike[str]) -> str:
         driven = {j.get("name") for j in transmission.findall("joint")}
         if driven & (names | set(locked)):
             root.remove(transmission)
-    header = _header(design, locked)
+    copies, missing_meshes = _relocate_meshes(
+        root, design, Path(source).resolve().parent, Path(out).resolve()
+    )
+    header = _header(design, locked, missing_meshes)
     root.insert(0, ET.Comment(header))
     for actuator in design.joints:
         _set_limits(joints[actuator.joint], actuator)
         if actuator.actuator_mass > 0:
             _add_actuator_link(root, joints[actuator.joint], actuator)
         _add_transmission(root, actuator)
-    _relocate_meshes(root, Path(source).resolve().parent, Path(out).resolve().parent)
+    extension = ET.SubElement(root, "mujoco")
+    ET.SubElement(extension, "compiler", strippath="false", discardvisual="true")
     ET.indent(root, space="  ")
-    return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+    return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n", copies
 
 
-def _header(design: RunDesign, locked: list[str]) -> str:
+def _header(design: RunDesign, locked: list[str], missing_meshes: list[str]) -> str:
     """The header comment: study, design, catalogue parts and sources, and how the model is written."""
     lines = [
         f"Exported by collision-reflex from study {design.study!r}, {design.label}.",
@@ -100,6 +111,8 @@ def _header(design: RunDesign, locked: list[str]) -> str:
     ]
     if locked:
         lines.append("Joints locked by the study (fixed here at 0): " + ", ".join(locked) + ".")
+    if missing_meshes:
+        lines.append("Meshes not found, references kept: " + ", ".join(missing_meshes) + ".")
     for actuator in design.joints:
         lines.append(_joint_summary(actuator))
     parts = design.catalogue["parts"] if design.catalogue else []
@@ -205,12 +218,52 @@ def _add_transmission(root: ET.Element, actuator: JointActuator) -> None:
     )
 
 
-def _relocate_meshes(root: ET.Element, source_dir: Path, out_dir: Path) -> None:
-    """Mesh paths that are not ``package://`` references, rewritten relative to the output's folder."""
+def _relocate_meshes(
+    root: ET.Element, design: RunDesign, source_dir: Path, out: Path
+) -> tuple[dict[Path, Path], list[str]]:
+    """Point every mesh at its copy in ``<out stem>_meshes/``; the copies to make and the meshes not found.
+
+    A ``package://PKG/rest`` reference is looked for as ``PKG/rest`` in each of the arm's package directories
+    and copied to ``PKG/rest`` there; a path (absolute, ``file://`` or relative to the source URDF) is copied
+    under its file name (numbered where two share one). A mesh not found keeps a ``package://`` reference, or
+    a path relative to the output's folder.
+    """
+    folder = Path(f"{out.stem}_meshes")
+    copies: dict[Path, Path] = {}
+    taken: dict[Path, Path] = {}  # destination -> source
+    missing: list[str] = []
     for mesh in root.iter("mesh"):
         filename = mesh.get("filename", "")
-        if not filename or filename.startswith("package://"):
+        if not filename:
             continue
-        path = Path(filename.removeprefix("file://"))
-        absolute = path if path.is_absolute() else source_dir / path
-        mesh.set("filename", Path(os.path.relpath(absolute.resolve(), out_dir)).as_posix())
+        source, relative = _mesh_source(filename, design.arm.package_dirs, source_dir)
+        if source is None:
+            missing.append(filename)
+            if not filename.startswith("package://"):
+                path = Path(filename.removeprefix("file://"))
+                absolute = path if path.is_absolute() else source_dir / path
+                mesh.set("filename", Path(os.path.relpath(absolute.resolve(), out.parent)).as_posix())
+            continue
+        destination = folder / relative
+        number_ = 1
+        while taken.get(destination, source) != source:  # another file of that name: number this one
+            destination = folder / f"{relative.stem}_{number_}{relative.suffix}"
+            number_ += 1
+        taken[destination] = source
+        copies[source] = out.parent / destination
+        mesh.set("filename", destination.as_posix())
+    return copies, sorted(set(missing))
+
+
+def _mesh_source(filename: str, package_dirs: tuple[str, ...], source_dir: Path) -> tuple[Path | None, Path]:
+    """The mesh file a reference names (None if it is not there), and where its copy goes in the meshes folder."""
+    if filename.startswith("package://"):
+        relative = Path(filename.removeprefix("package://"))
+        for directory in package_dirs:
+            candidate = Path(directory) / relative
+            if candidate.is_file():
+                return candidate.resolve(), relative
+        return None, relative
+    path = Path(filename.removeprefix("file://"))
+    absolute = path if path.is_absolute() else source_dir / path
+    return (absolute.resolve() if absolute.is_file() else None), Path(path.name)
