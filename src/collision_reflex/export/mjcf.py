@@ -61,7 +61,11 @@ def design_mjcf(design: RunDesign, urdf_text: str) -> str:
     root = ET.Element("mujoco", model=design.arm.name)
     root.append(ET.Comment(_header(design)))
     ET.SubElement(root, "compiler", angle="radian", autolimits="true", inertiafromgeom="false")
-    ET.SubElement(root, "option", gravity=" ".join(number(g) for g in model.opt.gravity))
+    # implicitfast: the joints' damping and the armature integrated implicitly, stable at MuJoCo's default step
+    # where the explicit Euler integrator lets a stiff arm diverge.
+    ET.SubElement(
+        root, "option", gravity=" ".join(number(g) for g in model.opt.gravity), integrator="implicitfast"
+    )
     world = ET.SubElement(root, "worldbody")
     actuators = {j.joint: j for j in design.joints}
     bodies: dict[int, ET.Element] = {0: world}
@@ -114,7 +118,8 @@ def _header(design: RunDesign) -> str:
         "Per joint: armature = N^2 (J_m + J_g) [kg m^2]; motor actuator with gear = N, control = motor torque "
         "[N m] within the motor's peak torque; actuatorfrcrange = driving peak output torque eta N tau_p [N m].",
         "Motor (and gearbox) masses: bodies JOINT_actuator welded to the parent link at the joint origin.",
-        "Meshes are left out (see the exported URDF for them); velocity limits are in the URDF only.",
+        "Meshes are left out (see the exported URDF for them); velocity limits are in the URDF only; the URDF's "
+        "joint damping and friction are kept; integrator implicitfast.",
     ]
     return "\n  " + "\n  ".join(line.replace("--", "- -") for line in lines) + "\n"
 
@@ -157,6 +162,10 @@ def _joint(mujoco: Any, model: Any, joint: int, body: ET.Element, actuators: dic
     }
     if model.jnt_limited[joint]:
         attributes["range"] = _vector(model.jnt_range[joint])
+    dof = int(model.jnt_dofadr[joint])
+    for field, values in (("damping", model.dof_damping), ("frictionloss", model.dof_frictionloss)):
+        if values[dof] > 0:  # the URDF's <dynamics damping friction>, kept
+            attributes[field] = number(values[dof])
     actuator = actuators.get(name)
     if actuator is not None:
         torque = number(actuator.driving_peak_torque)
