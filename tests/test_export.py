@@ -362,13 +362,11 @@ def test_mjcf_full_inertia_is_the_same_matrix_with_armature(runs, robot, tmp_pat
     expected = arm.kinematics(q).structure_mass_matrix(motor_mass) + np.diag(armature)
     model = mujoco.MjModel.from_xml_path(str(out))
     assert model.opt.integrator == mujoco.mjtIntegrator.mjINT_IMPLICITFAST
-    source = mujoco.MjModel.from_xml_path(str(arm.urdf_path)) if robot == "panda" else None
-    if source is not None:  # the URDF's joint damping (the Panda's 0.003 N m s/rad) kept
-        for name in arm.joint_names:
-            assert (
-                model.dof_damping[model.joint(name).dofadr[0]]
-                == source.dof_damping[source.joint(name).dofadr[0]]
-            )
+    urdf_joints = {j.get("name"): j for j in ET.parse(arm.urdf_path).getroot().findall("joint")}
+    for name in arm.joint_names:  # the URDF's joint damping kept (the Panda's 0.003 N m s/rad, the UR5's 0)
+        dynamics = urdf_joints[name].find("dynamics")
+        damping = float(dynamics.get("damping", 0.0)) if dynamics is not None else 0.0
+        assert model.dof_damping[model.joint(name).dofadr[0]] == damping
     data = mujoco.MjData(model)
     ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n) for n in arm.joint_names]
     dofs = [model.jnt_dofadr[j] for j in ids]
