@@ -317,6 +317,10 @@ def test_the_catalogue_design_exports_with_its_parts_and_loads(smoke_runs, tmp_p
         speed = motors[chosen["motor"]].max_speed
         if speed is not None:
             assert float(limit.get("velocity")) <= speed / saved["gear_ratio"] * (1 + 1e-12)
+    for saved in catalogue["design"]["joints"]:  # the header's figures are designs.json's, digit for digit
+        line = next(x for x in text.splitlines() if x.strip().startswith(saved["joint"] + ":"))
+        for key in ("motor_mass", "gear_ratio", "gearbox_mass"):
+            assert repr(float(saved[key])) in line, (key, line)
     pin.buildModelsFromUrdf(str(out), str(tmp_path))  # with its meshes, copied beside it
     assert mujoco.MjModel.from_xml_path(str(out)).nmesh > 0  # MuJoCo reads the URDF as written
     mjcf = tmp_path / "built.xml"

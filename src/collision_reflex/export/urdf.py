@@ -126,18 +126,16 @@ def _header(design: RunDesign, locked: list[str], missing_meshes: list[str]) -> 
 
 
 def _joint_summary(actuator: JointActuator) -> str:
-    """One line describing a joint's actuator."""
-    gearbox = f", gearbox {actuator.gearbox} ({actuator.gearbox_mass:.4g} kg)" if actuator.gearbox else ""
+    """One line describing a joint's actuator, every figure as ``designs.json`` holds it (SI, full precision)."""
+    gearbox = f", gearbox {actuator.gearbox} ({number(actuator.gearbox_mass)} kg)" if actuator.gearbox else ""
     if actuator.motor:
         motor = f"catalogue motor {actuator.motor}"
     else:
         nearest = f" (nearest catalogue motor {actuator.nearest_motor})" if actuator.nearest_motor else ""
-        motor = (
-            f"motor {actuator.stator_diameter * 1e3:.4g} mm x {actuator.stack_length * 1e3:.4g} mm{nearest}"
-        )
+        motor = f"motor {number(actuator.stator_diameter)} m x {number(actuator.stack_length)} m{nearest}"
     return (
-        f"{actuator.joint}: {motor}, {actuator.motor_mass:.4g} kg, N = {actuator.gear_ratio:.6g}{gearbox}, "
-        f"effort {actuator.driving_peak_torque:.6g} N m"
+        f"{actuator.joint}: {motor}, {number(actuator.motor_mass)} kg, N = {number(actuator.gear_ratio)}{gearbox}, "
+        f"effort {number(actuator.driving_peak_torque)} N m"
     )
 
 
