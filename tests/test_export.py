@@ -434,6 +434,21 @@ def test_a_mesh_is_copied_beside_the_output_or_its_reference_kept_when_missing(t
     assert (tmp_path / "out" / "arm_meshes" / "link1.stl").read_bytes() == b"solid link1\nendsolid link1\n"
 
 
+@pytest.mark.parametrize("name", ['--><link name="INJECTED"/><!--', "bad\ud800name", "a\x01b-"])
+def test_a_hostile_name_in_the_run_folder_stays_inside_its_comment(tmp_path, name):
+    """A gearbox name in designs.json is input: ``-->`` cannot close the header comment and add a link, a
+    lone surrogate or a control character cannot break the file; URDF and MJCF parse, with nothing added."""
+    run = synthetic_run(tmp_path / "run", REPO / "studies" / "two_link_paper.yaml", 5, gearbox=name)
+    for fmt, out in (("urdf", tmp_path / "arm.urdf"), ("mjcf", tmp_path / "arm.xml")):
+        try:
+            export_design(run, "recommended", fmt, out)
+        except MujocoMissing:
+            continue
+        root = ET.parse(out).getroot()
+        assert not [e for e in root.iter() if e.get("name") == "INJECTED"]
+        assert out.read_text(encoding="utf-8").count("<!--") == out.read_text(encoding="utf-8").count("-->")
+
+
 def _one_line_error(argv: list[str], capsys: pytest.CaptureFixture[str]) -> str:
     """Run ``crx`` expecting exit status 2, no output and a one-line error; return the line."""
     assert main(argv) == 2

@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import CollisionReflexError, UrdfError
 from .run_design import RunDesign
-from .urdf import number
+from .urdf import comment, number
 
 CONTACT_SITE = "collision_reflex_contact"
 """The site at the design's contact point."""
@@ -59,7 +59,7 @@ def design_mjcf(design: RunDesign, urdf_text: str) -> str:
             design.label, f"MuJoCo cannot read the exported URDF: {' '.join(str(error).split())}"
         ) from None
     root = ET.Element("mujoco", model=design.arm.name)
-    root.append(ET.Comment(_header(design)))
+    root.append(comment(_header(design)))
     ET.SubElement(root, "compiler", angle="radian", autolimits="true", inertiafromgeom="false")
     # implicitfast: the joints' damping and the armature integrated implicitly, stable at MuJoCo's default step
     # where the explicit Euler integrator lets a stiff arm diverge.
@@ -121,7 +121,7 @@ def _header(design: RunDesign) -> str:
         "Meshes are left out (see the exported URDF for them); velocity limits are in the URDF only; the URDF's "
         "joint damping and friction are kept; integrator implicitfast.",
     ]
-    return "\n  " + "\n  ".join(line.replace("--", "- -") for line in lines) + "\n"
+    return "\n  " + "\n  ".join(lines) + "\n"
 
 
 def _vector(values: Any) -> str:

@@ -25,8 +25,10 @@ What the optimiser models, written into the robot's own URDF:
 from __future__ import annotations
 
 import os
+import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from typing import Any
 
 from ..errors import InvalidParameter, UrdfError
 from .run_design import JointActuator, RunDesign
@@ -42,6 +44,19 @@ ACTUATOR_LINK = "{joint}_actuator"
 def number(value: float) -> str:
     """A float as text that reads back to the same double."""
     return repr(float(value))
+
+
+def comment(text: str) -> ET.Element[Any]:
+    """An XML comment of ``text`` that cannot end early or break the file, whatever the text holds.
+
+    A run folder is input like any other file: a name in it may hold ``-->`` (which would close the comment and
+    let the rest in as elements), characters XML forbids, or lone surrogates (which no encoding writes).
+    """
+    safe = text.encode("utf-8", "replace").decode("utf-8")
+    safe = re.sub(r"[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff]", "?", safe)
+    while "--" in safe:
+        safe = safe.replace("--", "- -")
+    return ET.Comment(safe + " " if safe.endswith("-") else safe)
 
 
 def design_urdf(design: RunDesign, out: str | os.PathLike[str]) -> tuple[str, dict[Path, Path]]:
@@ -77,7 +92,7 @@ def design_urdf(design: RunDesign, out: str | os.PathLike[str]) -> tuple[str, di
         root, design, Path(source).resolve().parent, Path(out).resolve()
     )
     header = _header(design, locked, missing_meshes)
-    root.insert(0, ET.Comment(header))
+    root.insert(0, comment(header))
     for actuator in design.joints:
         _set_limits(joints[actuator.joint], actuator)
         if actuator.actuator_mass > 0:
@@ -122,7 +137,7 @@ def _header(design: RunDesign, locked: list[str], missing_meshes: list[str]) -> 
             + "; ".join(p or "none" for p in parts)
             + "."
         )
-    return "\n  " + "\n  ".join(line.replace("--", "- -") for line in lines) + "\n"
+    return "\n  " + "\n  ".join(lines) + "\n"
 
 
 def _joint_summary(actuator: JointActuator) -> str:
@@ -163,7 +178,7 @@ def _set_limits(joint: ET.Element, actuator: JointActuator) -> None:
             "add max_speed to the reference motor's catalogue entry",
         )
     else:
-        joint.append(ET.Comment(" velocity limit of the source URDF: the catalogue gives no motor speed "))
+        joint.append(comment(" velocity limit of the source URDF: the catalogue gives no motor speed "))
 
 
 def _add_actuator_link(root: ET.Element, joint: ET.Element, actuator: JointActuator) -> None:
@@ -173,9 +188,7 @@ def _add_actuator_link(root: ET.Element, joint: ET.Element, actuator: JointActua
         raise UrdfError("URDF", f"joint {actuator.joint!r} has no parent link")
     name = ACTUATOR_LINK.format(joint=actuator.joint)
     gearbox = f" + gearbox {actuator.gearbox} {number(actuator.gearbox_mass)} kg" if actuator.gearbox else ""
-    root.append(
-        ET.Comment(f" {actuator.joint}: motor {number(actuator.motor_mass)} kg{gearbox}, a point mass ")
-    )
+    root.append(comment(f" {actuator.joint}: motor {number(actuator.motor_mass)} kg{gearbox}, a point mass "))
     link = ET.SubElement(root, "link", name=name)
     inertial = ET.SubElement(link, "inertial")
     ET.SubElement(inertial, "origin", xyz="0 0 0", rpy="0 0 0")
@@ -197,7 +210,7 @@ def _add_transmission(root: ET.Element, actuator: JointActuator) -> None:
     """A simple transmission: reduction N, rotor (+ gearbox input) inertia, and the armature as a comment."""
     armature = actuator.reflected_inertia
     root.append(
-        ET.Comment(
+        comment(
             f" {actuator.joint}: armature N^2 (J_m + J_g) = {number(actuator.gear_ratio)}^2 x "
             f"({number(actuator.rotor_inertia)} + {number(actuator.gearbox_inertia)}) = {number(armature)} kg m^2 "
         )
