@@ -1,14 +1,40 @@
-"""Atomic output: a file appears complete under its final name or not at all."""
+"""Files in and out: bounded input (a regular file of a limited size), atomic output (complete or absent)."""
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
+import stat
 import tempfile
 import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
+
+INPUT_LIMIT = 64 * 2**20
+"""Largest input file read [bytes]: more than any study, catalogue, trace or run record needs, and small enough
+that a wrong file (a disk image, ``/dev/zero``) is refused at once instead of filling the memory."""
+
+
+def read_limited(path: str | os.PathLike[str], limit: int = INPUT_LIMIT) -> bytes:
+    """The bytes of the regular file ``path``, of at most ``limit`` bytes.
+
+    Raises :class:`OSError` (its ``strerror`` says why) for a file that is not there, not a regular file (a
+    device, a pipe, a folder: reading it could block or never end) or larger than ``limit``, checked before
+    reading and again while reading (a file that grows).
+    """
+    target = Path(path)
+    if not stat.S_ISREG(target.stat().st_mode):
+        raise OSError(errno.EINVAL, "not a regular file (a device, a pipe or a folder)", str(target))
+    with target.open("rb") as handle:
+        if os.fstat(handle.fileno()).st_size > limit:
+            raise OSError(errno.EFBIG, f"larger than {limit / 2**20:g} MiB", str(target))
+        data = handle.read(limit + 1)
+    if len(data) > limit:
+        raise OSError(errno.EFBIG, f"larger than {limit / 2**20:g} MiB", str(target))
+    return data
+
 
 TEMPORARY_PREFIX = ".tmp-"
 """Names of temporary files start so: a writer killed before its rename leaves one, removable by name."""

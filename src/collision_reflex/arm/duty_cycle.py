@@ -24,11 +24,11 @@ from __future__ import annotations
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from .._io import read_limited
 from .._table import HEADER, TableProblem, read_table
 from ..errors import InvalidParameter, TraceError, TrajectoryError
 from ..experiments.traces import unit_factor
@@ -350,9 +350,10 @@ def _read_table(path: str | os.PathLike[str]) -> tuple[int, Any]:
     """The header's file line (1-based) and the table of strings below it."""
     source = str(path)
     try:
-        text = Path(path).read_text()
-    except (OSError, UnicodeDecodeError) as error:
-        raise TrajectoryError(source, f"cannot read the file ({error})") from None
+        text = read_limited(path).decode("utf-8")
+    except (OSError, UnicodeDecodeError, ValueError) as error:
+        reason = getattr(error, "strerror", None) or error
+        raise TrajectoryError(source, f"cannot read the file ({reason})") from None
     lines = text.splitlines()
     header = 0
     while header < len(lines) and (lines[header].startswith("#") or not lines[header].strip()):

@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 import numpy as np
 
-from .._io import atomic_open
+from .._io import atomic_open, read_limited
 from .._table import HEADER, TableProblem, read_table
 from .._units import QuantityError, parse_quantity, si_scale
 from ..errors import TraceError
@@ -193,9 +193,10 @@ def read_traces(
     """
     source = str(path)
     try:
-        lines = Path(path).read_text().splitlines()
-    except (OSError, UnicodeDecodeError) as error:
-        raise TraceError(source, "", f"cannot read the file ({error})") from None
+        lines = read_limited(path).decode("utf-8").splitlines()
+    except (OSError, UnicodeDecodeError, ValueError) as error:
+        reason = getattr(error, "strerror", None) or error
+        raise TraceError(source, "", f"cannot read the file ({reason})") from None
     metadata, header_line = _leading_metadata(lines)
     if header_line >= len(lines):
         raise TraceError(source, "", "no header line and no samples")

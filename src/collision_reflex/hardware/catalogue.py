@@ -19,10 +19,15 @@ from typing import Any, Literal
 import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError, field_validator
 
+from .._io import read_limited
 from .._units import QuantityError, parse_quantity
 from .._yaml import NodeProblem, check_nodes, one_line
 from ..errors import CatalogueError
 from ..vocabulary import GEARBOX_KINDS
+
+CATALOGUE_LIMIT = 4 * 2**20
+"""Largest catalogue file read [bytes]: the packaged ones are tens of kilobytes; a multi-megabyte one is not a
+catalogue but a mistake, refused before it is parsed (parsing YAML costs far more than its size)."""
 
 # Field -> the unit a plain number is taken in (SI), and the pint dimensionality a quantity string must have.
 _MOTOR_UNITS = {
@@ -330,7 +335,7 @@ _READ: dict[tuple[str, str, bytes], dict[str, CatalogueEntry]] = {}
 def _file_bytes(path: Path) -> bytes:
     """The file's bytes, or a :class:`CatalogueError` saying why they cannot be read."""
     try:
-        return Path(path).read_bytes()
+        return read_limited(path, CATALOGUE_LIMIT)
     except (OSError, ValueError) as error:  # ValueError: a NUL byte in the path
         reason = getattr(error, "strerror", None) or str(error)
         raise CatalogueError(str(path), None, "", f"cannot read the file ({reason})") from None

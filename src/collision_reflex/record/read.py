@@ -14,6 +14,7 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from .._io import read_limited
 from ..errors import InvalidParameter
 from ..vocabulary import DESIGN_CHOICES
 from .checked import ResultsDamaged, ResultsMissing
@@ -50,10 +51,14 @@ def read_saved_record(path: str | os.PathLike[str]) -> dict[str, Any]:
             f"{path.parent} has no {path.name}: run the study first (crx run STUDY --out {path.parent})"
         )
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError) as error:
+        data = json.loads(read_limited(path).decode("utf-8"))
+    except (OSError, ValueError, RecursionError) as error:  # RecursionError: nesting too deep to parse
+        reason = (
+            "nested too deeply" if isinstance(error, RecursionError) else getattr(error, "strerror", None)
+        )
+        reason = reason or str(error)
         raise ResultsDamaged(
-            f"{path} cannot be read ({' '.join(str(error).split())}); run the study again"
+            f"{path} cannot be read ({' '.join(reason.split())}); run the study again"
         ) from None
     kind = data.get("kind") if isinstance(data, dict) else None
     if kind not in RUN_KINDS:

@@ -1,0 +1,69 @@
+"""Input files are read bounded: a device, a pipe or a huge file is refused before it is read (never a hang or a
+full memory), and a run record nested too deeply to parse is damaged, not a traceback."""
+
+from __future__ import annotations
+
+import os
+import shutil
+
+import pytest
+
+from collision_reflex._io import INPUT_LIMIT, read_limited
+from collision_reflex.cli import main
+
+
+def _error(argv: list[str], capsys: pytest.CaptureFixture[str]) -> str:
+    """Run ``crx`` expecting exit status 2; its last line of stderr."""
+    assert main(argv) == 2
+    return capsys.readouterr().err.strip().splitlines()[-1]
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/zero"), reason="needs /dev/zero")
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["motors", "--catalogue", "/dev/zero"],
+        ["fit", "/dev/zero"],
+        ["safety", "--regions", "/dev/zero", "--list-regions"],
+    ],
+)
+def test_a_device_is_refused_before_it_is_read(argv, capsys):
+    assert main(argv) == 2
+    assert "not a regular file" in capsys.readouterr().err
+
+
+def test_a_pipe_is_refused_without_waiting_for_a_writer(tmp_path):
+    pipe = tmp_path / "pipe.csv"
+    os.mkfifo(pipe)
+    with pytest.raises(OSError, match="not a regular file"):
+        read_limited(pipe)
+
+
+def test_a_file_beyond_the_limit_is_refused_unread(tmp_path, capsys):
+    """A sparse 100 MB file: its size decides, not its content (reading it would take 100 MB)."""
+    big = tmp_path / "big.yaml"
+    with open(big, "wb") as handle:
+        handle.truncate(100 * 2**20)
+    assert 100 * 2**20 > INPUT_LIMIT
+    with pytest.raises(OSError, match="larger than"):
+        read_limited(big)
+    assert "larger than 4 MiB" in _error(["motors", "--catalogue", str(big)], capsys)
+    small = tmp_path / "small.txt"
+    small.write_bytes(b"12345")
+    assert read_limited(small, limit=5) == b"12345"
+    with pytest.raises(OSError, match="larger than"):
+        read_limited(small, limit=4)
+
+
+@pytest.mark.parametrize("command", ["report", "export", "safety"])
+def test_a_run_record_nested_too_deeply_is_damaged_not_a_traceback(smoke_runs, tmp_path, capsys, command):
+    run = tmp_path / "run"
+    shutil.copytree(smoke_runs["two_link_paper"], run)
+    (run / "designs.json").write_text("[" * 50_000 + "]" * 50_000)
+    extra = {
+        "report": [],
+        "export": ["--format", "urdf", "--out", str(tmp_path / "x.urdf")],
+        "safety": ["--region", "chest"],
+    }
+    line = _error([command, str(run), *extra[command]], capsys)
+    assert "nested too deeply" in line and "run the study again" in line
