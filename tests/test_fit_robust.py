@@ -128,3 +128,30 @@ def test_an_unidentifiable_parameter_is_left_out_of_the_system_mean() -> None:
     ]
     summary = ex.analyse_traces(traces).one_shot_summary().set_index("parameter")
     assert summary.loc["a", "trials"] == 0 and summary.loc["m_f", "trials"] == 2
+
+
+TRACE = Path(__file__).resolve().parents[1] / "studies" / "traces" / "u8_soft" / "u8_soft_v120mm.csv"
+
+
+@pytest.mark.parametrize(
+    ("unit", "words"),
+    [
+        ("9**9**9 s", "not a unit"),  # pint would evaluate the power and not finish
+        ("1 m**0", "not a unit"),  # pint's KeyError 'meter' before
+        ("m", "[length], not [time]"),
+    ],
+)
+def test_a_bad_time_unit_is_a_usage_error_before_any_file_is_read(unit, words, capsys) -> None:
+    assert main(["fit", str(TRACE), "--time-unit", unit]) == 2
+    err = capsys.readouterr().err
+    assert words in err and "--time-unit" in err and len(err.strip().splitlines()) == 1
+
+
+def test_an_out_that_is_a_file_is_refused_before_the_analysis(tmp_path, capsys) -> None:
+    taken = tmp_path / "taken"
+    taken.write_text("not a folder")
+    assert main(["fit", str(TRACE), "--out", str(taken)]) == 2
+    captured = capsys.readouterr()
+    assert "it is a file, not a folder" in captured.err and captured.out == ""
+    assert main(["fit", str(TRACE), "--out", str(taken / "inside")]) == 2
+    assert "cannot write to" in capsys.readouterr().err

@@ -34,6 +34,7 @@ _POWER = r"(?:\^|\*\*)\s*(?:[+-]?\d{1,2}|\(\s*[+-]?\d{1,2}\s*\))"
 _FACTOR = rf"{_NAME}(?:\s*{_POWER})?"
 _UNIT = rf"{_FACTOR}(?:\s*[*/·]\s*{_FACTOR}|\s+{_FACTOR})*"
 _QUANTITY = re.compile(rf"\s*(?P<number>{_NUMBER})\s*(?P<unit>{_UNIT})?\s*")
+_UNIT_TEXT = re.compile(rf"\s*{_UNIT}\s*")
 _GRAMMAR = "a number and a unit, e.g. '60 mm', '1.3 N*m' or '2.21e-5 kg*m^2'"
 
 
@@ -304,15 +305,29 @@ def _converted(number: float, text: str, unit: str, angle_explicit: bool) -> flo
 
 
 @functools.lru_cache(maxsize=1024)  # a catalogue gives 100 numbers in a dozen units
+def check_unit(text: str) -> str:
+    """``text`` if it is a unit of the bounded grammar (names, small integer powers, products and quotients).
+
+    A unit given on a command line or in a file header is checked so before pint evaluates it: pint evaluates
+    powers as arithmetic, and ``'9**9**9 s'`` would not finish. Raises :class:`QuantityError` otherwise.
+    """
+    if len(text) > MAX_QUANTITY_LENGTH or _UNIT_TEXT.fullmatch(text) is None:
+        raise QuantityError(
+            "syntax", "not a unit: names with powers of at most two digits, e.g. 'ms', 'N*m', 'kg*m^2'"
+        )
+    return text
+
+
 def _factor(text: str, unit: str, angle_explicit: bool) -> float | None:
     """The factor from the unit ``text`` to ``unit``, once its dimension is checked (None for an offset unit)."""
     pint = import_pint()
     registry = unit_registry()
     try:
         given = registry.Quantity(1.0, text.replace("^", "**"))
-    except (pint.PintError, AttributeError, ValueError, TypeError, SyntaxError):
+        target = registry.Quantity(1.0, (check_unit(unit) if unit.strip() else unit).replace("^", "**"))
+    except (pint.PintError, AttributeError, ValueError, TypeError, SyntaxError, KeyError):
+        # KeyError: pint's own, for a unit to the power 0 ('m**0')
         raise QuantityError("unit", f"an unknown unit; expected {_GRAMMAR}") from None
-    target = registry.Quantity(1.0, unit)
     if given.dimensionality != target.dimensionality:
         raise QuantityError(
             "dimension",
@@ -327,7 +342,13 @@ def _factor(text: str, unit: str, angle_explicit: bool) -> float | None:
     try:
         zero = registry.Quantity(0.0, text.replace("^", "**")).to(unit).magnitude
         factor = float(given.to(unit).magnitude)
-    except (pint.PintError, OverflowError, ValueError, TypeError):  # offset units (degC) in a product, ...
+    except (
+        pint.PintError,
+        OverflowError,
+        ValueError,
+        TypeError,
+        KeyError,
+    ):  # offset units (degC) in a product
         raise QuantityError("unit", f"a unit that cannot be converted to {unit}") from None
     return factor if zero == 0 else None
 

@@ -3,13 +3,17 @@
 from __future__ import annotations
 
 import argparse
+import errno
 import math
+import os
 import re
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from .._io import atomic_open
+from .._units import QuantityError, check_unit, parse_quantity
 from ..errors import CollisionReflexError
 from ..experiments import analyse_files
 from ..plots.impulse_velocity import plot_impulse_velocity
@@ -44,8 +48,20 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     options.BANDWIDTH.add(parser, note="Butterworth", shown="unfiltered")
     options.APPROACH_VELOCITY.add(parser, note="for trials whose file does not give one")
     add("--system", default=None, metavar="NAME", help="system name for trials whose file gives none")
-    add("--time-unit", default="s", metavar="UNIT", help="unit of a time column without one (default s)")
-    add("--force-unit", default="N", metavar="UNIT", help="unit of a force column without one (default N)")
+    add(
+        "--time-unit",
+        default="s",
+        type=_unit_of("s"),
+        metavar="UNIT",
+        help="unit of a time column without one (default s)",
+    )
+    add(
+        "--force-unit",
+        default="N",
+        type=_unit_of("N"),
+        metavar="UNIT",
+        help="unit of a force column without one (default N)",
+    )
     options.NOISE_SIGMAS.add(parser, 5.0)
     add(
         "--reaction",
@@ -59,8 +75,25 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.set_defaults(run=run)
 
 
+def _unit_of(si_unit: str) -> Callable[[str], str]:
+    """An argparse type: a unit of ``si_unit``'s kind (bounded grammar, dimension checked), or a usage error."""
+
+    def unit(text: str) -> str:
+        try:
+            parse_quantity(f"1 {check_unit(text)}", si_unit)
+        except QuantityError as error:
+            raise argparse.ArgumentTypeError(
+                f"{text!r:.60} is not a unit of {si_unit}'s kind: {error.reason}"
+            ) from None
+        return text
+
+    return unit
+
+
 def run(args: argparse.Namespace) -> int:
     """Run ``crx fit`` with parsed ``args``; return the exit status."""
+    if args.out is not None:  # before the analysis: a bad folder loses nothing
+        _output_folder(Path(args.out))
     results = analyse_files(
         args.traces,
         time_unit=args.time_unit,
@@ -136,6 +169,20 @@ def _print_summary(results: ExperimentResults) -> None:
             )
         else:
             print(f"  {system or '(no system)'}: {problems[system]}")
+
+
+def _output_folder(out: Path) -> None:
+    """Make ``out`` (and its parents), or say in one line why it cannot be written to."""
+    if out.exists() and not out.is_dir():
+        raise CollisionReflexError(
+            f"cannot write to {out}: it is a file, not a folder; give a folder for --out"
+        )
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        if not os.access(out, os.W_OK | os.X_OK):
+            raise PermissionError(errno.EACCES, "permission denied")
+    except OSError as error:
+        raise CollisionReflexError(f"cannot write to {out}: {error.strerror or error}") from None
 
 
 def _write_outputs(out: Path, results: ExperimentResults, figures: bool) -> None:
