@@ -67,3 +67,21 @@ def test_a_run_record_nested_too_deeply_is_damaged_not_a_traceback(smoke_runs, t
     }
     line = _error([command, str(run), *extra[command]], capsys)
     assert "nested too deeply" in line and "run the study again" in line
+
+
+@pytest.mark.parametrize("constant", ["NaN", "Infinity", "-Infinity"])
+def test_a_nan_anywhere_in_a_run_record_is_damage_located_not_a_number(
+    smoke_runs, tmp_path, capsys, constant
+):
+    """The package never writes NaN (``allow_nan=False``): one in designs.json, even in a field the record's
+    types leave open (the resolved study's objective weight here), is refused with its field, never reported as
+    "worst-case impulse nan N·s"."""
+    run = tmp_path / "run"
+    shutil.copytree(smoke_runs["two_link_paper"], run)
+    text = (run / "designs.json").read_text()
+    field = '"worst_case_impulse": '
+    start = text.index(field) + len(field)
+    end = min(text.index(c, start) for c in ",\n}")
+    (run / "designs.json").write_text(text[:start] + constant + text[end:])
+    line = _error(["report", str(run)], capsys)
+    assert "'resolved.objective.worst_case_impulse'" in line and "expected a finite number" in line

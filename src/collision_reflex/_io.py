@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import json
 import os
 import stat
 import tempfile
@@ -34,6 +35,15 @@ def read_limited(path: str | os.PathLike[str], limit: int = INPUT_LIMIT) -> byte
     if len(data) > limit:
         raise OSError(errno.EFBIG, f"larger than {limit / 2**20:g} MiB", str(target))
     return data
+
+
+def read_json(path: str | os.PathLike[str]) -> Any:
+    """A JSON file (UTF-8), bounded as :func:`read_limited`.
+
+    NaN and infinities are read as floats: the package writes none (``allow_nan=False``), and the record
+    checks (:mod:`collision_reflex.record.checked`) refuse one where it is found, naming its field.
+    """
+    return json.loads(read_limited(path).decode("utf-8"))
 
 
 TEMPORARY_PREFIX = ".tmp-"

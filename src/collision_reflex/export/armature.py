@@ -16,8 +16,8 @@ import os
 from pathlib import Path
 from typing import Any
 
+from .._io import read_json
 from ..errors import InvalidParameter
-from ..report.files import read_json
 from .run_design import RunDesign
 
 SUFFIX = ".armature.json"

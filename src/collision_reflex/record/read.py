@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import functools
 import json
+import math
 import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from .._io import read_limited
+from .._io import read_json
 from ..errors import InvalidParameter
 from ..vocabulary import DESIGN_CHOICES
 from .checked import ResultsDamaged, ResultsMissing
@@ -51,7 +52,7 @@ def read_saved_record(path: str | os.PathLike[str]) -> dict[str, Any]:
             f"{path.parent} has no {path.name}: run the study first (crx run STUDY --out {path.parent})"
         )
     try:
-        data = json.loads(read_limited(path).decode("utf-8"))
+        data = read_json(path)
     except (OSError, ValueError, RecursionError) as error:  # RecursionError: nesting too deep to parse
         reason = (
             "nested too deeply" if isinstance(error, RecursionError) else getattr(error, "strerror", None)
@@ -87,6 +88,25 @@ def record_problem(data: dict[str, Any]) -> str | None:
         _adapter(str(data.get("kind"))).validate_python(data)
     except ValidationError as error:
         return _problem(error.errors()[0])
+    return _non_finite(data)
+
+
+def _non_finite(data: Any) -> str | None:
+    """The first NaN or infinity anywhere in ``data`` (the fields the types leave open too), in words, or None.
+
+    A run writes none (``allow_nan=False``); walked without recursion, however deep the record.
+    """
+    stack: list[tuple[list[Any], Any]] = [([], data)]
+    while stack:
+        loc, value = stack.pop()
+        if isinstance(value, float) and not math.isfinite(value):
+            return (
+                f"field {_dotted(loc)!r} holds a value of the wrong kind ({value}, expected a finite number)"
+            )
+        if isinstance(value, dict):
+            stack.extend(([*loc, key], item) for key, item in reversed(value.items()))
+        elif isinstance(value, list):
+            stack.extend(([*loc, i], item) for i, item in reversed(list(enumerate(value))))
     return None
 
 

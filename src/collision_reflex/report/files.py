@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import json
 import os
-from pathlib import Path
-from typing import Any
 
 from .._io import atomic_open
 
@@ -26,8 +24,3 @@ def write_text(path: str | os.PathLike[str], text: str) -> None:
     """Write ``text`` as UTF-8, atomically."""
     with atomic_open(path, "w", encoding="utf-8") as handle:
         handle.write(text)
-
-
-def read_json(path: str | os.PathLike[str]) -> Any:
-    """Read a JSON file (UTF-8)."""
-    return json.loads(Path(path).read_text(encoding="utf-8"))

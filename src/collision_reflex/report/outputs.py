@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from .._interrupt import interruptible
-from .._io import atomic_open
+from .._io import atomic_open, read_json
 from ..errors import CollisionReflexError
 from ..record.checked import ResultsDamaged
 from ..record.read import read_run_record
@@ -30,7 +30,6 @@ from .files import (
     PARETO,
     REPORT,
     TIMINGS,
-    read_json,
     write_json,
     write_text,
 )

@@ -19,9 +19,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .._io import remove_temporary_files
+from .._io import read_json, remove_temporary_files
 from ..errors import CollisionReflexError
-from ..report.files import DESIGNS, PARETO, REPORT, read_json, write_json, write_text
+from ..report.files import DESIGNS, PARETO, REPORT, write_json, write_text
 
 MANIFEST = "run.json"
 RESOLVED = "study.resolved.yaml"
