@@ -463,3 +463,22 @@ def test_an_error_a_ctrl_c_caused_ends_crx_as_interrupted(monkeypatch, capsys):
     monkeypatch.setattr(run_command, "run", cut_short)
     assert main(["run", str(TWO_LINK)]) == 130
     assert capsys.readouterr().err.strip() == "crx run: interrupted; rerun the same command to resume"
+
+
+def test_a_killed_writer_s_temporary_file_goes_at_once_a_live_one_s_stays(tmp_path):
+    """A run killed (kill -9) while it wrote a point leaves ``.tmp-*``; resumed at once, it must go: its writer's
+    process id (in the name) is gone. A live process's (this one's) stays until it is old."""
+    import subprocess
+
+    from collision_reflex._io import TEMPORARY_PREFIX, atomic_path, remove_temporary_files
+
+    finished = subprocess.Popen(["true"])
+    finished.wait()
+    dead = tmp_path / f"{TEMPORARY_PREFIX}point-003.{finished.pid}.k1l2m3n4.json"
+    live = tmp_path / f"{TEMPORARY_PREFIX}point-004.{os.getpid()}.k1l2m3n4.json"
+    for path in (dead, live):
+        path.write_text("{")
+    assert remove_temporary_files(tmp_path) == [dead]
+    assert live.exists() and not dead.exists()
+    with atomic_path(tmp_path / "point-005.json") as written:  # the writer's own id is in the name
+        assert f".{os.getpid()}." in written.name

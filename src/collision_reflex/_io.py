@@ -6,6 +6,7 @@ import contextlib
 import errno
 import json
 import os
+import re
 import stat
 import tempfile
 import time
@@ -60,8 +61,8 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     """
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp_name = tempfile.mkstemp(
-        prefix=f"{TEMPORARY_PREFIX}{target.stem}.", suffix=target.suffix, dir=target.parent
+    fd, tmp_name = tempfile.mkstemp(  # the writer's process id in the name: a dead writer's is removable
+        prefix=f"{TEMPORARY_PREFIX}{target.stem}.{os.getpid()}.", suffix=target.suffix, dir=target.parent
     )
     tmp = Path(tmp_name)
     try:
@@ -87,16 +88,35 @@ def atomic_open(path: str | os.PathLike[str], mode: str = "w", **kwargs: Any) ->
 def remove_temporary_files(folder: str | os.PathLike[str], older_than: float = 60.0) -> list[Path]:
     """Remove the temporary files a killed writer left in ``folder`` (not below it); returns them.
 
-    Only files untouched for ``older_than`` [s] go: a younger one may be another process's write in progress.
+    A file whose writer (the process id in its name) is gone goes at once; any other only once untouched for
+    ``older_than`` [s]: a younger one may be another process's write in progress.
     """
     removed = []
     now = time.time()
     for stale in Path(folder).glob(f"{TEMPORARY_PREFIX}*"):
         with contextlib.suppress(FileNotFoundError):
-            if stale.is_file() and now - stale.stat().st_mtime >= older_than:
+            if stale.is_file() and (_writer_gone(stale) or now - stale.stat().st_mtime >= older_than):
                 stale.unlink()
                 removed.append(stale)
     return removed
+
+
+_WRITER = re.compile(r"\.(\d+)\.[A-Za-z0-9_]+(?:\.[^.]*)?$")
+"""The writer's process id in a temporary file's name (:func:`atomic_path`), before mkstemp's random part."""
+
+
+def _writer_gone(path: Path) -> bool:
+    """Whether the process that wrote the temporary file ``path`` no longer runs (False when unknown)."""
+    match = _WRITER.search(path.name)
+    if match is None:
+        return False
+    try:
+        os.kill(int(match.group(1)), 0)  # signal 0: only asks whether the process exists
+    except ProcessLookupError:
+        return True
+    except (PermissionError, OverflowError, ValueError):  # another user's process, or not a process id
+        return False
+    return False
 
 
 def _umask() -> int:
