@@ -235,3 +235,40 @@ def test_moving_optimum_is_finite_or_refused(exponents: list[float]) -> None:
 def test_solve_refuses_wrong_types(small_problem: cr.DesignProblem, change: dict, name: str) -> None:
     with pytest.raises(InvalidParameter, match=rf"^{name} = "):
         cr.solve(small_problem, **change)
+
+
+@pytest.fixture(scope="module")
+def planar() -> Arm:
+    return Arm.from_urdf(Path(__file__).resolve().parents[1] / "designs" / "planar_two_link.urdf", "tip")
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda arm, s: arm.kinematics(np.array([[0.3 + 1j, 1.2]])),
+        lambda arm, s: cr.arm.effective_mass(s, np.array([[1.0 + 1j, 0.0]])),
+        lambda arm, s: cr.arm.effective_mass(s, [[1.0, 0.0]], reflected_inertia=[1e-3 + 1j, 1e-3]),
+        lambda arm, s: cr.arm.metrics.generalized_inertia_ellipsoid(s, reflected_inertia=[1e-3 + 1j, 1e-3]),
+        lambda arm, s: effective_parameters(
+            s,
+            [[1.0 + 1j, 0.0]],
+            reflected_inertia=1e-3,
+            stiffness=50.0,
+            mechanical_stiffness=50.0,
+            torque_limit=1.0,
+        ),
+        lambda arm, s: cr.model.current_threshold_torque(10.0 + 1j, 0.1),
+    ],
+    ids=[
+        "kinematics",
+        "effective_mass",
+        "effective_mass_inertia",
+        "inertia_ellipsoid",
+        "parameters",
+        "current",
+    ],
+)
+def test_complex_input_to_the_arm_functions_is_refused_not_cut_to_its_real_part(planar, call) -> None:
+    """NumPy would drop the imaginary part (with a ComplexWarning) and compute on; the edge refuses it instead."""
+    with pytest.raises(InvalidParameter, match="complex"):
+        call(planar, planar.kinematics([[0.3, 1.2]]))

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from .. import _validate
 from ..errors import InvalidParameter
 from .kinematic_tree import JointKinematics
 
@@ -115,7 +116,7 @@ class ConfigurationSpace:
 
     def checked(self, q: npt.ArrayLike) -> np.ndarray:
         """Configurations ``q`` as a finite (n, nq) array [rad, m]; a single (nq,) one becomes (1, nq)."""
-        q = np.atleast_2d(np.asarray(q, dtype=float))
+        q = np.atleast_2d(_validate.real("q", q, "real joint coordinates [rad, m]"))
         if q.ndim != 2 or q.shape[1] != self.nq:
             raise InvalidParameter("q", q.shape, f"configurations of shape (n, {self.nq})")
         if not np.all(np.isfinite(q)):

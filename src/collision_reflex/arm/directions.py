@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import _validate
 from ..errors import InvalidParameter
 
 NAMED_DIRECTIONS: dict[str, tuple[float, float, float]] = {
@@ -87,7 +88,7 @@ def unit_directions(spec: Any, task_dim: int, plane: np.ndarray | None = None) -
 
 def normalised_directions(directions: Any, task_dim: int) -> np.ndarray:
     """Direction vectors (d, task_dim) checked (non-zero, finite) and scaled to unit length."""
-    units = np.atleast_2d(np.asarray(directions, dtype=float))
+    units = np.atleast_2d(_validate.real("directions", directions, "real direction vectors"))
     if units.ndim != 2 or units.shape[1] != task_dim:
         raise InvalidParameter("directions", units.shape, f"unit vectors of shape (d, {task_dim})")
     norms = np.linalg.norm(units, axis=1)

@@ -89,7 +89,7 @@ def joint_array(
 ) -> np.ndarray:
     """``value`` as one float per joint, (nv,), checked: a scalar is broadcast; NaN (unknown) is refused."""
     hint = "the URDF gives none for some joint; pass actuators= to the Arm or give the values explicitly"
-    array = np.asarray(value, dtype=float)
+    array = _validate.real(name, value, f"real numbers, one value or {nv}, one per joint")
     if array.ndim > 1 or array.size not in (1, nv):
         raise InvalidParameter(name, array, f"one value or {nv} values, one per joint")
     if np.any(np.isnan(array)):

@@ -57,4 +57,7 @@ def current_threshold_torque(gear_ratio: Any, motor_torque: Any, friction_torque
     motor_torque: motor-side threshold torque ``tau_s`` [N m] (current times torque constant).
     friction_torque: joint-side friction the motor overcomes before the contact loads it [N m].
     """
+    gear_ratio = _validate.positive("gear_ratio", gear_ratio)
+    motor_torque = _validate.positive("motor_torque", motor_torque)
+    friction_torque = _validate.non_negative("friction_torque", friction_torque)
     return gear_ratio * motor_torque + friction_torque
