@@ -102,10 +102,11 @@ def test_wide_range_calls_are_finite_or_refused(exponents: list[float], reaction
     try:
         got = cr.total_impulse(m_f, k, k_m, F_s, a, v0, reaction, v_r_arg)
     except InvalidParameter:
-        # Refused only where the total, or a phase of it, lies beyond float64.
-        assert reference > Decimal(FLOAT_MAX) / 3
+        # Refused only where the total, or a phase of it, lies beyond float64, or the total underflows (below
+        # the smallest subnormal, 4.9e-324: it would round to a silent 0).
+        assert reference > Decimal(FLOAT_MAX) / 3 or reference < Decimal(5e-324)
         return
-    assert math.isfinite(got)
+    assert math.isfinite(got) and got > 0
     if reference > Decimal("1e-290"):  # well above the subnormals, where rounding is relative
         assert got == pytest.approx(float(reference), rel=LOG_PATH_RTOL)
 
@@ -272,3 +273,10 @@ def test_complex_input_to_the_arm_functions_is_refused_not_cut_to_its_real_part(
     """NumPy would drop the imaginary part (with a ComplexWarning) and compute on; the edge refuses it instead."""
     with pytest.raises(InvalidParameter, match="complex"):
         call(planar, planar.kinematics([[0.3, 1.2]]))
+
+
+def test_a_total_that_underflows_is_refused_not_a_silent_zero() -> None:
+    """m_f v0 = 1e-600 and the other phases smaller still: the impulse is positive but below 5e-324."""
+    with pytest.raises(InvalidParameter, match="underflows to 0"):
+        cr.total_impulse(1e-300, 1e300, 1e300, 1e-300, 1e300, 1e-300)
+    assert cr.total_impulse(1e-160, 1e150, 1e150, 1e-160, 1e150, 1e-160) > 0  # 1e-320, a subnormal: kept

@@ -18,7 +18,8 @@ Supported range of numeric inputs: any finite positive number (integers and inte
 float64 first; strings, booleans and complex numbers are refused with :class:`InvalidParameter`). A result is
 computed without intermediate overflow or underflow wherever it is representable: where the direct formula
 overflows, it is evaluated from logarithms instead. A result beyond the float64 range (about ``1.8e308``)
-raises :class:`InvalidParameter`; one below the smallest float64 (about ``5e-324``) is 0. None is ever NaN.
+raises :class:`InvalidParameter`, and so does a total, a time or a minimum impulse that underflows below the
+smallest float64 (about ``5e-324``): never a silent 0 for a quantity that is positive. None is ever NaN.
 """
 
 from __future__ import annotations
@@ -378,9 +379,23 @@ def _representable(
 
 
 def _finite(what: str, value: Any) -> Any:
-    """``value`` if it is symbolic or finite; else :class:`InvalidParameter` (a sum beyond the float64 range)."""
-    if not is_symbolic(value) and not np.all(np.isfinite(value)):
+    """``value`` (positive by construction) if it is symbolic or a positive finite number.
+
+    Else :class:`InvalidParameter`: a sum beyond the float64 range, or one that underflowed to 0 (never
+    returned as a silent 0 for a quantity that cannot be 0).
+    """
+    if is_symbolic(value):
+        return value
+    if not np.all(np.isfinite(value)):
         raise InvalidParameter(what, value, "a result within the float64 range (below 1.8e308)")
+    if np.any(np.asarray(value) == 0):
+        raise InvalidParameter(
+            what,
+            value,
+            "a result within the float64 range (above 5e-324)",
+            "it underflows to 0 though it is positive: the inputs are at the edge of the float64 range; rescale "
+            "them (other units)",
+        )
     return value
 
 
