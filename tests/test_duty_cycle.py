@@ -268,3 +268,14 @@ def test_generated_motion_bad_input(options, name):
 def test_payload_bad_input(mass, inertia):
     with pytest.raises(InvalidParameter):
         Payload(mass) if inertia is None else Payload(mass, inertia)
+
+
+@pytest.mark.parametrize(
+    "header", ["time [s],j1 [deg],j1 [deg],j2 [deg]", "time [s],j1 [deg],j1 [rad],j2 [deg]"]
+)
+def test_a_header_naming_a_joint_twice_is_located(tmp_path, header) -> None:
+    """Pandas renamed the repeated column, which then matched no header pattern: an AttributeError before."""
+    path = tmp_path / "cycle.csv"
+    path.write_text(header + "\n" + "".join(f"{t * 0.1},{t},{t},{t}\n" for t in range(20)))
+    with pytest.raises(TrajectoryError, match=r"line 1: the header names the column 'j1.*' twice"):
+        DutyCycle.from_csv(path, ["j1", "j2"])

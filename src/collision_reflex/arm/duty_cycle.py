@@ -219,7 +219,18 @@ class DutyCycle:
         """
         source = str(path)
         header_line, table = _read_table(path)
-        columns = {HEADER.match(str(c)).group("name"): str(c) for c in table.columns}  # type: ignore[union-attr]
+        columns: dict[str, str] = {}
+        for column in map(str, table.columns):
+            match = HEADER.match(column)
+            name = match.group("name") if match else None
+            if name is None or name in columns:  # pandas renames a repeated 'j1 [deg]' to 'j1 [deg].1'
+                shown = name or column.rsplit(".", 1)[0]
+                raise TrajectoryError(
+                    source,
+                    f"the header names the column {shown[:60]!r} twice; name each column once",
+                    header_line,
+                )
+            columns[name] = column
         lowered = {name.lower(): column for name, column in columns.items()}
         time_column = next((lowered[n] for n in TIME_COLUMN_NAMES if n in lowered), None)
         if time_column is None:
