@@ -280,3 +280,33 @@ def test_a_total_that_underflows_is_refused_not_a_silent_zero() -> None:
     with pytest.raises(InvalidParameter, match="underflows to 0"):
         cr.total_impulse(1e-300, 1e300, 1e300, 1e-300, 1e300, 1e-300)
     assert cr.total_impulse(1e-160, 1e150, 1e150, 1e-160, 1e150, 1e-160) > 0  # 1e-320, a subnormal: kept
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: cr.arm.Payload("x"),
+        lambda: cr.arm.Payload(1 + 1j),
+        lambda: cr.arm.Payload(1.0, "x"),
+        lambda: cr.arm.circle_directions(1e300),
+        lambda: cr.arm.sphere_directions(float("inf")),
+        lambda: cr.arm.circle_directions(True),
+        lambda: cr.arm.sphere_directions(1 + 1j),
+        lambda: cr.model.threshold_force("position", float("nan"), 1.0),
+        lambda: cr.model.threshold_force("position", 1.0, "x"),
+        lambda: cr.model.threshold_force("force", "x", 1.0),
+        lambda: cr.simulate.contact_restitution([1.0, 2.0]),
+        lambda: cr.simulate.contact_damping_for_restitution(0.5, [1.0, 2.0], 1e4),
+        lambda: cr.simulate.contact_damping_for_restitution("0.5", 1.0, 1e4),
+    ],
+)
+def test_bad_input_at_the_api_s_edges_is_invalid_parameter_not_a_traceback(call) -> None:
+    """Each of these was a TypeError, ValueError or OverflowError from inside, or a NaN passed on."""
+    with pytest.raises(InvalidParameter):
+        call()
+
+
+def test_a_very_damped_contact_takes_the_asymptotic_restitution() -> None:
+    """Above a damping ratio of 1e4 the restitution is 1/(4 zeta^2) (within 1e-7 there); 1e300 overflowed."""
+    assert cr.simulate.contact_restitution(2e4) == pytest.approx(1 / (4 * 4e8), rel=1e-12)
+    assert cr.simulate.contact_restitution(1e300) == 0.0

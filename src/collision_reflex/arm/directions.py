@@ -6,6 +6,7 @@ Directions are world-aligned. For a planar arm they are given in the arm's plane
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import Any
 
@@ -123,7 +124,15 @@ def _vector(item: Any, task_dim: int, plane: np.ndarray | None) -> np.ndarray:
     return vector / np.linalg.norm(vector)
 
 
+MAX_DIRECTIONS = 1_000_000
+"""Most directions a set may hold: far beyond any study's, and a bound on the memory a count can ask for."""
+
+
 def _count(count: Any) -> int:
-    if int(count) != count or count < 1:
-        raise InvalidParameter("count", count, "an integer >= 1")
+    """``count`` as an int, if it is a whole number from 1 to :data:`MAX_DIRECTIONS` (not a bool)."""
+    allowed = f"a whole number from 1 to {MAX_DIRECTIONS:,}"
+    if isinstance(count, bool | np.bool_) or not isinstance(count, int | np.integer | float | np.floating):
+        raise InvalidParameter("count", count, allowed)
+    if not (math.isfinite(count) and int(count) == count and 1 <= count <= MAX_DIRECTIONS):
+        raise InvalidParameter("count", count, allowed)
     return int(count)

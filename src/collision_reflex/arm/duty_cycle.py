@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import _validate
 from .._io import read_limited
 from .._table import HEADER, TableProblem, read_table
 from ..errors import InvalidParameter, TraceError, TrajectoryError
@@ -58,10 +59,10 @@ class Payload:
     inertia: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
 
     def __post_init__(self) -> None:
-        mass = float(self.mass)
-        if not (np.isfinite(mass) and mass > 0):
+        mass = _validate.positive("mass", self.mass)
+        if np.ndim(mass) != 0:
             raise InvalidParameter("mass", self.mass, "a finite payload mass > 0 [kg]")
-        inertia = np.asarray(self.inertia, dtype=float)
+        inertia = _validate.real("inertia", self.inertia, "a finite 3x3 matrix [kg m^2]")
         if inertia.shape != (3, 3) or not np.all(np.isfinite(inertia)):
             raise InvalidParameter("inertia", self.inertia, "a finite 3x3 matrix [kg m^2]")
         scale = max(float(np.max(np.abs(inertia))), 1e-300)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -16,12 +17,13 @@ def contact_restitution(damping_ratio: float) -> float:
     ``damping_ratio = c / (2 sqrt(k m))`` (dimensionless). The contact ends when ``k x + c xdot`` returns to
     zero, which for an undamped contact is at ``x = 0`` (restitution 1) and for a damped one while the surface
     is still indented; the restitution falls to ``exp(-2) = 0.135`` at critical damping and to 0 as
-    ``1/(4 zeta^2)``.
+    ``1/(4 zeta^2)``, which it is taken as above ``zeta = 1e4`` (within 1e-7; it underflows to 0 above 1e154).
     """
-    _validate.non_negative("damping_ratio", damping_ratio)
-    zeta = float(damping_ratio)
+    zeta = _scalar("damping_ratio", _validate.non_negative("damping_ratio", damping_ratio))
     if zeta == 0:
         return 1.0
+    if zeta > 1e4:
+        return 1 / (4 * zeta * zeta)
     # Unit mass, unit stiffness, unit impact velocity: x(t) = (e^{s1 t} - e^{s2 t}) / (s1 - s2).
     root = np.sqrt(complex(zeta**2 - 1))
     s1, s2 = -zeta + root, -zeta - root
@@ -55,8 +57,10 @@ def contact_damping_for_restitution(restitution: float, m_f: float, contact_stif
     m_f: finger mass [kg].
     contact_stiffness: contact stiffness [N/m], finite.
     """
-    _validate.positive("m_f", m_f)
-    _validate.positive("contact_stiffness", contact_stiffness)
+    m_f = _scalar("m_f", _validate.positive("m_f", m_f))
+    contact_stiffness = _scalar(
+        "contact_stiffness", _validate.positive("contact_stiffness", contact_stiffness)
+    )
     return damping_from_ratio(damping_ratio_for_restitution(restitution), m_f, contact_stiffness)
 
 
@@ -65,6 +69,7 @@ def damping_ratio_for_restitution(restitution: float) -> float:
 
     The inverse of :func:`contact_restitution`, found by bracketing.
     """
+    restitution = _scalar("restitution", _validate.real("restitution", restitution, "a number in (0, 1]"))
     if not 0 < restitution <= 1:
         raise InvalidParameter(
             "restitution", restitution, "a number in (0, 1]", "a perfectly plastic contact is a rigid wall"
@@ -89,3 +94,10 @@ def damping_from_ratio(damping_ratio: float, mass: float, stiffness: float) -> f
     Here ``mass`` [kg] is on a spring of ``stiffness`` [N/m].
     """
     return 2 * damping_ratio * math.sqrt(stiffness * mass)
+
+
+def _scalar(name: str, value: Any) -> float:
+    """``value`` (already checked to be real) as one float, or :class:`InvalidParameter` for an array."""
+    if np.ndim(value) != 0:
+        raise InvalidParameter(name, value, "one number, not an array")
+    return float(value)
