@@ -85,3 +85,28 @@ def test_a_nan_anywhere_in_a_run_record_is_damage_located_not_a_number(
     (run / "designs.json").write_text(text[:start] + constant + text[end:])
     line = _error(["report", str(run)], capsys)
     assert "'resolved.objective.worst_case_impulse'" in line and "expected a finite number" in line
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "words"),
+    [
+        ("peak_torque", -5.0, "a number above 0"),
+        ("motor_mass", 0.0, "a number above 0"),
+        ("gearbox_efficiency", 1.5, "a number of at most 1"),
+        ("rotor_inertia", -1e-6, "a number of at least 0"),
+    ],
+)
+def test_a_tampered_design_is_refused_by_its_physical_range(
+    smoke_runs, tmp_path, capsys, field, value, words
+):
+    """designs.json is input like a study: a negative torque, a massless motor or an efficiency above 1 is not
+    exported as if valid."""
+    import json
+
+    run = tmp_path / "run"
+    shutil.copytree(smoke_runs["two_link_paper"], run)
+    data = json.loads((run / "designs.json").read_text())
+    data["recommended"]["joints"][0][field] = value
+    (run / "designs.json").write_text(json.dumps(data))
+    line = _error(["export", str(run), "--format", "urdf", "--out", str(tmp_path / "x.urdf")], capsys)
+    assert f"'recommended.joints[0].{field}'" in line and words in line

@@ -6,9 +6,18 @@ Python 3.12) decorated with :func:`checked`: no key missing or unknown, no conve
 
 from __future__ import annotations
 
-from typing import TypeVar
+from typing import Annotated, TypeVar
+
+from annotated_types import Ge, Gt, Le
 
 from ..errors import CollisionReflexError
+
+Positive = Annotated[float, Gt(0)]
+"""A physical quantity that is above zero in every record a run writes (a mass of a motor, a gear ratio)."""
+NonNegative = Annotated[float, Ge(0)]
+"""A physical quantity a run writes as zero or more (a gearbox's mass, a required torque)."""
+Efficiency = Annotated[float, Gt(0), Le(1)]
+"""A gearbox efficiency, in (0, 1]."""
 
 STRICT = {"extra": "forbid", "strict": True, "allow_inf_nan": False}
 """How a saved record is checked: no unknown key, no conversion (a number is a number, not text), finite numbers."""

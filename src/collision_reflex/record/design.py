@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from typing_extensions import NotRequired, TypedDict
 
-from .checked import checked
+from .checked import Efficiency, NonNegative, Positive, checked
 
 
 @checked
@@ -66,24 +66,24 @@ class SolvedJoint(TypedDict):
     """
 
     joint: str
-    stator_diameter: float
-    stack_length: float
-    gear_ratio: float
-    rotor_inertia: float
-    reflected_inertia: float
-    motor_peak_torque: float
-    peak_torque: float
-    required_torque: float
+    stator_diameter: Positive
+    stack_length: Positive
+    gear_ratio: Positive
+    rotor_inertia: NonNegative
+    reflected_inertia: NonNegative
+    motor_peak_torque: Positive
+    peak_torque: Positive
+    required_torque: NonNegative
     torque_margin: float | None
-    mechanical_stiffness: float
-    software_stiffness: float
-    stiffness: float
-    motor_mass: float
+    mechanical_stiffness: Positive
+    software_stiffness: Positive
+    stiffness: Positive
+    motor_mass: Positive
     gearbox: str
-    gearbox_mass: float
-    gearbox_inertia: float
-    gearbox_efficiency: float
-    actuator_mass: float
+    gearbox_mass: NonNegative
+    gearbox_inertia: NonNegative
+    gearbox_efficiency: Efficiency
+    actuator_mass: NonNegative
     required_rms_torque: float | None
     rms_margin: float | None
     max_motor_speed: float | None

@@ -131,6 +131,13 @@ _EXPECTED = {
 }
 """What a field of each pydantic error type should hold, in words."""
 
+_BOUNDS = {
+    "greater_than": "a number above {:g}",
+    "greater_than_equal": "a number of at least {:g}",
+    "less_than_equal": "a number of at most {:g}",
+}
+"""A physical range a field holds (:mod:`.checked`), in words, with its bound."""
+
 
 def _problem(error: Any) -> str:
     """One pydantic error as a sentence naming the field: ``field 'gear_ratio' is missing: recommended.joints[0] has fields ...``."""
@@ -144,6 +151,9 @@ def _problem(error: Any) -> str:
         return f"field {key!r} of {where} is not one a run writes"
     value = json.dumps(error["input"]) if _plain(error["input"]) else type(error["input"]).__name__
     expected = _EXPECTED.get(error["type"], error["msg"][0].lower() + error["msg"][1:])
+    bound = _BOUNDS.get(error["type"])
+    if bound is not None:  # a physical range: say it as a range
+        expected = bound.format(*(error.get("ctx") or {}).values())
     if error["type"] == "float_type":
         expected = "a finite number"  # text such as "NaN" is not a number either
     return f"field {_dotted(loc)!r} holds a value of the wrong kind ({value[:40]}, expected {expected})"
