@@ -481,3 +481,39 @@ def test_the_quantity_grammar_refuses_the_rest(text, kind):
     with pytest.raises(QuantityError) as caught:
         parse_quantity(text, "m")
     assert caught.value.kind == kind
+
+
+# --- joint limits ------------------------------------------------------------------------------------------
+
+
+PANDA = (ROOT / "studies" / "panda.yaml").read_text().replace("fresh: 57344", "fresh: 0")
+PANDA_RANDOM = "configurations: {random: {count: 48, seed: 11}}"
+
+
+def test_a_listed_configuration_outside_the_joint_limits_is_refused_at_its_line():
+    """The Panda's joint 4 is limited to [-176 deg, -4 deg] (its URDF): +90 deg was accepted before."""
+    text = _replaced(
+        PANDA_RANDOM,
+        "configurations: {list: [[0 deg, 0 deg, 0 deg, -90 deg, 0 deg, 90 deg, 0 deg],"
+        " [0 deg, 0 deg, 0 deg, 90 deg, 0 deg, 90 deg, 0 deg]]}",
+        PANDA,
+    )
+    with pytest.raises(StudyFileError) as caught:
+        describe_study(parse_study(text, "panda.yaml", ROOT / "studies"))
+    (problem,) = caught.value.problems
+    assert problem.path == "samples.configurations.list[1]"
+    assert "panda_joint4 at 1.5708 rad, outside its limits" in problem.found and "-3.0718 to -0.0698" in str(
+        problem
+    )
+
+
+def test_a_trajectory_row_outside_the_joint_limits_is_refused_at_its_csv_line(tmp_path):
+    header = ",".join(f"panda_joint{i} [deg]" for i in range(1, 8))
+    rows = ["0,0,0,-90,0,90,0", "0,10,0,-80,0,90,0", "0,10,0,90,0,90,0"]
+    (tmp_path / "traj.csv").write_text("\n".join([header, *rows]) + "\n")
+    text = _replaced(PANDA_RANDOM, "configurations: {trajectory: {file: traj.csv}}", PANDA)
+    text = text.replace("studies/", "")
+    with pytest.raises(StudyFileError) as caught:
+        describe_study(parse_study(text, "panda.yaml", tmp_path))
+    problem = caught.value.problems[0]
+    assert problem.found.startswith("traj.csv:4: panda_joint4 at 1.5708 rad, outside its limits")

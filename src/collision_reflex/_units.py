@@ -324,7 +324,9 @@ def _factor(text: str, unit: str, angle_explicit: bool) -> float | None:
     registry = unit_registry()
     try:
         given = registry.Quantity(1.0, text.replace("^", "**"))
-        target = registry.Quantity(1.0, (check_unit(unit) if unit.strip() else unit).replace("^", "**"))
+        target = registry.Quantity(
+            1.0, unit
+        )  # the caller's unit: the package's own, or one check_unit passed
     except (pint.PintError, AttributeError, ValueError, TypeError, SyntaxError, KeyError):
         # KeyError: pint's own, for a unit to the power 0 ('m**0')
         raise QuantityError("unit", f"an unknown unit; expected {_GRAMMAR}") from None

@@ -35,7 +35,7 @@ import numpy as np
 
 from .._io import atomic_open, read_limited
 from .._table import HEADER, TableProblem, read_table
-from .._units import QuantityError, parse_quantity, si_scale
+from .._units import QuantityError, check_unit, parse_quantity, si_scale
 from ..errors import TraceError
 from ..vocabulary import TIME_COLUMN_NAMES
 
@@ -153,7 +153,7 @@ def to_si(
 def unit_factor(unit: str, default_unit: str, what: str, source: str = "") -> float:
     """The factor converting values in ``unit`` to SI; ``unit`` must have ``default_unit``'s dimension."""
     try:
-        return parse_quantity(f"1 {unit}", default_unit) * si_scale(default_unit)
+        return parse_quantity(f"1 {unit}", check_unit(default_unit)) * si_scale(default_unit)
     except QuantityError as error:
         raise TraceError(
             source,

@@ -111,7 +111,7 @@ def _from_file(loaded: LoadedStudy, arm: Arm, file: str, payload: Payload | None
     if not path.is_file():
         raise loaded.fail(where, f"{file!r} (no such file)", "a path relative to the study file's folder")
     try:
-        return DutyCycle.from_csv(path, arm.joint_names, payload, prismatic=prismatic_joints(arm))
+        cycle = DutyCycle.from_csv(path, arm.joint_names, payload, prismatic=prismatic_joints(arm))
     except TrajectoryError as error:
         located = f"{file}:{error.line}" if error.line is not None else file
         raise loaded.fail(
@@ -119,6 +119,16 @@ def _from_file(loaded: LoadedStudy, arm: Arm, file: str, payload: Payload | None
             f"{located}: {error.reason}",
             "a trajectory file: a time column and one position column per joint, units in the header",
         ) from None
+    lower, upper = position_limits(arm)
+    outside = np.argwhere((cycle.q < lower) | (cycle.q > upper))
+    if outside.size:
+        sample, j = map(int, outside[0])
+        raise loaded.fail(
+            where,
+            f"{file}: {arm.joint_names[j]} at {cycle.q[sample, j]:.6g} at t = {cycle.t[sample]:.6g} s",
+            f"positions within the joint limits [{lower[j]:.6g}, {upper[j]:.6g}] (rad or m)",
+        )
+    return cycle
 
 
 def _through_via_points(
@@ -127,7 +137,7 @@ def _through_via_points(
     joints = list(arm.joint_names)
     problems: list[StudyProblem] = []
     via = spec.via or []
-    lower, upper = _position_limits(arm)
+    lower, upper = position_limits(arm)
     for index, point in enumerate(via):
         if len(point) != len(joints):
             problems.append(
@@ -168,7 +178,7 @@ def _through_via_points(
         raise loaded.fail(_SECTION, str(error), "a motion through the via points") from None
 
 
-def _position_limits(arm: Arm) -> tuple[np.ndarray, np.ndarray]:
+def position_limits(arm: Arm) -> tuple[np.ndarray, np.ndarray]:
     """The URDF's position limits per joint [rad or m]; infinite where it gives none.
 
     As :meth:`~collision_reflex.arm.Arm.joint_limits` reads them, without its stand-in full turn for a revolute

@@ -18,7 +18,7 @@ from ..arm.directions import circle_directions, sphere_directions, unit_directio
 from ..arm.domain import ContactDomain, DomainTooSmall
 from ..arm.duty_cycle import joint_positions
 from ..errors import InvalidParameter, StudyFileError, StudyProblem, TrajectoryError
-from .duty import per_joint_values, prismatic_joints
+from .duty import per_joint_values, position_limits, prismatic_joints
 from .load import LoadedStudy
 from .sample_specs import ConfigurationSamples, DirectionSamples
 from .schema import ArmStudy
@@ -105,7 +105,12 @@ def configuration_samples(loaded: LoadedStudy, arm: Arm) -> np.ndarray:
     spec: ConfigurationSamples = study.samples.configurations
     assert spec.random is None, "random configurations are drawn in the domain (domain_draw)"
     if spec.list is not None:
-        return np.asarray(arm.configuration(np.asarray(spec.list, dtype=float)), dtype=float)
+        angles = np.asarray(spec.list, dtype=float)
+        outside = _outside_limits(arm, angles)
+        if outside is not None:
+            row, what, expected = outside
+            raise loaded.fail(("samples", "configurations", "list", row), what, expected)
+        return np.asarray(arm.configuration(angles), dtype=float)
     assert spec.trajectory is not None  # exactly one source is guaranteed by the schema
     return _trajectory(loaded, arm, spec.trajectory.file, spec.trajectory.every)
 
@@ -127,6 +132,26 @@ def sample_counts(loaded: LoadedStudy, arm: Arm) -> tuple[int, int]:
     counted = directions.circle if directions.circle is not None else directions.sphere
     n_directions = counted if counted is not None else direction_samples(loaded, arm).shape[0]
     return int(n_configurations), int(n_directions)
+
+
+def _outside_limits(arm: Arm, angles: np.ndarray) -> tuple[int, str, str] | None:
+    """The first row of joint coordinates (n, nv) outside the robot model's position limits: (row, what, expected).
+
+    None where every row is within them (a joint without limits, a continuous one, takes any position).
+    """
+    lower, upper = position_limits(arm)
+    outside = (angles < lower) | (angles > upper)
+    if not outside.any():
+        return None
+    row, joint = map(int, np.argwhere(outside)[0])
+    name = arm.joint_names[joint]
+    unit = " m" if name in prismatic_joints(arm) else " rad"
+    return (
+        row,
+        f"{name} at {angles[row, joint]:.6g}{unit}, outside its limits",
+        f"a configuration within the joint limits: {name} from {lower[joint]:.6g} to {upper[joint]:.6g}{unit} "
+        "(the robot model's)",
+    )
 
 
 _MAX_TRAJECTORY_SIZE = 64 << 20
@@ -165,6 +190,10 @@ def _trajectory(loaded: LoadedStudy, arm: Arm, file: str, every: int) -> np.ndar
         raise loaded.fail(
             where, f"{file}:{line}: a value that is not a finite number", "finite joint positions [rad]"
         )
+    outside = _outside_limits(arm, values)
+    if outside is not None:
+        row, what, expected = outside
+        raise loaded.fail(where, f"{file}:{header + 2 + row}: {what}", expected)
     values = values[::every]
     if values.size == 0:
         raise loaded.fail(where, f"{file}: no rows below the header", "finite joint positions [rad]")
