@@ -96,3 +96,21 @@ def test_step_below_float_spacing_is_explained() -> None:
     with pytest.raises(SimulationError, match="below the resolution of double precision") as error:
         cr.simulate.simulate(replace(BASE, v0=1e-15))
     assert "raise v0" in str(error.value)
+
+
+def test_the_paper_s_u8_soft_fit_runs_instead_of_being_refused() -> None:
+    """A stiff sensor (k_m = 2e7 N/m) against a rigid wall: the finger is held there through the reaction, so
+    its 28 us oscillation does not set the step; the ideal drive retreats from v0 k / k_m, not from v0. It was
+    refused at 1.5e8 estimated steps; the estimate is now about 600 and the run takes a few hundred."""
+    setup = cr.simulate.CollisionSetup(
+        m_f=0.1,
+        m_r=10.0,
+        k_m=2e7,
+        k_s=440.0,
+        F_a=4.7e-4,
+        v0=0.1,
+        detection=cr.simulate.Detection("force", 3.0),
+    )
+    assert budget.estimated_steps(setup) < setup.max_steps / 10
+    result = cr.simulate.simulate(setup)
+    assert result.contact_end is not None and result.impulse > 0
