@@ -279,3 +279,20 @@ def test_a_header_naming_a_joint_twice_is_located(tmp_path, header) -> None:
     path.write_text(header + "\n" + "".join(f"{t * 0.1},{t},{t},{t}\n" for t in range(20)))
     with pytest.raises(TrajectoryError, match=r"line 1: the header names the column 'j1.*' twice"):
         DutyCycle.from_csv(path, ["j1", "j2"])
+
+
+def test_a_cycle_with_absurd_joint_speeds_or_too_many_samples_is_refused() -> None:
+    """2.5e300 rad/s validated before (a wrong unit, never a motion); a million samples grew a run past 10 GB."""
+    from collision_reflex.arm.duty_cycle import MAX_CYCLE_SAMPLES, MAX_JOINT_SPEED
+
+    t = np.linspace(0.0, 1.0, 11)
+    q = np.zeros((11, 1))
+    qd = np.zeros((11, 1))
+    qd[5, 0] = 2.5e300
+    with pytest.raises(InvalidParameter, match="joint speeds of at most"):
+        DutyCycle(("j1",), t, q, qd, np.zeros((11, 1)))
+    qd[5, 0] = MAX_JOINT_SPEED  # at the bound: a (very fast) motion
+    DutyCycle(("j1",), t, q, qd, np.zeros((11, 1)))
+    n = MAX_CYCLE_SAMPLES + 1
+    with pytest.raises(InvalidParameter, match="resample the cycle"):
+        DutyCycle(("j1",), np.linspace(0.0, 1.0, n), np.zeros((n, 1)), np.zeros((n, 1)), np.zeros((n, 1)))

@@ -74,6 +74,15 @@ class Payload:
         object.__setattr__(self, "inertia", inertia)
 
 
+MAX_CYCLE_SAMPLES = 200_000
+"""Most samples a duty cycle may hold: the requirement evaluates the arm's dynamics at each (a million rows grew a
+smoke run past 10 GB); an hour of motion at 50 Hz is 180,000."""
+
+MAX_JOINT_SPEED = 1e4
+"""Fastest joint speed a duty cycle may hold [rad/s or m/s]: 95,000 rpm at the joint, far beyond any robot's, so
+a larger one is a wrong unit or a wrong time column, never a motion."""
+
+
 @dataclass(frozen=True, eq=False)
 class DutyCycle:
     """Joint motion over one cycle, with the payload carried.
@@ -103,6 +112,13 @@ class DutyCycle:
         t = np.asarray(self.t, dtype=float)
         if t.ndim != 1 or t.size < 2:
             raise InvalidParameter("t", t.shape, "a 1-D array of at least 2 times [s]")
+        if t.size > MAX_CYCLE_SAMPLES:
+            raise InvalidParameter(
+                "t",
+                f"{t.size:,} samples",
+                f"at most {MAX_CYCLE_SAMPLES:,} samples",
+                "the requirement is evaluated at every sample: resample the cycle more coarsely",
+            )
         _check_times(t, "")
         object.__setattr__(self, "t", t)
         for name in ("q", "qd", "qdd"):
@@ -113,6 +129,15 @@ class DutyCycle:
             if bad.size:
                 raise InvalidParameter(name, values, "finite values", f"sample {int(bad[0])} is not")
             object.__setattr__(self, name, values)
+        too_fast = np.flatnonzero(np.any(np.abs(self.qd) > MAX_JOINT_SPEED, axis=1))
+        if too_fast.size:
+            sample = int(too_fast[0])
+            raise InvalidParameter(
+                "qd",
+                f"{float(np.max(np.abs(self.qd[sample]))):.3g} at t = {t[sample]:.6g} s",
+                f"joint speeds of at most {MAX_JOINT_SPEED:g} rad/s (or m/s)",
+                "no robot joint moves so fast: check the positions' unit and the time column's",
+            )
         if self.payload is not None and not isinstance(self.payload, Payload):
             raise InvalidParameter("payload", self.payload, "a Payload or None")
 
