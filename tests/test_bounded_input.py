@@ -110,3 +110,57 @@ def test_a_tampered_design_is_refused_by_its_physical_range(
     (run / "designs.json").write_text(json.dumps(data))
     line = _error(["export", str(run), "--format", "urdf", "--out", str(tmp_path / "x.urdf")], capsys)
     assert f"'recommended.joints[0].{field}'" in line and words in line
+
+
+def test_export_from_mutated_run_folders_is_a_model_or_one_line(smoke_runs, tmp_path, capsys):
+    """40 seeded mutations of designs.json (numbers made negative, zero, huge, NaN, text; names made hostile
+    XML): each export is a well-formed model with no injected element, or exit 2 with one line."""
+    import json
+    import random
+    import xml.etree.ElementTree as ET
+
+    source = smoke_runs["two_link_paper"]
+    base = json.loads((source / "designs.json").read_text())
+    rng = random.Random(33)
+    hostile: list[object] = [
+        -1.0,
+        0.0,
+        1e308,
+        float("nan"),
+        "x",
+        10**400,
+        True,
+        None,
+        '--><link name="X"/><!--',
+    ]
+
+    def leaves(node, path=()):
+        if isinstance(node, dict):
+            for key, value in node.items():
+                yield from leaves(value, (*path, key))
+        elif isinstance(node, list):
+            for i, value in enumerate(node):
+                yield from leaves(value, (*path, i))
+        else:
+            yield path
+
+    paths = [p for p in leaves(base["recommended"]) if p and p[0] == "joints"]
+    run = tmp_path / "run"
+    shutil.copytree(source, run)
+    for trial in range(40):
+        data = json.loads(json.dumps(base))
+        path = rng.choice(paths)
+        target = data["recommended"]
+        for key in path[:-1]:
+            target = target[key]
+        target[path[-1]] = rng.choice(hostile)
+        text = json.dumps(data, allow_nan=True) if not isinstance(target[path[-1]], int) else json.dumps(data)
+        (run / "designs.json").write_text(text)
+        out = tmp_path / f"m{trial}.urdf"
+        status = main(["export", str(run), "--format", "urdf", "--out", str(out)])
+        captured = capsys.readouterr()
+        if status == 0:
+            root = ET.parse(out).getroot()  # well-formed
+            assert not [e for e in root.iter() if e.get("name") == "X"], path
+        else:
+            assert status == 2 and len(captured.err.strip().splitlines()) == 1, (path, captured.err)
