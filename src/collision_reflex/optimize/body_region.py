@@ -22,11 +22,11 @@ from typing import TYPE_CHECKING
 import casadi as ca
 import numpy as np
 
-from ..arm.effective import effective_parameters
 from ..model.contact import BodyRegion, permissible_speed
+from ..model.effective import finger_mass_matrix
 from .constraints import ConstraintList
 from .objectives import RELAXED_ROW
-from .samples import SPEED_CAP_TOLERANCE, ContactSamples
+from .samples import SPEED_CAP_TOLERANCE, ContactSamples, kinematic_term
 
 if TYPE_CHECKING:
     from .design import Design
@@ -79,19 +79,17 @@ def region_speeds(samples: ContactSamples, design: Design, region: BodyRegion) -
     The robot mass is the exact coupled one, ``1 / (w^T (M_f + diag(N^2 J))^-1 w)`` (the NumPy path); the NLP's
     rows bound it from above, so a design they admit has these speeds at least its approach velocity.
     """
-    params = effective_parameters(
-        samples.kinematics,
-        samples.directions,
-        config_index=samples.config_index,
-        reflected_inertia=design.reflected_inertia,
-        stiffness=design.mechanical_stiffness,
-        mechanical_stiffness=design.mechanical_stiffness,
-        torque_limit=design.peak_torque,
-        motor_mass=design.actuator_mass,
-        finger_joint_inertia=design.reflected_inertia,
+    index = samples.config_index
+    matrix = finger_mass_matrix(
+        samples.kinematics.mass_matrix[index],
+        kinematic_term(samples, "motor_mass_influence")[index],
+        design.actuator_mass,
+        design.reflected_inertia,
     )
+    w = samples.joint_moment_arms
+    mass = 1 / np.einsum("si,si->s", w, np.linalg.solve(matrix, w[..., None])[..., 0])
     assert region.transient_force is not None
-    return np.asarray(permissible_speed(region.transient_force, params.m_f, region.stiffness, region.mass))
+    return np.asarray(permissible_speed(region.transient_force, mass, region.stiffness, region.mass))
 
 
 def region_violations(
