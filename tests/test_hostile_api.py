@@ -310,3 +310,14 @@ def test_a_very_damped_contact_takes_the_asymptotic_restitution() -> None:
     """Above a damping ratio of 1e4 the restitution is 1/(4 zeta^2) (within 1e-7 there); 1e300 overflowed."""
     assert cr.simulate.contact_restitution(2e4) == pytest.approx(1 / (4 * 4e8), rel=1e-12)
     assert cr.simulate.contact_restitution(1e300) == 0.0
+
+
+def test_a_one_element_array_is_one_bound_and_bounds_hold_floats() -> None:
+    """A valid input the edge refused: np.array([1.0]) is one number; np.float32 bounds become floats."""
+    from collision_reflex.optimize import Bounds
+
+    bounds = Bounds(np.array([1.0]), np.array([[2.0]]))
+    assert (bounds.lower, bounds.upper) == (1.0, 2.0) and type(bounds.lower) is float
+    assert type(Bounds(np.float32(1.0), 2).upper) is float
+    with pytest.raises(InvalidParameter, match="lower bound"):
+        Bounds(np.array([1.0, 2.0]), 3.0)

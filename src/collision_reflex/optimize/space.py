@@ -41,8 +41,11 @@ class Bounds:
 
     def __post_init__(self) -> None:
         for side, value in (("lower", self.lower), ("upper", self.upper)):
+            if isinstance(value, np.ndarray) and value.size == 1:  # a 1-element array is one number
+                value = value.reshape(()).item()
             if not (_is_number(value) and math.isfinite(value) and value > 0):
                 raise InvalidParameter(f"{self.name} {side} bound", value, "a finite number > 0")
+            object.__setattr__(self, side, float(value))
         if self.lower > self.upper:
             raise InvalidParameter(
                 f"{self.name} bounds", (self.lower, self.upper), "lower <= upper", "swap or widen the bounds"
