@@ -325,6 +325,9 @@ def test_the_catalogue_design_exports_with_its_parts_and_loads(smoke_runs, tmp_p
     assert mujoco.MjModel.from_xml_path(str(out)).nmesh > 0  # MuJoCo reads the URDF as written
     mjcf = tmp_path / "built.xml"
     export_design(run, "catalogue", "mjcf", mjcf)
+    assert (
+        "the study was optimised with reflected_inertia_in = robot" in mjcf.read_text()
+    )  # the placement stated
     model = mujoco.MjModel.from_xml_path(str(mjcf))
     for saved in catalogue["design"]["joints"]:
         joint = model.joint(saved["joint"])

@@ -118,10 +118,25 @@ def _header(design: RunDesign) -> str:
         "Per joint: armature = N^2 (J_m + J_g) [kg m^2]; motor actuator with gear = N, control = motor torque "
         "[N m] within the motor's peak torque; actuatorfrcrange = driving peak output torque eta N tau_p [N m].",
         "Motor (and gearbox) masses: bodies JOINT_actuator welded to the parent link at the joint origin.",
+        _placement_line(design.placement),
         "Meshes are left out (see the exported URDF for them); velocity limits are in the URDF only; the URDF's "
         "joint damping and friction are kept; integrator implicitfast.",
     ]
     return "\n  " + "\n  ".join(lines) + "\n"
+
+
+def _placement_line(placement: str) -> str:
+    """What the armature means against the placement the study was optimised with."""
+    line = (
+        "Reflected inertia: the armature sits rigidly on the joints, in the impact (the 'finger' placement); "
+        f"the study was optimised with reflected_inertia_in = {placement}"
+    )
+    if placement == "finger":
+        return line + ", the same."
+    return line + (
+        " (the rotors behind the joint springs): along a contact direction this model's finger mass is larger by "
+        "the rotors' share, and its impulse a bound of the design's."
+    )
 
 
 def _vector(values: Any) -> str:

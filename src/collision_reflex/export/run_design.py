@@ -99,7 +99,9 @@ class RunDesign:
     study: the study's name; label: which design (``"recommended design (Pareto design 0)"``); arm: the arm
     as the study loads it (locked joints removed, contact point set); joints: one :class:`JointActuator` per
     joint of the arm, in its order; parts: provenance lines (catalogue parts and their sources);
-    catalogue: the design record's ``catalogue`` entry (its quick snap) where it has one (None otherwise).
+    catalogue: the design record's ``catalogue`` entry (its quick snap) where it has one (None otherwise);
+    placement: where the study placed the reflected inertia in the impact (``reflected_inertia_in``, as its
+    resolved study writes it).
     """
 
     study: str
@@ -108,6 +110,7 @@ class RunDesign:
     joints: tuple[JointActuator, ...]
     parts: tuple[str, ...]
     catalogue: QuickSnap | None = None
+    placement: str = "robot"
 
 
 def read_run_design(run_dir: str | os.PathLike[str], design: str | int = "recommended") -> RunDesign:
@@ -222,6 +225,9 @@ def _run_design(
         joints=tuple(joints),
         parts=_parts(joints, catalogue, gearboxes, reference.name, law),
         catalogue=record.get("catalogue"),
+        placement=str(
+            study.reflected_inertia_in if isinstance(study.reflected_inertia_in, str) else "a rule"
+        ),
     )
 
 
