@@ -23,7 +23,7 @@ import pytest
 from collision_reflex.arm import effective_parameters
 from collision_reflex.cli import main
 from collision_reflex.export import companion_path, export_design, read_run_design, set_armature
-from collision_reflex.export.mjcf import MujocoMissing
+from collision_reflex.export.mjcf import TOKEN_INERTIA, MujocoMissing
 from collision_reflex.report.files import write_json
 from collision_reflex.study import load_study, resolved_yaml
 
@@ -325,12 +325,12 @@ def test_the_catalogue_design_exports_with_its_parts_and_loads(smoke_runs, tmp_p
     assert mujoco.MjModel.from_xml_path(str(out)).nmesh > 0  # MuJoCo reads the URDF as written
     mjcf = tmp_path / "built.xml"
     export_design(run, "catalogue", "mjcf", mjcf)
-    assert (
-        "the study was optimised with reflected_inertia_in = robot" in mjcf.read_text()
-    )  # the placement stated
+    assert "as the study was optimised (reflected_inertia_in = robot)" in mjcf.read_text()  # the placement
     model = mujoco.MjModel.from_xml_path(str(mjcf))
-    for saved in catalogue["design"]["joints"]:
-        joint = model.joint(saved["joint"])
+    for saved in catalogue["design"][
+        "joints"
+    ]:  # the output torque range on the rotor, behind the joint spring
+        joint = model.joint(saved["joint"] + "_rotor")
         assert model.jnt_actfrcrange[joint.id][1] == pytest.approx(_effort(saved), rel=1e-12)
 
 
@@ -359,14 +359,19 @@ def _full_inertia(mujoco, model, data) -> np.ndarray:
 
 @pytest.mark.parametrize("robot", ROBOTS)
 def test_mjcf_full_inertia_is_the_same_matrix_with_armature(runs, robot, tmp_path):
+    """The study placed the rotors behind the joint springs (``robot``): each is a DOF of its own with the armature,
+    joined to its link by a tendon spring of the joint's stiffness, so the links' block of MuJoCo's inertia is the
+    structure with the motor masses (the finger mass the optimiser used, exactly) and the rotors' block is the
+    armature; rigidly coupled, the two add up to the model with the armature on the joints."""
     mujoco = pytest.importorskip("mujoco", reason="the mujoco extra is not installed")
     out = tmp_path / f"{robot}.xml"
     export_design(runs[robot], "recommended", "mjcf", out)
     design = read_run_design(runs[robot], "recommended")
+    assert design.placement == "robot"
     arm = design.arm
     motor_mass, armature = _design_arrays(design)
     q = arm.sample_configurations(6, np.random.default_rng(3))
-    expected = arm.kinematics(q).structure_mass_matrix(motor_mass) + np.diag(armature)
+    expected = arm.kinematics(q).structure_mass_matrix(motor_mass)
     model = mujoco.MjModel.from_xml_path(str(out))
     assert model.opt.integrator == mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     urdf_joints = {j.get("name"): j for j in ET.parse(arm.urdf_path).getroot().findall("joint")}
@@ -375,25 +380,34 @@ def test_mjcf_full_inertia_is_the_same_matrix_with_armature(runs, robot, tmp_pat
         damping = float(dynamics.get("damping", 0.0)) if dynamics is not None else 0.0
         assert model.dof_damping[model.joint(name).dofadr[0]] == damping
     data = mujoco.MjData(model)
-    ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n) for n in arm.joint_names]
-    dofs = [model.jnt_dofadr[j] for j in ids]
+    links = [model.joint(n).id for n in arm.joint_names]
+    rotors = [model.joint(f"{n}_rotor").id for n in arm.joint_names]
+    link_dofs, rotor_dofs = ([model.jnt_dofadr[j] for j in ids] for ids in (links, rotors))
     for expected_s, angles in zip(expected, arm.joint_coordinates(q), strict=True):
-        data.qpos[[model.jnt_qposadr[j] for j in ids]] = angles
+        for ids in (links, rotors):
+            data.qpos[[model.jnt_qposadr[j] for j in ids]] = angles
         mujoco.mj_forward(model, data)
-        full = _full_inertia(mujoco, model, data)[np.ix_(dofs, dofs)]
-        assert np.abs(full - expected_s).max() / np.abs(expected_s).max() < TOLERANCE
+        full = _full_inertia(mujoco, model, data)
+        block = full[np.ix_(link_dofs, link_dofs)]
+        assert np.abs(block - expected_s).max() / np.abs(expected_s).max() < TOLERANCE
+        np.testing.assert_allclose(np.diag(full)[rotor_dofs], armature, rtol=1e-12, atol=2 * TOKEN_INERTIA)
+        assert np.abs(full[np.ix_(link_dofs, rotor_dofs)]).max() < 1e-9  # a rotor moves no link mass
+    for joint, tendon in zip(design.joints, range(model.ntendon), strict=True):
+        assert model.tendon(tendon).name == f"{joint.joint}_spring"
+        assert model.tendon_stiffness[tendon] == joint.mechanical_stiffness
     for joint in design.joints:
         actuator = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, f"{joint.joint}_motor")
+        assert model.actuator_trnid[actuator, 0] == model.joint(f"{joint.joint}_rotor").id  # drives the rotor
         assert model.actuator_gear[actuator, 0] == joint.gear_ratio
         np.testing.assert_array_equal(
             model.actuator_ctrlrange[actuator], [-joint.motor_peak_torque, joint.motor_peak_torque]
         )
-        jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint.joint)
         driving = joint.driving_peak_torque  # eta N tau_p, within the catalogue gearbox's repeated peak
         assert driving == min(
             joint.gearbox_efficiency * joint.peak_torque, joint.gearbox_peak_torque or np.inf
         )
-        np.testing.assert_array_equal(model.jnt_actfrcrange[jid], [-driving, driving])
+        rotor = model.joint(f"{joint.joint}_rotor").id
+        np.testing.assert_array_equal(model.jnt_actfrcrange[rotor], [-driving, driving])
 
 
 def test_no_absolute_path_in_the_exported_files(runs, tmp_path):

@@ -5,9 +5,12 @@ tree, the inertials and the joints are read as MuJoCo reads URDF; the compiled m
 every number at full precision (MuJoCo's own XML writer rounds to six digits, too coarse to reproduce a mass
 matrix), with per joint
 
-- ``armature`` = ``N^2 (J_m + J_g)`` [kg m^2] (MuJoCo adds it to the diagonal of the joint-space inertia);
-- ``actuatorfrcrange`` = the peak output torque ``N tau_p`` [N m];
-- a ``<motor>`` actuator with ``gear`` = N whose control is the motor torque [N m]: ``ctrlrange`` and
+- ``armature`` = ``N^2 (J_m + J_g)`` [kg m^2] (MuJoCo adds it to the diagonal of the joint-space inertia): where
+  the study placed the rotors behind the joint springs (``robot``), on a rotor of its own (body and joint
+  ``JOINT_rotor`` on the parent link, joined to the link by a fixed tendon ``JOINT_spring`` of the joint's
+  stiffness ``k_m``), else on the joint;
+- ``actuatorfrcrange`` = the driving peak output torque ``eta N tau_p`` [N m], on the rotor or the joint;
+- a ``<motor>`` actuator with ``gear`` = N on the rotor (or the joint) whose control is the motor torque [N m]: ``ctrlrange`` and
   ``forcerange`` are the motor's peak torque ``tau_p`` (the force MuJoCo clamps is the actuator's, before the
   gear);
 
@@ -18,6 +21,7 @@ collision shapes are kept. MuJoCo has no joint velocity limit: the URDF carries 
 
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
 from typing import Any
 
@@ -28,6 +32,11 @@ from .run_design import RunDesign
 from .urdf import comment, number
 
 CONTACT_SITE = "collision_reflex_contact"
+
+ROTOR = "_rotor"
+"""Suffix of a joint's rotor body and joint, where the design places the rotor behind the joint spring."""
+TOKEN_MASS, TOKEN_INERTIA = 1e-12, 1e-12
+"""A rotor body's own inertial [kg, kg m^2]: MuJoCo moves no massless body; its inertia is the armature."""
 """The site at the design's contact point."""
 
 _GEOM_SIZES = {2: ("sphere", 1), 3: ("capsule", 2), 4: ("ellipsoid", 3), 5: ("cylinder", 2), 6: ("box", 3)}
@@ -68,15 +77,32 @@ def design_mjcf(design: RunDesign, urdf_text: str) -> str:
     )
     world = ET.SubElement(root, "worldbody")
     actuators = {j.joint: j for j in design.joints}
+    rotors = _has_rotors(design)
     bodies: dict[int, ET.Element] = {0: world}
     for body in range(1, model.nbody):
-        element = _body(mujoco, model, body, bodies[int(model.body_parentid[body])])
+        parent = bodies[int(model.body_parentid[body])]
+        element = _body(mujoco, model, body, parent)
         bodies[body] = element
         for joint in range(model.body_jntadr[body], model.body_jntadr[body] + model.body_jntnum[body]):
-            _joint(mujoco, model, joint, element, actuators)
+            actuator = actuators.get(str(mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, joint)))
+            _joint(mujoco, model, joint, element, None if rotors else actuator)
+            if rotors and actuator is not None:
+                _rotor(mujoco, model, body, joint, parent, actuator)
         for geom in range(model.body_geomadr[body], model.body_geomadr[body] + model.body_geomnum[body]):
             _geom(model, geom, element)
     _contact_site(mujoco, model, design, bodies)
+    if rotors:
+        tendons = ET.SubElement(root, "tendon")
+        for actuator in design.joints:  # the joint spring, between the link and the rotor
+            spring = ET.SubElement(
+                tendons,
+                "fixed",
+                name=f"{actuator.joint}_spring",
+                stiffness=number(actuator.mechanical_stiffness),
+                springlength="0",
+            )
+            ET.SubElement(spring, "joint", joint=actuator.joint, coef="1")
+            ET.SubElement(spring, "joint", joint=f"{actuator.joint}{ROTOR}", coef="-1")
     motors = ET.SubElement(root, "actuator")
     for actuator in design.joints:
         torque = number(actuator.motor_peak_torque)
@@ -84,7 +110,7 @@ def design_mjcf(design: RunDesign, urdf_text: str) -> str:
             motors,
             "motor",
             name=f"{actuator.joint}_motor",
-            joint=actuator.joint,
+            joint=actuator.joint + (ROTOR if rotors else ""),
             gear=number(actuator.gear_ratio),
             ctrlrange=f"-{torque} {torque}",
             forcerange=f"-{torque} {torque}",
@@ -118,25 +144,33 @@ def _header(design: RunDesign) -> str:
         "Per joint: armature = N^2 (J_m + J_g) [kg m^2]; motor actuator with gear = N, control = motor torque "
         "[N m] within the motor's peak torque; actuatorfrcrange = driving peak output torque eta N tau_p [N m].",
         "Motor (and gearbox) masses: bodies JOINT_actuator welded to the parent link at the joint origin.",
-        _placement_line(design.placement),
+        _placement_line(design.placement, _has_rotors(design)),
         "Meshes are left out (see the exported URDF for them); velocity limits are in the URDF only; the URDF's "
         "joint damping and friction are kept; integrator implicitfast.",
     ]
     return "\n  " + "\n  ".join(lines) + "\n"
 
 
-def _placement_line(placement: str) -> str:
-    """What the armature means against the placement the study was optimised with."""
+def _placement_line(placement: str, rotors: bool) -> str:
+    """Where the reflected inertia sits, against the placement the study was optimised with."""
+    if rotors:
+        return (
+            "Reflected inertia: each rotor is a degree of freedom of its own behind the joint spring (body and joint "
+            "JOINT_rotor with the armature, a fixed tendon JOINT_spring of the joint's stiffness k_m, the motor on "
+            "the rotor), as the study was optimised (reflected_inertia_in = robot)."
+        )
     line = (
         "Reflected inertia: the armature sits rigidly on the joints, in the impact (the 'finger' placement); "
         f"the study was optimised with reflected_inertia_in = {placement}"
     )
-    if placement == "finger":
-        return line + ", the same."
     return line + (
-        " (the rotors behind the joint springs): along a contact direction this model's finger mass is larger by "
-        "the rotors' share, and its impulse a bound of the design's."
+        ", the same." if placement == "finger" else ": this model's impact is a bound of the design's."
     )
+
+
+def _has_rotors(design: RunDesign) -> bool:
+    """Whether the rotors are degrees of freedom of their own: the study placed them behind finite springs."""
+    return design.placement == "robot" and all(math.isfinite(j.mechanical_stiffness) for j in design.joints)
 
 
 def _vector(values: Any) -> str:
@@ -161,8 +195,11 @@ def _body(mujoco: Any, model: Any, body: int, parent: ET.Element) -> ET.Element:
     return element
 
 
-def _joint(mujoco: Any, model: Any, joint: int, body: ET.Element, actuators: dict[str, Any]) -> None:
-    """A hinge or slide joint, with the design's armature and output torque range."""
+def _joint(mujoco: Any, model: Any, joint: int, body: ET.Element, actuator: Any) -> None:
+    """A hinge or slide joint, with the armature and output torque range of its ``actuator``.
+
+    ``actuator`` is None where the rotor is a degree of freedom of its own (:func:`_rotor`).
+    """
     name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, joint)
     kind = {int(mujoco.mjtJoint.mjJNT_HINGE): "hinge", int(mujoco.mjtJoint.mjJNT_SLIDE): "slide"}.get(
         int(model.jnt_type[joint])
@@ -181,12 +218,40 @@ def _joint(mujoco: Any, model: Any, joint: int, body: ET.Element, actuators: dic
     for field, values in (("damping", model.dof_damping), ("frictionloss", model.dof_frictionloss)):
         if values[dof] > 0:  # the URDF's <dynamics damping friction>, kept
             attributes[field] = number(values[dof])
-    actuator = actuators.get(name)
     if actuator is not None:
         torque = number(actuator.driving_peak_torque)
         attributes["armature"] = number(actuator.reflected_inertia)
         attributes["actuatorfrcrange"] = f"-{torque} {torque}"
     ET.SubElement(body, "joint", attributes)
+
+
+def _rotor(mujoco: Any, model: Any, body: int, joint: int, parent: ET.Element, actuator: Any) -> None:
+    """The joint's rotor as a degree of freedom of its own, behind the joint spring.
+
+    A body on the parent link at the joint, turning about the joint's axis with the armature ``N^2 (J_m + J_g)``
+    and the output torque range; the joint spring ``k_m`` joins it to the link (a fixed tendon). Its inertial is
+    a token (MuJoCo moves no massless body).
+    """
+    quat = model.body_quat[body]
+    position, axis = np.zeros(3), np.zeros(3)
+    mujoco.mju_rotVecQuat(position, model.jnt_pos[joint], quat)
+    mujoco.mju_rotVecQuat(axis, model.jnt_axis[joint], quat)
+    name = f"{actuator.joint}{ROTOR}"
+    rotor = ET.SubElement(parent, "body", name=name, pos=_vector(model.body_pos[body] + position))
+    ET.SubElement(
+        rotor, "inertial", pos="0 0 0", mass=number(TOKEN_MASS), diaginertia=_vector([TOKEN_INERTIA] * 3)
+    )
+    kind = "slide" if int(model.jnt_type[joint]) == int(mujoco.mjtJoint.mjJNT_SLIDE) else "hinge"
+    torque = number(actuator.driving_peak_torque)
+    ET.SubElement(
+        rotor,
+        "joint",
+        name=name,
+        type=kind,
+        axis=_vector(axis),
+        armature=number(actuator.reflected_inertia),
+        actuatorfrcrange=f"-{torque} {torque}",
+    )
 
 
 def _geom(model: Any, geom: int, body: ET.Element) -> None:

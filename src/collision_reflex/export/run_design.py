@@ -46,7 +46,8 @@ class JointActuator:
     gearbox_max_speed: the catalogue gearbox's maximum input speed [rad/s] (None for none or not known);
     stator_diameter, stack_length [m]; nearest_motor: the nearest catalogue motor ("" for none); motor: the
     catalogue motor the joint is built from ("" for a motor scaled from the reference); gearbox_peak_torque: the
-    catalogue gearbox's repeated peak torque [N m] (None for none or a gearbox the catalogue lacks).
+    catalogue gearbox's repeated peak torque [N m] (None for none or a gearbox the catalogue lacks);
+    mechanical_stiffness: the joint's spring between link and rotor [N m/rad] (``inf``: rigid).
     """
 
     joint: str
@@ -67,6 +68,7 @@ class JointActuator:
     nearest_motor: str
     motor: str = ""
     gearbox_peak_torque: float | None = None
+    mechanical_stiffness: float = float("inf")
 
     @property
     def driving_peak_torque(self) -> float:
@@ -216,6 +218,7 @@ def _run_design(
                 gearbox_peak_torque=_gearbox_figure(
                     str(saved.get("gearbox") or ""), gearboxes, "peak_torque"
                 ),
+                mechanical_stiffness=float(saved["mechanical_stiffness"]),
             )
         )
     return RunDesign(
