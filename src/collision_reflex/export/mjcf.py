@@ -103,6 +103,7 @@ def design_mjcf(design: RunDesign, urdf_text: str) -> str:
             )
             ET.SubElement(spring, "joint", joint=actuator.joint, coef="1")
             ET.SubElement(spring, "joint", joint=f"{actuator.joint}{ROTOR}", coef="-1")
+    _controller(root, design)
     motors = ET.SubElement(root, "actuator")
     for actuator in design.joints:
         torque = number(actuator.motor_peak_torque)
@@ -145,6 +146,10 @@ def _header(design: RunDesign) -> str:
         "[N m] within the motor's peak torque; actuatorfrcrange = driving peak output torque eta N tau_p [N m].",
         "Motor (and gearbox) masses: bodies JOINT_actuator welded to the parent link at the joint origin.",
         _placement_line(design.placement, _has_rotors(design)),
+        "Controller (MuJoCo runs none; a script reads it): custom numerics collision_reflex_threshold (a contact "
+        "force [N], or a position error [m] where collision_reflex_position_sensing is 1), "
+        "collision_reflex_approach_velocity [m/s] and collision_reflex_JOINT_software_stiffness [N m/rad] per joint "
+        "(the impedance controller's k_s on the motor).",
         "Meshes are left out (see the exported URDF for them); velocity limits are in the URDF only; the URDF's "
         "joint damping and friction are kept; integrator implicitfast.",
     ]
@@ -166,6 +171,29 @@ def _placement_line(placement: str, rotors: bool) -> str:
     return line + (
         ", the same." if placement == "finger" else ": this model's impact is a bound of the design's."
     )
+
+
+CONTROLLER = "collision_reflex_"
+"""Prefix of the controller block's numerics (``<custom>``): what the design's controller and detector use."""
+
+
+def _controller(root: ET.Element, design: RunDesign) -> None:
+    """The design's controller as numbers a script reads (MuJoCo runs no controller of its own).
+
+    ``collision_reflex_threshold`` (the detection threshold: a contact force [N] for force sensing, a position
+    error [m] for position sensing), ``collision_reflex_position_sensing`` (1 or 0),
+    ``collision_reflex_approach_velocity`` [m/s] and per joint ``collision_reflex_JOINT_software_stiffness``
+    [N m/rad], the impedance controller's joint stiffness ``k_s`` on the motor.
+    """
+    custom = ET.SubElement(root, "custom")
+    values = {
+        "threshold": design.threshold,
+        "position_sensing": 1.0 if design.sensing == "position" else 0.0,
+        "approach_velocity": design.approach_velocity,
+        **{f"{j.joint}_software_stiffness": j.software_stiffness for j in design.joints},
+    }
+    for name, value in values.items():
+        ET.SubElement(custom, "numeric", name=f"{CONTROLLER}{name}", data=number(value))
 
 
 def _has_rotors(design: RunDesign) -> bool:

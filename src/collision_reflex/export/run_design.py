@@ -47,7 +47,8 @@ class JointActuator:
     stator_diameter, stack_length [m]; nearest_motor: the nearest catalogue motor ("" for none); motor: the
     catalogue motor the joint is built from ("" for a motor scaled from the reference); gearbox_peak_torque: the
     catalogue gearbox's repeated peak torque [N m] (None for none or a gearbox the catalogue lacks);
-    mechanical_stiffness: the joint's spring between link and rotor [N m/rad] (``inf``: rigid).
+    mechanical_stiffness: the joint's spring between link and rotor [N m/rad] (``inf``: rigid); software_stiffness:
+    the controller's joint stiffness ``k_s`` [N m/rad].
     """
 
     joint: str
@@ -69,6 +70,7 @@ class JointActuator:
     motor: str = ""
     gearbox_peak_torque: float | None = None
     mechanical_stiffness: float = float("inf")
+    software_stiffness: float = float("inf")
 
     @property
     def driving_peak_torque(self) -> float:
@@ -103,7 +105,8 @@ class RunDesign:
     joint of the arm, in its order; parts: provenance lines (catalogue parts and their sources);
     catalogue: the design record's ``catalogue`` entry (its quick snap) where it has one (None otherwise);
     placement: where the study placed the reflected inertia in the impact (``reflected_inertia_in``, as its
-    resolved study writes it).
+    resolved study writes it); sensing, threshold and approach_velocity: the design's detection (its scheme and
+    threshold, a force [N] or a position error [m]) and approach speed [m/s].
     """
 
     study: str
@@ -113,6 +116,9 @@ class RunDesign:
     parts: tuple[str, ...]
     catalogue: QuickSnap | None = None
     placement: str = "robot"
+    sensing: str = "force"
+    threshold: float = float("nan")
+    approach_velocity: float = float("nan")
 
 
 def read_run_design(run_dir: str | os.PathLike[str], design: str | int = "recommended") -> RunDesign:
@@ -219,6 +225,7 @@ def _run_design(
                     str(saved.get("gearbox") or ""), gearboxes, "peak_torque"
                 ),
                 mechanical_stiffness=float(saved["mechanical_stiffness"]),
+                software_stiffness=float(saved["software_stiffness"]),
             )
         )
     return RunDesign(
@@ -228,6 +235,9 @@ def _run_design(
         joints=tuple(joints),
         parts=_parts(joints, catalogue, gearboxes, reference.name, law),
         catalogue=record.get("catalogue"),
+        sensing=str(record["sensing"]),
+        threshold=float(record["threshold"]),
+        approach_velocity=float(record["approach_velocity"]),
         placement=str(
             study.reflected_inertia_in if isinstance(study.reflected_inertia_in, str) else "a rule"
         ),
