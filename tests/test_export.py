@@ -327,9 +327,14 @@ def test_the_catalogue_design_exports_with_its_parts_and_loads(smoke_runs, tmp_p
     export_design(run, "catalogue", "mjcf", mjcf)
     assert "as the study was optimised (reflected_inertia_in = robot)" in mjcf.read_text()  # the placement
     model = mujoco.MjModel.from_xml_path(str(mjcf))
-    for saved in catalogue["design"][
-        "joints"
-    ]:  # the output torque range on the rotor, behind the joint spring
+    built = catalogue["design"]  # the controller block: the design's figures, digit for digit
+    assert model.numeric("collision_reflex_threshold").data[0] == built["threshold"]
+    assert model.numeric("collision_reflex_approach_velocity").data[0] == built["approach_velocity"]
+    assert model.numeric("collision_reflex_position_sensing").data[0] == (built["sensing"] == "position")
+    for saved in built["joints"]:
+        stiffness = model.numeric(f"collision_reflex_{saved['joint']}_software_stiffness").data[0]
+        assert stiffness == saved["software_stiffness"]
+    for saved in built["joints"]:  # the output torque range on the rotor, behind the joint spring
         joint = model.joint(saved["joint"] + "_rotor")
         assert model.jnt_actfrcrange[joint.id][1] == pytest.approx(_effort(saved), rel=1e-12)
 
