@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 import casadi as ca
 import numpy as np
 
+from .._backend import solve_vector
 from ..model.contact import BodyRegion, permissible_speed
 from ..model.effective import finger_mass_matrix
 from .constraints import ConstraintList
@@ -73,6 +74,18 @@ def add_body_region_constraints(
     )
 
 
+def coupled_mass_matrix(
+    mass_matrix: np.ndarray, motor_mass_influence: np.ndarray, design: Design
+) -> np.ndarray:
+    """``M_f + diag(N^2 J)`` [kg m^2] per configuration: the links, the actuator masses they carry and the rotors.
+
+    ``mass_matrix`` (n, nv, nv) and ``motor_mass_influence`` (n, nv, nv, nv): the configurations' kinematic terms.
+    """
+    return np.asarray(
+        finger_mass_matrix(mass_matrix, motor_mass_influence, design.actuator_mass, design.reflected_inertia)
+    )
+
+
 def region_speeds(samples: ContactSamples, design: Design, region: BodyRegion) -> np.ndarray:
     """The permissible approach speed [m/s] against ``region`` at each sample, (n_samples,), as the rows take it.
 
@@ -80,14 +93,11 @@ def region_speeds(samples: ContactSamples, design: Design, region: BodyRegion) -
     rows bound it from above, so a design they admit has these speeds at least its approach velocity.
     """
     index = samples.config_index
-    matrix = finger_mass_matrix(
-        samples.kinematics.mass_matrix[index],
-        kinematic_term(samples, "motor_mass_influence")[index],
-        design.actuator_mass,
-        design.reflected_inertia,
+    matrix = coupled_mass_matrix(
+        samples.kinematics.mass_matrix[index], kinematic_term(samples, "motor_mass_influence")[index], design
     )
     w = samples.joint_moment_arms
-    mass = 1 / np.einsum("si,si->s", w, np.linalg.solve(matrix, w[..., None])[..., 0])
+    mass = 1 / np.einsum("si,si->s", w, solve_vector(matrix, w))
     assert region.transient_force is not None
     return np.asarray(permissible_speed(region.transient_force, mass, region.stiffness, region.mass))
 

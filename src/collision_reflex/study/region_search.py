@@ -20,8 +20,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..model.contact import permissible_speed
-from ..model.effective import finger_mass_matrix
-from ..optimize.body_region import region_speeds
+from ..model.effective import task_inverse_inertia
+from ..optimize.body_region import coupled_mass_matrix, region_speeds
 from ..optimize.samples import ContactSamples
 from .arm_setup import ArmSetup, ExtraSamples
 
@@ -104,21 +104,28 @@ def search_region(
         inside = np.flatnonzero(samples.inside(design.approach_velocity))
         kept = ContactSamples(kinematics, samples.directions[inside], samples.config_index[inside])
         speeds = region_speeds(kept, design, region)
-        if refine:
-            kept, speeds = _with_refined(setup, design, kept, speeds)
+        # Per row: its configuration's id (the draw's index, refined poses after them) and direction.
+        configs, directions, joints = kept.config_index, kept.directions, kinematics.q
+        refined = _refined_poses(setup, design, joints, configs, speeds) if refine else None
+        if refined is not None:
+            q, u, refined_speeds = refined
+            configs = np.concatenate([configs, joints.shape[0] + np.arange(q.shape[0])])
+            directions = np.vstack([directions, u])
+            # Unit rows to the last digit, as a ContactSamples holds its directions.
+            directions /= np.linalg.norm(directions, axis=1)[:, None]
+            speeds = np.concatenate([speeds, refined_speeds])
+            joints = np.vstack([joints, q])
         below = np.flatnonzero(design.approach_velocity > speeds * (1 + tolerance))
         added: list[tuple[tuple[float, ...], tuple[float, ...]]] = []
         seen: set[int] = set()
         for row in below[np.argsort(speeds[below])]:
-            config = int(kept.config_index[row])
+            config = int(configs[row])
             if config not in seen and len(added) < ADDED_PER_DESIGN:
                 seen.add(config)
-                added.append(
-                    (tuple(map(float, kept.kinematics.q[config])), tuple(map(float, kept.directions[row])))
-                )
+                added.append((tuple(map(float, joints[config])), tuple(map(float, directions[row]))))
         slowest = int(np.argmin(speeds))
-        pose = setup.arm.kinematics(kept.kinematics.q[kept.config_index[slowest]][None, :])
-        direction = kept.directions[slowest]
+        pose = setup.arm.kinematics(joints[configs[slowest]][None, :])
+        direction = directions[slowest]
         masses = [
             effective_mass(pose, 0, direction, matrix[0])
             for matrix in (pose.mass_matrix, _coupled_matrix(pose, design))
@@ -145,15 +152,9 @@ def effective_mass(kinematics: ArmSamples, config: int, direction: np.ndarray, m
 
 
 def _coupled_matrix(kinematics: ArmSamples, design: Design) -> np.ndarray:
-    """``M_f + diag(N^2 J)`` per configuration: the links, the actuator masses they carry and the rotors."""
-    return np.asarray(
-        finger_mass_matrix(
-            kinematics.mass_matrix,
-            kinematics.motor_mass_influence,
-            design.actuator_mass,
-            design.reflected_inertia,
-        )
-    )
+    """:func:`~..optimize.body_region.coupled_mass_matrix` at every configuration of ``kinematics``."""
+    assert kinematics.motor_mass_influence is not None  # full kinematics
+    return coupled_mass_matrix(kinematics.mass_matrix, kinematics.motor_mass_influence, design)
 
 
 def heaviest_directions(kinematics: ArmSamples, matrix: np.ndarray) -> np.ndarray:
@@ -162,34 +163,30 @@ def heaviest_directions(kinematics: ArmSamples, matrix: np.ndarray) -> np.ndarra
     The effective mass along ``u`` is ``1 / (u^T J A^-1 J^T u)``: largest along the eigenvector of the smallest
     eigenvalue of ``J A^-1 J^T`` (either sign: the mass is the same). ``matrix``: (n, nv, nv) [kg m^2].
     """
-    jacobian = kinematics.jacobian
-    mobility = jacobian @ np.linalg.solve(matrix, np.swapaxes(jacobian, -1, -2))
-    _, vectors = np.linalg.eigh(mobility)
+    _, vectors = np.linalg.eigh(task_inverse_inertia(kinematics.jacobian, matrix))
     return np.asarray(vectors[..., :, 0])
 
 
-def _with_refined(
-    setup: ArmSetup, design: Design, kept: ContactSamples, speeds: np.ndarray
-) -> tuple[ContactSamples, np.ndarray]:
-    """``kept`` and its ``speeds`` with the refined poses of its :data:`REFINED` slowest configurations appended."""
+def _refined_poses(
+    setup: ArmSetup, design: Design, q: np.ndarray, configs: np.ndarray, speeds: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The refined poses of the :data:`REFINED` slowest configurations: joints, directions and speeds [m/s].
+
+    ``q``: the draw's configurations; ``configs`` and ``speeds``: each row's configuration and permissible speed.
+    None where no climb found a heavier pose.
+    """
     order = np.argsort(speeds)
-    starts = list(dict.fromkeys(int(kept.config_index[row]) for row in order))[:REFINED]
-    poses = [_refined_pose(setup, design, kept.kinematics.q[config]) for config in starts]
+    starts = list(dict.fromkeys(int(configs[row]) for row in order))[:REFINED]
+    poses = [_refined_pose(setup, design, q[config]) for config in starts]
     found = [pose for pose in poses if pose is not None]
     if not found:
-        return kept, speeds
-    q = np.array([pose[0] for pose in found])
+        return None
+    joints = np.array([pose[0] for pose in found])
     u = np.array([pose[1] for pose in found])
-    refined = ContactSamples(setup.arm.kinematics(q), u, np.arange(q.shape[0]))
+    refined = ContactSamples(setup.arm.kinematics(joints), u, np.arange(joints.shape[0]))
     region = setup.constraints.body_region
     assert region is not None
-    extra = region_speeds(refined, design, region)
-    both = ContactSamples(
-        setup.arm.kinematics(np.vstack([kept.kinematics.q, q])),
-        np.vstack([kept.directions, u]),
-        np.concatenate([kept.config_index, kept.kinematics.q.shape[0] + np.arange(q.shape[0])]),
-    )
-    return both, np.concatenate([speeds, extra])
+    return joints, u, region_speeds(refined, design, region)
 
 
 def _refined_pose(setup: ArmSetup, design: Design, q0: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
