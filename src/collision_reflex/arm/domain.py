@@ -37,17 +37,30 @@ _DRAW_BATCH = 512
 """Configurations drawn at a time when sampling within the domain."""
 
 
+_REACHES: dict[bytes, float] = {}
+"""Reaches from the default seed by :attr:`Arm.fingerprint`: a run sets its study up several times (as written,
+as solved, per gearbox option), and each reach is thousands of kinematics evaluations."""
+
+
 def arm_reach(arm: Arm, rng: np.random.Generator | None = None) -> float:
     """The arm's reach [m]: the largest base-to-contact distance over seeded random configurations.
 
     The base is the world origin the model is attached to. A sampled maximum is below the true reach by a
-    little, so a floor derived from it is on the side of the larger domain.
+    little, so a floor derived from it is on the side of the larger domain. Without ``rng`` (the seed 0), found
+    once per arm.
     """
-    generator = rng if rng is not None else np.random.default_rng(0)
-    q = arm.sample_configurations(REACH_SAMPLES, generator)
+    key = arm.fingerprint if rng is None else None
+    if key is not None and key in _REACHES:
+        return _REACHES[key]
+    q = arm.sample_configurations(REACH_SAMPLES, rng if rng is not None else np.random.default_rng(0))
     positions = arm.kinematics(q).contact_position
     assert positions is not None  # full kinematics
-    return float(np.linalg.norm(positions, axis=1).max())
+    reach = float(np.linalg.norm(positions, axis=1).max())
+    if key is not None:
+        if len(_REACHES) >= 32:
+            _REACHES.pop(next(iter(_REACHES)))
+        _REACHES[key] = reach
+    return reach
 
 
 def smallest_singular_values(jacobian: np.ndarray) -> np.ndarray:

@@ -6,6 +6,7 @@ m).
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import Any
 
@@ -26,12 +27,13 @@ class JointKinematics:
     rotation: np.ndarray  # placement of the joint frame in the parent joint frame
     translation: np.ndarray
 
-    @property
+    # Cached: forward kinematics uses them at every call, often for one configuration at a time.
+    @functools.cached_property
     def rotation_skew(self) -> np.ndarray:
         """``R_p K``: the placement rotation times the skew matrix of the axis (Rodrigues' ``sin`` term)."""
         return self.rotation @ skew(self.axis)
 
-    @property
+    @functools.cached_property
     def rotation_skew2(self) -> np.ndarray:
         """``R_p K^2``: the placement rotation times the squared skew matrix (Rodrigues' ``1 - cos`` term)."""
         cross = skew(self.axis)

@@ -11,7 +11,9 @@ separately and linearly (``M_bb(q; m) = M_bb0(q) + sum_i m_i A_i(q)``).
 
 from __future__ import annotations
 
+import hashlib
 import os
+import pickle
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -124,6 +126,15 @@ class Arm:
         self.reference_configuration: np.ndarray = np.array(pin.neutral(model))
         """A configuration to start from [rad, m]: the robot's reference pose when known, else neutral."""
         self._pin = pin
+
+    @property
+    def fingerprint(self) -> bytes:
+        """A digest of the model (links, joints, limits, armature) and the contact point.
+
+        Arms with equal fingerprints have the same kinematics: what is computed from those alone (the reach,
+        the worst hold poses) is shared between them.
+        """
+        return hashlib.sha256(pickle.dumps((self.model, self.contact_frame, self.contact_offset))).digest()
 
     # ------------------------------------------------------------------ construction
     @classmethod

@@ -10,7 +10,8 @@ _CASADI_BLAS_REGISTERED: list[bool] = []
 def single_threaded_blas() -> contextlib.AbstractContextManager[object]:
     """A context with every BLAS on one thread.
 
-    That is NumPy's, and the OpenBLAS that CasADi bundles for IPOPT and MUMPS. A threaded BLAS sums in an
+    That is NumPy's, SciPy's own (its optimisers' quasi-Newton steps call it), and the OpenBLAS that CasADi
+    bundles for IPOPT and MUMPS. A threaded BLAS sums in an
     order that depends on its thread count, and Dask workers pin it to one thread where a plain process does
     not; the difference moves IPOPT's iterates and so the results, within the solver tolerance. With one
     thread everywhere, every executor gives the same numbers, bitwise in practice (parallelism comes from the
@@ -21,6 +22,7 @@ def single_threaded_blas() -> contextlib.AbstractContextManager[object]:
     if not _CASADI_BLAS_REGISTERED:
         threadpoolctl.register(_casadi_openblas_controller())
         _load_casadi_openblas()
+        import scipy.linalg  # noqa: F401  # loads SciPy's OpenBLAS now: threadpoolctl limits only loaded ones
         _CASADI_BLAS_REGISTERED.append(True)
     return threadpoolctl.threadpool_limits(limits=1)
 

@@ -18,6 +18,7 @@ import numpy as np
 from ..arm.static_hold import worst_hold_poses
 from ..hardware.gearboxes import ScaledGearbox, load_gearbox_catalogue
 from ..optimize import ActuatorTechnology, Bounds, Constraints, ContactSamples, DesignSpace
+from ..optimize.blas import single_threaded_blas
 from ..optimize.technology import placements_from_stiffness
 from .actuator_specs import DIRECT_DRIVE, PlacementRuleSpec, ScaledGearboxSpec
 from .body_regions import transient_regions
@@ -85,7 +86,17 @@ class ArmSetup:
 
 
 def arm_setup(loaded: LoadedStudy) -> ArmSetup:
-    """Load the robot and motors and translate the study into the optimiser's inputs; every problem located."""
+    """Load the robot and motors and translate the study into the optimiser's inputs; every problem located.
+
+    With every BLAS on one thread: the same arithmetic in every process (see
+    :func:`~collision_reflex.optimize.blas.single_threaded_blas`), and the hold-pose search's many small
+    quasi-Newton steps are several times faster than with idle BLAS threads woken at each.
+    """
+    with single_threaded_blas():
+        return _arm_setup(loaded)
+
+
+def _arm_setup(loaded: LoadedStudy) -> ArmSetup:
     study = loaded.study
     assert isinstance(study, ArmStudy)
     catalogue = check_motors(loaded)
@@ -216,15 +227,13 @@ def _constraints(
 
 
 _HOLD_POSES: dict[bytes, np.ndarray] = {}
-"""Hold poses found, by :func:`_hold_key`: a run sets its study up several times (as written, as solved, per
+"""Hold poses found, by the arm's fingerprint, the payload and the actuator masses: a run sets its study up several times (as written, as solved, per
 gearbox option), and the search is a few thousand kinematics evaluations."""
 
 
 def _worst_hold_poses(arm: Arm, payload: float, actuator_mass: np.ndarray) -> np.ndarray:
     """:func:`~collision_reflex.arm.static_hold.worst_hold_poses` from the seed 0, found once per arm and load."""
-    key = hashlib.sha256(
-        pickle.dumps((arm.model, arm.contact_frame, np.asarray(arm.contact_offset), payload, actuator_mass))
-    ).digest()
+    key = hashlib.sha256(pickle.dumps((arm.fingerprint, payload, actuator_mass))).digest()
     if key not in _HOLD_POSES:
         if len(_HOLD_POSES) >= 32:
             _HOLD_POSES.pop(next(iter(_HOLD_POSES)))

@@ -18,7 +18,6 @@ from typing import Any
 
 from ..errors import InvalidParameter, StudyFileError
 from ..optimize import ContactSamples, DesignProblem, build_problem
-from ..optimize.blas import single_threaded_blas
 from ..optimize.pieces import built_problem
 from .arm_setup import ArmSetup, ExtraSamples, arm_setup, with_extra_samples
 from .checks import located_refusal, torque_out_of_reach
@@ -36,8 +35,7 @@ def study_setup(study: ResolvedStudy, extra: ExtraSamples = ()) -> ArmSetup:
     """The setup of a resolved study with the searched samples ``extra``, built once per process."""
     if extra:
         return with_extra_samples(study_setup(study), extra)
-    with single_threaded_blas():  # the same arithmetic in every process (see single_threaded_blas)
-        return arm_setup(study.loaded)
+    return arm_setup(study.loaded)
 
 
 def objective_key(objective: Mapping[str, float] | Mapping[Any, float]) -> Hashable:
