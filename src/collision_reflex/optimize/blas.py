@@ -20,9 +20,10 @@ def single_threaded_blas() -> contextlib.AbstractContextManager[object]:
     import threadpoolctl  # lazy: needed only once a solve runs
 
     if not _CASADI_BLAS_REGISTERED:
+        import scipy.linalg  # noqa: F401  # loads SciPy's OpenBLAS now: threadpoolctl limits only loaded ones
+
         threadpoolctl.register(_casadi_openblas_controller())
         _load_casadi_openblas()
-        import scipy.linalg  # noqa: F401  # loads SciPy's OpenBLAS now: threadpoolctl limits only loaded ones
         _CASADI_BLAS_REGISTERED.append(True)
     return threadpoolctl.threadpool_limits(limits=1)
 
