@@ -342,7 +342,8 @@ class ScaledGearbox(_OfferedRatios):
     with the full ``N tau_p``). ESTIMATE: the maximum input speed, where the reference gives one, scales as
     ``1/d`` (a constant pitch-line speed of the gear mesh), which the table of laws does not give.
 
-    reference: the catalogue unit scaled from (its kind, figures and source).
+    reference: the catalogue unit scaled from (its kind, figures and source; where its figures vary with the
+        ratio, its least favourable ones, as the scaled unit's ratio is free).
     ratios: the ratios the kind is sold with [-], ascending: a design relaxes them to the range between the
         first and the last; its catalogue design picks an offered one.
     largest: the largest unit of the kind one can buy (by repeated peak torque), or None: a design whose
