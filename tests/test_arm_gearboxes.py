@@ -374,6 +374,21 @@ def test_a_per_joint_gearbox_of_figures_is_scaled_into_a_joint_gearbox():
     assert second.inertia == pytest.approx(2e-6, rel=1e-12)
 
 
+def test_a_joint_fixed_at_an_offered_ratio_has_that_ratios_figures():
+    """A study fixing N = 5 with the NPS015: J1 0.17 kg cm^2, T2N 21 and T2B 40 N m at i = 5 (Beckhoff AG3300
+    manual), not the least favourable 0.25 kg cm^2, 17 and 32 N m of its ratio 3; a free ratio keeps those."""
+    from collision_reflex.study.arm_setup import arm_setup
+    from collision_reflex.study.load import parse_study
+
+    free = arm_setup(parse_study(_study_text(), "study.yaml", ROOT / "studies")).technology.gearboxes
+    assert all(g.inertia == pytest.approx(0.25e-4, rel=1e-12) for g in free)
+    fixed_text = _study_text(**{"  gear_ratio: {min: 1, max: 10}": "  gear_ratio: {min: 5, max: 5}"})
+    fixed = arm_setup(parse_study(fixed_text, "study.yaml", ROOT / "studies")).technology.gearboxes
+    for gearbox in fixed:
+        assert gearbox.ratios == (5.0,) and (gearbox.rated_torque, gearbox.peak_torque) == (21.0, 40.0)
+        assert gearbox.inertia == pytest.approx(0.17e-4, rel=1e-12)
+
+
 # --- gearboxes scaled to their motor ----------------------------------------------------------------------------
 
 

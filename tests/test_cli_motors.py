@@ -127,6 +127,10 @@ def test_motors_lists_gearbox_catalogue_too(capsys):
     row = next(line for line in out.splitlines() if line.startswith("NPS015-MF-1"))
     assert row.split()[1:6] == ["planetary", "3,4,5,7,8,10", "17", "32", "1.8"]
     assert "NPS015-MF-1: Beckhoff AG3300" in out
+    per_ratio = next(line for line in out.splitlines() if line.startswith("NPS015-MF-1 (N: "))
+    assert "3: 17/32 N m, 2.5e-05 kg m^2;" in per_ratio and per_ratio.endswith(
+        "10: 19/35 N m, 1.3e-05 kg m^2"
+    )
     assert main(["motors"]) == 0
     assert "NPS015" not in capsys.readouterr().out  # gearboxes only when asked
 

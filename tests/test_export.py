@@ -284,12 +284,17 @@ def test_urdf_limits_transmissions_and_companion(runs, robot, tmp_path):
         assert all(m.get("filename").startswith("panda_meshes/") for m in root.iter("mesh"))
 
 
-def _effort(saved) -> float:
-    """A joint's driving peak output torque: eta N tau_p, at most its catalogue gearbox's repeated peak [N m]."""
+def _effort(saved, catalogue_design: bool = False) -> float:
+    """A joint's driving peak output torque: eta N tau_p, at most its catalogue gearbox's repeated peak [N m].
+
+    A catalogue design's gearbox is sold at its ratio: the peak there (the entry's own for a continuous design).
+    """
     from collision_reflex.hardware.gearboxes import load_gearbox_catalogue
 
     driving = saved.get("gearbox_efficiency", 1.0) * saved["peak_torque"]
     gearbox = load_gearbox_catalogue().get(saved.get("gearbox") or "")
+    if gearbox is not None and catalogue_design:
+        gearbox = gearbox.at_ratio(saved["gear_ratio"])
     return driving if gearbox is None else min(driving, gearbox.peak_torque)
 
 
@@ -313,7 +318,7 @@ def test_the_catalogue_design_exports_with_its_parts_and_loads(smoke_runs, tmp_p
     for chosen, saved in zip(catalogue["joints"], catalogue["design"]["joints"], strict=True):
         assert f"catalogue motor {chosen['motor']}: {motors[chosen['motor']].source[:40]}" in text
         limit = joints[saved["joint"]].find("limit")
-        assert float(limit.get("effort")) == pytest.approx(_effort(saved), rel=1e-12)
+        assert float(limit.get("effort")) == pytest.approx(_effort(saved, True), rel=1e-12)
         speed = motors[chosen["motor"]].max_speed
         if speed is not None:
             assert float(limit.get("velocity")) <= speed / saved["gear_ratio"] * (1 + 1e-12)
@@ -336,7 +341,32 @@ def test_the_catalogue_design_exports_with_its_parts_and_loads(smoke_runs, tmp_p
         assert stiffness == saved["software_stiffness"]
     for saved in built["joints"]:  # the output torque range on the rotor, behind the joint spring
         joint = model.joint(saved["joint"] + "_rotor")
-        assert model.jnt_actfrcrange[joint.id][1] == pytest.approx(_effort(saved), rel=1e-12)
+        assert model.jnt_actfrcrange[joint.id][1] == pytest.approx(_effort(saved, True), rel=1e-12)
+
+
+def test_a_catalogue_design_is_charged_its_gearboxs_inertia_at_its_ratio(smoke_runs, tmp_path):
+    """two_link_planetary's catalogue design: each NPS015-MF-1 carries the datasheet's J1 at its own ratio in
+    designs.json, and the export's armature is N^2 (J_m + J_g(N)), its figures designs.json's digit for digit."""
+    # Beckhoff AG3300 manual, NPS015 MF mechanical data (1-stage): J1 with the 9 mm clamping hub per ratio.
+    table = {3.0: 0.25e-4, 4.0: 0.19e-4, 5.0: 0.17e-4, 7.0: 0.14e-4, 8.0: 0.14e-4, 10.0: 0.13e-4}
+    run = smoke_runs["two_link_planetary"]
+    built = json.loads((run / "designs.json").read_text())["catalogue"]["design"]
+    assert {j["gearbox"] for j in built["joints"]} == {"NPS015-MF-1"}
+    assert any(j["gear_ratio"] != 3.0 for j in built["joints"])  # a ratio below the least favourable J1
+    out = tmp_path / "built.urdf"
+    export_design(run, "catalogue", "urdf", out)
+    companion = json.loads(companion_path(out).read_text())["joints"]
+    text = out.read_text()
+    for saved in built["joints"]:
+        ratio, name = saved["gear_ratio"], saved["joint"]
+        assert saved["gearbox_inertia"] == pytest.approx(table[ratio], rel=1e-12)
+        assert saved["reflected_inertia"] == pytest.approx(
+            ratio**2 * (saved["rotor_inertia"] + table[ratio]), rel=1e-12
+        )
+        assert companion[name]["armature"] == saved["reflected_inertia"]
+        assert companion[name]["gearbox_inertia"] == saved["gearbox_inertia"]
+        armature = f"{ratio!r}^2 x ({saved['rotor_inertia']!r} + {saved['gearbox_inertia']!r}) = "
+        assert f"{name}: armature N^2 (J_m + J_g) = {armature}{saved['reflected_inertia']!r} kg m^2" in text
 
 
 def test_the_documented_armature_loop_is_set_armature(runs, tmp_path):

@@ -90,17 +90,65 @@ def test_gearbox_ratio_range(tmp_path):
     assert gearbox.continuous_ratio and gearbox.ratio_range == (50.0, 160.0)
 
 
+PER_RATIO = GEARBOX.replace(
+    "inertia: 0.25 kg*cm^2", "inertia: {3: 0.25 kg*cm^2, 5: 0.17 kg*cm^2, 10: 0.13 kg*cm^2}"
+).replace("rated_torque: 17 N*m", "rated_torque: {3: 17 N*m, 5: 21, 10: 19 N*m}")
+
+
+def test_gearbox_figures_per_ratio(tmp_path):
+    """A mapping gives each ratio its figure; the entry's own is the least favourable, safe at every ratio."""
+    _, load = _catalogue(tmp_path, PER_RATIO)
+    gearbox = load()["small"]
+    assert gearbox.inertia == pytest.approx(0.25e-4, rel=1e-12) and gearbox.rated_torque == 17.0
+    at_ten = gearbox.at_ratio(10.0)
+    assert at_ten.ratios == (10.0,) and at_ten.rated_torque == 19.0 and at_ten.peak_torque == 32.0
+    assert gearbox.inertia_at(10.0) == pytest.approx(0.13e-4, rel=1e-12)
+    assert gearbox.reflected_inertia(10.0) == pytest.approx(100 * 0.13e-4, rel=1e-12)
+    at_five = gearbox.at_ratio(5.0)
+    assert at_five.rated_torque == 21.0 and at_five.at_ratio(5.0) is at_five
+    # A ratio it does not offer (a design still free between them): the least favourable figures.
+    assert gearbox.at_ratio(7.0) is gearbox and gearbox.inertia_at(7.0) == gearbox.inertia
+    # One number keeps meaning that figure at every ratio.
+    _, plain = _catalogue(tmp_path, GEARBOX)
+    same = plain()["small"]
+    assert same.at_ratio(10.0) is same and same.reflected_inertia(10.0) == pytest.approx(
+        100 * 0.25e-4, rel=1e-12
+    )
+
+
 def test_packaged_gearboxes_match_their_datasheets():
     from collision_reflex.hardware.gearboxes import load_gearbox_catalogue
 
     gearboxes = load_gearbox_catalogue()
-    # Beckhoff AG3300 NPS015 MF, 1-stage: T2N 17 N m and T2B 32 N m at i = 3, 1.8 kg, J1 0.25 kg cm^2 (9 mm hub).
+    # Beckhoff AG3300 NPS015 MF, 1-stage, its mechanical data table: 1.8 kg; per ratio i = 3, 4, 5, 7, 8, 10
+    # T2N 17, 18, 21, 21, 19, 19 N m, T2B 32, 35, 40, 40, 35, 35 N m, J1 (9 mm hub) 0.25, 0.19, 0.17, 0.14, 0.14,
+    # 0.13 kg cm^2.
     nps = gearboxes["NPS015-MF-1"]
-    assert (nps.rated_torque, nps.peak_torque, nps.mass) == (17.0, 32.0, 1.8)
+    assert (nps.rated_torque, nps.peak_torque, nps.mass) == (17.0, 32.0, 1.8)  # the least favourable
     assert nps.inertia == pytest.approx(0.25e-4, rel=1e-12) and nps.efficiency == 0.97
+    table = {3: (17, 32, 0.25), 4: (18, 35, 0.19), 5: (21, 40, 0.17), 7: (21, 40, 0.14), 8: (19, 35, 0.14)}
+    table[10] = (19, 35, 0.13)
+    for ratio, (rated, peak, inertia) in table.items():
+        at = nps.at_ratio(ratio)
+        assert (at.rated_torque, at.peak_torque) == (rated, peak), ratio
+        assert at.inertia == pytest.approx(inertia * 1e-4, rel=1e-12) and at.momentary_torque == 80.0, ratio
+    # Beckhoff AG2400 TP010 MF, 1-stage, J1 (14 mm hub) at i = 4 and 10: 0.78 and 0.40 kg cm^2.
+    assert gearboxes["TP010-MF-1"].inertia_at(4) == pytest.approx(0.78e-4, rel=1e-12)
+    assert gearboxes["TP010-MF-1"].inertia_at(10) == pytest.approx(0.40e-4, rel=1e-12)
     assert all(
-        g.kind in cr.vocabulary.GEARBOX_KINDS and g.rated_torque <= g.peak_torque for g in gearboxes.values()
+        g.kind in cr.vocabulary.GEARBOX_KINDS
+        and all(f.rated_torque <= f.peak_torque for f in (g, *g.per_ratio))
+        for g in gearboxes.values()
     )
+
+
+def test_nps015_at_n_10_reflects_its_own_j1():
+    """At N = 10 the reflected inertia is N^2 x the table's J1 at i = 10 (0.13 kg cm^2), not J1 at i = 3 (0.25)."""
+    from collision_reflex.hardware.gearboxes import load_gearbox_catalogue
+
+    nps = load_gearbox_catalogue()["NPS015-MF-1"]
+    assert nps.reflected_inertia(10.0) == pytest.approx(10.0**2 * 0.13e-4, rel=1e-12)
+    assert nps.reflected_inertia(3.0) == pytest.approx(3.0**2 * 0.25e-4, rel=1e-12)
 
 
 GEARBOX_BAD = {
@@ -140,6 +188,49 @@ GEARBOX_BAD = {
         "exactly one",
     ),
     "unknown-kind": (GEARBOX.replace("planetary", "worm"), 3, "gearboxes.small.kind", "one of"),
+    "per-ratio-misses-a-ratio": (
+        PER_RATIO.replace(", 10: 0.13 kg*cm^2", ""),
+        8,
+        "gearboxes.small.inertia",
+        "no figure for ratio 10",
+    ),
+    "per-ratio-adds-a-ratio": (
+        PER_RATIO.replace("10: 0.13 kg*cm^2}", "10: 0.13 kg*cm^2,\n      7: 0.14 kg*cm^2}"),
+        9,
+        "gearboxes.small.inertia.7",
+        "not one of the ratios offered (3, 5, 10)",
+    ),
+    "per-ratio-with-a-range": (
+        PER_RATIO.replace("ratios: [3, 5, 10]", "ratio_range: [3, 10]"),
+        5,
+        "gearboxes.small.rated_torque",
+        "needs the list 'ratios'",
+    ),
+    "per-ratio-twice": (
+        PER_RATIO.replace("10: 0.13 kg*cm^2}", "10: 0.13 kg*cm^2, 3.0: 0.2 kg*cm^2}"),
+        8,
+        "gearboxes.small.inertia.3.0",
+        "ratio 3 given twice",
+    ),
+    "per-ratio-key-not-a-ratio": (
+        PER_RATIO.replace("5: 0.17", "five: 0.17"),
+        8,
+        "gearboxes.small.inertia",
+        "keyed by its gear ratio",
+    ),
+    "per-ratio-figure-bad-unit": (
+        PER_RATIO.replace("5: 0.17 kg*cm^2", "5: 0.17 kg"),
+        8,
+        "gearboxes.small.inertia",
+        "cannot be converted",
+    ),
+    "per-ratio-rated-above-peak": (
+        PER_RATIO.replace("10: 19 N*m", "10: 40 N*m"),
+        5,
+        "gearboxes.small.rated_torque",
+        "exceeds the peak torque 32 N m at ratio 10",
+    ),
+    "per-ratio-mass": (GEARBOX.replace("mass: 1800 g", "mass: {3: 1.8, 5: 1.8, 10: 1.8}"), 7, "mass", ""),
     "unknown-field": (
         GEARBOX.replace("    source:", "    colour: red\n    source:"),
         11,

@@ -298,8 +298,16 @@ def test_a_study_run_snaps_reports_and_resumes_without_redoing_it(smoke_runs, tm
     assert json.loads((folder / "designs.json").read_text())["catalogue"] == catalogue
 
 
-def _harmonic(name: str, ratios: tuple[float, ...], peak: float, mass: float, continuous: bool = False):
-    from collision_reflex.hardware.gearboxes import CatalogueGearbox
+def _harmonic(
+    name: str,
+    ratios: tuple[float, ...],
+    peak: float,
+    mass: float,
+    continuous: bool = False,
+    inertias: tuple[float, ...] = (),
+):
+    """A test gearbox; ``inertias``: its input inertia at each of ``ratios`` [kg m^2] (none: 1e-6 at every ratio)."""
+    from collision_reflex.hardware.gearboxes import CatalogueGearbox, RatioFigures
 
     return CatalogueGearbox(
         name=name,
@@ -309,19 +317,32 @@ def _harmonic(name: str, ratios: tuple[float, ...], peak: float, mass: float, co
         rated_torque=peak / 2,
         peak_torque=peak,
         mass=mass,
-        inertia=1e-6,
+        inertia=max(inertias, default=1e-6),  # the least favourable, as the catalogue loader makes it
         source="test figures",
         efficiency=0.8,
+        per_ratio=tuple(
+            RatioFigures(r, peak / 2, peak, None, j) for r, j in zip(ratios, inertias, strict=True)
+        )
+        if inertias
+        else (),
     )
 
 
 def test_a_gearbox_of_discrete_ratios_gets_an_offered_ratio(two_link):
     arm, problem, _ = two_link
     geared = cr.ActuatorTechnology(
-        cr.reference_motor(), 1000.0, gearboxes=(_harmonic("HD", (5.0, 10.0, 20.0, 40.0), 100.0, 0.3), None)
+        cr.reference_motor(),
+        1000.0,
+        gearboxes=(
+            _harmonic("HD", (5.0, 10.0, 20.0, 40.0), 100.0, 0.3, inertias=(4e-6, 3e-6, 2e-6, 1e-6)),
+            None,
+        ),
     )
+    inertia_at = {5.0: 4e-6, 10.0: 3e-6, 20.0: 2e-6, 40.0: 1e-6}
     # The continuous optimum may use any ratio of the gearbox's range 5-40; the catalogue design an offered one.
-    continuous = dataclasses.replace(geared.gearboxes[0], continuous_ratio=True, ratios=(5.0, 40.0))
+    continuous = dataclasses.replace(
+        geared.gearboxes[0], continuous_ratio=True, ratios=(5.0, 40.0), per_ratio=()
+    )
     technology = dataclasses.replace(geared, gearboxes=(continuous, None))
     built = cr.build_problem(arm, problem.samples, problem.space, technology, OBJECTIVE, problem.constraints)
     optimum = cr.solve(built, starts=2)
@@ -337,9 +358,15 @@ def test_a_gearbox_of_discrete_ratios_gets_an_offered_ratio(two_link):
             offered[offered >= matched].min(initial=40.0),
         }
         assert part.gear_ratio.is_fixed and part.gear_ratio.lower in bracket
+        assert part.gearbox.inertia == inertia_at[part.gear_ratio.lower]  # the gearbox as sold at its ratio
         chosen.add(part.gear_ratio.lower)
-    assert snapped.result.design.gear_ratio[0] in chosen
-    assert snapped.result.design.gearbox[0] == "HD"
+    design = snapped.result.design
+    assert design.gear_ratio[0] in chosen
+    assert design.gearbox[0] == "HD"
+    # Charged the inertia at its own ratio: N^2 (J_m + J_g(N)).
+    assert design.gearbox_inertia[0] == inertia_at[design.gear_ratio[0]]
+    expected = design.gear_ratio[0] ** 2 * (design.rotor_inertia[0] + inertia_at[design.gear_ratio[0]])
+    assert design.reflected_inertia[0] == pytest.approx(expected, rel=1e-12)
 
 
 def test_a_gearbox_given_by_its_figures_snaps_to_catalogue_gearboxes_of_its_kind(two_link):

@@ -102,6 +102,15 @@ def _print_gearboxes(gearboxes: dict[str, CatalogueGearbox]) -> None:
             f"{name:<14}{gearbox.kind:<11}{ratios:<22}{gearbox.rated_torque:>12.4g}{gearbox.peak_torque:>11.4g}"
             f"{gearbox.mass:>10.4g}{gearbox.inertia:>14.4g}{efficiency:>11}"
         )
+    per_ratio = {name: gearbox.per_ratio for name, gearbox in gearboxes.items() if gearbox.per_ratio}
+    if per_ratio:
+        print("\nFigures per ratio (the rows above show the least favourable):")
+    for name, figures in per_ratio.items():
+        each = "; ".join(
+            f"{f.ratio:g}: {f.rated_torque:.4g}/{f.peak_torque:.4g} N m, {f.inertia:.4g} kg m^2"
+            for f in figures
+        )
+        print(f"{name} (N: rated/peak torque, J_in): {each}")
     print()
     for name, gearbox in gearboxes.items():
         print(f"{name}: {gearbox.source}")

@@ -199,31 +199,30 @@ def _run_design(
         )
         rotor, ratio = float(saved["rotor_inertia"]), float(saved["gear_ratio"])
         reflected = float(saved["reflected_inertia"])
+        gearbox = str(saved.get("gearbox") or "")
+        # A catalogue design's gearbox is sold at its ratio (its figures there); a continuous design's ratio was
+        # free between the offered ones, and the optimiser charged it the entry's figures.
+        sold_at = ratio if built else None
         joints.append(
             JointActuator(
                 joint=name,
                 gear_ratio=ratio,
                 rotor_inertia=rotor,
-                # What the reflected inertia counts beyond the rotor: J_g, or 0 where the study leaves it out.
-                gearbox_inertia=max(0.0, reflected / ratio**2 - rotor),
+                gearbox_inertia=_counted_gearbox_inertia(saved, ratio, rotor, reflected),
                 reflected_inertia=reflected,
                 peak_torque=float(saved["peak_torque"]),
                 motor_peak_torque=float(saved["motor_peak_torque"]),
                 motor_mass=float(saved["motor_mass"]),
                 gearbox_mass=float(saved.get("gearbox_mass", 0.0)),
-                gearbox=str(saved.get("gearbox") or ""),
+                gearbox=gearbox,
                 gearbox_efficiency=float(saved.get("gearbox_efficiency", 1.0)),
                 motor_max_speed=None if speed is None or not math.isfinite(speed) else float(speed),
-                gearbox_max_speed=_gearbox_figure(
-                    str(saved.get("gearbox") or ""), gearboxes, "max_input_speed"
-                ),
+                gearbox_max_speed=_gearbox_figure(gearbox, sold_at, gearboxes, "max_input_speed"),
                 stator_diameter=diameter,
                 stack_length=stack,
                 nearest_motor=str(saved.get("nearest_catalogue_motor") or ""),
                 motor=motor,
-                gearbox_peak_torque=_gearbox_figure(
-                    str(saved.get("gearbox") or ""), gearboxes, "peak_torque"
-                ),
+                gearbox_peak_torque=_gearbox_figure(gearbox, sold_at, gearboxes, "peak_torque"),
                 mechanical_stiffness=float(saved["mechanical_stiffness"]),
                 software_stiffness=float(saved["software_stiffness"]),
             )
@@ -244,9 +243,29 @@ def _run_design(
     )
 
 
-def _gearbox_figure(name: str, gearboxes: Mapping[str, Any], figure: str) -> float | None:
-    """A catalogue gearbox's ``figure`` (SI); None without a gearbox, one the catalogue lacks, or no figure."""
-    value = getattr(gearboxes.get(name), figure, None) if name else None
+def _counted_gearbox_inertia(saved: JointRecord, ratio: float, rotor: float, reflected: float) -> float:
+    """What the reflected inertia ``N^2 (J_m + J_g)`` counts beyond the rotor [kg m^2]: ``J_g``, or 0.
+
+    0 where the study leaves the gearbox inertia out. The record's own ``gearbox_inertia`` (the figure the design
+    was charged at its ratio) where the reflected inertia counts it, so that the export shows designs.json's figure
+    digit for digit; else what the reflected inertia implies.
+    """
+    implied = max(0.0, reflected / ratio**2 - rotor)
+    recorded = float(saved.get("gearbox_inertia", 0.0))
+    return recorded if math.isclose(implied, recorded, rel_tol=1e-9, abs_tol=1e-12 * rotor) else implied
+
+
+def _gearbox_figure(
+    name: str, ratio: float | None, gearboxes: Mapping[str, Any], figure: str
+) -> float | None:
+    """A catalogue gearbox's ``figure`` (SI) as sold at gear ratio ``ratio`` [-] (None: the entry's own figure).
+
+    None without a gearbox, one the catalogue lacks, or no figure.
+    """
+    gearbox = gearboxes.get(name) if name else None
+    if gearbox is not None and ratio is not None:
+        gearbox = gearbox.at_ratio(ratio)
+    value = getattr(gearbox, figure, None)
     return float(value) if value is not None and math.isfinite(value) else None
 
 

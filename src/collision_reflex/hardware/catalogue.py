@@ -24,6 +24,7 @@ from .._units import QuantityError, parse_quantity
 from .._yaml import NodeProblem, check_nodes, one_line
 from ..errors import CatalogueError
 from ..vocabulary import GEARBOX_KINDS
+from .gearboxes import PER_RATIO_FIELDS
 
 CATALOGUE_LIMIT = 4 * 2**20
 """Largest catalogue file read [bytes]: the packaged ones are tens of kilobytes; a multi-megabyte one is not a
@@ -98,24 +99,43 @@ def _positive(value: float | None) -> float | None:
     return value
 
 
-def _quantity_validators(units: dict[str, str], optional: dict[str, str]) -> tuple[Any, Any]:
+def _quantity_validators(
+    units: dict[str, str], optional: dict[str, str], per_ratio: tuple[str, ...] = ()
+) -> tuple[Any, Any]:
     """An entry's validators of its quantities: each read in SI (see ``_to_si``), then a finite number > 0.
 
-    ``units`` and ``optional`` map each field to its unit; an ``optional`` field may be None.
+    ``units`` and ``optional`` map each field to its unit; an ``optional`` field may be None; a ``per_ratio``
+    field may also be a mapping gear ratio -> quantity (one figure per ratio), each figure read alike.
     """
     every = {**units, **optional}
 
     def si(cls: type, value: Any, info: Any) -> Any:
-        if value is None and info.field_name in optional:
+        name = info.field_name
+        if value is None and name in optional:
             return None
-        return _to_si(value, every[info.field_name])
+        if isinstance(value, dict) and name in per_ratio:
+            return {_ratio_key(ratio): _to_si(figure, every[name]) for ratio, figure in value.items()}
+        return _to_si(value, every[name])
 
-    def physical(cls: type, value: float | None) -> float | None:
+    def physical(cls: type, value: float | dict[float, float] | None) -> float | dict[float, float] | None:
+        if isinstance(value, dict):
+            for figure in value.values():
+                _positive(figure)
+            return value
         return _positive(value)
 
     return field_validator(*every, mode="before")(classmethod(si)), field_validator(*every)(
         classmethod(physical)
     )
+
+
+def _ratio_key(key: Any) -> float:
+    """A per-ratio mapping's key as a gear ratio [-], or ValueError saying why not."""
+    if isinstance(key, bool) or not isinstance(key, int | float) or not 1 <= float(key) < float("inf"):
+        raise ValueError(
+            f"a figure per ratio is keyed by its gear ratio (a number >= 1), got {_excerpt(key)}"
+        )
+    return float(key)
 
 
 class _Cited(BaseModel):
@@ -160,23 +180,23 @@ class _MotorEntry(_Cited):
 
 
 class _GearboxEntry(_Cited):
-    """One gearbox entry; every number in SI after validation."""
+    """One gearbox entry; every number in SI after validation; a field of ``PER_RATIO_FIELDS`` may be given per ratio."""
 
     kind: str
     ratios: list[float] | None = None
     ratio_range: list[float] | None = None
-    rated_torque: float
-    peak_torque: float
+    rated_torque: float | dict[float, float]
+    peak_torque: float | dict[float, float]
     mass: float
-    inertia: float
+    inertia: float | dict[float, float]
     efficiency: float | None = None
     stages: int = 1
-    momentary_torque: float | None = None
+    momentary_torque: float | dict[float, float] | None = None
     max_input_speed: float | None = None
     diameter: float | None = None
     length: float | None = None
 
-    _si, _physical = _quantity_validators(_GEARBOX_UNITS, _GEARBOX_OPTIONAL_UNITS)
+    _si, _physical = _quantity_validators(_GEARBOX_UNITS, _GEARBOX_OPTIONAL_UNITS, PER_RATIO_FIELDS)
 
     @field_validator("kind")
     @classmethod
@@ -422,16 +442,26 @@ def _entry(file: str, kind: str, part: str, key_node: Any, entry_node: Any) -> C
         return CatalogueError(file, _line(fields[field][1]), f"{where}.{field}", reason)
 
     values = entry.model_dump()
-    for lower, upper in (("continuous_torque", "peak_torque"), ("rated_torque", "peak_torque")):
-        if values.get(lower) is not None and values[lower] > values[upper]:
-            raise refuse(lower, f"{values[lower]:g} N m exceeds the peak torque {values[upper]:g} N m")
-    if values.get("momentary_torque") is not None and values["momentary_torque"] < values["peak_torque"]:
-        raise refuse("momentary_torque", "is below the (repeated) peak torque")
     if kind == "gearboxes":
         _check_ratios(values, fields, refuse, file, key_node, where)
-    elif kind == "motors":
+    for at, figures in _figures_at_each_ratio(values):
+        for lower, upper in (("continuous_torque", "peak_torque"), ("rated_torque", "peak_torque")):
+            if figures.get(lower) is not None and figures[lower] > figures[upper]:
+                raise refuse(
+                    lower, f"{figures[lower]:g} N m exceeds the peak torque {figures[upper]:g} N m{at}"
+                )
+        if (
+            figures.get("momentary_torque") is not None
+            and figures["momentary_torque"] < figures["peak_torque"]
+        ):
+            raise refuse("momentary_torque", f"is below the (repeated) peak torque{at}")
+    if kind == "motors":
         _check_inertia(values, refuse)
-    elif values["transient_force"] is not None and values["transient_force"] < values["quasi_static_force"]:
+    elif (
+        kind == "body_regions"
+        and values["transient_force"] is not None
+        and values["transient_force"] < values["quasi_static_force"]
+    ):
         raise refuse(
             "transient_force",
             f"{values['transient_force']:g} N is below the quasi-static force {values['quasi_static_force']:g} N "
@@ -471,6 +501,50 @@ def _check_ratios(
     low_high = values["ratio_range"]
     if low_high is not None and (len(low_high) != 2 or low_high[0] > low_high[1]):
         raise refuse("ratio_range", f"expected [min, max] with min <= max, got {low_high!r}")
+    listed = values["ratios"]
+    for field in PER_RATIO_FIELDS:
+        if not isinstance(values[field], dict):
+            continue
+        if listed is None:
+            raise refuse(
+                field,
+                "a figure per ratio needs the list 'ratios', not a 'ratio_range' (any ratio between): "
+                "give one number",
+            )
+        offered = ", ".join(f"{r:g}" for r in listed)
+        seen: set[float] = set()
+        for ratio_node, _ in fields[field][1].value:
+            ratio, text = _plain(ratio_node), str(ratio_node.value)
+            if ratio in seen:  # YAML keeps one of two equal keys (3 and 3.0): one figure would be lost
+                raise CatalogueError(
+                    file, _line(ratio_node), f"{where}.{field}.{text}", f"ratio {ratio:g} given twice"
+                )
+            seen.add(ratio)
+            if ratio not in listed:
+                raise CatalogueError(
+                    file,
+                    _line(ratio_node),
+                    f"{where}.{field}.{text}",
+                    f"not one of the ratios offered ({offered}): one figure per ratio of 'ratios'",
+                )
+        missing = [r for r in listed if r not in values[field]]
+        if missing:
+            raise refuse(
+                field,
+                f"no figure for ratio {', '.join(f'{r:g}' for r in missing)}: give one for every ratio of "
+                f"'ratios' ({offered}), or one number for all",
+            )
+
+
+def _figures_at_each_ratio(values: dict[str, Any]) -> list[tuple[str, dict[str, Any]]]:
+    """``(" at ratio N", figures)`` for each ratio of an entry with per-ratio figures; else ``[("", values)]``."""
+    per_ratio = [field for field in PER_RATIO_FIELDS if isinstance(values.get(field), dict)]
+    if not per_ratio:
+        return [("", values)]
+    return [
+        (f" at ratio {ratio:g}", {**values, **{field: values[field][ratio] for field in per_ratio}})
+        for ratio in values["ratios"]
+    ]
 
 
 def _provenance(

@@ -15,6 +15,11 @@ motor's peak output torque, so that its mass and inertia grow with the torque th
 Inertia convention: ``inertia`` is the gearbox's own inertia seen at its input (motor) shaft [kg m^2], so its
 reflected inertia at the output is ``N**2 inertia`` (the table's ``l r^4 N^2``); a ball screw's ``inertia`` is
 already the reflected one (the table's ``l r^4``, without ``N``).
+
+Figures per ratio: a datasheet may give a catalogue gearbox's inertia and torques per ratio. The entry's own
+figures are then the least favourable over its ratios (safe at every ratio, what a design whose ratio is still
+free between them is charged), and :meth:`CatalogueGearbox.at_ratio` is the gearbox as sold at one ratio, with
+that ratio's figures: what a design at an offered ratio is charged.
 """
 
 from __future__ import annotations
@@ -22,7 +27,7 @@ from __future__ import annotations
 import math
 import numbers
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, NamedTuple, Protocol
 
@@ -34,13 +39,22 @@ from ..vocabulary import GEARBOX_KINDS
 from .gearbox_scaling import GEARBOX_SCALING
 
 __all__ = [
+    "PER_RATIO_FIELDS",
     "CatalogueGearbox",
     "Gearbox",
+    "RatioFigures",
     "ScaledGearbox",
     "load_gearbox_catalogue",
 ]
 
 _STAGED = ("parallel_shaft", "planetary")
+
+PER_RATIO_FIELDS = ("rated_torque", "peak_torque", "momentary_torque", "inertia")
+"""The catalogue gearbox's fields a datasheet may give per ratio (:class:`RatioFigures`)."""
+
+RATIO_TOLERANCE = 1e-6
+"""Relative difference within which a design's gear ratio is one of a gearbox's offered ratios [-] (a ratio
+fixed at an offered one comes back from the solver equal to it, or within rounding)."""
 
 
 @dataclass(frozen=True)
@@ -196,6 +210,19 @@ class _OfferedRatios:
         return max(bounds.lower, low), min(bounds.upper, high)
 
 
+class RatioFigures(NamedTuple):
+    """A catalogue gearbox's figures at one of its ratios (those of :data:`PER_RATIO_FIELDS`, SI).
+
+    ratio [-]; rated_torque, peak_torque [N m]; momentary_torque [N m] or None; inertia at the input [kg m^2].
+    """
+
+    ratio: float
+    rated_torque: float
+    peak_torque: float
+    momentary_torque: float | None
+    inertia: float
+
+
 @dataclass(frozen=True)
 class CatalogueGearbox(_OfferedRatios):
     """A gearbox one can buy: a catalogue entry's figures (SI), as its datasheet states them.
@@ -230,6 +257,10 @@ class CatalogueGearbox(_OfferedRatios):
         Maximum input speed [rad/s], or None.
     diameter, length : float or None
         Outer diameter and length [m], or None.
+    per_ratio : tuple of RatioFigures
+        The figures at each offered ratio, in the order of ``ratios``, where the datasheet gives some per ratio;
+        empty when the figures hold at every ratio. With them, ``rated_torque``, ``peak_torque``,
+        ``momentary_torque`` and ``inertia`` are the least favourable over the ratios (see :meth:`at_ratio`).
     """
 
     name: str
@@ -247,11 +278,41 @@ class CatalogueGearbox(_OfferedRatios):
     max_input_speed: float | None = None
     diameter: float | None = None
     length: float | None = None
+    per_ratio: tuple[RatioFigures, ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.per_ratio and (
+            self.continuous_ratio or tuple(f.ratio for f in self.per_ratio) != tuple(self.ratios)
+        ):
+            raise InvalidParameter(
+                f"gearbox {self.name!r} per_ratio",
+                tuple(f.ratio for f in self.per_ratio),
+                f"the figures of each offered ratio, {tuple(self.ratios)}, in order (a ratio range has none)",
+            )
+
+    def at_ratio(self, gear_ratio: float) -> CatalogueGearbox:
+        """The gearbox as sold at ``gear_ratio`` [-]: that ratio's figures, and that ratio alone.
+
+        Itself where its figures hold at every ratio (no per-ratio figures), and at a ratio it does not offer
+        (a design whose ratio is free between its ratios): then its least favourable figures.
+        """
+        at = next(
+            (f for f in self.per_ratio if math.isclose(f.ratio, gear_ratio, rel_tol=RATIO_TOLERANCE)), None
+        )
+        if at is None or len(self.per_ratio) == 1:
+            return self
+        figures = at._asdict()
+        del figures["ratio"]
+        return replace(self, ratios=(at.ratio,), per_ratio=(at,), **figures)
+
+    def inertia_at(self, gear_ratio: float) -> float:
+        """Inertia at the input [kg m^2] at ``gear_ratio`` [-] (see :meth:`at_ratio`)."""
+        return self.at_ratio(gear_ratio).inertia
 
     def reflected_inertia(self, gear_ratio: float) -> float:
-        """Gearbox inertia seen at the output [kg m^2]: ``N**2 inertia``."""
+        """Gearbox inertia seen at the output [kg m^2]: ``N**2 J_g(N)``, ``J_g(N)`` :meth:`inertia_at` ``N``."""
         _validate.positive("gear_ratio", gear_ratio)
-        return float(gear_ratio**2 * self.inertia)
+        return float(gear_ratio**2 * self.inertia_at(gear_ratio))
 
 
 class ScaledFigures(NamedTuple):
@@ -281,7 +342,8 @@ class ScaledGearbox(_OfferedRatios):
     with the full ``N tau_p``). ESTIMATE: the maximum input speed, where the reference gives one, scales as
     ``1/d`` (a constant pitch-line speed of the gear mesh), which the table of laws does not give.
 
-    reference: the catalogue unit scaled from (its kind, figures and source).
+    reference: the catalogue unit scaled from (its kind, figures and source; where its figures vary with the
+        ratio, its least favourable ones, as the scaled unit's ratio is free).
     ratios: the ratios the kind is sold with [-], ascending: a design relaxes them to the range between the
         first and the last; its catalogue design picks an offered one.
     largest: the largest unit of the kind one can buy (by repeated peak torque), or None: a design whose
@@ -385,10 +447,28 @@ def load_gearbox_catalogue(path: str | os.PathLike[str] | None = None) -> dict[s
         listed, low_high = fields.pop("ratios"), fields.pop("ratio_range")
         for provenance in ("sources", "estimates"):
             fields.pop(provenance)
+        ratios = tuple(sorted(listed if listed is not None else low_high))
+        per_ratio = _per_ratio_figures(fields, ratios)
+        for field, least_favourable in _LEAST_FAVOURABLE.items():
+            if isinstance(fields[field], dict):  # the entry's own figure: safe at every ratio
+                fields[field] = least_favourable(fields[field].values())
         gearboxes[name] = CatalogueGearbox(
-            name=name,
-            ratios=tuple(sorted(listed if listed is not None else low_high)),
-            continuous_ratio=listed is None,
-            **fields,
+            name=name, ratios=ratios, continuous_ratio=listed is None, per_ratio=per_ratio, **fields
         )
     return gearboxes
+
+
+# The least favourable of a field's per-ratio figures: the smallest torque rating, the largest inertia.
+_LEAST_FAVOURABLE = {"rated_torque": min, "peak_torque": min, "momentary_torque": min, "inertia": max}
+
+
+def _per_ratio_figures(fields: dict[str, Any], ratios: tuple[float, ...]) -> tuple[RatioFigures, ...]:
+    """Each ratio's figures where an entry gives a field per ratio (a mapping ratio -> value); else ()."""
+    if not any(isinstance(fields[field], dict) for field in PER_RATIO_FIELDS):
+        return ()
+
+    def at(field: str, ratio: float) -> Any:
+        value = fields[field]
+        return value[ratio] if isinstance(value, dict) else value
+
+    return tuple(RatioFigures(ratio, *(at(field, ratio) for field in PER_RATIO_FIELDS)) for ratio in ratios)

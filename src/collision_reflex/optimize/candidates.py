@@ -394,8 +394,10 @@ def _screened_parts(
             below = [r for r in fits if r <= matched]
             above = [r for r in fits if r >= matched]
             bracket = sorted({*below[-1:], *above[:1]})
-            return [
-                CataloguePart(motor, Bounds.fixed(float(r), ratio.name), distance, gearbox, from_catalogue)
+            return [  # the gearbox as sold at that ratio: its figures there, where they vary with the ratio
+                CataloguePart(
+                    motor, Bounds.fixed(float(r), ratio.name), distance, gearbox.at_ratio(r), from_catalogue
+                )
                 for r in bracket
             ], ()
     with_gearbox = "" if gearbox is None else f" with {gearbox.name}"

@@ -317,6 +317,8 @@ def _joint_gearboxes(
         if isinstance(spec, str):  # a catalogue name, checked by the schema
             catalogue = catalogue if catalogue is not None else load_gearbox_catalogue()
             gearbox = catalogue[spec]
+            if bounds.is_fixed:  # a joint fixed at one of its ratios has that ratio's figures
+                gearbox = gearbox.at_ratio(bounds.lower)
         elif isinstance(spec, ScaledGearboxSpec):
             catalogue = catalogue if catalogue is not None else load_gearbox_catalogue()
             reference = catalogue[spec.scaled_from]
