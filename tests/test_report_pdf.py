@@ -20,6 +20,8 @@ import pytest
 from collision_reflex.cli import main
 from collision_reflex.report.html import SOLVER_TOLERANCE, _settled_rows, settled
 from collision_reflex.report.pdf import find_browser
+from collision_reflex.study import resolve
+from collision_reflex.study.load import load_study
 
 ROOT = Path(__file__).resolve().parents[1]
 STUDIES = {path.stem: path for path in sorted((ROOT / "studies").glob("*.yaml"))}
@@ -88,26 +90,38 @@ def printed_tables(html: str) -> _PrintedTables:
     return parser
 
 
-def _printed_report(study: Path, folder: Path) -> None:
-    """``study`` run at smoke size but with its full Pareto front and simulation (what sets the report's length:
-    sample counts only change its numbers) into ``folder / "out"``, printed to PDF."""
-    from collision_reflex.study import resolve
+_SMOKE = resolve.smoke_study
 
-    shrink = resolve.smoke_study
 
-    def smoke_keeping_the_front(data):
-        shrunk = shrink(data)
-        return {**shrunk, **{key: data[key] for key in ("pareto", "simulate") if key in data}}
+def _smoke_keeping_the_front(data: dict) -> dict:
+    """The smoke shrink, but with the study's full Pareto front and simulation: what sets the report's length
+    (sample counts only change its numbers)."""
+    shrunk = _SMOKE(data)
+    return {**shrunk, **{key: data[key] for key in ("pareto", "simulate") if data.get(key) is not None}}
 
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(resolve, "smoke_study", smoke_keeping_the_front)
-        out = folder / "out"
-        assert main(["run", str(study), "--out", str(out), "--quiet", "--smoke", "--executor", "serial"]) == 0
-        assert main(["report", str(out), "--pdf"]) == 0
+
+def _printed_report(study: Path, folder: Path, smoke_run: Path) -> None:
+    """``study`` run as :func:`_smoke_keeping_the_front` shrinks it into ``folder / "out"``, printed to PDF.
+
+    Where that is the smoke shrink itself (a front of at most its points, no simulation), the run is a copy of
+    ``smoke_run``, the shared smoke run of the study.
+    """
+    out = folder / "out"
+    data = resolve.resolved_study(load_study(study))
+    if _smoke_keeping_the_front(data) == _SMOKE(data):
+        shutil.copytree(smoke_run, out)
+    else:
+        with pytest.MonkeyPatch.context() as patch:
+            patch.setattr(resolve, "smoke_study", _smoke_keeping_the_front)
+            assert (
+                main(["run", str(study), "--out", str(out), "--quiet", "--smoke", "--executor", "serial"])
+                == 0
+            )
+    assert main(["report", str(out), "--pdf"]) == 0
 
 
 @pytest.fixture(scope="module")
-def reports(shared_folder) -> dict[str, Path]:
+def reports(shared_folder, smoke_runs) -> dict[str, Path]:
     """Every shipped study's printed report (:func:`_printed_report`), made when a test first asks for it."""
     if find_browser() is None or shutil.which("pdftotext") is None:
         pytest.skip("printing needs Chromium and pdftotext (apt-get install chromium poppler-utils)")
@@ -115,7 +129,10 @@ def reports(shared_folder) -> dict[str, Path]:
     class Printed(dict):
         def __missing__(self, name: str) -> Path:
             self[name] = (
-                shared_folder(f"pdf-{name}", lambda folder: _printed_report(STUDIES[name], folder)) / "out"
+                shared_folder(
+                    f"pdf-{name}", lambda folder: _printed_report(STUDIES[name], folder, smoke_runs[name])
+                )
+                / "out"
             )
             return self[name]
 
