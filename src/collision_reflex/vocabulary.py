@@ -37,6 +37,10 @@ GearboxKind = Literal["planetary", "parallel_shaft", "harmonic", "cycloidal", "b
 """The gearbox kinds with a scaling law (:data:`collision_reflex.hardware.gearbox_scaling.GEARBOX_SCALING`)."""
 GEARBOX_KINDS: tuple[GearboxKind, ...] = get_args(GearboxKind)
 
+PerRatioFigure = Literal["rated_torque", "peak_torque", "momentary_torque", "inertia"]
+"""The catalogue gearbox's figures a datasheet may give per ratio (a mapping gear ratio -> figure)."""
+PER_RATIO_FIELDS: tuple[PerRatioFigure, ...] = get_args(PerRatioFigure)
+
 ExecutorName = Literal["serial", "processes", "dask"]
 """Where a study's solves run: in the calling process, a local process pool, or a Dask cluster."""
 EXECUTORS: tuple[ExecutorName, ...] = get_args(ExecutorName)

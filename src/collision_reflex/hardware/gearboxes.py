@@ -35,11 +35,10 @@ import numpy as np
 
 from .. import _validate
 from ..errors import InvalidParameter
-from ..vocabulary import GEARBOX_KINDS
+from ..vocabulary import GEARBOX_KINDS, PER_RATIO_FIELDS
 from .gearbox_scaling import GEARBOX_SCALING
 
 __all__ = [
-    "PER_RATIO_FIELDS",
     "CatalogueGearbox",
     "Gearbox",
     "RatioFigures",
@@ -48,9 +47,6 @@ __all__ = [
 ]
 
 _STAGED = ("parallel_shaft", "planetary")
-
-PER_RATIO_FIELDS = ("rated_torque", "peak_torque", "momentary_torque", "inertia")
-"""The catalogue gearbox's fields a datasheet may give per ratio (:class:`RatioFigures`)."""
 
 RATIO_TOLERANCE = 1e-6
 """Relative difference within which a design's gear ratio is one of a gearbox's offered ratios [-] (a ratio
@@ -211,7 +207,7 @@ class _OfferedRatios:
 
 
 class RatioFigures(NamedTuple):
-    """A catalogue gearbox's figures at one of its ratios (those of :data:`PER_RATIO_FIELDS`, SI).
+    """A catalogue gearbox's figures at one of its ratios (those of :data:`~collision_reflex.vocabulary.PER_RATIO_FIELDS`, SI).
 
     ratio [-]; rated_torque, peak_torque [N m]; momentary_torque [N m] or None; inertia at the input [kg m^2].
     """
