@@ -135,25 +135,6 @@ def test_an_interrupted_ipopt_run_raises_keyboard_interrupt_and_is_not_retried(m
     assert len(calls) == 1  # neither retried nor followed by a feasibility solve
 
 
-def test_serial_and_process_pool_runs_give_byte_identical_result_files(smoke_runs, tmp_path):
-    """Every number, the catalogue design and its snap included (designs.json), to the last bit."""
-    serial = smoke_runs["two_link_paper"]  # the serial run
-    completed = _crx(
-        "run",
-        str(TWO_LINK),
-        "--smoke",
-        "--quiet",
-        "--executor",
-        "processes",
-        "--out",
-        str(tmp_path / "processes"),
-    )
-    assert completed.returncode == 0, completed.stderr
-    _same_results(tmp_path / "processes", serial)
-    assert "solve_time" not in (serial / "designs.json").read_text()
-    assert "solve_time" in (serial / "timings.json").read_text()
-
-
 def _run(folder: Path, *extra: str, study: Path = TWO_LINK) -> int:
     return main(
         ["run", str(study), "--smoke", "--quiet", "--executor", "serial", "--out", str(folder), *extra]
@@ -292,18 +273,6 @@ def test_a_resumed_run_removes_stale_temporary_files(two_link_run, tmp_path):
     assert _run(folder) == 0
     assert not any(path.exists() for path in stale)
     assert fresh.exists()
-
-
-def test_a_smoke_run_has_its_own_default_folder_and_its_files_get_the_umask_mode(tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)
-    previous = os.umask(0o027)
-    try:
-        assert main(["run", str(TWO_LINK), "--smoke", "--quiet", "--executor", "serial"]) == 0
-    finally:
-        os.umask(previous)
-    assert [p.name for p in (tmp_path / "results").iterdir()] == ["two-link-paper-smoke"]
-    files = [p for p in (tmp_path / "results").rglob("*") if p.is_file()]
-    assert files and {p.stat().st_mode & 0o777 for p in files} == {0o640}
 
 
 @pytest.mark.parametrize(

@@ -292,7 +292,9 @@ def _record_threads_at_fork() -> None:
         _THREADS_AT_FORK.append(threading.active_count())
 
 
-def test_a_process_pool_gives_the_serial_result_and_forks_before_the_run_starts_a_thread(runs, tmp_path):
+def test_a_process_pool_gives_the_serial_result_files_and_forks_before_the_run_starts_a_thread(
+    runs, tmp_path
+):
     """Forking copies only the forking thread: the progress bars' thread must not exist yet (fork safety).
 
     Workers are forked on Linux only: elsewhere the fork is not checked.
@@ -319,9 +321,12 @@ def test_a_process_pool_gives_the_serial_result_and_forks_before_the_run_starts_
     finally:
         _THREADS_AT_FORK = None
     assert not forked or (len(forks) == 2 and set(forks) == {before})
-    pd.testing.assert_frame_equal(
-        _numbers(tmp_path / "pool"), _numbers(runs["two_link_paper"]), check_exact=True
-    )
+    # Every number, the catalogue design and its snap included (designs.json), to the last bit.
+    serial = runs["two_link_paper"]
+    for name in ("pareto.csv", "designs.json"):
+        assert (tmp_path / "pool" / name).read_bytes() == (serial / name).read_bytes(), name
+    assert "solve_time" not in (serial / "designs.json").read_text()
+    assert "solve_time" in (serial / "timings.json").read_text()
 
 
 def test_crx_report_re_renders_from_saved_results(runs, tmp_path, capsys):
@@ -663,17 +668,26 @@ def test_the_recommended_design_is_not_dominated_and_the_verdict_says_it(runs, n
     assert html.index('id="verdict"') < html.index('id="recommended"')
 
 
-def test_crx_run_prints_the_verdict_and_the_same_study_gives_the_same_numbers(runs, tmp_path, capsys):
-    assert (
-        main(["run", str(TWO_LINK), "--out", str(tmp_path / "out"), "--smoke", "--executor", "serial"]) == 0
-    )
-    pd.testing.assert_frame_equal(
-        _numbers(tmp_path / "out"), _numbers(runs["two_link_paper"]), check_exact=True
-    )
+def test_crx_run_prints_the_verdict_into_its_default_folder_with_the_umask_and_the_same_numbers(
+    runs, tmp_path, capsys, monkeypatch
+):
+    """A smoke run without ``--out`` writes ``results/NAME-smoke``, its files with the umask's mode; the same
+    study gives the same numbers; the verdict is printed, and not with ``--quiet``."""
+    monkeypatch.chdir(tmp_path)
+    previous = os.umask(0o027)
+    try:
+        assert main(["run", str(TWO_LINK), "--smoke", "--executor", "serial"]) == 0
+    finally:
+        os.umask(previous)
+    assert [p.name for p in (tmp_path / "results").iterdir()] == ["two-link-paper-smoke"]
+    out = tmp_path / "results" / "two-link-paper-smoke"
+    files = [p for p in out.rglob("*") if p.is_file()]
+    assert files and {p.stat().st_mode & 0o777 for p in files} == {0o640}
+    pd.testing.assert_frame_equal(_numbers(out), _numbers(runs["two_link_paper"]), check_exact=True)
     printed = capsys.readouterr().out
-    verdict = json.loads((tmp_path / "out" / "designs.json").read_text())["verdict"]
+    verdict = json.loads((out / "designs.json").read_text())["verdict"]
     assert verdict and all(line in printed for line in verdict)
-    assert main(["run", str(TWO_LINK), "--out", str(tmp_path / "out"), "--smoke", "--quiet"]) == 0
+    assert main(["run", str(TWO_LINK), "--out", str(out), "--smoke", "--quiet"]) == 0
     assert verdict[0] not in capsys.readouterr().out
 
 
