@@ -246,21 +246,3 @@ def test_the_study_json_schema_documents_the_choice():
 
     text = json.dumps(study_json_schema())
     assert '"OptimizerSpec"' in text and "active sets of the contact samples" in text
-
-
-def _without_times(value):
-    """A record with its wall times dropped (they differ between runs; every number else must not)."""
-    if isinstance(value, dict):
-        return {k: _without_times(v) for k, v in value.items() if k not in ("solve_time", "build_time")}
-    if isinstance(value, list):
-        return [_without_times(v) for v in value]
-    return value
-
-
-def test_a_study_on_active_sets_gives_the_serial_numbers_through_a_process_pool(tmp_path):
-    study = _study(tmp_path, "always", count=40)  # 320 samples: the executors' agreement, not the scale
-    run_study(study, tmp_path / "serial", quiet=True, figures=False, executor="serial")
-    run_study(study, tmp_path / "pool", quiet=True, figures=False, executor="processes")
-    serial, pool = _designs(tmp_path / "serial"), _designs(tmp_path / "pool")
-    assert all(d["solver"]["method"] == "active set" for d in serial)
-    assert _without_times(pool) == _without_times(serial)

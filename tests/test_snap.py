@@ -540,11 +540,25 @@ def test_a_study_on_active_sets_snaps_on_them_and_through_a_process_pool_alike(t
     serial, pool = tmp_path / "serial", tmp_path / "pool"
     cr.run_study(study, serial, quiet=True, figures=False, smoke=True, executor="serial")
     cr.run_study(study, pool, quiet=True, figures=False, smoke=True, executor="processes", workers=2)
-    entries = [json.loads((folder / "designs.json").read_text())["catalogue"] for folder in (serial, pool)]
+    records = [json.loads((folder / "designs.json").read_text()) for folder in (serial, pool)]
+    entries = [record["catalogue"] for record in records]
     assert entries[0] == entries[1]
     solver = entries[0]["design"]["solver"]
     assert solver["method"] == "active set"
     assert 0 < solver["active_samples"] <= len(entries[0]["design"]["impulses"])
+    # Every design of the front too: the same numbers through either executor, on active sets.
+    designs = [[record["chosen"], *record["pareto"]["points"]] for record in records]
+    assert all(design["solver"]["method"] == "active set" for design in designs[0])
+    assert _without_times(designs[1]) == _without_times(designs[0])
+
+
+def _without_times(value):
+    """A record with its wall times dropped (they differ between runs; every number else must not)."""
+    if isinstance(value, dict):
+        return {k: _without_times(v) for k, v in value.items() if k not in ("solve_time", "build_time")}
+    if isinstance(value, list):
+        return [_without_times(v) for v in value]
+    return value
 
 
 @pytest.fixture(scope="module")
