@@ -228,13 +228,17 @@ def _study(tmp_path: Path, simulate: dict | None) -> Path:
 
 @pytest.fixture(scope="module")
 def simulated_run(tmp_path_factory):
+    """The study run without ``simulate`` (its designs.json), then with ``simulate: {samples: 2, detection:
+    force}`` added into the same folder: the study, the first run's record and the second run."""
     folder = tmp_path_factory.mktemp("simulated")
+    plain = run_study(_study(folder, None), folder / "out", quiet=True, figures=False)
+    record = json.loads((plain.folder / "designs.json").read_text())
     study = _study(folder, {"samples": 2, "detection": "force"})
-    return study, run_study(study, folder / "out", quiet=True, figures=False)
+    return study, record, run_study(study, folder / "out", quiet=True, figures=False)
 
 
 def test_study_simulates_the_recommended_design_on_its_worst_samples(simulated_run):
-    _, run = simulated_run
+    _, _, run = simulated_run
     designs = json.loads((run.folder / "designs.json").read_text())
     simulation = designs["simulation"]
     assert simulation["pareto"] == []
@@ -258,7 +262,7 @@ def test_study_simulates_the_recommended_design_on_its_worst_samples(simulated_r
 
 
 def test_resumed_run_does_not_simulate_again(simulated_run, monkeypatch):
-    study, run = simulated_run
+    study, _, run = simulated_run
     before = json.loads((run.folder / "designs.json").read_text())["simulation"]
 
     def refuse(*args, **kwargs):
@@ -270,16 +274,16 @@ def test_resumed_run_does_not_simulate_again(simulated_run, monkeypatch):
     assert json.loads((again.folder / "designs.json").read_text())["simulation"] == before
 
 
-def test_a_finished_run_is_simulated_afterwards_without_solving_again(tmp_path, monkeypatch):
+def test_a_finished_run_is_simulated_afterwards_without_solving_again(simulated_run):
     """The ``simulate`` section is no part of the fingerprint: added to a finished run, only it is computed."""
-    plain = run_study(_study(tmp_path, None), tmp_path / "out", quiet=True, figures=False)
-    assert "simulation" not in json.loads((plain.folder / "designs.json").read_text())
-    again = run_study(_study(tmp_path, {"samples": 1}), tmp_path / "out", quiet=True, figures=False)
+    _, plain, again = simulated_run
+    assert "simulation" not in plain
     assert again.resumed and again.computed == 0
-    assert (
-        len(json.loads((again.folder / "designs.json").read_text())["simulation"]["recommended"]["samples"])
-        == 1
-    )
+    record = json.loads((again.folder / "designs.json").read_text())
+    assert len(record["simulation"]["recommended"]["samples"]) == 2
+    assert {k: v for k, v in record.items() if k not in ("simulation", "resolved")} == {
+        k: v for k, v in plain.items() if k not in ("simulation", "resolved")
+    }  # nothing solved again: every design as the first run left it
 
 
 def test_smoke_run_and_default_do_not_simulate(tmp_path, monkeypatch):
