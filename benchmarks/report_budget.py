@@ -1,7 +1,9 @@
 """The length of each run's report: words a reader sees in report.html, words and pages of report.pdf.
 
 Usage: python benchmarks/report_budget.py RUN_DIR [RUN_DIR ...] (after crx run STUDY --out RUN_DIR); prints
-a Markdown table. The budget the tests hold every shipped study to: 2,500 words, 8 printed pages.
+a Markdown table and exits with status 1 if a report is over the budget: 2,500 words, 8 printed pages. The
+tests hold the smoke run of every shipped study to it, and the full front of the spatial arms' studies (the
+longest reports); this holds the full-size runs of every study to it.
 """
 
 from __future__ import annotations
@@ -34,6 +36,8 @@ class Words(HTMLParser):
             self.words += data.split()
 
 
+WORDS, PAGES = 2500, 8
+over = []
 print(f"load average {os.getloadavg()[0]:.2f}")
 print("| run | HTML words | PDF words | PDF pages |\n|---|---|---|---|")
 for folder in map(Path, sys.argv[1:]):
@@ -43,4 +47,10 @@ for folder in map(Path, sys.argv[1:]):
     text = subprocess.run(
         ["pdftotext", "-layout", str(folder / "report.pdf"), "-"], capture_output=True, text=True, check=True
     ).stdout
-    print(f"| {folder.name} | {len(parser.words):,} | {len(text.split()):,} | {text.count(chr(12))} |")
+    words, pages = max(len(parser.words), len(text.split())), text.count(chr(12))
+    print(f"| {folder.name} | {len(parser.words):,} | {len(text.split()):,} | {pages} |")
+    if words > WORDS or pages > PAGES:
+        over.append(folder.name)
+if over:
+    print(f"over the budget ({WORDS} words, {PAGES} pages): " + ", ".join(over))
+    sys.exit(1)

@@ -100,15 +100,18 @@ def _smoke_keeping_the_front(data: dict) -> dict:
     return {**shrunk, **{key: data[key] for key in ("pareto", "simulate") if data.get(key) is not None}}
 
 
-def _printed_report(study: Path, folder: Path, smoke_run: Path) -> None:
-    """``study`` run as :func:`_smoke_keeping_the_front` shrinks it into ``folder / "out"``, printed to PDF.
+FULL_FRONT = ("ur5", "panda", "two_link_planetary")
+"""The studies whose report is printed with its full front: those nearest to the budget in words or pages at
+full size (``benchmarks/results/report_budget.md``). The others' reports are their smoke runs';
+``benchmarks/report_budget.py`` holds every study's full-size run to the budget."""
 
-    Where that is the smoke shrink itself (a front of at most its points, no simulation), the run is a copy of
-    ``smoke_run``, the shared smoke run of the study.
-    """
+
+def _printed_report(study: Path, folder: Path, smoke_run: Path) -> None:
+    """``study``'s report printed to PDF in ``folder / "out"``: of a copy of ``smoke_run`` (the study's shared
+    smoke run), or for a study of :data:`FULL_FRONT` of a run shrunk by :func:`_smoke_keeping_the_front`."""
     out = folder / "out"
     data = resolve.resolved_study(load_study(study))
-    if _smoke_keeping_the_front(data) == _SMOKE(data):
+    if study.stem not in FULL_FRONT or _smoke_keeping_the_front(data) == _SMOKE(data):
         shutil.copytree(smoke_run, out)
     else:
         with pytest.MonkeyPatch.context() as patch:
