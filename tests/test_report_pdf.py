@@ -102,7 +102,8 @@ def _smoke_keeping_the_front(data: dict) -> dict:
 
 FULL_FRONT = ("ur5", "panda", "two_link_planetary")
 """The studies whose report is printed with its full front: those nearest to the budget in words or pages at
-full size (``benchmarks/results/report_budget.md``). The others' reports are their smoke runs';
+full size (``benchmarks/results/report_budget.md``; ur5_human_contact's smoke run keeps its whole front of
+four). The others' reports are their smoke runs';
 ``benchmarks/report_budget.py`` holds every study's full-size run to the budget."""
 
 
