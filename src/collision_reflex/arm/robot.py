@@ -28,7 +28,7 @@ from .effective import EffectiveParameters, effective_parameters
 from .joints import JointParameters
 from .kinematic_tree import joint_kinematics
 from .robots import captured_stderr, load_urdf, loaded_example_robot, parser_reason, with_locked_joints
-from .samples import ArmSamples, ContactKinematics
+from .samples import ArmSamples, ContactKinematics, GravityTerms
 
 if TYPE_CHECKING:
     from ..hardware.actuators import CurrentThreshold, ForceThreshold, PositionThreshold
@@ -350,6 +350,13 @@ class Arm:
         fields are None).
         """
         return self._contact_kinematics.samples(self.configuration_space.checked(q), full)
+
+    def gravity_terms(self, q: npt.ArrayLike) -> GravityTerms:
+        """The gravity fields of :meth:`kinematics` alone at configurations ``q`` (n, nq).
+
+        What holding the arm still needs, the same numbers without the mass matrix.
+        """
+        return self._contact_kinematics.gravity_terms(self.configuration_space.checked(q))
 
     def effective_parameters(
         self, samples: ArmSamples, directions: npt.ArrayLike, **options: Any

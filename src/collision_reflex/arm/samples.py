@@ -6,7 +6,7 @@ The stack is :class:`ArmSamples`; the task-space inverse inertia is ``J M^-1 J^T
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -16,6 +16,18 @@ from ..model import effective
 from ..model.effective import finger_mass_matrix
 from .joints import joint_array
 from .kinematic_tree import JointKinematics, forward_kinematics, plane_basis, skew, support_mask
+
+
+class GravityTerms(NamedTuple):
+    """What gravity asks of each joint, stacked over ``n`` configurations (the fields of :class:`ArmSamples`).
+
+    gravity: (n, nv) of the structure [N m]; motor_gravity: (n, nv motors, nv) per kg of each motor [N m/kg];
+    contact_gravity: (n, nv) per kg at the contact point [N m/kg].
+    """
+
+    gravity: np.ndarray
+    motor_gravity: np.ndarray
+    contact_gravity: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -207,6 +219,60 @@ class ContactKinematics:
         if not full:
             return ArmSamples(q=q, mass_matrix=mass, jacobian=jacobian)
 
+        gravity, motor_jac, rotations, origins = self._motor_jacobians(q)
+        contact_joint = self.contact_joint - 1
+        contact = origins[contact_joint] + rotations[contact_joint] @ self.contact_local
+        return ArmSamples(
+            q=q,
+            mass_matrix=mass,
+            jacobian=jacobian,
+            motor_mass_influence=np.swapaxes(motor_jac, -1, -2) @ motor_jac,
+            contact_position=contact,
+            joint_positions=np.stack(origins, axis=1),
+            **self._gravity_terms(gravity, motor_jac, jacobian3)._asdict(),
+        )
+
+    def gravity_terms(self, q: np.ndarray) -> GravityTerms:
+        """The gravity fields of :meth:`samples` alone, at checked configurations ``q`` (n, nq).
+
+        The same numbers, without the mass matrix and the motor-mass inertia terms: what holding the arm still
+        needs (:func:`collision_reflex.arm.static_hold.hold_torques`), at a fraction of the cost.
+        """
+        import pinocchio as pin
+
+        jacobian3 = np.empty((q.shape[0], 3, self.model.nv))
+        frame_jacobian, frame, aligned = (
+            pin.computeFrameJacobian,
+            self.contact_frame_id,
+            pin.LOCAL_WORLD_ALIGNED,
+        )
+        for s, qs in enumerate(q):
+            jacobian3[s] = frame_jacobian(self.model, self.data, qs, frame, aligned)[:3]
+        gravity, motor_jac, _, _ = self._motor_jacobians(q)
+        return self._gravity_terms(gravity, motor_jac, jacobian3)
+
+    def _gravity_terms(
+        self, gravity: np.ndarray, motor_jac: np.ndarray, jacobian3: np.ndarray
+    ) -> GravityTerms:
+        """The structure's gravity torques, and per kg at each motor point and at the contact point."""
+        return GravityTerms(
+            gravity=gravity,
+            motor_gravity=-np.einsum("sitj,t->sij", motor_jac, self.gravity),
+            contact_gravity=-np.einsum("stj,t->sj", jacobian3, self.gravity),
+        )
+
+    def _motor_jacobians(
+        self, q: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, list[np.ndarray], list[np.ndarray]]:
+        """Generalized gravity, the motor points' Jacobians and the joint frames at ``q`` (n, nq).
+
+        Gravity (n, nv) [N m]; Jacobians (n, motor i, 3, nv) [m/rad]; per joint its frame's rotation (n, 3, 3)
+        and origin (n, 3) [m].
+        """
+        import pinocchio as pin
+
+        model, data = self.model, self.data
+        n, nv = q.shape[0], model.nv
         spatial = np.empty((n, 6, nv))
         gravity = np.empty((n, nv))
         joint_jacobians, generalized_gravity = pin.computeJointJacobians, pin.computeGeneralizedGravity
@@ -215,24 +281,12 @@ class ContactKinematics:
             gravity[s] = generalized_gravity(model, data, qs)
         rotations, origins, motor_points = forward_kinematics(self.joints, q)
         linear, angular = spatial[:, :3], spatial[:, 3:]
-        contact_joint = self.contact_joint - 1
-        contact = origins[contact_joint] + rotations[contact_joint] @ self.contact_local
         # Motor i sits at joint i's origin on the parent link: it moves with the parent link's point there.
         points = np.stack(motor_points, axis=1)  # (n, motor i, 3)
         motor_jac = self.motor_masks[None, :, None, :] * (
             linear[:, None] - skew(points) @ angular[:, None]
         )  # (n, motor i, 3, nv)
-        return ArmSamples(
-            q=q,
-            mass_matrix=mass,
-            jacobian=jacobian,
-            gravity=gravity,
-            motor_mass_influence=np.swapaxes(motor_jac, -1, -2) @ motor_jac,
-            motor_gravity=-np.einsum("sitj,t->sij", motor_jac, self.gravity),
-            contact_gravity=-np.einsum("stj,t->sj", jacobian3, self.gravity),
-            contact_position=contact,
-            joint_positions=np.stack(origins, axis=1),
-        )
+        return gravity, motor_jac, rotations, origins
 
 
 def task_inverse_inertia(mass_matrix: np.ndarray, jacobian: np.ndarray) -> np.ndarray:

@@ -13,7 +13,7 @@ import numpy as np
 
 if TYPE_CHECKING:
     from .robot import Arm
-    from .samples import ArmSamples
+    from .samples import ArmSamples, GravityTerms
 
 HOLD_CANDIDATES = 2048
 """Configurations drawn uniformly within the joint limits to start each joint's search from."""
@@ -21,7 +21,9 @@ HOLD_STARTS = 3
 """Local searches per joint, from the candidates where its gravity torque is largest."""
 
 
-def hold_torques(kinematics: ArmSamples, payload: float, actuator_mass: np.ndarray) -> np.ndarray:
+def hold_torques(
+    kinematics: ArmSamples | GravityTerms, payload: float, actuator_mass: np.ndarray
+) -> np.ndarray:
     """Joint torques [N m] that hold the arm still, (n, nv): structure, actuators [kg] and payload [kg]."""
     assert kinematics.gravity is not None and kinematics.motor_gravity is not None
     assert kinematics.contact_gravity is not None
@@ -50,7 +52,7 @@ def worst_hold_poses(
 
         def negative(angles: np.ndarray, j: int = j) -> float:
             q = arm.configuration(np.clip(angles, lower, upper)[None])
-            return -float(abs(hold_torques(arm.kinematics(q), payload, actuator_mass)[0, j]))
+            return -float(abs(hold_torques(arm.gravity_terms(q), payload, actuator_mass)[0, j]))
 
         starts = np.argsort(-torques[:, j], kind="stable")[:HOLD_STARTS]
         best_angles, best = arm.joint_coordinates(candidates[starts[0]][None])[0], -np.inf
