@@ -14,6 +14,7 @@ import pytest
 
 import collision_reflex as cr
 from collision_reflex.errors import InvalidParameter, SimulationError
+from collision_reflex.model.impulse import phase_impulses, series_stiffness, sprung_reaction
 from collision_reflex.simulate import budget, integrator
 
 BASE = cr.simulate.CollisionSetup(0.2, 1.0, 1000.0, 100.0, 10.0, 0.3, cr.simulate.Detection("force", 3.0))
@@ -114,3 +115,12 @@ def test_the_paper_s_u8_soft_fit_runs_instead_of_being_refused() -> None:
     assert budget.estimated_steps(setup) < setup.max_steps / 10
     result = cr.simulate.simulate(setup)
     assert result.contact_end is not None and result.impulse > 0
+    # Its phases are the closed forms': impact and sensing as the paper's, and, since F_s is 6,400 x F_a, the
+    # reaction as the spring pushing the robot mass (sprung_reaction, from the ideal drive's v0 k / k_m), not the
+    # paper's constant acceleration F_a / m_r, which is far slower. The integrator's rtol is 1e-10.
+    k = series_stiffness(setup.k_m, setup.k_s)
+    paper = phase_impulses(setup.m_f, k, setup.k_m, 3.0, setup.F_a / setup.m_r, setup.v0)
+    assert result.impulse_to_detection == pytest.approx(paper.initial + paper.sensing, rel=1e-6)
+    _, reaction = sprung_reaction(3.0, setup.k_m, setup.F_a, setup.m_r, setup.v0 * k / setup.k_m)
+    assert result.impulse_reaction == pytest.approx(reaction, rel=1e-6)
+    assert paper.reaction > 50 * reaction
