@@ -11,11 +11,10 @@ def single_threaded_blas() -> contextlib.AbstractContextManager[object]:
     """A context with every BLAS on one thread.
 
     That is NumPy's, SciPy's own (its optimisers' quasi-Newton steps call it), and the OpenBLAS that CasADi
-    bundles for IPOPT and MUMPS. A threaded BLAS sums in an
-    order that depends on its thread count, and Dask workers pin it to one thread where a plain process does
-    not; the difference moves IPOPT's iterates and so the results, within the solver tolerance. With one
-    thread everywhere, every executor gives the same numbers, bitwise in practice (parallelism comes from the
-    executor's processes).
+    bundles for IPOPT and MUMPS. A threaded BLAS sums in an order that depends on its thread count, and Dask
+    workers pin it to one thread where a plain process does not; the difference moves IPOPT's iterates and so
+    the results, within the solver tolerance. With one thread everywhere, every executor gives the same
+    numbers, bitwise in practice (parallelism comes from the executor's processes).
     """
     import threadpoolctl  # lazy: needed only once a solve runs
 
