@@ -14,8 +14,9 @@ block:
   ``u`` against the commanded path reaches the threshold error;
 - reflex: the software spring is switched off and the motors push along ``-u`` with ``tau = -F_a J^T u``,
   ``F_a = min_i tau_max,i / |(J^T u)_i|`` at the configuration of detection (the closed form's reaction force);
-- the impulse is the integral of the wall's contact force until the finger has left the wall; the motors then
-  stop pushing, and a watch of two finger periods counts any touch again.
+- the impulse is the integral of the wall's contact force until the finger has left the wall (the reflex's
+  contact); the motors then stop pushing, and any touch of the wall in the two finger periods after is reported
+  on its own (``impulse_after``), not counted.
 
 The wall is MuJoCo's own soft contact (``solref``: a time constant and a damping ratio) on a small frictionless
 sphere at the contact site, stiffer than the joints along ``u`` by :data:`CONTACT_STIFFNESS_RATIO`, damped at
@@ -48,7 +49,7 @@ from .mjcf import CONTACT_SITE, CONTROLLER, ROTOR, design_mjcf, load_mujoco
 from .run_design import RunDesign, read_run_design
 from .urdf import design_urdf
 
-CONTACT_STIFFNESS_RATIO = 1000.0
+CONTACT_STIFFNESS_RATIO = 1e6
 """The wall's contact stiffness over the joints' mechanical stiffness along ``u`` (the validity map's rigid
 object): the closed form's ``k`` and ``k_m`` move by about 1/1000 in series with it."""
 
@@ -78,7 +79,7 @@ class MujocoReflex:
     predicted: the design's impulse at the sample as ``designs.json`` records it [N s].
     closed_form: the closed form at the sample against the wall's stiffness (rigid in the prediction) [N s].
     detection_time, contact_end: from the impact [s].
-    touched_again: whether the finger touched the wall again in the watch after it left.
+    impulse_after: the impulse of any touch of the wall in the watch after the finger has left it [N s] (0: none).
     timestep: MuJoCo's step [s]; contact_stiffness: the wall's stiffness along ``u`` [N/m].
     """
 
@@ -88,7 +89,7 @@ class MujocoReflex:
     closed_form: float
     detection_time: float
     contact_end: float
-    touched_again: bool
+    impulse_after: float
     timestep: float
     contact_stiffness: float
 
@@ -189,7 +190,7 @@ def mujoco_reflex(
     k_c = contact_stiffness_ratio * closed.k_m
     wall = arm_closed_form(arm, point.q, point.u, joints, contact_stiffness=k_c)
     run = _Run(mujoco, text, design, arm, joints, point, closed, k_c, steps_per_period, contact_damping_ratio)
-    impulse, detection, end, again = run.collide()
+    impulse, detection, end, after = run.collide()
     return MujocoReflex(
         sample=sample,
         impulse=impulse,
@@ -197,7 +198,7 @@ def mujoco_reflex(
         closed_form=wall.impulse(design.approach_velocity),
         detection_time=detection,
         contact_end=end,
-        touched_again=again,
+        impulse_after=after,
         timestep=run.timestep,
         contact_stiffness=k_c,
     )
@@ -319,8 +320,8 @@ class _Run:
         ET.SubElement(world, "geom", {**wall, **place})
         return mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
 
-    def collide(self) -> tuple[float, float, float, bool]:
-        """Run the collision: the impulse [N s], detection and contact-end times [s], whether it touched again.
+    def collide(self) -> tuple[float, float, float, float]:
+        """Run the collision: the impulse [N s], detection and contact-end times [s], the impulse after [N s].
 
         Times are from the first touch of the wall.
         """
@@ -334,7 +335,7 @@ class _Run:
         reference = mujoco.MjData(model)  # the commanded path's kinematics (position sensing)
         touch = detection = end = math.nan
         push: np.ndarray | None = None
-        state, impulse, again = "waiting", 0.0, False  # the detector: waiting, blanked, armed
+        state, impulse, after = "waiting", 0.0, 0.0  # the detector: waiting, blanked, armed
         limit = start + 1e4 * self.finger_period
         while data.time < limit:
             t = float(data.time)
@@ -346,7 +347,10 @@ class _Run:
             data.ctrl[self.motor] = torque / self.gear
             mujoco.mj_step(model, data)
             force = _wall_force(mujoco, model, data)
-            impulse += force * dt
+            if math.isnan(end):
+                impulse += force * dt
+            else:
+                after += force * dt
             if force > 0 and math.isnan(touch):
                 touch = t
             if push is None and not math.isnan(touch):
@@ -354,17 +358,17 @@ class _Run:
                 state, fire = _detector(state, signal >= self.threshold, t - touch >= self.blanking)
                 if fire:
                     detection, push = t - touch, self._push(data)
-            elif push is not None and math.isnan(end) and force == 0:
+            elif (
+                push is not None and math.isnan(end) and force == 0
+            ):  # the finger has left: the reflex is over
                 end = t - touch
                 limit = data.time + _WATCH_PERIODS * self.finger_period
-            elif push is not None and not math.isnan(end) and force > 0:
-                again = True
         if math.isnan(end):
             raise SimulationError(
                 f"the finger had not left the wall {limit - start:.3g} s after the start"
                 + ("" if push is not None else "; the contact was never detected")
             )
-        return impulse, detection, end, again
+        return impulse, detection, end, after
 
     def _position_error(self, reference: Any, data: Any, t: float) -> float:
         """The contact point's error along ``u`` against the commanded path [m]."""
@@ -460,7 +464,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     print(
         f"sample {result.sample}: MuJoCo impulse {result.impulse:.6g} N*s, predicted {result.predicted:.6g} N*s "
         f"({result.relative_difference:+.2%}); detected at {result.detection_time * 1e3:.3g} ms, contact over at "
-        f"{result.contact_end * 1e3:.3g} ms{'; the finger touched the wall again' if result.touched_again else ''}"
+        f"{result.contact_end * 1e3:.3g} ms{f'; it touched the wall again after, {result.impulse_after:.3g} N*s' if result.impulse_after else ''}"
     )
     return 0
 
