@@ -134,6 +134,28 @@ def contact_sample(run_dir: str | os.PathLike[str], sample: int) -> ContactSampl
     return ContactSample(q, u, float(record["impulses"][sample]))
 
 
+MODEL_SPREAD = 0.01
+"""How far the closed form's variants may move the prediction at a sample where its assumptions hold [-]."""
+
+
+def model_spread(run_dir: str | os.PathLike[str], sample: int) -> float:
+    """How much the closed form's assumptions move the catalogue design's impulse at ``sample`` [-].
+
+    The largest ``|I / I_report - 1|`` over the closed form with the robot mass still moving at detection
+    (``reaction="moving"``) and the joint-space model, which keeps the links' motion along the wall
+    (:data:`collision_reflex.simulate.design_closed_form.REACTION_MODELS`), against the report's impulse
+    (``designs.json``). Where it is small, the report's model (robot at rest at detection, the finger's motion
+    along ``u`` only) is not what sets the impulse there.
+    """
+    design = read_run_design(run_dir, "catalogue")
+    point = contact_sample(run_dir, sample)
+    joints = joint_design(design)
+    closed = arm_closed_form(joints.on(design.arm), point.q, point.u, joints, reaction="moving")
+    v0 = design.approach_velocity
+    variants = (closed.impulse(v0), closed.impulse(v0, "joint_space"))
+    return max(abs(value / point.predicted - 1) for value in variants)
+
+
 def joint_design(design: RunDesign) -> JointDesign:
     """The design's joint parameters as the arm simulator and the closed form take them."""
     joints = design.joints
@@ -455,7 +477,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument(
         "--model", metavar="FILE", help="the MJCF of `crx export RUN_DIR --design catalogue --format mjcf`"
     )
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as done:  # --help, or a usage error already printed as one line
+        return done.code if isinstance(done.code, int) else 0
     try:
         result = mujoco_reflex(args.run_dir, args.sample, args.model)
     except CollisionReflexError as error:

@@ -1,0 +1,99 @@
+"""The collision reflex of an exported catalogue design run in MuJoCo gives the report's impulse (issue 32).
+
+The UR5 smoke study's catalogue design is exported (MJCF and URDF, each loaded unmodified by MuJoCo and
+Pinocchio); :mod:`collision_reflex.export.mujoco_reflex` runs it against a rigid plastic wall at one contact
+sample, and its impulse must be the one ``designs.json`` predicts there within :data:`TOLERANCE`.
+
+The sample is chosen by a stated rule, not by trial: the first sample where the closed form's own assumptions do
+not move the prediction (:func:`~collision_reflex.export.mujoco_reflex.model_spread` within
+:data:`~collision_reflex.export.mujoco_reflex.MODEL_SPREAD`: the robot mass still moving at detection, or the
+links moving along the wall, change the closed form by less than 1 % there). Elsewhere the report's model is
+not what MuJoCo simulates (sample 6 of this run: the joint-space model is 55 % above the report, MuJoCo 64 %).
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import sys
+
+import pytest
+
+from collision_reflex.export import export_design, read_run_design
+from collision_reflex.export.mujoco_reflex import (
+    MODEL_SPREAD,
+    contact_sample,
+    joint_design,
+    main,
+    model_spread,
+    mujoco_reflex,
+)
+from collision_reflex.simulate.design_closed_form import arm_closed_form
+
+mujoco = pytest.importorskip("mujoco", reason="the mujoco extra is not installed")
+pin = pytest.importorskip("pinocchio")
+
+TOLERANCE = 0.02
+"""The issue's criterion. What the simulation adds to it, measured (benchmarks/results/export_mujoco.md): the
+wall's stiffness (1e5 to 1e6 times the joints') and damping (10 to 30 times critical) and the step move the
+impulse by 0.3 % at most; the prediction's own spread over the closed form's variants at the chosen sample is
+below 1 % (the rule)."""
+
+STUDY = "ur5"
+
+
+def _first_agreeing_sample(run) -> int:
+    """The first sample where the closed form's variants agree with the report within MODEL_SPREAD."""
+    count = len(json.loads((run / "designs.json").read_text())["samples"]["config_index"])
+    return next(s for s in range(count) if model_spread(run, s) <= MODEL_SPREAD)
+
+
+def test_mujoco_gives_the_reports_impulse_of_the_catalogue_design(smoke_runs, tmp_path):
+    run = smoke_runs[STUDY]
+    mjcf, urdf = tmp_path / "built.xml", tmp_path / "built.urdf"
+    export_design(run, "catalogue", "mjcf", mjcf)
+    export_design(run, "catalogue", "urdf", urdf)
+    mujoco.MjModel.from_xml_path(str(mjcf))  # both files load as written
+    mujoco.MjModel.from_xml_path(str(urdf))
+    pin.buildModelsFromUrdf(str(urdf), str(tmp_path))
+    sample = _first_agreeing_sample(run)
+    result = mujoco_reflex(run, sample, mjcf)
+    assert (
+        result.predicted
+        == json.loads((run / "designs.json").read_text())["catalogue"]["design"]["impulses"][sample]
+    )
+    assert abs(result.relative_difference) <= TOLERANCE, result
+    assert result.detection_time < result.contact_end
+    # A wrong model misses by far more: the rotors rigidly on the links (the 'finger' placement) at the same sample.
+    design = read_run_design(run, "catalogue")
+    point, joints = contact_sample(run, sample), joint_design(design)
+    rigid = arm_closed_form(
+        joints.on(design.arm), point.q, point.u, joints, placement="finger", reaction="at_rest"
+    )
+    assert abs(rigid.impulse(design.approach_velocity) / result.impulse - 1) > 5 * TOLERANCE
+
+
+def _one_line(argv: list[str], capsys: pytest.CaptureFixture[str]) -> str:
+    """Run the script expecting exit status 2, no output and a one-line error; return the line."""
+    capsys.readouterr()  # what a smoke run printed when the fixture made it
+    assert main(argv) == 2
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert captured.out == "" and len(lines) == 1, captured.err
+    return lines[0]
+
+
+def test_bad_inputs_are_one_line_errors(smoke_runs, tmp_path, capsys, monkeypatch):
+    run = smoke_runs[STUDY]
+    assert "sample index 0 to" in _one_line([str(run), "--sample", "999"], capsys)
+    assert "invalid int" in _one_line([str(run), "--sample", "two"], capsys)
+    assert "designs.json" in _one_line([str(tmp_path), "--sample", "0"], capsys)
+    assert "actuator study" in _one_line([str(smoke_runs["direct_drive_vs_geared"]), "--sample", "0"], capsys)
+    bare = tmp_path / "bare"
+    shutil.copytree(run, bare)
+    data = json.loads((bare / "designs.json").read_text())
+    del data["catalogue"]  # as a run with catalogue.snap off writes it
+    (bare / "designs.json").write_text(json.dumps(data))
+    assert "no catalogue design" in _one_line([str(bare), "--sample", "0"], capsys)
+    monkeypatch.setitem(sys.modules, "mujoco", None)  # as if the extra were not installed
+    assert "pip install" in _one_line([str(run), "--sample", "0"], capsys)
