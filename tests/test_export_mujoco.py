@@ -16,6 +16,7 @@ from __future__ import annotations
 import json
 import shutil
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -40,6 +41,7 @@ impulse by 0.3 % at most; the prediction's own spread over the closed form's var
 below 1 % (the rule)."""
 
 STUDY = "ur5"
+REPO = Path(__file__).resolve().parents[1]
 
 
 def _first_agreeing_sample(run) -> int:
@@ -97,3 +99,26 @@ def test_bad_inputs_are_one_line_errors(smoke_runs, tmp_path, capsys, monkeypatc
     assert "no catalogue design" in _one_line([str(bare), "--sample", "0"], capsys)
     monkeypatch.setitem(sys.modules, "mujoco", None)  # as if the extra were not installed
     assert "pip install" in _one_line([str(run), "--sample", "0"], capsys)
+
+
+def test_the_blocked_stiffness_is_the_papers_form():
+    """``arm_closed_form(..., stiffness_form="paper")`` (used by the sample rule) has the sensing stiffness
+    ``u^T J^-T K J^-1 u`` of the planar two-link arm, above the compliance form ``1 / (u^T J K^-1 J^T u)`` (the
+    links free along the wall)."""
+    import numpy as np
+
+    from collision_reflex import Arm
+    from collision_reflex.simulate.design_closed_form import JointDesign
+
+    arm = Arm.from_urdf(str(REPO / "designs" / "planar_two_link.urdf"), "tip")
+    q, u = np.array([0.3, 0.9]), np.array([0.6, 0.8])
+    stiffness = np.array([400.0, 150.0])
+    joints = JointDesign(stiffness, 1e-3, 50.0, 3.0)
+    jac = arm.kinematics(q[None]).jacobian[0]
+    inverse = np.linalg.inv(jac)
+    blocked = arm_closed_form(arm, q, u, joints, stiffness_form="paper")
+    free = arm_closed_form(arm, q, u, joints)
+    # The lumped stiffness k of the sensing phase (the software spring infinite here: k is the joints' own).
+    assert blocked.k == pytest.approx(u @ inverse.T @ np.diag(stiffness) @ inverse @ u, rel=1e-12)
+    assert free.k == pytest.approx(1 / (u @ jac @ np.diag(1 / stiffness) @ jac.T @ u), rel=1e-12)
+    assert blocked.k > free.k

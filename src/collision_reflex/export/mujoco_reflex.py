@@ -141,18 +141,24 @@ MODEL_SPREAD = 0.01
 def model_spread(run_dir: str | os.PathLike[str], sample: int) -> float:
     """How much the closed form's assumptions move the catalogue design's impulse at ``sample`` [-].
 
-    The largest ``|I / I_report - 1|`` over the closed form with the robot mass still moving at detection
-    (``reaction="moving"``) and the joint-space model, which keeps the links' motion along the wall
-    (:data:`collision_reflex.simulate.design_closed_form.REACTION_MODELS`), against the report's impulse
-    (``designs.json``). Where it is small, the report's model (robot at rest at detection, the finger's motion
-    along ``u`` only) is not what sets the impulse there.
+    The largest ``|I / I_report - 1|`` against the report's impulse (``designs.json``) over the closed form with
+    the robot mass still moving at detection (``reaction="moving"``), the joint-space model, which keeps the
+    links' motion along the wall (:data:`collision_reflex.simulate.design_closed_form.REACTION_MODELS`), and,
+    for a square Jacobian, the sensing stiffness ``k`` with the links blocked along the wall (the paper's form):
+    on a sensing phase shorter than the links' own period along the wall their inertia holds them, and the force
+    rises with that stiffness, not the compliance form's. Where the spread is small, the report's model (robot at
+    rest at detection, the links free along the wall) is not what sets the impulse there.
     """
     design = read_run_design(run_dir, "catalogue")
     point = contact_sample(run_dir, sample)
     joints = joint_design(design)
-    closed = arm_closed_form(joints.on(design.arm), point.q, point.u, joints, reaction="moving")
+    arm = joints.on(design.arm)
+    closed = arm_closed_form(arm, point.q, point.u, joints, reaction="moving")
     v0 = design.approach_velocity
-    variants = (closed.impulse(v0), closed.impulse(v0, "joint_space"))
+    variants = [closed.impulse(v0), closed.impulse(v0, "joint_space")]
+    if arm.task_dim == arm.nv:
+        blocked = arm_closed_form(arm, point.q, point.u, joints, reaction="at_rest", stiffness_form="paper")
+        variants.append(blocked.impulse(v0))
     return max(abs(value / point.predicted - 1) for value in variants)
 
 
@@ -486,10 +492,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except CollisionReflexError as error:
         print(f"{parser.prog}: error: {error}", file=sys.stderr)
         return 2
+    later = f"; a later touch, not counted: {result.impulse_after:.3g} N*s" if result.impulse_after else ""
     print(
         f"sample {result.sample}: MuJoCo impulse {result.impulse:.6g} N*s, predicted {result.predicted:.6g} N*s "
         f"({result.relative_difference:+.2%}); detected at {result.detection_time * 1e3:.3g} ms, contact over at "
-        f"{result.contact_end * 1e3:.3g} ms{f'; it touched the wall again after, {result.impulse_after:.3g} N*s' if result.impulse_after else ''}"
+        f"{result.contact_end * 1e3:.3g} ms{later}"
     )
     return 0
 
