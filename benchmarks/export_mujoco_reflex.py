@@ -1,9 +1,9 @@
 """The catalogue design's collision reflex in MuJoCo against the report's impulse, sample by sample.
 
-Runs the smoke size of the UR5 and the planar two-link (planetary) studies, exports each catalogue design's MJCF
+Runs the smoke size of the UR5 and the two planar two-link studies, exports each catalogue design's MJCF
 and runs :mod:`collision_reflex.export.mujoco_reflex` on its first samples. Per sample it prints the spread of
-the closed form's variants (the robot moving at detection, the links moving along the wall: how much the
-report's assumptions matter there), the report's impulse, MuJoCo's, their relative difference, the impulse of a
+the closed form's variants (the robot moving at detection, the links moving along the wall, the links blocked
+along the wall in the sensing phase: how much the report's assumptions matter there), the report's impulse, MuJoCo's, their relative difference, the impulse of a
 later touch (not counted) and the wall time. Then, at the UR5's first sample with a spread within 1 % (the test's
 sample), how the wall's stiffness and damping and the step move MuJoCo's impulse, and what the arm simulator's
 own wall (1000 x the joints' stiffness, damping ratio 2) gives there.
@@ -24,7 +24,7 @@ from collision_reflex.cli import main as crx
 from collision_reflex.export import export_design
 from collision_reflex.export.mujoco_reflex import MODEL_SPREAD, model_spread, mujoco_reflex
 
-STUDIES = ("ur5", "two_link_planetary")
+STUDIES = ("ur5", "two_link_planetary", "two_link_paper")
 ROOT = Path(__file__).resolve().parents[1]
 
 

@@ -6,9 +6,11 @@ sample, and its impulse must be the one ``designs.json`` predicts there within :
 
 The sample is chosen by a stated rule, not by trial: the first sample where the closed form's own assumptions do
 not move the prediction (:func:`~collision_reflex.export.mujoco_reflex.model_spread` within
-:data:`~collision_reflex.export.mujoco_reflex.MODEL_SPREAD`: the robot mass still moving at detection, or the
-links moving along the wall, change the closed form by less than 1 % there). Elsewhere the report's model is
-not what MuJoCo simulates (sample 6 of this run: the joint-space model is 55 % above the report, MuJoCo 64 %).
+:data:`~collision_reflex.export.mujoco_reflex.MODEL_SPREAD`: the robot mass still moving at detection, the links
+moving along the wall, or, for a square Jacobian, blocked along it in the sensing phase, change the closed form
+by less than 1 % there). Elsewhere the report's model is not what MuJoCo simulates (sample 6 of this run: the
+joint-space model is 55 % above the report, MuJoCo 64 %). The same rule does not guarantee 2 % everywhere:
+``benchmarks/results/export_mujoco.md`` lists the samples where it does not hold.
 """
 
 from __future__ import annotations
