@@ -124,3 +124,35 @@ def test_the_blocked_stiffness_is_the_papers_form():
     assert blocked.k == pytest.approx(u @ inverse.T @ np.diag(stiffness) @ inverse @ u, rel=1e-12)
     assert free.k == pytest.approx(1 / (u @ jac @ np.diag(1 / stiffness) @ jac.T @ u), rel=1e-12)
     assert blocked.k > free.k
+
+
+def _edited_model(run, tmp_path, **numerics: str):
+    """The catalogue design's MJCF with controller numerics replaced (``None``: removed)."""
+    import xml.etree.ElementTree as ET
+
+    path = tmp_path / "edited.xml"
+    export_design(run, "catalogue", "mjcf", path)
+    root = ET.parse(path).getroot()
+    custom = root.find("custom")
+    for name, value in numerics.items():
+        element = custom.find(f"numeric[@name='collision_reflex_{name}']")
+        if value is None:
+            custom.remove(element)
+        else:
+            element.set("data", value)
+    ET.ElementTree(root).write(path)
+    return path
+
+
+def test_the_script_runs_the_controller_the_model_carries(smoke_runs, tmp_path, capsys):
+    """Position sensing set in the MJCF's controller block: the finger stops at the impact and the commanded path
+    runs on at v0, so the error reaches e_th after e_th / v0 (within 2 %: the links still move a little); a
+    model without a number of the block is a one-line error."""
+    run = smoke_runs[STUDY]
+    error = 2e-4  # [m]
+    model = _edited_model(run, tmp_path, position_sensing="1", threshold=repr(error))
+    result = mujoco_reflex(run, 2, model)
+    v0 = read_run_design(run, "catalogue").approach_velocity
+    assert result.detection_time == pytest.approx(error / v0, rel=0.02)
+    broken = _edited_model(run, tmp_path, approach_velocity=None)
+    assert "approach_velocity" in _one_line([str(run), "--sample", "2", "--model", str(broken)], capsys)

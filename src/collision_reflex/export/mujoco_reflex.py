@@ -28,6 +28,8 @@ the closed form leaves it out. MuJoCo is imported when a run starts (the ``mujoc
 from __future__ import annotations
 
 import argparse
+import copy
+import dataclasses
 import math
 import os
 import sys
@@ -40,6 +42,7 @@ from typing import Any, NoReturn
 import numpy as np
 
 from ..errors import CollisionReflexError, InvalidParameter, SimulationError
+from ..model.sensing import threshold_force
 from ..record.read import checked_run_record, read_saved_record
 from ..report.files import DESIGNS
 from ..simulate.arm_dynamics import impact_pulse_duration
@@ -151,15 +154,26 @@ def model_spread(run_dir: str | os.PathLike[str], sample: int) -> float:
     """
     design = read_run_design(run_dir, "catalogue")
     point = contact_sample(run_dir, sample)
-    joints = joint_design(design)
-    arm = joints.on(design.arm)
-    closed = arm_closed_form(arm, point.q, point.u, joints, reaction="moving")
+    closed = sample_closed_form(design, point, reaction="moving")
     v0 = design.approach_velocity
     variants = [closed.impulse(v0), closed.impulse(v0, "joint_space")]
-    if arm.task_dim == arm.nv:
-        blocked = arm_closed_form(arm, point.q, point.u, joints, reaction="at_rest", stiffness_form="paper")
+    if design.arm.task_dim == design.arm.nv:
+        blocked = sample_closed_form(design, point, reaction="at_rest", stiffness_form="paper")
         variants.append(blocked.impulse(v0))
     return max(abs(value / point.predicted - 1) for value in variants)
+
+
+def sample_closed_form(design: RunDesign, point: ContactSample, **options: Any) -> ArmClosedForm:
+    """The design's closed form at the sample, its threshold as the force at detection.
+
+    For position sensing that is ``k e_th`` with the sample's (rigid-contact) ``k``, as the optimiser takes it
+    (:func:`collision_reflex.model.sensing.threshold_force`). ``options``: those of :func:`arm_closed_form`.
+    """
+    joints = joint_design(design)
+    arm = joints.on(design.arm)
+    stiffness = arm_closed_form(arm, point.q, point.u, joints).k
+    force = float(threshold_force(design.sensing, design.threshold, stiffness))
+    return arm_closed_form(arm, point.q, point.u, dataclasses.replace(joints, threshold=force), **options)
 
 
 def joint_design(design: RunDesign) -> JointDesign:
@@ -198,11 +212,15 @@ def mujoco_reflex(
     Raises
     ------
     MujocoMissing: MuJoCo is not installed.
-    InvalidParameter: not an arm study, no catalogue design, a sample out of range, a model without the
-        design's rotors or controller block.
+    InvalidParameter: not an arm study, no catalogue design, a sample out of range, a design sensed otherwise
+        than by force or position, a model without the design's rotors or controller block.
     """
     mujoco = load_mujoco()
     design = read_run_design(run_dir, "catalogue")
+    if design.sensing not in ("force", "position"):
+        raise InvalidParameter(
+            "run_dir", str(run_dir), "a design with force or position sensing", f"not {design.sensing!r}"
+        )
     if not all(math.isfinite(j.mechanical_stiffness) for j in design.joints) or design.placement != "robot":
         raise InvalidParameter(
             "run_dir",
@@ -211,13 +229,14 @@ def mujoco_reflex(
             "the reflex needs the rotors as degrees of freedom of their own",
         )
     point = contact_sample(run_dir, sample)
-    text = _model_text(design, model)
+    root = _parsed(_model_text(design, model))
+    design = _as_modelled(design, root)
     joints = joint_design(design)
     arm = joints.on(design.arm)
-    closed = arm_closed_form(arm, point.q, point.u, joints)
+    closed = sample_closed_form(design, point)
     k_c = contact_stiffness_ratio * closed.k_m
-    wall = arm_closed_form(arm, point.q, point.u, joints, contact_stiffness=k_c)
-    run = _Run(mujoco, text, design, arm, joints, point, closed, k_c, steps_per_period, contact_damping_ratio)
+    wall = sample_closed_form(design, point, contact_stiffness=k_c)
+    run = _Run(mujoco, root, design, arm, joints, point, closed, k_c, steps_per_period, contact_damping_ratio)
     impulse, detection, end, after = run.collide()
     return MujocoReflex(
         sample=sample,
@@ -251,7 +270,7 @@ class _Run:
     def __init__(
         self,
         mujoco: Any,
-        text: str,
+        root: ET.Element,
         design: RunDesign,
         arm: Any,
         joints: JointDesign,
@@ -275,9 +294,8 @@ class _Run:
         self.position_sensing = design.sensing == "position"
         m_f = closed.m_f
         omega = math.sqrt(contact_stiffness / m_f)
-        time_constant = 1 / (
-            omega * damping_ratio
-        )  # MuJoCo's solref: stiffness omega^2, damping 2 zeta omega
+        # MuJoCo's solref (time constant, damping ratio): stiffness omega^2, damping 2 zeta omega, per unit mass.
+        time_constant = 1 / (omega * damping_ratio)
         periods = [2 * math.pi / omega, 2 * math.pi * time_constant] + [
             2 * math.pi * math.sqrt(j.reflected_inertia / (j.software_stiffness + j.mechanical_stiffness))
             for j in design.joints
@@ -285,33 +303,22 @@ class _Run:
         self.timestep = min(periods) / steps_per_period
         self.finger_period = 2 * math.pi * math.sqrt(m_f / closed.k_m)
         damping = damping_from_ratio(damping_ratio, m_f, contact_stiffness)
-        self.model = self._compile(text, design, time_constant, damping_ratio)
+        self.model = self._compile(root, time_constant, damping_ratio)
         self.blanking = (
             0.0
             if self.position_sensing
             else impact_pulse_duration(m_f, contact_stiffness, damping, closed.k_m, self.v0, design.threshold)
         )
-        self.threshold = float(self.model.numeric(f"{CONTROLLER}threshold").data[0])
+        self.threshold = design.threshold
         self.link = np.array([self.model.joint(n).qposadr[0] for n in self.names])
         self.rotor = np.array([self.model.joint(n + ROTOR).qposadr[0] for n in self.names])
         self.motor = np.array([self.model.actuator(n + "_motor").id for n in self.names])
 
-    def _compile(self, text: str, design: RunDesign, time_constant: float, damping_ratio: float) -> Any:
+    def _compile(self, root: ET.Element, time_constant: float, damping_ratio: float) -> Any:
         """The MJCF with the wall, the finger sphere (the only pair that collides), no gravity, the step."""
         mujoco = self.mujoco
-        root = _parsed(text)
-        numerics = [f"{j.joint}_software_stiffness" for j in design.joints]
-        for name in ("threshold", "approach_velocity", *numerics):
-            if root.find(f"custom/numeric[@name='{CONTROLLER}{name}']") is None:
-                raise InvalidParameter(
-                    "model", design.label, f"an MJCF with the controller block ({CONTROLLER}{name})"
-                )
-        names = {j.get("name") for j in root.iter("joint")}
-        if any(j.joint + ROTOR not in names for j in design.joints):
-            raise InvalidParameter("model", design.label, "an MJCF with the design's rotors (JOINT_rotor)")
-        site = next((s for s in root.iter("site") if s.get("name") == CONTACT_SITE), None)
-        if site is None:
-            raise InvalidParameter("model", design.label, f"an MJCF with the site {CONTACT_SITE}")
+        root = copy.deepcopy(root)
+        site = next(s for s in root.iter("site") if s.get("name") == CONTACT_SITE)  # checked by _as_modelled
         default = ET.Element("default")
         ET.SubElement(default, "geom", contype="0", conaffinity="0")
         root.insert(1, default)
@@ -450,6 +457,50 @@ def _wall_force(mujoco: Any, model: Any, data: Any) -> float:
         mujoco.mj_contactForce(model, data, i, wrench)
         force += wrench[0]
     return force
+
+
+def _as_modelled(design: RunDesign, root: ET.Element) -> RunDesign:
+    """``design`` with the controller of the MJCF ``root`` (threshold, sensing, approach velocity, ``k_s``).
+
+    Raises :class:`InvalidParameter` for a model without the design's rotors, the contact site or a number of the
+    controller block.
+    """
+    names = {j.get("name") for j in root.iter("joint")}
+    if any(j.joint + ROTOR not in names for j in design.joints):
+        raise InvalidParameter("model", design.label, "an MJCF with the design's rotors (JOINT_rotor)")
+    if not any(s.get("name") == CONTACT_SITE for s in root.iter("site")):
+        raise InvalidParameter("model", design.label, f"an MJCF with the site {CONTACT_SITE}")
+
+    def numeric(name: str) -> float:
+        element = root.find(f"custom/numeric[@name='{CONTROLLER}{name}']")
+        try:
+            return float(str(element.get("data")) if element is not None else "nan")
+        except ValueError:
+            return math.nan
+
+    stiffnesses = [f"{j.joint}_software_stiffness" for j in design.joints]
+    values = {
+        name: numeric(name) for name in ("threshold", "position_sensing", "approach_velocity", *stiffnesses)
+    }
+    bad = [name for name, value in values.items() if not value > 0 and name != "position_sensing"]
+    if bad or values["position_sensing"] not in (0.0, 1.0):
+        name = (bad or ["position_sensing"])[0]
+        raise InvalidParameter(
+            "model",
+            design.label,
+            f"an MJCF whose controller block has {CONTROLLER}{name} (crx export writes it)",
+        )
+    joints = tuple(
+        dataclasses.replace(j, software_stiffness=values[f"{j.joint}_software_stiffness"])
+        for j in design.joints
+    )
+    return dataclasses.replace(
+        design,
+        joints=joints,
+        threshold=values["threshold"],
+        sensing="position" if values["position_sensing"] else "force",
+        approach_velocity=values["approach_velocity"],
+    )
 
 
 def _parsed(text: str) -> ET.Element:
