@@ -53,8 +53,12 @@ from .run_design import RunDesign, read_run_design
 from .urdf import design_urdf
 
 CONTACT_STIFFNESS_RATIO = 1e6
-"""The wall's contact stiffness over the joints' mechanical stiffness along ``u`` (the validity map's rigid
-object): the closed form's ``k`` and ``k_m`` move by about 1/1000 in series with it."""
+"""The wall's contact stiffness over the joints' mechanical stiffness along ``u``: the closed form's ``k`` and
+``k_m`` move by about 1e-6 in series with it, and the wall's damper, which a contact sensor also reads, carries a
+share of the force in the sensing ramp that falls as one over its square root
+(:func:`collision_reflex.simulate.validity.damper_share`). Against the validity map's rigid object (1000 times
+the joints') with this damping, the UR5 catalogue design's contact force stays above its threshold from the
+impact on, and the force sensor detects only at the end of its blanking window."""
 
 CONTACT_DAMPING_RATIO = 10.0
 """The wall's damping, a ratio of critical for the finger mass: a plastic impact. The finger alone leaves such a
@@ -82,6 +86,7 @@ class MujocoReflex:
     predicted: the design's impulse at the sample as ``designs.json`` records it [N s].
     closed_form: the closed form at the sample against the wall's stiffness (rigid in the prediction) [N s].
     detection_time, contact_end: from the impact [s].
+    detected_impulse: the impulse until detection [N s] (the closed form's impact and sensing phases).
     impulse_after: the impulse of any touch of the wall in the watch after the finger has left it [N s] (0: none).
     timestep: MuJoCo's step [s]; contact_stiffness: the wall's stiffness along ``u`` [N/m].
     """
@@ -91,6 +96,7 @@ class MujocoReflex:
     predicted: float
     closed_form: float
     detection_time: float
+    detected_impulse: float
     contact_end: float
     impulse_after: float
     timestep: float
@@ -208,6 +214,10 @@ def mujoco_reflex(
         here the same way.
     contact_stiffness_ratio: the wall's stiffness over the joints' along ``u`` [-].
     steps_per_period: MuJoCo steps per shortest period in play [-].
+    contact_damping_ratio: the wall's damping, a ratio of critical for the finger mass [-].
+
+    The controller (threshold, sensing, approach velocity, software stiffnesses) is the model's controller
+    block; the prediction is ``designs.json``'s at the design's own.
 
     Raises
     ------
@@ -237,13 +247,14 @@ def mujoco_reflex(
     k_c = contact_stiffness_ratio * closed.k_m
     wall = sample_closed_form(design, point, contact_stiffness=k_c)
     run = _Run(mujoco, root, design, arm, joints, point, closed, k_c, steps_per_period, contact_damping_ratio)
-    impulse, detection, end, after = run.collide()
+    impulse, detection, detected, end, after = run.collide()
     return MujocoReflex(
         sample=sample,
         impulse=impulse,
         predicted=point.predicted,
         closed_form=wall.impulse(design.approach_velocity),
         detection_time=detection,
+        detected_impulse=detected,
         contact_end=end,
         impulse_after=after,
         timestep=run.timestep,
@@ -355,10 +366,10 @@ class _Run:
         ET.SubElement(world, "geom", {**wall, **place})
         return mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
 
-    def collide(self) -> tuple[float, float, float, float]:
-        """Run the collision: the impulse [N s], detection and contact-end times [s], the impulse after [N s].
+    def collide(self) -> tuple[float, float, float, float, float]:
+        """Run the collision; its impulse, detection time, impulse until then, contact end, impulse after.
 
-        Times are from the first touch of the wall.
+        Impulses in [N s], times in [s] from the first touch of the wall.
         """
         mujoco, model = self.mujoco, self.model
         data = mujoco.MjData(model)
@@ -368,7 +379,7 @@ class _Run:
         data.time = start
         mujoco.mj_forward(model, data)
         reference = mujoco.MjData(model)  # the commanded path's kinematics (position sensing)
-        touch = detection = end = math.nan
+        touch = detection = detected = end = math.nan
         push: np.ndarray | None = None
         state, impulse, after = "waiting", 0.0, 0.0  # the detector: waiting, blanked, armed
         limit = start + 1e4 * self.finger_period
@@ -392,7 +403,7 @@ class _Run:
                 signal = self._position_error(reference, data, t) if self.position_sensing else force
                 state, fire = _detector(state, signal >= self.threshold, t - touch >= self.blanking)
                 if fire:
-                    detection, push = t - touch, self._push(data)
+                    detection, detected, push = t - touch, impulse, self._push(data)
             elif (
                 push is not None and math.isnan(end) and force == 0
             ):  # the finger has left: the reflex is over
@@ -403,7 +414,7 @@ class _Run:
                 f"the finger had not left the wall {limit - start:.3g} s after the start"
                 + ("" if push is not None else "; the contact was never detected")
             )
-        return impulse, detection, end, after
+        return impulse, detection, detected, end, after
 
     def _position_error(self, reference: Any, data: Any, t: float) -> float:
         """The contact point's error along ``u`` against the commanded path [m]."""
