@@ -37,10 +37,11 @@ mujoco = pytest.importorskip("mujoco", reason="the mujoco extra is not installed
 pin = pytest.importorskip("pinocchio")
 
 TOLERANCE = 0.02
-"""The issue's criterion. What the simulation adds to it, measured (benchmarks/results/export_mujoco.md): the
-wall's stiffness (1e5 to 1e6 times the joints') and damping (10 to 30 times critical) and the step move the
-impulse by 0.3 % at most; the prediction's own spread over the closed form's variants at the chosen sample is
-below 1 % (the rule)."""
+"""The issue's criterion. At the chosen sample (measured: -0.18 %, benchmarks/results/export_mujoco.md) the wall's
+stiffness (1e5 to 1e6 times the joints'), its damping (10 to 30 times critical) and the step move MuJoCo's
+impulse by 0.6 % at most, and the closed form's variants move the prediction by less than 1 % (the rule): 2 %
+holds both with a margin. The impact phase ``m_f v0`` is 98 % of the impulse there, so the check is mostly one
+of the finger mass and the plastic impact; the rotors rigidly on the links change it by far more than 2 %."""
 
 STUDY = "ur5"
 REPO = Path(__file__).resolve().parents[1]

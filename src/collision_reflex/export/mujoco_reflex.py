@@ -60,14 +60,19 @@ share of the force in the sensing ramp that falls as one over its square root
 the joints') with this damping, the UR5 catalogue design's contact force stays above its threshold from the
 impact on, and the force sensor detects only at the end of its blanking window."""
 
-CONTACT_DAMPING_RATIO = 10.0
+CONTACT_DAMPING_RATIO = 30.0
 """The wall's damping, a ratio of critical for the finger mass: a plastic impact. The finger alone leaves such a
-wall at 0.0024 of its speed (0.048 at the arm simulator's default of 2, which is too elastic here: at an approach
-many times ``v*`` the finger's flight after that rebound outlasts the sensing phase, and its second impact sets
-the detection; see ``benchmarks/results/export_mujoco.md``)."""
+wall at 0.028 % of its speed (4.8 % at the arm simulator's default of 2, which is too elastic here: at an
+approach many times ``v*`` the finger's flight after that rebound outlasts the sensing phase, and its second
+impact sets the detection). The more damped, the shorter the impact pulse's tail, which a force sensor must see
+fall below its threshold before the sensing ramp crosses it: near a singularity (a finger of 100 kg and more
+against a threshold of a few newtons) 10 times critical still holds it above; see
+``benchmarks/results/export_mujoco.md``."""
 
-STEPS_PER_PERIOD = 40
-"""MuJoCo steps per shortest period in play: the wall's time constant and period, each rotor on its springs."""
+STEPS_PER_PERIOD = 20
+"""MuJoCo steps per shortest period in play: the wall's time constant and period, each rotor on its springs (20
+steps per ``2 pi`` time constants: 0.31 of the time constant, within MuJoCo's least of two steps per time
+constant)."""
 
 FINGER_RADIUS = 1e-3
 """The sphere at the contact site that touches the wall [m]; the force's line passes through its centre."""
