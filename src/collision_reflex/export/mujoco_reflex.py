@@ -48,6 +48,7 @@ from ..report.files import DESIGNS
 from ..simulate.arm_dynamics import impact_pulse_duration
 from ..simulate.contact import damping_from_ratio
 from ..simulate.design_closed_form import ArmClosedForm, JointDesign, arm_closed_form
+from ..vocabulary import OPTIMIZED_SENSING_SCHEMES
 from .mjcf import CONTACT_SITE, CONTROLLER, ROTOR, design_mjcf, load_mujoco
 from .run_design import RunDesign, read_run_design
 from .urdf import design_urdf
@@ -232,7 +233,7 @@ def mujoco_reflex(
     """
     mujoco = load_mujoco()
     design = read_run_design(run_dir, "catalogue")
-    if design.sensing not in ("force", "position"):
+    if design.sensing not in OPTIMIZED_SENSING_SCHEMES:
         raise InvalidParameter(
             "run_dir", str(run_dir), "a design with force or position sensing", f"not {design.sensing!r}"
         )
