@@ -48,6 +48,7 @@ from ..report.files import DESIGNS
 from ..simulate.arm_dynamics import impact_pulse_duration
 from ..simulate.contact import damping_from_ratio
 from ..simulate.design_closed_form import ArmClosedForm, JointDesign, arm_closed_form
+from ..simulate.setup import oscillation_period
 from ..vocabulary import OPTIMIZED_SENSING_SCHEMES
 from .mjcf import CONTACT_SITE, CONTROLLER, ROTOR, design_mjcf, load_mujoco
 from .run_design import RunDesign, read_run_design
@@ -313,12 +314,12 @@ class _Run:
         omega = math.sqrt(contact_stiffness / m_f)
         # MuJoCo's solref (time constant, damping ratio): stiffness omega^2, damping 2 zeta omega, per unit mass.
         time_constant = 1 / (omega * damping_ratio)
-        periods = [2 * math.pi / omega, 2 * math.pi * time_constant] + [
-            2 * math.pi * math.sqrt(j.reflected_inertia / (j.software_stiffness + j.mechanical_stiffness))
+        periods = [oscillation_period(m_f, contact_stiffness), 2 * math.pi * time_constant] + [
+            oscillation_period(j.reflected_inertia, j.software_stiffness + j.mechanical_stiffness)
             for j in design.joints
         ]
         self.timestep = min(periods) / steps_per_period
-        self.finger_period = 2 * math.pi * math.sqrt(m_f / closed.k_m)
+        self.finger_period = oscillation_period(m_f, closed.k_m)
         damping = damping_from_ratio(damping_ratio, m_f, contact_stiffness)
         self.model = self._compile(root, time_constant, damping_ratio)
         self.blanking = (
