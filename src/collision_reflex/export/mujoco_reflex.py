@@ -67,9 +67,8 @@ CONTACT_DAMPING_RATIO = 30.0
 wall at 0.028 % of its speed (4.8 % at the arm simulator's default of 2, which is too elastic here: at an
 approach many times ``v*`` the finger's flight after that rebound outlasts the sensing phase, and its second
 impact sets the detection). The more damped, the shorter the impact pulse's tail, which a force sensor must see
-fall below its threshold before the sensing ramp crosses it: near a singularity (a finger of 100 kg and more
-against a threshold of a few newtons) 10 times critical still holds it above; see
-``benchmarks/results/export_mujoco.md``."""
+fall below its threshold before the sensing ramp crosses it; the tail is longest where the impact is largest
+against the threshold, near a singularity (``benchmarks/results/export_mujoco.md`` has the figures)."""
 
 STEPS_PER_PERIOD = 20
 """MuJoCo steps per shortest period in play: the wall's time constant and period, each rotor on its springs (20
