@@ -134,6 +134,7 @@ def arm_closed_form(
     placement: str = "robot",
     contact_stiffness: float = math.inf,
     reaction: str = "moving",
+    stiffness_form: str = "compliance",
 ) -> ArmClosedForm:
     """The arm closed form of a design at configuration ``q`` [rad] along ``direction``.
 
@@ -145,6 +146,8 @@ def arm_closed_form(
     placement: ``"robot"`` or ``"finger"`` (reflected inertia also in ``m_f``).
     contact_stiffness: stiffness of the object hit [N/m], in series with ``k`` and ``k_m``; ``inf``: rigid.
     reaction: ``"moving"`` (robot still moving at detection, as the simulation) or ``"at_rest"``.
+    stiffness_form: the form of ``k``, ``"compliance"`` (the links free along the wall) or ``"paper"`` (blocked;
+        square Jacobians only), see :func:`collision_reflex.arm.effective.effective_parameters`.
     """
     arm = joints.on(arm)
     _validate.choice("placement", placement, REFLECTED_INERTIA_PLACEMENTS)
@@ -167,6 +170,7 @@ def arm_closed_form(
         joints.torque_limit,
         motor_mass=motor_mass if np.any(motor_mass > 0) else None,
         finger_joint_inertia=inertia if placement == "finger" else None,
+        stiffness_form=stiffness_form,
     )
     if bool(effective.singular[0, 0]):
         raise InvalidParameter(
