@@ -93,7 +93,9 @@ class MujocoReflex:
     closed_form: the closed form at the sample against the wall's stiffness (rigid in the prediction) [N s].
     detection_time, contact_end: from the impact [s].
     detected_impulse: the impulse until detection [N s] (the closed form's impact and sensing phases).
-    impulse_after: the impulse of any touch of the wall in the watch after the finger has left it [N s] (0: none).
+    impulse_after: the impulse of any touch of the wall in the watch after the finger has left it [N s] (0: none);
+        the watch steps by the arm's own periods until the finger nears the wall, so that figure, whose timing is
+        sensitive to the step, is approximate (a few per cent).
     timestep: MuJoCo's step [s]; contact_stiffness: the wall's stiffness along ``u`` [N/m].
     """
 
@@ -313,12 +315,15 @@ class _Run:
         omega = math.sqrt(contact_stiffness / m_f)
         # MuJoCo's solref (time constant, damping ratio): stiffness omega^2, damping 2 zeta omega, per unit mass.
         time_constant = 1 / (omega * damping_ratio)
-        periods = [oscillation_period(m_f, contact_stiffness), 2 * math.pi * time_constant] + [
+        self.finger_period = oscillation_period(m_f, closed.k_m)
+        arm_periods = [self.finger_period] + [
             oscillation_period(j.reflected_inertia, j.software_stiffness + j.mechanical_stiffness)
             for j in design.joints
         ]
-        self.timestep = min(periods) / steps_per_period
-        self.finger_period = oscillation_period(m_f, closed.k_m)
+        wall_periods = [oscillation_period(m_f, contact_stiffness), 2 * math.pi * time_constant]
+        self.timestep = min(wall_periods + arm_periods) / steps_per_period
+        # Off the wall its stiffness is out of play: the watch after the reflex steps by the arm's own periods.
+        self.watch_timestep = min(arm_periods) / steps_per_period
         damping = damping_from_ratio(damping_ratio, m_f, contact_stiffness)
         self.model = self._compile(root, time_constant, damping_ratio)
         self.blanking = (
@@ -362,7 +367,8 @@ class _Run:
         data = mujoco.MjData(model)
         _set_state(model, data, self.names, self.q0, self.v_ref)
         mujoco.mj_kinematics(model, data)
-        position = data.site(CONTACT_SITE).xpos + FINGER_RADIUS * self.normal
+        self.site0 = np.array(data.site(CONTACT_SITE).xpos)  # where the finger touches the wall
+        position = self.site0 + FINGER_RADIUS * self.normal
         quat = np.zeros(4)
         mujoco.mju_quatZ2Vec(quat, -self.normal)  # the plane's normal (its z) points back at the arm
         world = root.find("worldbody")
@@ -387,6 +393,8 @@ class _Run:
         reference = mujoco.MjData(model)  # the commanded path's kinematics (position sensing)
         touch = detection = detected = end = math.nan
         push: np.ndarray | None = None
+        idle = np.zeros(len(self.motor))  # the motors' torque once the reflex is over
+        wrench = np.zeros(6)  # mj_contactForce's output, reused at every step
         state, impulse, after = "waiting", 0.0, 0.0  # the detector: waiting, blanked, armed
         limit = start + 1e4 * self.finger_period
         while data.time < limit:
@@ -395,10 +403,10 @@ class _Run:
                 theta = data.qpos[self.rotor]
                 torque = np.clip(self.k_s * (self.q0 + self.v_ref * t - theta), -self.tau_max, self.tau_max)
             else:
-                torque = push if math.isnan(end) else np.zeros_like(push)
+                torque = push if math.isnan(end) else idle
             data.ctrl[self.motor] = torque / self.gear
             mujoco.mj_step(model, data)
-            force = _wall_force(mujoco, model, data)
+            force = _wall_force(mujoco, model, data, wrench)
             if math.isnan(end):
                 impulse += force * dt
             else:
@@ -415,12 +423,34 @@ class _Run:
             ):  # the finger has left: the reflex is over
                 end = t - touch
                 limit = data.time + _WATCH_PERIODS * self.finger_period
+            if not math.isnan(end) and force == 0:  # watching: the motors idle, the finger off the wall
+                self._step_off_the_wall(data, limit)
         if math.isnan(end):
             raise SimulationError(
                 f"the finger had not left the wall {limit - start:.3g} s after the start"
                 + ("" if push is not None else "; the contact was never detected")
             )
         return impulse, detection, detected, end, after
+
+    def _step_off_the_wall(self, data: Any, limit: float) -> None:
+        """One step of :attr:`watch_timestep` (the arm's own periods' step) if the finger surely stays off the wall.
+
+        Else none: the wall's step follows. Sure: its gap to the wall is three steps of travel at its closing speed, or at the approach velocity if
+        that is larger (the scale of the arm's motion; a step is a twentieth of the shortest period, in which no
+        speed turns by much more).
+        """
+        if data.time + self.watch_timestep > limit:
+            return
+        gap = float(self.normal @ (self.site0 - data.site(CONTACT_SITE).xpos))
+        velocity = np.zeros(6)  # [rotation; translation] of the contact site, world axes
+        self.mujoco.mj_objectVelocity(
+            self.model, data, self.mujoco.mjtObj.mjOBJ_SITE, self.model.site(CONTACT_SITE).id, velocity, 0
+        )
+        closing = max(float(self.normal @ velocity[3:]), self.v0)  # [m/s], toward the wall
+        if gap > 3 * closing * self.watch_timestep:
+            self.model.opt.timestep = self.watch_timestep
+            self.mujoco.mj_step(self.model, data)
+            self.model.opt.timestep = self.timestep
 
     def _position_error(self, reference: Any, data: Any, t: float) -> float:
         """The contact point's error along ``u`` against the commanded path [m]."""
@@ -467,9 +497,9 @@ def _detector(state: str, above: bool, window_over: bool) -> tuple[str, bool]:
     return state, state == "armed" and above
 
 
-def _wall_force(mujoco: Any, model: Any, data: Any) -> float:
-    """The normal force of the wall's contacts [N] (only the finger touches it)."""
-    force, wrench = 0.0, np.zeros(6)
+def _wall_force(mujoco: Any, model: Any, data: Any, wrench: np.ndarray) -> float:
+    """The normal force of the wall's contacts [N] (only the finger touches it); ``wrench``: a (6,) buffer."""
+    force = 0.0
     for i in range(data.ncon):
         mujoco.mj_contactForce(model, data, i, wrench)
         force += wrench[0]
