@@ -88,6 +88,29 @@ def test_resolved_pulse_impulse_and_finger_mass_within_their_noise(seed: int) ->
     assert fit.residual_rms < RESIDUAL_LIMIT * result.window.floor.sigma
 
 
+@pytest.mark.parametrize("seed", [4, 49, 74])
+def test_a_clean_resolved_trace_is_fitted_down_to_its_noise(seed: int) -> None:
+    # Reproduction (issue 33): of 50 seeded clean traces (seeds 0-49) the fit stopped in a poorer local optimum
+    # on seeds 4 and 49, residual 1.34 and 1.26 x the noise where the true parameters give 1.01 and 0.98 (seed 4's
+    # impact time 0.5 samples late), and said nothing; seed 74 (of seeds 50-199) at 1.51, 1.47 x its floor.
+    # The pulse's end sat on a sample boundary, where its jump kinks the sampled cost.
+    noise, sensor = 0.029, ex.SensorModel(3500.0)
+    trace = ex.synthetic_trace(RESOLVED, 0.016, sensor, np.random.default_rng(seed), noise=noise)
+    fit = ex.analyse_trace(trace, k_m=RESOLVED.k_m).fit
+    assert fit is not None and not fit.notes
+    impact = float(trace.metadata["synthetic"].split()[2])
+    exact = ex.model_samples(
+        trace.time, RESOLVED.m_f, RESOLVED.k, RESOLVED.k_m, RESOLVED.F_s, RESOLVED.a, 0.016, impact, sensor
+    )
+    truth_rms = float(np.sqrt(np.mean((trace.force - exact) ** 2)))
+    # Least squares is no worse than the true parameters, one point of its search (1e-3: the solver's stop) ...
+    assert fit.residual_rms <= 1.001 * truth_rms
+    # ... and at the noise floor: an rms of n samples of the noise is sigma within sigma / sqrt(2 n).
+    assert fit.residual_rms < noise * (1 + SIGMAS / math.sqrt(2 * trace.time.size))
+    assert abs(fit.m_f - RESOLVED.m_f) < SIGMAS * fit.stderr["m_f"]
+    assert abs(fit.impact_time - impact) < SIGMAS * fit.stderr["impact_time"]
+
+
 def test_a_fit_far_above_the_noise_is_flagged() -> None:
     # A resonance the model does not have: a 20-sigma ringing at 300 Hz through the contact.
     trace = ex.synthetic_trace(RESOLVED, 0.016, ex.SensorModel(3500.0), np.random.default_rng(0), noise=0.029)

@@ -12,7 +12,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..errors import InvalidParameter, StudyFileError, StudyProblem
+from ..errors import CatalogueError, InvalidParameter, StudyFileError, StudyProblem
+from ..hardware.catalogue import read_entries
 from ..hardware.motors import scaled_motor_quantities
 from ..vocabulary import GLOBAL_VARIABLES, PER_JOINT_VARIABLES
 from .body_regions import load_body_regions, transient_regions
@@ -86,6 +87,7 @@ def _arm_checks(loaded: LoadedStudy, study: ArmStudy) -> list[StudyProblem]:
                     )
                 )
     problems += _body_region_checks(loaded, study)
+    problems += _catalogue_checks(loaded, study)
     robot = study.robot
     if robot.urdf is not None and not _is_file(loaded.path(robot.urdf)):
         problems.append(
@@ -358,6 +360,34 @@ def _body_region_checks(loaded: LoadedStudy, study: ArmStudy) -> list[StudyProbl
             "one of " + ", ".join(regions),
         )
     ]
+
+
+def _catalogue_checks(loaded: LoadedStudy, study: ArmStudy) -> list[StudyProblem]:
+    """Each catalogue the study names (``catalogue.motors``, ``catalogue.gearboxes``), read as the packaged ones.
+
+    Read by the same loader (:func:`~collision_reflex.hardware.catalogue.read_entries`): a problem is told at
+    the study's line, quoting the catalogue's own file and line.
+    """
+    problems = []
+    for kind in ("motors", "gearboxes"):
+        named = getattr(study.catalogue, kind)
+        if named is None:
+            continue
+        try:
+            read_entries(loaded.path(named), kind)
+        except CatalogueError as error:
+            shown = named if named.strip() else excerpt(named)
+            where = shown if error.line is None else f"{shown}:{error.line}"
+            field = f"{error.field}: " if error.field else ""
+            problems.append(
+                loaded.problem(
+                    ("catalogue", kind),
+                    f"{where}: {field}{error.reason}",
+                    f"a {kind} catalogue file like designs/{kind}.yaml, relative to the study file's folder: "
+                    f"fix it where quoted, or leave catalogue.{kind} out for the packaged one",
+                )
+            )
+    return problems
 
 
 def located_refusal(loaded: LoadedStudy, error: InvalidParameter) -> StudyFileError:

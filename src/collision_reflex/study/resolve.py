@@ -36,6 +36,10 @@ def resolved_study(loaded: LoadedStudy) -> dict[str, Any]:
         cycle = data["duty_cycle"]
         if cycle is not None and cycle["file"] is not None:
             cycle["file"] = str(loaded.path(cycle["file"]))
+        catalogue = data["catalogue"]
+        for kind in ("motors", "gearboxes"):
+            if catalogue[kind] is not None:
+                catalogue[kind] = str(loaded.path(catalogue[kind]))
         for path in JOINT_POSITION_PATHS:
             _with_units(data, loaded.source.data, path)
     return data
