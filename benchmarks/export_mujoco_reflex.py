@@ -24,11 +24,11 @@ from pathlib import Path
 
 from collision_reflex.cli import main as crx
 from collision_reflex.export import export_design, read_run_design
-from collision_reflex.export.mujoco_reflex import (
+from collision_reflex.export.mujoco_reflex import mujoco_reflex
+from collision_reflex.export.reflex_sample import (
     MODEL_SPREAD,
     contact_sample,
     model_spread,
-    mujoco_reflex,
     sample_closed_form,
 )
 from collision_reflex.model.impulse import collision_times, phase_impulses

@@ -5,8 +5,8 @@ Pinocchio); :mod:`collision_reflex.export.mujoco_reflex` runs it against a rigid
 sample, and its impulse must be the one ``designs.json`` predicts there within :data:`TOLERANCE`.
 
 The sample is chosen by a stated rule, not by trial: the first sample where the closed form's own assumptions do
-not move the prediction (:func:`~collision_reflex.export.mujoco_reflex.model_spread` within
-:data:`~collision_reflex.export.mujoco_reflex.MODEL_SPREAD`: the robot mass still moving at detection, the links
+not move the prediction (:func:`~collision_reflex.export.reflex_sample.model_spread` within
+:data:`~collision_reflex.export.reflex_sample.MODEL_SPREAD`: the robot mass still moving at detection, the links
 moving along the wall, or, for a square Jacobian, blocked along it in the sensing phase, change the closed form
 by less than 1 % there). Elsewhere the report's model is not what MuJoCo simulates (sample 6 of this run: the
 joint-space model is 55 % above the report, MuJoCo 64 %). The same rule does not guarantee 2 % everywhere:
@@ -23,14 +23,8 @@ from pathlib import Path
 import pytest
 
 from collision_reflex.export import export_design, read_run_design
-from collision_reflex.export.mujoco_reflex import (
-    MODEL_SPREAD,
-    contact_sample,
-    joint_design,
-    main,
-    model_spread,
-    mujoco_reflex,
-)
+from collision_reflex.export.mujoco_reflex import main, mujoco_reflex
+from collision_reflex.export.reflex_sample import MODEL_SPREAD, contact_sample, joint_design, model_spread
 from collision_reflex.simulate.design_closed_form import arm_closed_form
 
 mujoco = pytest.importorskip("mujoco", reason="the mujoco extra is not installed")
