@@ -253,26 +253,36 @@ def test_dask_cluster_gives_the_serial_result(runs, tmp_path):
     distributed = pytest.importorskip("distributed")
     with distributed.LocalCluster(
         n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None
-    ) as cluster:
-        assert (
-            main(
-                [
-                    "run",
-                    str(TWO_LINK),
-                    "--out",
-                    str(tmp_path / "dask"),
-                    "--quiet",
-                    "--smoke",
-                    "--scheduler",
-                    cluster.scheduler_address,
-                ]
-            )
-            == 0
+    ) as cluster:  # as crx run --scheduler ADDRESS runs it (the option: test_cli_options)
+        run_study(
+            TWO_LINK,
+            tmp_path / "dask",
+            quiet=True,
+            figures=False,
+            smoke=True,
+            scheduler=cluster.scheduler_address,
         )
     # The same solves from the same start points with single-threaded BLAS: the same numbers, to the last bit.
     pd.testing.assert_frame_equal(
         _numbers(tmp_path / "dask"), _numbers(runs["two_link_paper"]), check_exact=True
     )
+
+
+def test_crx_run_hands_its_scheduler_and_executor_options_to_the_run(monkeypatch, capsys):
+    """What ``crx run`` passes on (the run itself through a cluster: the test above)."""
+    from collision_reflex.study import runner
+
+    seen = {}
+
+    def recorded(study, out, **options):
+        seen.update(options, study=study, out=out)
+        raise SystemExit(0)
+
+    monkeypatch.setattr(runner, "run_study", recorded)
+    with pytest.raises(SystemExit):
+        main(["run", str(TWO_LINK), "--scheduler", "tcp://cluster:8786", "--workers", "3", "--smoke"])
+    assert seen["scheduler"] == "tcp://cluster:8786" and seen["workers"] == 3 and seen["smoke"] is True
+    assert seen["study"] == str(TWO_LINK) and seen["executor"] is None
 
 
 def test_local_dask_cluster_gives_the_serial_result(runs, tmp_path):
