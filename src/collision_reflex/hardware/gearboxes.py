@@ -357,7 +357,8 @@ class ScaledGearbox(_OfferedRatios):
             raise InvalidParameter(
                 "ScaledGearbox.reference.kind", self.reference.kind, f"one of {GEARBOX_KINDS}"
             )
-        ratios = tuple(sorted(float(r) for r in self.ratios))
+        given = _validate.real("ScaledGearbox.ratios", self.ratios, "ratios >= 1, at least one")
+        ratios = tuple(sorted(given.tolist())) if given.ndim == 1 else ()
         if not ratios or not all(math.isfinite(r) and r >= 1 for r in ratios):
             raise InvalidParameter("ScaledGearbox.ratios", self.ratios, "ratios >= 1, at least one")
         object.__setattr__(self, "ratios", ratios)
