@@ -19,6 +19,7 @@ import pytest
 import collision_reflex as cr
 from collision_reflex import hardware, model
 from collision_reflex.errors import InvalidParameter
+from collision_reflex.model import effective
 
 SEED = 33
 HOSTILE: tuple[Any, ...] = (
@@ -160,6 +161,49 @@ CASES: dict[str, Case] = {
     "cr.total_impulse": Case(cr.total_impulse, {**IMPULSE, "v0": 0.1}),
     "cr.optimal_velocity": Case(cr.optimal_velocity, {"m_f": 0.2, "k": 90.9, "F_s": 200.0}),
 }
+J = np.array([[0.3, 0.2]])  # a contact Jacobian row (1, nv) [m/rad]
+M = np.array([[2.0, 0.3], [0.3, 1.0]])  # a joint-space mass matrix [kg m^2]
+# The effective-parameter formulas (not in model.__all__; the arm and the optimiser's CasADi problem call them).
+CASES.update(
+    {
+        "effective.reflected_inertia": Case(
+            effective.reflected_inertia, {"gear_ratio": 10.0, "rotor_inertia": 2e-5}
+        ),
+        "effective.finger_inertia": Case(
+            effective.finger_inertia, {"joint_reflected_inertia": 2e-3, "in_finger": 1.0}
+        ),
+        "effective.finger_mass_matrix": Case(
+            effective.finger_mass_matrix,
+            {
+                "structure_mass_matrix": M,
+                "motor_mass_influence": np.stack([M, M]),
+                "motor_mass": np.array([0.5, 0.3]),
+                "joint_finger_inertia": np.array([1e-3, 2e-3]),
+            },
+        ),
+        "effective.task_inverse_inertia": Case(
+            effective.task_inverse_inertia, {"jacobian": J, "mass_matrix": M}
+        ),
+        "effective.task_compliance": Case(
+            effective.task_compliance, {"jacobian": J, "joint_values": np.array([100.0, 200.0])}
+        ),
+        "effective.torque_fractions": Case(
+            effective.torque_fractions, {"moment_arms": J[0], "torque_limit": np.array([10.0, 5.0])}
+        ),
+        "effective.reaction_compliance": Case(
+            effective.reaction_compliance, {"fractions": np.array([0.03, 0.04]), "joint_axis": -1}
+        ),
+        "effective.reaction_acceleration": Case(
+            effective.reaction_acceleration, {"robot_compliance": 0.5, "reaction_compliance_": 0.04}
+        ),
+        "effective.finger_mass_direction": Case(
+            effective.finger_mass_direction, {"moment_arms": J[0], "mass_matrix": M}
+        ),
+        "effective.finger_mass": Case(
+            effective.finger_mass, {"direction": np.array([2.0, 1.0]), "mass_matrix": M}
+        ),
+    }
+)
 SKIPPED = {  # public names that take no numbers
     "model": {"PhaseImpulses", "Rebound", "TransientContact"},  # result records, built by the functions
     "hardware": {
@@ -172,8 +216,14 @@ SKIPPED = {  # public names that take no numbers
         "scaling_law",
     },
 }
-# (case, argument) -> reason, for a known finding left unfixed (a fix that would change numbers); none open.
+# (case, argument) -> reason, for a known finding left unfixed (a fix that would change numbers); the effective
+# formulas' below.
 XFAIL: dict[tuple[str, str], str] = {}
+UNCHECKED_EFFECTIVE = (
+    "known finding: the effective-parameter formulas are unchecked arithmetic shared with the optimiser's CasADi "
+    "problem (NaN in gives NaN out, a string or None a TypeError, 0 a division by zero); their callers in "
+    "collision_reflex.arm check the inputs, and a check here would touch the CasADi path"
+)
 LABEL_ONLY = {"name", "source", "kind"}  # free-text labels, not numbers
 MODEL_OBJECTS = ("Motor", "Gearbox", "Threshold")  # arguments annotated with these take a model object
 
@@ -190,8 +240,14 @@ def _floats(value: Any, nan_fields: tuple[str, ...]) -> Iterator[float]:
         for item in value:
             yield from _floats(item, nan_fields)
         return
-    if isinstance(value, (int, float, np.number, np.ndarray)):
-        yield from np.asarray(value, dtype=np.float64).ravel().tolist()
+    if isinstance(value, (int, float, complex, np.number, np.ndarray)):
+        array = np.asarray(value)
+        if array.dtype.kind == "b":  # flags, not numbers
+            return
+        if array.dtype.kind not in "iuf":  # a complex (or object) result is not a real number: a finding
+            yield math.nan
+            return
+        yield from array.astype(np.float64).ravel().tolist()
 
 
 def _is_nan(value: Any) -> bool:
@@ -211,9 +267,8 @@ def _calls() -> Iterator[Any]:
         for name, parameter in inspect.signature(case.function).parameters.items():
             if name in LABEL_ONLY or any(kind in str(parameter.annotation) for kind in MODEL_OBJECTS):
                 continue
-            marks = (
-                [pytest.mark.xfail(strict=True, reason=XFAIL[label, name])] if (label, name) in XFAIL else []
-            )
+            reason = XFAIL.get((label, name), UNCHECKED_EFFECTIVE if label.startswith("effective.") else None)
+            marks = [pytest.mark.xfail(strict=True, reason=reason)] if reason else []
             yield pytest.param(label, name, _hostile_values(rng), id=f"{label}-{name}", marks=marks)
 
 
