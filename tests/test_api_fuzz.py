@@ -244,7 +244,7 @@ XFAIL: dict[tuple[str, str], str] = {}
 UNCHECKED_EFFECTIVE = (
     "known finding: the effective-parameter formulas are unchecked arithmetic shared with the optimiser's CasADi "
     "problem (NaN in gives NaN out, a string or None a TypeError, 0 a division by zero); their callers in "
-    "collision_reflex.arm check the inputs, and a check here would touch the CasADi path"
+    "collision_reflex.arm check their own inputs, and a check here would touch the CasADi path"
 )
 LABEL_ONLY = {"name", "source", "kind"}  # free-text labels, not numbers
 MODEL_OBJECTS = ("Motor", "Gearbox", "Threshold")  # arguments annotated with these take a model object
