@@ -13,6 +13,7 @@ from collision_reflex.model import (
     contact_robot_mass,
     iso_robot_mass,
     permissible_speed,
+    rebound,
     reduced_mass,
     transient_contact,
 )
@@ -143,3 +144,14 @@ def test_arrays_broadcast_and_the_choice_is_per_element():
 def test_bad_input_is_refused_with_its_name(call, name):
     with pytest.raises(InvalidParameter, match=name):
         call()
+
+
+@pytest.mark.parametrize("e", [1e-300, 1e-100, 1e-17, 2.0**-53], ids=["1e-300", "1e-100", "1e-17", "2^-53"])
+def test_rebound_below_float_resolution_is_the_small_e_limit(e: float) -> None:
+    # 1 + e == 1: the flight cannot be solved for in float (a ZeroDivisionError before). The limit e -> 0 is one
+    # flight s = sqrt(6 e); the solved flights just above float resolution follow it to 1e-12.
+    got = rebound(e)
+    assert got.impacts == 1
+    assert got.settling == pytest.approx(math.sqrt(6 * e), rel=1e-15)
+    for solved in (1e-14, 1e-12):
+        assert rebound(solved).settling == pytest.approx(math.sqrt(6 * solved), rel=1e-12)

@@ -30,6 +30,11 @@ def non_negative(name: str, value: Any) -> Any:
     return _check(name, value, lambda a: a >= 0, "a finite number >= 0", False)
 
 
+def finite(name: str, value: Any) -> Any:
+    """``value`` as float64 (a float, or an array) if every element is a finite number, of any sign, else raise."""
+    return _check(name, value, lambda a: a == a, "a finite number", False)
+
+
 def real(name: str, value: Any, allowed: str) -> np.ndarray:
     """``value`` as a float64 array; :class:`InvalidParameter` (saying ``allowed``) if it is not real numbers.
 

@@ -195,6 +195,10 @@ class CollisionParameters:
     a: float
     F_a: float
 
+    def __post_init__(self) -> None:
+        for name in ("m_f", "m_r", "k", "k_m", "F_s", "a", "F_a"):
+            _validate.positive(f"CollisionParameters.{name}", getattr(self, name))
+
     def impulse_arguments(self) -> dict[str, Any]:
         """Keyword arguments for :func:`collision_reflex.model.phase_impulses` (all but ``v0``)."""
         return {"m_f": self.m_f, "k": self.k, "k_m": self.k_m, "F_s": self.F_s, "a": self.a}
@@ -243,6 +247,8 @@ class Actuator:
             )
         if self.gearbox is not None and not isinstance(self.gearbox, Gearbox):
             raise InvalidParameter("Actuator.gearbox", self.gearbox, "a Gearbox or None")
+        if not isinstance(self.gearbox_inertia, bool | np.bool_):
+            raise InvalidParameter("Actuator.gearbox_inertia", self.gearbox_inertia, "True or False")
         if self.gearbox_inertia and self.gearbox is None:
             raise InvalidParameter(
                 "Actuator.gearbox_inertia", True, "False without a gearbox", "pass gearbox=Gearbox(...)"

@@ -277,6 +277,7 @@ class CatalogueGearbox(_OfferedRatios):
     per_ratio: tuple[RatioFigures, ...] = ()
 
     def __post_init__(self) -> None:
+        self._check_figures()
         if self.per_ratio and (
             self.continuous_ratio or tuple(f.ratio for f in self.per_ratio) != tuple(self.ratios)
         ):
@@ -285,6 +286,33 @@ class CatalogueGearbox(_OfferedRatios):
                 tuple(f.ratio for f in self.per_ratio),
                 f"the figures of each offered ratio, {tuple(self.ratios)}, in order (a ratio range has none)",
             )
+
+    def _check_figures(self) -> None:
+        """Raise :class:`InvalidParameter` naming the field unless each figure is as the catalogue file allows."""
+        label = f"gearbox {self.name!r}"
+        ratios = _validate.real(f"{label} ratios", self.ratios, "gear ratios >= 1, at least one")
+        if ratios.ndim != 1 or not ratios.size or not np.all(np.isfinite(ratios) & (ratios >= 1)):
+            raise InvalidParameter(f"{label} ratios", self.ratios, "gear ratios >= 1, at least one")
+        if not isinstance(self.continuous_ratio, bool | np.bool_):
+            raise InvalidParameter(f"{label} continuous_ratio", self.continuous_ratio, "True or False")
+        optional = ("momentary_torque", "max_input_speed", "diameter", "length", "efficiency")
+        for name in ("rated_torque", "peak_torque", "mass", "inertia", *optional):
+            value = getattr(self, name)
+            if value is None and name in optional:
+                continue
+            check = (
+                _validate.non_negative if name in ("mass", "inertia") else _validate.positive
+            )  # 0: neutral
+            if np.ndim(check(f"{label} {name}", value)) or (name == "efficiency" and value > 1):
+                allowed = "a number in (0, 1], or None" if name == "efficiency" else "one finite number"
+                raise InvalidParameter(f"{label} {name}", value, allowed)
+        stages = self.stages
+        if isinstance(stages, bool) or not isinstance(stages, numbers.Integral) or stages < 1:
+            raise InvalidParameter(f"{label} stages", stages, "an integer >= 1")
+        if not isinstance(self.per_ratio, tuple) or not all(
+            isinstance(f, RatioFigures) for f in self.per_ratio
+        ):
+            raise InvalidParameter(f"{label} per_ratio", self.per_ratio, "a tuple of RatioFigures")
 
     def at_ratio(self, gear_ratio: float) -> CatalogueGearbox:
         """The gearbox as sold at ``gear_ratio`` [-]: that ratio's figures, and that ratio alone.
@@ -357,7 +385,8 @@ class ScaledGearbox(_OfferedRatios):
             raise InvalidParameter(
                 "ScaledGearbox.reference.kind", self.reference.kind, f"one of {GEARBOX_KINDS}"
             )
-        ratios = tuple(sorted(float(r) for r in self.ratios))
+        given = _validate.real("ScaledGearbox.ratios", self.ratios, "ratios >= 1, at least one")
+        ratios = tuple(sorted(given.tolist())) if given.ndim == 1 else ()
         if not ratios or not all(math.isfinite(r) and r >= 1 for r in ratios):
             raise InvalidParameter("ScaledGearbox.ratios", self.ratios, "ratios >= 1, at least one")
         object.__setattr__(self, "ratios", ratios)

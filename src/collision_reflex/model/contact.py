@@ -226,6 +226,9 @@ def rebound(restitution: float) -> Rebound:
 @functools.lru_cache(maxsize=256)
 def _settle(e: float) -> Rebound:
     """:func:`rebound` of a checked ``e``."""
+    if 0 < e and 1 + e == 1:  # below float resolution the flight cannot be solved for; its limit e -> 0:
+        # one flight s = sqrt(6 e) (from -e s + s^3/6 = 0), excess e s^2/2 - s^4/24 = 3 e^2 / 2
+        return Rebound(e, 1.5 * e * e, math.sqrt(6 * e), 1)
     t, u, excess, impacts = 0.0, 1.0, 0.0, 0
     while e > 0:
         kick = 1 + e * u  # the finger's speed away from the spring's far end just after the impact

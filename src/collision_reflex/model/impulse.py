@@ -184,6 +184,7 @@ def minimum_impulse(m_f: Any, k: Any, k_m: Any, F_s: Any, a: Any, reaction: str 
     its own derivation uses ``k_m`` in the reaction, which is what is used here). For ``"moving"``, the total
     impulse at the numerically found optimum with ``v_r = v0``.
     """
+    _validate.choice("reaction", reaction, REACTION_MODES)
     if reaction == "moving":
         v_opt = optimal_velocity(m_f, k, F_s, "moving", k_m, a)
         return total_impulse(m_f, k, k_m, F_s, a, v_opt, "moving")
@@ -211,16 +212,22 @@ def force_profile(
     - the reaction from ``t1`` until the force returns to zero at ``t2``: ``F_s - k_m a tau^2/2`` at rest, or
       ``k_m (x1 + v_r tau - a tau^2/2)`` with ``x1 = F_s/k_m`` when moving (``tau = t - t1``).
     """
+    t = _validate.finite("t", t)
     m_f, k, k_m, F_s, a, v0, v_r = _checked(m_f, k, k_m, F_s, a, v0, reaction, v_r)
+    _broadcastable(t=t, m_f=m_f, k=k, k_m=k_m, F_s=F_s, a=a, v0=v0, v_r=v_r)
     omega = sqrt(k_m / m_f)
     t1 = _detection_time(F_s, k, v0)
     duration, _ = _reaction_phase(F_s, k_m, a, v_r)
     tau = t - t1
+
+    def in_reaction(value: Any) -> Any:  # the value inside the reaction's window, 0 outside
+        return where(tau >= 0, where(tau <= duration, value, 0.0), 0.0)
+
     pulse_end = impact_pulse_duration(m_f, k_m)
     pulse = where(t >= 0, where(t <= pulse_end, m_f * v0 * omega * sin(omega * t), 0.0), 0.0)
     ramp = where(t >= 0, where(t < t1, sensing_force(t, k, v0), 0.0), 0.0)
-    reaction_force = k_m * (F_s / k_m + v_r * tau - a * tau**2 / 2)
-    reaction_part = where(tau >= 0, where(tau <= duration, reaction_force, 0.0), 0.0)
+    window_tau = in_reaction(tau)  # tau**2 of a far-off t would overflow
+    reaction_part = in_reaction(k_m * (F_s / k_m + v_r * window_tau - a * window_tau**2 / 2))
     return pulse + ramp + reaction_part
 
 
@@ -397,6 +404,18 @@ def _finite(what: str, value: Any) -> Any:
             "them (other units)",
         )
     return value
+
+
+def _broadcastable(**arguments: Any) -> None:
+    """Raise :class:`InvalidParameter` unless the NumPy arrays among ``arguments`` broadcast together."""
+    shapes = {name: np.shape(value) for name, value in arguments.items() if not is_symbolic(value)}
+    try:
+        np.broadcast_shapes(*shapes.values())
+    except ValueError:
+        arrays = {name: shape for name, shape in shapes.items() if shape}
+        raise InvalidParameter(
+            ", ".join(arrays), arrays, "shapes that broadcast together (NumPy rules)"
+        ) from None
 
 
 def _checked(
