@@ -238,14 +238,8 @@ SKIPPED = {  # public names that take no numbers: result records, a table, file 
         "scaling_law",
     },
 }
-# (case, argument) -> reason, for a known finding left unfixed (a fix that would change numbers); the effective
-# formulas' below.
+# (case, argument) -> reason, for a known finding left unfixed (a fix that would change numbers).
 XFAIL: dict[tuple[str, str], str] = {}
-UNCHECKED_EFFECTIVE = (
-    "known finding: the effective-parameter formulas are unchecked arithmetic shared with the optimiser's CasADi "
-    "problem (NaN in gives NaN out, a string or None a TypeError, 0 a division by zero); their callers in "
-    "collision_reflex.arm check their own inputs, and a check here would touch the CasADi path"
-)
 LABEL_ONLY = {"name", "source", "kind"}  # free-text labels, not numbers
 MODEL_OBJECTS = ("Motor", "Gearbox", "Threshold")  # arguments annotated with these take a model object
 
@@ -289,7 +283,7 @@ def _calls() -> Iterator[Any]:
         for name, parameter in inspect.signature(case.function).parameters.items():
             if name in LABEL_ONLY or any(kind in str(parameter.annotation) for kind in MODEL_OBJECTS):
                 continue
-            reason = XFAIL.get((label, name), UNCHECKED_EFFECTIVE if label.startswith("effective.") else None)
+            reason = XFAIL.get((label, name))
             marks = [pytest.mark.xfail(strict=True, reason=reason)] if reason else []
             yield pytest.param(label, name, _hostile_values(rng), id=f"{label}-{name}", marks=marks)
 

@@ -295,6 +295,8 @@ def test_a_total_that_underflows_is_refused_not_a_silent_zero() -> None:
         lambda: cr.model.threshold_force("position", float("nan"), 1.0),
         lambda: cr.model.threshold_force("position", 1.0, "x"),
         lambda: cr.model.threshold_force("force", "x", 1.0),
+        lambda: cr.model.threshold_force("force", -3.0, 1.0),  # a negative threshold was passed on
+        lambda: cr.model.threshold_force("position", -1e-3, 1e4),
         lambda: cr.simulate.contact_restitution([1.0, 2.0]),
         lambda: cr.simulate.contact_damping_for_restitution(0.5, [1.0, 2.0], 1e4),
         lambda: cr.simulate.contact_damping_for_restitution("0.5", 1.0, 1e4),

@@ -132,3 +132,31 @@ def test_sensing_vocabulary():
         sensing.sensing_scheme("joint_torque")  # the current scheme's name before the first release
     with pytest.raises(InvalidParameter, match="sensing"):
         sensing.sensing_scheme("current", ("force", "position"))
+
+
+def test_the_formulas_refuse_what_numpy_would_fail_on_with_the_argument_named(system) -> None:
+    """Shapes that do not fit, a singular mass matrix, zero moment arms, an overflow: one located error each."""
+    mass, _, motor_mass, _, _ = system
+    with pytest.raises(InvalidParameter, match=r"jacobian, mass_matrix .*shapes that fit together"):
+        effective.task_inverse_inertia(np.ones((3, 5)), mass)  # 5 joints against 4
+    with pytest.raises(InvalidParameter, match="non-singular matrices"):
+        effective.task_inverse_inertia(np.ones((3, 4)), np.zeros((4, 4)))
+    with pytest.raises(InvalidParameter, match="motor_mass_influence"):
+        effective.finger_mass_matrix(mass, None, motor_mass)  # masses without their influence matrices
+    with pytest.raises(InvalidParameter, match="not all zero"):
+        effective.finger_mass_direction(np.zeros(4), mass[0])  # no joint moves the contact: 0/0
+    with pytest.raises(InvalidParameter, match="float64 range"):
+        effective.reflected_inertia(1e200, 1.0)
+    with pytest.raises(InvalidParameter, match="in_finger"):
+        effective.finger_inertia(1e-3, 2.0)  # a fraction of the rotor beyond the whole
+    assert effective.finger_inertia(np.array([1e-3, 2e-3]), np.array([True, False])).tolist() == [1e-3, 0.0]
+
+
+def test_casadi_arguments_pass_the_checks_unchanged() -> None:
+    """The optimiser's symbols cannot be checked: the formulas build the same expressions as before."""
+    w, m = ca.SX.sym("w", 2), ca.SX.sym("m", 2)
+    fractions = effective.torque_fractions(w, ca.DM([10.0, 5.0]))
+    value = ca.Function("f", [w], [effective.reaction_compliance(fractions)])(ca.DM([0.3, -0.4]))
+    assert float(value) == pytest.approx(0.08, rel=1e-15)
+    matrix = effective.finger_mass_matrix(ca.DM(np.eye(2)), [ca.DM(np.eye(2))] * 2, m)
+    assert ca.Function("g", [m], [matrix])(ca.DM([1.0, 2.0])).full().tolist() == [[4.0, 0.0], [0.0, 4.0]]

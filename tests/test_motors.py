@@ -182,3 +182,5 @@ def test_max_speed_and_speed_scaling_validated():
         SpeedScaling(0.0, float("nan"), "x")
     with pytest.raises(cr.InvalidParameter, match=r"ScalingLaw\.speed"):
         cr.hardware.ScalingLaw("x", 2.0, 4.0, 2.5, speed=-1.0)  # type: ignore[arg-type]
+    with pytest.raises(cr.InvalidParameter, match=r"ScalingLaw\.torque_exponent"):
+        cr.hardware.ScalingLaw("x", 2.0, 4.0, 0.0)  # a zero exponent divided J_m ~ tau**p by zero

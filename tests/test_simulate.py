@@ -294,6 +294,14 @@ def test_bad_parameters_are_refused_with_the_fix(changes, message):
     assert message in str(caught.value)
 
 
+def test_a_play_beyond_the_position_threshold_says_so() -> None:
+    """The play is taken up before the spring builds force: an e_th below it leaves no threshold force."""
+    setup = soft_setup(detection=Detection("position", 0.001), backlash=0.004, initial_play=0.003)
+    assert setup.equivalent_threshold == 0.0
+    with pytest.raises(InvalidParameter, match="the play or the friction alone already reaches it"):
+        setup.closed_form()
+
+
 def test_undetectable_threshold_says_so():
     with pytest.raises(SimulationError, match="never reached"):
         simulate(soft_setup(drive="impedance", detection=Detection("current", 9.9), duration=0.2))

@@ -7,7 +7,8 @@ symbols cannot be checked and pass through, since the optimiser imposes bounds o
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from typing import Any
 
 import numpy as np
@@ -30,9 +31,60 @@ def non_negative(name: str, value: Any) -> Any:
     return _check(name, value, lambda a: a >= 0, "a finite number >= 0", False)
 
 
+def unit_interval(name: str, value: Any) -> Any:
+    """``value`` as float64 (a float, or an array) if every element is in [0, 1], else raise."""
+    return _check(name, value, lambda a: (a >= 0) & (a <= 1), "a number in [0, 1]", False)
+
+
 def finite(name: str, value: Any) -> Any:
     """``value`` as float64 (a float, or an array) if every element is a finite number, of any sign, else raise."""
     return _check(name, value, lambda a: a == a, "a finite number", False)
+
+
+def arrays(name: str, value: Any, *, ndim: int = 1, square: bool = False) -> Any:
+    """``value`` if it holds finite real numbers in at least ``ndim`` axes (the last two equal if ``square``).
+
+    A NumPy float array is returned as it is, without a copy (the effective-parameter formulas check whole
+    batches of matrices); CasADi values, and sequences of them, pass unchecked. Raises
+    :class:`InvalidParameter` naming ``name`` otherwise.
+    """
+    if is_symbolic(value) or (isinstance(value, (list, tuple)) and is_symbolic(*value)):
+        return value
+    kind = (
+        ("square matrices (..., n, n)" if square else "matrices (..., m, n)")
+        if ndim == 2
+        else "a vector (..., n)"
+    )
+    allowed = f"finite real numbers, {kind}"
+    array = value if isinstance(value, np.ndarray) and value.dtype.kind == "f" else real(name, value, allowed)
+    if array.ndim < ndim or (square and array.shape[-1] != array.shape[-2]) or not np.isfinite(array).all():
+        raise InvalidParameter(name, value, allowed)
+    return array
+
+
+@contextmanager
+def combining(**values: Any) -> Iterator[None]:
+    """Report NumPy's errors in combining ``values`` inside the block as :class:`InvalidParameter`.
+
+    Shapes that do not fit, a singular matrix, a result beyond the float64 range. ``values`` are the checked
+    arguments the block combines, named as the caller spelled them; CasADi's own errors pass unchanged.
+    """
+    try:
+        with np.errstate(over="raise"):
+            yield
+    except InvalidParameter:
+        raise
+    except (ValueError, np.linalg.LinAlgError, OverflowError, FloatingPointError) as error:
+        if is_symbolic(*values.values()):
+            raise
+        shapes = ", ".join(f"{name} {np.shape(value)}" for name, value in values.items())
+        if isinstance(error, (OverflowError, FloatingPointError)):
+            allowed = "values whose result is below the float64 range (about 1.8e308)"
+        elif isinstance(error, np.linalg.LinAlgError) and "ingular" in str(error):
+            allowed = "non-singular matrices"
+        else:
+            allowed = "shapes that fit together"
+        raise InvalidParameter(", ".join(values), shapes, allowed, f"NumPy says: {error}") from None
 
 
 def real(name: str, value: Any, allowed: str) -> np.ndarray:
@@ -55,8 +107,10 @@ def _check(name: str, value: Any, ok: Callable[[np.ndarray], Any], allowed: str,
     if is_symbolic(value):
         return value
     array = real(name, value, allowed)
-    finite = np.isfinite(array) | (allow_inf & np.isposinf(array))
-    if not np.all(finite & ok(np.where(np.isnan(array), 0.0, array))):
+    good = ok(array)  # False at NaN: every comparison with NaN is
+    if not allow_inf:
+        good &= np.isfinite(array)
+    if not good.all():
         raise InvalidParameter(name, value, allowed)
     return array if array.ndim else float(array)
 

@@ -145,7 +145,10 @@ def effective_parameters(
         singular = w_f <= singular_tolerance * scale_s
         m_f = np.reciprocal(w_f, out=w_f)
         load = _reaction_compliance(jac, tau_max, units, pair_index)  # 1 / F_a
-        a = formulas.reaction_acceleration(w_r, load)
+        # Singular directions get a = 0 below; with every torque unlimited (1 / F_a = 0) a is unlimited too.
+        a = np.where(load > 0, 0.0, np.inf)
+        live = ~singular & (load > 0)
+        a[live] = formulas.reaction_acceleration(w_r[live], load[live])
         m_r = np.reciprocal(w_r, out=w_r)
         F_a = np.reciprocal(load, out=load)
         if stiffness_form == "paper":

@@ -238,9 +238,11 @@ class CatalogueGearbox(_OfferedRatios):
     peak_torque : float
         Repeated peak output torque (acceleration/braking) [N m].
     mass : float
-        Mass [kg].
+        Mass [kg], >= 0: 0 builds the neutral gearbox, which adds nothing to the joint (a catalogue file, which
+        lists real units, needs > 0).
     inertia : float
-        Inertia at the input (motor) shaft [kg m^2]; reflected to the output it is ``N**2 inertia``.
+        Inertia at the input (motor) shaft [kg m^2], >= 0 as ``mass``; reflected to the output it is
+        ``N**2 inertia``.
     source : str
         Where the figures come from (the default source of every field).
     efficiency : float or None
@@ -302,7 +304,7 @@ class CatalogueGearbox(_OfferedRatios):
                 continue
             check = (
                 _validate.non_negative if name in ("mass", "inertia") else _validate.positive
-            )  # 0: neutral
+            )  # 0: the neutral gearbox
             if np.ndim(check(f"{label} {name}", value)) or (name == "efficiency" and value > 1):
                 allowed = "a number in (0, 1], or None" if name == "efficiency" else "one finite number"
                 raise InvalidParameter(f"{label} {name}", value, allowed)

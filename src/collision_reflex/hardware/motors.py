@@ -102,7 +102,8 @@ class ScalingLaw:
 
     def __post_init__(self) -> None:
         for field in ("mass_exponent", "inertia_exponent", "torque_exponent"):
-            _validate.non_negative(f"ScalingLaw.{field}", getattr(self, field))
+            # > 0: a size that did not change a motor's mass, inertia or torque would not be a motor law.
+            _validate.positive(f"ScalingLaw.{field}", getattr(self, field))
         if not isinstance(self.speed, SpeedScaling):
             raise InvalidParameter("ScalingLaw.speed", self.speed, "a SpeedScaling")
 

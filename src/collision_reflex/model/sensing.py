@@ -19,11 +19,7 @@ from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
-
 from .. import _validate
-from .._backend import is_symbolic
-from ..errors import InvalidParameter
 from ..vocabulary import OPTIMIZED_SENSING_SCHEMES, SENSING_SCHEMES
 
 
@@ -49,11 +45,7 @@ def threshold_force(sensing: str, threshold: Any, stiffness: Any) -> Any:
     ``F_s`` [N] (or the joint torque [N m] for joint units): ``threshold`` itself, or ``k e_th``.
     """
     _validate.choice("sensing", sensing, OPTIMIZED_SENSING_SCHEMES)
-    if not is_symbolic(threshold):
-        threshold = _validate.real("threshold", threshold, "real numbers")
-        if not np.all(np.isfinite(threshold)):
-            raise InvalidParameter("threshold", threshold, "finite numbers")
-        threshold = threshold if threshold.ndim else float(threshold)
+    threshold = _validate.non_negative("threshold", threshold)
     if sensing == "force":
         return threshold
     return _validate.positive("stiffness", stiffness, allow_inf=True) * threshold

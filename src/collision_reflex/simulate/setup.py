@@ -178,8 +178,8 @@ class CollisionSetup:
         """
         threshold = self.detection.threshold
         if self.detection.kind == "position":
-            # The play is taken up before the spring builds force.
-            return float(threshold_force("position", threshold - self.play, self.lumped_stiffness))
+            # The play is taken up before the spring builds force; a play beyond the threshold leaves none.
+            return float(threshold_force("position", max(threshold - self.play, 0.0), self.lumped_stiffness))
         if self.detection.kind == "current":
             v_r = self.detection_robot_velocity
             return threshold - self.coulomb_friction - self.viscous_friction * v_r
