@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import contextlib
+from typing import Any
 
-_CASADI_BLAS_REGISTERED: list[bool] = []
+_CONTROLLER: list[Any] = []  # threadpoolctl's controller of every BLAS, made once they are all loaded
 
 
 def single_threaded_blas() -> contextlib.AbstractContextManager[object]:
@@ -15,16 +16,18 @@ def single_threaded_blas() -> contextlib.AbstractContextManager[object]:
     workers pin it to one thread where a plain process does not; the difference moves IPOPT's iterates and so
     the results, within the solver tolerance. With one thread everywhere, every executor gives the same
     numbers, bitwise in practice (parallelism comes from the executor's processes).
-    """
-    import threadpoolctl  # lazy: needed only once a solve runs
 
-    if not _CASADI_BLAS_REGISTERED:
+    The libraries are found once per process (a search of the loaded libraries costs milliseconds, and a
+    study enters this context hundreds of times), after the three above are loaded.
+    """
+    if not _CONTROLLER:
         import scipy.linalg  # noqa: F401  # loads SciPy's OpenBLAS now: threadpoolctl limits only loaded ones
+        import threadpoolctl  # lazy: needed only once a solve runs
 
         threadpoolctl.register(_casadi_openblas_controller())
         _load_casadi_openblas()
-        _CASADI_BLAS_REGISTERED.append(True)
-    return threadpoolctl.threadpool_limits(limits=1)
+        _CONTROLLER.append(threadpoolctl.ThreadpoolController())
+    return _CONTROLLER[0].limit(limits=1)
 
 
 def _load_casadi_openblas() -> None:
