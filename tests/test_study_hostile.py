@@ -102,6 +102,13 @@ def test_a_recursive_alias_is_refused():
     assert "recursive alias" in problem.found
 
 
+@pytest.mark.parametrize("nested", ["[" * 100_000 + "]" * 100_000, "- " * 200_000 + "x"])
+def test_a_deeply_nested_value_is_refused_not_a_crash(nested):
+    """libyaml's composer recursed in C on 100,000 levels: a segmentation fault, not even a RecursionError."""
+    problem = _only_problem(BASE + "description:\n  " + nested + "\n", load_robot=False)
+    assert "nested deeper than" in problem.found
+
+
 @pytest.mark.parametrize(
     ("line", "replacement", "path"),
     [
@@ -400,6 +407,12 @@ def test_catalogue_tags_and_expressions_are_located(tmp_path, old, new, line, fi
 def test_a_catalogue_alias_bomb_is_refused(tmp_path):
     error = _catalogue_error(tmp_path, MOTOR + _bomb())
     assert "aliases that expand to" in error.reason
+
+
+def test_a_deeply_nested_catalogue_is_refused_not_a_crash(tmp_path):
+    """A catalogue nested 100,000 levels deep crashed the interpreter in libyaml's composer."""
+    error = _catalogue_error(tmp_path, MOTOR + "extra: " + "{a: " * 100_000 + "1" + "}" * 100_000 + "\n")
+    assert "nested deeper than" in error.reason
 
 
 def test_a_catalogue_quantity_is_read_by_the_study_grammar(tmp_path):
