@@ -435,7 +435,7 @@ def _check_resolution(
     cubic = make_interp_spline(t, q, k=3).derivative(2)(midpoints)
     scale = np.max(np.abs(acceleration(t)), axis=0)
     disagreement = np.abs(quintic - cubic)
-    moving = scale > 0
+    moving = (scale > 0) & (np.ptp(q, axis=0) > 0)  # a joint held still has only round-off accelerations
     relative = np.zeros_like(disagreement)
     relative[:, moving] = disagreement[:, moving] / scale[moving]
     worst = np.unravel_index(int(np.argmax(relative)), relative.shape)
