@@ -169,6 +169,14 @@ def test_a_joint_held_still_is_not_sampled_too_coarsely(tmp_path):
     assert np.all(np.abs(cycle.qd[:, 0]) < 1e-9)
 
 
+def test_time_steps_too_short_for_the_derivatives_are_located(tmp_path, recwarn):
+    """Times of 1e-302 s gave NumPy overflow warnings and an unlocated 'qdd = array ... containing nan'."""
+    t = np.linspace(0.0, 2.0, 201)
+    error = _failure(tmp_path, _csv(t * 1e-300, _sines(t)[0]))
+    assert "float64 range" in error.reason and error.line == 2
+    assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
+
+
 def test_error_survives_pickling(tmp_path):
     import pickle
 
