@@ -43,13 +43,19 @@ class NodeProblem(ValueError):
         self.column = node.start_mark.column + 1
 
 
-def check_depth(text: str) -> None:
+def check_depth(text: str, max_nodes: int | None = None) -> None:
     """Refuse ``text`` nested deeper than :data:`MAX_DEPTH`, from its parse events, before it is composed.
 
-    Raises :class:`NodeProblem` at the first node too deep; a YAML error as composing would.
+    Also refuse more than ``max_nodes`` nodes (scalars, mappings and lists written), if given: composing and
+    checking a node costs about 10 us, so a catalogue of 400,000 short lines took 6 s to refuse.
+    Raises :class:`NodeProblem` at the first node too deep or too many; a YAML error as composing would.
     """
-    depth = 0
+    depth = nodes = 0
     for event in yaml.parse(text, Loader=LOADER):
+        if isinstance(event, yaml.NodeEvent) and not isinstance(event, yaml.AliasEvent):
+            nodes += 1
+            if max_nodes is not None and nodes > max_nodes:
+                raise NodeProblem(f"more than {max_nodes} values", event)
         if isinstance(event, (yaml.MappingStartEvent, yaml.SequenceStartEvent)):
             depth += 1
             if depth > MAX_DEPTH:

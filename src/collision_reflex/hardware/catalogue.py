@@ -33,6 +33,9 @@ CATALOGUE_LIMIT = 4 * 2**20
 """Largest catalogue file read [bytes]: the packaged ones are tens of kilobytes; a multi-megabyte one is not a
 catalogue but a mistake, refused before it is parsed (parsing YAML costs far more than its size)."""
 
+CATALOGUE_NODES = 100_000
+"""Most values (scalars, mappings, lists) a catalogue file may hold: the packaged ones hold about 500."""
+
 
 def packaged_catalogue_path(file: str = "motors.yaml") -> Path:
     """Return the path of a catalogue shipped with the package, ``designs/<file>``.
@@ -148,7 +151,7 @@ def _parsed_entries(name: str, data: bytes, kind: str) -> dict[str, CatalogueEnt
         at = data.count(b"\n", 0, error.start) + 1
         raise CatalogueError(name, at, "", f"the byte 0x{data[error.start]:02x} is not UTF-8 text") from None
     try:
-        check_depth(text)  # libyaml's composer recurses in C: a deep file would crash it
+        check_depth(text, CATALOGUE_NODES)  # libyaml's composer recurses in C: a deep file would crash it
         root = yaml.compose(text, Loader=LOADER)
         if root is not None:
             check_nodes(root)  # before constructing any value: tags, alias bombs, huge values
