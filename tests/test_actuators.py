@@ -121,3 +121,11 @@ def test_contact_parameters_keep_the_robot_mass():
     actuator = cr.Actuator(MOTOR, 4.0, mechanical_stiffness=80.0, software_stiffness=40.0)
     new = actuator.contact_parameters(0.2, m_f=0.1, m_r=0.3)
     assert new.m_r == pytest.approx(0.3 + 16 * 2e-5 / 0.04, rel=1e-15)  # the robot mass is not dropped
+
+
+def test_gear_ratio_for_names_unfitting_shapes_and_overflow():
+    """Unbroadcastable arrays were NumPy's unnamed ValueError; 4.6e18 / 1e-300 returned inf."""
+    with pytest.raises(cr.InvalidParameter, match="torque_required, peak_torque"):
+        cr.hardware.gear_ratio_for(np.ones((3, 3)), np.ones(2))
+    with pytest.raises(cr.InvalidParameter, match="float64 range"):
+        cr.hardware.gear_ratio_for(2**62, 1e-300)

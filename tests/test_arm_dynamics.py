@@ -222,3 +222,14 @@ def test_cycle_must_cover_the_arm(two_link_vertical):
         cycle_torques(two_link_vertical, cycle)
     with pytest.raises(InvalidParameter, match="increasing"):
         time_weights([0.0, 0.0, 1.0])
+
+
+def test_max_speed_refuses_a_nan_or_a_vector_instead_of_returning_nan():
+    """max_speed([nan, 1]) returned an array(nan); complex values a bare TypeError."""
+    from collision_reflex.arm.dynamics import max_speed
+    from collision_reflex.errors import InvalidParameter
+
+    for velocity in (np.array([[np.nan, 1.0], [0.0, 1.0]]), np.array([np.nan, 1.0]), 1 + 1j):
+        with pytest.raises(InvalidParameter, match="velocity"):
+            max_speed(velocity)
+    assert max_speed(np.array([[1.0, -3.0], [-2.0, 0.5]])).tolist() == [2.0, 3.0]

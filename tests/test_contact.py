@@ -155,3 +155,38 @@ def test_rebound_below_float_resolution_is_the_small_e_limit(e: float) -> None:
     assert got.settling == pytest.approx(math.sqrt(6 * e), rel=1e-15)
     for solved in (1e-14, 1e-12):
         assert rebound(solved).settling == pytest.approx(math.sqrt(6 * solved), rel=1e-12)
+
+
+def test_contact_formulas_name_arguments_whose_shapes_do_not_fit():
+    """Unbroadcastable arrays raised NumPy's unnamed ValueError from the contact formulas."""
+    from collision_reflex.model import contact
+
+    calls = [
+        lambda: permissible_speed(np.ones((2, 2, 2)), 3.0, np.ones((3, 3))),
+        lambda: contact_robot_mass(np.ones((3, 3)), np.eye(2) + 1, 1.0, 1.0),
+        lambda: contact_robot_mass(1.0, 1.0, np.ones(2), np.ones(3)),
+        lambda: transient_contact(np.ones(2), np.ones(3), 1.0),
+        lambda: contact.settled_rebound_speed(10.0, np.ones(0) + 1, np.ones(2), 0.5),
+        lambda: contact.rebound_impulse(np.ones((3, 3)), 3.0, np.ones(2), np.ones(4), 0.5),
+    ]
+    for call in calls:
+        with pytest.raises(InvalidParameter, match="shapes that fit together"):
+            call()
+
+
+def test_normal_modes_and_first_crossing_refuse_what_is_not_their_input():
+    """A scalar, a ragged list or a non-square matrix gave AttributeError, IndexError or SciPy's ValueError."""
+    from collision_reflex.model import modal
+
+    for mass, stiffness in [
+        (-math.inf, 3),
+        (np.float32(1e38), 0.5),
+        ([[1, 2], [3]], np.ones(2)),
+        (np.ones(2), 1.0),
+    ]:
+        with pytest.raises(InvalidParameter):
+            modal.normal_modes(mass, stiffness)
+    with pytest.raises(InvalidParameter, match="stiffness"):
+        modal.normal_modes(np.eye(2), np.eye(3))
+    with pytest.raises(InvalidParameter, match="modes"):
+        modal.first_crossing(2.0, 1.0, 1.0, True, "the force")

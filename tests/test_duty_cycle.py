@@ -160,6 +160,23 @@ def test_sampling_too_coarse(tmp_path):
     assert COARSE_TOLERANCE == 0.1
 
 
+def test_a_joint_held_still_is_not_sampled_too_coarsely(tmp_path):
+    """A joint at a constant 0.5236 rad has round-off accelerations only; it was refused as sampled too coarsely."""
+    t = np.linspace(0.0, 2.0, 201)
+    q = _sines(t)[0]
+    q[:, 0] = 0.5236
+    cycle = DutyCycle.from_csv(_write(tmp_path / "held.csv", _csv(t, q)), NAMES)
+    assert np.all(np.abs(cycle.qd[:, 0]) < 1e-9)
+
+
+def test_time_steps_too_short_for_the_derivatives_are_located(tmp_path, recwarn):
+    """Times of 1e-302 s gave NumPy overflow warnings and an unlocated 'qdd = array ... containing nan'."""
+    t = np.linspace(0.0, 2.0, 201)
+    error = _failure(tmp_path, _csv(t * 1e-300, _sines(t)[0]))
+    assert "float64 range" in error.reason and error.line == 2
+    assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
+
+
 def test_error_survives_pickling(tmp_path):
     import pickle
 

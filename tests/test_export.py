@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import stat
 import sysconfig
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -549,6 +551,22 @@ def test_bad_inputs_are_one_line_and_exit_2(runs, tmp_path, capsys):
         ["export", str(damaged), "--format", "urdf", "--out", out], capsys
     )
     assert not Path(out).exists()
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="named pipes are POSIX")
+def test_an_output_that_is_a_device_or_a_pipe_is_refused_not_replaced(runs, tmp_path, capsys):
+    """--out /dev/zero (as root) renamed the export over the device node; a pipe stands in for it here."""
+    pipe = tmp_path / "pipe.urdf"
+    os.mkfifo(pipe)
+    planar = str(runs["planar"])
+    assert "not a regular file" in _one_line_error(
+        ["export", planar, "--format", "urdf", "--out", str(pipe)], capsys
+    )
+    assert stat.S_ISFIFO(pipe.lstat().st_mode)
+    too_long = str(tmp_path / ("a" * 300 + ".urdf"))  # a traceback (ENAMETOOLONG) before
+    assert "cannot write" in _one_line_error(
+        ["export", planar, "--format", "urdf", "--out", too_long], capsys
+    )
 
 
 def test_cli_writes_the_model_and_its_companion(runs, tmp_path, capsys):

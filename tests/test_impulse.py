@@ -205,3 +205,28 @@ def test_bad_reaction_mode_lists_options():
         cr.model.phase_impulses(**GOOD, v_r=0.1)  # a robot velocity needs the moving reaction
     with pytest.raises(cr.InvalidParameter, match="v_r"):
         cr.model.phase_impulses(**GOOD, reaction="moving", v_r=-0.1)
+
+
+IMPULSE = cr.model.impulse
+HOSTILE_FORMULAS = {
+    # each was a ZeroDivisionError, an inf or NaN result, or NumPy's unnamed broadcast ValueError
+    "pulse_zero_mass": (IMPULSE.impact_pulse_duration, (-0.0, 0.5), "m_f"),
+    "pulse_none": (IMPULSE.impact_pulse_duration, (2.0, None), "k_m"),
+    "sensing_overflow": (IMPULSE.sensing_force, (1e70, 2.0, 1e300), "float64 range"),
+    "sensing_none": (IMPULSE.sensing_force, (None, 10.0, 1.0), "t"),
+    "sprung_overflow": (IMPULSE.sprung_reaction, (1.0, 1e-300, 2.0, 10.0), "float64 range"),
+    "sprung_shapes": (IMPULSE.sprung_reaction, (np.ones(2), np.ones((3, 3)), 1.0, 1.0), "broadcast"),
+    "reaction_shapes": (IMPULSE.reaction_duration, (1.0, np.ones(0), np.ones((3, 3))), "broadcast"),
+    "total_shapes": (IMPULSE.total_impulse, (np.ones((3, 3)), np.ones(2), 0.5, 1.0, 1.0, 1.0), "broadcast"),
+    "times_shapes": (IMPULSE.collision_times, (2.0, 3, 3, np.ones(0), 2.0, np.ones((3, 3))), "broadcast"),
+    "series_shapes": (IMPULSE.series_stiffness, (np.ones(0), np.ones(2)), "broadcast"),
+    "optimum_shapes": (IMPULSE.optimal_velocity, (np.ones((2, 2, 2)), 2.0, np.ones((3, 3))), "broadcast"),
+}
+
+
+@pytest.mark.parametrize("name", list(HOSTILE_FORMULAS), ids=list(HOSTILE_FORMULAS))
+def test_impulse_formulas_refuse_hostile_numbers_with_a_named_error(name: str) -> None:
+    """Zero, None, overflowing or unbroadcastable inputs raise InvalidParameter, not a crash or a silent NaN."""
+    function, args, words = HOSTILE_FORMULAS[name]
+    with pytest.raises(cr.InvalidParameter, match=words):
+        function(*args)

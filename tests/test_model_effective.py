@@ -160,3 +160,21 @@ def test_casadi_arguments_pass_the_checks_unchanged() -> None:
     assert float(value) == pytest.approx(0.08, rel=1e-15)
     matrix = effective.finger_mass_matrix(ca.DM(np.eye(2)), [ca.DM(np.eye(2))] * 2, m)
     assert ca.Function("g", [m], [matrix])(ca.DM([1.0, 2.0])).full().tolist() == [[4.0, 0.0], [0.0, 4.0]]
+
+
+def test_effective_formulas_refuse_no_joints_unfitting_shapes_and_overflow():
+    """An empty joint axis, unbroadcastable arrays or an overflowing N tau_s were NumPy errors or a silent inf."""
+    calls = {
+        "fractions": lambda: effective.reaction_compliance(np.array([])),
+        "joint_reflected_inertia, in_finger": lambda: effective.finger_inertia(np.eye(2), np.array([])),
+        "robot_compliance, reaction_compliance_": lambda: effective.reaction_acceleration(
+            np.ones((3, 3)), np.ones(2)
+        ),
+        "gear_ratio, motor_torque": lambda: sensing.current_threshold_torque(1e300, 2**62),
+        "gear_ratio, motor_torque, friction_torque": lambda: sensing.current_threshold_torque(
+            np.ones((3, 3)), np.ones(2)
+        ),
+    }
+    for name, call in calls.items():
+        with pytest.raises(InvalidParameter, match=f"^{name} ="):
+            call()

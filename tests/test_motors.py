@@ -184,3 +184,11 @@ def test_max_speed_and_speed_scaling_validated():
         cr.hardware.ScalingLaw("x", 2.0, 4.0, 2.5, speed=-1.0)  # type: ignore[arg-type]
     with pytest.raises(cr.InvalidParameter, match=r"ScalingLaw\.torque_exponent"):
         cr.hardware.ScalingLaw("x", 2.0, 4.0, 0.0)  # a zero exponent divided J_m ~ tau**p by zero
+
+
+def test_a_name_or_reference_of_the_wrong_kind_is_invalid_parameter():
+    """get_motor([1, 2]) raised 'unhashable type'; scaled_motor_quantities(0.06, ...) an AttributeError."""
+    with pytest.raises(cr.InvalidParameter, match=r"^name ="):
+        cr.hardware.motors.get_motor(np.ones(2))
+    with pytest.raises(cr.InvalidParameter, match=r"^reference ="):
+        cr.hardware.motors.scaled_motor_quantities(0.06, 0.05)

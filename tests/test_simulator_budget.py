@@ -124,3 +124,33 @@ def test_the_paper_s_u8_soft_fit_runs_instead_of_being_refused() -> None:
     _, reaction = sprung_reaction(3.0, setup.k_m, setup.F_a, setup.m_r, setup.v0 * k / setup.k_m)
     assert result.impulse_reaction == pytest.approx(reaction, rel=1e-6)
     assert paper.reaction > 50 * reaction
+
+
+CHEAP_BUT_REFUSED = {
+    # F_a is far below the detection force: the spring pushes the robot mass back, not F_a alone (was 3.7e5 steps).
+    "weak_actuator": cr.simulate.CollisionSetup(
+        1.787,
+        2.217,
+        16654.0,
+        86846.0,
+        1.909e-4,
+        0.07246,
+        cr.simulate.Detection("position", 9.835e-4),
+        "impedance",
+    ),
+    # The free drive never detects: no approach-until-detection phase, and the robot mass bounces off (1.9e5 steps).
+    "free_heavy_robot": cr.simulate.CollisionSetup(
+        3.822, 735.0, 101111.0, 73933.0, 0.3581, 1.533, cr.simulate.Detection("force", 0.813), "free"
+    ),
+    "free_slow_approach": cr.simulate.CollisionSetup(
+        4.758, 0.2934, 2.304e7, 36.87, 236.2, 0.0012917, cr.simulate.Detection("position", 0.0029046), "free"
+    ),
+}
+
+
+@pytest.mark.parametrize("name", list(CHEAP_BUT_REFUSED), ids=list(CHEAP_BUT_REFUSED))
+def test_cheap_runs_with_a_weak_actuator_or_free_drive_are_not_refused(name: str) -> None:
+    """Settings that run in a few hundred steps were refused up front at 5e4-4e5 estimated steps."""
+    setup = CHEAP_BUT_REFUSED[name]
+    assert budget.estimated_steps(setup) < setup.max_steps / 10
+    assert cr.simulate.simulate(setup).impulse > 0

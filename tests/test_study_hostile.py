@@ -102,6 +102,13 @@ def test_a_recursive_alias_is_refused():
     assert "recursive alias" in problem.found
 
 
+@pytest.mark.parametrize("nested", ["[" * 100_000 + "]" * 100_000, "- " * 200_000 + "x"])
+def test_a_deeply_nested_value_is_refused_not_a_crash(nested):
+    """libyaml's composer recursed in C on 100,000 levels: a segmentation fault, not even a RecursionError."""
+    problem = _only_problem(BASE + "description:\n  " + nested + "\n", load_robot=False)
+    assert "nested deeper than" in problem.found
+
+
 @pytest.mark.parametrize(
     ("line", "replacement", "path"),
     [
@@ -402,6 +409,12 @@ def test_a_catalogue_alias_bomb_is_refused(tmp_path):
     assert "aliases that expand to" in error.reason
 
 
+def test_a_deeply_nested_catalogue_is_refused_not_a_crash(tmp_path):
+    """A catalogue nested 100,000 levels deep crashed the interpreter in libyaml's composer."""
+    error = _catalogue_error(tmp_path, MOTOR + "extra: " + "{a: " * 100_000 + "1" + "}" * 100_000 + "\n")
+    assert "nested deeper than" in error.reason
+
+
 def test_a_catalogue_quantity_is_read_by_the_study_grammar(tmp_path):
     """One parser for both: the same text gives the same SI number in a catalogue and in a study."""
     path = tmp_path / "motors.yaml"
@@ -517,3 +530,9 @@ def test_a_trajectory_row_outside_the_joint_limits_is_refused_at_its_csv_line(tm
         describe_study(parse_study(text, "panda.yaml", tmp_path))
     problem = caught.value.problems[0]
     assert problem.found.startswith("traj.csv:4: panda_joint4 at 1.5708 rad, outside its limits")
+
+
+def test_a_catalogue_of_400_000_short_lines_is_refused_at_once(tmp_path):
+    """200,000 repeated two-line entries (1.4 MB) took 6 s to compose before the repeated key was reported."""
+    error = _catalogue_error(tmp_path, "motors:\n" + "  A:\n    mass: 1 kg\n" * 200_000)
+    assert "more than 100000 values" in error.reason

@@ -151,3 +151,11 @@ def test_the_keywords_reach_the_stiffness_sweep():
     np.testing.assert_allclose(new.force_threshold, 4.0)
     # F_s = k e_th with k the series of k_m and k_s = 1e4 N/m.
     np.testing.assert_allclose(new.position_threshold, k * 1e4 / (k + 1e4) * 0.01, rtol=1e-12)
+
+
+def test_an_empty_grid_is_invalid_parameter():
+    """An empty array of diameters or stiffnesses raised IndexError or 'argmin of an empty sequence'."""
+    with pytest.raises(cr.InvalidParameter, match=r"^stiffnesses ="):
+        cr.hardware.sweeps.stiffness_sweep(np.array([]))
+    with pytest.raises(cr.InvalidParameter, match=r"^diameters ="):
+        cr.hardware.sweeps.radius_velocity_sweep(np.array([]), np.array([0.1]))

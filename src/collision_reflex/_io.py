@@ -60,6 +60,10 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     0600), so that the result is as readable as any other file the user writes.
     """
     target = Path(path)
+    # Renaming onto a device or a pipe would replace it (as root, /dev/zero itself): refuse it.
+    with contextlib.suppress(FileNotFoundError):
+        if not stat.S_ISREG(mode := target.lstat().st_mode) and not stat.S_ISLNK(mode):
+            raise OSError(errno.EINVAL, "not a regular file (a device, a pipe or a folder)", str(target))
     target.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp_name = tempfile.mkstemp(  # the writer's process id in the name: a dead writer's is removable
         prefix=f"{TEMPORARY_PREFIX}{target.stem}.{os.getpid()}.", suffix=target.suffix, dir=target.parent

@@ -213,10 +213,22 @@ class DutyCycle:
                     line(int(bad[0])),
                 )
         _check_times(t, source, lines)
-        quintic = make_interp_spline(t, q, k=SPLINE_ORDER)
-        velocity, acceleration = quintic.derivative(1), quintic.derivative(2)
+        with np.errstate(
+            over="ignore", invalid="ignore", divide="ignore"
+        ):  # a non-finite result is refused next
+            quintic = make_interp_spline(t, q, k=SPLINE_ORDER)
+            velocity, acceleration = quintic.derivative(1), quintic.derivative(2)
+            qd, qdd = velocity(t), acceleration(t)
+        bad = np.flatnonzero(~(np.isfinite(qd) & np.isfinite(qdd)).all(axis=1))
+        if bad.size:
+            raise TrajectoryError(
+                source,
+                f"the speeds or accelerations at sample {int(bad[0])} exceed the float64 range: time steps of "
+                f"{float(np.min(np.diff(t))):.3g} s are too short for the positions (check the time unit)",
+                line(int(bad[0])),
+            )
         _check_resolution(t, q, acceleration, names, source, line)
-        return cls(names, t, q, velocity(t), acceleration(t), payload)
+        return cls(names, t, q, qd, qdd, payload)
 
     @classmethod
     def from_csv(
@@ -435,7 +447,7 @@ def _check_resolution(
     cubic = make_interp_spline(t, q, k=3).derivative(2)(midpoints)
     scale = np.max(np.abs(acceleration(t)), axis=0)
     disagreement = np.abs(quintic - cubic)
-    moving = scale > 0
+    moving = (scale > 0) & (np.ptp(q, axis=0) > 0)  # a joint held still has only round-off accelerations
     relative = np.zeros_like(disagreement)
     relative[:, moving] = disagreement[:, moving] / scale[moving]
     worst = np.unravel_index(int(np.argmax(relative)), relative.shape)

@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .. import _backend as backend
+from .. import _validate
 from ..errors import InvalidParameter
 from .duty_cycle import DutyCycle, Payload
 from .joints import joint_array
@@ -267,4 +268,5 @@ def rms(values: Any, t: Any) -> Any:
 
 def max_speed(velocity: Any) -> np.ndarray:
     """``max_t |qd_i(t)|`` per joint [rad/s or m/s], (nv,), of joint velocities (n, nv)."""
+    velocity = _validate.arrays("velocity", velocity, ndim=2)
     return np.asarray(peak(np.asarray(velocity, dtype=float).T))

@@ -56,10 +56,13 @@ def export_design(
     if format not in EXPORT_FORMATS:
         raise InvalidParameter("format", format, " or ".join(EXPORT_FORMATS))
     out = Path(out)
-    if out.is_dir():
-        raise ExportUnwritable(f"cannot write {out}: it is a folder; give a file name")
-    if out.parent.exists() and not out.parent.is_dir():
-        raise ExportUnwritable(f"cannot write {out}: {out.parent} is a file, not a folder")
+    try:
+        if out.is_dir():
+            raise ExportUnwritable(f"cannot write {out}: it is a folder; give a file name")
+        if out.parent.exists() and not out.parent.is_dir():
+            raise ExportUnwritable(f"cannot write {out}: {out.parent} is a file, not a folder")
+    except OSError as error:  # a name too long for the file system, say
+        raise ExportUnwritable(f"cannot write {out}: {error.strerror or error}") from None
     chosen = read_run_design(run_dir, design)
     urdf, meshes = design_urdf(chosen, out)
     if format == "mjcf":

@@ -54,9 +54,10 @@ def gear_ratio_for(torque_required: ArrayLike, peak_torque: ArrayLike) -> float 
     torque_required: output torque the joint must deliver [N m], > 0.
     peak_torque: the motor's peak torque ``tau_p`` [N m], > 0.
     """
-    _validate.positive("torque_required", torque_required)
-    _validate.positive("peak_torque", peak_torque)
-    ratio = np.maximum(1.0, np.asarray(torque_required, dtype=float) / np.asarray(peak_torque, dtype=float))
+    required = np.asarray(_validate.positive("torque_required", torque_required))
+    peak = np.asarray(_validate.positive("peak_torque", peak_torque))
+    with _validate.combining(torque_required=required, peak_torque=peak):
+        ratio = np.maximum(1.0, required / peak)
     return ratio if ratio.ndim else float(ratio)
 
 

@@ -20,7 +20,7 @@ import yaml
 from pydantic import ValidationError
 
 from .._io import read_limited
-from .._yaml import NodeProblem, check_nodes, one_line
+from .._yaml import LOADER, NodeProblem, check_depth, check_nodes, one_line
 from ..errors import CatalogueError
 from ..vocabulary import PER_RATIO_FIELDS
 from .catalogue_schema import DESCRIPTIVE_FIELDS, ENTRY_SCHEMAS, PROVENANCE_FIELDS, CitedEntry, excerpt
@@ -32,6 +32,9 @@ _MAX_INERTIA_PER_MASS_RADIUS2 = 2.0
 CATALOGUE_LIMIT = 4 * 2**20
 """Largest catalogue file read [bytes]: the packaged ones are tens of kilobytes; a multi-megabyte one is not a
 catalogue but a mistake, refused before it is parsed (parsing YAML costs far more than its size)."""
+
+CATALOGUE_NODES = 100_000
+"""Most values (scalars, mappings, lists) a catalogue file may hold: the packaged ones hold about 500."""
 
 
 def packaged_catalogue_path(file: str = "motors.yaml") -> Path:
@@ -148,7 +151,8 @@ def _parsed_entries(name: str, data: bytes, kind: str) -> dict[str, CatalogueEnt
         at = data.count(b"\n", 0, error.start) + 1
         raise CatalogueError(name, at, "", f"the byte 0x{data[error.start]:02x} is not UTF-8 text") from None
     try:
-        root = yaml.compose(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))  # libyaml if built
+        check_depth(text, CATALOGUE_NODES)  # libyaml's composer recurses in C: a deep file would crash it
+        root = yaml.compose(text, Loader=LOADER)
         if root is not None:
             check_nodes(root)  # before constructing any value: tags, alias bombs, huge values
     except NodeProblem as error:

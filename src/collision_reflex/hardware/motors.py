@@ -294,6 +294,8 @@ def scaled_motor_quantities(
     stack_length: new stack length ``l`` [m], > 0; default the reference's.
     law: a scaling-law name (see :data:`SCALING_LAWS`) or a :class:`ScalingLaw`.
     """
+    if not isinstance(reference, Motor):
+        raise InvalidParameter("reference", reference, "a Motor (e.g. reference_motor() or get_motor(name))")
     law = scaling_law(law)
     _validate.positive("stator_diameter", stator_diameter)
     if stack_length is None:
@@ -359,6 +361,8 @@ def reference_motor() -> Motor:
 
 def get_motor(name: str, path: str | os.PathLike[str] | None = None) -> Motor:
     """The motor called ``name`` in a catalogue (default: the packaged one)."""
+    if not isinstance(name, str):
+        raise InvalidParameter("name", name, "a motor's name (text)")
     catalogue = load_catalogue(path)
     try:
         return catalogue[name]

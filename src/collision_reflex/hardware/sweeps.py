@@ -447,6 +447,6 @@ def _grid(name: str, values: ArrayLike) -> np.ndarray:
     """A sorted 1D float array of positive finite values, or InvalidParameter."""
     _validate.positive(name, values)
     array = np.atleast_1d(np.asarray(values, dtype=float))
-    if array.ndim != 1:
-        raise InvalidParameter(name, values, "a 1D sequence of numbers > 0")
+    if array.ndim != 1 or array.size == 0:
+        raise InvalidParameter(name, values, "a non-empty 1D sequence of numbers > 0")
     return np.sort(array)

@@ -124,12 +124,13 @@ def transient_contact(
     v = _validate.positive("velocity", velocity)
     k_c = _validate.positive("contact_stiffness", contact_stiffness)
     mu = reduced_mass(robot_mass, body_mass)
-    return TransientContact(
-        reduced_mass=mu,
-        peak_force=_plain(v * sqrt(mu * k_c)),
-        duration=_plain(math.pi * sqrt(mu / k_c)),
-        compression=_plain(v * sqrt(mu / k_c)),
-    )
+    with _validate.combining(velocity=v, robot_mass=robot_mass, contact_stiffness=k_c, body_mass=body_mass):
+        return TransientContact(
+            reduced_mass=mu,
+            peak_force=_plain(v * sqrt(mu * k_c)),
+            duration=_plain(math.pi * sqrt(mu / k_c)),
+            compression=_plain(v * sqrt(mu / k_c)),
+        )
 
 
 def permissible_speed(
@@ -142,7 +143,11 @@ def permissible_speed(
     """
     F_T = _validate.positive("force_limit", force_limit)
     k_c = _validate.positive("contact_stiffness", contact_stiffness)
-    return _plain(F_T / sqrt(reduced_mass(robot_mass, body_mass) * k_c))
+    mu = reduced_mass(robot_mass, body_mass)
+    with _validate.combining(
+        force_limit=F_T, robot_mass=robot_mass, contact_stiffness=k_c, body_mass=body_mass
+    ):
+        return _plain(F_T / sqrt(mu * k_c))
 
 
 def contact_robot_mass(
@@ -160,7 +165,11 @@ def contact_robot_mass(
     m_r = _validate.non_negative("rotor_mass", rotor_mass)
     k_c = _validate.positive("contact_stiffness", contact_stiffness)
     k_m = _validate.positive("mechanical_stiffness", mechanical_stiffness, allow_inf=True)
-    coupled = m_f + m_r
+    with _validate.combining(
+        finger_mass=m_f, rotor_mass=m_r, contact_stiffness=k_c, mechanical_stiffness=k_m
+    ):
+        coupled = m_f + m_r
+        np.broadcast_shapes(*(np.shape(x) for x in (m_f, m_r, k_c, k_m) if not is_symbolic(x)))
     if is_symbolic(m_f, m_r, k_c, k_m):
         return coupled, False
     ratio = np.asarray(k_c, dtype=float) / np.asarray(k_m, dtype=float)
@@ -272,7 +281,7 @@ def settled_rebound_speed(finger_mass: Any, stiffness: Any, threshold: Any, rest
     k = _validate.positive("stiffness", stiffness)
     F_s = _validate.positive("threshold", threshold)
     settling = rebound(restitution).settling
-    with np.errstate(divide="ignore"):
+    with _validate.combining(finger_mass=m_f, stiffness=k, threshold=F_s), np.errstate(divide="ignore"):
         return _plain(np.divide(F_s, settling * np.sqrt(k * m_f)))
 
 
@@ -288,7 +297,8 @@ def rebound_impulse(
     """
     v0 = _validate.positive("velocity", velocity)
     fastest = settled_rebound_speed(finger_mass, stiffness, threshold, restitution)
-    beyond = np.asarray(v0 > fastest * (1 + 1e-12))
+    with _validate.combining(velocity=v0, finger_mass=finger_mass, stiffness=stiffness, threshold=threshold):
+        beyond = np.asarray(v0 > fastest * (1 + 1e-12))
     if beyond.any():
         raise InvalidParameter(
             "velocity",

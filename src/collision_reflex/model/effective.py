@@ -69,7 +69,9 @@ def finger_inertia(joint_reflected_inertia: Any, in_finger: Any) -> Any:
     joint_reflected_inertia = _validate.non_negative("joint_reflected_inertia", joint_reflected_inertia)
     if isinstance(in_finger, bool) or (isinstance(in_finger, np.ndarray) and in_finger.dtype == bool):
         in_finger = np.asarray(in_finger, dtype=float)  # flags: True is 1
-    return joint_reflected_inertia * _validate.unit_interval("in_finger", in_finger)
+    in_finger = _validate.unit_interval("in_finger", in_finger)
+    with _validate.combining(joint_reflected_inertia=joint_reflected_inertia, in_finger=in_finger):
+        return joint_reflected_inertia * in_finger
 
 
 def finger_mass_matrix(
@@ -166,13 +168,17 @@ def reaction_compliance(fractions: Any, joint_axis: int = -1) -> Any:
             joint_axis,
             f"an axis of fractions, an integer in [{-fractions.ndim}, {fractions.ndim})",
         )
+    if fractions.shape[joint_axis] == 0:
+        raise InvalidParameter("fractions", fractions, "at least one joint along joint_axis")
     return largest(absolute(fractions), joint_axis)
 
 
 def reaction_acceleration(robot_compliance: Any, reaction_compliance_: Any) -> Any:
     """``a = F_a / m_r`` [m/s^2] from ``1 / m_r = u^T J M_jj^-1 J^T u`` [1/kg] and ``1 / F_a`` [1/N]."""
     robot_compliance = _validate.positive("robot_compliance", robot_compliance)
-    return robot_compliance / _validate.positive("reaction_compliance_", reaction_compliance_)
+    reaction_compliance_ = _validate.positive("reaction_compliance_", reaction_compliance_)
+    with _validate.combining(robot_compliance=robot_compliance, reaction_compliance_=reaction_compliance_):
+        return robot_compliance / reaction_compliance_
 
 
 def finger_mass_direction(moment_arms: Any, mass_matrix: Any) -> Any:

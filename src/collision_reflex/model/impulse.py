@@ -65,6 +65,7 @@ def series_stiffness(k_m: Any, k_s: Any) -> Any:
     """
     _validate.positive("k_m", k_m, allow_inf=True)
     _validate.positive("k_s", k_s, allow_inf=True)
+    _broadcastable(k_m=k_m, k_s=k_s)
     # Compliances add; written this way an infinite stiffness simply drops out (and two give inf).
     if is_symbolic(k_m, k_s):
         return 1 / (1 / k_m + 1 / k_s)
@@ -147,6 +148,7 @@ def optimal_velocity(
     """
     _validate.choice("reaction", reaction, REACTION_MODES)
     m_f, k, F_s = (_validate.positive(name, value) for name, value in (("m_f", m_f), ("k", k), ("F_s", F_s)))
+    _broadcastable(m_f=m_f, k=k, F_s=F_s)
     v_star = _representable(
         "the optimal velocity F_s / sqrt(2 k m_f)",
         (F_s, k, m_f),
@@ -167,6 +169,7 @@ def optimal_velocity(
             "the moving-robot optimum has no closed form; use numeric values",
         )
     k_m, a = _validate.positive("k_m", k_m), _validate.positive("a", a)
+    _broadcastable(m_f=m_f, k=k, F_s=F_s, k_m=k_m, a=a)
     if np.any(np.asarray(v_star) < np.finfo(np.float64).tiny):
         raise InvalidParameter(
             "the optimal velocity F_s / sqrt(2 k m_f)",
@@ -236,7 +239,9 @@ def impact_pulse_duration(m_f: Any, k_m: Any) -> Any:
 
     That of the finger mass ``m_f`` [kg] on the mechanical spring ``k_m`` [N/m], ``w = sqrt(k_m / m_f)``.
     """
-    return np.pi / (2 * sqrt(k_m / m_f))
+    m_f, k_m = _validate.positive("m_f", m_f), _validate.positive("k_m", k_m)
+    with _validate.combining(m_f=m_f, k_m=k_m):
+        return _finite("the impact pulse duration", np.pi / (2 * sqrt(k_m / m_f)))
 
 
 def sensing_force(t: Any, k: Any, v0: Any) -> Any:
@@ -245,7 +250,14 @@ def sensing_force(t: Any, k: Any, v0: Any) -> Any:
     The velocity-controlled robot compresses the lumped spring ``k`` [N/m] at ``v0`` [m/s], ``F = k v0 t``
     (valid until detection, ``t1``).
     """
-    return k * v0 * t
+    t, k, v0 = _validate.finite("t", t), _validate.positive("k", k), _validate.positive("v0", v0)
+    with _validate.combining(t=t, k=k, v0=v0):
+        force = k * v0 * t
+    if not is_symbolic(force) and not np.all(np.isfinite(force)):
+        raise InvalidParameter(
+            "t, k, v0", (t, k, v0), "values whose force k v0 t is within the float64 range"
+        )
+    return force
 
 
 def reaction_duration(F_s: Any, k_m: Any, a: Any, v_r: Any = 0.0) -> Any:
@@ -256,7 +268,9 @@ def reaction_duration(F_s: Any, k_m: Any, a: Any, v_r: Any = 0.0) -> Any:
     robot at rest, ``sqrt(2 F_s / (a k_m))``).
     """
     F_s, k_m, a = (_validate.positive(name, value) for name, value in (("F_s", F_s), ("k_m", k_m), ("a", a)))
-    duration, _ = _reaction_phase(F_s, k_m, a, _validate.non_negative("v_r", v_r))
+    v_r = _validate.non_negative("v_r", v_r)
+    _broadcastable(F_s=F_s, k_m=k_m, a=a, v_r=v_r)
+    duration, _ = _reaction_phase(F_s, k_m, a, v_r)
     return duration
 
 
@@ -314,13 +328,16 @@ def sprung_reaction(F_s: Any, k_m: Any, F_a: Any, m_r: Any, v_r: Any = 0.0) -> t
         for name, value in (("F_s", F_s), ("k_m", k_m), ("F_a", F_a), ("m_r", m_r))
     )
     v_r = np.asarray(_validate.non_negative("v_r", v_r), dtype=float)
-    w = np.sqrt(k_m / m_r)
-    x1, push = F_s / k_m, F_a / k_m
-    phase = np.arctan2(v_r / w, x1 + push)
-    tau_e = (phase + np.arccos(push / np.hypot(x1 + push, v_r / w))) / w
-    impulse = k_m * (
-        -push * tau_e + (x1 + push) * np.sin(w * tau_e) / w + v_r * (1 - np.cos(w * tau_e)) / w**2
-    )
+    _broadcastable(F_s=F_s, k_m=k_m, F_a=F_a, m_r=m_r, v_r=v_r)
+    with _validate.combining(F_s=F_s, k_m=k_m, F_a=F_a, m_r=m_r, v_r=v_r), np.errstate(invalid="ignore"):
+        w = np.sqrt(k_m / m_r)
+        x1, push = F_s / k_m, F_a / k_m
+        phase = np.arctan2(v_r / w, x1 + push)
+        tau_e = (phase + np.arccos(push / np.hypot(x1 + push, v_r / w))) / w
+        impulse = k_m * (
+            -push * tau_e + (x1 + push) * np.sin(w * tau_e) / w + v_r * (1 - np.cos(w * tau_e)) / w**2
+        )
+    tau_e, impulse = _finite("the reaction time", tau_e), _finite("the reaction impulse", impulse)
     return (tau_e if tau_e.ndim else float(tau_e)), (impulse if impulse.ndim else float(impulse))
 
 
@@ -435,6 +452,7 @@ def _checked(
         v_r = v0
     else:
         v_r = _validate.non_negative("v_r", v_r)
+    _broadcastable(m_f=m_f, k=k, k_m=k_m, F_s=F_s, a=a, v0=v0, v_r=v_r)
     return m_f, k, k_m, F_s, a, v0, v_r
 
 

@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import _validate
 from ..errors import InvalidParameter
 
 SAMPLES_PER_PERIOD = 32
@@ -90,6 +91,12 @@ def normal_modes(mass: np.ndarray, stiffness: np.ndarray) -> tuple[np.ndarray, n
     """Frequencies [rad/s] and mass-normalised mode shapes (``Phi^T mass Phi = I``) of ``mass, stiffness``."""
     from scipy.linalg import eigh  # lazy: scipy
 
+    mass = _validate.arrays("mass", mass, ndim=2, square=True)
+    stiffness = _validate.arrays("stiffness", stiffness, ndim=2, square=True)
+    if mass.ndim != 2 or stiffness.shape != mass.shape:
+        raise InvalidParameter(
+            "mass, stiffness", (mass.shape, stiffness.shape), "two square matrices of one shape"
+        )
     if mass.shape[0] == 0:
         return np.zeros(0), np.zeros((0, 0))
     w2, shapes = eigh(stiffness, mass)
@@ -101,6 +108,9 @@ def first_crossing(modes: Modes, level: float, horizon: float, rising: bool, wha
     """The first time in ``(0, horizon]`` [s] where the force crosses ``level`` [N] (upward if ``rising``)."""
     from scipy.optimize import brentq  # lazy: scipy
 
+    if not isinstance(modes, Modes):
+        raise InvalidParameter("modes", modes, "a Modes (the collision's modal solution)")
+    level, horizon = _validate.finite("level", level), _validate.positive("horizon", horizon)
     step = min(modes.shortest_period(), horizon) / SAMPLES_PER_PERIOD
     count = math.ceil(horizon / step)
     if count > MAX_SAMPLES:

@@ -19,7 +19,11 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
+
 from .. import _validate
+from .._backend import is_symbolic
+from ..errors import InvalidParameter
 from ..vocabulary import OPTIMIZED_SENSING_SCHEMES, SENSING_SCHEMES
 
 
@@ -63,4 +67,14 @@ def current_threshold_torque(gear_ratio: Any, motor_torque: Any, friction_torque
     gear_ratio = _validate.positive("gear_ratio", gear_ratio)
     motor_torque = _validate.positive("motor_torque", motor_torque)
     friction_torque = _validate.non_negative("friction_torque", friction_torque)
-    return gear_ratio * motor_torque + friction_torque
+    with _validate.combining(
+        gear_ratio=gear_ratio, motor_torque=motor_torque, friction_torque=friction_torque
+    ):
+        torque = gear_ratio * motor_torque + friction_torque
+    if not is_symbolic(torque) and not np.all(np.isfinite(torque)):  # Python floats overflow to inf silently
+        raise InvalidParameter(
+            "gear_ratio, motor_torque",
+            (gear_ratio, motor_torque),
+            "values whose N tau_s is below about 1.8e308",
+        )
+    return torque

@@ -12,7 +12,7 @@ import math
 from dataclasses import dataclass
 
 from ..errors import SimulationError
-from ..model.impulse import collision_times
+from ..model.impulse import collision_times, series_stiffness, sprung_reaction
 from ..model.sensing import threshold_force
 from .setup import CollisionSetup, oscillation_period
 
@@ -81,8 +81,10 @@ def phases(setup: CollisionSetup) -> tuple[Phase, Phase, Phase]:
     approach = _approach_scales(setup)
     reaction = _reaction_scales(setup)
     rate = setup.control_rate
-    sensing_span = _sensing_time(setup)
-    delay_span = setup.delay + (1 / rate if rate is not None else 0.0)
+    # The free drive never detects: its whole run is the bounce and the watch after it.
+    free = setup.drive == "free"
+    sensing_span = 0.0 if free else _sensing_time(setup)
+    delay_span = 0.0 if free else setup.delay + (1 / rate if rate is not None else 0.0)
     watch = WATCH_PERIODS * oscillation_period(setup.m_f, setup.k_m)
     reaction_time = _reaction_time(setup)
     reaction_span = reaction_time + watch
@@ -183,12 +185,16 @@ def _reaction_time(setup: CollisionSetup) -> float:
     """The closed form's reaction time ``t2 - t1`` [s], the robot moving at detection.
 
     At ``v0 k / k_m`` for the ideal drive (what it moves at while the finger is held), at ``v0`` (the most it
-    can) for the others.
+    can) for the others; the shorter of the paper's (``F_a`` alone decelerates the robot mass) and
+    :func:`~collision_reflex.model.impulse.sprung_reaction`'s (the compressed spring pushes it back too).
     """
     F_ref, k, a = reference_force(setup), setup.lumped_stiffness, setup.acceleration
     v_r = setup.detection_robot_velocity if setup.drive == "ideal" else setup.v0
     t1, t2 = collision_times(setup.m_f, k, setup.k_m, F_ref, a, setup.v0, "moving", v_r)
-    return float(t2 - t1)
+    # The compressed spring pushes the robot mass back too: far sooner than F_a alone where F_ref >> F_a.
+    k_push = series_stiffness(setup.k_m, setup.contact_stiffness)
+    sprung, _ = sprung_reaction(F_ref, k_push, setup.F_a, setup.m_r, max(v_r, 0.0))
+    return min(float(t2 - t1), float(sprung))
 
 
 def _approach_scales(setup: CollisionSetup) -> dict[str, float]:

@@ -17,7 +17,7 @@ from typing import Any
 
 import yaml
 
-from .._yaml import NodeProblem, check_nodes, one_line
+from .._yaml import LOADER, NodeProblem, check_depth, check_nodes, one_line
 from ..errors import StudyFileError, StudyProblem
 
 PathKey = tuple[Hashable, ...]
@@ -169,6 +169,7 @@ def parse_study_source(text: str, file: str = "<string>", directory: Path | None
         found = "a lone surrogate (not a Unicode character)"
         raise StudyFileError(file, [problem_at(file, line, column, "", found, "text")]) from None
     try:
+        check_depth(text)  # libyaml's composer recurses in C: a deep file would crash it
         node = loader.get_single_node()
         if node is not None:
             check_nodes(node)  # before constructing: an alias bomb or a tag is refused here
@@ -248,8 +249,7 @@ def _constructed_key(key_node: yaml.Node, raw: Any) -> Any:
         return raw
 
 
-_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
-"""The safe loader, on libyaml's parser where PyYAML was built with it (faster; the same marks)."""
+_LOADER = LOADER
 
 _KEY_CONSTRUCTOR = yaml.SafeLoader("")
 """Constructs single key nodes (a loader over no text: only its constructor is used)."""
