@@ -34,7 +34,7 @@ from .._table import HEADER, TableProblem, read_table
 from ..errors import InvalidParameter, TraceError, TrajectoryError
 from ..experiments.traces import unit_factor
 from ..vocabulary import TIME_COLUMN_NAMES
-from .motion_profiles import trapezoidal_motion
+from .motion_profiles import MAX_CYCLE_SAMPLES, checked_motion, trapezoidal_motion
 
 SPLINE_ORDER = 5
 """Order of the interpolating spline differentiated for velocities and accelerations (quintic)."""
@@ -73,10 +73,6 @@ class Payload:
         object.__setattr__(self, "mass", mass)
         object.__setattr__(self, "inertia", inertia)
 
-
-MAX_CYCLE_SAMPLES = 200_000
-"""Most samples a duty cycle may hold: the requirement evaluates the arm's dynamics at each (a million rows grew a
-smoke run past 10 GB); an hour of motion at 50 Hz is 180,000."""
 
 MAX_JOINT_SPEED = 1e4
 """Fastest joint speed a duty cycle may hold [rad/s or m/s]: 95,000 rpm at the joint, far beyond any robot's, so
@@ -310,28 +306,14 @@ class DutyCycle:
         The cycle, with analytic velocities and accelerations; it starts and ends at rest.
         """
         names = tuple(joint_names)
-        points = np.asarray(via_points, dtype=float)
-        if points.ndim != 2 or points.shape[0] < 2 or points.shape[1] != len(names):
+        points, speeds, accelerations, rate, dwell = checked_motion(
+            via_points, max_velocity, max_acceleration, rate, dwell
+        )
+        if points.shape[1] != len(names):
             raise InvalidParameter(
                 "via_points", points.shape, f"an array of shape (k >= 2, {len(names)}) [rad or m]"
             )
-        if not np.all(np.isfinite(points)):
-            raise InvalidParameter("via_points", points, "finite joint positions [rad or m]")
-        limits = {}
-        for name, value in (("max_velocity", max_velocity), ("max_acceleration", max_acceleration)):
-            array = np.broadcast_to(np.asarray(value, dtype=float), (len(names),)).copy()
-            if not np.all(np.isfinite(array) & (array > 0)):
-                raise InvalidParameter(name, value, "finite limits > 0, one per joint or one for all")
-            limits[name] = array
-        rate = float(rate)
-        if not (np.isfinite(rate) and rate > 0):
-            raise InvalidParameter("rate", rate, "a finite sampling rate > 0 [Hz]")
-        rest = np.broadcast_to(np.asarray(dwell, dtype=float), (points.shape[0],)).copy()
-        if not np.all(np.isfinite(rest) & (rest >= 0)):
-            raise InvalidParameter("dwell", dwell, "finite times >= 0 [s], one per via point or one for all")
-        t, q, qd, qdd = trapezoidal_motion(
-            points, limits["max_velocity"], limits["max_acceleration"], rate, rest
-        )
+        t, q, qd, qdd = trapezoidal_motion(points, speeds, accelerations, rate, dwell)
         return cls(names, t, q, qd, qdd, payload)
 
 
