@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from .. import _validate
 from ..errors import InvalidParameter
 from .directions import unit_directions
 from .effective import CollisionImpulses, EffectiveParameters, collision_impulses
@@ -113,7 +114,7 @@ def reflex_surface(
     stiffness_form: ``"compliance"`` or ``"paper"``.
     joint_threshold: joint-side threshold torques [N m] for ``sensing="current"``.
     """
-    configuration = np.asarray(q, dtype=float)
+    configuration = _validate.real("q", q, f"one configuration of shape ({arm.nq},)")
     if configuration.shape != (arm.nq,):
         raise InvalidParameter("q", configuration.shape, f"one configuration of shape ({arm.nq},)")
     spec = DEFAULT_DIRECTION_COUNT[arm.task_dim] if directions is None else directions
