@@ -105,7 +105,7 @@ class DutyCycle:
         if not names or len(set(names)) != len(names):
             raise InvalidParameter("joint_names", self.joint_names, "distinct joint names, at least one")
         object.__setattr__(self, "joint_names", names)
-        t = np.asarray(self.t, dtype=float)
+        t = _validate.real("t", self.t, "a 1-D array of at least 2 times [s]")
         if t.ndim != 1 or t.size < 2:
             raise InvalidParameter("t", t.shape, "a 1-D array of at least 2 times [s]")
         if t.size > MAX_CYCLE_SAMPLES:
@@ -118,7 +118,7 @@ class DutyCycle:
         _check_times(t, "")
         object.__setattr__(self, "t", t)
         for name in ("q", "qd", "qdd"):
-            values = np.asarray(getattr(self, name), dtype=float)
+            values = _validate.real(name, getattr(self, name), f"an array of shape ({t.size}, {len(names)})")
             if values.shape != (t.size, len(names)):
                 raise InvalidParameter(name, values.shape, f"an array of shape ({t.size}, {len(names)})")
             bad = np.flatnonzero(~np.all(np.isfinite(values), axis=1))
@@ -183,8 +183,8 @@ class DutyCycle:
         """
         from scipy.interpolate import make_interp_spline
 
-        t = np.asarray(t, dtype=float)
-        q = np.asarray(q, dtype=float)
+        t = _validate.real("t", t, "a 1-D array of strictly increasing times [s]")
+        q = _validate.real("q", q, "joint positions (n, nv) [rad or m]")
         names = tuple(joint_names)
         if t.ndim != 1 or q.shape != (t.size, len(names)):
             raise InvalidParameter(
