@@ -68,6 +68,10 @@ class ReflexSurface:
 
         In [m per N s times ``scale``]; ``cap`` [N s] bounds the infinite values of singular directions.
         """
+        if np.ndim(_validate.positive("scale", scale)) != 0:
+            raise InvalidParameter("scale", scale, "one finite number > 0")
+        if cap is not None and np.ndim(_validate.positive("cap", cap)) != 0:
+            raise InvalidParameter("cap", cap, "one finite impulse > 0 [N s], or None")
         radius = self.impulse if cap is None else np.minimum(self.impulse, cap)
         return scale * radius[:, None] * self.directions
 
@@ -75,7 +79,9 @@ class ReflexSurface:
         """World points (..., 3) [m] in the plane coordinates of a planar arm (..., 2)."""
         if self.plane is None:
             raise InvalidParameter("plane", None, "a planar arm")
-        return np.asarray(points) @ self.plane
+        points = _validate.arrays("points", points)
+        with _validate.combining(points=points, plane=self.plane):
+            return points @ self.plane
 
     def extremes(self) -> tuple[np.ndarray, np.ndarray]:
         """Directions of the smallest and the largest impulse (the largest may be a singular one)."""
