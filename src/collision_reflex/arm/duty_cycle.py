@@ -101,7 +101,7 @@ class DutyCycle:
     payload: Payload | None = None
 
     def __post_init__(self) -> None:
-        names = tuple(str(name) for name in self.joint_names)
+        names = tuple(str(name) for name in _joint_names(self.joint_names))
         if not names or len(set(names)) != len(names):
             raise InvalidParameter("joint_names", self.joint_names, "distinct joint names, at least one")
         object.__setattr__(self, "joint_names", names)
@@ -185,7 +185,7 @@ class DutyCycle:
 
         t = _validate.real("t", t, "a 1-D array of strictly increasing times [s]")
         q = _validate.real("q", q, "joint positions (n, nv) [rad or m]")
-        names = tuple(joint_names)
+        names = tuple(_joint_names(joint_names))
         if t.ndim != 1 or q.shape != (t.size, len(names)):
             raise InvalidParameter(
                 "q", q.shape, f"an array of shape ({t.size}, {len(names)}) for t {t.shape}"
@@ -305,7 +305,7 @@ class DutyCycle:
         -------
         The cycle, with analytic velocities and accelerations; it starts and ends at rest.
         """
-        names = tuple(joint_names)
+        names = tuple(_joint_names(joint_names))
         points, speeds, accelerations, rate, dwell = checked_motion(
             via_points, max_velocity, max_acceleration, rate, dwell
         )
@@ -395,6 +395,13 @@ def _read_table(path: str | os.PathLike[str]) -> tuple[int, Any]:
         return header + 1, read_table(lines, header)
     except TableProblem as problem:
         raise TrajectoryError(source, problem.reason, problem.line) from None
+
+
+def _joint_names(value: Any) -> Sequence[Any] | np.ndarray:
+    """``value`` if it is a sequence of joint names (not one string), else raise."""
+    if isinstance(value, str | bytes) or not isinstance(value, Sequence | np.ndarray):
+        raise InvalidParameter("joint_names", value, "a sequence of joint names, e.g. ('joint1', 'joint2')")
+    return value
 
 
 def _check_times(t: np.ndarray, source: str, lines: np.ndarray | None = None) -> None:

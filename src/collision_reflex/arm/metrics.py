@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from .. import _validate
 from ..errors import FrameNotFound, InvalidParameter
 from .directions import normalised_directions
 from .joints import joint_array
@@ -113,7 +114,8 @@ def dynamic_manipulability_ellipsoid(
     The task accelerations reachable with joint torques of unit norm lie in this ellipsoid.
     """
     mass = full_mass_matrix(samples, reflected_inertia, motor_mass)
-    return Ellipsoid(task_inverse_inertia(np.swapaxes(mass, 1, 2) @ mass, samples.jacobian))
+    with _validate.combining(reflected_inertia=reflected_inertia, motor_mass=motor_mass):
+        return Ellipsoid(task_inverse_inertia(np.swapaxes(mass, 1, 2) @ mass, samples.jacobian))
 
 
 def effective_mass(
