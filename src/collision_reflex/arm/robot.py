@@ -70,6 +70,8 @@ class Arm:
         self.package_dirs = tuple(str(p) for p in package_dirs or ())
         self._joints = joint_kinematics(model, self.name)
         self.joint_names: tuple[str, ...] = tuple(model.names[i] for i in range(1, model.njoints))
+        if not isinstance(contact_frame, str):
+            raise InvalidParameter("contact_frame", contact_frame, "the name of a frame of the model")
         if not model.existFrame(contact_frame):
             raise FrameNotFound(contact_frame, [f.name for f in model.frames], "frame", self.name)
         self.contact_frame = contact_frame
