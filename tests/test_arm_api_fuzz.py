@@ -3,7 +3,8 @@
 The names of ``collision_reflex.arm.__all__``, the public methods of :class:`~collision_reflex.arm.Arm` and of
 its results, and the functions their docs point to (:mod:`collision_reflex.arm.dynamics`, the motion
 profiles, the joint checks). Every call either returns a result whose floats are not NaN (where NaN is not a
-documented value) or raises :class:`InvalidParameter` (a :class:`TrajectoryError` for a duty cycle's samples).
+documented value) or raises :class:`InvalidParameter` (a :class:`TrajectoryError` for a duty cycle's samples, a
+:class:`FrameNotFound` for an unknown frame name).
 A TypeError, IndexError, MemoryError, OverflowError or bare ValueError from inside is a finding.
 """
 
@@ -20,7 +21,7 @@ import pytest
 
 from collision_reflex import arm, hardware
 from collision_reflex.arm import actuation, dynamics, joints, motion_profiles
-from collision_reflex.errors import InvalidParameter, TrajectoryError
+from collision_reflex.errors import FrameNotFound, InvalidParameter, TrajectoryError
 
 SEED = 41
 HOSTILE: tuple[Any, ...] = (
@@ -64,6 +65,8 @@ EFFECTIVE = {"reflected_inertia": TWO, **JOINTS, "torque_limit": np.array([10.0,
 PARAMS = arm.effective_parameters(SAMPLES, DIRECTIONS, **EFFECTIVE)
 SURFACE = arm.reflex_surface(DRIVEN, np.array([0.3, 0.5]), 0.2, 20.0)
 METRIC = {"samples": SAMPLES, "reflected_inertia": TWO, "motor_mass": np.array([0.5, 0.5])}
+LEGS = [0.1, 0.8, -1.6, -0.1, 0.8, -1.6, 0.1, -0.8, 1.6, -0.1, -0.8, 1.6]
+SOLO12_STANDING = np.array([0, 0, 0.235, 0, 0, 0, 1, *LEGS])  # its reference "standing" configuration
 MOTION = {"max_velocity": 1.0, "max_acceleration": 2.0, "rate": 100.0, "dwell": 0.1}
 
 
@@ -128,7 +131,8 @@ CASES: dict[str, Case] = {
     "dynamic_manipulability_ellipsoid": Case(arm.dynamic_manipulability_ellipsoid, METRIC),
     "effective_mass": Case(arm.effective_mass, {**METRIC, "directions": DIRECTIONS}),
     "impact_mitigation_factor": Case(
-        arm.impact_mitigation_factor, {"robot": "solo12", "reflected_inertia": 1e-3}
+        arm.impact_mitigation_factor,
+        {"robot": "solo12", "reflected_inertia": 1e-3, "q": SOLO12_STANDING, "contact_frame": "FL_FOOT"},
     ),
     "reflex_surface": Case(
         arm.reflex_surface, {"arm": DRIVEN, "q": np.array([0.3, 0.5]), "v0": 0.2, "threshold": 20.0}
@@ -260,7 +264,7 @@ def test_hostile_argument(label: str, name: str, values: list[Any]) -> None:
     for value in values:
         try:
             result = case.function(**{**case.kwargs, name: value})
-        except (InvalidParameter, TrajectoryError):
+        except (InvalidParameter, TrajectoryError, FrameNotFound):
             continue
         except Exception as error:  # anything else from inside is the finding
             findings.append(f"{value!r}: {type(error).__name__}: {error}"[:300])
