@@ -162,6 +162,8 @@ TRACE = Path(__file__).resolve().parents[1] / "studies" / "traces" / "u8_soft" /
         ("9**9**9 s", "not a unit"),  # pint would evaluate the power and not finish
         ("1 m**0", "not a unit"),  # pint's KeyError 'meter' before
         ("m", "[length], not [time]"),
+        ("0 s", "without the number '0' in front"),  # said 'powers of at most two digits' before
+        ("-1 ms", "without the number '-1' in front"),
     ],
 )
 def test_a_bad_time_unit_is_a_usage_error_before_any_file_is_read(unit, words, capsys) -> None:

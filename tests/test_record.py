@@ -5,6 +5,7 @@ is refused in one line naming the file and the field."""
 from __future__ import annotations
 
 import json
+import os
 import shutil
 from pathlib import Path
 
@@ -117,6 +118,19 @@ def test_optional_fields_may_be_null_or_absent_where_the_run_leaves_them(arm):
         "field 'recommended.joints[0].stator_diameter' holds a value of the wrong kind (null"
         in record_problem(record)
     )
+
+
+def test_a_designs_json_that_is_a_link_to_a_device_or_a_folder_is_not_missing(tmp_path):
+    link = tmp_path / "designs.json"
+    link.symlink_to(os.devnull)  # only looked at (stat), never opened
+    with pytest.raises(
+        ResultsDamaged, match=r"designs\.json cannot be read \(a device, not a regular file\)"
+    ):
+        read_run_record(link)
+    link.unlink()
+    link.mkdir()
+    with pytest.raises(ResultsDamaged, match=r"a folder, not a file"):
+        read_run_record(link)
 
 
 def test_read_run_record_raises_the_run_folder_errors(arm, tmp_path):

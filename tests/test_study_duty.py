@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import textwrap
 from pathlib import Path
 
@@ -350,6 +351,31 @@ def test_bad_duty_cycle_sections_are_located(tmp_path, section, extra, offset, w
     text = str(error.value)
     for word in words:
         assert word in text
+
+
+@pytest.mark.parametrize(
+    ("kind", "words"),
+    [
+        ("folder", "a folder, not a file"),
+        ("fifo", "a named pipe (FIFO), not a regular file"),
+        ("device", "a device, not a regular file"),
+    ],
+)
+def test_a_duty_cycle_path_that_is_not_a_regular_file_says_what_it_is(tmp_path, kind, words):
+    path = _study(tmp_path, FILE)
+    target = tmp_path / "cycle.csv"
+    if kind == "folder":
+        target.mkdir()
+    elif kind == "fifo":
+        os.mkfifo(target)
+    else:
+        target.symlink_to(os.devnull)  # only looked at (stat), never opened
+    with pytest.raises(StudyFileError) as error:
+        load_study(path)
+    problem = _only_problem(error)
+    assert (
+        problem.path == "duty_cycle.file" and words in problem.found and "no such file" not in problem.found
+    )
 
 
 ROBOT_BAD = [

@@ -19,6 +19,30 @@ INPUT_LIMIT = 64 * 2**20
 that a wrong file (a disk image, ``/dev/zero``) is refused at once instead of filling the memory."""
 
 
+def not_a_file(path: str | os.PathLike[str]) -> str | None:
+    """Why ``path`` is not a regular file to read, in a short phrase, or None when it is one.
+
+    Symbolic links are followed: ``"no such file"`` (also for a dangling link), ``"a folder, not a file"``,
+    ``"a named pipe (FIFO), not a regular file"``, ``"a device, not a regular file"``, ``"a socket, not a
+    regular file"``, or the system's reason for a path it refuses (too long, a NUL byte).
+    """
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        return "no such file"
+    except (OSError, ValueError) as error:  # ValueError: a NUL byte in the path
+        return str(getattr(error, "strerror", None) or error)
+    if stat.S_ISREG(mode):
+        return None
+    if stat.S_ISDIR(mode):
+        return "a folder, not a file"
+    if stat.S_ISFIFO(mode):
+        return "a named pipe (FIFO), not a regular file"
+    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
+        return "a device, not a regular file"
+    return "a socket, not a regular file" if stat.S_ISSOCK(mode) else "not a regular file"
+
+
 def read_limited(path: str | os.PathLike[str], limit: int = INPUT_LIMIT) -> bytes:
     """The bytes of the regular file ``path``, of at most ``limit`` bytes.
 

@@ -311,7 +311,16 @@ def check_unit(text: str) -> str:
     A unit given on a command line or in a file header is checked so before pint evaluates it: pint evaluates
     powers as arithmetic, and ``'9**9**9 s'`` would not finish. Raises :class:`QuantityError` otherwise.
     """
-    if len(text) > MAX_QUANTITY_LENGTH or _UNIT_TEXT.fullmatch(text) is None:
+    if len(text) > MAX_QUANTITY_LENGTH:
+        raise QuantityError("syntax", f"not a unit: longer than {MAX_QUANTITY_LENGTH} characters")
+    quantity = _QUANTITY.fullmatch(text)
+    if quantity is not None and quantity.group("unit"):  # '0 s', '-1 ms': a quantity, not a unit
+        raise QuantityError(
+            "syntax",
+            f"not a unit: a unit name alone, without the number {quantity.group('number')!r} in front, "
+            "e.g. 'ms', 'N*m', 'kg*m^2'",
+        )
+    if _UNIT_TEXT.fullmatch(text) is None:
         raise QuantityError(
             "syntax", "not a unit: names with powers of at most two digits, e.g. 'ms', 'N*m', 'kg*m^2'"
         )

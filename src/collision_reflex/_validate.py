@@ -7,6 +7,7 @@ symbols cannot be checked and pass through, since the optimiser imposes bounds o
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Any
@@ -113,6 +114,23 @@ def _check(name: str, value: Any, ok: Callable[[np.ndarray], Any], allowed: str,
     if not good.all():
         raise InvalidParameter(name, value, allowed)
     return array if array.ndim else float(array)
+
+
+def integer(name: str, value: Any, low: int, high: int | None = None) -> int:
+    """``value`` as an int if it is a whole number (not a bool) in ``[low, high]``, else raise.
+
+    Python and NumPy integers are accepted, and floats holding a whole number (``3.0``); NaN, infinities,
+    fractions, strings and arrays are refused.
+    """
+    allowed = f"a whole number >= {low}" + ("" if high is None else f" and <= {high}")
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise InvalidParameter(name, value, allowed)
+    if isinstance(value, (float, np.floating)) and not (math.isfinite(value) and float(value).is_integer()):
+        raise InvalidParameter(name, value, allowed)
+    number = int(value)
+    if number < low or (high is not None and number > high):
+        raise InvalidParameter(name, value, allowed)
+    return number
 
 
 def choice(name: str, value: str, allowed: tuple[str, ...]) -> str:

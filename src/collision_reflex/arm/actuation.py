@@ -11,10 +11,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
+from .. import _validate
 from ..errors import InvalidParameter
 from ..hardware.actuators import Actuator, ForceThreshold, gear_ratio_for
 from ..hardware.motors import reference_motor
-from .joints import JointParameters, joint_array
+from .joints import JointParameters, joint_array, joint_count
 
 if TYPE_CHECKING:
     from ..hardware.actuators import CurrentThreshold, PositionThreshold
@@ -29,13 +30,14 @@ def joint_parameters(
     Without actuators: the model's ``armature`` [kg m^2] and ``torque_limit`` [N m] per joint, rigid joints and
     no motor masses.
     """
+    nv = joint_count("nv", nv)
     if isinstance(actuators, JointParameters):
         params = actuators
     elif actuators is not None:
         params = JointParameters.from_actuators(actuators, nv)
     else:
         params = JointParameters(
-            reflected_inertia=np.asarray(armature, dtype=float),
+            reflected_inertia=armature,
             torque_limit=torque_limit,
             stiffness=np.full(nv, np.inf),
             mechanical_stiffness=np.full(nv, np.inf),
@@ -71,6 +73,10 @@ def scaled_actuators(
         force threshold.
     """
     required = joint_array("torque_required", torque_required, nv)
+    if np.ndim(_validate.positive("stator_diameter", stator_diameter)) != 0:
+        raise InvalidParameter(
+            "stator_diameter", stator_diameter, "one finite diameter > 0 [m] for every motor"
+        )
     motor = (reference if reference is not None else reference_motor()).scaled(
         stator_diameter=stator_diameter, law=law
     )

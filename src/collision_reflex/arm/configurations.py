@@ -21,6 +21,10 @@ from .kinematic_tree import JointKinematics
 _UNBOUNDED_LIMIT = 1e3
 
 
+MAX_CONFIGURATIONS = 10_000_000
+"""Most configurations drawn at once: ten million (n, nq) rows are already gigabytes of kinematics."""
+
+
 @dataclass(frozen=True)
 class ConfigurationSpace:
     """The joints of an arm as coordinates: their limits, and the map to and from configurations.
@@ -74,9 +78,11 @@ class ConfigurationSpace:
 
     def configuration(self, angles: npt.ArrayLike) -> np.ndarray:
         """Configurations (..., nq) from joint coordinates (..., nv) [rad or m]."""
-        angles = np.asarray(angles, dtype=float)
+        angles = _validate.real("angles", angles, "real joint coordinates [rad, m]")
         if angles.shape[-1:] != (self.nv,):
             raise InvalidParameter("angles", angles.shape, f"a last axis of {self.nv} joint coordinates")
+        if not np.all(np.isfinite(angles)):
+            raise InvalidParameter("angles", angles, "finite joint coordinates [rad, m]")
         q = np.empty((*angles.shape[:-1], self.nq))
         for v, joint in enumerate(self.joints):
             if joint.nq == 1:
@@ -109,8 +115,7 @@ class ConfigurationSpace:
             raise InvalidParameter(
                 "rng", rng, "a numpy.random.Generator", "use numpy.random.default_rng(seed)"
             )
-        if int(count) != count or count < 1:
-            raise InvalidParameter("count", count, "an integer >= 1")
+        count = _validate.integer("count", count, 1, MAX_CONFIGURATIONS)
         lower, upper = self.joint_limits()
         return self.configuration(rng.uniform(lower, upper, size=(int(count), self.nv)))
 

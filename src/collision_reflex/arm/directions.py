@@ -28,6 +28,8 @@ NAMED_DIRECTIONS: dict[str, tuple[float, float, float]] = {
 def circle_directions(count: int, start: float = 0.0) -> np.ndarray:
     """``count`` unit vectors evenly spaced on the circle, (count, 2), the first at angle ``start`` [rad]."""
     count = _count(count)
+    if np.ndim(_validate.finite("start", start)) != 0:
+        raise InvalidParameter("start", start, "one finite angle [rad]")
     angles = start + 2 * np.pi * np.arange(count) / count
     return np.stack([np.cos(angles), np.sin(angles)], axis=1)
 
@@ -73,7 +75,11 @@ def unit_directions(spec: Any, task_dim: int, plane: np.ndarray | None = None) -
     task_dim: 2 (planar arm) or 3.
     plane: (3, 2) basis of a planar arm's plane (``Arm.plane``), needed to project world vectors.
     """
-    if task_dim not in (2, 3):
+    if (
+        isinstance(task_dim, bool | np.bool_)
+        or not isinstance(task_dim, int | np.integer)
+        or task_dim not in (2, 3)
+    ):
         raise InvalidParameter("task_dim", task_dim, "2 or 3")
     if isinstance(spec, int | np.integer):
         return circle_directions(int(spec)) if task_dim == 2 else sphere_directions(int(spec))

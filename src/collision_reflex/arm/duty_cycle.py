@@ -34,7 +34,7 @@ from .._table import HEADER, TableProblem, read_table
 from ..errors import InvalidParameter, TraceError, TrajectoryError
 from ..experiments.traces import unit_factor
 from ..vocabulary import TIME_COLUMN_NAMES
-from .motion_profiles import trapezoidal_motion
+from .motion_profiles import MAX_CYCLE_SAMPLES, checked_motion, trapezoidal_motion
 
 SPLINE_ORDER = 5
 """Order of the interpolating spline differentiated for velocities and accelerations (quintic)."""
@@ -74,10 +74,6 @@ class Payload:
         object.__setattr__(self, "inertia", inertia)
 
 
-MAX_CYCLE_SAMPLES = 200_000
-"""Most samples a duty cycle may hold: the requirement evaluates the arm's dynamics at each (a million rows grew a
-smoke run past 10 GB); an hour of motion at 50 Hz is 180,000."""
-
 MAX_JOINT_SPEED = 1e4
 """Fastest joint speed a duty cycle may hold [rad/s or m/s]: 95,000 rpm at the joint, far beyond any robot's, so
 a larger one is a wrong unit or a wrong time column, never a motion."""
@@ -105,11 +101,11 @@ class DutyCycle:
     payload: Payload | None = None
 
     def __post_init__(self) -> None:
-        names = tuple(str(name) for name in self.joint_names)
+        names = tuple(str(name) for name in _joint_names(self.joint_names))
         if not names or len(set(names)) != len(names):
             raise InvalidParameter("joint_names", self.joint_names, "distinct joint names, at least one")
         object.__setattr__(self, "joint_names", names)
-        t = np.asarray(self.t, dtype=float)
+        t = _validate.real("t", self.t, "a 1-D array of at least 2 times [s]")
         if t.ndim != 1 or t.size < 2:
             raise InvalidParameter("t", t.shape, "a 1-D array of at least 2 times [s]")
         if t.size > MAX_CYCLE_SAMPLES:
@@ -122,7 +118,7 @@ class DutyCycle:
         _check_times(t, "")
         object.__setattr__(self, "t", t)
         for name in ("q", "qd", "qdd"):
-            values = np.asarray(getattr(self, name), dtype=float)
+            values = _validate.real(name, getattr(self, name), f"an array of shape ({t.size}, {len(names)})")
             if values.shape != (t.size, len(names)):
                 raise InvalidParameter(name, values.shape, f"an array of shape ({t.size}, {len(names)})")
             bad = np.flatnonzero(~np.all(np.isfinite(values), axis=1))
@@ -187,9 +183,9 @@ class DutyCycle:
         """
         from scipy.interpolate import make_interp_spline
 
-        t = np.asarray(t, dtype=float)
-        q = np.asarray(q, dtype=float)
-        names = tuple(joint_names)
+        t = _validate.real("t", t, "a 1-D array of strictly increasing times [s]")
+        q = _validate.real("q", q, "joint positions (n, nv) [rad or m]")
+        names = tuple(_joint_names(joint_names))
         if t.ndim != 1 or q.shape != (t.size, len(names)):
             raise InvalidParameter(
                 "q", q.shape, f"an array of shape ({t.size}, {len(names)}) for t {t.shape}"
@@ -309,29 +305,15 @@ class DutyCycle:
         -------
         The cycle, with analytic velocities and accelerations; it starts and ends at rest.
         """
-        names = tuple(joint_names)
-        points = np.asarray(via_points, dtype=float)
-        if points.ndim != 2 or points.shape[0] < 2 or points.shape[1] != len(names):
+        names = tuple(_joint_names(joint_names))
+        points, speeds, accelerations, rate, dwell = checked_motion(
+            via_points, max_velocity, max_acceleration, rate, dwell
+        )
+        if points.shape[1] != len(names):
             raise InvalidParameter(
                 "via_points", points.shape, f"an array of shape (k >= 2, {len(names)}) [rad or m]"
             )
-        if not np.all(np.isfinite(points)):
-            raise InvalidParameter("via_points", points, "finite joint positions [rad or m]")
-        limits = {}
-        for name, value in (("max_velocity", max_velocity), ("max_acceleration", max_acceleration)):
-            array = np.broadcast_to(np.asarray(value, dtype=float), (len(names),)).copy()
-            if not np.all(np.isfinite(array) & (array > 0)):
-                raise InvalidParameter(name, value, "finite limits > 0, one per joint or one for all")
-            limits[name] = array
-        rate = float(rate)
-        if not (np.isfinite(rate) and rate > 0):
-            raise InvalidParameter("rate", rate, "a finite sampling rate > 0 [Hz]")
-        rest = np.broadcast_to(np.asarray(dwell, dtype=float), (points.shape[0],)).copy()
-        if not np.all(np.isfinite(rest) & (rest >= 0)):
-            raise InvalidParameter("dwell", dwell, "finite times >= 0 [s], one per via point or one for all")
-        t, q, qd, qdd = trapezoidal_motion(
-            points, limits["max_velocity"], limits["max_acceleration"], rate, rest
-        )
+        t, q, qd, qdd = trapezoidal_motion(points, speeds, accelerations, rate, dwell)
         return cls(names, t, q, qd, qdd, payload)
 
 
@@ -413,6 +395,13 @@ def _read_table(path: str | os.PathLike[str]) -> tuple[int, Any]:
         return header + 1, read_table(lines, header)
     except TableProblem as problem:
         raise TrajectoryError(source, problem.reason, problem.line) from None
+
+
+def _joint_names(value: Any) -> Sequence[Any] | np.ndarray:
+    """``value`` if it is a sequence of joint names (not one string), else raise."""
+    if isinstance(value, str | bytes) or not isinstance(value, Sequence | np.ndarray):
+        raise InvalidParameter("joint_names", value, "a sequence of joint names, e.g. ('joint1', 'joint2')")
+    return value
 
 
 def _check_times(t: np.ndarray, source: str, lines: np.ndarray | None = None) -> None:

@@ -23,6 +23,7 @@ import numpy as np
 
 from .. import _backend as backend
 from .. import _validate
+from .._backend import is_symbolic
 from ..errors import InvalidParameter
 from .duty_cycle import DutyCycle, Payload
 from .joints import joint_array
@@ -94,6 +95,7 @@ class CycleTorques:
 
         Columns: ``tau0_j`` [N m], ``tau_unit[i]_j`` [N m/kg] for each motor ``i``, ``qdd_j`` [rad/s^2].
         """
+        joint = _validate.integer("joint", joint, 0, self.nv - 1)
         return np.column_stack(
             [self.structure[:, joint], self.per_motor_mass[:, :, joint].T, self.qdd[:, joint]]
         )
@@ -232,7 +234,11 @@ def joint_side_torque(torque: Any, reflected_inertia: Any, acceleration: Any) ->
     neglected, as is the rotor's mass, which is part of the motor mass. Plain arithmetic: NumPy arrays broadcast
     (e.g. (n, nv) with (nv,)), CasADi expressions work as they are.
     """
-    return torque + reflected_inertia * acceleration
+    torque = _validate.arrays("torque", torque, ndim=0)
+    reflected_inertia = _validate.non_negative("reflected_inertia", reflected_inertia)
+    acceleration = _validate.arrays("acceleration", acceleration, ndim=0)
+    with _validate.combining(torque=torque, reflected_inertia=reflected_inertia, acceleration=acceleration):
+        return torque + reflected_inertia * acceleration
 
 
 def time_weights(t: Any) -> np.ndarray:
@@ -240,7 +246,7 @@ def time_weights(t: Any) -> np.ndarray:
 
     ``sum_s w_s f(t_s)`` is the trapezoidal rule for the integral of ``f`` from ``t[0]`` to ``t[-1]``.
     """
-    t = np.asarray(t, dtype=float)
+    t = _validate.real("t", t, "at least 2 strictly increasing times [s]")
     if t.ndim != 1 or t.size < 2 or not np.all(np.diff(t) > 0):
         raise InvalidParameter("t", t, "at least 2 strictly increasing times [s]")
     steps = np.diff(t)
@@ -252,6 +258,13 @@ def time_weights(t: Any) -> np.ndarray:
 
 def peak(values: Any) -> Any:
     """``max_t |values|`` over the last axis (NumPy, batched) or of a CasADi column."""
+    values = _validate.arrays("values", values)
+    if not is_symbolic(values) and values.shape[-1] == 0:
+        raise InvalidParameter("values", values.shape, "at least one sample on the last axis")
+    return _peak(values)
+
+
+def _peak(values: Any) -> Any:
     return backend.largest(backend.absolute(values), axis=-1)
 
 
@@ -262,11 +275,19 @@ def rms(values: Any, t: Any) -> Any:
     :func:`time_weights`), ``T = t[-1] - t[0]``. ``values``: time on the last axis, (..., n) NumPy, or an
     (n, 1) CasADi column.
     """
-    weights = time_weights(t) / float(np.asarray(t)[-1] - np.asarray(t)[0])
-    return backend.sqrt(backend.dot(values * values, weights))
+    weights = time_weights(t)
+    duration = float(np.asarray(t, dtype=float)[-1] - np.asarray(t, dtype=float)[0])
+    values = _validate.arrays("values", values)
+    if not is_symbolic(values) and values.shape[-1] != weights.size:
+        raise InvalidParameter(
+            "values", values.shape, f"{weights.size} samples on the last axis, one per time"
+        )
+    weights = weights / duration
+    with _validate.combining(values=values, t=weights):
+        return backend.sqrt(backend.dot(values * values, weights))
 
 
 def max_speed(velocity: Any) -> np.ndarray:
     """``max_t |qd_i(t)|`` per joint [rad/s or m/s], (nv,), of joint velocities (n, nv)."""
     velocity = _validate.arrays("velocity", velocity, ndim=2)
-    return np.asarray(peak(np.asarray(velocity, dtype=float).T))
+    return np.asarray(_peak(np.asarray(velocity, dtype=float).T))

@@ -120,7 +120,8 @@ def effective_parameters(
     inertia, joint_k, joint_km, tau_max, tau_s = _joint_arrays(
         nv, reflected_inertia, stiffness, mechanical_stiffness, torque_limit, joint_threshold
     )
-    if not (np.isfinite(singular_tolerance) and 0 < singular_tolerance < 1):
+    tolerance = _validate.real("singular_tolerance", singular_tolerance, "a number in (0, 1)")
+    if tolerance.ndim != 0 or not (np.isfinite(tolerance) and 0 < tolerance < 1):
         raise InvalidParameter("singular_tolerance", singular_tolerance, "a number in (0, 1)")
     units = normalised_directions(directions, task_dim)
     pair_index = None if config_index is None else _checked_index(config_index, units, samples.count)
@@ -321,7 +322,14 @@ def collision_impulses(
 
 def _checked_index(config_index: Any, units: np.ndarray, count: int) -> np.ndarray:
     """The configuration index of paired samples, one per direction, each in ``[0, count)``."""
-    index = np.asarray(config_index, dtype=int).ravel()
+    allowed = f"whole-number indices in [0, {count}), one per direction"
+    if isinstance(config_index, np.ndarray) and config_index.dtype.kind in "iu":
+        index = config_index.ravel()
+    else:
+        raw = _validate.real("config_index", config_index, allowed).ravel()
+        if not np.all(np.isfinite(raw) & (raw == np.round(raw)) & (np.abs(raw) <= count)):
+            raise InvalidParameter("config_index", config_index, allowed)  # (a fraction was truncated before)
+        index = raw.astype(int)
     if index.shape != (units.shape[0],):
         raise InvalidParameter("config_index", index.shape, f"one index per direction, ({units.shape[0]},)")
     if index.size and (index.min() < 0 or index.max() >= count):

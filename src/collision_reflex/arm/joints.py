@@ -32,7 +32,10 @@ class JointParameters:
     motor_mass: np.ndarray
 
     def __post_init__(self) -> None:
-        arrays = [np.atleast_1d(np.asarray(getattr(self, n), dtype=float)) for n in _JOINT_FIELDS]
+        arrays = [
+            np.atleast_1d(_validate.real(n, getattr(self, n), "real numbers, one per joint"))
+            for n in _JOINT_FIELDS
+        ]
         size = max(a.size for a in arrays)
         for name, array in zip(_JOINT_FIELDS, arrays, strict=True):
             if array.ndim != 1 or array.size not in (1, size):
@@ -59,6 +62,7 @@ class JointParameters:
         An actuator is anything with ``reflected_inertia`` [kg m^2], ``peak_torque`` [N m], ``stiffness`` and
         ``mechanical_stiffness`` [N m/rad] and ``mass`` [kg] (:class:`collision_reflex.hardware.actuators.Actuator`).
         """
+        nv = joint_count("nv", nv)
         items = list(actuators) if isinstance(actuators, list | tuple) else [actuators] * nv
         if len(items) != nv:
             raise InvalidParameter(
@@ -72,13 +76,24 @@ class JointParameters:
                 mechanical_stiffness=np.array([float(a.mechanical_stiffness) for a in items]),
                 motor_mass=np.array([float(a.mass) for a in items]),
             )
-        except AttributeError as error:
+        except InvalidParameter:
+            raise
+        except (AttributeError, TypeError, ValueError) as error:  # a missing or non-numeric attribute
             raise InvalidParameter(
                 "actuators",
                 actuators,
                 "Actuator objects (with reflected_inertia, peak_torque, stiffness, mechanical_stiffness, mass)",
                 str(error),
             ) from None
+
+
+MAX_JOINTS = 10_000
+"""Most joints an arm may have: far beyond any robot's, so that a wrong count is refused before allocating."""
+
+
+def joint_count(name: str, value: Any) -> int:
+    """``value`` as a number of joints, a whole number in [1, :data:`MAX_JOINTS`]; else raise."""
+    return _validate.integer(name, value, 1, MAX_JOINTS)
 
 
 _JOINT_FIELDS = ("reflected_inertia", "torque_limit", "stiffness", "mechanical_stiffness", "motor_mass")
@@ -88,6 +103,7 @@ def joint_array(
     name: str, value: Any, nv: int, *, allow_inf: bool = False, allow_zero: bool = False
 ) -> np.ndarray:
     """``value`` as one float per joint, (nv,), checked: a scalar is broadcast; NaN (unknown) is refused."""
+    nv = joint_count("nv", nv)
     hint = "the URDF gives none for some joint; pass actuators= to the Arm or give the values explicitly"
     array = _validate.real(name, value, f"real numbers, one value or {nv}, one per joint")
     if array.ndim > 1 or array.size not in (1, nv):

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from .. import _validate
 from ..errors import FrameNotFound, InvalidParameter
 from .directions import normalised_directions
 from .joints import joint_array
@@ -113,7 +114,8 @@ def dynamic_manipulability_ellipsoid(
     The task accelerations reachable with joint torques of unit norm lie in this ellipsoid.
     """
     mass = full_mass_matrix(samples, reflected_inertia, motor_mass)
-    return Ellipsoid(task_inverse_inertia(np.swapaxes(mass, 1, 2) @ mass, samples.jacobian))
+    with _validate.combining(reflected_inertia=reflected_inertia, motor_mass=motor_mass):
+        return Ellipsoid(task_inverse_inertia(np.swapaxes(mass, 1, 2) @ mass, samples.jacobian))
 
 
 def effective_mass(
@@ -174,6 +176,10 @@ def impact_mitigation_factor(
     import pinocchio as pin
 
     name, model = _floating_base_model(robot)
+    if contact_frame is not None and not isinstance(contact_frame, str):
+        raise InvalidParameter(
+            "contact_frame", contact_frame, "a frame name, or None for the robot's default"
+        )
     if contact_frame is None:
         contact_frame = ROBOT_DEFAULTS.get(name, {}).get("contact_frame")
         if contact_frame is None:
@@ -183,7 +189,7 @@ def impact_mitigation_factor(
     if q is None:
         reference = model.referenceConfigurations
         q = np.array(reference["standing"]) if "standing" in reference else pin.neutral(model)
-    q = np.asarray(q, dtype=float)
+    q = _validate.real("q", q, f"a finite configuration of shape ({model.nq},)")
     if q.shape != (model.nq,) or not np.all(np.isfinite(q)):
         raise InvalidParameter("q", q.shape, f"a finite configuration of shape ({model.nq},)")
     free = model.copy()
@@ -215,8 +221,10 @@ def impact_mitigation_factor(
 def _floating_base_model(robot: str | Any) -> tuple[str, Any]:
     if isinstance(robot, str):
         model, name = example_robot(robot)[0], robot
-    else:
+    elif all(hasattr(robot, a) for a in ("name", "njoints", "joints", "existFrame")):  # a pinocchio.Model
         model, name = robot, str(robot.name)
+    else:
+        raise InvalidParameter("robot", robot, "an example-robot-data name or a pinocchio.Model")
     if model.njoints < 2 or model.joints[1].nv != 6:
         raise InvalidParameter("robot", name, "a floating-base model (a free-flyer root joint)")
     return name, model

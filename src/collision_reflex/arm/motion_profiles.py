@@ -12,10 +12,16 @@ any sampling holds their exact extremes, and the samples include the switching t
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
+from .. import _validate
 from ..errors import InvalidParameter
+
+MAX_CYCLE_SAMPLES = 200_000
+"""Most samples a duty cycle may hold: the requirement evaluates the arm's dynamics at each (a million rows grew a
+smoke run past 10 GB); an hour of motion at 50 Hz is 180,000."""
 
 
 @dataclass(frozen=True)
@@ -109,30 +115,15 @@ def trapezoidal_motion(
     Returns
     -------
     ``t`` (n,) [s] from 0, and ``q``, ``qd``, ``qdd`` (n, nv), analytic.
+
+    Raises :class:`InvalidParameter` naming the argument for misshapen, non-finite or out-of-range inputs, and
+    for a motion that would take more than :data:`MAX_CYCLE_SAMPLES` samples.
     """
-    segments: list[tuple[float, TrapezoidSegment | None]] = []  # (start time, move or None for a rest)
-    clock = 0.0
-    breaks = [0.0]
-    for index in range(len(via_points)):
-        if dwell[index] > 0:
-            segments.append((clock, None))
-            clock += float(dwell[index])
-            breaks.append(clock)
-        if index + 1 == len(via_points) or np.array_equal(via_points[index], via_points[index + 1]):
-            continue
-        move = TrapezoidSegment.fastest(
-            via_points[index], via_points[index + 1], max_velocity, max_acceleration
-        )
-        segments.append((clock, move))
-        breaks.extend(clock + move.switch_times[1:])
-        clock += move.duration
-    if clock <= 0:
-        raise InvalidParameter("via_points", via_points, "configurations that differ, or a dwell > 0")
-    grid = np.arange(int(np.floor(clock * rate)) + 1) / rate
-    t = np.unique(np.concatenate([grid, breaks]))
-    # Switching times that fall within rounding of a grid time would make near-repeated samples.
-    t = t[np.concatenate([[True], np.diff(t) > 1e-9 * max(clock, 1.0)])]
-    t[-1] = clock
+    via_points, max_velocity, max_acceleration, rate, dwell = checked_motion(
+        via_points, max_velocity, max_acceleration, rate, dwell
+    )
+    with _validate.combining(max_velocity=max_velocity, max_acceleration=max_acceleration):
+        t, segments, clock = _time_grid(via_points, max_velocity, max_acceleration, rate, dwell)
     nv = via_points.shape[1]
     q = np.empty((t.size, nv))
     qd = np.zeros((t.size, nv))
@@ -152,3 +143,71 @@ def trapezoidal_motion(
     qd[t >= clock] = 0.0
     qdd[t >= clock] = 0.0
     return t, q, qd, qdd
+
+
+def _time_grid(
+    via_points: np.ndarray,
+    max_velocity: np.ndarray,
+    max_acceleration: np.ndarray,
+    rate: float,
+    dwell: np.ndarray,
+) -> tuple[np.ndarray, list[tuple[float, TrapezoidSegment | None]], float]:
+    """The sample times, the segments (start time, move or None for a rest) and the total duration [s]."""
+    segments: list[tuple[float, TrapezoidSegment | None]] = []
+    clock = 0.0
+    breaks = [0.0]
+    for index in range(len(via_points)):
+        if dwell[index] > 0:
+            segments.append((clock, None))
+            clock += float(dwell[index])
+            breaks.append(clock)
+        if index + 1 == len(via_points) or np.array_equal(via_points[index], via_points[index + 1]):
+            continue
+        move = TrapezoidSegment.fastest(
+            via_points[index], via_points[index + 1], max_velocity, max_acceleration
+        )
+        segments.append((clock, move))
+        breaks.extend(clock + move.switch_times[1:])
+        clock += move.duration
+    if clock <= 0:
+        raise InvalidParameter("via_points", via_points, "configurations that differ, or a dwell > 0")
+    if not clock * rate < MAX_CYCLE_SAMPLES:  # also refuses an infinite duration
+        raise InvalidParameter(
+            "max_velocity, max_acceleration, rate, dwell",
+            f"a motion of {clock:.3g} s sampled at {rate:.3g} Hz",
+            f"at most {MAX_CYCLE_SAMPLES:,} samples",
+            "raise the limits, lower the rate or shorten the dwells",
+        )
+    grid = np.arange(int(np.floor(clock * rate)) + 1) / rate
+    t = np.unique(np.concatenate([grid, breaks]))
+    # Switching times that fall within rounding of a grid time would make near-repeated samples.
+    t = t[np.concatenate([[True], np.diff(t) > 1e-9 * max(clock, 1.0)])]
+    t[-1] = clock
+    return t, segments, clock
+
+
+def checked_motion(
+    via_points: Any, max_velocity: Any, max_acceleration: Any, rate: Any, dwell: Any
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, np.ndarray]:
+    """The inputs of :func:`trapezoidal_motion` as float64 arrays of their shapes, checked; else raise."""
+    points = _validate.real("via_points", via_points, "joint configurations (k >= 2, nv) [rad or m]")
+    if points.ndim != 2 or points.shape[0] < 2 or points.shape[1] < 1:
+        raise InvalidParameter("via_points", points.shape, "an array of shape (k >= 2, nv >= 1) [rad or m]")
+    if not np.all(np.isfinite(points)):
+        raise InvalidParameter("via_points", points, "finite joint positions [rad or m]")
+    nv, k = points.shape[1], points.shape[0]
+    limits = []
+    for name, value in (("max_velocity", max_velocity), ("max_acceleration", max_acceleration)):
+        allowed = "finite limits > 0, one per joint or one for all"
+        array = _validate.real(name, value, allowed)
+        if array.ndim > 1 or array.size not in (1, nv) or not np.all(np.isfinite(array) & (array > 0)):
+            raise InvalidParameter(name, value, f"{allowed} ({nv} joints)")
+        limits.append(np.broadcast_to(array, (nv,)).copy())
+    if np.ndim(_validate.real("rate", rate, "a finite sampling rate > 0 [Hz]")) != 0:
+        raise InvalidParameter("rate", rate, "a finite sampling rate > 0 [Hz]")
+    rate = _validate.positive("rate", rate)
+    allowed = "finite times >= 0 [s], one per via point or one for all"
+    rest = _validate.real("dwell", dwell, allowed)
+    if rest.ndim > 1 or rest.size not in (1, k) or not np.all(np.isfinite(rest) & (rest >= 0)):
+        raise InvalidParameter("dwell", dwell, f"{allowed} ({k} via points)")
+    return points, limits[0], limits[1], float(rate), np.broadcast_to(rest, (k,)).copy()

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
+from .. import _validate
 from ..errors import FrameNotFound, InvalidParameter, UrdfError
 from .actuation import joint_parameters, scaled_actuators, sensing_options
 from .configurations import ConfigurationSpace
@@ -69,10 +70,16 @@ class Arm:
         self.package_dirs = tuple(str(p) for p in package_dirs or ())
         self._joints = joint_kinematics(model, self.name)
         self.joint_names: tuple[str, ...] = tuple(model.names[i] for i in range(1, model.njoints))
+        if not isinstance(contact_frame, str):
+            raise InvalidParameter("contact_frame", contact_frame, "the name of a frame of the model")
         if not model.existFrame(contact_frame):
             raise FrameNotFound(contact_frame, [f.name for f in model.frames], "frame", self.name)
         self.contact_frame = contact_frame
-        offset = np.zeros(3) if contact_offset is None else np.asarray(contact_offset, dtype=float)
+        offset = (
+            np.zeros(3)
+            if contact_offset is None
+            else _validate.real("contact_offset", contact_offset, "three finite coordinates [m]")
+        )
         if offset.shape != (3,) or not np.all(np.isfinite(offset)):
             raise InvalidParameter("contact_offset", contact_offset, "three finite coordinates [m]")
         self.contact_offset = offset

@@ -109,7 +109,13 @@ class ArmSamples:
 
     def take(self, index: Any) -> ArmSamples:
         """The samples at ``index`` (an integer array, slice or boolean mask over configurations)."""
-        single = np.ndim(np.arange(self.count)[index]) == 0  # an integer: keep the leading axis
+        allowed = f"an integer, slice, boolean mask or integer array over {self.count} configurations"
+        if isinstance(index, bool | np.bool_):
+            raise InvalidParameter("index", index, allowed)
+        try:
+            single = np.ndim(np.arange(self.count)[index]) == 0  # an integer: keep the leading axis
+        except (IndexError, TypeError, ValueError):
+            raise InvalidParameter("index", index, allowed) from None
         picked: dict[str, Any] = {}
         for name in self.__dataclass_fields__:
             value = getattr(self, name)

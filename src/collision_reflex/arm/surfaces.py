@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from .. import _validate
 from ..errors import InvalidParameter
 from .directions import unit_directions
 from .effective import CollisionImpulses, EffectiveParameters, collision_impulses
@@ -67,6 +68,10 @@ class ReflexSurface:
 
         In [m per N s times ``scale``]; ``cap`` [N s] bounds the infinite values of singular directions.
         """
+        if np.ndim(_validate.positive("scale", scale)) != 0:
+            raise InvalidParameter("scale", scale, "one finite number > 0")
+        if cap is not None and np.ndim(_validate.positive("cap", cap)) != 0:
+            raise InvalidParameter("cap", cap, "one finite impulse > 0 [N s], or None")
         radius = self.impulse if cap is None else np.minimum(self.impulse, cap)
         return scale * radius[:, None] * self.directions
 
@@ -74,7 +79,9 @@ class ReflexSurface:
         """World points (..., 3) [m] in the plane coordinates of a planar arm (..., 2)."""
         if self.plane is None:
             raise InvalidParameter("plane", None, "a planar arm")
-        return np.asarray(points) @ self.plane
+        points = _validate.arrays("points", points)
+        with _validate.combining(points=points, plane=self.plane):
+            return points @ self.plane
 
     def extremes(self) -> tuple[np.ndarray, np.ndarray]:
         """Directions of the smallest and the largest impulse (the largest may be a singular one)."""
@@ -113,7 +120,7 @@ def reflex_surface(
     stiffness_form: ``"compliance"`` or ``"paper"``.
     joint_threshold: joint-side threshold torques [N m] for ``sensing="current"``.
     """
-    configuration = np.asarray(q, dtype=float)
+    configuration = _validate.real("q", q, f"one configuration of shape ({arm.nq},)")
     if configuration.shape != (arm.nq,):
         raise InvalidParameter("q", configuration.shape, f"one configuration of shape ({arm.nq},)")
     spec = DEFAULT_DIRECTION_COUNT[arm.task_dim] if directions is None else directions

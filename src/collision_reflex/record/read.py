@@ -15,7 +15,7 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from .._io import read_json
+from .._io import not_a_file, read_json
 from ..errors import InvalidParameter
 from ..vocabulary import DESIGN_CHOICES
 from .checked import ResultsDamaged, ResultsMissing
@@ -47,10 +47,13 @@ def read_saved_record(path: str | os.PathLike[str]) -> dict[str, Any]:
     its ``kind``.
     """
     path = Path(path)
-    if not path.is_file():
+    why = not_a_file(path)
+    if why == "no such file":
         raise ResultsMissing(
             f"{path.parent} has no {path.name}: run the study first (crx run STUDY --out {path.parent})"
         )
+    if why is not None:  # a folder, a pipe or a device (or a link to one) is there: not a missing record
+        raise ResultsDamaged(f"{path} cannot be read ({why}); run the study again")
     try:
         data = read_json(path)
     except (OSError, ValueError, RecursionError) as error:  # RecursionError: nesting too deep to parse

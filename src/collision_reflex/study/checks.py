@@ -12,6 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from .._io import not_a_file
 from ..errors import CatalogueError, InvalidParameter, StudyFileError, StudyProblem
 from ..hardware.catalogue import read_entries
 from ..hardware.motors import scaled_motor_quantities
@@ -139,11 +140,10 @@ def _duty_cycle_checks(loaded: LoadedStudy, study: ArmStudy) -> list[StudyProble
     if cycle is None:
         return []
     problems = []
-    if cycle.file is not None and not _is_file(loaded.path(cycle.file)):
+    why = None if cycle.file is None else not_a_file(loaded.path(cycle.file))
+    if why is not None:  # a folder, a pipe or a device is not 'no such file'
         problems.append(
-            loaded.problem(
-                ("duty_cycle", "file"), f"{excerpt(cycle.file)} (no such file)", _relative_hint(loaded)
-            )
+            loaded.problem(("duty_cycle", "file"), f"{excerpt(cycle.file)} ({why})", _relative_hint(loaded))
         )
     if cycle.payload is not None and study.constraints.payload != 0:
         problems.append(

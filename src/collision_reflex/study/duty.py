@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._io import not_a_file
 from ..arm.duty_cycle import DutyCycle, Payload
 from ..arm.kinematic_tree import joint_kinematics
 from ..arm.rating import Rating
@@ -108,8 +109,8 @@ def prismatic_joints(arm: Arm) -> list[str]:
 def _from_file(loaded: LoadedStudy, arm: Arm, file: str, payload: Payload | None) -> DutyCycle:
     where = (*_SECTION, "file")
     path = loaded.path(file)
-    if not path.is_file():
-        raise loaded.fail(where, f"{file!r} (no such file)", "a path relative to the study file's folder")
+    if (why := not_a_file(path)) is not None:  # a folder, a pipe or a device is not 'no such file'
+        raise loaded.fail(where, f"{file!r} ({why})", "a path relative to the study file's folder")
     try:
         cycle = DutyCycle.from_csv(path, arm.joint_names, payload, prismatic=prismatic_joints(arm))
     except TrajectoryError as error:
