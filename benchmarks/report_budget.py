@@ -2,8 +2,7 @@
 
 Usage: python benchmarks/report_budget.py RUN_DIR [RUN_DIR ...] (after crx run STUDY --out RUN_DIR); prints
 a Markdown table and exits with status 1 if a report is over the budget: 2,500 words, 8 printed pages. The
-tests hold the smoke run of every shipped study to it, and two_link_planetary's full front (eight pages at full
-size); this holds the full-size runs of every study to it, ur5's longest front among them.
+tests hold the smoke run of every shipped study to it; this holds the full-size runs of every study to it.
 """
 
 from __future__ import annotations

@@ -17,10 +17,8 @@ from pathlib import Path
 
 import pytest
 
-from collision_reflex.cli import main
 from collision_reflex.report.html import SOLVER_TOLERANCE, _settled_rows, settled
 from collision_reflex.report.pdf import find_browser, html_to_pdf
-from collision_reflex.study import resolve
 
 ROOT = Path(__file__).resolve().parents[1]
 STUDIES = {path.stem: path for path in sorted((ROOT / "studies").glob("*.yaml"))}
@@ -89,37 +87,15 @@ def printed_tables(html: str) -> _PrintedTables:
     return parser
 
 
-_SMOKE = resolve.smoke_study
+def _printed_report(folder: Path, smoke_run: Path) -> None:
+    """The report of a copy of ``smoke_run`` (a study's shared smoke run) printed to PDF in ``folder / "out"``.
 
-
-def _smoke_keeping_the_front(data: dict) -> dict:
-    """The smoke shrink, but with the study's full Pareto front and simulation: what sets the report's length
-    (sample counts only change its numbers). The figures as SVG only: the report inlines those."""
-    shrunk = _SMOKE(data)
-    kept = {key: data[key] for key in ("pareto", "simulate") if data.get(key) is not None}
-    return {**shrunk, **kept, "outputs": {**shrunk["outputs"], "figures": ["svg"]}}
-
-
-FULL_FRONT = ("two_link_planetary",)
-"""The studies whose report is printed with its full front: the planar study at eight pages at full size
-(``benchmarks/results/report_budget.md``); ur5_human_contact's smoke run keeps its whole front of four. The
-others' reports are their smoke runs'; ``benchmarks/report_budget.py`` holds every study's full-size run to the
-budget (exit status 1 over it), ur5's longest front among them."""
-
-
-def _printed_report(study: Path, folder: Path, smoke_run: Path) -> None:
-    """``study``'s report printed to PDF in ``folder / "out"``: of a copy of ``smoke_run`` (the study's shared
-    smoke run), or for a study of :data:`FULL_FRONT` of a run shrunk by :func:`_smoke_keeping_the_front`."""
+    Printed from smoke runs: ur5_human_contact's keeps its whole front of four; every study's full-size report
+    is held to the same budget by ``benchmarks/report_budget.py`` (exit status 1 over it), ur5's longest front
+    and two_link_planetary's eight pages among them (``benchmarks/results/report_budget.md``).
+    """
     out = folder / "out"
-    if study.stem not in FULL_FRONT:
-        shutil.copytree(smoke_run, out)
-    else:
-        with pytest.MonkeyPatch.context() as patch:
-            patch.setattr(resolve, "smoke_study", _smoke_keeping_the_front)
-            assert (
-                main(["run", str(study), "--out", str(out), "--quiet", "--smoke", "--executor", "serial"])
-                == 0
-            )
+    shutil.copytree(smoke_run, out)
     html_to_pdf(out / "report.html", out / "report.pdf")  # what crx report --pdf prints (test_study_run)
 
 
@@ -132,10 +108,7 @@ def reports(shared_folder, smoke_runs) -> dict[str, Path]:
     class Printed(dict):
         def __missing__(self, name: str) -> Path:
             self[name] = (
-                shared_folder(
-                    f"pdf-{name}", lambda folder: _printed_report(STUDIES[name], folder, smoke_runs[name])
-                )
-                / "out"
+                shared_folder(f"pdf-{name}", lambda folder: _printed_report(folder, smoke_runs[name])) / "out"
             )
             return self[name]
 
