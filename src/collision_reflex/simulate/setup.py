@@ -87,8 +87,8 @@ class CollisionSetup:
         miss it: steps above a quarter of the contact time are refused.
     rtol: relative tolerance of the integrator.
     max_steps: budget of integrator steps. A setup whose up-front estimate (its phases' spans over their
-        fastest time scales, :mod:`collision_reflex.simulate.budget`) exceeds it is refused at once with what
-        to change; a run that uses it up (12 right-hand-side evaluations a step, 3 steps a control sample or
+        fastest time scales, :mod:`collision_reflex.simulate.budget`) exceeds ten times it is refused at once
+        with what to change; a run that uses it up (12 right-hand-side evaluations a step, 3 steps a control sample or
         mode change) stops with a :class:`~collision_reflex.errors.SimulationError`. The default is about ten
         seconds of work at most; ordinary collisions take a few hundred steps.
     """
