@@ -148,7 +148,8 @@ def check_work(setup: CollisionSetup) -> None:
     """Raise :class:`SimulationError` if ``setup`` needs more than :data:`REFUSED_BEYOND` budgets, saying why."""
     run = phases(setup)
     total = sum(phase.steps for phase in run)
-    if total <= REFUSED_BEYOND * setup.max_steps:  # (an inf or NaN estimate, from extreme settings, is refused)
+    # An inf or NaN estimate, from extreme settings, is refused.
+    if total <= REFUSED_BEYOND * setup.max_steps:
         return
     worst = max(run, key=lambda phase: phase.steps)
     if SEGMENT_STEPS * worst.samples > worst.span / worst.step:
