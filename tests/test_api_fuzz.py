@@ -20,6 +20,7 @@ import collision_reflex as cr
 from collision_reflex import hardware, model
 from collision_reflex.errors import InvalidParameter
 from collision_reflex.model import effective
+from fuzz_values import hostile_values, result_floats
 
 SEED = 33
 HOSTILE: tuple[Any, ...] = (
@@ -244,39 +245,6 @@ LABEL_ONLY = {"name", "source", "kind"}  # free-text labels, not numbers
 MODEL_OBJECTS = ("Motor", "Gearbox", "Threshold")  # arguments annotated with these take a model object
 
 
-def _floats(value: Any, nan_fields: tuple[str, ...]) -> Iterator[float]:
-    if isinstance(value, (bool, str, type(None))):
-        return
-    if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        for field in dataclasses.fields(value):
-            if field.name not in nan_fields or not _is_nan(getattr(value, field.name)):
-                yield from _floats(getattr(value, field.name), ())
-        return
-    if isinstance(value, (tuple, list)):
-        for item in value:
-            yield from _floats(item, nan_fields)
-        return
-    if isinstance(value, (int, float, complex, np.number, np.ndarray)):
-        array = np.asarray(value)
-        if array.dtype.kind == "b":  # flags, not numbers
-            return
-        if array.dtype.kind not in "iuf":  # a complex (or object) result is not a real number: a finding
-            yield math.nan
-            return
-        yield from array.astype(np.float64).ravel().tolist()
-
-
-def _is_nan(value: Any) -> bool:
-    return isinstance(value, float) and math.isnan(value)
-
-
-def _hostile_values(rng: np.random.Generator) -> list[Any]:
-    extra = [
-        float(s * 10.0**e) for s, e in zip(rng.choice([-1.0, 1.0], 3), rng.uniform(-300, 300, 3), strict=True)
-    ]
-    return [*HOSTILE, *extra]
-
-
 def _calls() -> Iterator[Any]:
     rng = np.random.default_rng(SEED)
     for label, case in CASES.items():
@@ -285,7 +253,9 @@ def _calls() -> Iterator[Any]:
                 continue
             reason = XFAIL.get((label, name))
             marks = [pytest.mark.xfail(strict=True, reason=reason)] if reason else []
-            yield pytest.param(label, name, _hostile_values(rng), id=f"{label}-{name}", marks=marks)
+            yield pytest.param(
+                label, name, hostile_values(HOSTILE, rng, 3), id=f"{label}-{name}", marks=marks
+            )
 
 
 def test_every_public_numeric_callable_is_covered() -> None:
@@ -298,7 +268,7 @@ def test_every_public_numeric_callable_is_covered() -> None:
 def test_valid_calls_return_finite(label: str) -> None:
     case = CASES[label]
     result = case.function(**case.kwargs)
-    assert all(math.isfinite(x) for x in _floats(result, case.nan_fields)), result
+    assert all(math.isfinite(x) for x in result_floats(result, case.nan_fields)), result
 
 
 @pytest.mark.parametrize(("label", "name", "values"), list(_calls()))
@@ -313,7 +283,7 @@ def test_hostile_argument(label: str, name: str, values: list[Any]) -> None:
         except Exception as error:  # anything else from inside is the finding
             findings.append(f"{value!r}: {type(error).__name__}: {error}")
             continue
-        for x in _floats(result, case.nan_fields):
+        for x in result_floats(result, case.nan_fields):
             if math.isnan(x) or (math.isinf(x) and not case.inf_result):
                 findings.append(f"{value!r}: returned {x} in {result!r}"[:300])
                 break

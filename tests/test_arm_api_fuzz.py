@@ -22,6 +22,7 @@ import pytest
 from collision_reflex import arm, hardware
 from collision_reflex.arm import actuation, dynamics, joints, motion_profiles
 from collision_reflex.errors import FrameNotFound, InvalidParameter, TrajectoryError
+from fuzz_values import hostile_values, result_floats
 
 SEED = 41
 HOSTILE: tuple[Any, ...] = (
@@ -208,38 +209,12 @@ NOT_NUMBERS = {
 }
 
 
-def _floats(value: Any) -> Iterator[float]:
-    if isinstance(value, (bool, str, bytes, type(None))):
-        return
-    if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        for field in dataclasses.fields(value):
-            yield from _floats(getattr(value, field.name))
-        return
-    if isinstance(value, (tuple, list)):
-        for item in value:
-            yield from _floats(item)
-        return
-    if isinstance(value, (int, float, complex, np.number, np.ndarray)):
-        array = np.asarray(value)
-        if array.dtype.kind in "iuf":
-            yield from array.astype(np.float64).ravel().tolist()
-        elif array.dtype.kind != "b":  # a complex (or object) result is not a real number: a finding
-            yield math.nan
-
-
-def _hostile_values(rng: np.random.Generator) -> list[Any]:
-    extra = [
-        float(s * 10.0**e) for s, e in zip(rng.choice([-1.0, 1.0], 2), rng.uniform(-300, 300, 2), strict=True)
-    ]
-    return [*HOSTILE, *extra]
-
-
 def _calls() -> Iterator[Any]:
     rng = np.random.default_rng(SEED)
     for label, case in CASES.items():
         for name in case.kwargs:
             if name not in NOT_NUMBERS:
-                yield pytest.param(label, name, _hostile_values(rng), id=f"{label}-{name}")
+                yield pytest.param(label, name, hostile_values(HOSTILE, rng, 2), id=f"{label}-{name}")
 
 
 def test_every_public_arm_name_is_covered() -> None:
@@ -254,7 +229,7 @@ def test_every_public_arm_name_is_covered() -> None:
 @pytest.mark.parametrize("label", list(CASES))
 def test_valid_calls_give_no_nan(label: str) -> None:
     case = CASES[label]
-    assert not any(math.isnan(x) for x in _floats(case.function(**case.kwargs)))
+    assert not any(math.isnan(x) for x in result_floats(case.function(**case.kwargs)))
 
 
 @pytest.mark.parametrize(("label", "name", "values"), list(_calls()))
@@ -271,6 +246,6 @@ def test_hostile_argument(label: str, name: str, values: list[Any]) -> None:
             continue
         if name in case.nan_fields:
             continue  # NaN is documented there ("unknown") and is passed on
-        if any(math.isnan(x) for x in _floats(result)):
+        if any(math.isnan(x) for x in result_floats(result)):
             findings.append(f"{value!r}: returned NaN in {result!r}"[:300])
     assert not findings, "\n".join(findings)
