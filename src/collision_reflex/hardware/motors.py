@@ -21,8 +21,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, NamedTuple
 
-import numpy as np
-
 from .. import _validate
 from ..errors import InvalidParameter, UnknownMotor
 
@@ -303,15 +301,8 @@ def scaled_motor_quantities(
     _validate.positive("stack_length", stack_length)
     length_ratio = stack_length / reference.stack_length
     diameter_ratio = stator_diameter / reference.stator_diameter
-    try:
-        with np.errstate(over="raise"):
-            return _scaled(reference, law, length_ratio, diameter_ratio)
-    except (OverflowError, FloatingPointError):
-        raise InvalidParameter(
-            "stator_diameter, stack_length",
-            (stator_diameter, stack_length),
-            "a size whose scaled quantities are finite numbers",
-        ) from None
+    with _validate.combining(stator_diameter=stator_diameter, stack_length=stack_length):
+        return _scaled(reference, law, length_ratio, diameter_ratio)
 
 
 def _scaled(reference: Motor, law: ScalingLaw, length_ratio: Any, diameter_ratio: Any) -> MotorQuantities:
